@@ -1,0 +1,3 @@
+"""VIPLE Maze Lab Workbench."""
+
+__version__ = "0.1.0"

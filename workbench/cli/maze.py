@@ -1,0 +1,111 @@
+"""``workbench maze ...``: check, show, convert and generate mazes."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from workbench.sim.maze import Maze, MazeError, Problem
+from workbench.sim.mazeio import load_maze
+from workbench.sim.mazeview import render
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    maze = sub.add_parser("maze", help="check, show, convert and generate mazes")
+    msub = maze.add_subparsers(dest="maze_command", metavar="ACTION", required=True)
+
+    check = msub.add_parser("check", help="validate maze files (exit 0 when all are valid)")
+    check.add_argument("files", nargs="+", metavar="FILE")
+    check.add_argument("--json", action="store_true", help="one JSON object per line")
+    check.add_argument("--from", dest="fmt", help="force the input format")
+    check.set_defaults(func=cmd_check)
+
+    show = msub.add_parser("show", help="draw a maze")
+    show.add_argument("file", metavar="FILE")
+    show.add_argument("--unicode", action="store_true", help="box-drawing characters")
+    show.add_argument("--from", dest="fmt", help="force the input format")
+    show.set_defaults(func=cmd_show)
+
+
+def check_report(maze: Maze | None, problems: list[Problem], source: str) -> dict:
+    report: dict = {"file": source, "valid": not problems}
+    if maze is not None:
+        report.update(
+            name=maze.name,
+            width=maze.width,
+            height=maze.height,
+            start=list(maze.start) if maze.start else None,
+            heading=maze.heading,
+            exits=[list(e) for e in maze.exits],
+            shortest_path=maze.shortest_path_length() if not problems else None,
+            notes=maze.notes() if not problems else [],
+        )
+    report["problems"] = [p.as_dict() for p in problems]
+    return report
+
+
+def check_one(path: str, fmt: str | None = None) -> tuple[Maze | None, list[Problem]]:
+    try:
+        maze = load_maze(path, fmt)
+    except MazeError as exc:
+        return None, exc.problems
+    return maze, maze.validate()
+
+
+def describe(report: dict) -> str:
+    if "width" not in report:
+        return f"{report['file']}: INVALID"
+    start = report["start"]
+    start_txt = f"({start[0]}, {start[1]}) facing {report['heading']}" if start else "none"
+    exits = report["exits"]
+    exits_txt = ", ".join(f"({x}, {y})" for x, y in exits) if exits else "none"
+    sp = report["shortest_path"]
+    lines = [
+        f"{report['file']}: {'valid' if report['valid'] else 'INVALID'}"
+        + (f" - {report['name']}" if report["name"] else ""),
+        f"  size {report['width']}x{report['height']} blocks, start {start_txt}",
+        f"  exits {exits_txt}",
+    ]
+    if report["valid"] and exits:
+        lines.append(f"  shortest path to an exit: {sp} blocks")
+    lines += [f"  note: {n}" for n in report["notes"]]
+    return "\n".join(lines)
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    ok = True
+    for path in args.files:
+        maze, problems = check_one(path, args.fmt)
+        report = check_report(maze, problems, path)
+        ok &= report["valid"]
+        if args.json:
+            print(json.dumps(report, sort_keys=True))
+        else:
+            print(describe(report))
+            for p in problems:
+                print(f"  {p}")
+    return 0 if ok else 1
+
+
+def cmd_show(args: argparse.Namespace) -> int:
+    try:
+        maze = load_maze(args.file, args.fmt)
+    except MazeError as exc:
+        for p in exc.problems:
+            print(p, file=sys.stderr)
+        return 1
+    print(render(maze, unicode=args.unicode))
+    return 0
+
+
+def show_and_check(path: str) -> int:
+    maze, problems = check_one(path)
+    if maze is not None:
+        print(render(maze))
+        print()
+    report = check_report(maze, problems, path)
+    print(describe(report))
+    for p in problems:
+        print(f"  {p}")
+    return 0 if report["valid"] else 1
