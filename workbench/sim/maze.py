@@ -84,7 +84,9 @@ class Maze:
             raise ValueError(f"maze rows may only hold '#' and '.', not {sorted(bad)}")
         if self.heading not in HEADINGS:
             raise ValueError(f"unknown heading {self.heading!r}; use one of {list(HEADINGS)}")
-        object.__setattr__(self, "exits", tuple(sorted(set(self.exits), key=lambda c: (c[1], c[0]))))
+        object.__setattr__(
+            self, "exits", tuple(sorted(set(self.exits), key=lambda c: (c[1], c[0])))
+        )
 
     # -- shape -------------------------------------------------------------------------
     @property
@@ -115,7 +117,7 @@ class Maze:
     def with_block(self, x: int, y: int, wall: bool) -> Maze:
         row = self.rows[y]
         new_row = row[:x] + (WALL if wall else FLOOR) + row[x + 1 :]
-        rows = self.rows[:y] + (new_row,) + self.rows[y + 1 :]
+        rows = (*self.rows[:y], new_row, *self.rows[y + 1 :])
         exits = tuple(e for e in self.exits if not (wall and e == (x, y)))
         return replace(self, rows=rows, exits=exits)
 
@@ -195,7 +197,9 @@ class Maze:
             problems.append(self.problem("start is outside the maze", "move the start inside"))
         elif self.is_wall(*self.start):
             problems.append(
-                self.problem("start is inside a wall block", "move the start onto floor", self.start)
+                self.problem(
+                    "start is inside a wall block", "move the start onto floor", self.start
+                )
             )
         for e in self.exits:
             if not self.in_bounds(*e):

@@ -14,6 +14,7 @@ profile: unity
 
 from __future__ import annotations
 
+import contextlib
 import os
 import tempfile
 from pathlib import Path
@@ -36,15 +37,19 @@ def _front_matter(lines: list[str], source: str) -> tuple[dict, int, list[Proble
         if lines[end].strip() == "---":
             break
     else:
-        return {}, len(lines), [
-            Problem(
-                "front matter is never closed",
-                "end the header with a line holding only ---",
-                source,
-                1,
-                1,
-            )
-        ]
+        return (
+            {},
+            len(lines),
+            [
+                Problem(
+                    "front matter is never closed",
+                    "end the header with a line holding only ---",
+                    source,
+                    1,
+                    1,
+                )
+            ],
+        )
     text = "\n".join(lines[1:end])
     try:
         meta = yaml.safe_load(text) if text.strip() else {}
@@ -53,19 +58,29 @@ def _front_matter(lines: list[str], source: str) -> tuple[dict, int, list[Proble
         line = mark.line + 2 if mark is not None else 2
         col = mark.column + 1 if mark is not None else 1
         reason = getattr(exc, "problem", None) or "invalid YAML"
-        return {}, end + 1, [
-            Problem(f"front matter is not valid YAML: {reason}", "fix the header", source, line, col)
-        ]
+        return (
+            {},
+            end + 1,
+            [
+                Problem(
+                    f"front matter is not valid YAML: {reason}", "fix the header", source, line, col
+                )
+            ],
+        )
     if not isinstance(meta, dict):
-        return {}, end + 1, [
-            Problem(
-                "front matter must be key: value lines",
-                f"use the keys {', '.join(FRONT_MATTER_KEYS)}",
-                source,
-                2,
-                1,
-            )
-        ]
+        return (
+            {},
+            end + 1,
+            [
+                Problem(
+                    "front matter must be key: value lines",
+                    f"use the keys {', '.join(FRONT_MATTER_KEYS)}",
+                    source,
+                    2,
+                    1,
+                )
+            ],
+        )
     problems = []
     key_lines = {}
     for i, raw in enumerate(lines[1:end], start=2):
@@ -94,7 +109,9 @@ def _front_matter(lines: list[str], source: str) -> tuple[dict, int, list[Proble
             )
         )
     cell = meta.get("cell")
-    if cell is not None and (isinstance(cell, bool) or not isinstance(cell, int | float) or cell <= 0):
+    if cell is not None and (
+        isinstance(cell, bool) or not isinstance(cell, int | float) or cell <= 0
+    ):
         problems.append(
             Problem(
                 f"cell must be a positive number, not {cell!r}",
@@ -149,7 +166,13 @@ def parse_maze(text: str, source: str = "<maze>") -> Maze:
                 exits.append((x, y))
             elif ch == "\t":
                 problems.append(
-                    Problem("tab character", "replace tabs with spaces or .", source, body_line + y, x + 1)
+                    Problem(
+                        "tab character",
+                        "replace tabs with spaces or .",
+                        source,
+                        body_line + y,
+                        x + 1,
+                    )
                 )
             else:
                 problems.append(
@@ -192,7 +215,9 @@ def format_maze(maze: Maze, front_matter: bool = True) -> str:
         meta = {k: getattr(maze, k) for k in FRONT_MATTER_KEYS if getattr(maze, k)}
         if meta:
             out.append("---")
-            out.append(yaml.safe_dump(meta, sort_keys=False, allow_unicode=True, width=100).rstrip())
+            out.append(
+                yaml.safe_dump(meta, sort_keys=False, allow_unicode=True, width=100).rstrip()
+            )
             out.append("---")
     for y, row in enumerate(maze.rows):
         chars = list(row)
@@ -216,10 +241,8 @@ def write_text_atomic(path: str | os.PathLike, text: str) -> None:
             os.fsync(fh.fileno())
         os.replace(tmp, p)
     except BaseException:
-        try:
+        with contextlib.suppress(OSError):
             os.unlink(tmp)
-        except OSError:
-            pass
         raise
 
 

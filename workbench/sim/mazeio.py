@@ -18,7 +18,9 @@ def load_maze(path: str | os.PathLike, fmt: str | None = None) -> Maze:
     try:
         data = p.read_bytes()
     except OSError as exc:
-        raise MazeError([Problem(f"cannot read: {exc.strerror}", "check the path", str(p))]) from None
+        raise MazeError(
+            [Problem(f"cannot read: {exc.strerror}", "check the path", str(p))]
+        ) from None
     fmt = fmt or "workbench"
     if fmt not in FORMATS:
         raise MazeError(

@@ -28,10 +28,12 @@ class SensorSpec:
                 f"unknown sensor kind {self.kind!r}: use one of {', '.join(KINDS)}"
             )
         if self.mount not in MOUNTS:
-            raise SensorConfigError(
-                f"unknown mount {self.mount!r}: use one of {', '.join(MOUNTS)}"
-            )
-        if isinstance(self.port, bool) or not isinstance(self.port, int) or self.port not in PORT_RANGE:
+            raise SensorConfigError(f"unknown mount {self.mount!r}: use one of {', '.join(MOUNTS)}")
+        if (
+            isinstance(self.port, bool)
+            or not isinstance(self.port, int)
+            or self.port not in PORT_RANGE
+        ):
             raise SensorConfigError(
                 f"port {self.port!r} is out of range: use a whole number from "
                 f"{PORT_RANGE.start} to {PORT_RANGE.stop - 1}"
