@@ -6,7 +6,9 @@ import argparse
 import json
 import sys
 
+from workbench.sim.generate import EXITS, STYLES, check_seed, check_size, generate
 from workbench.sim.maze import Maze, MazeError, Problem
+from workbench.sim.mazefile import format_maze, write_maze
 from workbench.sim.mazeio import load_maze
 from workbench.sim.mazeview import render
 
@@ -26,6 +28,28 @@ def register(sub: argparse._SubParsersAction) -> None:
     show.add_argument("--unicode", action="store_true", help="box-drawing characters")
     show.add_argument("--from", dest="fmt", help="force the input format")
     show.set_defaults(func=cmd_show)
+
+    gen = msub.add_parser(
+        "generate", help="generate a random maze from a seed (the same seed, the same maze)"
+    )
+    gen.add_argument(
+        "--size",
+        required=True,
+        type=parse_size,
+        metavar="WxH",
+        help="size in cells, e.g. 16x16 (1 to 99 each way; a cell and its walls are 2 blocks)",
+    )
+    gen.add_argument("--seed", required=True, type=parse_seed, help="a whole number, 0 or more")
+    gen.add_argument("--style", choices=STYLES, default="perfect", help="default: perfect")
+    gen.add_argument(
+        "--exit",
+        dest="exit_option",
+        choices=EXITS,
+        default="boundary",
+        help="an opening in the outer wall (default), the centre cells, or none",
+    )
+    gen.add_argument("-o", "--output", metavar="FILE", help="write here instead of stdout")
+    gen.set_defaults(func=cmd_generate)
 
 
 def check_report(maze: Maze | None, problems: list[Problem], source: str) -> dict:
@@ -96,6 +120,48 @@ def cmd_show(args: argparse.Namespace) -> int:
             print(p, file=sys.stderr)
         return 1
     print(render(maze, unicode=args.unicode))
+    return 0
+
+
+def parse_seed(text: str) -> int:
+    """A ``--seed`` value; argparse reports the error and exits with 2."""
+    try:
+        seed = int(text)
+        check_seed(seed)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not a seed: give a whole number 0 or more, e.g. 7"
+        ) from None
+    return seed
+
+
+def parse_size(text: str) -> tuple[int, int]:
+    """``WxH`` in cells, for ``--size``; argparse reports the error and exits with 2."""
+    parts = [p.strip() for p in text.strip().lower().split("x")]
+    if len(parts) != 2 or not all(p.isascii() and p.isdigit() for p in parts):
+        raise argparse.ArgumentTypeError(
+            f"{text!r} is not a size: give WIDTHxHEIGHT in cells, e.g. 16x16"
+        )
+    width, height = int(parts[0]), int(parts[1])
+    try:
+        check_size(width, height)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return width, height
+
+
+def cmd_generate(args: argparse.Namespace) -> int:
+    width, height = args.size
+    maze = generate(width, height, args.seed, args.style, args.exit_option)
+    if args.output is None:
+        print(format_maze(maze), end="")
+        return 0
+    try:
+        write_maze(args.output, maze)
+    except OSError as exc:
+        print(f"{args.output}: cannot write: {exc.strerror} (check the path)", file=sys.stderr)
+        return 1
+    print(f"{args.output}: written, {maze.name} ({maze.width}x{maze.height} blocks)")
     return 0
 
 
