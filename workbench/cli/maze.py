@@ -9,7 +9,7 @@ import sys
 from workbench.sim.generate import EXITS, STYLES, check_seed, check_size, generate
 from workbench.sim.maze import Maze, MazeError, Problem
 from workbench.sim.mazefile import format_maze, write_maze
-from workbench.sim.mazeio import load_maze
+from workbench.sim.mazeio import format_for_path, load_maze, save_maze
 from workbench.sim.mazeview import render
 
 
@@ -50,6 +50,19 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     gen.add_argument("-o", "--output", metavar="FILE", help="write here instead of stdout")
     gen.set_defaults(func=cmd_generate)
+
+    convert = msub.add_parser(
+        "convert", help="convert a maze file (writes nothing when the input is invalid)"
+    )
+    convert.add_argument("input", metavar="IN")
+    convert.add_argument("output", metavar="OUT")
+    convert.add_argument("--from", dest="fmt", help="force the input format")
+    convert.add_argument(
+        "--to",
+        dest="to_fmt",
+        help="workbench, micromouse or maz (default: maz for a .maz OUT, else workbench)",
+    )
+    convert.set_defaults(func=cmd_convert)
 
 
 def check_report(maze: Maze | None, problems: list[Problem], source: str) -> dict:
@@ -120,6 +133,34 @@ def cmd_show(args: argparse.Namespace) -> int:
             print(p, file=sys.stderr)
         return 1
     print(render(maze, unicode=args.unicode))
+    return 0
+
+
+def cmd_convert(args: argparse.Namespace) -> int:
+    maze, problems = check_one(args.input, args.fmt)
+    if maze is None or problems:
+        for p in problems:
+            print(p, file=sys.stderr)
+        print(f"{args.output}: not written, {args.input} is not a valid maze", file=sys.stderr)
+        return 1
+    fmt = args.to_fmt or format_for_path(args.output)
+    try:
+        save_maze(args.output, maze, fmt)
+    except MazeError as exc:
+        for p in exc.problems:
+            print(p, file=sys.stderr)
+        print(f"{args.output}: not written, the maze cannot be saved as {fmt}", file=sys.stderr)
+        return 1
+    except OSError as exc:
+        print(f"{args.output}: cannot write: {exc.strerror} (check the path)", file=sys.stderr)
+        return 1
+    print(f"{args.output}: written as {fmt}, {maze.width}x{maze.height} blocks")
+    back = load_maze(args.output)
+    if back.heading != maze.heading:
+        print(
+            f"note: {fmt} has no start heading; {args.output} starts facing {back.heading}, "
+            f"not {maze.heading}"
+        )
     return 0
 
 

@@ -1,34 +1,102 @@
-"""Open a maze file of any supported format (detected from its content) as a block ``Maze``."""
+"""Open a maze file of any supported format (detected from its content) as a block ``Maze``,
+and save a maze in the workbench, micromouse text or ``.maz`` format.
+"""
 
 from __future__ import annotations
 
 import os
+import re
 from dataclasses import replace
 from pathlib import Path
 
+from .maz import format_maz, parse_maz
 from .maze import Maze, MazeError, Problem
-from .mazefile import parse_maze
+from .mazefile import format_maze, parse_maze, write_bytes_atomic, write_text_atomic
+from .micromouse import format_micromouse, parse_micromouse, parse_mms_map, parse_mms_num
+from .wallmaze import to_blocks
 
-FORMATS = ("workbench",)
+FORMATS = ("workbench", "micromouse", "mms-map", "mms-num", "maz")
+WRITE_FORMATS = ("workbench", "micromouse", "maz")
+WALL_READERS = {"micromouse": parse_micromouse, "mms-map": parse_mms_map, "mms-num": parse_mms_num}
+_NUM_LINE = re.compile(r"\s*\d+(\s+\d+){5}\s*")
+_CONTROL = set(range(32)) - {9, 10, 13}
+
+
+def detect_format(data: bytes) -> str:
+    """The format of a file's content: binary -> maz, then by the first non-blank line."""
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        return "maz"
+    if b"\0" in data or (len(data) == 256 and any(b in _CONTROL for b in data)):
+        return "maz"
+    first = next((line for line in text.splitlines() if line.strip()), "")
+    if first.startswith("o"):
+        return "micromouse"
+    if first.startswith("+"):
+        return "mms-map"
+    if _NUM_LINE.fullmatch(first):
+        return "mms-num"
+    return "workbench"
+
+
+def _unknown(fmt: str, known: tuple[str, ...], source: str) -> MazeError:
+    return MazeError([Problem(f"unknown format {fmt!r}", f"use one of {', '.join(known)}", source)])
 
 
 def load_maze(path: str | os.PathLike, fmt: str | None = None) -> Maze:
     """Read ``path`` as ``fmt`` (or the detected format); errors are :class:`MazeError`."""
     p = Path(path)
+    source = str(p)
+    if fmt is not None and fmt not in FORMATS:
+        raise _unknown(fmt, FORMATS, source)
     try:
         data = p.read_bytes()
     except OSError as exc:
         raise MazeError(
-            [Problem(f"cannot read: {exc.strerror}", "check the path", str(p))]
+            [Problem(f"cannot read: {exc.strerror}", "check the path", source)]
         ) from None
-    fmt = fmt or "workbench"
-    if fmt not in FORMATS:
-        raise MazeError(
-            [Problem(f"unknown format {fmt!r}", f"use one of {', '.join(FORMATS)}", str(p))]
-        )
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError:
-        raise MazeError([Problem("not a UTF-8 text file", "check the file", str(p))]) from None
-    maze = parse_maze(text, source=str(p))
+    if fmt is None:
+        fmt = detect_format(data)
+        if fmt == "maz" and len(data) != 256:
+            raise MazeError(
+                [
+                    Problem(
+                        "a binary file, neither UTF-8 text nor a .maz maze "
+                        f"(256 bytes; this one is {len(data)} bytes)",
+                        f"check the file; the formats read are {', '.join(FORMATS)}",
+                        source,
+                    )
+                ]
+            )
+    if fmt == "maz":
+        maze = to_blocks(parse_maz(data, source))
+    else:
+        try:
+            text = data.decode("utf-8")
+        except UnicodeDecodeError:
+            raise MazeError(
+                [Problem("not a UTF-8 text file", f"check that it is a {fmt} maze", source)]
+            ) from None
+        if fmt == "workbench":
+            maze = parse_maze(text, source=source)
+        else:
+            maze = to_blocks(WALL_READERS[fmt](text, source))
     return maze if maze.name else replace(maze, name=p.stem)
+
+
+def format_for_path(path: str | os.PathLike) -> str:
+    """The format a file is written in when none is asked for: by its extension."""
+    return "maz" if Path(path).suffix.lower() == ".maz" else "workbench"
+
+
+def save_maze(path: str | os.PathLike, maze: Maze, fmt: str = "workbench") -> None:
+    """Write ``maze`` atomically; MazeError when the format cannot hold it."""
+    if fmt not in WRITE_FORMATS:
+        raise _unknown(fmt, WRITE_FORMATS, str(path))
+    if fmt == "maz":
+        write_bytes_atomic(path, format_maz(maze))
+    elif fmt == "micromouse":
+        write_text_atomic(path, format_micromouse(maze))
+    else:
+        write_text_atomic(path, format_maze(maze))
