@@ -52,3 +52,8 @@ def test_default_heading_faces_the_only_opening():
     assert default_heading(maze, (1, 1)) == "down"
     open_room = Maze(rows=("####", "#..#", "#..#", "####"))
     assert default_heading(open_room, (1, 1)) == "up"
+
+
+def test_start_on_an_exit_is_reported():
+    maze = ROOM.with_exit(1, 1)
+    assert "start is on an exit" in [p.message for p in maze.validate()]

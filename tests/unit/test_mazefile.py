@@ -159,3 +159,14 @@ def test_name_defaults_to_file_stem(tmp_path):
     path = tmp_path / "little.txt"
     path.write_text("###\n#S#\n###\n")
     assert load_maze(path).name == "little"
+
+
+def test_saved_files_keep_their_permissions(tmp_path):
+    path = tmp_path / "m.txt"
+    path.write_text("old")
+    path.chmod(0o640)
+    write_maze(path, parse_maze(CORRIDOR))
+    assert path.stat().st_mode & 0o777 == 0o640
+    fresh = tmp_path / "fresh.txt"
+    write_maze(fresh, parse_maze(CORRIDOR))
+    assert fresh.stat().st_mode & 0o044 == 0o044  # readable by others, like any new file

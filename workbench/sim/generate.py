@@ -195,7 +195,13 @@ def _exits(
     if option == "center":
         cols = [width // 2] if width % 2 else [width // 2 - 1, width // 2]
         rows = [height // 2] if height % 2 else [height // 2 - 1, height // 2]
-        return tuple(block_of((cx, cy)) for cy in rows for cx in cols)
+        centre = tuple(block_of((cx, cy)) for cy in rows for cx in cols if (cx, cy) != start)
+        if not centre:
+            raise ValueError(
+                f"a {width}x{height} maze has no centre cell apart from the start; "
+                "use a larger size or --exit boundary"
+            )
+        return centre
     dist = _cell_distances(start, passages, width, height)
     edge_cells = [
         (cx, cy)

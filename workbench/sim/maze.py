@@ -201,6 +201,10 @@ class Maze:
                     "start is inside a wall block", "move the start onto floor", self.start
                 )
             )
+        if self.start is not None and self.start in self.exits:
+            problems.append(
+                self.problem("start is on an exit", "move the start or the exit", self.start)
+            )
         for e in self.exits:
             if not self.in_bounds(*e):
                 problems.append(self.problem(f"exit {e} is outside the maze", "remove it"))
