@@ -1,0 +1,525 @@
+"""The physical world of one robot in a block maze: walls, motion, sensors, odometry.
+
+Coordinates are world units of the profile (``unit`` / ``px``). The origin is the top-left
+corner of block (0, 0); x grows to the right and y grows *downwards*, like the grid, so block
+(i, j) spans ``[i*cell, (i+1)*cell] x [j*cell, (j+1)*cell]``.
+
+Headings are degrees in [0, 360): 0 = +x (right/east on the screen), 90 = +y (down the
+page), i.e. clockwise on the screen, so a positive change of heading is a right turn. (The
+maze's ``HEADING_DEGREES`` are compass-like, 0 = up; :data:`HEADING_ANGLES` converts.)
+
+Walls are pymunk segments on the exposed faces of wall blocks, collinear faces merged, with
+the grid's outer edge closed as well, so a robot leaving through an exit on the boundary
+stops just outside the grid. The robot is a dynamic circle pulled by a kinematic control
+body through a pivot joint (linear velocity) and a gear joint (angular velocity), both with
+``max_bias = 0``; the robot's own velocity is never written, so the solver keeps it out of
+the walls. Distance sensors march the ray through the block grid (exact faces, no physics
+query); touch sensors look for wall within a small tolerance on their side's 90-degree arc.
+"""
+
+from __future__ import annotations
+
+import math
+import random
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import pymunk
+
+from ..control.commands import (
+    Command,
+    MotorPower,
+    MoveAtPower,
+    Stop,
+    TurnByDegrees,
+    WheelPowers,
+)
+from .maze import Maze
+from .noise import NoiseSettings, motor_gains, noise_settings, turn_factor
+from .profiles import Profile, get_profile
+from .sensors import MOUNTS, SensorSpec, check_ports
+
+TURN_DONE = "turn_done"
+COLLISION = "collision"
+EXIT = "exit"
+
+#: maze heading name -> world heading in degrees (0 = right, clockwise)
+HEADING_ANGLES: dict[str, float] = {"right": 0.0, "down": 90.0, "left": 180.0, "up": 270.0}
+
+_ROBOT = 1
+_WALL = 2
+#: a turn counts as finished when the heading is this close to its target (radians)
+_TURN_EPS = 1e-7
+#: contacts that start again within this time after the last one ended are the same collision
+_COLLISION_GAP = 0.1
+_COS45 = math.sqrt(0.5)
+_NO_EVENTS: tuple[str, ...] = ()
+
+
+class WorldError(ValueError):
+    """A world cannot be built from this maze, profile or configuration."""
+
+
+class Pose(NamedTuple):
+    x: float
+    y: float
+    heading: float
+
+
+@dataclass(frozen=True)
+class Odometry:
+    """What the run has done so far, for metrics and the run record."""
+
+    time: float
+    distance: float
+    turn_degrees: float
+    collisions: int
+    exit_time: float | None
+
+
+def wall_segments(maze: Maze) -> list[tuple[tuple[int, int], tuple[int, int]]]:
+    """Exposed block faces as merged segments in grid coordinates (block corners).
+
+    A face lies between a floor block and a wall block or the outside of the grid.
+    """
+    w, h = maze.width, maze.height
+
+    def floor(x: int, y: int) -> bool:
+        return 0 <= x < w and 0 <= y < h and maze.rows[y][x] != "#"
+
+    segments: list[tuple[tuple[int, int], tuple[int, int]]] = []
+    for j in range(h + 1):
+        start = None
+        for i in range(w + 1):
+            face = i < w and floor(i, j - 1) != floor(i, j)
+            if face and start is None:
+                start = i
+            elif not face and start is not None:
+                segments.append(((start, j), (i, j)))
+                start = None
+    for i in range(w + 1):
+        start = None
+        for j in range(h + 1):
+            face = j < h and floor(i - 1, j) != floor(i, j)
+            if face and start is None:
+                start = j
+            elif not face and start is not None:
+                segments.append(((i, start), (i, j)))
+                start = None
+    return segments
+
+
+def _march(solid: bytes, wp: int, gx: float, gy: float, dx: float, dy: float, tmax: float) -> float:
+    """Grid units from (gx, gy) along unit (dx, dy) to the first solid block; -1 if > tmax.
+
+    Coordinates are in blocks of the padded grid (the real grid shifted by one block).
+    """
+    ix = int(gx)
+    iy = int(gy)
+    idx = iy * wp + ix
+    if solid[idx]:
+        return 0.0
+    if dx > 0.0:
+        sx = 1
+        tdx = 1.0 / dx
+        tx = (ix + 1 - gx) * tdx
+    elif dx < 0.0:
+        sx = -1
+        tdx = -1.0 / dx
+        tx = (gx - ix) * tdx
+    else:
+        sx = 0
+        tdx = tx = math.inf
+    if dy > 0.0:
+        sy = wp
+        tdy = 1.0 / dy
+        ty = (iy + 1 - gy) * tdy
+    elif dy < 0.0:
+        sy = -wp
+        tdy = -1.0 / dy
+        ty = (gy - iy) * tdy
+    else:
+        sy = 0
+        tdy = ty = math.inf
+    while True:
+        if tx < ty:
+            t = tx
+            idx += sx
+            tx += tdx
+        else:
+            t = ty
+            idx += sy
+            ty += tdy
+        if t > tmax:
+            return -1.0
+        if solid[idx]:
+            return t
+
+
+class World:
+    """One robot in a maze, stepped at a fixed ``dt`` (simulated seconds)."""
+
+    def __init__(
+        self,
+        maze: Maze,
+        profile: Profile | str,
+        sensors: list[SensorSpec] | tuple[SensorSpec, ...] | None = None,
+        noise: NoiseSettings | str | None = None,
+        seed: int = 0,
+        dt: float = 1 / 60,
+    ) -> None:
+        if isinstance(profile, str):
+            profile = get_profile(profile)
+        if not (isinstance(dt, int | float) and 0 < dt <= 0.1):
+            raise WorldError(f"dt must be a time step in seconds in (0, 0.1], not {dt!r}")
+        if maze.width == 0 or maze.height == 0:
+            raise WorldError(f"{maze.source}: the maze has no blocks")
+        if maze.start is None:
+            raise WorldError(f"{maze.source}: the maze has no start")
+        if maze.is_wall(*maze.start):
+            raise WorldError(f"{maze.source}: the start {maze.start} is not on a floor block")
+        if isinstance(noise, str):
+            noise = noise_settings(noise, profile)
+        elif noise is None:
+            noise = noise_settings(profile.noise, profile)
+        self.maze = maze
+        self.profile = profile
+        self.noise = noise
+        self.seed = seed
+        self.dt = float(dt)
+        # a maze's own block size counts when it was written for this profile
+        own_cell = maze.cell is not None and maze.profile in (None, profile.name)
+        self.cell = float(maze.cell) if own_cell else profile.cell
+        if 2 * profile.robot_radius >= self.cell:
+            raise WorldError(
+                f"the {profile.name} robot ({2 * profile.robot_radius:g} {profile.unit} wide) "
+                f"does not fit the maze's {self.cell:g} {profile.unit} blocks"
+            )
+        self._radius = profile.robot_radius
+        self._touch_reach = profile.robot_radius + 0.005 * self.cell
+        self._tmax = profile.sensor_range / self.cell
+        self._inv_cell = 1.0 / self.cell
+        # the grid padded with one ring of wall: rays and neighbour checks need no bounds test
+        w, h = maze.width, maze.height
+        self._wp = wp = w + 2
+        solid = bytearray([1]) * (wp * (h + 2))
+        exits = bytearray(wp * (h + 2))
+        for y, row in enumerate(maze.rows):
+            for x, ch in enumerate(row):
+                if ch != "#":
+                    solid[(y + 1) * wp + x + 1] = 0
+        for x, y in maze.exits:
+            if maze.in_bounds(x, y) and not maze.is_wall(x, y):
+                exits[(y + 1) * wp + x + 1] = 1
+        self._solid = bytes(solid)
+        self._exits = bytes(exits)
+        c = self.cell
+        self._segments = [
+            ((a * c, b * c), (p * c, q * c)) for (a, b), (p, q) in wall_segments(maze)
+        ]
+        sx, sy = maze.start
+        self._start = ((sx + 0.5) * c, (sy + 0.5) * c, math.radians(HEADING_ANGLES[maze.heading]))
+        self.set_sensors(profile.sensors if sensors is None else sensors)
+        self.reset()
+
+    # -- configuration -------------------------------------------------------------------
+    def set_sensors(self, specs: list[SensorSpec] | tuple[SensorSpec, ...]) -> None:
+        """Replace the sensor configuration (effective at the next read)."""
+        specs = list(specs)
+        for spec in specs:
+            if not isinstance(spec, SensorSpec):
+                raise WorldError(f"{spec!r} is not a SensorSpec")
+        check_ports(specs)
+        self.sensors = tuple(specs)
+        self._distance_plan = tuple(
+            (s.port, MOUNTS.index(s.mount), self.profile.sensor_offset(s.mount))
+            for s in specs
+            if s.kind == "distance"
+        )
+        self._touch_plan = tuple(
+            (s.port, MOUNTS.index(s.mount)) for s in specs if s.kind == "touch"
+        )
+        self._readings: dict[int, float | int] | None = None
+
+    # -- the run -------------------------------------------------------------------------
+    def reset(self, seed: int | None = None) -> None:
+        """Back to the start: start pose, motors off, time and odometry zero, noise re-seeded.
+
+        A reset world replays exactly like a new one with the same seed.
+        """
+        if seed is not None:
+            self.seed = seed
+        self._rng = random.Random(self.seed)
+        self._gains = motor_gains(self.noise, self._rng)
+        self._build_space()
+        self._steps = 0
+        self.time = 0.0
+        self._x, self._y, self._angle = self._start
+        self._distance = 0.0
+        self._turned = 0.0
+        self._collisions = 0
+        self._contacts = 0
+        self._last_contact_end = -math.inf
+        self._new_collision = False
+        self._exit_time: float | None = None
+        self._wheels = (0.0, 0.0)
+        self._v = 0.0
+        self._w = 0.0
+        self._reaim = False
+        self._turn_target: float | None = None
+        self._readings = None
+
+    def _build_space(self) -> None:
+        space = pymunk.Space()
+        space.collision_slop = 0.001 * self.cell
+        for a, b in self._segments:
+            seg = pymunk.Segment(space.static_body, a, b, 0.0)
+            seg.friction = 0.0
+            seg.elasticity = 0.0
+            seg.collision_type = _WALL
+            space.add(seg)
+        r = self._radius
+        mass = 1.0
+        moment = pymunk.moment_for_circle(mass, 0.0, r)
+        body = pymunk.Body(mass, moment)
+        x, y, angle = self._start
+        body.position = (x, y)
+        body.angle = angle
+        shape = pymunk.Circle(body, r)
+        shape.friction = 0.0
+        shape.elasticity = 0.0
+        shape.collision_type = _ROBOT
+        control = pymunk.Body(body_type=pymunk.Body.KINEMATIC)
+        control.position = (x, y)
+        control.angle = angle
+        pivot = pymunk.PivotJoint(control, body, (0.0, 0.0), (0.0, 0.0))
+        pivot.max_bias = 0.0
+        # just enough to go from full speed backward to full speed forward in one step;
+        # more lets the joint press the robot into walls between contact corrections
+        top_speed = max(self.profile.max_wheel_speed, self.profile.move_speed)
+        pivot.max_force = mass * 2.0 * top_speed / self.dt
+        gear = pymunk.GearJoint(control, body, 0.0, 1.0)
+        gear.max_bias = 0.0
+        space.add(body, shape, control, pivot, gear)
+        space.on_collision(_ROBOT, _WALL, begin=self._contact_begin, separate=self._contact_end)
+        self._space = space
+        self._body = body
+        self._control = control
+
+    def _contact_begin(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: object) -> None:
+        if space is not self._space:
+            return
+        if self._contacts == 0 and self.time - self._last_contact_end > _COLLISION_GAP:
+            self._collisions += 1
+            self._new_collision = True
+        self._contacts += 1
+
+    def _contact_end(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: object) -> None:
+        if space is not self._space:
+            return
+        self._contacts = max(0, self._contacts - 1)
+        if self._contacts == 0:
+            self._last_contact_end = self.time
+
+    # -- commands ------------------------------------------------------------------------
+    def apply(self, command: Command) -> None:
+        """Hand the robot a motor command; it holds until the next one.
+
+        Any command abandons a Turn by Degree in progress.
+        """
+        self._turn_target = None
+        p = self.profile
+        if isinstance(command, WheelPowers):
+            self._wheels = (command.left * p.max_wheel_speed, command.right * p.max_wheel_speed)
+        elif isinstance(command, MoveAtPower):
+            power = command.power
+            if p.move_sign_only:
+                speed = math.copysign(p.move_speed, power) if power else 0.0
+            else:
+                speed = p.move_speed * power
+            self._wheels = (speed, speed)
+        elif isinstance(command, TurnByDegrees):
+            degrees = float(command.degrees)
+            if not math.isfinite(degrees):
+                raise WorldError(f"cannot turn by {command.degrees!r} degrees")
+            self._wheels = (0.0, 0.0)
+            turn = math.radians(degrees) * turn_factor(self.noise, self._rng)
+            self._turn_target = self._angle + turn
+        elif isinstance(command, MotorPower):
+            speed = command.power * p.max_wheel_speed
+            left, right = self._wheels
+            self._wheels = (speed, right) if command.wheel == "left" else (left, speed)
+        elif isinstance(command, Stop):
+            self._wheels = (0.0, 0.0)
+        else:
+            raise WorldError(
+                f"{command!r} is not a motor command: use WheelPowers, MotorPower, "
+                "MoveAtPower, TurnByDegrees or Stop"
+            )
+        left, right = self._wheels
+        gl, gr = self._gains
+        left *= gl
+        right *= gr
+        self._v = v = 0.5 * (left + right)
+        self._w = w = (left - right) / p.track_width
+        control = self._control
+        a = self._angle
+        control.velocity = (v * math.cos(a), v * math.sin(a))
+        control.angular_velocity = w
+        self._reaim = v != 0.0 and w != 0.0
+
+    @property
+    def turning(self) -> bool:
+        """True while a Turn by Degree is in progress."""
+        return self._turn_target is not None
+
+    # -- stepping ------------------------------------------------------------------------
+    def step(self) -> tuple[str, ...]:
+        """Advance one ``dt``; the events of this step ("turn_done", "collision", "exit")."""
+        body = self._body
+        target = self._turn_target
+        if target is not None:
+            # positions integrate with the previous step's velocity: plan one step ahead
+            ahead = self._angle + body.angular_velocity * self.dt
+            rate = math.radians(self.profile.turn_rate)
+            w = (target - ahead) / self.dt
+            self._control.angular_velocity = max(-rate, min(rate, w))
+        elif self._reaim:
+            v = self._v
+            a = self._angle
+            self._control.velocity = (v * math.cos(a), v * math.sin(a))
+        self._space.step(self.dt)
+        self._steps += 1
+        self.time = t = self._steps * self.dt
+        x, y = body.position
+        a = body.angle
+        self._distance += math.hypot(x - self._x, y - self._y)
+        self._turned += abs(a - self._angle)
+        self._x = x
+        self._y = y
+        self._angle = a
+        self._readings = None
+        events = _NO_EVENTS
+        if target is not None and abs(target - a) < _TURN_EPS:
+            self._turn_target = None
+            self._control.angular_velocity = 0.0
+            events = (TURN_DONE,)
+        if self._new_collision:
+            self._new_collision = False
+            events = (*events, COLLISION)
+        if self._exit_time is None:
+            inv = self._inv_cell
+            if self._exits[(int(y * inv) + 1) * self._wp + int(x * inv) + 1]:
+                self._exit_time = t
+                events = (*events, EXIT)
+        return events
+
+    def run(self, seconds: float) -> list[tuple[float, str]]:
+        """Step for ``seconds`` of simulated time; the (time, event) pairs that happened."""
+        out = []
+        for _ in range(round(seconds / self.dt)):
+            for event in self.step():
+                out.append((self.time, event))
+        return out
+
+    # -- state ---------------------------------------------------------------------------
+    @property
+    def pose(self) -> Pose:
+        """Centre (x, y) in world units and heading in degrees, 0 = right, clockwise."""
+        heading = math.degrees(self._angle) % 360.0
+        return Pose(self._x, self._y, 0.0 if heading == 360.0 else heading)
+
+    @property
+    def block(self) -> tuple[int, int]:
+        """The maze block (x, y) the robot's centre is in."""
+        inv = self._inv_cell
+        return int(self._x * inv), int(self._y * inv)
+
+    @property
+    def in_contact(self) -> bool:
+        """True while the robot touches a wall."""
+        return self._contacts > 0
+
+    @property
+    def odometry(self) -> Odometry:
+        return Odometry(
+            time=self.time,
+            distance=self._distance,
+            turn_degrees=math.degrees(self._turned),
+            collisions=self._collisions,
+            exit_time=self._exit_time,
+        )
+
+    # -- sensors -------------------------------------------------------------------------
+    def read_sensors(self) -> dict[int, float | int]:
+        """Readings by port for the current step: distances in world units, touch 0/1.
+
+        Read twice in one step, the readings (and their noise) are the same.
+        """
+        if self._readings is not None:
+            return dict(self._readings)
+        a = self._angle
+        c = math.cos(a)
+        s = math.sin(a)
+        # unit vectors of the mounts in MOUNTS order: front, right, back, left
+        dirs = ((c, s), (-s, c), (-c, -s), (s, -c))
+        x = self._x
+        y = self._y
+        out: dict[int, float | int] = {}
+        if self._distance_plan:
+            inv = self._inv_cell
+            solid = self._solid
+            wp = self._wp
+            tmax = self._tmax
+            cell = self.cell
+            p = self.profile
+            noise = self.noise
+            rel = noise.distance_relative
+            absolute = noise.distance_absolute
+            gauss = self._rng.gauss
+            for port, mount, offset in self._distance_plan:
+                dx, dy = dirs[mount]
+                t = _march(
+                    solid, wp, (x + offset * dx) * inv + 1.0, (y + offset * dy) * inv + 1.0,
+                    dx, dy, tmax,
+                )  # fmt: skip
+                if t < 0.0:
+                    out[port] = p.no_echo
+                    continue
+                d = t * cell
+                if rel or absolute:
+                    d = min(p.sensor_range, max(0.0, d + gauss(0.0, rel * d + absolute)))
+                out[port] = d
+        if self._touch_plan:
+            contacts = self._wall_contacts()
+            for port, mount in self._touch_plan:
+                ux, uy = dirs[mount]
+                out[port] = int(
+                    any(vx * ux + vy * uy >= _COS45 * math.hypot(vx, vy) for vx, vy in contacts)
+                )
+        self._readings = out
+        return dict(out)
+
+    def _wall_contacts(self) -> list[tuple[float, float]]:
+        """Vectors from the centre to the nearest point of each wall block within reach."""
+        x = self._x
+        y = self._y
+        cell = self.cell
+        inv = self._inv_cell
+        bx = int(x * inv)
+        by = int(y * inv)
+        reach2 = self._touch_reach**2
+        wp = self._wp
+        solid = self._solid
+        found = []
+        for j in (by - 1, by, by + 1):
+            row = (j + 1) * wp + 1
+            y0 = j * cell
+            ny = min(max(y, y0), y0 + cell) - y
+            for i in (bx - 1, bx, bx + 1):
+                if solid[row + i]:
+                    x0 = i * cell
+                    nx = min(max(x, x0), x0 + cell) - x
+                    if nx * nx + ny * ny <= reach2:
+                        found.append((nx, ny))
+        return found
