@@ -1,0 +1,130 @@
+"""The session: commands in, metrics, snapshots and run records out."""
+
+import io
+import json
+
+import pytest
+
+from workbench.control.commands import MoveAtPower, TurnByDegrees, WheelPowers
+from workbench.sim.mazefile import parse_maze
+from workbench.sim.metrics import TurnCounter
+from workbench.sim.record import FORMAT, Recorder, RecordError, read_record
+from workbench.sim.session import Session
+
+CORRIDOR = parse_maze("##########\n#S......E#\n##########\n", source="corridor.txt")
+ROOM = parse_maze("#######\n#.....#\n#..S..#\n#.....#\n#######\n", source="room.txt")
+
+
+def test_driving_to_the_exit_gives_the_course_metrics():
+    session = Session(CORRIDOR, "erobotic", noise="off")
+    session.command(MoveAtPower(1.0), driver="keyboard")
+    metrics = session.run(max_time=30)
+    assert metrics.reached_exit
+    # the exit block's edge is 6.5 blocks from the start block's centre
+    assert metrics.distance_cells == pytest.approx(6.5, abs=0.05)
+    assert metrics.turn_degrees == pytest.approx(0, abs=0.01)
+    assert metrics.turns == 0 and metrics.collisions == 0
+    assert metrics.efficiency == pytest.approx(1.0, abs=0.01)
+    assert metrics.exit_time == metrics.sim_time
+    assert session.snapshot().driver == "keyboard"
+
+
+def test_run_without_exits_goes_to_the_time_limit():
+    session = Session(ROOM, "erobotic", noise="off")
+    metrics = session.run(max_time=2.0)
+    assert not metrics.reached_exit and metrics.sim_time == pytest.approx(2.0)
+    assert metrics.efficiency is None
+
+
+def test_turns_count_rotations_not_corrections():
+    session = Session(ROOM, "unity", noise="off")
+    for degrees in (90, -90, 1, -1, 180):
+        session.command(TurnByDegrees(degrees))
+        session.run(max_time=session.world.time + 8)
+    metrics = session.metrics()
+    assert metrics.turns == 3
+    assert metrics.turn_degrees == pytest.approx(362, abs=1)
+
+
+def test_turn_counter_counts_each_sweep_once():
+    counter = TurnCounter()
+    for _ in range(20):
+        counter.update(5.0, 0.05)  # 100 deg/s for a second: one 100-degree turn
+    counter.update(0.0, 0.05)
+    for _ in range(20):
+        counter.update(0.05, 0.05)  # 1 deg/s drift: not a turn
+    counter.update(0.0, 0.05)
+    assert counter.turns == 1
+
+
+def test_snapshot_has_readings_by_port():
+    session = Session(ROOM, "erobotic", noise="off")
+    snap = session.snapshot()
+    assert set(snap.readings) == {1, 2, 3}
+    assert snap.block == (3, 2)
+    assert snap.state is None and snap.driver == "nobody"
+
+
+def test_reset_returns_to_the_start_and_clears_metrics():
+    session = Session(CORRIDOR, "erobotic", noise="off")
+    session.command(WheelPowers(1, 1))
+    session.run(max_time=2)
+    session.reset()
+    assert session.world.time == 0
+    assert session.metrics().distance == 0
+    assert session.snapshot().block == CORRIDOR.start
+
+
+def test_record_has_header_ticks_and_summary(tmp_path):
+    path = tmp_path / "run.jsonl"
+    recorder = Recorder(path)
+    session = Session(CORRIDOR, "erobotic", noise="off", recorder=recorder)
+    session.record_header(algorithm="keyboard", params={})
+    session.command(MoveAtPower(1.0))
+    session.run(max_time=30)
+    session.record_summary(final_state=None, cut_by_limit=False)
+    recorder.close()
+    record = read_record(path)
+    assert record.header["format"] == FORMAT
+    assert record.header["maze"]["digest"] == CORRIDOR.digest()
+    assert record.header["sensors"] == ["distance:1:front", "distance:2:left", "distance:3:right"]
+    assert record.summary["reached_exit"] is True
+    assert record.ticks[0]["cmd"] == [{"move": 1.0}]
+    assert record.ticks[-1]["events"] == ["exit"]
+    # one line per control tick (20 Hz)
+    assert len(record.ticks) == pytest.approx(record.summary["sim_time"] * 20, abs=1)
+
+
+def test_cut_short_record_loads_without_summary(tmp_path):
+    buf = io.StringIO()
+    recorder = Recorder(buf)
+    session = Session(CORRIDOR, "erobotic", noise="off", recorder=recorder)
+    session.record_header()
+    session.run(max_time=1)
+    path = tmp_path / "cut.jsonl"
+    path.write_text(buf.getvalue())
+    assert read_record(path).summary is None
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("", "empty file"),
+        ('{"type":"header","format":"other"}\n', "not a workbench run record"),
+        (f'{{"type":"header","format":"{FORMAT}"}}\n{{oops\n', ":2: not JSON"),
+        (f'{{"type":"header","format":"{FORMAT}"}}\n[1]\n', ":2: each line must be a JSON object"),
+    ],
+)
+def test_bad_records_are_clear_errors(tmp_path, text, message):
+    path = tmp_path / "bad.jsonl"
+    path.write_text(text)
+    with pytest.raises(RecordError, match=message):
+        read_record(path)
+
+
+def test_record_lines_are_compact_json(tmp_path):
+    buf = io.StringIO()
+    session = Session(CORRIDOR, "erobotic", noise="off", recorder=Recorder(buf))
+    session.run(max_time=0.1)
+    line = json.loads(buf.getvalue().splitlines()[0])
+    assert set(line) == {"t", "pose", "sensors"}

@@ -1,0 +1,236 @@
+"""One robot, its controller and its recorder: what every front end drives and reads.
+
+Physics steps at ``dt``; the controller (an FSM, or nothing while keys or a VIPLE program
+drive) runs at the control rate ``control_hz`` on simulated time, and the run record gets one
+line per control tick. Front ends call :meth:`Session.step` (or :meth:`Session.run`), hand
+commands to :meth:`Session.command`, and read :meth:`Session.snapshot`.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any, Protocol
+
+from .maze import Maze
+from .metrics import Metrics, TurnCounter, efficiency
+from .noise import NoiseSettings
+from .record import Recorder
+from .sensors import SensorSpec
+from .world import EXIT, Pose, World
+
+
+class Controller(Protocol):
+    """What decides motor commands each control tick (the FSM engine is one)."""
+
+    state: str | None
+    variables: dict[str, Any]
+
+    def start(self, t: float) -> list[Any]: ...
+
+    def tick(self, t: float, readings: dict[str, float], events: frozenset[str]) -> list[Any]: ...
+
+
+@dataclass(frozen=True)
+class Snapshot:
+    """Everything a front end shows about the session at one moment."""
+
+    time: float
+    pose: Pose
+    block: tuple[int, int]
+    readings: dict[int, float | int]
+    sensors: tuple[SensorSpec, ...]
+    driver: str
+    state: str | None
+    variables: dict[str, Any]
+    metrics: Metrics
+    events: tuple[str, ...] = field(default=())
+
+
+class Session:
+    def __init__(
+        self,
+        maze: Maze,
+        profile: str = "unity",
+        sensors: Sequence[SensorSpec] | None = None,
+        noise: NoiseSettings | str | None = None,
+        seed: int = 0,
+        dt: float = 1 / 60,
+        control_hz: float = 20.0,
+        recorder: Recorder | None = None,
+    ) -> None:
+        self.world = World(maze, profile, sensors, noise, seed, dt)
+        self.maze = maze
+        self.profile = self.world.profile
+        self.recorder = recorder
+        self.every = max(1, round(1.0 / (dt * control_hz)))
+        self.shortest_blocks = maze.shortest_path_length()
+        self.controller: Controller | None = None
+        self.binding: dict[str, int] = {}
+        self.driver = "nobody"
+        self._reset_run_state()
+
+    def _reset_run_state(self) -> None:
+        self._steps = 0
+        self._events: list[str] = []
+        self._commands: list[Any] = []
+        self._started = False
+        self._turns = TurnCounter()
+        self._last_heading = self.world.pose.heading
+        self._last_time = 0.0
+        self.readings: dict[int, float | int] = self.world.read_sensors()
+        self.last_events: tuple[str, ...] = ()
+
+    # -- who drives ---------------------------------------------------------------------
+    def attach(self, controller: Controller, binding: dict[str, int], driver: str) -> None:
+        """Let ``controller`` drive; ``binding`` maps its sensor names to ports."""
+        self.controller = controller
+        self.binding = dict(binding)
+        self.driver = driver
+        self._started = False
+
+    def detach(self, driver: str = "nobody") -> None:
+        self.controller = None
+        self.binding = {}
+        self.driver = driver
+
+    def command(self, cmd: Any, driver: str | None = None) -> None:
+        """A command from outside the controller (a key, a VIPLE message)."""
+        self.world.apply(cmd)
+        self._commands.append(cmd)
+        if driver is not None:
+            self.driver = driver
+
+    def set_sensors(self, specs: Sequence[SensorSpec]) -> None:
+        self.world.set_sensors(list(specs))
+        self.readings = self.world.read_sensors()
+
+    def reset(self, seed: int | None = None) -> None:
+        """Robot back to the start, odometry and controller state cleared."""
+        self.world.reset(seed)
+        reset = getattr(self.controller, "reset", None)
+        if reset is not None:
+            reset()
+        self._reset_run_state()
+
+    # -- time ----------------------------------------------------------------------------
+    def step(self) -> tuple[str, ...]:
+        """One physics step (and a control tick every ``every`` steps)."""
+        events = self.world.step()
+        if events:
+            self._events.extend(events)
+        self._steps += 1
+        if self._steps % self.every == 0:
+            self._control_tick()
+        return events
+
+    def _control_tick(self, run_controller: bool = True) -> None:
+        world = self.world
+        t = world.time
+        self.readings = readings = world.read_sensors()
+        heading = world.pose.heading
+        turned = (heading - self._last_heading + 180.0) % 360.0 - 180.0
+        self._turns.update(turned, t - self._last_time)
+        self._last_heading = heading
+        self._last_time = t
+        events = self._events
+        controller = self.controller
+        if controller is not None and run_controller:
+            if not self._started:
+                self._started = True
+                commands = controller.start(t)
+            else:
+                named = {name: readings[port] for name, port in self.binding.items()}
+                commands = controller.tick(t, named, frozenset(events))
+            for cmd in commands:
+                world.apply(cmd)
+            if commands:
+                self._commands.extend(commands)
+        if self.recorder is not None:
+            self.recorder.tick(
+                t,
+                world.pose,
+                readings,
+                self._commands,
+                controller.state if controller is not None else None,
+                events,
+                controller.variables if controller is not None else None,
+            )
+        self.last_events = tuple(events)
+        self._events = []
+        self._commands = []
+
+    @property
+    def reached_exit(self) -> bool:
+        return self.world.odometry.exit_time is not None
+
+    def run(self, max_time: float, stop_at_exit: bool = True) -> Metrics:
+        """Step until an exit is reached (when the maze has exits) or ``max_time`` passes."""
+        steps = math.ceil(max_time / self.world.dt - 1e-9)
+        step = self.step
+        stop = stop_at_exit and bool(self.maze.exits)
+        for _ in range(steps - self._steps):
+            if EXIT in step() and stop:
+                break
+        if self._steps % self.every:
+            self._control_tick(run_controller=False)  # the last steps reach the record too
+        return self.metrics()
+
+    # -- reading -------------------------------------------------------------------------
+    def metrics(self) -> Metrics:
+        odo = self.world.odometry
+        reached = odo.exit_time is not None
+        cell = self.world.cell
+        return Metrics(
+            reached_exit=reached,
+            exit_time=odo.exit_time,
+            sim_time=odo.time,
+            distance=odo.distance,
+            distance_cells=odo.distance / cell,
+            turn_degrees=odo.turn_degrees,
+            turns=self._turns.current(),
+            collisions=odo.collisions,
+            efficiency=efficiency(self.shortest_blocks, cell, odo.distance, reached),
+        )
+
+    def snapshot(self) -> Snapshot:
+        controller = self.controller
+        return Snapshot(
+            time=self.world.time,
+            pose=self.world.pose,
+            block=self.world.block,
+            readings=dict(self.readings),
+            sensors=self.world.sensors,
+            driver=self.driver,
+            state=controller.state if controller is not None else None,
+            variables=dict(controller.variables) if controller is not None else {},
+            metrics=self.metrics(),
+            events=self.last_events,
+        )
+
+    def record_header(self, **fields: Any) -> None:
+        """Write the run record's header: the maze, the set-up, and ``fields`` (algorithm...)."""
+        if self.recorder is None:
+            return
+        world = self.world
+        self.recorder.header(
+            maze={
+                "name": self.maze.name,
+                "source": self.maze.source,
+                "digest": self.maze.digest(),
+                "shortest_path": self.shortest_blocks,
+            },
+            profile=self.profile.name,
+            cell=world.cell,
+            sensors=[str(s) for s in world.sensors],
+            seed=world.seed,
+            noise=world.noise.as_dict(),
+            dt=world.dt,
+            control_hz=1.0 / (world.dt * self.every),
+            **fields,
+        )
+
+    def record_summary(self, **extra: Any) -> None:
+        if self.recorder is not None:
+            self.recorder.summary(self.metrics().as_dict(), **extra)
