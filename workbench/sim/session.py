@@ -20,6 +20,8 @@ from .record import Recorder
 from .sensors import SensorSpec
 from .world import EXIT, Pose, World
 
+_NONE: frozenset[str] = frozenset()
+
 
 class Controller(Protocol):
     """What decides motor commands each control tick (the FSM engine is one)."""
@@ -77,7 +79,7 @@ class Session:
         self._commands: list[Any] = []
         self._started = False
         self._turns = TurnCounter()
-        self._last_heading = self.world.pose.heading
+        self._last_angle = self.world.angle
         self._last_time = 0.0
         self.readings: dict[int, float | int] = self.world.read_sensors()
         self.last_events: tuple[str, ...] = ()
@@ -129,10 +131,9 @@ class Session:
         world = self.world
         t = world.time
         self.readings = readings = world.read_sensors()
-        heading = world.pose.heading
-        turned = (heading - self._last_heading + 180.0) % 360.0 - 180.0
-        self._turns.update(turned, t - self._last_time)
-        self._last_heading = heading
+        angle = world.angle
+        self._turns.update(math.degrees(angle - self._last_angle), t - self._last_time)
+        self._last_angle = angle
         self._last_time = t
         events = self._events
         controller = self.controller
@@ -142,7 +143,7 @@ class Session:
                 commands = controller.start(t)
             else:
                 named = {name: readings[port] for name, port in self.binding.items()}
-                commands = controller.tick(t, named, frozenset(events))
+                commands = controller.tick(t, named, frozenset(events) if events else _NONE)
             for cmd in commands:
                 world.apply(cmd)
             if commands:

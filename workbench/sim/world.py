@@ -25,6 +25,7 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import pymunk
+from pymunk._chipmunk import lib as _cp
 
 from ..control.commands import (
     Command,
@@ -54,6 +55,11 @@ _TURN_EPS = 1e-7
 _COLLISION_GAP = 0.1
 _COS45 = math.sqrt(0.5)
 _NO_EVENTS: tuple[str, ...] = ()
+# the chipmunk calls of the hot loop, bypassing pymunk's per-call wrappers (pymunk is pinned <8)
+_space_step = _cp.cpSpaceStep
+_get_position = _cp.cpBodyGetPosition
+_get_angle = _cp.cpBodyGetAngle
+_get_angular_velocity = _cp.cpBodyGetAngularVelocity
 
 
 class WorldError(ValueError):
@@ -196,6 +202,7 @@ class World:
                 f"does not fit the maze's {self.cell:g} {profile.unit} blocks"
             )
         self._radius = profile.robot_radius
+        self._turn_rate = math.radians(profile.turn_rate)
         self._touch_reach = profile.robot_radius + 0.005 * self.cell
         self._tmax = profile.sensor_range / self.cell
         self._inv_cell = 1.0 / self.cell
@@ -214,6 +221,7 @@ class World:
         self._solid = bytes(solid)
         self._exits = bytes(exits)
         c = self.cell
+        self._boxes: dict[int, tuple[float, float, float, float]] = {}
         self._segments = [
             ((a * c, b * c), (p * c, q * c)) for (a, b), (p, q) in wall_segments(maze)
         ]
@@ -268,6 +276,9 @@ class World:
         self._reaim = False
         self._turn_target: float | None = None
         self._readings = None
+        self._free_w = 0.0
+        self._physics_stale = False
+        self._box = (math.inf, -math.inf, math.inf, -math.inf)
 
     def _build_space(self) -> None:
         space = pymunk.Space()
@@ -303,7 +314,9 @@ class World:
         space.add(body, shape, control, pivot, gear)
         space.on_collision(_ROBOT, _WALL, begin=self._contact_begin, separate=self._contact_end)
         self._space = space
+        self._space_ptr = space._space
         self._body = body
+        self._body_ptr = body._body
         self._control = control
 
     def _contact_begin(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: object) -> None:
@@ -375,26 +388,64 @@ class World:
 
     # -- stepping ------------------------------------------------------------------------
     def step(self) -> tuple[str, ...]:
-        """Advance one ``dt``; the events of this step ("turn_done", "collision", "exit")."""
-        body = self._body
+        """Advance one ``dt``; the events of this step ("turn_done", "collision", "exit").
+
+        Where no wall is within reach of this step's motion the pose is integrated directly
+        (free motion, exactly what the solver would do with nothing to collide with); anywhere
+        else, and whenever the robot touches a wall, pymunk steps the world.
+        """
+        dt = self.dt
         target = self._turn_target
+        x0 = self._x
+        y0 = self._y
+        a0 = self._angle
+        if self._contacts == 0:
+            if target is not None:
+                v = 0.0
+                w = (target - a0) / dt
+                rate = self._turn_rate
+                w = rate if w > rate else -rate if w < -rate else w
+            else:
+                v = self._v
+                w = self._w
+            x = x0 + v * math.cos(a0) * dt if v else x0
+            y = y0 + v * math.sin(a0) * dt if v else y0
+            box = self._box
+            if not (box[0] <= x0 <= box[1] and box[2] <= y0 <= box[3]):
+                box = self._box = self._free_box(x0, y0)
+            if box[0] <= x <= box[1] and box[2] <= y <= box[3]:
+                # free motion: no wall within reach, so no contact can start this step
+                self._free_w = w
+                self._physics_stale = True
+                return self._advance(x, y, a0 + w * dt, target, abs(v) * dt, abs(w) * dt)
+        if self._physics_stale:
+            self._sync_body()
         if target is not None:
             # positions integrate with the previous step's velocity: plan one step ahead
-            ahead = self._angle + body.angular_velocity * self.dt
-            rate = math.radians(self.profile.turn_rate)
-            w = (target - ahead) / self.dt
+            ahead = a0 + _get_angular_velocity(self._body_ptr) * dt
+            rate = self._turn_rate
+            w = (target - ahead) / dt
             self._control.angular_velocity = max(-rate, min(rate, w))
         elif self._reaim:
             v = self._v
-            a = self._angle
-            self._control.velocity = (v * math.cos(a), v * math.sin(a))
-        self._space.step(self.dt)
+            self._control.velocity = (v * math.cos(a0), v * math.sin(a0))
+        # the C step directly: the wrapper's bookkeeping (deferred adds and removals, first-step
+        # mass checks) has nothing to do for this space after it is built
+        _space_step(self._space_ptr, dt)
+        pos = _get_position(self._body_ptr)
+        x = pos.x
+        y = pos.y
+        a = _get_angle(self._body_ptr)
+        return self._advance(x, y, a, target, math.hypot(x - x0, y - y0), abs(a - a0))
+
+    def _advance(
+        self, x: float, y: float, a: float, target: float | None, moved: float, turned: float
+    ) -> tuple[str, ...]:
+        """Take the new pose and odometry; the step's events."""
         self._steps += 1
         self.time = t = self._steps * self.dt
-        x, y = body.position
-        a = body.angle
-        self._distance += math.hypot(x - self._x, y - self._y)
-        self._turned += abs(a - self._angle)
+        self._distance += moved
+        self._turned += turned
         self._x = x
         self._y = y
         self._angle = a
@@ -403,6 +454,7 @@ class World:
         if target is not None and abs(target - a) < _TURN_EPS:
             self._turn_target = None
             self._control.angular_velocity = 0.0
+            self._free_w = 0.0
             events = (TURN_DONE,)
         if self._new_collision:
             self._new_collision = False
@@ -413,6 +465,56 @@ class World:
                 self._exit_time = t
                 events = (*events, EXIT)
         return events
+
+    def _free_box(self, x: float, y: float) -> tuple[float, float, float, float]:
+        """Where the robot's centre may go in its block without coming near a wall:
+        (xmin, xmax, ymin, ymax), cached per block."""
+        inv = self._inv_cell
+        key = (int(y * inv) + 1) * self._wp + int(x * inv) + 1
+        box = self._boxes.get(key)
+        if box is None:
+            box = self._boxes[key] = self._make_box(key)
+        return box
+
+    def _make_box(self, key: int) -> tuple[float, float, float, float]:
+        wp = self._wp
+        solid = self._solid
+        c = self.cell
+        bx = key % wp - 1
+        by = key // wp - 1
+        keep = self._radius + 0.02 * c  # clearance kept from any wall block
+        if solid[key]:
+            return (math.inf, -math.inf, math.inf, -math.inf)
+
+        def any_solid(*offsets: int) -> bool:
+            return any(solid[key + o] for o in offsets)
+
+        left = any_solid(-1 - wp, -1, -1 + wp)
+        right = any_solid(1 - wp, 1, 1 + wp)
+        up = any_solid(-wp - 1, -wp, -wp + 1)
+        down = any_solid(wp - 1, wp, wp + 1)
+        x0 = bx * c
+        y0 = by * c
+        return (
+            x0 + (keep if left else 0.0),
+            x0 + c - (keep if right else 0.0),
+            y0 + (keep if up else 0.0),
+            y0 + c - (keep if down else 0.0),
+        )
+
+    def _sync_body(self) -> None:
+        """Hand the directly integrated pose and motion back to pymunk before it steps again."""
+        body = self._body
+        a = self._angle
+        v = self._v if self._turn_target is None else 0.0
+        velocity = (v * math.cos(a), v * math.sin(a))
+        body.position = (self._x, self._y)
+        body.angle = a
+        body.velocity = velocity
+        body.angular_velocity = self._free_w
+        self._control.velocity = velocity
+        self._control.angular_velocity = self._free_w
+        self._physics_stale = False
 
     def run(self, seconds: float) -> list[tuple[float, str]]:
         """Step for ``seconds`` of simulated time; the (time, event) pairs that happened."""
@@ -428,6 +530,11 @@ class World:
         """Centre (x, y) in world units and heading in degrees, 0 = right, clockwise."""
         heading = math.degrees(self._angle) % 360.0
         return Pose(self._x, self._y, 0.0 if heading == 360.0 else heading)
+
+    @property
+    def angle(self) -> float:
+        """Heading in radians, not wrapped: its change over time is the robot's signed turning."""
+        return self._angle
 
     @property
     def block(self) -> tuple[int, int]:
