@@ -9,6 +9,7 @@ from collections.abc import Sequence
 
 from workbench import __version__
 
+from . import algorithms as algorithms_cmd
 from . import maze as maze_cmd
 from .common import default_maze_path
 
@@ -22,6 +23,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--maze", help="maze file to open (default: the bundled Unity maze)")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     maze_cmd.register(sub)
+    algorithms_cmd.register(sub)
     return parser
 
 

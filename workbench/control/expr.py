@@ -1,0 +1,386 @@
+"""Small, safe expressions for FSM guards and actions: ``front < 50 and not turn_done``.
+
+An expression is parsed once with :func:`ast.parse` and only an allow-list of node types is
+accepted: numbers, strings, True/False, names, ``+ - * /``, unary ``-``/``+``, comparisons
+(chained too), ``and``/``or``/``not``, parentheses, and calls to ``abs``, ``min`` and ``max``.
+It is turned into a tree of closures, so evaluating it is a few Python calls and never ``eval``.
+"""
+
+from __future__ import annotations
+
+import ast
+import difflib
+import operator
+from collections.abc import Callable, Collection, Mapping
+from dataclasses import dataclass
+
+Value = float | int | bool | str
+Env = Mapping[str, Value]
+Fn = Callable[[Env], Value]
+
+FUNCTIONS: dict[str, Callable[..., Value]] = {"abs": abs, "min": min, "max": max}
+_ARITY = {"abs": (1, 1), "min": (2, None), "max": (2, None)}
+
+_BINOPS = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul}
+_BINOPS[ast.Div] = operator.truediv
+_CMPOPS = {
+    ast.Lt: operator.lt,
+    ast.LtE: operator.le,
+    ast.Gt: operator.gt,
+    ast.GtE: operator.ge,
+    ast.Eq: operator.eq,
+    ast.NotEq: operator.ne,
+}
+_REFUSED_OPS = {
+    ast.Pow: ("**", "multiply instead, e.g. x * x"),
+    ast.Mod: ("%", "only + - * / are available"),
+    ast.FloorDiv: ("//", "use / (results are not rounded)"),
+    ast.MatMult: ("@", "only + - * / are available"),
+    ast.LShift: ("<<", "only + - * / are available"),
+    ast.RShift: (">>", "only + - * / are available"),
+    ast.BitAnd: ("&", "write 'and' for both conditions"),
+    ast.BitOr: ("|", "write 'or' for either condition"),
+    ast.BitXor: ("^", "only + - * / are available"),
+    ast.In: ("in", "compare with == and combine with 'or'"),
+    ast.NotIn: ("not in", "compare with != and combine with 'and'"),
+    ast.Is: ("is", "use == to compare values"),
+    ast.IsNot: ("is not", "use != to compare values"),
+    ast.Invert: ("~", "use 'not' for a condition or '-' for a number"),
+}
+_REFUSED_NODES = {
+    ast.Attribute: ("attribute access (x.y) is not allowed", "use plain names such as front"),
+    ast.Subscript: ("indexing (x[...]) is not allowed", "use plain names such as front"),
+    ast.Lambda: ("lambda is not allowed", "write the condition directly"),
+    ast.IfExp: ("'x if c else y' is not allowed", "use two transitions with their own guards"),
+    ast.NamedExpr: ("':=' is not allowed", "assign variables with a set: action"),
+    ast.JoinedStr: ("f-strings are not allowed", "use a plain quoted string"),
+    ast.List: ("lists are not allowed", "use single values"),
+    ast.Tuple: ("tuples are not allowed", "use single values"),
+    ast.Dict: ("dictionaries are not allowed", "use single values"),
+    ast.Set: ("sets are not allowed", "use single values"),
+    ast.Starred: ("'*' unpacking is not allowed", "pass the values one by one"),
+}
+_ALLOWED_SUMMARY = "numbers, names, + - * /, comparisons, and/or/not, abs() min() max()"
+
+
+class ExprError(ValueError):
+    """An expression that cannot be compiled or evaluated; ``column`` is 1-based in ``text``."""
+
+    def __init__(
+        self, message: str, text: str = "", column: int | None = None, hint: str = ""
+    ) -> None:
+        self.message = message
+        self.text = text
+        self.column = column
+        self.hint = hint
+        super().__init__(str(self))
+
+    def __str__(self) -> str:
+        where = ""
+        if self.text:
+            where = f" in {self.text!r}"
+            if self.column is not None:
+                where += f" at column {self.column}"
+        return f"{self.message}{where}" + (f" ({self.hint})" if self.hint else "")
+
+
+@dataclass(frozen=True, eq=False)
+class Expr:
+    """A compiled expression: call it with a mapping of names to values."""
+
+    text: str
+    names: frozenset[str]
+    evaluate: Fn
+    constant: bool
+
+    def __call__(self, env: Env | None = None) -> Value:
+        return self.evaluate(env if env is not None else {})
+
+
+def compile_expr(
+    text: str,
+    names: Collection[str] | None = None,
+    constants: Mapping[str, Value] | None = None,
+) -> Expr:
+    """Compile ``text``; ``names`` are the names it may read (None: any), ``constants`` are
+    names whose values are fixed now and are folded into the result."""
+    if isinstance(text, bool):
+        text = "True" if text else "False"
+    elif isinstance(text, int | float):
+        text = repr(text)
+    if not isinstance(text, str):
+        raise ExprError(f"an expression must be text, not {type(text).__name__}")
+    body = text.lstrip()
+    lead = len(text) - len(body)
+    if not body.strip():
+        raise ExprError("empty expression", text, None, "write a value or a condition")
+    try:
+        tree = ast.parse(body, mode="eval")
+    except SyntaxError as exc:
+        col = (exc.offset or 1) + lead if (exc.lineno or 1) == 1 else exc.offset
+        raise ExprError(f"bad syntax: {exc.msg}", text, col, _syntax_hint(body)) from None
+    compiler = _Compiler(text, lead, names, constants or {})
+    kind, payload = compiler.node(tree.body)
+    if kind == "const":
+        value = payload
+        return Expr(text, frozenset(compiler.read), lambda env: value, True)
+    fn = _as_fn(kind, payload)
+    return Expr(text, frozenset(compiler.read), fn, False)
+
+
+def _syntax_hint(text: str) -> str:
+    if "&&" in text or "||" in text:
+        return "write 'and' / 'or' instead of && / ||"
+    if "!" in text.replace("!=", ""):
+        return "write 'not x' instead of !x"
+    stripped = text.replace("==", "").replace("!=", "").replace("<=", "").replace(">=", "")
+    if "=" in stripped:
+        return "compare with ==; assign variables with a set: action"
+    if text.count("(") != text.count(")"):
+        return "check that every '(' has its ')'"
+    return f"expressions may use {_ALLOWED_SUMMARY}"
+
+
+# A compiled node is ("const", value), ("name", name) or ("fn", closure).
+_Node = tuple[str, object]
+
+
+def _as_fn(kind: str, payload: object) -> Fn:
+    if kind == "const":
+        return lambda env: payload
+    if kind == "name":
+        key = payload
+        return lambda env: env[key]
+    return payload  # type: ignore[return-value]
+
+
+class _Compiler:
+    def __init__(
+        self,
+        text: str,
+        lead: int,
+        names: Collection[str] | None,
+        constants: Mapping[str, Value],
+    ) -> None:
+        self.text = text
+        self.lead = lead
+        self.names = names
+        self.constants = constants
+        self.read: set[str] = set()
+
+    def fail(
+        self, node: ast.AST, message: str, hint: str = "", after: ast.AST | None = None
+    ) -> ExprError:
+        """``after``: point at the operator that follows this operand instead of ``node``."""
+        col = getattr(node, "col_offset", None)
+        line = getattr(node, "lineno", 1)
+        if after is not None and getattr(after, "end_lineno", 0) == 1:
+            body = self.text[self.lead :]
+            col = after.end_col_offset or 0
+            while col < len(body) and body[col] in " \t()":
+                col += 1
+            line = 1
+        if col is not None:
+            col += 1 + (self.lead if line == 1 else 0)
+        return ExprError(message, self.text, col, hint)
+
+    def node(self, node: ast.AST) -> _Node:
+        method = getattr(self, "_" + type(node).__name__, None)
+        if method is not None:
+            return method(node)
+        if type(node) in _REFUSED_NODES:
+            message, hint = _REFUSED_NODES[type(node)]
+            raise self.fail(node, message, hint)
+        raise self.fail(
+            node,
+            f"{type(node).__name__} expressions are not allowed",
+            f"expressions may use {_ALLOWED_SUMMARY}",
+        )
+
+    def _Constant(self, node: ast.Constant) -> _Node:
+        value = node.value
+        if isinstance(value, bool | int | float | str):
+            return ("const", value)
+        raise self.fail(
+            node, f"the value {value!r} is not allowed", "use numbers, strings, True or False"
+        )
+
+    def _Name(self, node: ast.Name) -> _Node:
+        name = node.id
+        if name in FUNCTIONS:
+            raise self.fail(node, f"{name} is a function", f"call it, e.g. {name}(x)")
+        self.read.add(name)
+        if name in self.constants:
+            return ("const", self.constants[name])
+        if self.names is not None and name not in self.names:
+            raise self.fail(node, f"unknown name {name!r}", _name_hint(name, self.names))
+        return ("name", name)
+
+    def _UnaryOp(self, node: ast.UnaryOp) -> _Node:
+        if type(node.op) in _REFUSED_OPS:
+            symbol, hint = _REFUSED_OPS[type(node.op)]
+            raise self.fail(node, f"the operator {symbol} is not allowed", hint)
+        op = {ast.USub: operator.neg, ast.UAdd: operator.pos, ast.Not: operator.not_}[type(node.op)]
+        kind, payload = self.node(node.operand)
+        if kind == "const":
+            return ("const", self.fold(node, op, payload))
+        f = _as_fn(kind, payload)
+        return ("fn", lambda env: op(f(env)))
+
+    def _BinOp(self, node: ast.BinOp) -> _Node:
+        op = _BINOPS.get(type(node.op))
+        if op is None:
+            symbol, hint = _REFUSED_OPS.get(type(node.op), ("?", ""))
+            raise self.fail(node, f"the operator {symbol} is not allowed", hint, after=node.left)
+        left, right = self.node(node.left), self.node(node.right)
+        if op is operator.truediv and right[0] == "const" and right[1] == 0:
+            raise self.fail(node, "division by zero", "check the divisor", after=node.left)
+        if left[0] == "const" and right[0] == "const":
+            return ("const", self.fold(node, op, left[1], right[1]))
+        return ("fn", _binary(op, left, right))
+
+    def _BoolOp(self, node: ast.BoolOp) -> _Node:
+        parts = [self.node(v) for v in node.values]
+        fns = [_as_fn(*p) for p in parts]
+        if all(p[0] == "const" for p in parts):
+            env: dict[str, Value] = {}
+            if isinstance(node.op, ast.And):
+                return ("const", _all_of(fns)(env))
+            return ("const", _any_of(fns)(env))
+        if isinstance(node.op, ast.And):
+            return ("fn", _all_of(fns))
+        return ("fn", _any_of(fns))
+
+    def _Compare(self, node: ast.Compare) -> _Node:
+        ops = []
+        for i, op in enumerate(node.ops):
+            if type(op) not in _CMPOPS:
+                symbol, hint = _REFUSED_OPS.get(type(op), ("?", ""))
+                before = node.left if i == 0 else node.comparators[i - 1]
+                raise self.fail(
+                    node, f"the comparison '{symbol}' is not allowed", hint, after=before
+                )
+            ops.append(_CMPOPS[type(op)])
+        operands = [self.node(node.left)] + [self.node(c) for c in node.comparators]
+        if all(p[0] == "const" for p in operands):
+            fn = _chain(ops, [_as_fn(*p) for p in operands])
+            return ("const", self.fold(node, fn, {}))
+        if len(ops) == 1:
+            return ("fn", _binary(ops[0], operands[0], operands[1]))
+        return ("fn", _chain(ops, [_as_fn(*p) for p in operands]))
+
+    def _Call(self, node: ast.Call) -> _Node:
+        func = node.func
+        if not isinstance(func, ast.Name):
+            raise self.fail(
+                node,
+                "only the functions abs, min and max can be called",
+                "attribute access and method calls are not allowed",
+            )
+        if func.id not in FUNCTIONS:
+            raise self.fail(
+                node,
+                f"unknown function {func.id!r}",
+                "only abs(x), min(a, b, ...) and max(a, b, ...) can be called",
+            )
+        if node.keywords:
+            raise self.fail(node, f"{func.id}() takes no keyword arguments", "pass values only")
+        low, high = _ARITY[func.id]
+        count = len(node.args)
+        if count < low or (high is not None and count > high):
+            wanted = "exactly 1 argument" if low == high else f"at least {low} arguments"
+            example = f"{func.id}(x)" if low == high else f"{func.id}(a, b)"
+            raise self.fail(node, f"{func.id}() takes {wanted}, not {count}", f"e.g. {example}")
+        parts = [self.node(a) for a in node.args]
+        impl = FUNCTIONS[func.id]
+        if all(p[0] == "const" for p in parts):
+            return ("const", self.fold(node, impl, *(p[1] for p in parts)))
+        fns = [_as_fn(*p) for p in parts]
+        if len(fns) == 1:
+            (f,) = fns
+            return ("fn", lambda env: impl(f(env)))
+        return ("fn", lambda env: impl(*[f(env) for f in fns]))
+
+    def fold(self, node: ast.AST, fn: Callable[..., Value], *args: object) -> Value:
+        try:
+            return fn(*args)
+        except ZeroDivisionError:
+            raise self.fail(node, "division by zero", "check the divisor") from None
+        except TypeError as exc:
+            raise self.fail(node, f"values do not fit together: {exc}", "") from None
+
+
+def _binary(op: Callable[[Value, Value], Value], left: _Node, right: _Node) -> Fn:
+    lk, lp = left
+    rk, rp = right
+    if lk == "name" and rk == "const":
+        return lambda env: op(env[lp], rp)
+    if lk == "const" and rk == "name":
+        return lambda env: op(lp, env[rp])
+    if lk == "name" and rk == "name":
+        return lambda env: op(env[lp], env[rp])
+    lf, rf = _as_fn(lk, lp), _as_fn(rk, rp)
+    return lambda env: op(lf(env), rf(env))
+
+
+def _chain(ops: list[Callable[[Value, Value], bool]], fns: list[Fn]) -> Fn:
+    first = fns[0]
+    pairs = list(zip(ops, fns[1:], strict=True))
+
+    def chained(env: Env) -> bool:
+        left = first(env)
+        for op, f in pairs:
+            right = f(env)
+            if not op(left, right):
+                return False
+            left = right
+        return True
+
+    return chained
+
+
+def _all_of(fns: list[Fn]) -> Fn:
+    if len(fns) == 2:
+        a, b = fns
+        return lambda env: a(env) and b(env)
+
+    def all_of(env: Env) -> Value:
+        value: Value = True
+        for f in fns:
+            value = f(env)
+            if not value:
+                return value
+        return value
+
+    return all_of
+
+
+def _any_of(fns: list[Fn]) -> Fn:
+    if len(fns) == 2:
+        a, b = fns
+        return lambda env: a(env) or b(env)
+
+    def any_of(env: Env) -> Value:
+        value: Value = False
+        for f in fns:
+            value = f(env)
+            if value:
+                return value
+        return value
+
+    return any_of
+
+
+def _name_hint(name: str, known: Collection[str]) -> str:
+    if name in ("true", "false"):
+        return f"write {name.capitalize()}"
+    if name in ("null", "none", "None"):
+        return "there is no empty value; use 0 or False"
+    close = difflib.get_close_matches(name, list(known), n=1)
+    if close:
+        return f"did you mean {close[0]!r}?"
+    if known:
+        shown = sorted(known)
+        listing = ", ".join(shown[:12]) + (", ..." if len(shown) > 12 else "")
+        return f"known names: {listing}"
+    return "no names are defined here"
