@@ -111,7 +111,9 @@ def test_tabs_get_a_hint():
 
 def test_empty_file_and_non_mapping_file():
     assert problems("") == ["bad.yaml:1:1: the file is empty (hint: start with name: and states:)"]
-    assert "must be a mapping" in problems("- a\n- b\n")[0]
+    assert problems("- a\n- b\n") == [
+        "bad.yaml:1:1: an FSM file must be a mapping with name:, initial: and states:"
+    ]
 
 
 def test_unknown_state_in_to_points_at_the_value():
@@ -254,16 +256,23 @@ def test_sensor_problems():
     assert problems(text) == [
         "bad.yaml:4:17: unknown sensor kind 'sonar' (hint: use one of distance, touch)",
         "bad.yaml:4:31: unknown mount 'top' (hint: use one of front, right, back, left)",
-        "bad.yaml:5:47: port 2 (unity) is also used by sensor 'front' (hint: give each sensor "
-        "its own port)",
-        "bad.yaml:5:47: port 2 (web) is also used by sensor 'front' (hint: give each sensor its "
-        "own port)",
-        "bad.yaml:5:47: port 2 (erobotic) is also used by sensor 'front' (hint: give each "
-        "sensor its own port)",
+        "bad.yaml:5:47: port 2 (unity, web, erobotic) is also used by sensor 'front' (hint: "
+        "give each sensor its own port)",
         "bad.yaml:6:9: sensor left has no mount: (hint: e.g. front: {kind: distance, mount: "
         "front, port: 2})",
         "bad.yaml:7:42: no port for profile erobotic (hint: give one port number, or one per "
         "profile)",
+    ]
+
+
+def test_a_port_must_be_a_whole_number_in_range():
+    assert problems(GOOD.replace("port: 2}", "port: 1.5}")) == [
+        "bad.yaml:4:47: port 1.5 (unity, web, erobotic) is not a whole number from 0 to 99"
+    ]
+    text = GOOD.replace("port: 2}", "port: {unity: 2, web: 200, erobotic: 2, lego: 1}}")
+    assert problems(text) == [
+        "bad.yaml:4:63: port 200 (web) is not a whole number from 0 to 99",
+        "bad.yaml:4:81: unknown profile 'lego' (hint: use one of unity, web, erobotic)",
     ]
 
 

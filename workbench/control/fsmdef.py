@@ -277,24 +277,30 @@ def _check_sensors(defn: FsmDefinition, add: Callable) -> None:
             add(Problem((*path, "kind"), f"unknown sensor kind {s.kind!r}", _one_of(KINDS)))
         if s.mount not in MOUNTS:
             add(Problem((*path, "mount"), f"unknown mount {s.mount!r}", _one_of(MOUNTS)))
+        missing = [p for p in PROFILES if s.ports.get(p) is None]
+        if missing:
+            add(
+                Problem(
+                    (*path, "port"),
+                    f"no port for profile {', '.join(missing)}",
+                    "give one port number, or one per profile",
+                )
+            )
+        bad: dict[object, list[str]] = {}
         for profile in PROFILES:
             port = s.ports.get(profile)
-            if port is None:
-                add(
-                    Problem(
-                        (*path, "port"),
-                        f"no port for profile {profile}",
-                        "give one port number, or one per profile",
-                    )
+            if port is not None and (
+                isinstance(port, bool) or not isinstance(port, int) or port not in PORT_RANGE
+            ):
+                bad.setdefault(port, []).append(profile)
+        for port, profiles in bad.items():
+            add(
+                Problem(
+                    (*path, "port", profiles[0]),
+                    f"port {port!r} ({', '.join(profiles)}) is not a whole number from "
+                    f"{PORT_RANGE.start} to {PORT_RANGE.stop - 1}",
                 )
-            elif isinstance(port, bool) or not isinstance(port, int) or port not in PORT_RANGE:
-                add(
-                    Problem(
-                        (*path, "port"),
-                        f"port {port!r} ({profile}) is not a whole number from "
-                        f"{PORT_RANGE.start} to {PORT_RANGE.stop - 1}",
-                    )
-                )
+            )
         for profile in s.ports:
             if profile not in PROFILES:
                 add(
@@ -304,20 +310,23 @@ def _check_sensors(defn: FsmDefinition, add: Callable) -> None:
                         _one_of(PROFILES),
                     )
                 )
+    clashes: dict[tuple[str, int, str], list[str]] = {}
     for profile in PROFILES:
         owner: dict[int, str] = {}
         for s in defn.sensors:
             port = s.ports.get(profile)
             if port in owner:
-                add(
-                    Problem(
-                        ("sensors", s.name, "port"),
-                        f"port {port} ({profile}) is also used by sensor {owner[port]!r}",
-                        "give each sensor its own port",
-                    )
-                )
+                clashes.setdefault((s.name, port, owner[port]), []).append(profile)
             elif port is not None:
                 owner[port] = s.name
+    for (name, port, other), profiles in clashes.items():
+        add(
+            Problem(
+                ("sensors", name, "port"),
+                f"port {port} ({', '.join(profiles)}) is also used by sensor {other!r}",
+                "give each sensor its own port",
+            )
+        )
 
 
 def _check_parameters(defn: FsmDefinition, add: Callable) -> None:

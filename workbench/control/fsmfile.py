@@ -110,6 +110,10 @@ def loads_fsm(text: str, filename: str = "<text>") -> FsmDefinition:
         raise FsmFileError(
             [FileProblem(filename, 1, 1, "the file is empty", "start with name: and states:")]
         )
+    if not isinstance(root, MappingNode):
+        mark = root.start_mark
+        message = "an FSM file must be a mapping with name:, initial: and states:"
+        raise FsmFileError([FileProblem(filename, mark.line + 1, mark.column + 1, message)])
     reader = _Reader(filename)
     definition = reader.definition(root)
     for problem in check_definition(definition):
@@ -310,9 +314,6 @@ class _Reader:
 
     def definition(self, root: Node) -> FsmDefinition:
         self.nodes[()] = root
-        if not isinstance(root, MappingNode):
-            self.report(root, "an FSM file must be a mapping with name:, initial: and states:")
-            return FsmDefinition(Path(self.filename).stem, "", ())
         fields = {key: (k, v) for key, k, v in self.pairs(root, ("@top",), "the file", TOP_KEYS)}
         for key, (k, _v) in fields.items():
             self.nodes[(key,)] = k
