@@ -11,6 +11,7 @@ from workbench import __version__
 
 from . import algorithms as algorithms_cmd
 from . import maze as maze_cmd
+from . import run as run_cmd
 from .common import default_maze_path
 
 
@@ -24,6 +25,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     maze_cmd.register(sub)
     algorithms_cmd.register(sub)
+    run_cmd.register(sub)
     return parser
 
 

@@ -1,0 +1,143 @@
+"""``workbench run`` and ``workbench eval``: algorithms on mazes, headless, measured."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+
+from workbench.control.evaluate import EvalError, evaluate, format_table, write_csv
+from workbench.control.headless import RunSetupError, RunSpec, run
+from workbench.sim.noise import NOISE_LEVELS
+from workbench.sim.profiles import PROFILES
+
+
+def _simulation_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--profile", choices=list(PROFILES), help="default: the maze's, else unity")
+    parser.add_argument(
+        "--noise", choices=list(NOISE_LEVELS), help="default: the profile's (erobotic off)"
+    )
+    parser.add_argument(
+        "--noise-set",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="one noise parameter: motor_imbalance, turn_error, distance_relative, "
+        "distance_absolute",
+    )
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("run", help="run one algorithm on one maze and print its metrics")
+    p.add_argument("--maze", required=True, help="maze file (any supported format)")
+    p.add_argument("--algorithm", required=True, help="built-in name or an FSM .yaml file")
+    _simulation_options(p)
+    p.add_argument(
+        "--sensor",
+        action="append",
+        default=[],
+        metavar="KIND:PORT:MOUNT",
+        help="e.g. distance:1:right (default: the algorithm's own sensors)",
+    )
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE")
+    p.add_argument("--max-time", type=float, help="simulated seconds (default: from maze size)")
+    p.add_argument("--record", metavar="FILE.jsonl", help="write the run record")
+    p.add_argument("--json", action="store_true", help="one JSON object")
+    p.set_defaults(func=cmd_run)
+
+    e = sub.add_parser("eval", help="every algorithm on every maze, over several seeds")
+    e.add_argument("--maze", nargs="+", required=True, metavar="M")
+    e.add_argument("--algorithm", nargs="+", required=True, metavar="A")
+    _simulation_options(e)
+    e.add_argument("--seeds", type=int, default=3, help="seeds 0..N-1 (default 3)")
+    e.add_argument("--max-time", type=float, help="simulated seconds per run")
+    e.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="parallel processes")
+    e.add_argument("--csv", metavar="FILE", help="also write the matrix as CSV")
+    e.add_argument("--json", action="store_true", help="one JSON object")
+    e.set_defaults(func=cmd_eval)
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    spec = RunSpec(
+        maze=args.maze,
+        algorithm=args.algorithm,
+        profile=args.profile,
+        sensors=tuple(args.sensor),
+        seed=args.seed,
+        noise=args.noise,
+        noise_params=tuple(args.noise_set),
+        params=tuple(args.param),
+        max_time=args.max_time,
+        record=args.record,
+    )
+    try:
+        result = run(spec)
+    except RunSetupError as exc:
+        print(f"workbench run: {exc}", file=sys.stderr)
+        return 2
+    data = result.as_dict()
+    if args.json:
+        print(json.dumps(data, sort_keys=False))
+    else:
+        print(describe_run(result))
+    if not result.maze.exits:
+        return 0
+    return 0 if data["reached_exit"] else 1
+
+
+def describe_run(result) -> str:
+    d = result.as_dict()
+    m = result.metrics
+    unit = PROFILES[result.profile].unit
+    head = f"{result.spec.algorithm} on {result.maze.name} ({result.profile}, seed {d['seed']})"
+    if d["reached_exit"]:
+        outcome = f"reached the exit after {m['exit_time']:.1f} s"
+    elif result.maze.exits:
+        outcome = (
+            f"did NOT get out within the {result.max_time:g} s limit "
+            f"(the run was cut; final state {d['final_state']})"
+        )
+    else:
+        outcome = f"free exploration for {result.max_time:g} s (the maze has no exit)"
+    eff = f"{d['efficiency']:.0%}" if d["efficiency"] is not None else "n/a"
+    return "\n".join(
+        [
+            head,
+            f"  {outcome}",
+            f"  distance travelled  {d['distance']:.1f} {unit} ({d['distance_cells']:.1f} blocks)",
+            f"  turning degrees     {d['turn_degrees']:.0f} deg in {d['turns']} turns",
+            f"  collisions          {d['collisions']}",
+            f"  efficiency          {eff} (shortest path / distance travelled)",
+            f"  simulated time      {d['sim_time']:.1f} s",
+        ]
+    )
+
+
+def cmd_eval(args: argparse.Namespace) -> int:
+    if args.seeds < 1 or args.jobs < 1:
+        print("workbench eval: --seeds and --jobs must be at least 1", file=sys.stderr)
+        return 2
+    try:
+        result = evaluate(
+            args.maze,
+            args.algorithm,
+            seeds=args.seeds,
+            profile=args.profile,
+            noise=args.noise,
+            noise_params=tuple(args.noise_set),
+            max_time=args.max_time,
+            jobs=args.jobs,
+            progress=not args.json and sys.stderr.isatty(),
+        )
+    except (EvalError, RunSetupError) as exc:
+        print(f"workbench eval: {exc}", file=sys.stderr)
+        return 2
+    if args.csv:
+        write_csv(args.csv, result)
+    if args.json:
+        print(json.dumps(result.as_dict(), sort_keys=False))
+    else:
+        print(format_table(result))
+    return 0

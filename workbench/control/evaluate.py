@@ -1,0 +1,205 @@
+"""The algorithm x maze matrix: every algorithm on every maze over several seeds, in parallel."""
+
+from __future__ import annotations
+
+import csv
+import statistics
+from collections.abc import Callable, Sequence
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass
+from typing import Any
+
+from .headless import RunSetupError, RunSpec, prepare, run
+
+MEASURES = ("distance_cells", "turn_degrees", "sim_time", "collisions", "turns")
+
+
+class EvalError(ValueError):
+    """The evaluation cannot start (named inputs that do not load)."""
+
+
+@dataclass(frozen=True)
+class Cell:
+    """One algorithm on one maze, summarised over the seeds."""
+
+    maze: str
+    algorithm: str
+    runs: int
+    reached: int
+    mean: dict[str, float]
+    spread: dict[str, float]  # population standard deviation over the seeds
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "maze": self.maze,
+            "algorithm": self.algorithm,
+            "runs": self.runs,
+            "reached": self.reached,
+            "mean": {k: round(v, 3) for k, v in self.mean.items()},
+            "spread": {k: round(v, 3) for k, v in self.spread.items()},
+        }
+
+
+@dataclass(frozen=True)
+class EvalResult:
+    mazes: tuple[str, ...]
+    algorithms: tuple[str, ...]
+    seeds: int
+    cells: tuple[Cell, ...]
+
+    def cell(self, maze: str, algorithm: str) -> Cell:
+        return next(c for c in self.cells if c.maze == maze and c.algorithm == algorithm)
+
+    def ranking(self, maze: str) -> list[Cell]:
+        """Best first: most runs out, then fewest turning degrees, then shortest distance."""
+        cells = [c for c in self.cells if c.maze == maze]
+        return sorted(
+            cells,
+            key=lambda c: (-c.reached, c.mean["turn_degrees"], c.mean["distance_cells"]),
+        )
+
+    def as_dict(self) -> dict[str, Any]:
+        return {
+            "seeds": self.seeds,
+            "cells": [c.as_dict() for c in self.cells],
+            "ranking": {m: [c.algorithm for c in self.ranking(m)] for m in self.mazes},
+        }
+
+
+def _one(spec: RunSpec) -> dict[str, Any]:
+    return run(spec).as_dict()
+
+
+def _summarise(maze: str, algorithm: str, results: list[dict[str, Any]]) -> Cell:
+    mean = {k: statistics.fmean(r[k] for r in results) for k in MEASURES}
+    spread = {k: statistics.pstdev([r[k] for r in results]) for k in MEASURES}
+    return Cell(
+        maze, algorithm, len(results), sum(r["reached_exit"] for r in results), mean, spread
+    )
+
+
+def evaluate(
+    mazes: Sequence[str],
+    algorithms: Sequence[str],
+    seeds: int = 3,
+    profile: str | None = None,
+    noise: str | None = None,
+    noise_params: tuple[str, ...] = (),
+    max_time: float | None = None,
+    jobs: int = 1,
+    progress: bool | Callable[[int, int], None] = False,
+) -> EvalResult:
+    specs = [
+        RunSpec(
+            maze=m,
+            algorithm=a,
+            profile=profile,
+            seed=s,
+            noise=noise,
+            noise_params=noise_params,
+            max_time=max_time,
+        )
+        for m in mazes
+        for a in algorithms
+        for s in range(seeds)
+    ]
+    # fail fast, in this process, on inputs that cannot run at all
+    for m in mazes:
+        for a in algorithms:
+            try:
+                prepare(RunSpec(maze=m, algorithm=a, profile=profile, noise=noise,
+                                noise_params=noise_params))  # fmt: skip
+            except RunSetupError as exc:
+                raise EvalError(f"{a} on {m}: {exc}") from None
+    results = _run_all(specs, jobs, progress)
+    cells = []
+    for i, (m, a) in enumerate((m, a) for m in mazes for a in algorithms):
+        cells.append(_summarise(m, a, results[i * seeds : (i + 1) * seeds]))
+    return EvalResult(tuple(mazes), tuple(algorithms), seeds, tuple(cells))
+
+
+def _run_all(
+    specs: list[RunSpec], jobs: int, progress: bool | Callable[[int, int], None]
+) -> list[dict[str, Any]]:
+    report = _progress_bar(len(specs)) if progress is True else progress or None
+    try:
+        if jobs <= 1:
+            results = []
+            for spec in specs:
+                results.append(_one(spec))
+                if report:
+                    report(len(results), len(specs))
+            return results
+        with ProcessPoolExecutor(max_workers=jobs) as pool:
+            results = []
+            for r in pool.map(_one, specs, chunksize=1):
+                results.append(r)
+                if report:
+                    report(len(results), len(specs))
+            return results
+    finally:
+        close = getattr(report, "close", None)
+        if close:
+            close()
+
+
+class _progress_bar:
+    """A progress bar on standard error (rich), so standard output stays clean."""
+
+    def __init__(self, total: int) -> None:
+        from rich.console import Console
+        from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
+
+        self._progress = Progress(
+            "[progress.description]{task.description}",
+            BarColumn(),
+            MofNCompleteColumn(),
+            TimeElapsedColumn(),
+            console=Console(stderr=True),
+        )
+        self._task = self._progress.add_task("runs", total=total)
+        self._progress.start()
+
+    def __call__(self, done: int, total: int) -> None:
+        self._progress.update(self._task, completed=done)
+
+    def close(self) -> None:
+        self._progress.stop()
+
+
+def format_table(result: EvalResult) -> str:
+    """Per maze: each algorithm's means (± spread), best first."""
+    lines = []
+    for maze in result.mazes:
+        lines.append(f"{maze}  ({result.seeds} seed{'s' if result.seeds > 1 else ''})")
+        lines.append(
+            f"  {'rank':<5}{'algorithm':<26}{'out':>6}{'turning deg':>18}{'distance (blocks)':>22}"
+            f"{'time s':>10}{'collisions':>12}"
+        )
+        for rank, c in enumerate(result.ranking(maze), start=1):
+            lines.append(
+                f"  {rank:<5}{c.algorithm:<26}{f'{c.reached}/{c.runs}':>6}"
+                f"{_pm(c, 'turn_degrees', 0):>18}{_pm(c, 'distance_cells', 1):>22}"
+                f"{c.mean['sim_time']:>10.1f}{c.mean['collisions']:>12.1f}"
+            )
+        lines.append("")
+    return "\n".join(lines).rstrip()
+
+
+def _pm(c: Cell, key: str, digits: int) -> str:
+    return f"{c.mean[key]:.{digits}f} ± {c.spread[key]:.{digits}f}"
+
+
+def write_csv(path: str, result: EvalResult) -> None:
+    with open(path, "w", newline="", encoding="utf-8") as fh:
+        writer = csv.writer(fh)
+        header = ["maze", "algorithm", "rank", "runs", "reached"]
+        header += [f"{k}_mean" for k in MEASURES] + [f"{k}_spread" for k in MEASURES]
+        writer.writerow(header)
+        for maze in result.mazes:
+            for rank, c in enumerate(result.ranking(maze), start=1):
+                writer.writerow(
+                    [c.maze, c.algorithm, rank, c.runs, c.reached]
+                    + [round(c.mean[k], 3) for k in MEASURES]
+                    + [round(c.spread[k], 3) for k in MEASURES]
+                )
