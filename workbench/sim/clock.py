@@ -1,0 +1,68 @@
+"""Real time for a session: a fixed-step accumulator over wall-clock time.
+
+Front ends (the app, ``workbench serve``) call :meth:`Pacer.advance` with the wall time that has
+passed; the pacer runs as many fixed ``dt`` steps as that time (times the speed factor) holds,
+carrying the remainder, so the trajectory is the same as a headless run's whatever the frame
+rate. Timers that skip ticks do not lose simulated time.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from .session import Session
+
+SPEEDS = (1.0, 2.0, 4.0, 10.0, None)  # None = as fast as the budget allows ("max")
+
+
+@dataclass
+class Pacer:
+    session: Session
+    speed: float | None = 1.0
+    paused: bool = False
+    #: at most this much wall time of stepping per call, so a slow frame cannot snowball
+    budget: float = 0.05
+    #: wall time owed to the simulation beyond this is dropped (after a stall, do not race)
+    max_lag: float = 0.25
+    clock: Callable[[], float] = field(default=time.perf_counter)
+    _debt: float = 0.0
+
+    def advance(self, wall_seconds: float) -> int:
+        """Run the steps ``wall_seconds`` of real time call for; returns how many ran."""
+        if self.paused:
+            self._debt = 0.0
+            return 0
+        dt = self.session.world.dt
+        step = self.session.step
+        if self.speed is None:
+            deadline = self.clock() + self.budget
+            n = 0
+            while True:
+                for _ in range(30):
+                    step()
+                n += 30
+                if self.clock() >= deadline:
+                    return n
+        self._debt = min(self._debt + wall_seconds * self.speed, self.max_lag * self.speed)
+        n = int(self._debt / dt + 1e-9)
+        self._debt -= n * dt
+        deadline = self.clock() + self.budget
+        for i in range(n):
+            step()
+            if (i & 31) == 31 and self.clock() > deadline:
+                self._debt = 0.0
+                return i + 1
+        return n
+
+    def single_step(self, steps: int = 1) -> None:
+        """Advance exactly ``steps`` physics steps (for pause + step, and for tests)."""
+        for _ in range(steps):
+            self.session.step()
+
+    def next_speed(self) -> float | None:
+        i = SPEEDS.index(self.speed) if self.speed in SPEEDS else 0
+        self.speed = SPEEDS[(i + 1) % len(SPEEDS)]
+        self._debt = 0.0
+        return self.speed
