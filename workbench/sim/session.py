@@ -75,6 +75,7 @@ class Session:
 
     def _reset_run_state(self) -> None:
         self._steps = 0
+        self._scheduled: tuple[int, Any] | None = None
         self._events: list[str] = []
         self._commands: list[Any] = []
         self._started = False
@@ -98,11 +99,19 @@ class Session:
         self.driver = driver
 
     def command(self, cmd: Any, driver: str | None = None) -> None:
-        """A command from outside the controller (a key, a VIPLE message)."""
+        """A command from outside the controller (a key, a VIPLE message).
+
+        It cancels a command still waiting from :meth:`command_after`.
+        """
+        self._scheduled = None
         self.world.apply(cmd)
         self._commands.append(cmd)
         if driver is not None:
             self.driver = driver
+
+    def command_after(self, seconds: float, cmd: Any) -> None:
+        """Apply ``cmd`` after exactly ``seconds`` of simulated time (to the step)."""
+        self._scheduled = (self._steps + max(1, round(seconds / self.world.dt)), cmd)
 
     def set_sensors(self, specs: Sequence[SensorSpec]) -> None:
         self.world.set_sensors(list(specs))
@@ -123,6 +132,11 @@ class Session:
         if events:
             self._events.extend(events)
         self._steps += 1
+        if self._scheduled is not None and self._steps >= self._scheduled[0]:
+            cmd = self._scheduled[1]
+            self._scheduled = None
+            self.world.apply(cmd)
+            self._commands.append(cmd)
         if self._steps % self.every == 0:
             self._control_tick()
         return events

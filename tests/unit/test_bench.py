@@ -1,0 +1,151 @@
+"""The live workbench behind the app: keys, sensor panel, algorithms, runs."""
+
+import pytest
+
+from workbench.control.bench import Bench, SensorRow, check_sensor_rows
+from workbench.control.fsm import SensorBindingError
+from workbench.sim.mazefile import parse_maze
+from workbench.sim.mazeio import load_maze
+from workbench.sim.sensors import SensorSpec
+
+CORRIDOR = parse_maze("##########\n#S......E#\n##########\n", source="corridor.txt")
+ROOM = parse_maze("#######\n#.....#\n#..S..#\n#.....#\n#######\n", source="room.txt")
+
+
+def bench(maze=ROOM, profile="erobotic", **kw):
+    return Bench.open(maze, profile, noise="off", **kw)
+
+
+def test_unity_keys_move_and_turn_like_the_course_key_program():
+    b = bench(profile="unity")
+    b.key("d")
+    b.step(60 * 4)
+    assert b.snapshot().pose.heading == pytest.approx(90, abs=0.5)  # facing down the page
+    b.key("w")
+    b.step(30)
+    assert b.snapshot().pose.y > ROOM.start[1] * 2 + 1  # moved down
+    b.key("space")
+    y = b.snapshot().pose.y
+    b.step(30)
+    assert b.snapshot().pose.y == pytest.approx(y, abs=0.02)
+    assert b.keys_used == {"d", "w", "space"} and b.snapshot().driver == "keys"
+
+
+def test_web_keys_spin_until_the_next_key():
+    b = bench(profile="web")
+    b.key("a")
+    b.step(90)  # (-0.2, 0.2) for 1.5 s: about 90 degrees left
+    assert b.snapshot().pose.heading == pytest.approx(270, abs=10)
+    b.key("space")
+    h = b.snapshot().pose.heading
+    b.step(30)
+    assert b.snapshot().pose.heading == pytest.approx(h, abs=0.01)
+
+
+def test_erobotic_w_moves_exactly_one_block_and_stops():
+    b = bench(CORRIDOR)
+    b.key("w")
+    b.step(120)
+    snap = b.snapshot()
+    assert snap.block == (CORRIDOR.start[0] + 1, CORRIDOR.start[1])
+    assert snap.metrics.distance_cells == pytest.approx(1.0, abs=1e-6)
+
+
+def test_non_drive_keys_are_ignored():
+    assert bench().key("x") is False
+
+
+def test_sensor_rows_are_checked_and_nothing_applied_on_error():
+    b = bench()
+    before = list(b.sensors)
+    errors = b.apply_sensor_rows(
+        [SensorRow("distance", "1", "right"), SensorRow("touch", "1", "front"),
+         SensorRow("distance", "x", "left"), SensorRow("distance", "120", "back")]
+    )  # fmt: skip
+    assert errors == {
+        0: "port 1 is also used by row 2",
+        1: "port 1 is already used by row 1",
+        2: "port 'x' is not a whole number",
+        3: "port 120 is out of range (0-99)",
+    }
+    assert b.sensors == before
+
+
+def test_unmounted_rows_are_left_out_and_readings_follow_the_new_ports():
+    b = bench()
+    assert (
+        b.apply_sensor_rows([SensorRow("distance", "7", "front"), SensorRow("touch", "2", None)])
+        == {}
+    )
+    assert b.sensors == [SensorSpec("distance", 7, "front")]
+    assert set(b.snapshot().readings) == {7}
+
+
+def test_check_sensor_rows_returns_specs_in_row_order():
+    specs, errors = check_sensor_rows([SensorRow("touch", " 4 ", "back")])
+    assert specs == [SensorSpec("touch", 4, "back")] and errors == {}
+
+
+def test_presets_of_the_course_simulators():
+    b = bench()
+    b.apply_preset("web-two-distance")
+    assert b.sensors == [SensorSpec("distance", 3, "front")]
+
+
+def test_missing_sensor_is_explained_and_fixed_with_the_preset():
+    b = bench()
+    b.apply_preset("web-two-distance")
+    b.select_algorithm("right-wall")
+    assert "needs a distance sensor mounted right" in b.missing_sensors()
+    with pytest.raises(SensorBindingError):
+        b.start_algorithm()
+    b.apply_algorithm_preset()
+    assert b.missing_sensors() is None
+    b.start_algorithm()
+    assert b.snapshot().driver == "algorithm right-wall"
+
+
+def test_algorithm_run_to_the_exit_is_recorded_in_runs(tmp_path):
+    b = bench(load_maze("mazes/rank-wall-wins.txt"), record_dir=str(tmp_path))
+    b.select_algorithm("right-wall")
+    b.start_algorithm()
+    for _ in range(200):
+        b.step(60)
+        if b.runs:
+            break
+    run = b.runs[0]
+    assert run.ended == "exit" and run.metrics.reached_exit
+    assert run.driver == "algorithm right-wall"
+    assert b.pacer.paused
+    assert (tmp_path / "run-001.jsonl").read_text().splitlines()[-1].startswith('{"type":"summary"')
+
+
+def test_parameters_are_validated_before_any_is_kept():
+    b = bench()
+    b.select_algorithm("right-wall")
+    with pytest.raises(ValueError, match="not a number"):
+        b.set_params(["open_right=120", "front_blocked=near"])
+    assert b.params()["open_right"] == 100
+    assert b.set_params(["open_right=120"])["open_right"] == 120
+    b.reset_params()
+    assert b.params()["open_right"] == 100
+
+
+def test_keys_take_over_from_an_algorithm_and_close_its_run():
+    b = bench(load_maze("mazes/erobotic.txt"))
+    b.select_algorithm("farthest-distance")
+    b.start_algorithm()
+    b.step(60)
+    b.key("space")
+    assert b.controller is None and b.runs[-1].ended == "stopped"
+    assert b.snapshot().driver == "keys"
+
+
+def test_reset_robot_returns_to_start_and_loading_a_maze_restarts():
+    b = bench(CORRIDOR)
+    b.key("w")
+    b.step(60)
+    b.reset_robot()
+    assert b.snapshot().block == CORRIDOR.start and b.runs[-1].ended == "reset"
+    b.load_maze(ROOM)
+    assert b.snapshot().block == ROOM.start

@@ -1,0 +1,331 @@
+"""The live workbench: one maze, one robot, who drives it, and the runs done so far.
+
+Everything the app shows and every action it offers goes through :class:`Bench`, so the app
+only renders and routes input. A bench owns a :class:`Session` and its :class:`Pacer`.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from workbench.sim.clock import Pacer
+from workbench.sim.maze import Maze
+from workbench.sim.metrics import Metrics
+from workbench.sim.noise import NoiseSettings
+from workbench.sim.profiles import get_profile
+from workbench.sim.record import Recorder
+from workbench.sim.sensors import (
+    KINDS,
+    MOUNTS,
+    PORT_RANGE,
+    SensorConfigError,
+    SensorSpec,
+    check_ports,
+)
+from workbench.sim.session import Session, Snapshot
+
+from .algorithms import load_algorithm
+from .commands import Stop
+from .fsm import FsmController, FsmDefinition, bind_sensors, preset_sensors
+from .fsmfile import parse_param_overrides
+from .manual import exact_move, key_command
+
+#: the sensor presets of the course's simulators (Web Simulator panel, Unity simulator)
+PRESETS: dict[str, tuple[SensorSpec, ...]] = {
+    "unity": (SensorSpec("distance", 1, "right"), SensorSpec("distance", 2, "front")),
+    "web-wall-following": (SensorSpec("distance", 1, "right"), SensorSpec("touch", 2, "front")),
+    "web-two-distance": (SensorSpec("distance", 3, "front"),),
+}
+KEYS_DRIVER = "keys"
+
+
+@dataclass(frozen=True)
+class SensorRow:
+    """One row of the sensor port panel as typed: kind, port text, mount (None = not mounted)."""
+
+    kind: str
+    port: str
+    mount: str | None
+
+
+@dataclass(frozen=True)
+class RunEntry:
+    """A finished (or abandoned) run, for comparing algorithms side by side."""
+
+    number: int
+    driver: str
+    maze: str
+    profile: str
+    seed: int
+    metrics: Metrics
+    ended: str  # "exit", "stopped", "reset", "maze changed"
+    record: str | None = None
+
+
+def check_sensor_rows(rows: Sequence[SensorRow]) -> tuple[list[SensorSpec], dict[int, str]]:
+    """The specs for the mounted rows, and an error per row index (empty when all is well)."""
+    specs: list[SensorSpec] = []
+    errors: dict[int, str] = {}
+    owner: dict[int, int] = {}
+    for i, row in enumerate(rows):
+        if row.mount is None:
+            continue
+        text = row.port.strip()
+        if not text.lstrip("-").isdigit():
+            errors[i] = f"port {text!r} is not a whole number"
+            continue
+        port = int(text)
+        if port not in PORT_RANGE:
+            errors[i] = f"port {port} is out of range ({PORT_RANGE.start}-{PORT_RANGE.stop - 1})"
+            continue
+        if row.kind not in KINDS:
+            errors[i] = f"unknown kind {row.kind!r}"
+            continue
+        if row.mount not in MOUNTS:
+            errors[i] = f"unknown mount {row.mount!r}"
+            continue
+        if port in owner:
+            errors[i] = f"port {port} is already used by row {owner[port] + 1}"
+            errors.setdefault(owner[port], f"port {port} is also used by row {i + 1}")
+            continue
+        owner[port] = i
+        specs.append(SensorSpec(row.kind, port, row.mount))
+    return specs, errors
+
+
+@dataclass
+class Bench:
+    maze: Maze
+    profile: str
+    sensors: list[SensorSpec]
+    seed: int = 0
+    noise: NoiseSettings | str | None = None
+    record_dir: str | None = None
+    session: Session = field(init=False)
+    pacer: Pacer = field(init=False)
+    algorithm: FsmDefinition | None = None
+    overrides: dict[str, float] = field(default_factory=dict)
+    controller: FsmController | None = None
+    runs: list[RunEntry] = field(default_factory=list)
+    keys_used: set[str] = field(default_factory=set)
+    message: str = ""
+    _run_open: bool = False
+    _recorder: Recorder | None = None
+    _record_path: str | None = None
+
+    @classmethod
+    def open(
+        cls,
+        maze: Maze,
+        profile: str | None = None,
+        sensors: Sequence[SensorSpec] | None = None,
+        **kwargs: Any,
+    ) -> Bench:
+        name = profile or maze.profile or "unity"
+        chosen = list(sensors) if sensors is not None else list(get_profile(name).sensors)
+        return cls(maze=maze, profile=name, sensors=check_ports(chosen), **kwargs)
+
+    def __post_init__(self) -> None:
+        self._build_session()
+
+    def _build_session(self) -> None:
+        paused = self.pacer.paused if hasattr(self, "pacer") else False
+        self.session = Session(self.maze, self.profile, self.sensors, self.noise, self.seed)
+        self.pacer = Pacer(self.session, paused=paused)
+        self.session.driver = KEYS_DRIVER
+
+    # -- time ----------------------------------------------------------------------------
+    def advance(self, wall_seconds: float) -> int:
+        """Run real time forward; closes the run when the robot gets out."""
+        steps = self.pacer.advance(wall_seconds)
+        self._after_steps()
+        return steps
+
+    def step(self, steps: int = 1) -> None:
+        """Exactly ``steps`` physics steps (pause + single step, tests, snapshots)."""
+        self.pacer.single_step(steps)
+        self._after_steps()
+
+    def _after_steps(self) -> None:
+        if self._run_open and self.maze.exits and self.session.reached_exit:
+            self._close_run("exit")
+            self.pacer.paused = True
+            self.message = "the robot is out: run finished (r resets the robot)"
+
+    def toggle_pause(self) -> bool:
+        self.pacer.paused = not self.pacer.paused
+        return self.pacer.paused
+
+    def snapshot(self) -> Snapshot:
+        return self.session.snapshot()
+
+    # -- driving by keys -----------------------------------------------------------------
+    def key(self, key: str) -> bool:
+        """A drive key (w a s d space); takes the robot from an algorithm. False if no drive key."""
+        cmd = key_command(self.profile, key)
+        if cmd is None:
+            return False
+        if self.controller is not None:
+            self.stop_algorithm("stopped")
+        if not self._run_open and not self.session.reached_exit:
+            self._open_run()  # a run starts at the robot's last reset
+        self.keys_used.add(key)
+        self.session.command(cmd, driver=KEYS_DRIVER)
+        if exact_move(self.profile, key):
+            profile = get_profile(self.profile)
+            self.session.command_after(self.session.world.cell / profile.move_speed, Stop())
+        return True
+
+    # -- sensors -------------------------------------------------------------------------
+    def apply_sensor_rows(self, rows: Sequence[SensorRow]) -> dict[int, str]:
+        """Apply the panel's rows to the live robot, or nothing at all when a row is wrong."""
+        specs, errors = check_sensor_rows(rows)
+        if errors:
+            return errors
+        self.apply_sensors(specs)
+        return {}
+
+    def apply_sensors(self, specs: Sequence[SensorSpec]) -> None:
+        specs = check_ports(specs)
+        self.session.set_sensors(specs)
+        self.sensors = list(specs)
+        if self.controller is not None:
+            self.session.binding = bind_sensors(self.algorithm, specs, self.profile)
+
+    def apply_preset(self, name: str) -> None:
+        try:
+            self.apply_sensors(PRESETS[name])
+        except KeyError:
+            raise SensorConfigError(
+                f"unknown preset {name!r}: use one of {', '.join(PRESETS)}"
+            ) from None
+
+    # -- algorithms ----------------------------------------------------------------------
+    def select_algorithm(self, name_or_path: str | os.PathLike) -> FsmDefinition:
+        """Choose an algorithm (built-in name or YAML file); errors name the line and fix."""
+        definition = load_algorithm(name_or_path)
+        if self.controller is not None:
+            self.stop_algorithm("stopped")
+        self.algorithm = definition
+        self.overrides = {}
+        return definition
+
+    def set_params(self, items: Sequence[str]) -> dict[str, float]:
+        """``NAME=VALUE`` edits, all checked before any is kept; returns the values in force."""
+        if self.algorithm is None:
+            raise ValueError("choose an algorithm first")
+        values = parse_param_overrides(self.algorithm, items)
+        FsmController(self.algorithm, {**self.overrides, **values}, self.profile)
+        self.overrides.update(values)
+        return self.params()
+
+    def reset_params(self) -> None:
+        self.overrides = {}
+
+    def params(self) -> dict[str, float]:
+        if self.algorithm is None:
+            return {}
+        return FsmController(self.algorithm, self.overrides, self.profile).params
+
+    def missing_sensors(self) -> str | None:
+        """Why the chosen algorithm cannot run with the current sensors (None if it can)."""
+        if self.algorithm is None:
+            return None
+        try:
+            bind_sensors(self.algorithm, self.sensors, self.profile)
+        except ValueError as exc:
+            return str(exc)
+        return None
+
+    def apply_algorithm_preset(self) -> None:
+        """The one-key fix: give the robot the sensors the chosen algorithm needs."""
+        if self.algorithm is not None:
+            self.apply_sensors(preset_sensors(self.algorithm, self.profile))
+
+    def start_algorithm(self) -> None:
+        """Robot back to the start and the chosen algorithm driving (a new run)."""
+        if self.algorithm is None:
+            raise ValueError("choose an algorithm first")
+        binding = bind_sensors(self.algorithm, self.sensors, self.profile)
+        controller = FsmController(self.algorithm, self.overrides, self.profile)
+        if self._run_open:
+            self._close_run("stopped")
+        self.session.reset()
+        self.controller = controller
+        self.session.attach(controller, binding, f"algorithm {self.algorithm.name}")
+        self._open_run()
+        self.pacer.paused = False
+        self.message = ""
+
+    def stop_algorithm(self, ended: str = "stopped") -> None:
+        if self.controller is None:
+            return
+        self.session.command(Stop())
+        self.session.detach(KEYS_DRIVER)
+        self.controller = None
+        if self._run_open:
+            self._close_run(ended)
+
+    # -- maze and robot ------------------------------------------------------------------
+    def reset_robot(self) -> None:
+        """Like the Unity simulator's reset button: the robot back at the start, stopped."""
+        if self._run_open:
+            self._close_run("reset")
+        if self.controller is not None:
+            self.stop_algorithm("reset")
+        self.session.reset()
+        self.session.driver = KEYS_DRIVER
+        self.message = ""
+
+    def load_maze(self, maze: Maze) -> None:
+        """Put a (new or edited) maze on the bench; the robot starts over on it."""
+        if self._run_open:
+            self._close_run("maze changed")
+        self.stop_algorithm("maze changed")
+        self.maze = maze
+        self._build_session()
+
+    # -- runs ----------------------------------------------------------------------------
+    def _open_run(self) -> None:
+        self._run_open = True
+        if self.record_dir:
+            Path(self.record_dir).mkdir(parents=True, exist_ok=True)
+            path = os.path.join(self.record_dir, f"run-{len(self.runs) + 1:03d}.jsonl")
+            self._recorder = Recorder(path)
+            self._record_path = path
+            self.session.recorder = self._recorder
+            self.session.record_header(
+                algorithm=self.algorithm.name if self.controller else KEYS_DRIVER,
+                params=self.params() if self.controller else {},
+            )
+
+    def _close_run(self, ended: str) -> None:
+        self._run_open = False
+        entry = RunEntry(
+            number=len(self.runs) + 1,
+            driver=self.session.driver,
+            maze=self.maze.name,
+            profile=self.profile,
+            seed=self.seed,
+            metrics=self.session.metrics(),
+            ended=ended,
+            record=self._record_path,
+        )
+        self.runs.append(entry)
+        if self._recorder is not None:
+            self.session.record_summary(
+                ended=ended, final_state=self.controller.state if self.controller else None
+            )
+            self._recorder.close()
+            self.session.recorder = None
+            self._recorder = None
+            self._record_path = None
+
+    def close(self) -> None:
+        """End the session: an open run is kept (with its record) as stopped."""
+        if self._run_open:
+            self._close_run("stopped")
