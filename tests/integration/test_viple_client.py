@@ -1,0 +1,315 @@
+"""`workbench viple-client`, the VIPLE stand-in: its pieces, its bytes on the wire, and whole
+runs through `workbench serve` compared with the same run in process."""
+
+from __future__ import annotations
+
+import asyncio
+
+import pytest
+from websockets.asyncio.client import connect as ws_connect
+
+from workbench.cli import main
+from workbench.control.commands import MoveAtPower, Stop, TurnByDegrees
+from workbench.sim.noise import noise_settings
+from workbench.sim.profiles import get_profile
+from workbench.viple import client as client_mod
+from workbench.viple.client import (
+    ClientRunError,
+    ClientSetupError,
+    Endpoint,
+    RemoteFsm,
+    parse_endpoint,
+    prepare,
+    readings_by_name,
+    run_client,
+    turn_wait,
+)
+
+EROBOTIC = get_profile("erobotic")
+MOVE = b'{"servos":[{"isTurn":false,"servoId":-1,"servoSpeed":1}]}\r\n'
+RIGHT90 = b'{"servos":[{"isTurn":true,"servoId":-1,"servoSpeed":90}]}\r\n'
+STOP = (
+    b'{"servos":[{"isTurn":false,"servoId":3,"servoSpeed":0},'
+    b'{"isTurn":false,"servoId":5,"servoSpeed":0}]}\r\n'
+)
+
+
+def report(front: float, port: int = 1) -> bytes:
+    return b'{"sensors":[{"name":"distance","id":%d,"value":%s}]}\r\n' % (port, str(front).encode())
+
+
+def local_best(**kw):
+    kw.setdefault("profile", "erobotic")
+    return prepare("two-distance-local-best", **kw)
+
+
+# ----------------------------------------------------------------------------- pieces
+
+
+def test_turn_wait_is_the_profiles_turn_time_plus_a_margin():
+    assert turn_wait(90, EROBOTIC) == pytest.approx(90 / 90 * 1.1 + 0.3)
+    assert turn_wait(-180, EROBOTIC) == turn_wait(180, EROBOTIC) == pytest.approx(2.5)
+    unity = get_profile("unity")
+    assert turn_wait(90, unity) == pytest.approx(90 / 35 * 1.1 + 0.3)
+
+
+@pytest.mark.parametrize("profile", ["unity", "web", "erobotic"])
+def test_turn_wait_covers_five_sigma_of_realistic_turn_noise(profile):
+    prof = get_profile(profile)
+    sigma = noise_settings("realistic", prof).turn_error
+    for degrees in (15, 90, 180, 360):
+        assert turn_wait(degrees, prof) > degrees * (1 + 5 * sigma) / prof.turn_rate + 0.2
+
+
+def test_readings_by_name_follow_the_binding():
+    assert readings_by_name({1: 52.0, 2: 300.0, 3: 60.0}, {"front": 1, "right": 3}) == {
+        "front": 52.0,
+        "right": 60.0,
+    }
+
+
+def test_a_report_without_a_bound_port_is_explained():
+    with pytest.raises(ClientRunError) as err:
+        readings_by_name({2: 1.0, 5: 0.0}, {"front": 1})
+    assert "no sensor on port 1 (front); they carry port(s) 2, 5" in str(err.value)
+    assert "--sensor" in str(err.value)
+
+
+def test_the_fsm_turns_by_degree_and_takes_the_turn_as_done_after_the_estimate():
+    fsm = RemoteFsm(local_best())
+    start = fsm.start(0.0)
+    assert start.started and start.commands == [MoveAtPower(1.0)]
+    assert fsm.report(0.05, {1: 172.0}).commands == []
+    step = fsm.report(1.0, {1: 49.0})
+    assert step.transition.target == "TurningRight"
+    assert step.commands == [TurnByDegrees(90.0)]
+    assert step.turn_done_at == pytest.approx(1.0 + turn_wait(90, EROBOTIC))
+    assert fsm.tick(2.3).transition is None  # 1.3 s: the turn is not yet taken as done
+    done = fsm.tick(2.41)
+    assert done.transition.source == "TurningRight" and done.commands == [Stop()]
+    assert fsm.turn_due is None
+    assert fsm.tick(2.46).transition.target == "TurningLeft"  # stop_wait 0: the next tick
+
+
+def test_ticks_wait_for_the_first_report_and_are_due_at_the_control_rate():
+    fsm = RemoteFsm(local_best())
+    fsm.start(0.0)
+    assert fsm.tick(0.5).commands == [] and fsm.readings is None
+    fsm.report(0.6, {1: 500.0})
+    assert fsm.next_tick() == pytest.approx(0.65)
+
+
+def test_any_other_command_abandons_the_turn_estimate():
+    setup = prepare("two-distance-local-best", profile="unity")
+    fsm = RemoteFsm(setup)
+    fsm.start(0.0)
+    fsm.report(0.1, {2: 0.5})
+    assert fsm.state == "TurningRight" and fsm.turn_due is not None
+    fsm._step(0.2, [Stop()], None)
+    assert fsm.turn_due is None
+
+
+@pytest.mark.parametrize(
+    ("connect", "listen", "expected"),
+    [
+        (None, None, Endpoint("connect", "localhost", 1350)),
+        ("tcp://127.0.0.1:4000", None, Endpoint("connect", "127.0.0.1", 4000)),
+        ("tcp://[::1]", None, Endpoint("connect", "::1", 1350)),
+        (None, "ws://localhost:8124/", Endpoint("listen", "localhost", 8124)),
+        (None, "ws://0.0.0.0", Endpoint("listen", "0.0.0.0", 8124)),
+    ],
+)
+def test_endpoints(connect, listen, expected):
+    assert parse_endpoint(connect, listen) == expected
+
+
+def test_endpoints_print_as_urls():
+    assert str(Endpoint("connect", "::1", 1350)) == "tcp://[::1]:1350"
+    assert str(Endpoint("listen", "localhost", 8124)) == "ws://localhost:8124/"
+
+
+@pytest.mark.parametrize(
+    ("kw", "message"),
+    [
+        ({"connect": "localhost:1350"}, "must be tcp://HOST:PORT, e.g. tcp://localhost:1350"),
+        ({"connect": "ws://localhost:1350"}, "must be tcp://HOST:PORT"),
+        ({"connect": "tcp://localhost:http"}, "the port is not a number from 1 to 65535"),
+        ({"connect": "tcp://localhost:70000"}, "the port is not a number from 1 to 65535"),
+        ({"connect": "tcp://localhost:1350/robot"}, "nothing may follow the port"),
+        ({"listen": "tcp://localhost:8124"}, "must be ws://HOST:PORT, e.g. ws://localhost:8124"),
+        ({"connect": "tcp://a:1", "listen": "ws://a:2"}, "either --connect or --listen"),
+    ],
+)
+def test_bad_endpoints_are_explained(kw, message):
+    with pytest.raises(ClientSetupError, match=message.replace("(", r"\(").replace(".", r"\.")):
+        parse_endpoint(**kw)
+
+
+@pytest.mark.parametrize(
+    ("kw", "message"),
+    [
+        ({"algorithm": "two-distance-best"}, "did you mean 'two-distance-local-best'?"),
+        ({"sensors": ["distance:one:front"]}, "port 'one' is not a whole number"),
+        ({"sensors": ["distance:1:right"]}, "needs a distance sensor mounted front"),
+        ({"params": ["front_blocked=near"]}, "'near' is not a number"),
+        ({"params": ["speed=1"]}, "has no parameter 'speed'"),
+        ({"profile": "lego"}, "unknown profile 'lego'"),
+        ({"duration": 0.0}, "--duration must be a positive number"),
+    ],
+)
+def test_bad_set_up_is_explained(kw, message):
+    kw.setdefault("algorithm", "two-distance-local-best")
+    with pytest.raises(ClientSetupError, match=message):
+        prepare(**kw)
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["--algorithm", "wall-right"], "no built-in algorithm or FSM file named 'wall-right'"),
+        (["--algorithm", "right-wall", "--connect", "http://x"], "must be tcp://HOST:PORT"),
+        (["--algorithm", "right-wall", "--sensor", "sonar:1:right"], "unknown sensor kind"),
+        (["--algorithm", "right-wall", "--duration", "-3"], "positive number of seconds"),
+        (["--algorithm", "missing.yaml"], "missing.yaml"),
+    ],
+)
+def test_cli_bad_input_exits_2_without_a_traceback(capsys, argv, message):
+    assert main(["viple-client", *argv]) == 2
+    err = capsys.readouterr().err
+    assert message in err and "Traceback" not in err
+
+
+def test_cli_with_nothing_listening_retries_then_exits_1(capsys, monkeypatch, unused_port):
+    monkeypatch.setattr(client_mod, "CONNECT_PATIENCE_S", 0.6)
+    argv = [
+        "viple-client",
+        "--algorithm",
+        "right-wall",
+        "--connect",
+        f"tcp://127.0.0.1:{unused_port}",
+    ]
+    assert main(argv) == 1
+    captured = capsys.readouterr()
+    assert "yet (connection refused, nothing listens there); retrying" in captured.out
+    assert f"cannot connect to tcp://127.0.0.1:{unused_port}" in captured.err
+    assert "workbench serve" in captured.err
+
+
+# ----------------------------------------------------------------------------- on the wire
+
+
+@pytest.fixture
+def unused_port():
+    import socket
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+class ScriptedRobot:
+    """A bare TCP robot: sends the given reports one by one, keeping what the client sends."""
+
+    def __init__(self, reports: list[bytes], gap: float = 0.1) -> None:
+        self.reports = reports
+        self.gap = gap
+        self.received = b""
+
+    async def serve(self, reader, writer) -> None:
+        async def collect():
+            while data := await reader.read(4096):
+                self.received += data
+
+        collector = asyncio.create_task(collect())
+        for line in self.reports:
+            writer.write(line)
+            await writer.drain()
+            await asyncio.sleep(self.gap)
+        writer.close()
+        await collector
+
+    async def run(self, **kw):
+        server = await asyncio.start_server(self.serve, "127.0.0.1", 0)
+        port = server.sockets[0].getsockname()[1]
+        async with server:
+            setup = local_best(connect=f"tcp://127.0.0.1:{port}", **kw)
+            return await run_client(setup, log=lambda text: None)
+
+
+def test_tcp_client_sends_viple_bytes_and_ends_when_the_robot_closes():
+    robot = ScriptedRobot([report(172.0), report(49.0), report(60.0)])
+    result = asyncio.run(robot.run())
+    assert robot.received.startswith(MOVE + RIGHT90)
+    assert result.ended == "closed" and result.exit_code == 0
+    assert result.reports == 3 and result.commands == 2 and result.final_state == "TurningRight"
+
+
+def test_reports_split_across_writes_and_bad_lines_are_handled():
+    robot = ScriptedRobot(
+        [b'{"sensors":[{"name":"distance",', b'"id":1,"value":"172"}]}\r\nnot json\n', report(40)]
+    )
+    result = asyncio.run(robot.run())
+    assert result.reports == 2 and result.rejected == 1
+    assert robot.received == MOVE + RIGHT90
+
+
+def test_a_report_missing_the_fsm_sensor_stops_the_robot_and_exits_1():
+    robot = ScriptedRobot([report(172.0, port=4)])
+    result = asyncio.run(robot.run())
+    assert result.ended == "error" and result.exit_code == 1
+    assert "no sensor on port 1 (front)" in result.message
+    assert robot.received == MOVE + STOP
+
+
+def test_duration_ends_the_run_and_stops_the_robot():
+    robot = ScriptedRobot([report(172.0)] * 20)
+    result = asyncio.run(robot.run(duration=0.5))
+    assert result.ended == "duration" and result.exit_code == 0
+    assert 0.5 <= result.time < 1.0
+    assert robot.received == MOVE + STOP
+
+
+def test_a_refusal_is_shown_and_a_run_without_reports_exits_1():
+    lines: list[str] = []
+    robot = ScriptedRobot([b'{"error":"the robot already has a driver"}\r\n'])
+
+    async def go():
+        server = await asyncio.start_server(robot.serve, "127.0.0.1", 0)
+        port = server.sockets[0].getsockname()[1]
+        async with server:
+            return await run_client(local_best(connect=f"tcp://127.0.0.1:{port}"), lines.append)
+
+    result = asyncio.run(go())
+    assert result.exit_code == 1 and result.rejected == 1
+    assert any("the simulator says: the robot already has a driver" in x for x in lines)
+
+
+def test_websocket_role_serves_one_simulator_and_refuses_a_second(unused_port):
+    url = f"ws://127.0.0.1:{unused_port}/"
+
+    async def simulator():
+        for _ in range(50):
+            try:
+                ws = await ws_connect(url)
+                break
+            except OSError:
+                await asyncio.sleep(0.05)
+        async with ws:
+            first = await ws.recv()
+            await ws.send(report(172.0).decode().strip())
+            await ws.send(report(45.0).decode())  # a frame ending in CRLF is accepted too
+            second = await ws.recv()
+            async with ws_connect(url) as other:
+                refused = await other.wait_closed() or other.close_code
+            return first, second, refused
+
+    async def go():
+        setup = local_best(listen=url)
+        client = asyncio.create_task(run_client(setup, log=lambda text: None))
+        frames = await simulator()
+        return frames, await client
+
+    (first, second, refused), result = asyncio.run(go())
+    assert first == MOVE.decode().strip() and second == RIGHT90.decode().strip()
+    assert refused == 1013
+    assert result.ended == "closed" and result.exit_code == 0 and result.reports == 2
