@@ -149,3 +149,52 @@ def test_reset_robot_returns_to_start_and_loading_a_maze_restarts():
     assert b.snapshot().block == CORRIDOR.start and b.runs[-1].ended == "reset"
     b.load_maze(ROOM)
     assert b.snapshot().block == ROOM.start
+
+
+def test_sensor_rows_pad_the_live_sensors_like_the_web_simulator_panel():
+    b = bench(profile="unity")
+    assert b.sensor_rows() == [
+        SensorRow("distance", "1", "right"),
+        SensorRow("distance", "2", "front"),
+        SensorRow("touch", "3", None),
+    ]
+    b.apply_preset("web-two-distance")
+    assert b.sensor_rows() == [
+        SensorRow("distance", "3", "front"),
+        SensorRow("distance", "1", None),
+        SensorRow("touch", "2", None),
+    ]
+    assert b.apply_sensor_rows(b.sensor_rows()) == {}
+    assert b.sensors == [SensorSpec("distance", 3, "front")]
+
+
+FAILING_FSM = """\
+name: failing
+sensors:
+  front: {kind: distance, mount: front, port: {unity: 2, web: 2, erobotic: 1}}
+initial: Go
+states:
+  Go:
+    on_enter:
+      - move: 1
+    transitions:
+      - when: 1 / (front - front) > 0
+        to: Go
+"""
+
+
+@pytest.mark.parametrize("how", ["step", "advance"])
+def test_a_failing_algorithm_is_stopped_with_the_reason_instead_of_raising(tmp_path, how):
+    path = tmp_path / "failing.yaml"
+    path.write_text(FAILING_FSM)
+    b = bench()
+    b.select_algorithm(path)
+    b.start_algorithm()
+    if how == "step":
+        b.step(30)
+    else:
+        b.advance(0.5)
+    assert b.controller is None and b.pacer.paused
+    assert b.message.startswith("algorithm stopped: failing, state Go: guard")
+    assert b.runs[-1].ended == "error"
+    assert b.snapshot().driver == "keys"

@@ -30,7 +30,7 @@ from workbench.sim.session import Session, Snapshot
 
 from .algorithms import load_algorithm
 from .commands import Stop
-from .fsm import FsmController, FsmDefinition, bind_sensors, preset_sensors
+from .fsm import FsmController, FsmDefinition, FsmRuntimeError, bind_sensors, preset_sensors
 from .fsmfile import parse_param_overrides
 from .manual import exact_move, key_command
 
@@ -41,6 +41,8 @@ PRESETS: dict[str, tuple[SensorSpec, ...]] = {
     "web-two-distance": (SensorSpec("distance", 3, "front"),),
 }
 KEYS_DRIVER = "keys"
+#: the rows the Web Simulator's sensor panel always offers: two distance sensors and one touch
+PANEL_KINDS = ("distance", "distance", "touch")
 
 
 @dataclass(frozen=True)
@@ -140,15 +142,32 @@ class Bench:
 
     # -- time ----------------------------------------------------------------------------
     def advance(self, wall_seconds: float) -> int:
-        """Run real time forward; closes the run when the robot gets out."""
-        steps = self.pacer.advance(wall_seconds)
+        """Run real time forward; closes the run when the robot gets out.
+
+        An algorithm whose guard or action fails is stopped with the reason in :attr:`message`
+        and the simulation paused, so a front end never sees the exception.
+        """
+        try:
+            steps = self.pacer.advance(wall_seconds)
+        except FsmRuntimeError as exc:
+            self._algorithm_failed(exc)
+            return 0
         self._after_steps()
         return steps
 
     def step(self, steps: int = 1) -> None:
         """Exactly ``steps`` physics steps (pause + single step, tests, snapshots)."""
-        self.pacer.single_step(steps)
+        try:
+            self.pacer.single_step(steps)
+        except FsmRuntimeError as exc:
+            self._algorithm_failed(exc)
+            return
         self._after_steps()
+
+    def _algorithm_failed(self, exc: FsmRuntimeError) -> None:
+        self.stop_algorithm("error")
+        self.pacer.paused = True
+        self.message = f"algorithm stopped: {exc}"
 
     def _after_steps(self) -> None:
         if self._run_open and self.maze.exits and self.session.reached_exit:
@@ -181,6 +200,24 @@ class Bench:
         return True
 
     # -- sensors -------------------------------------------------------------------------
+    def sensor_rows(self) -> list[SensorRow]:
+        """The live sensors as panel rows, padded like the Web Simulator's panel.
+
+        The panel always offers two distance sensors and one touch sensor: kinds the robot
+        lacks are added unmounted, each on the lowest port no other row uses.
+        """
+        rows = [SensorRow(s.kind, str(s.port), s.mount) for s in self.sensors]
+        used = {s.port for s in self.sensors}
+        missing = list(PANEL_KINDS)
+        for spec in self.sensors:
+            if spec.kind in missing:
+                missing.remove(spec.kind)
+        for kind in missing:
+            port = next(p for p in PORT_RANGE if p not in used and p > 0)
+            used.add(port)
+            rows.append(SensorRow(kind, str(port), None))
+        return rows
+
     def apply_sensor_rows(self, rows: Sequence[SensorRow]) -> dict[int, str]:
         """Apply the panel's rows to the live robot, or nothing at all when a row is wrong."""
         specs, errors = check_sensor_rows(rows)
