@@ -1,0 +1,215 @@
+"""The maze editor's model: cursor, edits, undo/redo, validation, new/generate, saving."""
+
+import os
+import stat
+
+import pytest
+
+from workbench.sim.editing import (
+    EditorError,
+    Finding,
+    MazeEditor,
+    blank_maze,
+    finding_of,
+    parse_seed,
+    parse_size,
+)
+from workbench.sim.mazefile import parse_maze
+from workbench.sim.mazeio import load_maze
+
+ROOM = parse_maze("#####\n#S..#\n#..E#\n#####\n", source="room.txt")
+
+
+def test_cursor_starts_on_the_start_and_is_clamped_to_the_maze():
+    ed = MazeEditor(ROOM)
+    assert ed.cursor == (1, 1)
+    assert ed.move(-5, 0) == (0, 1)
+    assert ed.move(0, 10) == (0, 3)
+    assert ed.move(100, -100) == (4, 0)
+    assert ed.move_to((2, 2)) == (2, 2)
+
+
+def test_toggle_wall_and_undo_redo_restore_exact_mazes():
+    ed = MazeEditor(ROOM)
+    ed.move_to((2, 1))
+    assert ed.toggle_wall()
+    assert ed.maze.is_wall(2, 1) and ed.dirty and ed.can_undo and not ed.can_redo
+    ed.toggle_wall((2, 2))
+    assert ed.cursor == (2, 2) and ed.maze.is_wall(2, 2)
+    assert ed.undo() and not ed.maze.is_wall(2, 2) and ed.maze.is_wall(2, 1)
+    assert ed.undo() and ed.maze == ROOM and not ed.dirty
+    assert not ed.undo()
+    assert ed.redo() and ed.maze.is_wall(2, 1)
+    assert ed.redo() and ed.maze.is_wall(2, 2)
+    assert not ed.redo()
+
+
+def test_a_new_edit_clears_redo():
+    ed = MazeEditor(ROOM)
+    ed.toggle_wall((2, 1))
+    ed.undo()
+    ed.toggle_wall((2, 2))
+    assert not ed.can_redo
+
+
+def test_walling_an_exit_removes_it():
+    ed = MazeEditor(ROOM)
+    ed.toggle_wall((3, 2))
+    assert ed.maze.exits == ()
+
+
+def test_set_start_moves_it_then_cycles_the_heading():
+    ed = MazeEditor(ROOM)
+    ed.move_to((2, 2))
+    assert ed.set_start() == "right" and ed.maze.start == (2, 2)
+    assert [ed.set_start() for _ in range(4)] == ["down", "left", "up", "right"]
+    ed.undo()
+    assert ed.maze.heading == "up"
+
+
+def test_toggle_exit_adds_and_removes():
+    ed = MazeEditor(ROOM)
+    ed.move_to((2, 1))
+    assert ed.toggle_exit() is True and ed.maze.is_exit(2, 1)
+    assert ed.toggle_exit() is False and not ed.maze.is_exit(2, 1)
+
+
+def test_problems_follow_the_maze_with_block_positions():
+    ed = MazeEditor(ROOM)
+    assert ed.problems == [] and ed.valid
+    ed.toggle_wall((4, 1))  # open the boundary
+    assert [(p.cell, p.message) for p in ed.problems] == [
+        ((4, 1), "open floor on the outer boundary: the robot could leave the maze")
+    ]
+    assert not ed.valid and "(4, 1)" in str(ed.problems[0])
+    ed.undo()
+    assert ed.problems == []
+
+
+def test_problem_positions_account_for_front_matter():
+    maze = parse_maze("---\nname: x\n---\n#####\n#S..#\n#...E\n#####\n#...#\n", source="f")
+    ed = MazeEditor(maze)
+    cells = {p.cell for p in ed.problems}
+    assert (4, 2) not in cells  # an exit on the boundary is fine
+    assert (1, 4) in cells  # bottom row floor
+    assert finding_of(maze, maze.problem("m", "h")) == Finding("m", "h", None)
+
+
+def test_new_maze_is_a_closed_room_with_the_start_at_1_1():
+    ed = MazeEditor(ROOM, "room.txt")
+    ed.new(6, 4)
+    assert ed.maze.rows == ("######", "#....#", "#....#", "######")
+    assert ed.maze.start == (1, 1) and ed.cursor == (1, 1)
+    assert ed.path is None and ed.dirty
+    assert ed.maze.notes() == ["no exits: free exploration (runs end at their time limit)"]
+    assert ed.valid
+    ed.undo()
+    assert ed.maze == ROOM
+
+
+def test_blank_maze_size_limits():
+    with pytest.raises(EditorError, match="3 to 200 blocks"):
+        blank_maze(2, 5)
+
+
+def test_generate_is_seeded_and_checked():
+    ed = MazeEditor(ROOM)
+    ed.generate(4, 3, 7, "braid", "center")
+    first = ed.maze
+    assert (first.width, first.height) == (9, 7) and ed.valid
+    ed.generate(4, 3, 7, "braid", "center")
+    assert ed.maze == first
+    with pytest.raises(EditorError, match="unknown style"):
+        ed.generate(4, 3, 7, "spiral", "none")
+    with pytest.raises(EditorError, match="unknown exit"):
+        ed.generate(4, 3, 7, "perfect", "everywhere")
+    with pytest.raises(EditorError, match="width must be 1 to 99"):
+        ed.generate(0, 3, 7, "perfect", "none")
+    assert ed.maze == first
+
+
+@pytest.mark.parametrize(
+    ("w", "h", "match"),
+    [
+        ("", "5", "width is empty"),
+        ("a", "5", "'a' is not a whole number"),
+        ("5", "-1", "'-1' is not a whole number"),
+        ("5", "500", "height must be 3 to 200 blocks, not 500"),
+    ],
+)
+def test_parse_size_explains_bad_input(w, h, match):
+    with pytest.raises(EditorError, match=match):
+        parse_size(w, h, 3, 200, "blocks")
+
+
+def test_parse_size_and_seed_accept_good_input():
+    assert parse_size(" 7 ", "9", 3, 200, "blocks") == (7, 9)
+    assert parse_seed("42") == 42
+    with pytest.raises(EditorError, match="seed"):
+        parse_seed("x")
+
+
+def test_save_writes_atomically_and_clears_dirty(tmp_path):
+    path = tmp_path / "room.txt"
+    ed = MazeEditor(ROOM)
+    ed.toggle_wall((2, 1))
+    assert ed.save(path) == str(path)
+    assert not ed.dirty and ed.path == str(path)
+    assert load_maze(path).same_layout(ed.maze)
+    assert [p.name for p in tmp_path.iterdir()] == ["room.txt"]  # no temporary left behind
+    ed.toggle_wall((2, 2))
+    ed.save()
+    assert load_maze(path).is_wall(2, 2)
+
+
+def test_save_without_a_path_asks_for_one():
+    ed = MazeEditor(ROOM)
+    with pytest.raises(EditorError, match="save as"):
+        ed.save()
+
+
+def test_failed_saves_keep_the_maze_and_the_dirty_flag(tmp_path):
+    ed = MazeEditor(ROOM, tmp_path / "room.txt")
+    ed.toggle_wall((2, 1))
+    edited = ed.maze
+    with pytest.raises(EditorError, match="does not exist"):
+        ed.save(tmp_path / "nowhere" / "m.txt")
+    with pytest.raises(EditorError, match="is a folder"):
+        ed.save(tmp_path)
+    with pytest.raises(EditorError, match=r"cannot save as .*maz"):
+        ed.save(tmp_path / "m.maz")  # not a 16x16 micromouse maze
+    assert ed.maze == edited and ed.dirty and ed.path == str(tmp_path / "room.txt")
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root writes into read-only folders")
+def test_read_only_folder_gives_a_clear_message(tmp_path):
+    folder = tmp_path / "ro"
+    folder.mkdir()
+    folder.chmod(stat.S_IRUSR | stat.S_IXUSR)
+    try:
+        ed = MazeEditor(ROOM)
+        ed.toggle_wall((2, 1))
+        with pytest.raises(EditorError, match="Permission denied; the maze is still here"):
+            ed.save(folder / "m.txt")
+        assert ed.dirty and ed.maze.is_wall(2, 1)
+    finally:
+        folder.chmod(stat.S_IRWXU)
+
+
+def test_maze_for_bench_has_a_name():
+    ed = MazeEditor(ROOM, "labs/room.txt")
+    assert ed.maze_for_bench().name == "room"
+    ed.new(5, 5)
+    assert ed.maze_for_bench().name == "new maze"
+
+
+def test_a_write_error_comes_back_as_a_message(tmp_path, monkeypatch):
+    def refuse(path, maze, fmt="workbench"):
+        raise PermissionError(13, "Permission denied", str(path))
+
+    monkeypatch.setattr("workbench.sim.editing.save_maze", refuse)
+    ed = MazeEditor(ROOM)
+    ed.toggle_wall((2, 1))
+    with pytest.raises(EditorError, match="Permission denied; the maze is still here"):
+        ed.save(tmp_path / "m.txt")
+    assert ed.dirty and ed.path is None and ed.maze.is_wall(2, 1)
