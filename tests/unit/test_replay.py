@@ -174,3 +174,35 @@ def test_replay_maze_prefers_a_known_maze_then_the_file(tmp_path):
     write_maze(tmp_path / "bend.txt", BEND.with_block(3, 1, True))
     maze, note = replay_maze(replay, path)
     assert maze is not None and "has changed since this run" in note
+
+
+def test_metrics_so_far_follow_the_recorded_poses(simple):
+    m = simple.metrics()
+    assert (m.distance, m.collisions, m.reached_exit) == (0.0, 0, False)
+    simple.jump(4)
+    m = simple.metrics()
+    assert m.distance == pytest.approx(4.0) and m.distance_cells == pytest.approx(0.4)
+    assert m.collisions == 1 and m.sim_time == pytest.approx(0.2)
+
+
+def test_snapshot_carries_the_tick_for_the_maze_view(tmp_path):
+    header = {"type": "header", "format": FORMAT, "cell": 10.0, "sensors": ["distance:1:front"]}
+    replay = load_replay(write_record(tmp_path / "s.jsonl", ticks(3), header=header))
+    snap = replay.snapshot(1)
+    assert snap.pose.x == 16.0 and snap.block == (1, 1) and snap.readings == {1: 39.0}
+    assert [str(s) for s in snap.sensors] == ["distance:1:front"] and snap.driver == "keys"
+
+
+def test_a_bad_sensor_in_the_header_is_reported(tmp_path):
+    header = {"type": "header", "format": FORMAT, "sensors": ["distance:1:top"]}
+    with pytest.raises(RecordError, match=r"s\.jsonl: header: sensor 'distance:1:top'"):
+        load_replay(write_record(tmp_path / "s.jsonl", ticks(3), header=header))
+
+
+def test_metrics_at_the_end_agree_with_the_summary(tmp_path):
+    replay = load_replay(bench_record(tmp_path))
+    replay.to_end()
+    m, summary = replay.metrics(), replay.summary
+    assert m.reached_exit and m.exit_time == pytest.approx(summary["exit_time"], abs=0.06)
+    assert m.distance == pytest.approx(summary["distance"], rel=0.05)
+    assert m.turns == summary["turns"] and m.collisions == summary["collisions"]

@@ -19,7 +19,10 @@ from typing import Any
 
 from .maze import Maze, MazeError
 from .mazeio import load_maze
+from .metrics import Metrics, TurnCounter, efficiency
 from .record import RecordError, RunRecord, iter_lines, read_record
+from .sensors import SensorConfigError, SensorSpec
+from .session import Snapshot
 from .world import Pose
 
 #: the playing speeds offered, as factors of simulated time over wall time
@@ -111,6 +114,58 @@ class _TickError(RecordError):
         self.reason = reason
 
 
+def _header_sensors(header: dict[str, Any]) -> tuple[SensorSpec, ...]:
+    raw = header.get("sensors", [])
+    if not isinstance(raw, list):
+        raise RecordError('header: "sensors" must be a list of KIND:PORT:MOUNT')
+    specs = []
+    for text in raw:
+        try:
+            specs.append(SensorSpec.parse(str(text)))
+        except SensorConfigError as exc:
+            raise RecordError(f"header: sensor {text!r}: {exc}") from None
+    return tuple(specs)
+
+
+def _metrics_so_far(
+    record: RunRecord, poses: list[Pose], times: list[float], cell: float
+) -> list[Metrics]:
+    info = record.header.get("maze")
+    shortest = info.get("shortest_path") if isinstance(info, dict) else None
+    shortest = shortest if isinstance(shortest, int) and not isinstance(shortest, bool) else None
+    out: list[Metrics] = []
+    distance = turning = 0.0
+    collisions = 0
+    exit_time: float | None = None
+    counter = TurnCounter()
+    for i, tick in enumerate(record.ticks):
+        if i:
+            a, b = poses[i - 1], poses[i]
+            distance += math.hypot(b.x - a.x, b.y - a.y)
+            turn = (b.heading - a.heading + 180.0) % 360.0 - 180.0
+            turning += abs(turn)
+            counter.update(turn, times[i] - times[i - 1])
+        events = tick.get("events", ())
+        collisions += sum(e == "collision" for e in events)
+        if exit_time is None and "exit" in events:
+            exit_time = times[i]
+        reached = exit_time is not None
+        out.append(
+            Metrics(
+                reached_exit=reached,
+                exit_time=exit_time,
+                sim_time=times[i],
+                distance=distance,
+                distance_cells=distance / cell,
+                turn_degrees=turning,
+                turns=counter.current(),
+                collisions=collisions,
+                efficiency=efficiency(shortest, cell, distance, reached),
+            )
+        )
+    return out
+
+
 def _changes(ticks: list[dict[str, Any]]) -> list[tuple[int, str]]:
     """(tick index, line) for every state change and event of a run, in order."""
     lines: list[tuple[int, str]] = []
@@ -142,10 +197,12 @@ class Replay:
                 raise _TickError(i, reason)
             previous = tick["t"]
         self.record = record
+        self.sensors = _header_sensors(record.header)
         self.times = [float(t["t"]) for t in record.ticks]
         self.poses = [Pose(*(float(v) for v in t["pose"])) for t in record.ticks]
         self._log = _changes(record.ticks)
         self._log_ticks = [i for i, _ in self._log]
+        self._metrics = _metrics_so_far(record, self.poses, self.times, self.cell)
         self.index = 0
         self.time = self.times[0]
         self.playing = False
@@ -201,6 +258,30 @@ class Replay:
             state=tick.get("state"),
             variables=dict(tick.get("vars", {})),
             events=tuple(tick.get("events", ())),
+        )
+
+    def metrics(self, index: int | None = None) -> Metrics:
+        """The run's measures up to a tick, worked out from the recorded poses and events.
+
+        Poses are recorded at the control rate, so distance and turning are sampled; the
+        summary line (when the record has one) holds the exact totals of the whole run.
+        """
+        return self._metrics[self.index if index is None else index]
+
+    def snapshot(self, index: int | None = None) -> Snapshot:
+        """The tick as a session snapshot, for the views that draw live sessions."""
+        f = self.frame(index)
+        return Snapshot(
+            time=f.t,
+            pose=f.pose,
+            block=f.block(self.cell),
+            readings=dict(f.sensors),
+            sensors=self.sensors,
+            driver=str(self.header.get("algorithm") or "keys"),
+            state=f.state,
+            variables=f.variables,
+            metrics=self.metrics(f.index),
+            events=f.events,
         )
 
     def trail(self) -> list[Pose]:
