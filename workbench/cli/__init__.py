@@ -12,6 +12,7 @@ from workbench import __version__
 from . import algorithms as algorithms_cmd
 from . import maze as maze_cmd
 from . import run as run_cmd
+from . import serve as serve_cmd
 from . import viple_client as viple_client_cmd
 from .common import default_maze_path
 
@@ -27,6 +28,7 @@ def build_parser() -> argparse.ArgumentParser:
     maze_cmd.register(sub)
     algorithms_cmd.register(sub)
     run_cmd.register(sub)
+    serve_cmd.register(sub)
     viple_client_cmd.register(sub)
     return parser
 

@@ -1,0 +1,448 @@
+"""The Unity-simulator role over real loopback sockets, with byte-exact VIPLE messages.
+
+The simulation is stepped by the test (``session.step``) between messages, so every number
+is deterministic; the server only carries messages.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import itertools
+import json
+import logging
+import math
+
+import pytest
+
+from workbench.sim.mazefile import parse_maze
+from workbench.sim.session import Session
+from workbench.viple.codec import parse_report
+from workbench.viple.link import Link, RateLimitedLog, check_report_ms
+from workbench.viple.tcp_server import EndpointError, TcpConfig, TcpServer
+
+# a corridor facing east, the far wall 7 blocks ahead; unity blocks are 2 units
+CORRIDOR = parse_maze("##########\n#S.......#\n##########\n", source="corridor.txt")
+ROOM = parse_maze("#######\n#.....#\n#..S..#\n#.....#\n#######\n", source="room.txt")
+
+MOVE = b'{"servos":[{"isTurn":false,"servoId":-1,"servoSpeed":1}]}\r\n'
+MOVE_TEXT = b'{"servos":[{"isTurn":false,"servoId":-1,"servoSpeed":"0.5"}]}\r\n'
+STOP = b'{"servos":[{"isTurn":false,"servoId":-1,"servoSpeed":0}]}\r\n'
+TURN_90 = b'{"servos":[{"isTurn":true,"servoId":-1,"servoSpeed":90}]}\r\n'
+DRIVE = (
+    b'{"servos":[{"isTurn":false,"servoId":3,"servoSpeed":0.5},'
+    b'{"isTurn":false,"servoId":5,"servoSpeed":0.5}]}\r\n'
+)
+
+
+def session_for(maze=CORRIDOR, profile="unity") -> Session:
+    return Session(maze, profile, noise="off")
+
+
+class Client:
+    """A scripted VIPLE: raw bytes out, report lines in."""
+
+    def __init__(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+        self.reader = reader
+        self.writer = writer
+
+    @classmethod
+    async def connect(cls, port: int, host: str = "127.0.0.1") -> Client:
+        reader, writer = await asyncio.open_connection(host, port)
+        return cls(reader, writer)
+
+    async def send(self, data: bytes) -> None:
+        self.writer.write(data)
+        await self.writer.drain()
+
+    async def line(self, timeout: float = 2.0) -> bytes:
+        return await asyncio.wait_for(self.reader.readline(), timeout)
+
+    async def report(self, timeout: float = 2.0) -> dict[int, float]:
+        raw = await self.line(timeout)
+        assert raw.endswith(b"\r\n"), raw
+        return parse_report(raw.decode())
+
+    async def skip_reports(self) -> None:
+        """Drop the reports already received."""
+        await asyncio.sleep(0.02)
+        while True:
+            try:
+                await asyncio.wait_for(self.reader.readline(), 0.001)
+            except TimeoutError:
+                return
+
+    async def close(self) -> None:
+        self.writer.close()
+        with contextlib.suppress(OSError):
+            await self.writer.wait_closed()
+
+
+async def until(predicate, timeout: float = 2.0) -> None:
+    loop = asyncio.get_running_loop()
+    deadline = loop.time() + timeout
+    while not predicate():
+        assert loop.time() < deadline, "timed out"
+        await asyncio.sleep(0.005)
+
+
+def serve(session: Session, **config) -> TcpServer:
+    return TcpServer(session, TcpConfig(port=0, **config))
+
+
+def steps(session: Session, n: int) -> None:
+    for _ in range(n):
+        session.step()
+
+
+def test_reports_carry_every_configured_port_and_commands_move_the_robot():
+    async def scenario():
+        session = session_for()
+        async with serve(session) as server:
+            client = await Client.connect(server.port)
+            first = await client.line()
+            assert first.endswith(b"\r\n")
+            message = json.loads(first)
+            assert [e["id"] for e in message["sensors"]] == [1, 2]
+            assert {e["name"] for e in message["sensors"]} == {"distance"}
+            await client.send(MOVE_TEXT)  # servoSpeed as a string
+            await client.report()
+            assert session.driver.startswith("VIPLE tcp 127.0.0.1:")
+            x0 = session.world.pose.x
+            steps(session, 60)
+            # unity: Move at Power goes 1 unit/s whatever the power's size
+            assert session.world.pose.x - x0 == pytest.approx(1.0, abs=0.02)
+            await client.close()
+
+    asyncio.run(scenario())
+
+
+def test_split_lines_and_several_lines_in_one_write_are_all_applied():
+    async def scenario():
+        session = session_for(profile="web")
+        async with serve(session) as server:
+            client = await Client.connect(server.port)
+            await client.report()
+            await client.send(DRIVE[:20])
+            await asyncio.sleep(0.02)
+            assert server.status.messages_in == 0
+            await client.send(DRIVE[20:] + STOP.replace(b"\r\n", b"\n") + DRIVE)
+            await until(lambda: server.status.messages_in == 3)
+            assert server.status.invalid == 0
+            x0 = session.world.pose.x
+            steps(session, 60)
+            # web: (0.5, 0.5) is 70 px/s
+            assert session.world.pose.x - x0 == pytest.approx(70.0, abs=1.0)
+            await client.close()
+
+    asyncio.run(scenario())
+
+
+def test_each_command_line_is_answered_with_a_report_at_once():
+    async def scenario():
+        session = session_for()
+        async with serve(session, report_ms=1000) as server:
+            client = await Client.connect(server.port)
+            await client.report()  # the one pushed on connect
+            for _ in range(3):
+                await client.send(STOP)
+                await client.report(timeout=0.5)  # long before the next push
+            assert server.status.messages_out == 4
+            await client.close()
+
+    asyncio.run(scenario())
+
+
+def test_turn_by_degree_90_turns_the_robot_90_degrees_clockwise():
+    async def scenario():
+        session = session_for(ROOM)
+        async with serve(session) as server:
+            client = await Client.connect(server.port)
+            await client.report()
+            heading0 = session.world.pose.heading
+            await client.send(TURN_90)
+            await client.report()
+            steps(session, 240)  # 90 degrees at 35 deg/s takes 2.6 s
+            turned = (session.world.pose.heading - heading0) % 360
+            assert turned == pytest.approx(90.0, abs=0.01)
+            assert not session.world.turning
+            await client.close()
+
+    asyncio.run(scenario())
+
+
+def test_front_distance_falls_while_driving_toward_a_wall():
+    async def scenario():
+        session = session_for()
+        async with serve(session) as server:
+            client = await Client.connect(server.port)
+            start = await client.report()
+            await client.send(MOVE)
+            await client.report()
+            fronts = [start[2]]
+            for _ in range(5):
+                steps(session, 30)
+                await client.send(MOVE)
+                fronts.append((await client.report())[2])
+            assert all(b < a for a, b in itertools.pairwise(fronts))
+            assert fronts[0] - fronts[-1] == pytest.approx(2.5, abs=0.1)
+            await client.close()
+
+    asyncio.run(scenario())
+
+
+def test_disconnect_stops_the_motors_and_the_next_client_is_served():
+    async def scenario():
+        session = session_for()
+        async with serve(session) as server:
+            first = await Client.connect(server.port)
+            await first.report()
+            await first.send(MOVE)
+            await first.report()
+            await first.close()
+            await until(lambda: not server.status.connected)
+            assert session.driver == "nobody"
+            x = session.world.pose.x
+            steps(session, 30)
+            assert session.world.pose.x == pytest.approx(x)
+
+            second = await Client.connect(server.port, host="::1")
+            await second.report()
+            await second.send(MOVE)
+            await second.report()
+            steps(session, 30)
+            assert session.world.pose.x == pytest.approx(x + 0.5, abs=0.02)
+            assert session.driver.startswith("VIPLE tcp [::1]:")
+            assert server.status.connections == 2
+            await second.close()
+
+    asyncio.run(scenario())
+
+
+def test_a_second_client_is_refused_with_a_json_error_and_the_refusal_logged(caplog):
+    caplog.set_level(logging.INFO, logger="workbench.viple")
+
+    async def scenario():
+        session = session_for()
+        async with serve(session) as server:
+            first = await Client.connect(server.port)
+            await first.report()
+            intruder = await Client.connect(server.port)
+            error = json.loads(await intruder.line())
+            assert error["error"].startswith(
+                "busy: another VIPLE program is driving this robot (from 127.0.0.1:"
+            )
+            assert await intruder.reader.read() == b""  # closed
+            await intruder.close()
+            assert server.status.refused == 1
+            # the first program still drives
+            await first.skip_reports()
+            await first.send(MOVE)
+            await first.report()
+            assert session.driver.startswith("VIPLE tcp 127.0.0.1:")
+            await first.close()
+
+    asyncio.run(scenario())
+    refusals = [r for r in caplog.records if "refused" in r.getMessage()]
+    assert len(refusals) == 1 and "already driving" in refusals[0].getMessage()
+
+
+def test_a_thousand_malformed_lines_are_counted_logged_sparingly_and_then_a_valid_one_works(
+    caplog,
+):
+    caplog.set_level(logging.INFO, logger="workbench.viple")
+
+    async def scenario():
+        session = session_for()
+        async with serve(session) as server:
+            client = await Client.connect(server.port)
+            await client.report()
+            bad = [
+                b"not json",
+                b'{"servos":[{"servoId":3,"servoSpeed":"fast"}]}',
+                b'{"servos":[]}',
+                b"[1,2,3]",
+                b'{"servo":1}',
+                b"\xff\xfe",
+                b'{"servos":[{"isTurn":"maybe","servoId":-1,"servoSpeed":1}]}',
+            ]
+            payload = b"\r\n".join(bad[i % len(bad)] for i in range(1000)) + b"\r\n"
+            await client.send(payload)
+            await client.send(MOVE)
+            await until(lambda: server.status.messages_in == 1001)
+            assert server.status.invalid == 1000
+            assert server.status.connected
+            assert server.status.last_rejection.startswith("line ")
+            x = session.world.pose.x
+            steps(session, 30)
+            assert session.world.pose.x == pytest.approx(x + 0.5, abs=0.02)
+            await client.close()
+            await until(lambda: not server.status.connected)
+
+    asyncio.run(scenario())
+    rejected = [r for r in caplog.records if "rejected" in r.getMessage()]
+    assert 1 <= len(rejected) <= 10
+    assert any("more invalid messages" in r.getMessage() for r in caplog.records)
+    assert any('line 2: servoSpeed "fast" is not a number' in r.getMessage() for r in rejected)
+
+
+def test_an_oversized_line_closes_only_that_connection(caplog):
+    caplog.set_level(logging.INFO, logger="workbench.viple")
+
+    async def scenario():
+        session = session_for()
+        async with serve(session) as server:
+            hog = await Client.connect(server.port)
+            await hog.report()
+            await hog.send(MOVE)
+            await hog.send(b'{"servos":[' + b" " * 70_000)
+            rest = await asyncio.wait_for(hog.reader.read(), 2.0)
+            assert rest.endswith(
+                b'{"error":"line longer than 65536 bytes; closing the connection"}\r\n'
+            )
+            await hog.close()
+            assert not server.status.connected
+            assert session.driver == "nobody"  # and the motors were stopped
+            x = session.world.pose.x
+            steps(session, 10)
+            assert session.world.pose.x == pytest.approx(x)
+
+            next_client = await Client.connect(server.port)
+            await next_client.report()
+            await next_client.send(MOVE)
+            await next_client.report()
+            assert server.status.connected
+            await next_client.close()
+
+    asyncio.run(scenario())
+    assert any("longer than 65536 bytes" in r.getMessage() for r in caplog.records)
+
+
+@pytest.mark.parametrize("report_ms", [50, 100])
+def test_reports_are_pushed_at_the_configured_rate(report_ms):
+    async def scenario():
+        session = session_for()
+        async with serve(session, report_ms=report_ms) as server:
+            client = await Client.connect(server.port)
+            loop = asyncio.get_running_loop()
+            await client.report()
+            start = loop.time()
+            count = 0
+            while loop.time() - start < 0.6:
+                await client.report()
+                count += 1
+            expected = 0.6 / (report_ms / 1000)
+            assert expected - 2 <= count <= expected + 2
+            await client.close()
+
+    asyncio.run(scenario())
+
+
+def test_a_flood_of_commands_does_not_starve_the_loop_or_the_report_timer():
+    async def scenario():
+        session = session_for(ROOM)
+        async with serve(session, report_ms=50) as server:
+            client = await Client.connect(server.port)
+            await client.report()
+            ticks = 0
+
+            async def ticker():
+                nonlocal ticks
+                while True:
+                    await asyncio.sleep(0.005)
+                    ticks += 1
+
+            lines = 0
+
+            async def reader():
+                nonlocal lines
+                while await client.reader.readline():
+                    lines += 1
+
+            tick_task = asyncio.create_task(ticker())
+            read_task = asyncio.create_task(reader())
+            flood = STOP * 2000
+            loop = asyncio.get_running_loop()
+            start = loop.time()
+            for _ in range(10):
+                await client.send(flood)
+            await until(lambda: server.status.messages_in == 20_000, timeout=10)
+            elapsed = loop.time() - start
+            # the other tasks ran all along: roughly one tick per 5 ms
+            assert ticks >= 0.3 * elapsed / 0.005
+            # replies plus periodic pushes
+            await until(lambda: lines >= 20_000)
+            tick_task.cancel()
+            read_task.cancel()
+            await client.close()
+
+    asyncio.run(scenario())
+
+
+def test_the_same_port_on_both_loopback_addresses_and_a_port_in_use_is_a_clear_error():
+    async def scenario():
+        session = session_for()
+        async with serve(session) as server:
+            hosts = {host for host, _ in server.addresses}
+            assert "127.0.0.1" in hosts
+            assert {port for _, port in server.addresses} == {server.port}
+            other = TcpServer(session, TcpConfig(port=server.port))
+            with pytest.raises(EndpointError) as caught:
+                await other.start()
+            assert f"port {server.port} is in use" in str(caught.value)
+            assert "stop the other simulator or choose --tcp-port" in str(caught.value)
+
+    asyncio.run(scenario())
+
+
+def test_explicit_bind_addresses_replace_the_loopback_pair():
+    async def scenario():
+        session = session_for()
+        async with TcpServer(session, TcpConfig(port=0, bind=("127.0.0.1",))) as server:
+            assert [host for host, _ in server.addresses] == ["127.0.0.1"]
+            assert server.status.address == f"127.0.0.1:{server.port}"
+            client = await Client.connect(server.port)
+            assert (await client.line()).startswith(b'{"sensors":')
+            await client.close()
+
+    asyncio.run(scenario())
+
+
+def test_report_interval_and_port_are_checked():
+    for bad in (49, 1001, 250.0, True):
+        with pytest.raises(ValueError, match="report interval"):
+            check_report_ms(bad)
+    assert check_report_ms(50) == 50 and check_report_ms(1000) == 1000
+    with pytest.raises(ValueError, match="out of range"):
+        TcpConfig(port=70000)
+
+
+def test_rate_limited_log_holds_back_repeats_and_says_how_many(caplog):
+    now = [0.0]
+    limited = RateLimitedLog(logging.getLogger("test.limited"), burst=3, period=10.0)
+    limited.clock = lambda: now[0]
+    with caplog.at_level(logging.WARNING, logger="test.limited"):
+        for _ in range(50):
+            limited.warning("bad %d", 1)
+        now[0] = 11.0
+        limited.warning("bad %d", 2)
+    messages = [r.getMessage() for r in caplog.records]
+    assert messages == [
+        "bad 1",
+        "bad 1",
+        "bad 1",
+        "... and 47 more invalid messages not logged one by one",
+        "bad 2",
+    ]
+
+
+def test_reports_follow_the_session_sensor_configuration():
+    from workbench.sim.sensors import SensorSpec
+
+    session = session_for()
+    link = Link(session, "tcp")
+    session.set_sensors([SensorSpec("touch", 7, "front"), SensorSpec("distance", 4, "left")])
+    report = json.loads(link.report())
+    assert [(e["name"], e["id"]) for e in report["sensors"]] == [("distance", 4), ("touch", 7)]
+    assert report["sensors"][1]["value"] in (0, 1)
+    assert math.isfinite(report["sensors"][0]["value"])

@@ -1,0 +1,315 @@
+"""One remote VIPLE program bound to a live session: commands in, sensor reports out.
+
+Both connection roles (the TCP server that stands in for the Unity simulator and the
+WebSocket client that stands in for the Web Simulator) share this piece. A :class:`Link`
+turns the lines it is given into ``session.command(...)`` calls, builds the reports VIPLE
+reads, counts what went in and out, and stops the robot when its driver goes.
+
+The robot has one driver. Endpoints that serve the same session share one :class:`Seat`:
+whoever holds it drives, anyone else is refused (TCP) or waits (WebSocket).
+
+The simulation is stepped by someone else's timer on the same event loop, so a flood of
+commands is handled in bounded batches with a yield to the loop between them.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import logging
+import time
+from collections.abc import Awaitable, Callable, Iterable
+from dataclasses import dataclass, field
+
+from workbench.control.commands import Stop
+from workbench.sim.session import Session
+
+from .codec import REPORT_KINDS, CodecError, WheelPorts, encode_report, parse_command
+
+#: report interval limits and default, milliseconds
+REPORT_MS_MIN = 50
+REPORT_MS_MAX = 1000
+REPORT_MS_DEFAULT = 250
+#: lines (and reads) handled before the loop gets a turn
+BATCH = 64
+
+NOBODY = "nobody"
+
+Send = Callable[[str], Awaitable[None]]
+
+
+def check_report_ms(value: object) -> int:
+    """The report interval in whole milliseconds, or ``ValueError`` naming the allowed range."""
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise ValueError(f"report interval must be a whole number of milliseconds, not {value!r}")
+    if not REPORT_MS_MIN <= value <= REPORT_MS_MAX:
+        raise ValueError(
+            f"report interval {value} ms is out of range: use {REPORT_MS_MIN} to "
+            f"{REPORT_MS_MAX} ms (VIPLE's Unity simulator used about 260)"
+        )
+    return value
+
+
+@dataclass(frozen=True)
+class LinkStatus:
+    """What a front end shows about one endpoint."""
+
+    #: "tcp" (Unity-simulator role) or "ws" (Web-Simulator role)
+    role: str
+    #: where the endpoint listens ("127.0.0.1:1350, [::1]:1350") or what it connects to
+    address: str = ""
+    #: the connected VIPLE program ("127.0.0.1:50312", "ws://localhost:8124/"), or None
+    peer: str | None = None
+    messages_in: int = 0
+    messages_out: int = 0
+    invalid: int = 0
+    last_rejection: str | None = None
+    #: connections served so far and connections refused because the robot was busy
+    connections: int = 0
+    refused: int = 0
+
+    @property
+    def connected(self) -> bool:
+        return self.peer is not None
+
+
+@dataclass
+class Seat:
+    """The one driver's seat of a robot, shared by every endpoint serving its session."""
+
+    holder: str | None = None
+
+    def claim(self, who: str) -> bool:
+        if self.holder is not None and self.holder != who:
+            return False
+        self.holder = who
+        return True
+
+    def release(self, who: str) -> None:
+        if self.holder == who:
+            self.holder = None
+
+
+@dataclass
+class RateLimitedLog:
+    """Logs at most ``burst`` messages per ``period`` seconds and counts the rest."""
+
+    logger: logging.Logger
+    burst: int = 5
+    period: float = 10.0
+    clock: Callable[[], float] = time.monotonic
+    _window_start: float = field(default=-1e18, init=False)
+    _in_window: int = field(default=0, init=False)
+    _suppressed: int = field(default=0, init=False)
+
+    def warning(self, message: str, *args: object) -> None:
+        now = self.clock()
+        if now - self._window_start >= self.period:
+            self.flush()
+            self._window_start = now
+            self._in_window = 0
+        if self._in_window < self.burst:
+            self._in_window += 1
+            self.logger.warning(message, *args)
+        else:
+            self._suppressed += 1
+
+    def flush(self) -> None:
+        """Log how many messages were held back, if any."""
+        if self._suppressed:
+            self.logger.warning(
+                "... and %d more invalid messages not logged one by one", self._suppressed
+            )
+            self._suppressed = 0
+
+
+class Link:
+    """Binds one remote driver at a time to ``session``.
+
+    An endpoint calls :meth:`connect` when a VIPLE program arrives, hands each received line
+    to :meth:`handle` with a way to send the reply, sends :meth:`report` on its timer, and
+    calls :meth:`disconnect` when the program goes.
+    """
+
+    def __init__(
+        self,
+        session: Session,
+        role: str,
+        address: str = "",
+        seat: Seat | None = None,
+        logger: logging.Logger | None = None,
+        batch: int = BATCH,
+    ) -> None:
+        if batch < 1:
+            raise ValueError(f"batch must be at least 1, not {batch!r}")
+        self.session = session
+        self.seat = seat if seat is not None else Seat()
+        self.log = logger or logging.getLogger(f"workbench.viple.{role}")
+        self.batch = batch
+        self.role = role
+        self.address = address
+        self.peer: str | None = None
+        self.messages_in = 0
+        self.messages_out = 0
+        self.invalid = 0
+        self.last_rejection: str | None = None
+        self.connections = 0
+        self.refused = 0
+        self._line_no = 0
+        self._driver: str | None = None
+        self._work = 0
+        self._bad_log = RateLimitedLog(self.log)
+
+    # -- status --------------------------------------------------------------------------
+    @property
+    def status(self) -> LinkStatus:
+        """The endpoint's status at this moment (a snapshot)."""
+        return LinkStatus(
+            role=self.role,
+            address=self.address,
+            peer=self.peer,
+            messages_in=self.messages_in,
+            messages_out=self.messages_out,
+            invalid=self.invalid,
+            last_rejection=self.last_rejection,
+            connections=self.connections,
+            refused=self.refused,
+        )
+
+    @property
+    def driver(self) -> str | None:
+        """The session's driver name while a program is connected (``VIPLE tcp HOST:PORT``)."""
+        return self._driver
+
+    @property
+    def wheels(self) -> WheelPorts:
+        profile = self.session.profile
+        return WheelPorts(profile.left_port, profile.right_port)
+
+    # -- who drives ----------------------------------------------------------------------
+    def busy_with(self) -> str | None:
+        """Who holds the robot's driver seat (any endpoint of this session), else None."""
+        return self.seat.holder
+
+    def connect(self, peer: str) -> bool:
+        """A VIPLE program at ``peer`` wants to drive; False (and counted) when busy.
+
+        The program takes over from any controller attached to the session.
+        """
+        if not self.seat.claim(peer):
+            self.refuse(peer)
+            return False
+        self.peer = peer
+        self.connections += 1
+        self._line_no = 0
+        self._driver = f"VIPLE {self.role} {peer}"
+        self._bad_log = RateLimitedLog(self.log)
+        self.session.detach(self._driver)
+        return True
+
+    def refuse(self, peer: str) -> None:
+        self.refused += 1
+        self.log.warning(
+            "refused %s: %s is already driving this robot", peer, self.seat.holder or "someone"
+        )
+
+    def busy_message(self) -> str:
+        """The one-line JSON error a refused program gets."""
+        holder = self.seat.holder or "another program"
+        text = f"busy: another VIPLE program is driving this robot (from {holder})"
+        return json.dumps({"error": text}, separators=(",", ":"))
+
+    def disconnect(self, reason: str = "") -> None:
+        """The program went: stop the motors (if it still drives) and free the seat."""
+        peer = self.peer
+        if peer is None:
+            return
+        self._bad_log.flush()
+        if self.session.driver == self._driver:
+            self.session.command(Stop(), driver=NOBODY)
+        self.seat.release(peer)
+        self._driver = None
+        self.peer = None
+        self.log.info("%s disconnected%s; motors stopped", peer, f" ({reason})" if reason else "")
+
+    # -- messages ------------------------------------------------------------------------
+    def report(self) -> str:
+        """A report carrying every configured sensor, from the session's latest readings."""
+        readings = self.session.readings
+        kinds = {
+            spec.port: spec.kind
+            for spec in self.session.world.sensors
+            if spec.kind in REPORT_KINDS and spec.port in readings
+        }
+        return encode_report({port: readings[port] for port in kinds}, kinds)
+
+    def sent(self, count: int = 1) -> None:
+        """Count reports the endpoint has sent."""
+        self.messages_out += count
+
+    def received(self) -> int:
+        """Count a received message; its line number in this connection."""
+        self.messages_in += 1
+        self._line_no += 1
+        return self._line_no
+
+    def reject(self, reason: str, line_no: int | None = None, log: bool = True) -> None:
+        """Count a message that was not accepted; log it (rate-limited) unless ``log`` is
+        False because the caller logs it itself."""
+        if line_no is not None:
+            reason = f"line {line_no}: {reason}"
+        self.invalid += 1
+        self.last_rejection = reason
+        if log:
+            self._bad_log.warning("%s: rejected %s", self.peer or "VIPLE", reason)
+
+    def apply(self, line: str) -> bool:
+        """Apply one command line to the session; False when it was rejected (and counted)."""
+        line_no = self.received()
+        try:
+            commands = parse_command(line, self.wheels)
+        except CodecError as err:
+            self.reject(str(err), line_no)
+            return False
+        driver = self._driver or f"VIPLE {self.role}"
+        for cmd in commands:
+            self.session.command(cmd, driver=driver)
+        if self.log.isEnabledFor(logging.DEBUG):
+            self.log.debug("%s: line %d: %s", self.peer or "VIPLE", line_no, commands)
+        return True
+
+    async def handle(self, lines: Iterable[str], send: Send) -> None:
+        """Apply each line and answer each accepted one with a report, yielding between batches."""
+        for line in lines:
+            await self.take(line, send)
+
+    async def take(self, line: str, send: Send) -> None:
+        """Apply one line, answer it with a report when it was accepted, and pace."""
+        if self.apply(line):
+            await send(self.report())
+            self.messages_out += 1
+        await self.pace()
+
+    async def pace(self, work: int = 1) -> None:
+        """Count ``work`` units; every ``batch`` units the event loop gets a turn."""
+        self._work += work
+        if self._work >= self.batch:
+            self._work = 0
+            await asyncio.sleep(0)
+
+    async def push_reports(self, send: Send, interval: float) -> None:
+        """Send a report now and then every ``interval`` seconds, until cancelled.
+
+        The schedule follows the loop's clock; reports missed while the loop was busy are
+        skipped, not sent in a burst.
+        """
+        loop = asyncio.get_running_loop()
+        due = loop.time()
+        while True:
+            await send(self.report())
+            self.sent()
+            due += interval
+            now = loop.time()
+            if due < now:
+                due = now + interval - (now - due) % interval
+            await asyncio.sleep(due - now)

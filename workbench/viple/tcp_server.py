@@ -1,0 +1,295 @@
+"""The Unity-simulator role: a TCP server VIPLE's Robot/IoT Controller (Wi-Fi) connects to.
+
+One JSON object per line each way. A report of every configured sensor is pushed every
+``report_ms`` from the moment a program connects, and each accepted command line is answered
+at once with a report. One program drives at a time: a second one gets a one-line JSON error
+and is closed. A line over the size limit closes that connection; malformed lines are counted
+and logged and the connection stays open.
+
+By default the server listens on 127.0.0.1 and ::1 (VIPLE resolves ``localhost`` to either);
+other interfaces only when they are named in ``bind``.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import errno
+import logging
+import socket
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+from workbench.sim.session import Session
+
+from .codec import DEFAULT_MAX_LINE_BYTES, FrameError, FrameTooLong, LineSplitter
+from .link import REPORT_MS_DEFAULT, Link, LinkStatus, Seat, check_report_ms
+
+DEFAULT_PORT = 1350
+LOOPBACK = ("127.0.0.1", "::1")
+READ_SIZE = 65536
+#: how long a refused or closing client gets to take its last line
+_GOODBYE_SECONDS = 1.0
+
+log = logging.getLogger("workbench.viple.tcp")
+
+
+class EndpointError(RuntimeError):
+    """An endpoint cannot start (port in use, address not available), with the reason."""
+
+
+@dataclass(frozen=True)
+class TcpConfig:
+    #: 0 lets the system choose a free port (the same one on every address)
+    port: int = DEFAULT_PORT
+    #: addresses to listen on; empty means 127.0.0.1 and ::1
+    bind: tuple[str, ...] = ()
+    report_ms: int = REPORT_MS_DEFAULT
+    max_line_bytes: int = DEFAULT_MAX_LINE_BYTES
+
+    def __post_init__(self) -> None:
+        check_port(self.port)
+        check_report_ms(self.report_ms)
+        if not self.max_line_bytes >= 1:
+            raise ValueError("max_line_bytes must be at least 1")
+        for host in self.bind:
+            if not isinstance(host, str) or not host.strip():
+                raise ValueError(f"bind address {host!r} is empty")
+
+
+def check_port(port: object) -> int:
+    if isinstance(port, bool) or not isinstance(port, int) or not 0 <= port <= 65535:
+        raise ValueError(f"port {port!r} is out of range: use 1 to 65535")
+    return port
+
+
+def format_address(host: str, port: int) -> str:
+    return f"[{host}]:{port}" if ":" in host else f"{host}:{port}"
+
+
+def _peer_of(writer: asyncio.StreamWriter) -> str:
+    peer = writer.get_extra_info("peername")
+    if isinstance(peer, tuple) and len(peer) >= 2:
+        return format_address(str(peer[0]), int(peer[1]))
+    return str(peer or "unknown peer")
+
+
+def _too_long(err: FrameError) -> bool:
+    """Whether a framing error dropped a line for its length (maybe after another problem)."""
+    return isinstance(err, FrameTooLong) or any("longer than the limit" in r for r in err.reasons)
+
+
+class TcpServer:
+    """Serves ``session`` to one VIPLE program at a time over TCP."""
+
+    def __init__(
+        self,
+        session: Session,
+        config: TcpConfig | None = None,
+        seat: Seat | None = None,
+        logger: logging.Logger | None = None,
+    ) -> None:
+        self.config = config or TcpConfig()
+        self.log = logger or log
+        self.link = Link(session, "tcp", seat=seat, logger=self.log)
+        self._servers: list[asyncio.Server] = []
+        self._handlers: set[asyncio.Task] = set()
+        self.addresses: list[tuple[str, int]] = []
+
+    @property
+    def status(self) -> LinkStatus:
+        return self.link.status
+
+    @property
+    def port(self) -> int:
+        """The port listened on (the chosen one when the config asked for 0)."""
+        return self.addresses[0][1] if self.addresses else self.config.port
+
+    # -- starting and stopping -------------------------------------------------------------
+    async def start(self) -> None:
+        """Listen on every configured address; raises ``EndpointError`` when it cannot."""
+        hosts = self.config.bind or LOOPBACK
+        port = self.config.port
+        try:
+            for host in hosts:
+                server = await self._listen(host, port)
+                if server is None:
+                    continue
+                self._servers.append(server)
+                for sock in server.sockets:
+                    name = sock.getsockname()
+                    self.addresses.append((str(name[0]), int(name[1])))
+                port = self.addresses[0][1]
+        except BaseException:
+            await self.close()
+            raise
+        if not self._servers:
+            raise EndpointError("no address to listen on")
+        shown = ", ".join(format_address(h, p) for h, p in self.addresses)
+        self.link.address = shown
+        self.log.info("listening for VIPLE (Unity simulator role) on %s", shown)
+
+    async def _listen(self, host: str, port: int) -> asyncio.Server | None:
+        try:
+            return await asyncio.start_server(
+                self._on_client, host, port, limit=READ_SIZE, reuse_address=True
+            )
+        except OSError as err:
+            default_v6 = not self.config.bind and host == "::1"
+            if err.errno == errno.EADDRINUSE:
+                raise EndpointError(
+                    f"port {port} is in use on {host}: stop the other simulator or choose "
+                    "--tcp-port"
+                ) from None
+            if default_v6 and _unavailable(err):
+                self.log.warning(
+                    "IPv6 loopback ::1 is not available (%s); using 127.0.0.1 only", err
+                )
+                return None
+            raise EndpointError(f"cannot listen on {host} port {port}: {_reason(err)}") from None
+
+    async def close(self) -> None:
+        """Stop listening, close the connection (the robot stops) and wait for it to end."""
+        for server in self._servers:
+            server.close()
+        handlers = list(self._handlers)
+        for task in handlers:
+            task.cancel()
+        if handlers:
+            await asyncio.gather(*handlers, return_exceptions=True)
+        for server in self._servers:
+            with contextlib.suppress(Exception):
+                await server.wait_closed()
+        self._servers.clear()
+
+    async def __aenter__(self) -> TcpServer:
+        await self.start()
+        return self
+
+    async def __aexit__(self, *exc: object) -> None:
+        await self.close()
+
+    # -- one connection ---------------------------------------------------------------------
+    async def _on_client(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+        # the connection runs in its own task so that close() can cancel it without asyncio
+        # reporting the cancelled connection callback as an error
+        task = asyncio.create_task(self._connection(reader, writer))
+        self._handlers.add(task)
+        try:
+            await asyncio.gather(task, return_exceptions=True)
+        finally:
+            self._handlers.discard(task)
+
+    async def _connection(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+        peer = _peer_of(writer)
+        try:
+            if not self.link.connect(peer):
+                await self._goodbye(reader, writer, self.link.busy_message())
+                return
+            self.log.info("VIPLE connected from %s", peer)
+            reason, farewell = "server stopping", None
+            try:
+                reason, farewell = await self._serve(reader, writer, peer)
+            finally:
+                self.link.disconnect(reason)
+            if farewell is not None:
+                await self._goodbye(reader, writer, farewell)
+        finally:
+            writer.close()
+
+    async def _serve(
+        self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter, peer: str
+    ) -> tuple[str, str | None]:
+        """Serve one program until it goes: why it ended, and a last line to send it."""
+        link = self.link
+
+        async def send(line: str) -> None:
+            writer.write(line.encode("utf-8") + b"\r\n")
+            await writer.drain()
+
+        pusher = asyncio.create_task(link.push_reports(send, self.config.report_ms / 1000))
+        splitter = LineSplitter(self.config.max_line_bytes)
+        try:
+            while True:
+                if pusher.done():
+                    return _ended(pusher), None
+                data = await reader.read(READ_SIZE)
+                if not data:
+                    return "closed by VIPLE", None
+                for line, err in _in_order(splitter, data):
+                    if err is None:
+                        await link.take(line, send)
+                    elif _too_long(err):
+                        why = f"line longer than {self.config.max_line_bytes} bytes"
+                        link.reject(f"{why}; connection closed", link.received(), log=False)
+                        self.log.warning("%s: %s; closing the connection", peer, why)
+                        return why, f'{{"error":"{why}; closing the connection"}}'
+                    else:
+                        for reason in err.reasons:
+                            link.reject(reason, link.received())
+                        await link.pace()
+                await link.pace()
+        except OSError as err:
+            return _reason(err), None
+        finally:
+            pusher.cancel()
+            await asyncio.gather(pusher, return_exceptions=True)
+
+    async def _goodbye(
+        self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter, line: str
+    ) -> None:
+        """Send a last line and close gracefully, so that the peer gets to read it.
+
+        Whatever the peer still sends is read and dropped for a moment: closing a socket with
+        unread input would reset the connection and could destroy the line on its way.
+        """
+        with contextlib.suppress(Exception):
+            writer.write(line.encode("utf-8") + b"\r\n")
+            await asyncio.wait_for(writer.drain(), _GOODBYE_SECONDS)
+            if writer.can_write_eof():
+                writer.write_eof()
+            await asyncio.wait_for(_drain_input(reader), _GOODBYE_SECONDS)
+
+
+async def _drain_input(reader: asyncio.StreamReader) -> None:
+    while await reader.read(READ_SIZE):
+        pass
+
+
+def _in_order(splitter: LineSplitter, data: bytes) -> Iterator[tuple[str, FrameError | None]]:
+    """The lines of one read and the framing errors between them, in the order received.
+
+    The splitter is fed one line at a time so that a dropped line's error keeps its place.
+    """
+    start = 0
+    size = len(data)
+    while start < size:
+        end = data.find(b"\n", start)
+        stop = size if end < 0 else end + 1
+        try:
+            lines = splitter.feed(data[start:stop])
+        except FrameError as err:
+            yield from ((line, None) for line in err.lines)
+            yield "", err
+        else:
+            yield from ((line, None) for line in lines)
+        start = stop
+
+
+def _ended(task: asyncio.Task) -> str:
+    err = task.exception() if not task.cancelled() else None
+    return _reason(err) if isinstance(err, OSError) else "report stream ended"
+
+
+def _unavailable(err: OSError) -> bool:
+    return err.errno in (
+        errno.EADDRNOTAVAIL,
+        errno.EAFNOSUPPORT,
+        getattr(errno, "EPROTONOSUPPORT", -1),
+    ) or isinstance(err, socket.gaierror)
+
+
+def _reason(err: BaseException) -> str:
+    if isinstance(err, OSError) and err.strerror:
+        return err.strerror.lower() if err.strerror[:1].isupper() else err.strerror
+    return str(err) or type(err).__name__
