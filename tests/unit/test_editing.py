@@ -8,6 +8,7 @@ import pytest
 from workbench.sim.editing import (
     EditorError,
     Finding,
+    GenerateOptions,
     MazeEditor,
     blank_maze,
     finding_of,
@@ -196,11 +197,44 @@ def test_read_only_folder_gives_a_clear_message(tmp_path):
         folder.chmod(stat.S_IRWXU)
 
 
-def test_maze_for_bench_has_a_name():
+def test_handover_gives_the_robot_a_changed_valid_maze_with_a_name(tmp_path):
     ed = MazeEditor(ROOM, "labs/room.txt")
-    assert ed.maze_for_bench().name == "room"
+    assert ed.handover() == (None, "")  # nothing changed: the robot keeps its run
+    ed.toggle_wall((2, 1))
+    maze, note = ed.handover()
+    assert maze.is_wall(2, 1) and maze.name == "room" and note == ""
+    assert ed.handover(discard=True) == (None, "")  # nothing saved: back to the opened maze
+    ed.toggle_wall((4, 1))
+    assert ed.handover() == (
+        None,
+        "the maze has 1 problem, so the robot stays on the previous maze",
+    )
+    ed.undo()
+    ed.save(tmp_path / "room2.txt")
+    ed.toggle_wall((3, 1))
+    maze, _ = ed.handover(discard=True)
+    assert maze is not None and not maze.is_wall(3, 1) and maze.is_wall(2, 1)
     ed.new(5, 5)
-    assert ed.maze_for_bench().name == "new maze"
+    assert ed.handover()[0].name == "new maze"
+
+
+def test_generate_options_are_parsed_with_reasons():
+    assert GenerateOptions.parse("4", "5", "9", "braid", "none") == GenerateOptions(
+        4, 5, 9, "braid", "none"
+    )
+    with pytest.raises(EditorError, match="height must be 1 to 99 cells, not 100"):
+        GenerateOptions.parse("4", "100", "9", "braid", "none")
+    with pytest.raises(EditorError, match="seed '-3'"):
+        GenerateOptions.parse("4", "4", "-3", "braid", "none")
+    with pytest.raises(EditorError, match="unknown style"):
+        GenerateOptions.parse("4", "4", "1", "x", "none")
+
+
+def test_suggested_path_comes_from_the_file_or_the_title():
+    ed = MazeEditor(ROOM, "labs/room.txt")
+    assert ed.suggested_path() == "labs/room.txt"
+    ed.generate(3, 3, 5, "perfect", "none")
+    assert ed.suggested_path() == "perfect-3x3-seed-5.txt"
 
 
 def test_a_write_error_comes_back_as_a_message(tmp_path, monkeypatch):

@@ -8,10 +8,11 @@ undo is exact and cheap. The editor never loses work: a failed save raises
 from __future__ import annotations
 
 import os
+import re
 from dataclasses import dataclass, replace
 from pathlib import Path
 
-from .generate import EXITS, STYLES, generate
+from .generate import EXITS, MAX_CELLS, MIN_CELLS, STYLES, generate
 from .maze import FLOOR, HEADINGS, MAX_SIZE, WALL, Cell, Maze, MazeError, Problem
 from .mazeio import format_for_path, save_maze
 
@@ -71,6 +72,29 @@ def parse_seed(raw: str | int) -> int:
     return int(text)
 
 
+@dataclass(frozen=True)
+class GenerateOptions:
+    """What the generate dialog asks for: a size in cells, a seed, a style and the exits."""
+
+    width: int = 8
+    height: int = 8
+    seed: int = 1
+    style: str = "perfect"
+    exit: str = "boundary"
+
+    @classmethod
+    def parse(
+        cls, width: str | int, height: str | int, seed: str | int, style: str, exit: str
+    ) -> GenerateOptions:
+        """The options as typed; EditorError names the first field that is wrong."""
+        w, h = parse_size(width, height, MIN_CELLS, MAX_CELLS, "cells")
+        if style not in STYLES:
+            raise EditorError(f"unknown style {style!r}: use one of {', '.join(STYLES)}")
+        if exit not in EXITS:
+            raise EditorError(f"unknown exit option {exit!r}: use one of {', '.join(EXITS)}")
+        return cls(w, h, parse_seed(seed), style, exit)
+
+
 def blank_maze(width: int, height: int) -> Maze:
     """All floor inside a closed wall boundary, the start at (1, 1) facing right."""
     if not (MIN_BLOCKS <= width <= MAX_SIZE and MIN_BLOCKS <= height <= MAX_SIZE):
@@ -89,6 +113,8 @@ class MazeEditor:
     def __init__(self, maze: Maze, path: str | os.PathLike | None = None) -> None:
         self.maze = maze
         self.path: str | None = os.fspath(path) if path is not None else None
+        #: the maze the editor was opened with, and the one last saved (or opened)
+        self.opened = maze
         self.saved = maze
         self.cursor: Cell = self._clamp(maze.start if maze.start is not None else (0, 0))
         self._undo: list[Maze] = []
@@ -132,11 +158,28 @@ class MazeEditor:
             return Path(self.path).stem
         return "new maze"
 
-    def maze_for_bench(self) -> Maze:
-        """The edited maze as the robot gets it (named, so runs can tell mazes apart)."""
-        if self.maze.name:
-            return self.maze
-        return replace(self.maze, name=self.title())
+    def handover(self, discard: bool = False) -> tuple[Maze | None, str]:
+        """On leaving: the maze the robot should now run on (None: keep the old one) and why.
+
+        With ``discard`` the unsaved edits are dropped and the last saved maze counts.
+        """
+        maze = self.saved if discard else self.maze
+        if maze == self.opened:
+            return None, ""
+        problems = maze.validate()
+        if problems:
+            count = f"{len(problems)} problem{'s' if len(problems) != 1 else ''}"
+            return None, f"the maze has {count}, so the robot stays on the previous maze"
+        if not maze.name:
+            maze = replace(maze, name=self.title())
+        return maze, ""
+
+    def suggested_path(self) -> str:
+        """Where save as proposes to write: the current file, else a name from the title."""
+        if self.path:
+            return self.path
+        slug = re.sub(r"[^a-z0-9]+", "-", self.title().lower()).strip("-") or "maze"
+        return f"{slug}.txt"
 
     # -- cursor --------------------------------------------------------------------------
     def _clamp(self, cell: Cell) -> Cell:
