@@ -4,12 +4,21 @@ runs through `workbench serve` compared with the same run in process."""
 from __future__ import annotations
 
 import asyncio
+import json
+import math
+import signal
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
 
 import pytest
 from websockets.asyncio.client import connect as ws_connect
 
 from workbench.cli import main
 from workbench.control.commands import MoveAtPower, Stop, TurnByDegrees
+from workbench.control.headless import RunSpec, run
 from workbench.sim.noise import noise_settings
 from workbench.sim.profiles import get_profile
 from workbench.viple import client as client_mod
@@ -198,13 +207,15 @@ def test_cli_with_nothing_listening_retries_then_exits_1(capsys, monkeypatch, un
 # ----------------------------------------------------------------------------- on the wire
 
 
-@pytest.fixture
-def unused_port():
-    import socket
-
+def free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))
         return s.getsockname()[1]
+
+
+@pytest.fixture
+def unused_port():
+    return free_port()
 
 
 class ScriptedRobot:
@@ -313,3 +324,133 @@ def test_websocket_role_serves_one_simulator_and_refuses_a_second(unused_port):
     assert first == MOVE.decode().strip() and second == RIGHT90.decode().strip()
     assert refused == 1013
     assert result.ended == "closed" and result.exit_code == 0 and result.reports == 2
+
+
+# ----------------------------------------------------------------------------- end to end
+
+#: a corridor with one corner: the robot drives up one block, looks right (a wall), looks left
+#: (the exit) and drives out: two Turn by Degree, about 6 s of simulated time
+ONE_CORNER = """\
+---
+name: One corner
+profile: erobotic
+---
+####
+E..#
+##^#
+####
+"""
+ALGORITHM = "two-distance-local-best"
+#: how far the served run may drive beyond the in-process one: it stops at the corner up to
+#: two report intervals (50 ms each: the reading's age and the push schedule) later than the
+#: in-process FSM does at its control tick, and its record sees the exit at the next control
+#: tick (up to 50 ms after it), all at the erobotic speed
+DISTANCE_SLACK = 0.2 * EROBOTIC.move_speed
+
+
+def metrics_at_exit(record: Path) -> dict:
+    """Distance and turning up to the first control tick that saw the exit, from the poses of
+    a run record (the served robot drives on after the exit; the in-process run stops)."""
+    distance = turning = 0.0
+    last = None
+    for line in record.read_text().splitlines():
+        tick = json.loads(line)
+        if "type" in tick:
+            continue
+        x, y, heading = tick["pose"]
+        if last is not None:
+            distance += math.hypot(x - last[0], y - last[1])
+            turning += abs((heading - last[2] + 180.0) % 360.0 - 180.0)
+        last = (x, y, heading)
+        if "exit" in tick.get("events", ()):
+            return {"reached_exit": True, "distance": distance, "turn_degrees": turning}
+    return {"reached_exit": False, "distance": distance, "turn_degrees": turning}
+
+
+def summary_of(record: Path) -> dict:
+    last = json.loads(record.read_text().splitlines()[-1])
+    assert last["type"] == "summary"
+    return last
+
+
+def workbench(*argv: str) -> subprocess.Popen:
+    return subprocess.Popen(
+        [sys.executable, "-m", "workbench", *argv],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+
+
+def wait_for_exit(record: Path, procs: list[subprocess.Popen], limit: float = 30.0) -> None:
+    deadline = time.monotonic() + limit
+    while time.monotonic() < deadline:
+        if record.exists() and '"exit"' in record.read_text():
+            return
+        for proc in procs:
+            assert proc.poll() is None, proc.communicate()
+        time.sleep(0.1)
+    pytest.fail(f"the robot did not reach the exit within {limit:g} s")
+
+
+def interrupt(proc: subprocess.Popen) -> tuple[int, str, str]:
+    proc.send_signal(signal.SIGINT)
+    out, err = proc.communicate(timeout=15)
+    return proc.returncode, out, err
+
+
+def served_run(tmp_path: Path, role: str) -> tuple[dict, dict, str]:
+    """The run through `workbench serve` driven by `workbench viple-client`; its metrics at the
+    exit, the server's summary line and the client's output."""
+    maze = tmp_path / "one-corner.txt"
+    maze.write_text(ONE_CORNER)
+    record = tmp_path / f"served-{role}.jsonl"
+    port = free_port()
+    serve = ["serve", "--maze", str(maze), "--report-ms", "50", "--record", str(record)]
+    client = ["viple-client", "--algorithm", ALGORITHM, "--profile", "erobotic"]
+    procs: list[subprocess.Popen] = []
+    try:
+        if role == "tcp":
+            procs.append(workbench(*serve, "--tcp-port", str(port)))
+            procs.append(workbench(*client, "--connect", f"tcp://localhost:{port}"))
+        else:
+            procs.append(workbench(*client, "--listen", f"ws://localhost:{port}"))
+            url = f"ws://localhost:{port}/"
+            procs.append(workbench(*serve, "--tcp-port", "0", "--ws-url", url))
+        wait_for_exit(record, procs)
+        viple = procs[0] if role == "ws" else procs[1]
+        code, out, err = interrupt(viple)
+        assert code == 130, err
+        code, _, err = interrupt(procs[0] if role == "tcp" else procs[1])
+        assert code == 0, err
+    finally:
+        for proc in procs:
+            if proc.poll() is None:
+                proc.kill()
+                proc.communicate()
+    return metrics_at_exit(record), summary_of(record), out
+
+
+@pytest.fixture(scope="module")
+def in_process(tmp_path_factory) -> dict:
+    folder = tmp_path_factory.mktemp("in-process")
+    maze = folder / "one-corner.txt"
+    maze.write_text(ONE_CORNER)
+    record = folder / "run.jsonl"
+    result = run(RunSpec(str(maze), ALGORITHM, profile="erobotic", record=str(record)))
+    at_exit = metrics_at_exit(record)
+    assert at_exit["distance"] == pytest.approx(result.metrics["distance"], abs=1e-6)
+    assert at_exit["turn_degrees"] == pytest.approx(result.metrics["turn_degrees"], abs=1e-6)
+    return {**result.metrics, "final_state": result.final_state}
+
+
+@pytest.mark.parametrize("role", ["tcp", "ws"])
+def test_viple_client_drives_out_through_serve_like_the_in_process_run(tmp_path, in_process, role):
+    at_exit, summary, out = served_run(tmp_path, role)
+    assert in_process["reached_exit"] and in_process["turns"] == 2
+    assert summary["reached_exit"] and at_exit["reached_exit"]
+    assert at_exit["turn_degrees"] == pytest.approx(in_process["turn_degrees"], abs=1.0)
+    assert at_exit["distance"] == pytest.approx(in_process["distance"], abs=DISTANCE_SLACK)
+    assert summary["collisions"] == in_process["collisions"] == 0
+    assert "TurningRight -> TurnedRight" in out and "TurnedLeft -> Forward" in out
+    assert "summary:" in out and "stopped by SIGINT" in out
