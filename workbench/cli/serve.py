@@ -187,6 +187,8 @@ def _endpoint_configs(args: argparse.Namespace) -> tuple[TcpConfig | None, WsCon
 
 
 def cmd_serve(args: argparse.Namespace) -> int:
+    logger = logging.getLogger("workbench")
+    level = logger.level
     handler = _log_to_stderr(logging.DEBUG if args.verbose else logging.INFO)
     try:
         try:
@@ -199,7 +201,8 @@ def cmd_serve(args: argparse.Namespace) -> int:
         except KeyboardInterrupt:
             return 0  # where signal handlers are not available, serve() has cleaned up
     finally:
-        logging.getLogger("workbench").removeHandler(handler)
+        logger.removeHandler(handler)
+        logger.setLevel(level)
 
 
 def _log_to_stderr(level: int) -> logging.Handler:

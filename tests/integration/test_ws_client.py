@@ -1,0 +1,277 @@
+"""The Web-Simulator role against a `websockets` server standing in for VIPLE, on loopback."""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import logging
+import socket
+
+import pytest
+from websockets.asyncio.server import ServerConnection, serve
+from websockets.exceptions import ConnectionClosed
+
+from workbench.sim.mazefile import parse_maze
+from workbench.sim.session import Session
+from workbench.viple.codec import parse_report
+from workbench.viple.link import Seat
+from workbench.viple.tcp_server import TcpConfig, TcpServer
+from workbench.viple.ws_client import RETRY_SECONDS, WsClient, WsConfig, check_ws_url
+
+CORRIDOR = parse_maze("##########\n#S.......#\n##########\n", source="corridor.txt")
+MOVE = '{"servos":[{"isTurn":false,"servoId":-1,"servoSpeed":1}]}'
+STOP = '{"servos":[{"isTurn":false,"servoId":-1,"servoSpeed":"0"}]}'
+DRIVE = (
+    '{"servos":[{"isTurn":false,"servoId":3,"servoSpeed":0.5},'
+    '{"isTurn":false,"servoId":5,"servoSpeed":0.5}]}'
+)
+RETRY = 0.1
+
+
+def free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+class FakeViple:
+    """VIPLE's WebSocket server: accepts the robot, sends frames, collects what arrives."""
+
+    def __init__(self, port: int) -> None:
+        self.port = port
+        self.url = f"ws://127.0.0.1:{port}/"
+        self.server = None
+        self.robot: ServerConnection | None = None
+        self.arrived = asyncio.Event()
+        self.messages: asyncio.Queue[str | bytes] = asyncio.Queue()
+
+    async def start(self) -> FakeViple:
+        self.arrived = asyncio.Event()
+        self.server = await serve(self._robot, "127.0.0.1", self.port, max_size=None)
+        return self
+
+    async def stop(self) -> None:
+        self.server.close()
+        await self.server.wait_closed()
+
+    async def _robot(self, ws: ServerConnection) -> None:
+        self.robot = ws
+        self.arrived.set()
+        try:
+            async for message in ws:
+                await self.messages.put(message)
+        except ConnectionClosed:
+            pass
+
+    async def connected(self, timeout: float = 2.0) -> ServerConnection:
+        await asyncio.wait_for(self.arrived.wait(), timeout)
+        return self.robot
+
+    async def report(self, timeout: float = 2.0) -> dict[int, float]:
+        message = await asyncio.wait_for(self.messages.get(), timeout)
+        assert isinstance(message, str)
+        return parse_report(message)
+
+    async def drop_reports(self) -> None:
+        while not self.messages.empty():
+            self.messages.get_nowait()
+
+
+async def until(predicate, timeout: float = 2.0) -> None:
+    loop = asyncio.get_running_loop()
+    deadline = loop.time() + timeout
+    while not predicate():
+        assert loop.time() < deadline, "timed out"
+        await asyncio.sleep(0.005)
+
+
+def session_for(profile: str = "unity") -> Session:
+    return Session(CORRIDOR, profile, noise="off")
+
+
+def client_for(session: Session, url: str, **config) -> WsClient:
+    return WsClient(session, WsConfig(url=url, retry_seconds=RETRY, **config))
+
+
+def steps(session: Session, n: int) -> None:
+    for _ in range(n):
+        session.step()
+
+
+def messages(caplog, text: str) -> list[str]:
+    return [r.getMessage() for r in caplog.records if text in r.getMessage()]
+
+
+def test_started_before_viple_it_retries_quietly_until_viple_appears(caplog):
+    caplog.set_level(logging.INFO, logger="workbench.viple")
+
+    async def scenario():
+        viple = FakeViple(free_port())
+        session = session_for()
+        async with client_for(session, viple.url) as client:
+            await asyncio.sleep(5 * RETRY)  # several failed attempts
+            assert not client.status.connected
+            await viple.start()
+            await viple.connected()
+            report = await viple.report()
+            assert sorted(report) == [1, 2]
+            assert client.status.connected and client.status.peer == viple.url
+            assert session.driver == f"VIPLE ws {viple.url}"
+        await viple.stop()
+
+    asyncio.run(scenario())
+    assert len(messages(caplog, "is not reachable")) == 1  # once per outage
+    assert len(messages(caplog, "connected to VIPLE at")) == 1
+
+
+def test_commands_in_frames_move_the_robot_and_each_is_answered():
+    async def scenario():
+        viple = await FakeViple(free_port()).start()
+        session = session_for()
+        async with client_for(session, viple.url, report_ms=1000) as client:
+            robot = await viple.connected()
+            await viple.report()  # pushed on connect
+            await robot.send(MOVE)
+            await viple.report(timeout=0.5)  # the answer, long before the next push
+            x = session.world.pose.x
+            steps(session, 60)
+            assert session.world.pose.x == pytest.approx(x + 1.0, abs=0.02)
+            # several CRLF-separated objects in one frame
+            await robot.send(STOP + "\r\n" + MOVE + "\r\n")
+            await viple.report(timeout=0.5)
+            await viple.report(timeout=0.5)
+            assert client.status.messages_in == 3 and client.status.invalid == 0
+            steps(session, 30)
+            assert session.world.pose.x == pytest.approx(x + 1.5, abs=0.02)
+        await viple.stop()
+
+    asyncio.run(scenario())
+
+
+def test_reports_arrive_at_the_configured_rate():
+    async def scenario():
+        viple = await FakeViple(free_port()).start()
+        async with client_for(session_for(), viple.url, report_ms=100):
+            await viple.connected()
+            await viple.report()
+            loop = asyncio.get_running_loop()
+            start = loop.time()
+            count = 0
+            while loop.time() - start < 0.6:
+                await viple.report()
+                count += 1
+            assert 4 <= count <= 8
+        await viple.stop()
+
+    asyncio.run(scenario())
+
+
+def test_viple_restarting_stops_the_robot_and_the_client_reconnects(caplog):
+    caplog.set_level(logging.INFO, logger="workbench.viple")
+
+    async def scenario():
+        port = free_port()
+        viple = await FakeViple(port).start()
+        session = session_for("web")
+        async with client_for(session, viple.url) as client:
+            robot = await viple.connected()
+            await robot.send(DRIVE)
+            await viple.report()
+            await viple.stop()
+            await until(lambda: not client.status.connected)
+            assert session.driver == "nobody"
+            x = session.world.pose.x
+            steps(session, 30)
+            assert session.world.pose.x == pytest.approx(x)  # motors stopped
+            await asyncio.sleep(4 * RETRY)  # VIPLE is down for a while
+
+            viple = await FakeViple(port).start()
+            robot = await viple.connected()
+            await viple.drop_reports()
+            await robot.send(DRIVE)
+            await until(lambda: client.status.messages_in == 2)
+            steps(session, 60)
+            assert session.world.pose.x == pytest.approx(x + 70.0, abs=1.0)
+            assert client.status.connections == 2
+        await viple.stop()
+
+    asyncio.run(scenario())
+    assert len(messages(caplog, "went away")) == 1
+    assert messages(caplog, "is not reachable") == []  # the outage was already reported
+
+
+def test_binary_frames_are_rejected_and_an_oversized_frame_closes_the_connection(caplog):
+    caplog.set_level(logging.INFO, logger="workbench.viple")
+
+    async def scenario():
+        viple = await FakeViple(free_port()).start()
+        session = session_for()
+        async with client_for(session, viple.url) as client:
+            robot = await viple.connected()
+            await robot.send(b"\x00\x01binary")
+            await robot.send("not json")
+            await robot.send(MOVE)
+            await until(lambda: client.status.messages_in == 3)
+            assert client.status.invalid == 2 and client.status.connected
+            viple.arrived.clear()
+            await robot.send('{"servos":[' + " " * 70_000 + "]}")
+            await until(lambda: client.status.invalid == 3)
+            assert await _closed(robot)
+            assert "longer than 65536 bytes" in client.status.last_rejection
+            await viple.connected()  # it came back
+            await until(lambda: client.status.connected)
+            assert client.status.connections == 2
+        await viple.stop()
+
+    asyncio.run(scenario())
+    assert messages(caplog, "binary frame of 8 bytes rejected")
+    assert messages(caplog, "frame longer than 65536 bytes; connection closed")
+
+
+async def _closed(ws: ServerConnection) -> bool:
+    await asyncio.wait_for(ws.wait_closed(), 2.0)
+    return True
+
+
+def test_the_ws_role_waits_while_a_tcp_program_drives_the_same_robot(caplog):
+    caplog.set_level(logging.INFO, logger="workbench.viple")
+
+    async def scenario():
+        viple = await FakeViple(free_port()).start()
+        session = session_for()
+        seat = Seat()
+        async with TcpServer(session, TcpConfig(port=0), seat) as tcp:
+            reader, writer = await asyncio.open_connection("127.0.0.1", tcp.port)
+            await reader.readline()
+            config = WsConfig(url=viple.url, retry_seconds=RETRY)
+            async with WsClient(session, config, seat) as client:
+                await asyncio.sleep(3 * RETRY)
+                assert not viple.arrived.is_set()
+                writer.close()
+                await viple.connected()
+                await until(lambda: client.status.connected)
+                assert session.driver == f"VIPLE ws {viple.url}"
+                # and now a TCP program is the one refused
+                reader, writer = await asyncio.open_connection("127.0.0.1", tcp.port)
+                error = json.loads(await reader.readline())
+                assert error["error"].endswith(f"(from {viple.url})")
+                writer.close()
+        await viple.stop()
+
+    asyncio.run(scenario())
+    assert len(messages(caplog, "is driving the robot; connecting to VIPLE when it is free")) == 1
+
+
+def test_urls_are_checked_and_the_retry_is_every_second_by_default():
+    assert RETRY_SECONDS == 1.0 and WsConfig().retry_seconds == 1.0
+    assert WsConfig().url == "ws://localhost:8124/"
+    assert check_ws_url(" ws://[::1]:8124/ ") == "ws://[::1]:8124/"
+    for bad, why in [
+        ("", "empty"),
+        ("http://localhost:8124/", "scheme isn't ws or wss"),
+        ("ws://", "hostname isn't provided"),
+        ("ws://localhost:99999/", "out of range"),
+        ("localhost:8124", "not usable"),
+    ]:
+        with pytest.raises(ValueError, match=why):
+            check_ws_url(bad)
