@@ -470,3 +470,29 @@ async def test_hide_robot_removes_robot_and_rays():
         await pilot.pause()
         assert maze_lines(view) == SMALL_ASCII
         assert view.robot_cell is None
+
+
+@sync
+async def test_an_edit_redraws_the_rays_at_once():
+    front = SensorSpec("distance", 2, "front")
+    app = Host(SMALL, trail=False)
+    async with app.run_test(size=(40, 10)) as pilot:
+        view = app.query_one(MazeView)
+        view.show(snap(1, 3, 0.0, (front,), {2: 6.4}), 1.0)
+        await pilot.pause()
+        view.set_maze(SMALL.with_block(4, 3, wall=True))
+        await pilot.pause()
+        assert maze_lines(view)[3] == "##> : : 2       ##"
+
+
+@sync
+async def test_tiny_view_does_not_break():
+    maze = generate(40, 40, 3)
+    app = Host(maze)
+    async with app.run_test(size=(4, 3)) as pilot:
+        view = app.query_one(MazeView)
+        for cell in ((1, 79), (79, 1), (40, 40)):
+            view.show(snap(*cell), 1.0)
+            await pilot.pause()
+        view.set_cursor((3, 3))
+        await pilot.pause()

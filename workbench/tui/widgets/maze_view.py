@@ -7,7 +7,8 @@ touch), the robot (a heading arrow), and the editor cursor.
 
 Each maze row is rendered once into a :class:`~textual.strip.Strip` and kept until something
 on that row changes; an update re-renders and refreshes only the changed span of the changed
-rows, so a robot moving at 20 Hz costs a few hundred bytes a second on the terminal.
+rows, so a robot moving at 20 Hz costs about 1-3 KB a second on an 80x24 terminal instead of
+the ~150 KB a whole-widget repaint costs (``bench/tui_render.py`` measures both).
 
 The widget only draws and routes input: it never runs the simulation. The host calls
 :meth:`MazeView.show` with a session snapshot, :meth:`MazeView.set_maze` after an edit and
@@ -231,6 +232,12 @@ class MazeView(ScrollView, can_focus=False):
             changed = [x for x, (a, b) in enumerate(zip(before, after, strict=True)) if a != b]
             if changed:
                 spans[y] = (changed[0], changed[-1])
+        if self._last_show is not None and self._robot is not None:
+            snapshot, cell_size = self._last_show
+            moved = self._set_sprites(self._sensor_sprites(snapshot, cell_size, self._robot))
+            for y, (x0, x1) in self._spans(moved).items():
+                span = spans.get(y)
+                spans[y] = (x0, x1) if span is None else (min(span[0], x0), max(span[1], x1))
         self._apply(spans)
 
     def show(self, snapshot: Snapshot, cell_size: float) -> None:
@@ -550,11 +557,11 @@ class MazeView(ScrollView, can_focus=False):
             return
         x, y = cell
         if margin is None:
-            my = min(3, (view_h - 1) // 4)
-            mx = min(6, (view_w - 2) // 4)
+            my = min(3, max(0, (view_h - 1) // 4))
+            mx = min(6, max(0, (view_w - 2) // 4))
         else:
-            my = min(margin, (view_h - 1) // 2)
-            mx = min(2 * margin, (view_w - 2) // 2)
+            my = min(margin, max(0, (view_h - 1) // 2))
+            mx = min(2 * margin, max(0, (view_w - 2) // 2))
         scroll_x, scroll_y = self.scroll_offset
         new_x, new_y = scroll_x, scroll_y
         col = 2 * x
