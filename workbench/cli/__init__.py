@@ -14,7 +14,7 @@ from . import maze as maze_cmd
 from . import run as run_cmd
 from . import serve as serve_cmd
 from . import viple_client as viple_client_cmd
-from .common import default_maze_path
+from .common import default_maze_path, error
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -24,6 +24,10 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"workbench {__version__}")
     parser.add_argument("--maze", help="maze file to open (default: the bundled Unity maze)")
+    parser.add_argument("--profile", help="unity, web or erobotic (default: the maze's own)")
+    parser.add_argument("--seed", type=int, default=0, help="noise seed (default 0)")
+    parser.add_argument("--noise", help="off, low or realistic (default: the profile's)")
+    parser.add_argument("--unicode", action="store_true", help="draw the maze with Unicode lines")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     maze_cmd.register(sub)
     algorithms_cmd.register(sub)
@@ -37,7 +41,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.command is None:
-        return demo(args)
+        return open_app(args)
     try:
         return int(args.func(args) or 0)
     except KeyboardInterrupt:
@@ -47,6 +51,29 @@ def main(argv: Sequence[str] | None = None) -> int:
         # the reader went away (e.g. `| head`): stop quietly, as other command-line tools do
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 141
+
+
+def open_app(args: argparse.Namespace) -> int:
+    """Without a command: the workbench app on the chosen (or bundled default) maze.
+
+    Bad arguments are reported before the app starts (exit 2). Without a terminal (output
+    piped, no Textual driver set) the maze and its check are printed instead.
+    """
+    from workbench.tui.app import AppSetupError, make_app
+
+    try:
+        app = make_app(
+            args.maze, args.profile, seed=args.seed, noise=args.noise, unicode=args.unicode
+        )
+    except AppSetupError as exc:
+        error(str(exc))
+        return 2
+    terminal = sys.stdin.isatty() and sys.stdout.isatty()
+    if not terminal and not os.environ.get("TEXTUAL_DRIVER"):
+        print("workbench: not a terminal, so no app: here is the maze", file=sys.stderr)
+        return demo(args)
+    app.run()
+    return app.return_code or 0
 
 
 def demo(args: argparse.Namespace) -> int:

@@ -1,0 +1,217 @@
+"""The workbench app: one bench (maze, robot, driver, runs) behind a Textual front end.
+
+:func:`make_app` builds the app for the command line, the SSH server and the tests. The app
+ticks the simulation from a Textual interval: each tick hands the real time that has passed to
+the bench (a fixed-step accumulator, so a late tick loses no simulated time), then draws one
+snapshot on every screen that shows it.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from time import perf_counter
+from typing import ClassVar
+
+from textual import events
+from textual.app import App
+from textual.binding import Binding, BindingType
+from textual.reactive import var
+from textual.screen import Screen
+
+from workbench.control.bench import Bench
+from workbench.sim.maze import MazeError
+from workbench.sim.mazeio import load_maze
+from workbench.sim.noise import NOISE_LEVELS
+from workbench.sim.profiles import PROFILES
+
+from .commands import WorkbenchCommands
+from .modals.help import HelpScreen
+from .modals.too_small import TooSmallScreen
+from .screens.main import MainScreen
+
+#: the smallest terminal the layout is made for (columns, rows)
+MIN_SIZE = (80, 24)
+ROLES = ("student", "instructor")
+
+
+class AppSetupError(ValueError):
+    """The app cannot start with these arguments; the message says what to change."""
+
+
+class WorkbenchApp(App[None]):
+    """VIPLE Maze Lab Workbench."""
+
+    CSS_PATH = "app.tcss"
+    TITLE = "VIPLE Maze Lab Workbench"
+    COMMANDS = App.COMMANDS | {WorkbenchCommands}
+    HORIZONTAL_BREAKPOINTS: ClassVar[list[tuple[int, str]]] = [(0, "-narrow"), (110, "-wide")]
+    BINDINGS: ClassVar[list[BindingType]] = [
+        Binding("ctrl+q", "quit", "Quit", priority=True, id="app.quit"),
+        Binding("question_mark", "help", "Help", key_display="?", id="app.help"),
+        Binding(
+            "ctrl+p", "command_palette", "Commands", show=False, priority=True, id="app.commands"
+        ),
+    ]
+
+    #: draw the maze with Unicode lines and arrows (False: plain ASCII)
+    unicode: var[bool] = var(False, init=False)
+    #: frames drawn so far (per-tick state: no repaint)
+    frames: var[int] = var(0)
+
+    def __init__(
+        self,
+        bench: Bench,
+        maze_path: Path | None = None,
+        user: str | None = None,
+        role: str = "student",
+        tick_hz: float = 20.0,
+        unicode: bool = False,
+    ) -> None:
+        super().__init__()
+        self.bench = bench
+        self.maze_path = maze_path
+        self.user = user
+        self.role = role
+        self.tick_hz = tick_hz
+        self.set_reactive(WorkbenchApp.unicode, unicode)
+        self._last_tick = perf_counter()
+        self._drawn: tuple[object, ...] = ()
+        self._too_small: TooSmallScreen | None = None
+
+    def who(self) -> str:
+        return f"{self.user} ({self.role})" if self.user else ""
+
+    def get_default_screen(self) -> Screen:
+        return MainScreen(self.bench, unicode=self.unicode)
+
+    def on_mount(self) -> None:
+        self.sub_title = f"{self.bench.maze.name} ({self.bench.profile})"
+        self._last_tick = perf_counter()
+        self.set_interval(1.0 / self.tick_hz, self._tick, name="simulation")
+        self._check_size(self.size.width, self.size.height)
+
+    # -- time --------------------------------------------------------------------------------
+    def _tick(self) -> None:
+        now = perf_counter()
+        elapsed = now - self._last_tick
+        self._last_tick = now
+        bench = self.bench
+        steps = bench.advance(elapsed)
+        state = (bench.pacer.paused, bench.message, bench.controller, len(bench.runs))
+        if steps or state != self._drawn:
+            self.refresh_views()
+
+    def refresh_views(self) -> None:
+        """Draw the bench's current snapshot on every screen of the stack that shows one."""
+        bench = self.bench
+        self._drawn = (bench.pacer.paused, bench.message, bench.controller, len(bench.runs))
+        snapshot = bench.snapshot()
+        for screen in self.screen_stack:
+            show = getattr(screen, "show_snapshot", None)
+            if show is not None:
+                show(snapshot)
+        self.frames += 1
+
+    # -- size --------------------------------------------------------------------------------
+    def on_resize(self, event: events.Resize) -> None:
+        self._check_size(event.size.width, event.size.height)
+
+    def _check_size(self, width: int, height: int) -> None:
+        small = width < MIN_SIZE[0] or height < MIN_SIZE[1]
+        if small and self._too_small is None:
+            self._too_small = TooSmallScreen(MIN_SIZE)
+            self.push_screen(self._too_small)
+        elif small and self._too_small is not None:
+            self._too_small.show_size(width, height)
+        elif not small and self._too_small is not None:
+            screen, self._too_small = self._too_small, None
+            if self.screen is screen:
+                self.pop_screen()
+
+    def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None:
+        """While the terminal is too small only quitting works."""
+        return self._too_small is None or action == "quit"
+
+    # -- view settings -------------------------------------------------------------------------
+    def watch_unicode(self, unicode: bool) -> None:
+        for screen in self.screen_stack:
+            setter = getattr(screen, "set_unicode", None)
+            if setter is not None:
+                setter(unicode)
+
+    # -- screens -------------------------------------------------------------------------------
+    def action_help(self) -> None:
+        if not isinstance(self.screen, HelpScreen):
+            self.push_screen(HelpScreen(self.bench.profile))
+
+    def open_editor(self) -> None:
+        try:
+            from .screens.editor import EditorScreen
+        except ImportError:
+            self._say("the maze editor is not in this version of the workbench")
+            return
+        self.push_screen(EditorScreen(self.bench, self.maze_path))
+
+    def open_runs(self) -> None:
+        try:
+            from .screens.runs import RunsScreen
+        except ImportError:
+            self._say("the runs screen is not in this version of the workbench")
+            return
+        self.push_screen(RunsScreen(self.bench))
+
+    def _say(self, message: str) -> None:
+        self.bench.message = message
+        self.refresh_views()
+
+    async def action_quit(self) -> None:
+        self.bench.close()
+        self.exit()
+
+
+def make_app(
+    maze_path: str | os.PathLike | None = None,
+    profile: str | None = None,
+    user: str | None = None,
+    role: str = "student",
+    seed: int = 0,
+    noise: str | None = None,
+    paused: bool = False,
+    tick_hz: float = 20,
+    unicode: bool = False,
+    record_dir: str | None = None,
+) -> WorkbenchApp:
+    """The workbench app on a maze file (default: the bundled Unity maze).
+
+    Raises :class:`AppSetupError` with a message for the user when the maze cannot be read or
+    an argument is not one the workbench knows.
+    """
+    if maze_path is None:
+        from workbench.cli.common import default_maze_path
+
+        maze_path = default_maze_path()
+    path = Path(maze_path)
+    if profile is not None and profile not in PROFILES:
+        raise AppSetupError(f"unknown profile {profile!r}: use one of {', '.join(PROFILES)}")
+    if noise is not None and noise not in NOISE_LEVELS:
+        raise AppSetupError(f"unknown noise level {noise!r}: use one of {', '.join(NOISE_LEVELS)}")
+    if role not in ROLES:
+        raise AppSetupError(f"unknown role {role!r}: use one of {', '.join(ROLES)}")
+    if not tick_hz > 0:
+        raise AppSetupError(f"the tick rate must be above 0 Hz, not {tick_hz}")
+    try:
+        maze = load_maze(path)
+    except MazeError as exc:
+        problems = "\n".join(f"  {p}" for p in exc.problems)
+        raise AppSetupError(f"cannot open the maze {str(path)!r}:\n{problems}") from None
+    try:
+        bench = Bench.open(maze, profile, seed=seed, noise=noise, record_dir=record_dir)
+    except ValueError as exc:
+        raise AppSetupError(f"cannot set up the robot: {exc}") from None
+    bench.pacer.paused = paused
+    # max speed may use at most 60 % of each frame, so keys and drawing stay responsive
+    bench.pacer.budget = 0.6 / tick_hz
+    return WorkbenchApp(
+        bench, maze_path=path, user=user, role=role, tick_hz=tick_hz, unicode=unicode
+    )

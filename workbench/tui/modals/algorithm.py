@@ -1,0 +1,350 @@
+"""The algorithm selector: pick a built-in or load a YAML FSM file, read what it does and what
+it needs, tune its parameters, and start, pause, step or reset it.
+
+A file with problems is reported as ``file:line:column: message``. A missing sensor is
+explained, with a one-key fix: ``f`` gives the robot the sensors the algorithm reads.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import ClassVar
+
+from textual import on
+from textual.app import ComposeResult
+from textual.binding import Binding, BindingType
+from textual.containers import Horizontal, Vertical, VerticalScroll
+from textual.screen import ModalScreen
+from textual.widgets import Button, Input, Label, OptionList, Static
+from textual.widgets.option_list import Option
+
+from workbench.control.algorithms import ALGORITHM_DIR, list_algorithms
+from workbench.control.bench import Bench
+from workbench.control.fsm import FsmError, resolve_params
+from workbench.control.fsmfile import FsmFileError
+from workbench.sim.session import Snapshot
+
+from ..widgets.param_editor import ParamEditor
+
+
+def _source(source: str) -> str:
+    """ "built-in" for the bundled algorithms, else the file as given."""
+    if not source:
+        return "built-in"
+    path = Path(source)
+    if path.parent.resolve() == ALGORITHM_DIR:
+        return "built-in"
+    return source
+
+
+class AlgorithmModal(ModalScreen[None]):
+    """Choose and set up the algorithm that drives the robot."""
+
+    DEFAULT_CSS = """
+    AlgorithmModal {
+        align: center middle;
+    }
+    AlgorithmModal > #alg-dialog {
+        width: 100%;
+        max-width: 110;
+        height: 100%;
+        max-height: 36;
+        border: round $primary;
+        border-title-color: $text-primary;
+        border-subtitle-color: $text-muted;
+        background: $surface;
+        padding: 0 1;
+    }
+    AlgorithmModal #alg-top {
+        height: 1fr;
+    }
+    AlgorithmModal #alg-choose {
+        width: 27;
+        margin-right: 1;
+    }
+    AlgorithmModal #alg-builtins {
+        height: auto;
+        max-height: 10;
+        border: none;
+        padding: 0;
+        margin-bottom: 1;
+        scrollbar-size-vertical: 1;
+    }
+    AlgorithmModal .heading {
+        color: $text-primary;
+        text-style: bold;
+    }
+    AlgorithmModal #alg-path {
+        margin: 0;
+    }
+    AlgorithmModal Button {
+        min-width: 0;
+        width: auto;
+    }
+    AlgorithmModal #alg-details {
+        width: 1fr;
+        scrollbar-size-vertical: 1;
+    }
+    AlgorithmModal #alg-details > Static {
+        height: auto;
+        margin-bottom: 1;
+    }
+    AlgorithmModal #alg-missing {
+        color: $text-warning;
+    }
+    AlgorithmModal #alg-params-head {
+        height: 1;
+    }
+    AlgorithmModal #alg-params-head Label {
+        width: 1fr;
+    }
+    AlgorithmModal #alg-error {
+        height: auto;
+        max-height: 6;
+        color: $text-error;
+    }
+    AlgorithmModal #alg-buttons {
+        height: 1;
+    }
+    AlgorithmModal #alg-buttons Button {
+        margin-right: 1;
+    }
+    AlgorithmModal #alg-live {
+        width: 1fr;
+        text-align: right;
+        color: $text-muted;
+    }
+    """
+
+    BINDINGS: ClassVar[list[BindingType]] = [
+        Binding("escape", "close", "Close", id="dialog.close"),
+        Binding("f", "fix", "Fit sensors", id="algorithm.fix"),
+        Binding("ctrl+d", "defaults", "Defaults", id="algorithm.defaults"),
+    ]
+
+    def __init__(self, bench: Bench) -> None:
+        super().__init__()
+        self.bench = bench
+
+    # -- layout ----------------------------------------------------------------------------
+    def compose(self) -> ComposeResult:
+        dialog = Vertical(id="alg-dialog")
+        dialog.border_title = "Algorithm"
+        dialog.border_subtitle = "enter picks, f fits sensors, escape closes"
+        names = list_algorithms()
+        with dialog:
+            with Horizontal(id="alg-top"):
+                with Vertical(id="alg-choose"):
+                    yield Label("Built-in", classes="heading")
+                    yield OptionList(*[Option(n, id=n) for n in names], id="alg-builtins")
+                    yield Label("FSM file (YAML)", classes="heading")
+                    yield Input(placeholder="path/to/fsm.yaml", compact=True, id="alg-path")
+                    yield Button("Load file", compact=True, id="alg-load")
+                with VerticalScroll(id="alg-details"):
+                    yield Static(id="alg-title", markup=False)
+                    yield Static(id="alg-description", markup=False)
+                    yield Static(id="alg-sensors", markup=False)
+                    yield Static(id="alg-missing", markup=False)
+                    with Horizontal(id="alg-params-head"):
+                        yield Label("Parameters", classes="heading")
+                        yield Button("Defaults", compact=True, id="alg-defaults")
+                    yield Vertical(id="alg-params")
+            yield Static(id="alg-error", markup=False)
+            with Horizontal(id="alg-buttons"):
+                yield Button("Start", variant="primary", compact=True, id="alg-start")
+                yield Button("Pause", compact=True, id="alg-pause")
+                yield Button("Step", compact=True, id="alg-step")
+                yield Button("Reset", compact=True, id="alg-reset")
+                yield Button("Fit sensors", compact=True, id="alg-fix")
+                yield Button("Close", compact=True, id="alg-close")
+                yield Label("", id="alg-live", markup=False)
+
+    async def on_mount(self) -> None:
+        options = self.query_one("#alg-builtins", OptionList)
+        current = self.bench.algorithm
+        names = list_algorithms()
+        if current is not None and _source(current.source) == "built-in":
+            options.highlighted = names.index(current.name)
+        elif current is not None and current.source:
+            self.query_one("#alg-path", Input).value = current.source
+            options.highlighted = 0
+        else:
+            options.highlighted = 0
+        options.focus()
+        await self._show_definition()
+        self.show_snapshot(self.bench.snapshot())
+
+    # -- drawing -------------------------------------------------------------------------------
+    async def _show_definition(self) -> None:
+        bench = self.bench
+        definition = bench.algorithm
+        params = self.query_one("#alg-params", Vertical)
+        await params.remove_children()
+        title = self.query_one("#alg-title", Static)
+        self.query_one("#alg-params-head").display = definition is not None
+        if definition is None:
+            title.update("No algorithm chosen: pick a built-in on the left, or load a YAML file.")
+            for name in ("#alg-description", "#alg-sensors", "#alg-missing"):
+                self.query_one(name, Static).display = False
+            return
+        title.update(f"{definition.name}  ({_source(definition.source)})")
+        description = self.query_one("#alg-description", Static)
+        description.update(" ".join(definition.description.split()) or "(no description)")
+        description.display = True
+        lines = [f"Sensors it reads ({bench.profile} ports):"]
+        lines += [
+            f"  {need.name}: {need.kind} sensor mounted {need.mount}, "
+            f"port {need.ports.get(bench.profile, '?')}"
+            for need in definition.sensors
+        ]
+        if not definition.sensors:
+            lines.append("  none")
+        sensors = self.query_one("#alg-sensors", Static)
+        sensors.update("\n".join(lines))
+        sensors.display = True
+        self._show_missing()
+        values = bench.params()
+        defaults = resolve_params(definition, bench.profile)
+        await params.mount_all(
+            ParamEditor(p, values[p.name], defaults[p.name]) for p in definition.parameters
+        )
+        if not definition.parameters:
+            await params.mount(Label("none", markup=False))
+
+    def _show_missing(self) -> None:
+        missing = self.bench.missing_sensors()
+        widget = self.query_one("#alg-missing", Static)
+        if missing:
+            widget.update(
+                f"{missing}\n\nPress f (or Fit sensors) to give the robot the sensors "
+                "this algorithm reads."
+            )
+        widget.display = bool(missing)
+        self.query_one("#alg-fix", Button).disabled = not missing
+
+    def show_snapshot(self, snapshot: Snapshot) -> None:
+        bench = self.bench
+        paused = " (paused)" if bench.pacer.paused else ""
+        if bench.controller is not None:
+            text = f"running, in {bench.controller.state}{paused}"
+        else:
+            text = f"driver: {snapshot.driver}{paused}"
+        self.query_one("#alg-live", Label).update(text)
+        self.query_one("#alg-pause", Button).label = "Resume" if bench.pacer.paused else "Pause"
+
+    def _error(self, text: str) -> None:
+        self.query_one("#alg-error", Static).update(text)
+
+    def _refresh_all(self) -> None:
+        refresh = getattr(self.app, "refresh_views", None)
+        if refresh is not None:
+            refresh()
+        else:
+            self.show_snapshot(self.bench.snapshot())
+
+    # -- choosing ---------------------------------------------------------------------------------
+    async def choose(self, name_or_path: str | Path) -> bool:
+        """Select an algorithm on the bench; a bad file's problems are shown, not raised."""
+        try:
+            definition = self.bench.select_algorithm(name_or_path)
+        except FsmFileError as exc:
+            self._error("\n".join(str(p) for p in exc.problems))
+            return False
+        except (FsmError, OSError) as exc:
+            self._error(str(exc))
+            return False
+        self._error("")
+        await self._show_definition()
+        self._refresh_all()
+        self.bench.message = f"chose {definition.name}: Start (or x) runs it"
+        return True
+
+    @on(OptionList.OptionSelected, "#alg-builtins")
+    async def _builtin_selected(self, event: OptionList.OptionSelected) -> None:
+        assert event.option.id is not None
+        await self.choose(event.option.id)
+
+    @on(Button.Pressed, "#alg-load")
+    @on(Input.Submitted, "#alg-path")
+    async def _load_file(self) -> None:
+        text = self.query_one("#alg-path", Input).value.strip()
+        if not text:
+            self._error("type the path of a YAML FSM file first")
+            return
+        await self.choose(Path(text).expanduser())
+
+    @on(ParamEditor.Edited)
+    def _param_edited(self, event: ParamEditor.Edited) -> None:
+        try:
+            self.bench.set_params([event.item])
+        except (FsmError, ValueError) as exc:
+            event.editor.set_error(str(exc))
+            return
+        event.editor.set_error(None)
+
+    # -- actions ----------------------------------------------------------------------------------
+    def action_start(self) -> None:
+        bench = self.bench
+        if bench.algorithm is None:
+            self._error("pick an algorithm first")
+            return
+        bad = [e.parameter.name for e in self.query(ParamEditor) if e.invalid]
+        if bad:
+            self._error(f"fix the parameters marked in red first: {', '.join(bad)}")
+            return
+        if bench.missing_sensors():
+            self._error("the robot lacks a sensor this algorithm reads: press f to fit them")
+            return
+        try:
+            bench.start_algorithm()
+        except (FsmError, ValueError) as exc:
+            self._error(f"cannot start: {exc}")
+            return
+        self._refresh_all()
+        self.dismiss()
+
+    def action_pause(self) -> None:
+        self.bench.toggle_pause()
+        self._refresh_all()
+
+    def action_step(self) -> None:
+        bench = self.bench
+        bench.pacer.paused = True
+        bench.step(bench.session.every)
+        self._refresh_all()
+
+    def action_reset(self) -> None:
+        self.bench.reset_robot()
+        self._refresh_all()
+
+    def action_fix(self) -> None:
+        bench = self.bench
+        if bench.algorithm is None or bench.missing_sensors() is None:
+            return
+        bench.apply_algorithm_preset()
+        ports = ", ".join(str(s) for s in bench.sensors)
+        self._error("")
+        bench.message = f"sensors set for {bench.algorithm.name}: {ports}"
+        self._show_missing()
+        self._refresh_all()
+
+    async def action_defaults(self) -> None:
+        if self.bench.algorithm is None:
+            return
+        self.bench.reset_params()
+        await self._show_definition()
+
+    def action_close(self) -> None:
+        self.dismiss()
+
+    @on(Button.Pressed, "#alg-buttons Button")
+    async def _button(self, event: Button.Pressed) -> None:
+        action = (event.button.id or "").removeprefix("alg-")
+        if action == "close":
+            self.dismiss()
+        elif action in ("start", "pause", "step", "reset", "fix"):
+            getattr(self, f"action_{action}")()
+
+    @on(Button.Pressed, "#alg-defaults")
+    async def _defaults(self) -> None:
+        await self.action_defaults()

@@ -1,0 +1,202 @@
+"""The main screen: the maze with the robot, and around it everything a lab needs at a glance.
+
+Layout: the maze view (most of the space) over the run status, a side panel with the key
+legend, the sensor readings by port and the algorithm's live state, the message line and the
+footer. Every action here calls the bench; the screen only draws what the bench reports.
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+from textual.app import ComposeResult
+from textual.binding import Binding, BindingType
+from textual.containers import Horizontal, Vertical
+from textual.reactive import var
+from textual.screen import Screen
+from textual.widgets import Footer
+
+from workbench.control.bench import Bench
+from workbench.control.fsm import FsmError
+from workbench.sim.sensors import SensorConfigError
+from workbench.sim.session import Snapshot
+
+from ..widgets.algorithm_state import AlgorithmState
+from ..widgets.key_legend import KeyLegend
+from ..widgets.maze_view import MazeView
+from ..widgets.message_bar import MessageBar
+from ..widgets.run_status import RunStatus
+from ..widgets.sensor_readings import SensorReadings
+
+
+class MainScreen(Screen[None]):
+    """Drive, watch and set up the robot."""
+
+    BINDINGS: ClassVar[list[BindingType]] = [
+        Binding("w", "drive('w')", "Forward", show=False, id="drive.forward"),
+        Binding("a", "drive('a')", "Left", show=False, id="drive.left"),
+        Binding("s", "drive('s')", "Backward", show=False, id="drive.backward"),
+        Binding("d", "drive('d')", "Right", show=False, id="drive.right"),
+        Binding("space", "drive('space')", "Stop", show=False, id="drive.stop"),
+        Binding("p", "pause", "Pause", id="sim.pause"),
+        Binding("n", "step", "Step", id="sim.step"),
+        Binding("plus,equals_sign", "speed", "Speed", key_display="+", id="sim.speed"),
+        Binding("r", "reset", "Reset", id="sim.reset"),
+        Binding("o", "sensors", "Ports", id="panel.sensors"),
+        Binding("g", "algorithm", "Algorithm", id="panel.algorithm"),
+        Binding("x", "run_algorithm", "Run", id="algorithm.run"),
+        Binding("f", "fix_sensors", "Fix sensors", show=False, id="algorithm.fix"),
+        Binding("u", "unicode", "Unicode", show=False, id="view.unicode"),
+        Binding("t", "trail", "Trail", show=False, id="view.trail"),
+        Binding("e", "editor", "Editor", show=False, id="screen.editor"),
+        Binding("R", "runs", "Runs", show=False, id="screen.runs"),
+    ]
+
+    #: the last snapshot drawn (per-tick state: never repaints by itself)
+    snapshot: var[Snapshot | None] = var(None)
+
+    def __init__(self, bench: Bench, unicode: bool = False, trail: bool = True) -> None:
+        super().__init__()
+        self.bench = bench
+        self._unicode = unicode
+        self._trail = trail
+
+    def compose(self) -> ComposeResult:
+        with Horizontal(id="body"):
+            with Vertical(id="stage"):
+                yield MazeView(self.bench.maze, unicode=self._unicode, trail=self._trail, id="maze")
+                yield RunStatus(id="run")
+            with Vertical(id="side"):
+                yield KeyLegend(self.bench.profile, id="legend")
+                yield SensorReadings(id="readings")
+                yield AlgorithmState(id="algorithm")
+        yield MessageBar(self.app_who(), id="message")
+        yield Footer(compact=True, show_command_palette=False)
+
+    def app_who(self) -> str:
+        who = getattr(self.app, "who", "")
+        return who() if callable(who) else ""
+
+    def on_mount(self) -> None:
+        self.show_snapshot(self.bench.snapshot())
+
+    def on_screen_resume(self) -> None:
+        view = self.query_one(MazeView)
+        if view.maze is not self.bench.maze:
+            view.set_maze(self.bench.maze)
+            view.clear_trail()
+        self.query_one(KeyLegend).profile = self.bench.profile
+        self.show_snapshot(self.bench.snapshot())
+
+    # -- drawing ---------------------------------------------------------------------------
+    @property
+    def unicode(self) -> bool:
+        return self.query_one(MazeView).unicode
+
+    def show_snapshot(self, snapshot: Snapshot) -> None:
+        """Draw one snapshot: each widget repaints only what changed."""
+        bench = self.bench
+        self.snapshot = snapshot
+        unicode = self.unicode
+        self.query_one(MazeView).show(snapshot, bench.session.world.cell)
+        self.query_one(SensorReadings).show(snapshot, bench.profile)
+        self.query_one(RunStatus).show(snapshot, bench, unicode)
+        self.query_one(AlgorithmState).show(bench, unicode)
+        self.query_one(MessageBar).message = bench.message
+
+    def refresh_views(self) -> None:
+        self.show_snapshot(self.bench.snapshot())
+
+    def say(self, message: str) -> None:
+        self.bench.message = message
+        self.refresh_views()
+
+    # -- actions -------------------------------------------------------------------------------
+    def action_drive(self, key: str) -> None:
+        bench = self.bench
+        bench.message = ""
+        bench.key(key)
+        self.refresh_views()
+
+    def action_pause(self) -> None:
+        paused = self.bench.toggle_pause()
+        self.say("paused: n steps, p resumes" if paused else "")
+
+    def action_step(self) -> None:
+        bench = self.bench
+        bench.pacer.paused = True
+        bench.step(bench.session.every)
+        self.refresh_views()
+
+    def action_speed(self) -> None:
+        self.bench.pacer.next_speed()
+        self.refresh_views()
+
+    def action_reset(self) -> None:
+        self.bench.reset_robot()
+        self.query_one(MazeView).clear_trail()
+        self.refresh_views()
+
+    def action_sensors(self) -> None:
+        from ..modals.sensor_ports import SensorPortsModal
+
+        self.app.push_screen(SensorPortsModal(self.bench))
+
+    def action_algorithm(self) -> None:
+        from ..modals.algorithm import AlgorithmModal
+
+        self.app.push_screen(AlgorithmModal(self.bench))
+
+    def action_run_algorithm(self) -> None:
+        bench = self.bench
+        if bench.controller is not None:
+            bench.stop_algorithm("stopped")
+            self.say("algorithm stopped: the keys drive")
+            return
+        if bench.algorithm is None:
+            self.action_algorithm()
+            return
+        missing = bench.missing_sensors()
+        if missing:
+            self.say("the algorithm lacks a sensor: f fits the sensors it needs")
+            return
+        try:
+            bench.start_algorithm()
+        except (FsmError, ValueError) as exc:
+            self.say(f"cannot start: {exc}")
+            return
+        self.query_one(MazeView).clear_trail()
+        self.refresh_views()
+
+    def action_fix_sensors(self) -> None:
+        bench = self.bench
+        if bench.algorithm is None:
+            self.say("choose an algorithm first (g)")
+            return
+        if bench.missing_sensors() is None:
+            self.say(f"the sensors already fit {bench.algorithm.name}")
+            return
+        try:
+            bench.apply_algorithm_preset()
+        except (SensorConfigError, FsmError, ValueError) as exc:
+            self.say(f"cannot fit the sensors: {exc}")
+            return
+        ports = ", ".join(str(s) for s in bench.sensors)
+        self.say(f"sensors set for {bench.algorithm.name}: {ports}; x starts it")
+
+    def action_unicode(self) -> None:
+        self.set_unicode(not self.unicode)
+
+    def set_unicode(self, unicode: bool) -> None:
+        self.query_one(MazeView).set_unicode(unicode)
+        self.refresh_views()
+
+    def action_trail(self) -> None:
+        view = self.query_one(MazeView)
+        view.set_trail(not view.trail)
+
+    def action_editor(self) -> None:
+        self.app.open_editor()  # type: ignore[attr-defined]
+
+    def action_runs(self) -> None:
+        self.app.open_runs()  # type: ignore[attr-defined]

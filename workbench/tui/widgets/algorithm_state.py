@@ -1,0 +1,150 @@
+"""The chosen algorithm and, while it runs, its state machine thinking: the states with the
+current one highlighted, the variables, the last transition with the sensor values that fired
+it, and a scrolling log of transitions."""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+from textual.app import ComposeResult
+from textual.containers import Vertical
+from textual.content import Content
+from textual.reactive import var
+from textual.widgets import Static
+
+from workbench.control.bench import Bench
+from workbench.sim.profiles import get_profile
+
+from .text import arrow, number
+from .transition_log import TransitionLog, values_text
+
+
+class AlgorithmState(Vertical):
+    """What the algorithm is doing, refreshed from the bench after each tick."""
+
+    DEFAULT_CSS = """
+    AlgorithmState {
+        height: 1fr;
+        padding: 0 1;
+        border-top: solid $primary;
+        border-title-color: $text-primary;
+    }
+    AlgorithmState > Static {
+        height: auto;
+    }
+    AlgorithmState > #algorithm-summary {
+        color: $text-secondary;
+    }
+    AlgorithmState > #algorithm-last {
+        color: $text-muted;
+    }
+    AlgorithmState > .algorithm-state--current {
+        background: $accent;
+        color: $text;
+        text-style: bold;
+    }
+    """
+    COMPONENT_CLASSES: ClassVar[set[str]] = {"algorithm-state--current"}
+
+    summary: var[str] = var("", init=False)
+    states: var[tuple[tuple[str, ...], str | None]] = var(((), None), init=False)
+    variables: var[str] = var("", init=False)
+    last: var[str] = var("", init=False)
+
+    def __init__(self, *, id: str | None = None, classes: str | None = None) -> None:
+        super().__init__(id=id, classes=classes)
+        self.border_title = "Algorithm"
+
+    def compose(self) -> ComposeResult:
+        yield Static(id="algorithm-summary", markup=False)
+        yield Static(id="algorithm-states", markup=False)
+        yield Static(id="algorithm-vars", markup=False)
+        yield Static(id="algorithm-last", markup=False)
+        yield TransitionLog(id="algorithm-log")
+
+    def on_mount(self) -> None:
+        self.watch_summary(self.summary)
+        self.watch_states(self.states)
+        self.watch_variables(self.variables)
+        self.watch_last(self.last)
+
+    @property
+    def highlighted(self) -> str | None:
+        """The state shown as the current one (None when no algorithm runs)."""
+        return self.states[1]
+
+    def show(self, bench: Bench, unicode: bool) -> None:
+        definition = bench.algorithm
+        controller = bench.controller
+        unit = get_profile(bench.profile).unit
+        log = self.query_one(TransitionLog)
+        if definition is None:
+            self.border_title = "Algorithm"
+            self.summary = "none chosen: the keys drive. g chooses one."
+            self.states = ((), None)
+            self.variables = ""
+            self.last = ""
+            log.show(None, (), unit, unicode)
+            log.display = False
+            return
+        self.border_title = f"Algorithm {definition.name}"
+        names = tuple(s.name for s in definition.states)
+        if controller is None:
+            missing = bench.missing_sensors()
+            if missing:
+                first = missing.splitlines()[0].split(": add one")[0]
+                self.summary = f"cannot start: {first}. f fits the sensors it needs."
+            else:
+                self.summary = "not running: x starts it, g changes it."
+            self.states = (names, None)
+            self.variables = ""
+            self.last = ""
+            log.display = False
+            return
+        t = bench.session.world.time
+        timer = controller.timer_remaining(t)
+        self.summary = f"in {controller.state}" + (
+            f", timer {timer:.1f} s" if timer is not None else ""
+        )
+        self.states = (names, controller.state)
+        self.variables = " ".join(
+            f"{k}={number(v, unit) if isinstance(v, int | float) else v}"
+            for k, v in controller.variables.items()
+        )
+        history = controller.history
+        if history:
+            tr = history[-1]
+            text = f"{tr.time:.1f} s {tr.source} {arrow(unicode)} {tr.target}"
+            if tr.guard_text:
+                text += f" when {tr.guard_text}"
+            if tr.values:
+                text += f" ({values_text(dict(tr.values), unit)})"
+            self.last = text
+        else:
+            self.last = "no transition yet"
+        log.display = True
+        log.show(controller, history, unit, unicode)
+
+    def watch_summary(self, text: str) -> None:
+        self.query_one("#algorithm-summary", Static).update(text)
+
+    def watch_states(self, value: tuple[tuple[str, ...], str | None]) -> None:
+        names, current = value
+        style = self.get_visual_style("algorithm-state--current", partial=True)
+        parts = [
+            Content.styled(f" {name} ", style) if name == current else Content(f" {name} ")
+            for name in names
+        ]
+        widget = self.query_one("#algorithm-states", Static)
+        widget.update(Content("").join(parts))
+        widget.display = bool(names)
+
+    def watch_variables(self, text: str) -> None:
+        widget = self.query_one("#algorithm-vars", Static)
+        widget.update(f"vars: {text}" if text else "")
+        widget.display = bool(text)
+
+    def watch_last(self, text: str) -> None:
+        widget = self.query_one("#algorithm-last", Static)
+        widget.update(text)
+        widget.display = bool(text)

@@ -1,0 +1,46 @@
+"""One line for what the workbench has to say (run finished, errors, hints) and who is in."""
+
+from __future__ import annotations
+
+from textual.reactive import var
+from textual.widgets import Static
+
+
+class MessageBar(Static):
+    """The bench message on the left; the user and role on the right."""
+
+    DEFAULT_CSS = """
+    MessageBar {
+        height: 1;
+        padding: 0 1;
+        background: $boost;
+        color: $text-warning;
+    }
+    """
+
+    message: var[str] = var("")
+    who: var[str] = var("")
+
+    def __init__(self, who: str = "", *, id: str | None = None, classes: str | None = None):
+        super().__init__(id=id, classes=classes, markup=False)
+        self.set_reactive(MessageBar.who, who)
+
+    def on_mount(self) -> None:
+        self._paint()
+
+    def watch_message(self) -> None:
+        self._paint()
+
+    def watch_who(self) -> None:
+        self._paint()
+
+    def _paint(self) -> None:
+        text = self.message or "? help  ctrl+p commands  ctrl+q quit"
+        who = self.who
+        width = max(self.size.width - 2, 0)
+        if who and width and len(text) + len(who) + 2 <= width:
+            text = text + " " * (width - len(text) - len(who)) + who
+        self.update(text, layout=False)
+
+    def on_resize(self) -> None:
+        self._paint()

@@ -1,0 +1,97 @@
+"""One tunable parameter of an algorithm: its value (checked as it is typed), its range and
+default, and what it means."""
+
+from __future__ import annotations
+
+from textual.app import ComposeResult
+from textual.containers import Horizontal, Vertical
+from textual.message import Message
+from textual.widgets import Input, Label, Static
+
+from workbench.control.fsm import Parameter
+
+
+def _g(value: float) -> str:
+    return f"{value:g}"
+
+
+class ParamEditor(Vertical):
+    """Posts :class:`ParamEditor.Edited` with ``NAME=VALUE`` whenever the value changes."""
+
+    DEFAULT_CSS = """
+    ParamEditor {
+        height: auto;
+    }
+    ParamEditor > Horizontal {
+        height: 1;
+    }
+    ParamEditor .param-name {
+        width: 16;
+    }
+    ParamEditor Input {
+        width: 10;
+        margin-right: 1;
+    }
+    ParamEditor .param-range {
+        width: 1fr;
+        color: $text-muted;
+    }
+    ParamEditor .param-error {
+        height: auto;
+        color: $text-error;
+        display: none;
+    }
+    ParamEditor.-invalid .param-error {
+        display: block;
+    }
+    ParamEditor.-invalid Input {
+        background: $error 30%;
+    }
+    """
+
+    class Edited(Message):
+        def __init__(self, editor: ParamEditor, item: str) -> None:
+            super().__init__()
+            self.editor = editor
+            self.item = item
+
+    def __init__(self, parameter: Parameter, value: float, default: float) -> None:
+        super().__init__()
+        self.parameter = parameter
+        self._value = value
+        self.default = default
+
+    def compose(self) -> ComposeResult:
+        p = self.parameter
+        bounds = []
+        if p.minimum is not None:
+            bounds.append(f"min {_g(p.minimum)}")
+        if p.maximum is not None:
+            bounds.append(f"max {_g(p.maximum)}")
+        bounds.append(f"default {_g(self.default)}")
+        with Horizontal():
+            yield Label(p.name, classes="param-name", markup=False)
+            yield Input(_g(self._value), compact=True, classes="param-value")
+            yield Label(", ".join(bounds), classes="param-range", markup=False)
+        yield Static("", classes="param-error", markup=False)
+        if p.description:
+            self.tooltip = p.description.strip()
+
+    @property
+    def text(self) -> str:
+        return self.query_one(Input).value.strip()
+
+    def set_value(self, value: float) -> None:
+        self.query_one(Input).value = _g(value)
+
+    def set_error(self, error: str | None) -> None:
+        self.query_one(".param-error", Static).update(error or "")
+        self.set_class(bool(error), "-invalid")
+
+    @property
+    def invalid(self) -> bool:
+        return self.has_class("-invalid")
+
+    def on_input_changed(self, event: Input.Changed) -> None:
+        event.stop()
+        self.post_message(self.Edited(self, f"{self.parameter.name}={event.value.strip()}"))

@@ -1,0 +1,53 @@
+"""Who drives, how fast the simulation runs, and the run's metrics."""
+
+from __future__ import annotations
+
+from textual.reactive import var
+from textual.widgets import Static
+
+from workbench.control.bench import Bench
+from workbench.sim.profiles import get_profile
+from workbench.sim.session import Snapshot
+
+from .text import degrees, number, separator, speed
+
+
+class RunStatus(Static):
+    """Who drives; pause, speed and time; distance; turning and collisions."""
+
+    DEFAULT_CSS = """
+    RunStatus {
+        height: 5;
+        padding: 0 1;
+        border-top: solid $primary;
+        border-title-color: $text-primary;
+    }
+    """
+
+    lines: var[tuple[str, ...]] = var(())
+
+    def __init__(self, *, id: str | None = None, classes: str | None = None) -> None:
+        super().__init__(id=id, classes=classes, markup=False)
+        self.border_title = "Run"
+
+    def show(self, snapshot: Snapshot, bench: Bench, unicode: bool) -> None:
+        sep = separator(unicode)
+        unit = get_profile(bench.profile).unit
+        m = snapshot.metrics
+        state = "PAUSED" if bench.pacer.paused else "running"
+        self.border_title = f"Run: {bench.maze.name} ({bench.profile})"
+        driver = f"driver: {snapshot.driver}"
+        clock = f"{state} at {speed(bench.pacer.speed)}{sep}t {snapshot.time:.1f} s"
+        if m.reached_exit and m.exit_time is not None:
+            clock += f"{sep}out at {m.exit_time:.1f} s"
+            if m.efficiency is not None:
+                clock += f" ({m.efficiency:.0%} efficient)"
+        travel = f"distance {number(m.distance, unit)} {unit} ({m.distance_cells:.1f} blocks)"
+        turning = (
+            f"turned {degrees(m.turn_degrees, unicode)} in {m.turns} turns"
+            f"{sep}collisions {m.collisions}"
+        )
+        self.lines = (driver, clock, travel, turning)
+
+    def watch_lines(self, lines: tuple[str, ...]) -> None:
+        self.update("\n".join(lines), layout=False)

@@ -1,0 +1,45 @@
+"""Shared wording of the side panel: numbers in the profile's unit, ASCII or Unicode marks."""
+
+from __future__ import annotations
+
+from workbench.sim.sensors import SensorSpec
+
+
+def degrees(value: float, unicode: bool) -> str:
+    return f"{value:.0f}°" if unicode else f"{value:.0f} deg"
+
+
+def arrow(unicode: bool) -> str:
+    return "→" if unicode else "->"
+
+
+def separator(unicode: bool) -> str:
+    return " · " if unicode else " | "
+
+
+def number(value: float | int | None, unit: str = "") -> str:
+    """A reading or a length: whole pixels, two decimals for metre-like units."""
+    if value is None:
+        return "-"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if unit == "px":
+        return f"{value:.0f}"
+    if isinstance(value, int):
+        return str(value)
+    return f"{value:.2f}"
+
+
+def reading(spec: SensorSpec, value: float | int | None, unit: str, no_echo: float) -> str:
+    """What a sensor reads, as a student would say it."""
+    if value is None:
+        return "-"
+    if spec.kind == "touch":
+        return "pressed" if value else "free"
+    if value >= no_echo:
+        return f"no echo ({number(value, unit)})"
+    return number(value, unit)
+
+
+def speed(value: float | None) -> str:
+    return "max" if value is None else f"{value:g}x"

@@ -1,0 +1,61 @@
+"""A scrolling log of the transitions an algorithm has taken (newest at the bottom)."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+
+from textual.widgets import Log
+
+from workbench.control.fsm import Transition
+
+from .text import arrow, number
+
+
+def values_text(values: dict[str, object], unit: str) -> str:
+    return " ".join(
+        f"{name}={number(v, unit) if isinstance(v, int | float) else v}"
+        for name, v in values.items()
+    )
+
+
+class TransitionLog(Log):
+    """Appends only the transitions it has not shown yet; cleared when a new run starts."""
+
+    DEFAULT_CSS = """
+    TransitionLog {
+        height: 1fr;
+        min-height: 2;
+        padding: 0;
+        background: $surface;
+        scrollbar-size-vertical: 1;
+        overflow-x: hidden;
+    }
+    """
+
+    def __init__(self, *, id: str | None = None, classes: str | None = None) -> None:
+        super().__init__(max_lines=200, id=id, classes=classes)
+        self._run: object = None
+        self._last: Transition | None = None
+
+    def show(self, run: object, history: Iterable[Transition], unit: str, unicode: bool) -> None:
+        """``run`` identifies the run (its controller); ``history`` is oldest first."""
+        if run is not self._run:
+            self._run = run
+            self._last = None
+            self.clear()
+        entries = list(history)
+        if not entries or entries[-1] is self._last:
+            return
+        start = 0
+        if self._last is not None:
+            for i in range(len(entries) - 1, -1, -1):
+                if entries[i] is self._last:
+                    start = i + 1
+                    break
+        self._last = entries[-1]
+        go = arrow(unicode)
+        self.write_lines(
+            f"{t.time:6.1f} {t.source} {go} {t.target}"
+            + (f"  {values_text(dict(t.values), unit)}" if t.values else "")
+            for t in entries[start:]
+        )
