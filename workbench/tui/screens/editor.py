@@ -1,0 +1,498 @@
+"""The maze editor screen: draw walls, place the start and exits, check and save the maze.
+
+All editing happens in :class:`~workbench.sim.editing.MazeEditor`; this screen draws it and
+routes keys and clicks to it. On leaving, a changed maze that is valid goes to the bench, so
+the robot runs on it; the screen is dismissed with that maze (or None when the bench kept its
+maze).
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+from rich.text import Text
+from textual import on
+from textual.app import ComposeResult
+from textual.binding import Binding, BindingType
+from textual.containers import Horizontal, Vertical
+from textual.screen import Screen
+from textual.widgets import Footer, OptionList, Static
+from textual.widgets.option_list import Option
+
+from workbench.control.bench import Bench
+from workbench.sim.editing import EditorError, Finding, GenerateOptions, MazeEditor
+from workbench.sim.maze import Maze
+
+from ..widgets.maze_view import MazeView
+from .generate_dialog import GenerateDialog
+from .path_dialog import PathDialog
+from .size_dialog import SizeDialog
+from .unsaved_dialog import Choice, UnsavedDialog
+
+SAVE_HELP = (
+    "The file is written atomically: a crash leaves the old file or the new one, never half. "
+    "A .maz name writes a micromouse binary maze; any other name the workbench text format."
+)
+
+
+KEYS = (
+    "arrows move  space/click wall\n"
+    "s start (again: turn)  x exit\n"
+    "^z undo  ^y redo  p problem\n"
+    "n new  g generate  u unicode\n"
+    "^s save  a save as  esc back"
+)
+
+
+def _problem_line(finding: Finding) -> str:
+    if finding.cell is None:
+        return finding.message
+    return f"({finding.cell[0]}, {finding.cell[1]}) {finding.message}"
+
+
+class EditorScreen(Screen[Maze | None]):
+    """Edit the bench's maze; dismissed with the maze the robot now runs on, or None."""
+
+    AUTO_FOCUS = ""
+
+    DEFAULT_CSS = """
+    EditorScreen #editor-title {
+        height: 1;
+        padding: 0 1;
+        background: $boost;
+        text-style: bold;
+    }
+    EditorScreen #editor-body {
+        height: 1fr;
+    }
+    EditorScreen #editor-maze {
+        width: 1fr;
+        height: 1fr;
+    }
+    EditorScreen #editor-side {
+        width: 34;
+        height: 1fr;
+        padding: 0 1;
+        border-left: vkey $panel;
+    }
+    EditorScreen #editor-info {
+        height: auto;
+    }
+    EditorScreen #editor-problems-title {
+        height: 1;
+        margin-top: 1;
+        text-style: bold;
+    }
+    EditorScreen #editor-problems-title.-ok {
+        color: $text-success;
+    }
+    EditorScreen #editor-problems-title.-bad {
+        color: $text-error;
+    }
+    EditorScreen #editor-problems {
+        height: 1fr;
+        min-height: 3;
+        border: none;
+        padding: 0;
+        background: $surface;
+    }
+    EditorScreen #editor-problems:focus {
+        background-tint: $foreground 5%;
+    }
+    EditorScreen #editor-status {
+        height: auto;
+        max-height: 4;
+        color: $text-muted;
+    }
+    EditorScreen #editor-status.-error {
+        color: $text-error;
+    }
+    EditorScreen #editor-keys {
+        height: auto;
+        margin-top: 1;
+        color: $text-muted;
+    }
+    """
+
+    BINDINGS: ClassVar[list[BindingType]] = [
+        Binding("up", "move(0, -1)", "Cursor up", show=False, id="editor.up"),
+        Binding("down", "move(0, 1)", "Cursor down", show=False, id="editor.down"),
+        Binding("left", "move(-1, 0)", "Cursor left", show=False, id="editor.left"),
+        Binding("right", "move(1, 0)", "Cursor right", show=False, id="editor.right"),
+        Binding(
+            "space",
+            "toggle_wall",
+            "Wall",
+            id="editor.wall",
+            tooltip="Turn the block under the cursor into wall or floor (or click a block).",
+        ),
+        Binding(
+            "s",
+            "start",
+            "Start",
+            id="editor.start",
+            tooltip="Put the start on the cursor; press again to turn its heading.",
+        ),
+        Binding(
+            "x", "exit", "Exit", id="editor.exit", tooltip="Add or remove an exit at the cursor."
+        ),
+        Binding(
+            "ctrl+z", "undo", "Undo", key_display="^z", id="editor.undo", tooltip="Undo an edit."
+        ),
+        Binding(
+            "ctrl+y",
+            "redo",
+            "Redo",
+            key_display="^y",
+            show=False,
+            id="editor.redo",
+            tooltip="Redo an undone edit.",
+        ),
+        Binding(
+            "n",
+            "new",
+            "New",
+            show=False,
+            id="editor.new",
+            tooltip="Start an empty maze of a size you type.",
+        ),
+        Binding(
+            "g",
+            "generate",
+            "Generate",
+            show=False,
+            id="editor.generate",
+            tooltip="Generate a maze from a seed (perfect or braid, with exits or none).",
+        ),
+        Binding(
+            "ctrl+s",
+            "save",
+            "Save",
+            key_display="^s",
+            id="editor.save",
+            tooltip="Save to the maze's file (asks for a path the first time).",
+        ),
+        Binding(
+            "a",
+            "save_as",
+            "Save as",
+            show=False,
+            id="editor.save_as",
+            tooltip="Save to a new path.",
+        ),
+        Binding(
+            "p",
+            "next_problem",
+            "Next problem",
+            show=False,
+            id="editor.next_problem",
+            tooltip="Move the cursor to the next problem in the list.",
+        ),
+        Binding(
+            "u",
+            "unicode",
+            "Unicode",
+            show=False,
+            id="editor.unicode",
+            tooltip="Draw the maze in plain ASCII or with Unicode lines.",
+        ),
+        Binding(
+            "escape",
+            "leave",
+            "Back",
+            id="editor.leave",
+            tooltip="Leave the editor; a changed valid maze goes to the robot.",
+        ),
+    ]
+
+    def __init__(
+        self,
+        bench: Bench,
+        path: str | None = None,
+        unicode: bool | None = None,
+        *,
+        name: str | None = None,
+        id: str | None = None,
+        classes: str | None = None,
+    ) -> None:
+        super().__init__(name=name, id=id, classes=classes)
+        self.bench = bench
+        self.editor = MazeEditor(bench.maze, path)
+        self._unicode = unicode
+        self._generate_options = GenerateOptions()
+        self._shown_problems: tuple[bool, tuple[str, ...]] | None = None
+        self._problem_index = -1
+        #: the last message shown under the problems (what an action did, or why it failed)
+        self.status = ""
+
+    # -- layout ----------------------------------------------------------------------------
+    def compose(self) -> ComposeResult:
+        if self._unicode is None:
+            self._unicode = bool(getattr(self.app, "unicode", False))
+        yield Static(id="editor-title", markup=False)
+        with Horizontal(id="editor-body"):
+            yield MazeView(
+                self.editor.maze,
+                unicode=self._unicode,
+                trail=False,
+                follow=False,
+                id="editor-maze",
+            )
+            with Vertical(id="editor-side"):
+                yield Static(id="editor-info", markup=False)
+                yield Static(id="editor-problems-title", markup=False)
+                yield OptionList(id="editor-problems", markup=False)
+                yield Static(id="editor-status", markup=False)
+                yield Static(KEYS, id="editor-keys", markup=False)
+        yield Footer()
+
+    def on_mount(self) -> None:
+        self._refresh()
+
+    # -- public ------------------------------------------------------------------------------
+    @property
+    def unicode(self) -> bool:
+        return bool(self._unicode)
+
+    @property
+    def dirty(self) -> bool:
+        """True while the maze has changes that are not saved."""
+        return self.editor.dirty
+
+    def set_unicode(self, unicode: bool) -> None:
+        self._unicode = unicode
+        if self.is_mounted:
+            self.query_one(MazeView).set_unicode(unicode)
+
+    # -- drawing -------------------------------------------------------------------------------
+    def _refresh(self) -> None:
+        editor = self.editor
+        view = self.query_one(MazeView)
+        if view.maze is not editor.maze:
+            view.set_maze(editor.maze)
+        view.set_cursor(editor.cursor)
+        marker = " (modified)" if editor.dirty else ""
+        where = editor.path or "not saved yet"
+        self.query_one("#editor-title", Static).update(
+            f"Maze editor: {editor.title()}{marker}  [{where}]"
+        )
+        self.query_one("#editor-info", Static).update(self._info())
+        self._show_problems(editor.problems)
+
+    def _info(self) -> Text:
+        maze = self.editor.maze
+        x, y = self.editor.cursor
+        if maze.start == (x, y):
+            kind = f"start facing {maze.heading}"
+        elif maze.is_exit(x, y):
+            kind = "exit"
+        else:
+            kind = "wall" if maze.is_wall(x, y) else "floor"
+        text = Text()
+        text.append(f"Cursor ({x}, {y}): ", style="bold")
+        text.append(f"{kind}\n")
+        start = f"({maze.start[0]}, {maze.start[1]}) {maze.heading}" if maze.start else "none"
+        text.append(f"Start {start}\n")
+        exits = len(maze.exits)
+        text.append(f"{maze.width} x {maze.height} blocks, {exits} exit{'s' * (exits != 1)}")
+        return text
+
+    def _show_problems(self, findings: list[Finding]) -> None:
+        title = self.query_one("#editor-problems-title", Static)
+        title.set_class(not findings, "-ok")
+        title.set_class(bool(findings), "-bad")
+        if findings:
+            title.update(f"Problems ({len(findings)}): p or click")
+            lines = tuple(_problem_line(f) for f in findings)
+        else:
+            title.update("No problems: ready to run")
+            lines = tuple(f"note: {n}" for n in self.editor.notes())
+        shown = (bool(findings), lines)
+        if shown == self._shown_problems:
+            return
+        self._shown_problems = shown
+        self._problem_index = -1
+        options = [Option(line, disabled=not findings) for line in lines]
+        self.query_one("#editor-problems", OptionList).set_options(options)
+
+    def _status(self, text: str, error: bool = False) -> None:
+        self.status = text
+        status = self.query_one("#editor-status", Static)
+        status.update(text)
+        status.set_class(error, "-error")
+
+    # -- editing -----------------------------------------------------------------------------
+    def action_move(self, dx: int, dy: int) -> None:
+        self.editor.move(dx, dy)
+        self._refresh()
+
+    def action_toggle_wall(self) -> None:
+        self.editor.toggle_wall()
+        self._status_block()
+        self._refresh()
+
+    def _status_block(self) -> None:
+        x, y = self.editor.cursor
+        kind = "wall" if self.editor.maze.is_wall(x, y) else "floor"
+        self._status(f"({x}, {y}) is {kind} now")
+
+    @on(MazeView.BlockClicked)
+    def _block_clicked(self, event: MazeView.BlockClicked) -> None:
+        event.stop()
+        self.editor.toggle_wall(event.cell)
+        self._status_block()
+        self._refresh()
+
+    def action_start(self) -> None:
+        heading = self.editor.set_start()
+        x, y = self.editor.cursor
+        self._status(f"start at ({x}, {y}) facing {heading}; s again turns it")
+        self._refresh()
+
+    def action_exit(self) -> None:
+        present = self.editor.toggle_exit()
+        x, y = self.editor.cursor
+        self._status(f"exit {'added at' if present else 'removed from'} ({x}, {y})")
+        self._refresh()
+
+    def action_undo(self) -> None:
+        self._status("undone" if self.editor.undo() else "nothing to undo")
+        self._refresh()
+
+    def action_redo(self) -> None:
+        self._status("redone" if self.editor.redo() else "nothing to redo")
+        self._refresh()
+
+    def action_new(self) -> None:
+        maze = self.editor.maze
+        self.app.push_screen(SizeDialog(maze.width, maze.height), self._new_size)
+
+    def _new_size(self, size: tuple[int, int] | None) -> None:
+        if size is None:
+            return
+        self.editor.new(*size)
+        self._status(f"new {size[0]} x {size[1]} maze; ctrl+z brings the old one back")
+        self._refresh()
+
+    def action_generate(self) -> None:
+        self.app.push_screen(GenerateDialog(self._generate_options), self._generated)
+
+    def _generated(self, options: GenerateOptions | None) -> None:
+        if options is None:
+            return
+        self._generate_options = options
+        o = options
+        try:
+            self.editor.generate(o.width, o.height, o.seed, o.style, o.exit)
+        except EditorError as exc:
+            self._status(str(exc), error=True)
+            return
+        self._status(f"generated {self.editor.maze.name}; ctrl+z brings the old one back")
+        self._refresh()
+
+    # -- problems ----------------------------------------------------------------------------
+    @on(OptionList.OptionSelected, "#editor-problems")
+    def _problem_selected(self, event: OptionList.OptionSelected) -> None:
+        event.stop()
+        self._go_to_problem(event.option_index)
+        self.set_focus(None)
+
+    def action_next_problem(self) -> None:
+        findings = self.editor.problems
+        if not findings:
+            self._status("no problems")
+            return
+        self._go_to_problem((self._problem_index + 1) % len(findings))
+
+    def _go_to_problem(self, index: int) -> None:
+        findings = self.editor.problems
+        if not 0 <= index < len(findings):
+            return
+        self._problem_index = index
+        finding = findings[index]
+        self.query_one("#editor-problems", OptionList).highlighted = index
+        if finding.cell is None:
+            self._status(f"{finding.message}: {finding.hint}")
+        else:
+            self.editor.move_to(finding.cell)
+            self._status(f"({finding.cell[0]}, {finding.cell[1]}): {finding.hint}")
+        self._refresh()
+
+    # -- saving ------------------------------------------------------------------------------
+    def _save(self, path: str | None) -> bool:
+        try:
+            written = self.editor.save(path)
+        except EditorError as exc:
+            self._status(str(exc), error=True)
+            return False
+        count = len(self.editor.problems)
+        extra = f" (with {count} problem{'s' * (count != 1)} still to fix)" if count else ""
+        self._status(f"saved to {written}{extra}")
+        self._refresh()
+        return True
+
+    def action_save(self) -> None:
+        if self.editor.path is None:
+            self.action_save_as()
+        else:
+            self._save(None)
+
+    def action_save_as(self, leave_after: bool = False, error: str = "") -> None:
+        def saved(path: str | None) -> None:
+            if path is None:
+                return
+            if self._save(path):
+                if leave_after:
+                    self._leave(discard=False)
+            else:
+                self.action_save_as(leave_after, self.status)
+
+        self.app.push_screen(
+            PathDialog(
+                "Save maze as",
+                SAVE_HELP,
+                value=self.editor.suggested_path(),
+                action="Save",
+                error=error,
+            ),
+            saved,
+        )
+
+    # -- leaving -----------------------------------------------------------------------------
+    def action_leave(self) -> None:
+        problems = self.query_one("#editor-problems", OptionList)
+        if problems.has_focus:
+            self.set_focus(None)
+            return
+        if self.editor.dirty:
+            self.app.push_screen(UnsavedDialog(self.editor.title()), self._unsaved_choice)
+        else:
+            self._leave(discard=False)
+
+    def _unsaved_choice(self, choice: Choice | None) -> None:
+        if choice == "save":
+            if self.editor.path is None:
+                self.action_save_as(leave_after=True)
+            elif self._save(None):
+                self._leave(discard=False)
+        elif choice == "discard":
+            self._leave(discard=True)
+
+    def _leave(self, discard: bool) -> None:
+        maze, note = self.editor.handover(discard)
+        if maze is not None:
+            self.bench.load_maze(maze)
+            self.bench.message = f"the robot is on the edited maze {maze.name}"
+        elif note:
+            self.bench.message = note
+        if len(self.app.screen_stack) > 1 and self.app.screen is self:
+            self.dismiss(maze)
+        else:
+            self.app.exit(maze)
+
+    def action_unicode(self) -> None:
+        unicode = not self.unicode
+        if hasattr(self.app, "unicode"):
+            self.app.unicode = unicode
+        if self.unicode != unicode:
+            self.set_unicode(unicode)

@@ -1,0 +1,58 @@
+"""A dialog asking for a file path (save as, open a run record)."""
+
+from __future__ import annotations
+
+from textual import on
+from textual.app import ComposeResult
+from textual.containers import Horizontal, Vertical
+from textual.widgets import Button, Input, Label, Static
+
+from .dialog import Dialog
+
+
+class PathDialog(Dialog[str | None]):
+    """Asks for a path; dismisses with the path typed (stripped) or None.
+
+    The caller does the work (saving, opening) and, when it fails, can open the dialog again
+    with the same text and the reason in ``error``.
+    """
+
+    def __init__(
+        self,
+        title: str,
+        help: str,
+        value: str = "",
+        action: str = "OK",
+        error: str = "",
+    ) -> None:
+        super().__init__()
+        self._title = title
+        self._help = help
+        self._value = value
+        self._action = action
+        self._error = error
+
+    def compose(self) -> ComposeResult:
+        with Vertical(id="dialog") as box:
+            box.border_title = self._title
+            yield Static(self._help, classes="help")
+            with Horizontal(classes="field"):
+                yield Label("Path")
+                yield Input(self._value, id="path", compact=True)
+            yield Static(self._error, id="error", classes="" if self._error else "-empty")
+            with Horizontal(id="buttons"):
+                yield Button(self._action, id="ok", variant="primary", compact=True)
+                yield Button("Cancel", id="cancel", compact=True)
+
+    def on_mount(self) -> None:
+        self.query_one("#path", Input).focus()
+
+    @on(Input.Submitted)
+    @on(Button.Pressed, "#ok")
+    def submit(self, event: Input.Submitted | Button.Pressed) -> None:
+        event.stop()
+        path = self.query_one("#path", Input).value.strip()
+        if not path:
+            self.show_error("type a path, e.g. mazes/my-maze.txt")
+            return
+        self.dismiss(path)

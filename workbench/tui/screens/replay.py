@@ -1,0 +1,377 @@
+"""The replay screen: a recorded run (JSONL) drawn tick by tick, stepped or played at a speed.
+
+The cursor over the record is :class:`~workbench.sim.replay.Replay`; this screen draws its
+current tick (the robot on the maze, its sensor readings, the state and the events) and turns
+keys into steps, jumps and play/pause. Playing uses a timer only while it plays, fed with the
+real time elapsed, so a replay at 1x takes as long as the run did.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from dataclasses import replace
+from time import monotonic
+from typing import ClassVar
+
+from rich.text import Text
+from textual.app import ComposeResult
+from textual.binding import Binding, BindingType
+from textual.containers import Horizontal, Vertical
+from textual.screen import Screen
+from textual.timer import Timer
+from textual.widgets import Footer, Static
+
+from workbench.sim.maze import Maze
+from workbench.sim.replay import Replay, load_replay, replay_maze
+
+from ..widgets.maze_view import MazeView
+
+#: how often the view is redrawn while playing (frames per second of wall time)
+PLAY_HZ = 20
+#: transition log lines shown before the screen has its size
+LOG_LINES = 8
+KEYS = "left/right step  pgup/pgdn 10\nspace play/pause  +/- speed\nhome/end first/last  esc back"
+
+
+def _number(value: object) -> str:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        return str(value)
+    if isinstance(value, int):
+        return str(value)
+    return f"{value:.1f}"
+
+
+def _command(cmd: object) -> str:
+    if not isinstance(cmd, dict) or len(cmd) != 1:
+        return str(cmd)
+    ((name, value),) = cmd.items()
+    if name == "stop":
+        return "stop"
+    if name == "wheels" and isinstance(value, list):
+        return "wheels " + " ".join(_number(v) for v in value)
+    if name == "motor" and isinstance(value, dict):
+        return f"motor {value.get('wheel')} {_number(value.get('power'))}"
+    return f"{name} {_number(value)}"
+
+
+class ReplayScreen(Screen[None]):
+    """Step through or play a recorded run; escape goes back."""
+
+    AUTO_FOCUS = ""
+
+    DEFAULT_CSS = """
+    ReplayScreen #replay-title {
+        height: 1;
+        padding: 0 1;
+        background: $boost;
+        text-style: bold;
+    }
+    ReplayScreen #replay-note {
+        height: auto;
+        padding: 0 1;
+        color: $text-warning;
+    }
+    ReplayScreen #replay-note.-empty {
+        display: none;
+    }
+    ReplayScreen #replay-body {
+        height: 1fr;
+    }
+    ReplayScreen #replay-maze, ReplayScreen #replay-nomaze {
+        width: 1fr;
+        height: 1fr;
+    }
+    ReplayScreen #replay-nomaze {
+        padding: 1 2;
+        color: $text-muted;
+    }
+    ReplayScreen #replay-side {
+        width: 34;
+        height: 1fr;
+        padding: 0 1;
+        border-left: vkey $panel;
+    }
+    ReplayScreen #replay-tick {
+        height: 12;
+    }
+    ReplayScreen #replay-log {
+        height: 1fr;
+        margin-top: 1;
+        color: $text-muted;
+        text-wrap: nowrap;
+        text-overflow: ellipsis;
+    }
+    ReplayScreen #replay-keys {
+        height: auto;
+        color: $text-muted;
+    }
+    """
+
+    BINDINGS: ClassVar[list[BindingType]] = [
+        Binding(
+            "right",
+            "step(1)",
+            "Step",
+            key_display="→",
+            id="replay.step",
+            tooltip="Forward one control tick.",
+        ),
+        Binding(
+            "left",
+            "step(-1)",
+            "Back",
+            key_display="←",
+            id="replay.back",
+            tooltip="Back one control tick.",
+        ),
+        Binding(
+            "pagedown",
+            "step(10)",
+            "+10",
+            show=False,
+            id="replay.step10",
+            tooltip="Forward ten ticks.",
+        ),
+        Binding(
+            "pageup",
+            "step(-10)",
+            "-10",
+            show=False,
+            id="replay.back10",
+            tooltip="Back ten ticks.",
+        ),
+        Binding(
+            "space",
+            "play",
+            "Play/pause",
+            id="replay.play",
+            tooltip="Play the run at the speed shown, or pause it.",
+        ),
+        Binding(
+            "plus,equals_sign",
+            "faster",
+            "Faster",
+            key_display="+",
+            id="replay.faster",
+            tooltip="Play faster.",
+        ),
+        Binding(
+            "minus",
+            "slower",
+            "Slower",
+            key_display="-",
+            id="replay.slower",
+            tooltip="Play slower.",
+        ),
+        Binding("home", "first", "First", show=False, id="replay.first", tooltip="The first tick."),
+        Binding("end", "last", "Last", show=False, id="replay.last", tooltip="The last tick."),
+        Binding(
+            "u",
+            "unicode",
+            "Unicode",
+            show=False,
+            id="replay.unicode",
+            tooltip="Draw the maze in plain ASCII or with Unicode lines.",
+        ),
+        Binding("escape", "leave", "Back", id="replay.leave", tooltip="Back to the runs."),
+    ]
+
+    def __init__(
+        self,
+        record_path: str | os.PathLike,
+        replay: Replay | None = None,
+        mazes: Sequence[Maze] = (),
+        unicode: bool | None = None,
+        *,
+        name: str | None = None,
+        id: str | None = None,
+        classes: str | None = None,
+    ) -> None:
+        """``replay`` is the record already loaded (else it is loaded here and a malformed
+        record raises :class:`~workbench.sim.record.RecordError`); ``mazes`` are mazes the run
+        may have been on (the bench's), found again by their layout digest."""
+        super().__init__(name=name, id=id, classes=classes)
+        self.record_path = os.fspath(record_path)
+        self.replay = replay if replay is not None else load_replay(record_path)
+        self.maze, self.note = replay_maze(self.replay, record_path, mazes)
+        self._unicode = unicode
+        self._timer: Timer | None = None
+        self._last_time = 0.0
+        self._drawn = -1
+
+    def compose(self) -> ComposeResult:
+        if self._unicode is None:
+            self._unicode = bool(getattr(self.app, "unicode", False))
+        yield Static(id="replay-title", markup=False)
+        yield Static(
+            self.note, id="replay-note", markup=False, classes="" if self.note else "-empty"
+        )
+        with Horizontal(id="replay-body"):
+            if self.maze is not None:
+                yield MazeView(self.maze, unicode=self._unicode, id="replay-maze")
+            else:
+                yield Static(
+                    "The maze cannot be drawn; the recorded ticks are on the right.",
+                    id="replay-nomaze",
+                    markup=False,
+                )
+            with Vertical(id="replay-side"):
+                yield Static(id="replay-tick", markup=False)
+                yield Static(id="replay-log", markup=False)
+                yield Static(KEYS, id="replay-keys", markup=False)
+        yield Footer()
+
+    def on_mount(self) -> None:
+        self._draw()
+
+    def on_resize(self) -> None:
+        self.call_after_refresh(self._draw_panel)
+
+    # -- public ------------------------------------------------------------------------------
+    @property
+    def unicode(self) -> bool:
+        return bool(self._unicode)
+
+    def set_unicode(self, unicode: bool) -> None:
+        self._unicode = unicode
+        if self.is_mounted and self.maze is not None:
+            self.query_one(MazeView).set_unicode(unicode)
+            self._draw_panel()
+
+    # -- drawing -------------------------------------------------------------------------------
+    def _draw(self) -> None:
+        self._draw_view()
+        self._draw_panel()
+
+    def _draw_view(self) -> None:
+        replay = self.replay
+        index = replay.index
+        if self.maze is None or index == self._drawn:
+            return
+        view = self.query_one(MazeView)
+        cell = replay.cell
+        if index < self._drawn or self._drawn < 0:
+            view.hide_robot()
+            view.clear_trail()
+            first = 0
+        else:
+            first = self._drawn + 1
+        current = replay.snapshot(index)
+        last_block = None
+        for i in range(first, index):
+            pose = replay.poses[i]
+            block = (int(pose.x // cell), int(pose.y // cell))
+            if block != last_block:
+                last_block = block
+                view.show(replace(current, pose=pose, block=block, sensors=(), readings={}), cell)
+        view.show(current, cell)
+        self._drawn = index
+
+    def _draw_panel(self) -> None:
+        replay = self.replay
+        frame = replay.frame()
+        state = "playing" if replay.playing else "paused"
+        self.query_one("#replay-title", Static).update(
+            f"Replay: {replay.title}  [{os.path.basename(self.record_path)}]"
+        )
+        deg = "°" if self.unicode else " deg"
+        text = Text()
+        text.append(f"Tick {frame.index + 1}/{len(replay)}", style="bold")
+        text.append(f"  t {frame.t:.2f} s\n")
+        text.append(f"{state} at {replay.speed:g}x\n")
+        x, y, heading = frame.pose
+        text.append(f"Pose {x:.1f}, {y:.1f}  {heading:.0f}{deg}\n")
+        text.append("State ", style="bold")
+        text.append(f"{frame.state or '-'}\n")
+        sensors = {s.port: s for s in replay.sensors}
+        for port, value in sorted(frame.sensors.items()):
+            spec = sensors.get(port)
+            what = f"{spec.kind} {spec.mount}" if spec else "sensor"
+            shown = ("pressed" if value else "free") if spec and spec.kind == "touch" else value
+            text.append(f"port {port} {what}: {_number(shown)}\n")
+        if frame.commands:
+            text.append(f"Cmd {', '.join(_command(c) for c in frame.commands)}\n")
+        if frame.events:
+            text.append(f"Events {', '.join(frame.events)}\n", style="bold")
+        m = replay.metrics()
+        text.append(
+            f"So far {m.distance_cells:.2f} blocks, {m.turn_degrees:.0f}{deg}\n"
+            f"{m.turns} turns, {m.collisions} collisions"
+        )
+        if replay.at_end and replay.summary is not None:
+            s = replay.summary
+            ended = s.get("ended", "stopped")
+            out = "out through the exit" if s.get("reached_exit") else f"{ended}, not out"
+            text.append(f"\nEnd: {out}", style="bold")
+        self.query_one("#replay-tick", Static).update(text)
+        log_view = self.query_one("#replay-log", Static)
+        height = log_view.size.height
+        log = replay.log(height if height > 0 else LOG_LINES)
+        lines = [line.strip() for line in log] or ["no state changes yet"]
+        log_view.update("\n".join(lines))
+
+    # -- actions ------------------------------------------------------------------------------
+    def action_step(self, ticks: int) -> None:
+        self.replay.step(ticks)
+        self._stop_timer()
+        self._draw()
+
+    def action_first(self) -> None:
+        self.replay.to_start()
+        self._stop_timer()
+        self._draw()
+
+    def action_last(self) -> None:
+        self.replay.to_end()
+        self._stop_timer()
+        self._draw()
+
+    def action_play(self) -> None:
+        if self.replay.toggle():
+            self._last_time = monotonic()
+            if self._timer is None:
+                self._timer = self.set_interval(1 / PLAY_HZ, self._tick)
+            else:
+                self._timer.resume()
+        else:
+            self._stop_timer()
+        self._draw()
+
+    def action_faster(self) -> None:
+        self.replay.faster()
+        self._draw_panel()
+
+    def action_slower(self) -> None:
+        self.replay.slower()
+        self._draw_panel()
+
+    def _tick(self) -> None:
+        now = monotonic()
+        elapsed, self._last_time = now - self._last_time, now
+        self.replay.advance(elapsed)
+        if not self.replay.playing:
+            self._stop_timer()
+        self._draw()
+
+    def _stop_timer(self) -> None:
+        if self._timer is not None:
+            self._timer.pause()
+
+    def action_unicode(self) -> None:
+        unicode = not self.unicode
+        if hasattr(self.app, "unicode"):
+            self.app.unicode = unicode
+        if self.unicode != unicode:
+            self.set_unicode(unicode)
+
+    def action_leave(self) -> None:
+        self._stop_timer()
+        if len(self.app.screen_stack) > 1 and self.app.screen is self:
+            self.dismiss(None)
+        else:
+            self.app.exit()
+
+    def on_unmount(self) -> None:
+        if self._timer is not None:
+            self._timer.stop()

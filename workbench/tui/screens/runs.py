@@ -1,0 +1,271 @@
+"""The runs screen: the bench's last runs side by side, and the way into their replays.
+
+Each row is one run with the course's measures, so students can answer "which algorithm is
+better on this maze". Enter (or a click) on a run with a record opens its replay; ``o`` opens
+any run record (JSONL) by path.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import ClassVar
+
+from textual import on
+from textual.app import ComposeResult
+from textual.binding import Binding, BindingType
+from textual.screen import Screen
+from textual.widgets import DataTable, Footer, Static
+
+from workbench.control.bench import Bench, RunEntry
+from workbench.sim.record import RecordError
+from workbench.sim.replay import load_replay
+
+from .path_dialog import PathDialog
+from .replay import ReplayScreen
+
+ALGORITHM_PREFIX = "algorithm "
+#: column key, heading (ASCII), heading (Unicode)
+COLUMNS: tuple[tuple[str, str, str], ...] = (
+    ("number", "#", "#"),
+    ("driver", "Driver", "Driver"),
+    ("reached", "Out", "Out"),
+    ("time", "Time s", "Time s"),
+    ("distance", "Blocks", "Blocks"),
+    ("turning", "Turn deg", "Turn °"),
+    ("turns", "Turns", "Turns"),
+    ("collisions", "Hits", "Hits"),
+    ("efficiency", "Eff", "Eff"),
+    ("ended", "Ended", "Ended"),
+    ("maze", "Maze", "Maze"),
+    ("record", "Rec", "Rec"),
+)
+OPEN_HELP = (
+    "A run record is a .jsonl file written by 'workbench run --record FILE' or by the app "
+    "when it records runs."
+)
+
+
+def driver_name(driver: str) -> str:
+    """``algorithm right-wall`` -> ``right-wall``; ``keys`` stays."""
+    return driver[len(ALGORITHM_PREFIX) :] if driver.startswith(ALGORITHM_PREFIX) else driver
+
+
+def run_cells(run: RunEntry, unicode: bool) -> tuple[str, ...]:
+    """The table cells of a run, in :data:`COLUMNS` order."""
+    m = run.metrics
+    time = m.exit_time if m.reached_exit and m.exit_time is not None else m.sim_time
+    yes, no = ("✓", "✗") if unicode else ("yes", "no")
+    return (
+        str(run.number),
+        driver_name(run.driver),
+        yes if m.reached_exit else no,
+        f"{time:.1f}",
+        f"{m.distance_cells:.2f}",
+        f"{m.turn_degrees:.0f}",
+        str(m.turns),
+        str(m.collisions),
+        f"{m.efficiency:.2f}" if m.efficiency is not None else "-",
+        run.ended,
+        run.maze or "-",
+        yes if run.record else "-",
+    )
+
+
+class RunsScreen(Screen[None]):
+    """The bench's runs side by side; enter replays one, ``o`` opens a record file."""
+
+    DEFAULT_CSS = """
+    RunsScreen #runs-title {
+        height: 1;
+        padding: 0 1;
+        background: $boost;
+        text-style: bold;
+    }
+    RunsScreen #runs-help {
+        height: auto;
+        padding: 0 1;
+        color: $text-muted;
+    }
+    RunsScreen #runs-table {
+        height: 1fr;
+    }
+    RunsScreen #runs-status {
+        height: auto;
+        padding: 0 1;
+        color: $text-muted;
+    }
+    RunsScreen #runs-status.-error {
+        color: $text-error;
+    }
+    """
+
+    BINDINGS: ClassVar[list[BindingType]] = [
+        Binding(
+            "enter",
+            "replay",
+            "Replay",
+            id="runs.replay",
+            tooltip="Replay the selected run from its record.",
+        ),
+        Binding(
+            "o",
+            "open",
+            "Open record",
+            id="runs.open",
+            tooltip="Replay any run record (.jsonl) by its path.",
+        ),
+        Binding(
+            "u",
+            "unicode",
+            "Unicode",
+            show=False,
+            id="runs.unicode",
+            tooltip="Plain ASCII or Unicode marks.",
+        ),
+        Binding("escape", "leave", "Back", id="runs.leave", tooltip="Back to the workbench."),
+    ]
+
+    def __init__(
+        self,
+        bench: Bench,
+        unicode: bool | None = None,
+        *,
+        name: str | None = None,
+        id: str | None = None,
+        classes: str | None = None,
+    ) -> None:
+        super().__init__(name=name, id=id, classes=classes)
+        self.bench = bench
+        self._unicode = unicode
+        self._shown: tuple[tuple[str, ...], ...] | None = None
+        #: the last message shown under the table (what happened, or why not)
+        self.status = ""
+
+    def compose(self) -> ComposeResult:
+        if self._unicode is None:
+            self._unicode = bool(getattr(self.app, "unicode", False))
+        yield Static(id="runs-title", markup=False)
+        yield Static(id="runs-help", markup=False)
+        yield DataTable(id="runs-table", cursor_type="row", zebra_stripes=True)
+        yield Static(id="runs-status", markup=False)
+        yield Footer()
+
+    def on_mount(self) -> None:
+        self.refresh_runs()
+
+    def on_screen_resume(self) -> None:
+        self.refresh_runs()
+
+    # -- public ------------------------------------------------------------------------------
+    @property
+    def unicode(self) -> bool:
+        return bool(self._unicode)
+
+    def set_unicode(self, unicode: bool) -> None:
+        self._unicode = unicode
+        if self.is_mounted:
+            self._shown = None
+            self.refresh_runs()
+
+    def refresh_runs(self) -> None:
+        """Show the bench's runs (newest last); repaints only when they changed."""
+        runs = self.bench.runs
+        rows = tuple(run_cells(run, self.unicode) for run in runs)
+        table = self.query_one(DataTable)
+        self.query_one("#runs-title", Static).update(
+            f"Runs on this bench: {len(runs)}  [maze now: {self.bench.maze.name or '-'}]"
+        )
+        if runs:
+            help_text = (
+                "Compare time, distance and turning of runs on the same maze. "
+                "Enter replays a run with a record; o opens a record file."
+            )
+        else:
+            help_text = (
+                "No runs yet: drive with the keys or start an algorithm, then come back. "
+                "o opens a record file."
+            )
+        self.query_one("#runs-help", Static).update(help_text)
+        if rows == self._shown:
+            return
+        self._shown = rows
+        row = table.cursor_row
+        table.clear(columns=True)
+        for key, ascii_label, unicode_label in COLUMNS:
+            table.add_column(unicode_label if self.unicode else ascii_label, key=key)
+        for run, cells in zip(runs, rows, strict=True):
+            table.add_row(*cells, key=str(run.number))
+        if runs:
+            table.move_cursor(row=min(max(row, 0), len(runs) - 1))
+
+    # -- status ------------------------------------------------------------------------------
+    def _status(self, text: str, error: bool = False) -> None:
+        self.status = text
+        status = self.query_one("#runs-status", Static)
+        status.update(text)
+        status.set_class(error, "-error")
+
+    # -- replay ------------------------------------------------------------------------------
+    def _selected(self) -> RunEntry | None:
+        table = self.query_one(DataTable)
+        if not self.bench.runs or table.row_count == 0:
+            return None
+        key = table.coordinate_to_cell_key(table.cursor_coordinate).row_key.value
+        return next((r for r in self.bench.runs if str(r.number) == key), None)
+
+    def action_replay(self) -> None:
+        run = self._selected()
+        if run is None:
+            self._status("no run to replay yet", error=True)
+            return
+        if run.record is None:
+            self._status(
+                f"run {run.number} was not recorded: start the workbench with a record folder "
+                "to replay runs",
+                error=True,
+            )
+            return
+        self.open_record(run.record)
+
+    @on(DataTable.RowSelected, "#runs-table")
+    def _row_selected(self, event: DataTable.RowSelected) -> None:
+        event.stop()
+        self.action_replay()
+
+    def open_record(self, path: str) -> bool:
+        """Open the replay of the record at ``path``; a bad record is reported here."""
+        try:
+            replay = load_replay(path)
+            screen = ReplayScreen(path, replay, mazes=(self.bench.maze,), unicode=self.unicode)
+        except RecordError as exc:
+            self._status(str(exc), error=True)
+            return False
+        self._status("")
+        self.app.push_screen(screen)
+        return True
+
+    def action_open(self, error: str = "", value: str = "") -> None:
+        def chosen(path: str | None) -> None:
+            if path is None:
+                return
+            path = os.path.expanduser(path)
+            if not self.open_record(path):
+                self.action_open(self.status, path)
+
+        self.app.push_screen(
+            PathDialog("Open a run record", OPEN_HELP, value=value, action="Open", error=error),
+            chosen,
+        )
+
+    def action_unicode(self) -> None:
+        unicode = not self.unicode
+        if hasattr(self.app, "unicode"):
+            self.app.unicode = unicode
+        if self.unicode != unicode:
+            self.set_unicode(unicode)
+
+    def action_leave(self) -> None:
+        if len(self.app.screen_stack) > 1 and self.app.screen is self:
+            self.dismiss(None)
+        else:
+            self.app.exit()
