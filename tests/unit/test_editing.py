@@ -68,6 +68,29 @@ def test_set_start_moves_it_then_cycles_the_heading():
     assert ed.maze.heading == "up"
 
 
+def test_the_start_block_cannot_be_walled():
+    ed = MazeEditor(ROOM)
+    with pytest.raises(EditorError, match=r"move the start \(s\) before walling it"):
+        ed.toggle_wall((1, 1))
+    assert ed.maze == ROOM and not ed.can_undo
+
+
+def test_start_and_exit_placed_on_a_wall_clear_the_block_in_one_undo_step():
+    ed = MazeEditor(ROOM)
+    ed.move_to((2, 0))
+    ed.toggle_exit()
+    assert not ed.maze.is_wall(2, 0) and ed.maze.is_exit(2, 0)
+    ed.toggle_exit()
+    assert not ed.maze.is_wall(2, 0) and not ed.maze.is_exit(2, 0)
+    ed.toggle_wall()
+    ed.move_to((2, 1))
+    ed.toggle_wall()
+    ed.set_start()
+    assert not ed.maze.is_wall(2, 1) and ed.maze.start == (2, 1)
+    ed.undo()
+    assert ed.maze.is_wall(2, 1) and ed.maze.start == (1, 1)
+
+
 def test_toggle_exit_adds_and_removes():
     ed = MazeEditor(ROOM)
     ed.move_to((2, 1))

@@ -208,14 +208,22 @@ class MazeEditor:
         return True
 
     def toggle_wall(self, cell: Cell | None = None) -> bool:
-        """Wall <-> floor at ``cell`` (default: the cursor); an exit on a new wall goes."""
+        """Wall <-> floor at ``cell`` (default: the cursor); an exit on a new wall goes.
+
+        The start's block stays floor (a maze file cannot hold a start inside a wall):
+        raises :class:`EditorError` saying to move the start first.
+        """
         x, y = self.move_to(cell) if cell is not None else self.cursor
-        return self._apply(self.maze.with_block(x, y, not self.maze.is_wall(x, y)))
+        wall = not self.maze.is_wall(x, y)
+        if wall and self.maze.start == (x, y):
+            raise EditorError("the start is on this block: move the start (s) before walling it")
+        return self._apply(self.maze.with_block(x, y, wall))
 
     def set_start(self) -> str:
-        """Put the start on the cursor; on the start already, turn it to the next heading."""
+        """Put the start on the cursor (its block becomes floor); on the start already, turn
+        it to the next heading."""
         x, y = self.cursor
-        maze = self.maze
+        maze = self.maze.with_block(x, y, False)
         if maze.start == (x, y):
             heading = HEADING_CYCLE[(HEADING_CYCLE.index(maze.heading) + 1) % len(HEADING_CYCLE)]
         else:
@@ -224,10 +232,14 @@ class MazeEditor:
         return heading
 
     def toggle_exit(self) -> bool:
-        """Add an exit at the cursor, or remove the one there. True when one is there now."""
+        """Add an exit at the cursor (its block becomes floor), or remove the one there.
+
+        Returns True when an exit is there now.
+        """
         x, y = self.cursor
         present = not self.maze.is_exit(x, y)
-        self._apply(self.maze.with_exit(x, y, present))
+        maze = self.maze.with_block(x, y, False) if present else self.maze
+        self._apply(maze.with_exit(x, y, present))
         return present
 
     def new(self, width: int, height: int) -> None:

@@ -327,8 +327,15 @@ class EditorScreen(Screen[Maze | None]):
         self._refresh()
 
     def action_toggle_wall(self) -> None:
-        self.editor.toggle_wall()
-        self._status_block()
+        self._toggle(None)
+
+    def _toggle(self, cell: tuple[int, int] | None) -> None:
+        try:
+            self.editor.toggle_wall(cell)
+        except EditorError as exc:
+            self._status(str(exc), error=True)
+        else:
+            self._status_block()
         self._refresh()
 
     def _status_block(self) -> None:
@@ -339,9 +346,7 @@ class EditorScreen(Screen[Maze | None]):
     @on(MazeView.BlockClicked)
     def _block_clicked(self, event: MazeView.BlockClicked) -> None:
         event.stop()
-        self.editor.toggle_wall(event.cell)
-        self._status_block()
-        self._refresh()
+        self._toggle(event.cell)
 
     def action_start(self) -> None:
         heading = self.editor.set_start()
