@@ -60,17 +60,25 @@ class MainScreen(Screen[None]):
         self.bench = bench
         self._unicode = unicode
         self._trail = trail
+        self._controller: object = None
 
     def compose(self) -> ComposeResult:
+        bench = self.bench
+        self._maze_view = MazeView(bench.maze, unicode=self._unicode, trail=self._trail, id="maze")
+        self._run_status = RunStatus(id="run")
+        self._legend = KeyLegend(bench.profile, id="legend")
+        self._readings = SensorReadings(id="readings")
+        self._algorithm = AlgorithmState(id="algorithm")
+        self._message = MessageBar(self.app_who(), id="message")
         with Horizontal(id="body"):
             with Vertical(id="stage"):
-                yield MazeView(self.bench.maze, unicode=self._unicode, trail=self._trail, id="maze")
-                yield RunStatus(id="run")
+                yield self._maze_view
+                yield self._run_status
             with Vertical(id="side"):
-                yield KeyLegend(self.bench.profile, id="legend")
-                yield SensorReadings(id="readings")
-                yield AlgorithmState(id="algorithm")
-        yield MessageBar(self.app_who(), id="message")
+                yield self._legend
+                yield self._readings
+                yield self._algorithm
+        yield self._message
         yield Footer(compact=True, show_command_palette=False)
 
     def app_who(self) -> str:
@@ -81,28 +89,34 @@ class MainScreen(Screen[None]):
         self.show_snapshot(self.bench.snapshot())
 
     def on_screen_resume(self) -> None:
-        view = self.query_one(MazeView)
+        view = self._maze_view
         if view.maze is not self.bench.maze:
             view.set_maze(self.bench.maze)
             view.clear_trail()
-        self.query_one(KeyLegend).profile = self.bench.profile
+        self._legend.profile = self.bench.profile
         self.show_snapshot(self.bench.snapshot())
 
     # -- drawing ---------------------------------------------------------------------------
     @property
     def unicode(self) -> bool:
-        return self.query_one(MazeView).unicode
+        return self._maze_view.unicode
 
     def show_snapshot(self, snapshot: Snapshot) -> None:
         """Draw one snapshot: each widget repaints only what changed."""
+        if not self.is_attached:
+            return
         bench = self.bench
         self.snapshot = snapshot
         unicode = self.unicode
-        self.query_one(MazeView).show(snapshot, bench.session.world.cell)
-        self.query_one(SensorReadings).show(snapshot, bench.profile)
-        self.query_one(RunStatus).show(snapshot, bench, unicode)
-        self.query_one(AlgorithmState).show(bench, unicode)
-        self.query_one(MessageBar).message = bench.message
+        if bench.controller is not self._controller:
+            self._controller = bench.controller
+            if bench.controller is not None:
+                self._maze_view.clear_trail()  # a new run starts from the start block
+        self._maze_view.show(snapshot, bench.session.world.cell)
+        self._readings.show(snapshot, bench.profile)
+        self._run_status.show(snapshot, bench, unicode)
+        self._algorithm.show(bench, unicode)
+        self._message.message = bench.message
 
     def refresh_views(self) -> None:
         self.show_snapshot(self.bench.snapshot())
@@ -134,7 +148,7 @@ class MainScreen(Screen[None]):
 
     def action_reset(self) -> None:
         self.bench.reset_robot()
-        self.query_one(MazeView).clear_trail()
+        self._maze_view.clear_trail()
         self.refresh_views()
 
     def action_sensors(self) -> None:
@@ -165,7 +179,6 @@ class MainScreen(Screen[None]):
         except (FsmError, ValueError) as exc:
             self.say(f"cannot start: {exc}")
             return
-        self.query_one(MazeView).clear_trail()
         self.refresh_views()
 
     def action_fix_sensors(self) -> None:
@@ -185,14 +198,18 @@ class MainScreen(Screen[None]):
         self.say(f"sensors set for {bench.algorithm.name}: {ports}; x starts it")
 
     def action_unicode(self) -> None:
-        self.set_unicode(not self.unicode)
+        app = self.app
+        if hasattr(app, "unicode"):
+            app.unicode = not self.unicode  # the app tells every screen
+        else:
+            self.set_unicode(not self.unicode)
 
     def set_unicode(self, unicode: bool) -> None:
-        self.query_one(MazeView).set_unicode(unicode)
+        self._maze_view.set_unicode(unicode)
         self.refresh_views()
 
     def action_trail(self) -> None:
-        view = self.query_one(MazeView)
+        view = self._maze_view
         view.set_trail(not view.trail)
 
     def action_editor(self) -> None:

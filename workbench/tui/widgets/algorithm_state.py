@@ -54,18 +54,23 @@ class AlgorithmState(Vertical):
     def __init__(self, *, id: str | None = None, classes: str | None = None) -> None:
         super().__init__(id=id, classes=classes)
         self.border_title = "Algorithm"
+        self._summary = Static(id="algorithm-summary", markup=False)
+        self._states = Static(id="algorithm-states", markup=False)
+        self._vars = Static(id="algorithm-vars", markup=False)
+        self._last = Static(id="algorithm-last", markup=False)
+        self._log = TransitionLog(id="algorithm-log")
 
     def compose(self) -> ComposeResult:
-        yield Static(id="algorithm-summary", markup=False)
-        yield Static(id="algorithm-states", markup=False)
-        yield Static(id="algorithm-vars", markup=False)
-        yield Static(id="algorithm-last", markup=False)
-        yield TransitionLog(id="algorithm-log")
+        yield self._summary
+        yield self._states
+        yield self._vars
+        yield self._last
+        yield self._log
 
     def on_mount(self) -> None:
-        self.watch_summary(self.summary)
+        self.watch_summary("", self.summary)
         self.watch_states(self.states)
-        self.watch_variables(self.variables)
+        self.watch_variables("", self.variables)
         self.watch_last(self.last)
 
     @property
@@ -77,7 +82,7 @@ class AlgorithmState(Vertical):
         definition = bench.algorithm
         controller = bench.controller
         unit = get_profile(bench.profile).unit
-        log = self.query_one(TransitionLog)
+        log = self._log
         if definition is None:
             self.border_title = "Algorithm"
             self.summary = "none chosen: the keys drive. g chooses one."
@@ -125,8 +130,9 @@ class AlgorithmState(Vertical):
         log.display = True
         log.show(controller, history, unit, unicode)
 
-    def watch_summary(self, text: str) -> None:
-        self.query_one("#algorithm-summary", Static).update(text)
+    def watch_summary(self, old: str, text: str) -> None:
+        # the timer counts down every tick: lay out again only when the length changes
+        self._summary.update(text, layout=len(old) != len(text))
 
     def watch_states(self, value: tuple[tuple[str, ...], str | None]) -> None:
         names, current = value
@@ -135,16 +141,16 @@ class AlgorithmState(Vertical):
             Content.styled(f" {name} ", style) if name == current else Content(f" {name} ")
             for name in names
         ]
-        widget = self.query_one("#algorithm-states", Static)
+        widget = self._states
         widget.update(Content("").join(parts))
         widget.display = bool(names)
 
-    def watch_variables(self, text: str) -> None:
-        widget = self.query_one("#algorithm-vars", Static)
-        widget.update(f"vars: {text}" if text else "")
+    def watch_variables(self, old: str, text: str) -> None:
+        widget = self._vars
+        widget.update(f"vars: {text}" if text else "", layout=len(old) != len(text))
         widget.display = bool(text)
 
     def watch_last(self, text: str) -> None:
-        widget = self.query_one("#algorithm-last", Static)
+        widget = self._last
         widget.update(text)
         widget.display = bool(text)

@@ -37,5 +37,6 @@ class SensorReadings(Static):
             lines.append(f"{spec.port:>2} {spec.kind:<8} {spec.mount:<5} {value}")
         self.lines = tuple(lines) or ("no sensors: o opens the ports",)
 
-    def watch_lines(self, lines: tuple[str, ...]) -> None:
-        self.update("\n".join(lines), layout=True)
+    def watch_lines(self, old: tuple[str, ...], lines: tuple[str, ...]) -> None:
+        # new readings every tick: a layout pass only when the number of lines changes
+        self.update("\n".join(lines), layout=len(old) != len(lines))

@@ -1,0 +1,306 @@
+"""The workbench app driven like a student drives it: keys, pause, step, speed, reset, help,
+the command palette, a terminal that is too small, quitting, and the command line."""
+
+from __future__ import annotations
+
+import asyncio
+import io
+from collections.abc import Awaitable, Callable
+
+import pytest
+from rich.console import Console
+from textual.pilot import Pilot
+from textual.widgets import Static
+
+from workbench.cli import main
+from workbench.control.manual import key_legend
+from workbench.tui.app import AppSetupError, WorkbenchApp, make_app
+from workbench.tui.commands import COMMANDS, WorkbenchCommands
+from workbench.tui.modals.help import HelpScreen
+from workbench.tui.modals.too_small import TooSmallScreen
+from workbench.tui.screens.main import MainScreen
+from workbench.tui.widgets.key_legend import KeyLegend
+from workbench.tui.widgets.maze_view import MazeView
+from workbench.tui.widgets.run_status import RunStatus
+
+ROOM = "#######\n#.....#\n#..S..#\n#.....#\n#######\n"
+CORRIDOR = "##########\n#S......E#\n##########\n"
+
+
+def maze_file(tmp_path, text: str, profile: str) -> str:
+    path = tmp_path / f"{profile}.txt"
+    path.write_text(f"---\nname: test {profile}\nprofile: {profile}\n---\n{text}")
+    return str(path)
+
+
+def run(
+    app: WorkbenchApp,
+    body: Callable[[Pilot], Awaitable[None]],
+    size: tuple[int, int] = (80, 24),
+) -> None:
+    async def go() -> None:
+        async with app.run_test(size=size) as pilot:
+            await pilot.pause()
+            await body(pilot)
+
+    asyncio.run(go())
+
+
+def status(app: WorkbenchApp) -> str:
+    return "\n".join(app.screen.query_one(RunStatus).lines)
+
+
+# -- drive-by-wire ------------------------------------------------------------------------------
+
+
+def test_unity_keys_turn_by_degree_and_move_at_power(tmp_path):
+    app = make_app(maze_file(tmp_path, ROOM, "unity"), paused=True, noise="off")
+    start = app.bench.snapshot().pose
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.press("d")
+        app.bench.step(60 * 4)
+        assert app.bench.snapshot().pose.heading == pytest.approx(90, abs=0.5)
+        await pilot.press("w")
+        app.bench.step(60)
+        await pilot.press("space")
+        app.bench.step(30)
+        app.refresh_views()
+        await pilot.pause()
+        pose = app.bench.snapshot().pose
+        assert pose.y > start.y + 0.5 and pose.x == pytest.approx(start.x, abs=0.05)
+        assert app.screen.query_one(MazeView).robot_cell == app.bench.snapshot().block
+        assert "driver: keys" in status(app)
+        assert app.bench.keys_used == {"d", "w", "space"}
+
+    run(app, body)
+
+
+def test_web_keys_spin_until_the_next_key(tmp_path):
+    app = make_app(maze_file(tmp_path, ROOM, "web"), paused=True, noise="off")
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.press("a")
+        app.bench.step(90)  # (-0.2, 0.2) for 1.5 s: a quarter turn left
+        assert app.bench.snapshot().pose.heading == pytest.approx(270, abs=10)
+        await pilot.press("space")
+        heading = app.bench.snapshot().pose.heading
+        app.bench.step(60)
+        assert app.bench.snapshot().pose.heading == pytest.approx(heading, abs=0.01)
+
+    run(app, body)
+
+
+def test_erobotic_w_drives_exactly_one_block(tmp_path):
+    app = make_app(maze_file(tmp_path, CORRIDOR, "erobotic"), paused=True)
+    start = app.bench.maze.start
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.press("w")
+        app.bench.step(120)
+        app.refresh_views()
+        await pilot.pause()
+        snap = app.bench.snapshot()
+        assert snap.block == (start[0] + 1, start[1])
+        assert snap.metrics.distance_cells == pytest.approx(1.0, abs=1e-6)
+        assert app.screen.query_one(MazeView).robot_cell == snap.block
+
+    run(app, body)
+
+
+@pytest.mark.parametrize("profile", ["unity", "web", "erobotic"])
+def test_the_key_legend_follows_the_profile(tmp_path, profile):
+    app = make_app(maze_file(tmp_path, ROOM, profile), paused=True)
+
+    async def body(pilot: Pilot) -> None:
+        legend = app.screen.query_one(KeyLegend)
+        text = str(legend.content)
+        assert legend.border_title == f"Keys ({profile})"
+        for _key, what in key_legend(profile):
+            assert what in text
+
+    run(app, body)
+
+
+# -- time ----------------------------------------------------------------------------------------
+
+
+def test_pause_step_speed_and_reset(tmp_path):
+    app = make_app(maze_file(tmp_path, ROOM, "unity"), noise="off")
+    bench = app.bench
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.press("w")
+        await pilot.pause(0.3)
+        assert bench.snapshot().time > 0  # the interval runs the simulation in real time
+        await pilot.press("p")
+        assert bench.pacer.paused and "PAUSED" in status(app)
+        t = bench.snapshot().time
+        await pilot.pause(0.2)
+        assert bench.snapshot().time == t
+        await pilot.press("n")
+        assert bench.snapshot().time == pytest.approx(t + bench.session.every / 60)
+        assert bench.pacer.paused
+        seen = []
+        for _ in range(5):
+            await pilot.press("plus")
+            seen.append(status(app).splitlines()[1].split(" at ")[1].split()[0])
+        assert seen == ["2x", "4x", "10x", "max", "1x"]
+        await pilot.press("r")
+        snap = bench.snapshot()
+        assert snap.time == 0 and snap.block == bench.maze.start
+        assert bench.runs[-1].ended == "reset"
+        await pilot.press("p")
+        assert not bench.pacer.paused and "running" in status(app)
+
+    run(app, body)
+
+
+def test_a_slow_frame_loses_no_simulated_time(tmp_path):
+    app = make_app(maze_file(tmp_path, ROOM, "unity"), paused=True, tick_hz=20)
+
+    async def body(pilot: Pilot) -> None:
+        app.bench.pacer.paused = False
+        app._last_tick -= 0.2  # the next tick comes 200 ms late
+        app._tick()
+        assert app.bench.snapshot().time == pytest.approx(0.2, abs=2 / 60)
+
+    run(app, body)
+
+
+# -- screens and keys --------------------------------------------------------------------------
+
+
+def test_help_explains_every_key(tmp_path):
+    app = make_app(maze_file(tmp_path, ROOM, "web"), paused=True)
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.press("question_mark")
+        assert isinstance(app.screen, HelpScreen)
+        console = Console(width=100, record=True, file=io.StringIO())
+        console.print(app.screen.query_one("#help-text", Static).content)
+        text = " ".join(console.export_text().split())
+        for binding in [*MainScreen.BINDINGS, *WorkbenchApp.BINDINGS]:
+            info = COMMANDS[binding.id]
+            if info.group != "Drive":
+                assert " ".join(info.explanation.split()) in text
+        for _key, what in key_legend("web"):
+            assert what in text
+        await pilot.press("escape")
+        assert isinstance(app.screen, MainScreen)
+
+    run(app, body, size=(120, 40))
+
+
+def test_every_binding_has_an_id_and_a_help_entry():
+    for binding in [*MainScreen.BINDINGS, *WorkbenchApp.BINDINGS]:
+        assert binding.id in COMMANDS, binding
+
+
+def test_the_command_palette_offers_the_bindings_and_runs_them(tmp_path):
+    app = make_app(maze_file(tmp_path, ROOM, "unity"), paused=True)
+
+    async def body(pilot: Pilot) -> None:
+        provider = WorkbenchCommands(app.screen)
+        titles = [title for title, _help, _run in provider._commands()]
+        assert "Simulation: pause / resume" in titles and "App: quit" in titles
+        assert len(titles) == len(titles) and len(set(titles)) == len(titles)
+        await pilot.press("ctrl+p")
+        await pilot.pause()
+        await pilot.press(*"speed")
+        await pilot.pause(0.3)
+        await pilot.press("enter")
+        await pilot.pause(0.1)
+        assert app.bench.pacer.speed == 2.0
+
+    run(app, body)
+
+
+def test_unicode_and_trail_toggles(tmp_path):
+    app = make_app(maze_file(tmp_path, ROOM, "unity"), paused=True)
+
+    async def body(pilot: Pilot) -> None:
+        view = app.screen.query_one(MazeView)
+        assert not view.unicode and view.trail
+        await pilot.press("u", "t")
+        assert view.unicode and not view.trail
+        assert app.unicode
+        await pilot.press("u", "t")
+        assert not view.unicode and view.trail
+
+    run(app, body)
+
+
+def test_a_terminal_below_80x24_gets_a_message_instead_of_the_layout(tmp_path):
+    app = make_app(maze_file(tmp_path, ROOM, "unity"), paused=True)
+
+    async def body(pilot: Pilot) -> None:
+        assert isinstance(app.screen, TooSmallScreen)
+        text = str(app.screen.query_one("#too-small-text").render())
+        assert "70x20" in text and "80x24" in text
+        await pilot.press("w", "question_mark")
+        assert isinstance(app.screen, TooSmallScreen)
+        assert app.bench.keys_used == set()
+        await pilot.resize_terminal(80, 24)
+        await pilot.pause(0.1)
+        assert isinstance(app.screen, MainScreen)
+        await pilot.resize_terminal(79, 24)
+        await pilot.pause(0.1)
+        assert isinstance(app.screen, TooSmallScreen)
+
+    run(app, body, size=(70, 20))
+
+
+def test_ctrl_q_quits_and_keeps_the_open_run(tmp_path):
+    app = make_app(maze_file(tmp_path, ROOM, "unity"), paused=True)
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.press("w")
+        await pilot.press("ctrl+c")  # does not quit
+        assert app.is_running
+        await pilot.press("ctrl+q")
+
+    run(app, body)
+    assert app.return_code == 0
+    assert [r.ended for r in app.bench.runs] == ["stopped"]
+
+
+def test_editor_and_runs_keys_are_bound():
+    keys = {b.id: b.key for b in MainScreen.BINDINGS}
+    assert keys["screen.editor"] == "e" and keys["screen.runs"] == "R"
+
+
+# -- setting up ----------------------------------------------------------------------------------
+
+
+def test_make_app_reports_bad_arguments_in_words(tmp_path):
+    with pytest.raises(AppSetupError, match="unknown profile 'lego'"):
+        make_app(profile="lego")
+    with pytest.raises(AppSetupError, match="unknown noise level"):
+        make_app(noise="loud")
+    with pytest.raises(AppSetupError, match="cannot open the maze"):
+        make_app(tmp_path / "missing.txt")
+    bad = tmp_path / "bad.txt"
+    bad.write_text("#####\n#.X.#\n#####\n")
+    with pytest.raises(AppSetupError, match="unknown character"):
+        make_app(bad)
+
+
+def test_make_app_defaults_to_the_bundled_maze():
+    app = make_app(paused=True)
+    assert app.bench.maze.name == "Unity default" and app.bench.profile == "unity"
+    assert app.bench.pacer.paused
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--profile", "lego"], "unknown profile 'lego'"),
+        (["--maze", "no/such/maze.txt"], "cannot read"),
+        (["--noise", "loud"], "unknown noise level"),
+    ],
+)
+def test_workbench_with_bad_arguments_exits_2_before_the_app(capsys, args, message):
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("workbench: ") and message in err and "Traceback" not in err

@@ -1,0 +1,402 @@
+"""The sensor port panel and the algorithm selector, used through the app as a student would."""
+
+from __future__ import annotations
+
+import asyncio
+from collections.abc import Awaitable, Callable
+
+from textual.pilot import Pilot
+from textual.widgets import Input, OptionList, Select, Static
+
+from workbench.sim.sensors import SensorSpec
+from workbench.tui.app import WorkbenchApp, make_app
+from workbench.tui.modals.algorithm import AlgorithmModal
+from workbench.tui.modals.sensor_ports import SensorPortsModal
+from workbench.tui.screens.main import MainScreen
+from workbench.tui.widgets.algorithm_state import AlgorithmState
+from workbench.tui.widgets.param_editor import ParamEditor
+from workbench.tui.widgets.sensor_readings import SensorReadings
+from workbench.tui.widgets.sensor_row_editor import SensorRowEditor
+from workbench.tui.widgets.transition_log import TransitionLog
+
+ROOM = "#######\n#.....#\n#..S..#\n#.....#\n#######\n"
+
+
+def run(app: WorkbenchApp, body: Callable[[Pilot], Awaitable[None]], size=(80, 24)) -> None:
+    async def go() -> None:
+        async with app.run_test(size=size) as pilot:
+            await pilot.pause()
+            await body(pilot)
+
+    asyncio.run(go())
+
+
+def unity_app(tmp_path=None, **kw) -> WorkbenchApp:
+    return make_app(paused=True, noise="off", **kw)
+
+
+def text_of(widget: Static) -> str:
+    return str(widget.render())
+
+
+# -- sensor ports --------------------------------------------------------------------------------
+
+
+async def open_ports(pilot: Pilot) -> SensorPortsModal:
+    await pilot.press("o")
+    await pilot.pause()
+    screen = pilot.app.screen
+    assert isinstance(screen, SensorPortsModal)
+    return screen
+
+
+def row_editors(screen: SensorPortsModal) -> list[SensorRowEditor]:
+    return screen.editors
+
+
+def set_row(editor: SensorRowEditor, port: str | None = None, mount: str | None = None) -> None:
+    if port is not None:
+        editor.query_one(".row-port", Input).value = port
+    if mount is not None:
+        editor.query_one(".row-mount", Select).value = mount
+
+
+def test_the_panel_opens_with_two_distance_sensors_and_a_touch_sensor():
+    app = unity_app()
+
+    async def body(pilot: Pilot) -> None:
+        screen = await open_ports(pilot)
+        rows = screen.rows()
+        assert [(r.kind, r.port, r.mount) for r in rows] == [
+            ("distance", "1", "right"),
+            ("distance", "2", "front"),
+            ("touch", "3", None),
+        ]
+        readings = [str(e.query_one(".row-reading").render()) for e in row_editors(screen)]
+        snap = app.bench.snapshot()
+        assert readings == [f"{snap.readings[1]:.2f}", f"{snap.readings[2]:.2f}", "not mounted"]
+
+    run(app, body)
+
+
+def test_duplicate_and_out_of_range_ports_are_shown_inline_and_nothing_is_applied():
+    app = unity_app()
+    before = list(app.bench.sensors)
+
+    async def body(pilot: Pilot) -> None:
+        screen = await open_ports(pilot)
+        first, second, third = row_editors(screen)
+        set_row(second, port="1")
+        set_row(third, port="120", mount="front")
+        await pilot.pause()
+        await pilot.click("#ports-apply")
+        await pilot.pause()
+        assert first.error == "port 1 is also used by row 2"
+        assert second.error == "port 1 is already used by row 1"
+        assert third.error == "port 120 is out of range (0-99)"
+        assert all(e.has_class("-invalid") for e in (first, second, third))
+        status = text_of(screen.query_one("#ports-status", Static))
+        assert status.startswith("nothing applied: 3 rows to fix")
+        assert app.bench.sensors == before
+        set_row(second, port="2")
+        set_row(third, port="5")
+        await pilot.pause()
+        assert [e.error for e in row_editors(screen)] == [None, None, None]
+
+    run(app, body)
+
+
+def test_a_valid_apply_changes_the_live_robot_and_the_readings_by_port():
+    app = unity_app()
+
+    async def body(pilot: Pilot) -> None:
+        screen = await open_ports(pilot)
+        first, _second, third = row_editors(screen)
+        set_row(first, port="7")
+        set_row(third, mount="back")
+        await pilot.pause()
+        first.query_one(".row-port", Input).focus()
+        await pilot.press("enter")  # enter in a port field applies
+        assert app.bench.sensors == [
+            SensorSpec("distance", 7, "right"),
+            SensorSpec("distance", 2, "front"),
+            SensorSpec("touch", 3, "back"),
+        ]
+        assert set(app.bench.snapshot().readings) == {7, 2, 3}
+        await pilot.pause()
+        assert str(third.query_one(".row-reading").render()) == "free"
+        await pilot.press("escape")
+        assert isinstance(app.screen, MainScreen)
+        lines = app.screen.query_one(SensorReadings).lines
+        assert [line.split()[0] for line in lines] == ["2", "3", "7"]
+        assert lines[2].split()[1:3] == ["distance", "right"]
+
+    run(app, body)
+
+
+def test_presets_add_and_remove_rows():
+    app = unity_app()
+
+    async def body(pilot: Pilot) -> None:
+        screen = await open_ports(pilot)
+        await pilot.click("#preset-web-two-distance")
+        await pilot.pause()
+        assert app.bench.sensors == [SensorSpec("distance", 3, "front")]
+        assert [(r.kind, r.port, r.mount) for r in screen.rows()] == [
+            ("distance", "3", "front"),
+            ("distance", "1", None),
+            ("touch", "2", None),
+        ]
+        await pilot.click("#preset-web-wall-following")
+        await pilot.pause()
+        assert app.bench.sensors == [
+            SensorSpec("distance", 1, "right"),
+            SensorSpec("touch", 2, "front"),
+        ]
+        await pilot.click("#ports-add")
+        await pilot.pause()
+        assert len(screen.rows()) == 4 and screen.rows()[-1].port == "4"
+        await pilot.click(".row-remove")
+        await pilot.pause()
+        assert [r.port for r in screen.rows()] == ["2", "3", "4"]
+        assert [e.number for e in row_editors(screen)] == [1, 2, 3]
+        await pilot.click("#ports-apply")
+        assert app.bench.sensors == [SensorSpec("touch", 2, "front")]
+
+    run(app, body)
+
+
+# -- algorithms ------------------------------------------------------------------------------------
+
+
+async def open_algorithms(pilot: Pilot) -> AlgorithmModal:
+    await pilot.press("g")
+    await pilot.pause()
+    screen = pilot.app.screen
+    assert isinstance(screen, AlgorithmModal)
+    return screen
+
+
+async def choose_builtin(pilot: Pilot, screen: AlgorithmModal, name: str) -> None:
+    options = screen.query_one("#alg-builtins", OptionList)
+    options.focus()
+    options.highlighted = options.get_option_index(name)
+    await pilot.press("enter")
+    await pilot.pause()
+
+
+def test_choosing_shows_description_sensors_and_parameters():
+    app = unity_app()
+
+    async def body(pilot: Pilot) -> None:
+        screen = await open_algorithms(pilot)
+        await choose_builtin(pilot, screen, "right-wall")
+        assert app.bench.algorithm.name == "right-wall"
+        assert text_of(screen.query_one("#alg-title", Static)) == "right-wall  (built-in)"
+        assert "Right-wall following" in text_of(screen.query_one("#alg-description", Static))
+        sensors = text_of(screen.query_one("#alg-sensors", Static))
+        assert "right: distance sensor mounted right, port 1" in sensors
+        assert not screen.query_one("#alg-missing").display
+        params = {e.parameter.name: e.text for e in screen.query(ParamEditor)}
+        assert params["front_blocked"] == "0.9" and params["forward_power"] == "1"
+
+    run(app, body)
+
+
+def test_start_and_the_state_display_follows_the_engine():
+    app = unity_app()
+    bench = app.bench
+
+    async def body(pilot: Pilot) -> None:
+        screen = await open_algorithms(pilot)
+        await choose_builtin(pilot, screen, "right-wall")
+        await pilot.click("#alg-start")
+        await pilot.pause()
+        assert isinstance(app.screen, MainScreen)
+        assert bench.controller is not None and not bench.pacer.paused
+        bench.pacer.paused = True
+        state = app.screen.query_one(AlgorithmState)
+        seen = set()
+        for _ in range(40):
+            bench.step(60)
+            app.refresh_views()
+            await pilot.pause()
+            assert state.highlighted == bench.controller.state
+            seen.add(state.highlighted)
+        assert len(seen) >= 3
+        assert state.summary.startswith(f"in {bench.controller.state}")
+        last = bench.controller.history[-1]
+        assert state.last.startswith(f"{last.time:.1f} s {last.source} -> {last.target}")
+        log = app.screen.query_one(TransitionLog)
+        assert log.line_count == len(bench.controller.history)
+        assert "driver: algorithm right-wall" in "\n".join(app.screen.query_one("#run").lines)
+
+    run(app, body)
+
+
+def test_pause_step_and_reset_from_the_dialog():
+    app = unity_app()
+    bench = app.bench
+
+    async def body(pilot: Pilot) -> None:
+        screen = await open_algorithms(pilot)
+        await choose_builtin(pilot, screen, "right-wall")
+        await pilot.click("#alg-start")
+        await pilot.pause()
+        screen = await open_algorithms(pilot)
+        await pilot.click("#alg-pause")
+        assert bench.pacer.paused
+        t = bench.snapshot().time
+        await pilot.click("#alg-step")
+        assert bench.snapshot().time == t + bench.session.every / 60
+        assert "running, in" in str(screen.query_one("#alg-live").render())
+        await pilot.click("#alg-reset")
+        assert bench.controller is None and bench.snapshot().time == 0
+        assert bench.runs[-1].ended == "reset"
+
+    run(app, body, size=(120, 40))
+
+
+def test_x_starts_and_stops_the_chosen_algorithm_from_the_main_screen():
+    app = unity_app()
+    app.bench.select_algorithm("right-wall")
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.press("x")
+        assert app.bench.controller is not None
+        await pilot.press("x")
+        assert app.bench.controller is None
+        assert app.bench.snapshot().driver == "keys"
+
+    run(app, body)
+
+
+def test_a_missing_sensor_is_explained_with_a_one_key_fix():
+    app = unity_app()
+    bench = app.bench
+    bench.apply_preset("web-two-distance")
+    bench.select_algorithm("right-wall")
+
+    async def body(pilot: Pilot) -> None:
+        state = app.screen.query_one(AlgorithmState)
+        assert "cannot start" in state.summary and "f fits" in state.summary
+        await pilot.press("x")
+        assert bench.controller is None
+        assert "f fits the sensors it needs" in bench.message
+        await pilot.press("f")
+        assert bench.missing_sensors() is None
+        assert bench.sensors == [
+            SensorSpec("distance", 1, "right"),
+            SensorSpec("distance", 2, "front"),
+        ]
+        await pilot.press("x")
+        assert bench.controller is not None
+
+    run(app, body)
+
+
+def test_the_dialog_explains_a_missing_sensor_and_f_fixes_it():
+    app = unity_app()
+    app.bench.apply_preset("web-two-distance")
+
+    async def body(pilot: Pilot) -> None:
+        screen = await open_algorithms(pilot)
+        await choose_builtin(pilot, screen, "right-wall")
+        missing = screen.query_one("#alg-missing", Static)
+        assert missing.display and "needs a distance sensor mounted right" in text_of(missing)
+        await pilot.click("#alg-start")
+        assert app.bench.controller is None
+        assert "press f" in text_of(screen.query_one("#alg-error", Static))
+        await pilot.press("f")
+        assert app.bench.missing_sensors() is None and not missing.display
+        await pilot.click("#alg-start")
+        assert app.bench.controller is not None
+
+    run(app, body, size=(120, 40))
+
+
+def test_a_bad_fsm_file_is_reported_with_file_line_and_column(tmp_path):
+    bad = tmp_path / "mine.yaml"
+    bad.write_text("name: mine\ninitial: Go\nstates:\n  Go:\n    on_enter:\n      - fly: 1\n")
+    app = unity_app()
+
+    async def body(pilot: Pilot) -> None:
+        screen = await open_algorithms(pilot)
+        path = screen.query_one("#alg-path", Input)
+        path.value = str(bad)
+        path.focus()
+        await pilot.press("enter")
+        await pilot.pause()
+        error = text_of(screen.query_one("#alg-error", Static))
+        assert error.startswith(f"{bad}:6:")
+        assert app.bench.algorithm is None
+
+    run(app, body, size=(120, 40))
+
+
+def test_a_good_fsm_file_loads(tmp_path):
+    good = tmp_path / "mine.yaml"
+    good.write_text(
+        "name: mine\nsensors:\n  front: {kind: distance, mount: front, port: 2}\n"
+        "initial: Go\nstates:\n  Go:\n    on_enter:\n      - move: 1\n"
+        "    transitions:\n      - when: front < 1\n        to: Stop\n"
+        "  Stop:\n    on_enter:\n      - stop: true\n"
+    )
+    app = unity_app()
+
+    async def body(pilot: Pilot) -> None:
+        screen = await open_algorithms(pilot)
+        screen.query_one("#alg-path", Input).value = str(good)
+        await pilot.click("#alg-load")
+        await pilot.pause()
+        assert app.bench.algorithm is not None and app.bench.algorithm.name == "mine"
+        assert text_of(screen.query_one("#alg-title", Static)) == f"mine  ({good})"
+        assert text_of(screen.query_one("#alg-error", Static)) == ""
+
+    run(app, body, size=(120, 40))
+
+
+def test_parameters_are_checked_as_typed_and_reset_to_defaults():
+    app = unity_app()
+
+    async def body(pilot: Pilot) -> None:
+        screen = await open_algorithms(pilot)
+        await choose_builtin(pilot, screen, "right-wall")
+        editor = next(e for e in screen.query(ParamEditor) if e.parameter.name == "forward_power")
+        editor.query_one(Input).value = "5"
+        await pilot.pause()
+        assert editor.invalid
+        assert "above its maximum 1" in text_of(editor.query_one(".param-error", Static))
+        await pilot.click("#alg-start")
+        assert app.bench.controller is None
+        assert "forward_power" in text_of(screen.query_one("#alg-error", Static))
+        editor.query_one(Input).value = "0.5"
+        await pilot.pause()
+        assert not editor.invalid and app.bench.params()["forward_power"] == 0.5
+        await pilot.click("#alg-defaults")
+        await pilot.pause()
+        assert app.bench.params()["forward_power"] == 1.0
+        fresh = next(e for e in screen.query(ParamEditor) if e.parameter.name == "forward_power")
+        assert fresh.text == "1"
+
+    run(app, body, size=(120, 40))
+
+
+def test_a_failing_algorithm_stops_with_its_reason_on_the_message_line(tmp_path):
+    failing = tmp_path / "failing.yaml"
+    failing.write_text(
+        "name: failing\nsensors:\n  front: {kind: distance, mount: front, port: 2}\n"
+        "initial: Go\nstates:\n  Go:\n    transitions:\n"
+        "      - when: 1 / (front - front) > 0\n        to: Go\n"
+    )
+    app = unity_app()
+    app.bench.select_algorithm(failing)
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.press("x")
+        await pilot.pause(0.3)
+        assert app.bench.controller is None
+        message = app.screen.query_one("#message").message
+        assert message.startswith("algorithm stopped: failing, state Go")
+
+    run(app, body)
