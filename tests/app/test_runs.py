@@ -1,0 +1,271 @@
+"""The runs screen and the replay screen, driven through a tiny host app with App.run_test()."""
+
+from __future__ import annotations
+
+import asyncio
+import functools
+import json
+from collections.abc import Callable, Coroutine
+from typing import Any
+
+from textual.app import App
+from textual.screen import Screen
+from textual.widgets import DataTable, Input, Static
+
+from workbench.control.bench import Bench
+from workbench.sim.mazefile import parse_maze
+from workbench.sim.record import FORMAT
+from workbench.tui.screens.path_dialog import PathDialog
+from workbench.tui.screens.replay import ReplayScreen
+from workbench.tui.screens.runs import RunsScreen, driver_name
+from workbench.tui.widgets import MazeView
+
+BEND = parse_maze(
+    "---\nname: Bend\n---\n#######\n#S....#\n#####.#\n#E....#\n#######\n", source="bend.txt"
+)
+SIZE = (80, 24)
+
+
+def sync(test: Callable[..., Coroutine[Any, Any, None]]) -> Callable[..., None]:
+    """Run an async test body with asyncio (the suite has no async test plugin)."""
+
+    @functools.wraps(test)
+    def run(*args: Any, **kwargs: Any) -> None:
+        asyncio.run(test(*args, **kwargs))
+
+    return run
+
+
+class Host(App):
+    def __init__(self, screen: Screen) -> None:
+        super().__init__()
+        self.under_test = screen
+
+    def on_mount(self) -> None:
+        self.push_screen(self.under_test)
+
+
+def run_algorithms(bench: Bench, *names: str) -> Bench:
+    for name in names:
+        bench.select_algorithm(name)
+        bench.apply_algorithm_preset()
+        bench.start_algorithm()
+        before = len(bench.runs)
+        for _ in range(200):
+            bench.step(60)
+            if len(bench.runs) > before:
+                break
+    return bench
+
+
+def two_runs(tmp_path) -> Bench:
+    bench = Bench.open(BEND, "erobotic", noise="off", record_dir=str(tmp_path / "runs"))
+    return run_algorithms(bench, "right-wall", "two-distance-local-best")
+
+
+def text(widget: Static) -> str:
+    return str(widget.render())
+
+
+def table_rows(table: DataTable) -> list[list[str]]:
+    return [[str(c) for c in table.get_row_at(i)] for i in range(table.row_count)]
+
+
+@sync
+async def test_the_table_shows_each_run_with_its_measures(tmp_path):
+    bench = two_runs(tmp_path)
+    app = Host(RunsScreen(bench, unicode=False))
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        table = app.screen.query_one(DataTable)
+        assert [str(c.label) for c in table.columns.values()] == [
+            "#",
+            "Driver",
+            "Out",
+            "Time s",
+            "Blocks",
+            "Turn deg",
+            "Turns",
+            "Hits",
+            "Eff",
+            "Ended",
+            "Maze",
+            "Rec",
+        ]
+        assert table_rows(table) == [
+            [
+                "1",
+                "right-wall",
+                "yes",
+                "11.6",
+                "9.95",
+                "180",
+                "2",
+                "0",
+                "0.95",
+                "exit",
+                "Bend",
+                "yes",
+            ],
+            [
+                "2",
+                "two-distance-local-best",
+                "yes",
+                "19.9",
+                "9.75",
+                "900",
+                "6",
+                "0",
+                "0.97",
+                "exit",
+                "Bend",
+                "yes",
+            ],
+        ]
+        assert text(app.screen.query_one("#runs-title")).startswith("Runs on this bench: 2")
+
+
+@sync
+async def test_new_runs_appear_when_the_screen_comes_back(tmp_path):
+    bench = two_runs(tmp_path)
+    screen = RunsScreen(bench)
+    app = Host(screen)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.press("enter")
+        await pilot.pause()
+        assert isinstance(app.screen, ReplayScreen)
+        run_algorithms(bench, "right-wall")
+        await pilot.press("escape")
+        await pilot.pause()
+        assert app.screen is screen and screen.query_one(DataTable).row_count == 3
+
+
+@sync
+async def test_no_runs_yet_and_a_run_without_a_record(tmp_path):
+    bench = Bench.open(BEND, "erobotic", noise="off")
+    screen = RunsScreen(bench)
+    app = Host(screen)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        assert text(screen.query_one("#runs-help")).startswith("No runs yet")
+        run_algorithms(bench, "right-wall")
+        screen.refresh_runs()
+        await pilot.pause()
+        await pilot.press("enter")
+        await pilot.pause()
+        assert app.screen is screen
+        assert screen.status.startswith("run 1 was not recorded")
+
+
+@sync
+async def test_replay_steps_through_the_recorded_run(tmp_path):
+    bench = two_runs(tmp_path)
+    app = Host(RunsScreen(bench, unicode=False))
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.press("down", "enter")
+        await pilot.pause()
+        replay_screen = app.screen
+        assert isinstance(replay_screen, ReplayScreen)
+        replay = replay_screen.replay
+        assert replay.title == "two-distance-local-best on Bend"
+        assert replay_screen.maze is bench.maze and replay_screen.note == ""
+        view = replay_screen.query_one(MazeView)
+        assert view.robot_cell == BEND.start
+        await pilot.press("right", "right", "right")
+        assert replay.index == 3
+        frame = replay.frame()
+        panel = text(replay_screen.query_one("#replay-tick"))
+        assert panel.startswith(f"Tick 4/{len(replay)}  t {frame.t:.2f} s")
+        assert f"State {frame.state}" in panel
+        for port, value in frame.sensors.items():
+            assert f"port {port} distance" in panel and f": {value:.1f}" in panel
+        await pilot.press("left")
+        assert replay.index == 2
+        await pilot.press("end")
+        await pilot.pause()
+        assert replay.at_end and view.robot_cell == BEND.exits[0]
+        assert "End: out through the exit" in text(replay_screen.query_one("#replay-tick"))
+        assert "exit" in text(replay_screen.query_one("#replay-log"))
+        await pilot.press("home")
+        assert replay.index == 0 and view.robot_cell == BEND.start
+        await pilot.press("pagedown")
+        assert replay.index == 10
+
+
+@sync
+async def test_replay_plays_at_a_speed_and_pauses(tmp_path):
+    bench = two_runs(tmp_path)
+    app = Host(RunsScreen(bench))
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.press("enter")
+        await pilot.pause()
+        screen = app.screen
+        replay = screen.replay
+        await pilot.press("plus", "plus", "plus")
+        assert replay.speed == 10.0
+        await pilot.press("minus")
+        assert replay.speed == 4.0
+        await pilot.press("space")
+        assert replay.playing
+        await pilot.pause(0.3)
+        await pilot.press("space")
+        assert not replay.playing and replay.index > 0
+        assert "paused at 4x" in text(screen.query_one("#replay-tick"))
+        replay.speed = 50.0
+        await pilot.press("space")
+        for _ in range(40):
+            await pilot.pause(0.05)
+            if replay.at_end:
+                break
+        assert replay.at_end and not replay.playing
+
+
+@sync
+async def test_open_a_record_by_path_and_a_malformed_one(tmp_path):
+    bench = two_runs(tmp_path)
+    screen = RunsScreen(bench)
+    app = Host(screen)
+    bad = tmp_path / "bad.jsonl"
+    bad.write_text(
+        json.dumps({"type": "header", "format": FORMAT})
+        + "\n"
+        + json.dumps({"t": 0.0, "pose": [1, 2]})
+        + "\n"
+    )
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.press("o")
+        assert isinstance(app.screen, PathDialog)
+        app.screen.query_one(Input).value = str(bad)
+        await pilot.press("enter")
+        await pilot.pause()
+        assert isinstance(app.screen, PathDialog)  # asked again with the reason
+        assert screen.status == f'{bad}:2: "pose" must be [x, y, heading], three numbers'
+        assert screen.status in text(app.screen.query_one("#error"))
+        await pilot.press("escape")
+        await pilot.pause()
+        assert app.screen is screen
+        await pilot.press("o")
+        app.screen.query_one(Input).value = bench.runs[0].record
+        await pilot.press("enter")
+        await pilot.pause()
+        assert isinstance(app.screen, ReplayScreen)
+        assert app.screen.replay.title == "right-wall on Bend"
+
+
+@sync
+async def test_replay_of_a_run_whose_maze_cannot_be_found(tmp_path):
+    bench = two_runs(tmp_path)
+    record = bench.runs[0].record
+    app = Host(ReplayScreen(record))  # no known mazes; bend.txt is nowhere
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        screen = app.screen
+        assert screen.maze is None and "bend.txt is not found" in screen.note
+        assert not screen.query(MazeView)
+        await pilot.press("right")
+        assert screen.replay.index == 1
+
+
+def test_driver_names_drop_the_algorithm_prefix():
+    assert driver_name("algorithm right-wall") == "right-wall"
+    assert driver_name("keys") == "keys"
