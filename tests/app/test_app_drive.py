@@ -18,7 +18,9 @@ from workbench.tui.app import AppSetupError, WorkbenchApp, make_app
 from workbench.tui.commands import COMMANDS, WorkbenchCommands
 from workbench.tui.modals.help import HelpScreen
 from workbench.tui.modals.too_small import TooSmallScreen
+from workbench.tui.screens.editor import EditorScreen
 from workbench.tui.screens.main import MainScreen
+from workbench.tui.screens.runs import RunsScreen
 from workbench.tui.widgets.key_legend import KeyLegend
 from workbench.tui.widgets.maze_view import MazeView
 from workbench.tui.widgets.run_status import RunStatus
@@ -265,9 +267,30 @@ def test_ctrl_q_quits_and_keeps_the_open_run(tmp_path):
     assert [r.ended for r in app.bench.runs] == ["stopped"]
 
 
-def test_editor_and_runs_keys_are_bound():
-    keys = {b.id: b.key for b in MainScreen.BINDINGS}
-    assert keys["screen.editor"] == "e" and keys["screen.runs"] == "R"
+def test_e_opens_the_maze_editor_and_capital_r_the_runs(tmp_path):
+    app = make_app(maze_file(tmp_path, ROOM, "unity"), paused=True)
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.press("w", "r")  # one run, ended by the reset
+        await pilot.press("e")
+        assert isinstance(app.screen, EditorScreen)
+        titles = [t for t, _h, _r in WorkbenchCommands(app.screen)._commands()]
+        assert "App: quit" in titles and any(t.startswith("Editor: ") for t in titles)
+        edited = app.bench.maze.with_block(5, 2, True)
+        app.bench.load_maze(edited)  # what the editor does with a valid edit on leaving
+        app.screen.dismiss(edited)
+        await pilot.pause()
+        assert isinstance(app.screen, MainScreen)
+        view = app.screen.query_one(MazeView)
+        assert view.maze is edited and view.robot_cell == edited.start
+        assert app.sub_title == "test unity (unity)"
+        await pilot.press("R")
+        assert isinstance(app.screen, RunsScreen)
+        await pilot.press("escape")
+        await pilot.pause()
+        assert isinstance(app.screen, MainScreen)
+
+    run(app, body)
 
 
 # -- setting up ----------------------------------------------------------------------------------

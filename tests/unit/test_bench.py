@@ -198,3 +198,13 @@ def test_a_failing_algorithm_is_stopped_with_the_reason_instead_of_raising(tmp_p
     assert b.message.startswith("algorithm stopped: failing, state Go: guard")
     assert b.runs[-1].ended == "error"
     assert b.snapshot().driver == "keys"
+
+
+def test_a_new_maze_keeps_pause_speed_and_frame_budget():
+    b = bench()
+    b.toggle_pause()
+    b.pacer.next_speed()
+    b.pacer.budget = 0.03
+    b.load_maze(CORRIDOR)
+    assert (b.pacer.paused, b.pacer.speed, b.pacer.budget) == (True, 2.0, 0.03)
+    assert b.pacer.session is b.session and b.snapshot().block == CORRIDOR.start

@@ -135,9 +135,13 @@ class Bench:
         self._build_session()
 
     def _build_session(self) -> None:
-        paused = self.pacer.paused if hasattr(self, "pacer") else False
+        old = getattr(self, "pacer", None)
         self.session = Session(self.maze, self.profile, self.sensors, self.noise, self.seed)
-        self.pacer = Pacer(self.session, paused=paused)
+        self.pacer = Pacer(self.session)
+        if old is not None:  # a new maze keeps the pace the user (and the front end) set
+            self.pacer.paused = old.paused
+            self.pacer.speed = old.speed
+            self.pacer.budget = old.budget
         self.session.driver = KEYS_DRIVER
 
     # -- time ----------------------------------------------------------------------------

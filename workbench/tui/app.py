@@ -20,7 +20,7 @@ from textual.reactive import var
 from textual.screen import Screen
 
 from workbench.control.bench import Bench
-from workbench.sim.maze import MazeError
+from workbench.sim.maze import Maze, MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.noise import NOISE_LEVELS
 from workbench.sim.profiles import PROFILES
@@ -28,7 +28,9 @@ from workbench.sim.profiles import PROFILES
 from .commands import WorkbenchCommands
 from .modals.help import HelpScreen
 from .modals.too_small import TooSmallScreen
+from .screens.editor import EditorScreen
 from .screens.main import MainScreen
+from .screens.runs import RunsScreen
 
 #: the smallest terminal the layout is made for (columns, rows)
 MIN_SIZE = (80, 24)
@@ -146,20 +148,16 @@ class WorkbenchApp(App[None]):
             self.push_screen(HelpScreen(self.bench.profile))
 
     def open_editor(self) -> None:
-        try:
-            from .screens.editor import EditorScreen
-        except ImportError:
-            self._say("the maze editor is not in this version of the workbench")
-            return
-        self.push_screen(EditorScreen(self.bench, self.maze_path))
+        path = str(self.maze_path) if self.maze_path is not None else None
+        self.push_screen(EditorScreen(self.bench, path, unicode=self.unicode), self._edited)
+
+    def _edited(self, maze: Maze | None) -> None:
+        if maze is not None:
+            self.sub_title = f"{maze.name} ({self.bench.profile})"
+        self.refresh_views()
 
     def open_runs(self) -> None:
-        try:
-            from .screens.runs import RunsScreen
-        except ImportError:
-            self._say("the runs screen is not in this version of the workbench")
-            return
-        self.push_screen(RunsScreen(self.bench))
+        self.push_screen(RunsScreen(self.bench, unicode=self.unicode))
 
     def _say(self, message: str) -> None:
         self.bench.message = message

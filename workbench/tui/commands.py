@@ -7,7 +7,7 @@ the bindings of the screen the palette was opened on as commands.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Awaitable, Callable, Iterator
 from dataclasses import dataclass
 from functools import partial
 
@@ -124,42 +124,54 @@ def key_display(node: DOMNode, binding: Binding) -> str:
     return node.app.get_key_display(binding)
 
 
-def bindings_with_ids(node: DOMNode) -> Iterator[tuple[DOMNode, Binding]]:
-    """The node's own bindings that have an entry in :data:`COMMANDS`, in declared order."""
+def describe(node: DOMNode, binding: Binding) -> CommandInfo:
+    """The palette entry of a binding: from :data:`COMMANDS`, else from the binding itself."""
+    info = COMMANDS.get(binding.id or "")
+    if info is not None:
+        return info
+    group = type(node).__name__.removesuffix("Screen") or "App"
+    title = binding.description or binding.action
+    return CommandInfo(group, title.lower(), binding.tooltip or binding.description)
+
+
+def bindings_with_ids(node: DOMNode) -> Iterator[Binding]:
+    """The node's bindings that have an id, once each, in declared order."""
     seen: set[str] = set()
     for _key, binding in node._bindings:
-        if binding.id in COMMANDS and binding.id not in seen:
+        if (
+            binding.id
+            and binding.id not in seen
+            and (binding.description or binding.id in COMMANDS)
+        ):
             seen.add(binding.id)
-            yield node, binding
+            yield binding
 
 
 class WorkbenchCommands(Provider):
-    """The workbench's key bindings as command palette commands."""
+    """The key bindings of the current screen and of the app as command palette commands."""
 
-    def _commands(self) -> list[tuple[str, str, object]]:
-        screen = self.screen
+    def _commands(self) -> list[tuple[str, str, Callable[[], Awaitable[object]]]]:
         out = []
         seen: set[str] = set()
-        for node in (screen, self.app):
-            for owner, binding in bindings_with_ids(node):
+        for node in (self.screen, self.app):
+            for binding in bindings_with_ids(node):
                 assert binding.id is not None
                 if binding.id in seen or binding.id == "app.commands":
                     continue
                 seen.add(binding.id)
-                info = COMMANDS[binding.id]
+                info = describe(node, binding)
                 title = f"{info.group}: {info.title}"
-                help_text = f"key {key_display(owner, binding)}: {info.explanation}"
-                run = partial(self.app.run_action, binding.action, owner)
-                out.append((title, help_text, run))
+                help_text = f"key {key_display(node, binding)}: {info.explanation}"
+                out.append((title, help_text, partial(self.app.run_action, binding.action, node)))
         return out
 
     async def discover(self) -> Hits:
         for title, help_text, run in self._commands():
-            yield DiscoveryHit(title, run, help=help_text)  # type: ignore[arg-type]
+            yield DiscoveryHit(title, run, help=help_text)
 
     async def search(self, query: str) -> Hits:
         matcher = self.matcher(query)
         for title, help_text, run in self._commands():
             score = matcher.match(title)
             if score > 0:
-                yield Hit(score, matcher.highlight(title), run, help=help_text)  # type: ignore[arg-type]
+                yield Hit(score, matcher.highlight(title), run, help=help_text)
