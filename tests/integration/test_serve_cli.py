@@ -92,7 +92,10 @@ def test_serve_in_process_with_the_websocket_role_runs_in_real_time(tmp_path):
     port = free_port()
     url = f"ws://127.0.0.1:{port}/"
     args = build_parser().parse_args(
-        ["serve", "--tcp-port", "0", "--ws-url", url, "--noise", "off", "--record", str(record)]
+        [
+            *("serve", "--tcp-port", "0", "--ws-url", url, "--noise", "off"),
+            *("--sensor", "distance:4:front", "touch:6:back", "--record", str(record)),
+        ]
     )
     the_plan = plan(args)
     session = the_plan.session
@@ -116,7 +119,7 @@ def test_serve_in_process_with_the_websocket_role_runs_in_real_time(tmp_path):
     # about a second of real time at 1 unit/s (the start waits for the connection)
     assert 0.5 < session.world.pose.y - y0 < 1.2
     assert session.driver == "nobody"
-    assert reports and all(parse_report(r) for r in reports)
+    assert reports and all(sorted(parse_report(r)) == [4, 6] for r in reports)
     summary = json.loads(record.read_text().splitlines()[-1])
     assert summary["type"] == "summary" and summary["endpoints"][0]["role"] == "ws"
 
@@ -163,3 +166,10 @@ def test_a_port_in_use_is_a_clear_error(capsys):
     err = capsys.readouterr().err
     assert f"port {port} is in use" in err
     assert "stop the other simulator or choose --tcp-port" in err
+
+
+def test_an_address_that_is_not_on_this_machine_is_a_clear_error(capsys):
+    # 192.0.2.1 is reserved for documentation: no machine has it
+    assert main(["serve", "--tcp-port", str(free_port()), "--bind", "192.0.2.1"]) == 1
+    err = capsys.readouterr().err
+    assert "cannot listen on 192.0.2.1 port" in err and "cannot assign requested address" in err

@@ -16,6 +16,7 @@ import math
 import pytest
 
 from workbench.sim.mazefile import parse_maze
+from workbench.sim.sensors import SensorSpec
 from workbench.sim.session import Session
 from workbench.viple.codec import parse_report
 from workbench.viple.link import Link, RateLimitedLog, check_report_ms
@@ -437,8 +438,6 @@ def test_rate_limited_log_holds_back_repeats_and_says_how_many(caplog):
 
 
 def test_reports_follow_the_session_sensor_configuration():
-    from workbench.sim.sensors import SensorSpec
-
     session = session_for()
     link = Link(session, "tcp")
     session.set_sensors([SensorSpec("touch", 7, "front"), SensorSpec("distance", 4, "left")])
@@ -446,3 +445,20 @@ def test_reports_follow_the_session_sensor_configuration():
     assert [(e["name"], e["id"]) for e in report["sensors"]] == [("distance", 4), ("touch", 7)]
     assert report["sensors"][1]["value"] in (0, 1)
     assert math.isfinite(report["sensors"][0]["value"])
+
+
+def test_report_ids_are_the_ports_configured_for_the_session():
+    async def scenario():
+        sensors = [SensorSpec("touch", 9, "front"), SensorSpec("distance", 4, "left")]
+        session = Session(ROOM, "web", sensors, noise="off")
+        async with serve(session) as server:
+            client = await Client.connect(server.port)
+            message = json.loads(await client.line())
+            assert [(e["name"], e["id"]) for e in message["sensors"]] == [
+                ("distance", 4),
+                ("touch", 9),
+            ]
+            assert message["sensors"][1]["value"] == 0
+            await client.close()
+
+    asyncio.run(scenario())

@@ -16,6 +16,7 @@ import asyncio
 import contextlib
 import errno
 import logging
+import os
 import socket
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -120,22 +121,22 @@ class TcpServer:
                     name = sock.getsockname()
                     self.addresses.append((str(name[0]), int(name[1])))
                 port = self.addresses[0][1]
+            if not self.addresses:
+                raise EndpointError(f"no address to listen on among {', '.join(hosts)}")
         except BaseException:
             await self.close()
             raise
-        if not self._servers:
-            raise EndpointError("no address to listen on")
         shown = ", ".join(format_address(h, p) for h, p in self.addresses)
         self.link.address = shown
         self.log.info("listening for VIPLE (Unity simulator role) on %s", shown)
 
     async def _listen(self, host: str, port: int) -> asyncio.Server | None:
+        default_v6 = not self.config.bind and host == "::1"
         try:
-            return await asyncio.start_server(
+            server = await asyncio.start_server(
                 self._on_client, host, port, limit=READ_SIZE, reuse_address=True
             )
         except OSError as err:
-            default_v6 = not self.config.bind and host == "::1"
             if err.errno == errno.EADDRINUSE:
                 raise EndpointError(
                     f"port {port} is in use on {host}: stop the other simulator or choose "
@@ -147,6 +148,14 @@ class TcpServer:
                 )
                 return None
             raise EndpointError(f"cannot listen on {host} port {port}: {_reason(err)}") from None
+        if server.sockets:
+            return server
+        # asyncio skips an address family the system cannot open a socket for
+        server.close()
+        if default_v6:
+            self.log.warning("IPv6 loopback ::1 is not available; using 127.0.0.1 only")
+            return None
+        raise EndpointError(f"cannot listen on {host} port {port}: no usable address")
 
     async def close(self) -> None:
         """Stop listening, close the connection (the robot stops) and wait for it to end."""
@@ -176,9 +185,13 @@ class TcpServer:
         task = asyncio.create_task(self._connection(reader, writer))
         self._handlers.add(task)
         try:
-            await asyncio.gather(task, return_exceptions=True)
+            (outcome,) = await asyncio.gather(task, return_exceptions=True)
         finally:
             self._handlers.discard(task)
+        if isinstance(outcome, Exception):
+            self.log.error(
+                "connection handling failed: %s", outcome, exc_info=(type(outcome), outcome, None)
+            )
 
     async def _connection(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
         peer = _peer_of(writer)
@@ -290,6 +303,9 @@ def _unavailable(err: OSError) -> bool:
 
 
 def _reason(err: BaseException) -> str:
-    if isinstance(err, OSError) and err.strerror:
-        return err.strerror.lower() if err.strerror[:1].isupper() else err.strerror
+    if isinstance(err, OSError) and (err.errno or err.strerror):
+        # asyncio wraps bind errors in a long message; the errno says it plainly
+        plain = not isinstance(err, socket.gaierror) and isinstance(err.errno, int)
+        text = os.strerror(err.errno) if plain and err.errno > 0 else str(err.strerror)
+        return text[:1].lower() + text[1:]
     return str(err) or type(err).__name__

@@ -134,8 +134,11 @@ class WsClient:
                         self.config.retry_seconds,
                     )
                     self._outage = True
-            except (OSError, TimeoutError, WebSocketException) as err:
-                if not self._outage:
+            except Exception as err:
+                if not isinstance(err, OSError | TimeoutError | WebSocketException):
+                    self.log.error("WebSocket connection failed: %s", err, exc_info=err)
+                    self._outage = True
+                elif not self._outage:
                     self.log.warning(
                         "VIPLE's WebSocket server at %s is not reachable (%s); trying again "
                         "every %g s",
