@@ -42,6 +42,10 @@ def _number(value: object) -> str:
     return f"{value:.1f}"
 
 
+def _count(n: int, thing: str) -> str:
+    return f"{n} {thing}" if n == 1 else f"{n} {thing}s"
+
+
 def _command(cmd: object) -> str:
     if not isinstance(cmd, dict) or len(cmd) != 1:
         return str(cmd)
@@ -113,7 +117,6 @@ class ReplayScreen(Screen[None]):
             "right",
             "step(1)",
             "Step",
-            key_display="→",
             id="replay.step",
             tooltip="Forward one control tick.",
         ),
@@ -121,7 +124,6 @@ class ReplayScreen(Screen[None]):
             "left",
             "step(-1)",
             "Back",
-            key_display="←",
             id="replay.back",
             tooltip="Back one control tick.",
         ),
@@ -297,7 +299,7 @@ class ReplayScreen(Screen[None]):
         m = replay.metrics()
         text.append(
             f"So far {m.distance_cells:.2f} blocks, {m.turn_degrees:.0f}{deg}\n"
-            f"{m.turns} turns, {m.collisions} collisions"
+            f"{_count(m.turns, 'turn')}, {_count(m.collisions, 'collision')}"
         )
         if replay.at_end and replay.summary is not None:
             s = replay.summary

@@ -1,0 +1,138 @@
+"""SVG snapshots of the maze editor, its dialogs, the runs screen and the replay screen.
+
+80x24 (the lab terminal over SSH) and 120x40, ASCII and Unicode. Nothing runs on a clock:
+runs are simulated to the end before the app starts, and replays are stepped by keys.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from textual.app import App
+from textual.pilot import Pilot
+from textual.screen import Screen
+from textual.widgets import Input
+
+from workbench.control.bench import Bench
+from workbench.sim.generate import generate
+from workbench.sim.mazeio import load_maze
+from workbench.tui.screens.editor import EditorScreen
+from workbench.tui.screens.replay import ReplayScreen
+from workbench.tui.screens.runs import RunsScreen
+
+ROOT = Path(__file__).resolve().parents[2]
+WEB = "mazes/web.txt"
+SMALL = (80, 24)
+LARGE = (120, 40)
+
+
+class Host(App):
+    """Pushes the screen under test over an empty default screen."""
+
+    def __init__(self, screen: Screen) -> None:
+        super().__init__()
+        self.under_test = screen
+
+    def on_mount(self) -> None:
+        self.push_screen(self.under_test)
+
+
+def web_bench(**kwargs) -> Bench:
+    return Bench.open(load_maze(ROOT / WEB), "web", noise="off", **kwargs)
+
+
+def still_inputs(pilot: Pilot) -> None:
+    """No blinking text cursor in the picture."""
+    for field in pilot.app.screen.query(Input):
+        field.cursor_blink = False
+
+
+def press_then_still(*keys: str):
+    async def run_before(pilot: Pilot) -> None:
+        await pilot.pause()
+        await pilot.press(*keys)
+        await pilot.pause()
+        still_inputs(pilot)
+
+    return run_before
+
+
+@pytest.fixture(scope="module")
+def web_runs(tmp_path_factory) -> Bench:
+    """A bench on the Web Simulator maze after two recorded algorithm runs."""
+    bench = web_bench(record_dir=str(tmp_path_factory.mktemp("runs")))
+    for name in ("web-wall-following", "two-distance-local-best"):
+        bench.select_algorithm(name)
+        bench.apply_algorithm_preset()
+        bench.start_algorithm()
+        before = len(bench.runs)
+        for _ in range(400):
+            bench.step(60)
+            if len(bench.runs) > before:
+                break
+    assert [r.ended for r in bench.runs] == ["exit", "exit"]
+    return bench
+
+
+# -- editor -----------------------------------------------------------------------------------
+#: cursor from the start to the outer wall, opened: one problem in the list
+EDIT_KEYS = ("left", "space", "up", "up", "right", "right", "x")
+
+
+@pytest.mark.parametrize("unicode", [False, True], ids=["ascii", "unicode"])
+def test_editor_80x24(snap_compare, unicode):
+    app = Host(EditorScreen(web_bench(), WEB, unicode=unicode))
+    assert snap_compare(app, press=EDIT_KEYS, terminal_size=SMALL)
+
+
+@pytest.mark.parametrize("unicode", [False, True], ids=["ascii", "unicode"])
+def test_editor_generated_120x40(snap_compare, unicode):
+    bench = Bench.open(generate(16, 16, 7), "unity", noise="off")
+    app = Host(EditorScreen(bench, None, unicode=unicode))
+    assert snap_compare(app, press=("up", "up", "right", "space", "s"), terminal_size=LARGE)
+
+
+def test_generate_dialog_80x24(snap_compare):
+    app = Host(EditorScreen(web_bench(), WEB))
+    assert snap_compare(app, run_before=press_then_still("g"), terminal_size=SMALL)
+
+
+def test_new_maze_dialog_with_an_error_80x24(snap_compare):
+    app = Host(EditorScreen(web_bench(), WEB))
+    keys = ("n", "backspace", "backspace", "2", "enter")
+    assert snap_compare(app, run_before=press_then_still(*keys), terminal_size=SMALL)
+
+
+def test_unsaved_changes_prompt_80x24(snap_compare):
+    app = Host(EditorScreen(web_bench(), WEB, unicode=True))
+    assert snap_compare(app, press=("right", "space", "escape"), terminal_size=SMALL)
+
+
+# -- runs -------------------------------------------------------------------------------------
+def test_runs_ascii_80x24(snap_compare, web_runs):
+    assert snap_compare(Host(RunsScreen(web_runs, unicode=False)), terminal_size=SMALL)
+
+
+def test_runs_unicode_120x40(snap_compare, web_runs):
+    app = Host(RunsScreen(web_runs, unicode=True))
+    assert snap_compare(app, press=("down",), terminal_size=LARGE)
+
+
+# -- replay -----------------------------------------------------------------------------------
+#: 400 ticks in (20 s of the run), then one back
+REPLAY_KEYS = ("pagedown",) * 40 + ("left",)
+
+
+@pytest.mark.parametrize("unicode", [False, True], ids=["ascii", "unicode"])
+@pytest.mark.parametrize("size", [SMALL, LARGE], ids=["80x24", "120x40"])
+def test_replay(snap_compare, web_runs, unicode, size):
+    record = web_runs.runs[0].record
+    app = Host(ReplayScreen(record, mazes=(web_runs.maze,), unicode=unicode))
+    assert snap_compare(app, press=REPLAY_KEYS, terminal_size=size)
+
+
+def test_replay_at_the_end_80x24(snap_compare, web_runs):
+    record = web_runs.runs[1].record
+    app = Host(ReplayScreen(record, mazes=(web_runs.maze,), unicode=False))
+    assert snap_compare(app, press=("end",), terminal_size=SMALL)
