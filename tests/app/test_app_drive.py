@@ -9,6 +9,7 @@ from collections.abc import Awaitable, Callable
 
 import pytest
 from rich.console import Console
+from textual.command import CommandList
 from textual.pilot import Pilot
 from textual.widgets import Static
 
@@ -210,9 +211,15 @@ def test_the_command_palette_offers_the_bindings_and_runs_them(tmp_path):
         await pilot.press("ctrl+p")
         await pilot.pause()
         await pilot.press(*"speed")
-        await pilot.pause(0.3)
+        for _ in range(50):  # the palette searches in the background
+            await pilot.pause(0.05)
+            if app.screen.query_one(CommandList).option_count:
+                break
         await pilot.press("enter")
-        await pilot.pause(0.1)
+        for _ in range(20):
+            await pilot.pause(0.05)
+            if app.bench.pacer.speed == 2.0:
+                break
         assert app.bench.pacer.speed == 2.0
 
     run(app, body)
