@@ -104,18 +104,42 @@ def test_ticks_wait_for_the_first_report_and_are_due_at_the_control_rate():
     fsm = RemoteFsm(local_best())
     fsm.start(0.0)
     assert fsm.tick(0.5).commands == [] and fsm.readings is None
+    assert fsm.next_tick() == pytest.approx(0.55)
     fsm.report(0.6, {1: 500.0})
     assert fsm.next_tick() == pytest.approx(0.65)
 
 
-def test_any_other_command_abandons_the_turn_estimate():
-    setup = prepare("two-distance-local-best", profile="unity")
-    fsm = RemoteFsm(setup)
-    fsm.start(0.0)
-    fsm.report(0.1, {2: 0.5})
-    assert fsm.state == "TurningRight" and fsm.turn_due is not None
-    fsm._step(0.2, [Stop()], None)
+TURN_THEN_GO = """\
+name: turn-then-go
+sensors:
+  front: {kind: distance, mount: front, port: 1}
+initial: Turn
+states:
+  Turn:
+    on_enter:
+      - turn: 90
+      - timer: 0.2
+    transitions:
+      - when: timer_done
+        to: Go
+  Go:
+    on_enter:
+      - move: 1
+    transitions:
+      - when: turn_done
+        to: Turn
+"""
+
+
+def test_any_other_command_abandons_the_turn_and_its_estimate(tmp_path):
+    path = tmp_path / "turn-then-go.yaml"
+    path.write_text(TURN_THEN_GO)
+    fsm = RemoteFsm(prepare(str(path), profile="erobotic"))
+    assert fsm.start(0.0).commands == [TurnByDegrees(90.0)] and fsm.turn_due is not None
+    fsm.report(0.1, {1: 500.0})
+    assert fsm.tick(0.25).commands == [MoveAtPower(1.0)]
     assert fsm.turn_due is None
+    assert fsm.tick(5.0).transition is None  # the abandoned turn never reports done
 
 
 @pytest.mark.parametrize(
@@ -202,6 +226,17 @@ def test_cli_with_nothing_listening_retries_then_exits_1(capsys, monkeypatch, un
     assert "yet (connection refused, nothing listens there); retrying" in captured.out
     assert f"cannot connect to tcp://127.0.0.1:{unused_port}" in captured.err
     assert "workbench serve" in captured.err
+
+
+def test_cli_listening_on_a_port_in_use_exits_1(capsys):
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        argv = ["viple-client", "--algorithm", "right-wall", "--listen", f"ws://127.0.0.1:{port}"]
+        assert main(argv) == 1
+    err = capsys.readouterr().err
+    assert f"cannot listen at ws://127.0.0.1:{port}/: port {port} is in use" in err
 
 
 # ----------------------------------------------------------------------------- on the wire

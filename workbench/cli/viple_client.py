@@ -63,7 +63,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         metavar="KIND:PORT:MOUNT",
         help="the sensors the simulator reports (default: the algorithm's own, as for serve)",
     )
-    p.add_argument("--duration", type=_seconds, metavar="S", help="stop after S seconds")
+    p.add_argument(
+        "--duration", type=_seconds, metavar="S", help="stop S seconds after the robot is connected"
+    )
     p.add_argument(
         "--json", action="store_true", help="print the summary as JSON (progress to stderr)"
     )
@@ -107,7 +109,7 @@ def cmd_viple_client(args: argparse.Namespace) -> int:
     result = asyncio.run(run_client(setup, log, on_step))
     if args.json:
         print(json.dumps(result.as_dict()))
-    else:
+    elif result.ended != "no connection":
         print(describe_result(result))
     if result.ended in ("no connection", "error"):
         print(f"workbench viple-client: {result.message}", file=sys.stderr)

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import errno
 import json
 import math
 import signal
@@ -225,9 +226,7 @@ class RemoteFsm:
         return self.controller.state
 
     def start(self, t: float) -> Step:
-        commands = self.controller.start(t)
-        step = self._step(t, commands, None)
-        return Step(step.t, step.commands, None, step.turn_done_at, started=True)
+        return self._step(t, self.controller.start(t), None, started=True)
 
     def report(self, t: float, readings: Mapping[int, float]) -> Step:
         """A sensor report arrived: tick with its readings."""
@@ -240,9 +239,9 @@ class RemoteFsm:
 
     def tick(self, t: float) -> Step:
         """Tick with the latest readings (none yet: nothing happens)."""
+        self.last_tick = t
         if self.readings is None:
             return Step(t, [])
-        self.last_tick = t
         events: frozenset[str] = frozenset()
         if self.turn_due is not None and t >= self.turn_due:
             self.turn_due = None
@@ -255,12 +254,16 @@ class RemoteFsm:
             self.transitions += 1
         return self._step(t, commands, fired)
 
-    def _step(self, t: float, commands: list[Command], fired: Transition | None) -> Step:
+    def _step(
+        self, t: float, commands: list[Command], fired: Transition | None, started: bool = False
+    ) -> Step:
+        """Follow the turn in progress: a Turn by Degree starts the wait for its end, any
+        other command abandons it (as on the robot)."""
         for cmd in commands:
             is_turn = isinstance(cmd, TurnByDegrees)
             self.turn_due = t + turn_wait(cmd.degrees, self.setup.profile) if is_turn else None
         due = self.turn_due if commands and isinstance(commands[-1], TurnByDegrees) else None
-        return Step(t, commands, fired, due)
+        return Step(t, commands, fired, due, started)
 
 
 # ----------------------------------------------------------------------------- links
@@ -417,7 +420,10 @@ class VipleClient:
                 await self._run_listening()
         except OSError as exc:
             ep = self.setup.endpoint
-            self._end("no connection", EXIT_FAILED, f"cannot listen at {ep}: {_os_reason(exc)}")
+            reason = _os_reason(exc)
+            if exc.errno == errno.EADDRINUSE:
+                reason = f"port {ep.port} is in use: stop the program using it or choose another"
+            self._end("no connection", EXIT_FAILED, f"cannot listen at {ep}: {reason}")
         return self.result
 
     # -- meeting the simulator ----------------------------------------------------------
@@ -435,7 +441,8 @@ class VipleClient:
             try:
                 reader, writer = await asyncio.open_connection(ep.host, ep.port)
             except socket.gaierror as exc:
-                self._end("no connection", EXIT_FAILED, f"cannot find host {ep.host!r}: {exc}")
+                reason = _os_reason(exc)
+                self._end("no connection", EXIT_FAILED, f"cannot find host {ep.host!r}: {reason}")
                 return None
             except OSError as exc:
                 if time.monotonic() >= deadline:
