@@ -38,7 +38,7 @@ from pathlib import Path
 
 ROUND_TRIPS = 2000
 #: the round trips alternate between the two servers in this many blocks
-BLOCKS = 4
+BLOCKS = 20
 IDLE_CONNECTIONS = 100
 REPORT_MS = 1000
 #: no round trip starts this long before an expected push, nor this long after one
