@@ -318,3 +318,40 @@ def test_the_editor_saves_into_the_bench_maze_file_it_was_given(tmp_path):
     write_maze(maze_path, bench.maze.with_block(3, 2, True))
     screen = EditorScreen(bench, str(maze_path))
     assert screen.editor.path == str(maze_path) and screen.editor.maze is bench.maze
+
+
+@sync
+async def test_ask_before_quitting_runs_the_action_after_save_or_discard_only(tmp_path):
+    app, screen, _, path = editor_app(tmp_path)
+    done: list[str] = []
+    async with app.run_test(size=SIZE) as pilot:
+        screen.ask_before(lambda: done.append("clean"))
+        assert done == ["clean"]  # nothing to save: at once
+        await pilot.press("right", "space")
+        screen.ask_before(lambda: done.append("cancelled"))
+        await pilot.pause()
+        await pilot.press("c")
+        await pilot.pause()
+        screen.ask_before(lambda: done.append("discarded"))
+        await pilot.pause()
+        await pilot.press("d")
+        await pilot.pause()
+        assert done == ["clean", "discarded"] and path.read_text() == ROOM_TEXT
+        screen.ask_before(lambda: done.append("saved"))
+        await pilot.pause()
+        await pilot.press("s")
+        await pilot.pause()
+        assert done[-1] == "saved" and load_maze(path).is_wall(2, 1)
+
+
+@sync
+async def test_a_failed_save_as_keeps_the_typed_path(tmp_path):
+    app, _screen, _, _ = editor_app(tmp_path, with_path=False)
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.press("a")
+        typed = str(tmp_path / "no" / "such" / "dir.txt")
+        app.screen.query_one(Input).value = typed
+        await pilot.press("enter")
+        await pilot.pause()
+        assert isinstance(app.screen, PathDialog)
+        assert app.screen.query_one(Input).value == typed

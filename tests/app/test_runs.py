@@ -266,6 +266,18 @@ async def test_replay_of_a_run_whose_maze_cannot_be_found(tmp_path):
         assert screen.replay.index == 1
 
 
+@sync
+async def test_runs_that_end_while_the_screen_is_open_appear(tmp_path):
+    bench = two_runs(tmp_path)
+    screen = RunsScreen(bench)
+    app = Host(screen)
+    async with app.run_test(size=SIZE) as pilot:
+        run_algorithms(bench, "right-wall")
+        screen.show_snapshot(bench.snapshot())
+        await pilot.pause()
+        assert screen.query_one(DataTable).row_count == 3
+
+
 def test_driver_names_drop_the_algorithm_prefix():
     assert driver_name("algorithm right-wall") == "right-wall"
     assert driver_name("keys") == "keys"

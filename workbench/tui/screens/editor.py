@@ -8,6 +8,7 @@ maze).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import ClassVar
 
 from rich.text import Text
@@ -438,50 +439,71 @@ class EditorScreen(Screen[Maze | None]):
 
     def action_save(self) -> None:
         if self.editor.path is None:
-            self.action_save_as()
+            self._ask_path(None)
         else:
             self._save(None)
 
-    def action_save_as(self, leave_after: bool = False, error: str = "") -> None:
-        def saved(path: str | None) -> None:
+    def action_save_as(self) -> None:
+        self._ask_path(None)
+
+    def _ask_path(
+        self, after: Callable[[], object] | None, value: str | None = None, error: str = ""
+    ) -> None:
+        """Ask where to save; on success run ``after``, on failure ask again with the reason."""
+
+        def chosen(path: str | None) -> None:
             if path is None:
                 return
             if self._save(path):
-                if leave_after:
-                    self._leave(discard=False)
+                if after is not None:
+                    after()
             else:
-                self.action_save_as(leave_after, self.status)
+                self._ask_path(after, path, self.status)
 
-        self.app.push_screen(
-            PathDialog(
-                "Save maze as",
-                SAVE_HELP,
-                value=self.editor.suggested_path(),
-                action="Save",
-                error=error,
-            ),
-            saved,
+        dialog = PathDialog(
+            "Save maze as",
+            SAVE_HELP,
+            value=self.editor.suggested_path() if value is None else value,
+            action="Save",
+            error=error,
         )
+        self.app.push_screen(dialog, chosen)
 
     # -- leaving -----------------------------------------------------------------------------
+    def ask_before(self, action: Callable[[], object]) -> None:
+        """Run ``action`` (quit, switch...) once the changes are saved or discarded.
+
+        Without unsaved changes it runs at once; otherwise the save / discard / cancel prompt
+        comes first, and cancel (or a save that is abandoned) does not run it.
+        """
+        if self.editor.dirty:
+            self._prompt(lambda _discarded: action())
+        else:
+            action()
+
+    def _prompt(self, then: Callable[[bool], object]) -> None:
+        """The unsaved-changes prompt; ``then(discarded)`` after a save or a discard."""
+
+        def chosen(choice: Choice | None) -> None:
+            if choice == "save":
+                if self.editor.path is None:
+                    self._ask_path(lambda: then(False))
+                elif self._save(None):
+                    then(False)
+            elif choice == "discard":
+                then(True)
+
+        self.app.push_screen(UnsavedDialog(self.editor.title()), chosen)
+
     def action_leave(self) -> None:
         problems = self.query_one("#editor-problems", OptionList)
         if problems.has_focus:
             self.set_focus(None)
             return
         if self.editor.dirty:
-            self.app.push_screen(UnsavedDialog(self.editor.title()), self._unsaved_choice)
+            self._prompt(lambda discarded: self._leave(discard=discarded))
         else:
             self._leave(discard=False)
-
-    def _unsaved_choice(self, choice: Choice | None) -> None:
-        if choice == "save":
-            if self.editor.path is None:
-                self.action_save_as(leave_after=True)
-            elif self._save(None):
-                self._leave(discard=False)
-        elif choice == "discard":
-            self._leave(discard=True)
 
     def _leave(self, discard: bool) -> None:
         maze, note = self.editor.handover(discard)

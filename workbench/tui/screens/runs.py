@@ -138,6 +138,7 @@ class RunsScreen(Screen[None]):
         self.bench = bench
         self._unicode = unicode
         self._shown: tuple[tuple[str, ...], ...] | None = None
+        self._shown_count = -1
         #: the last message shown under the table (what happened, or why not)
         self.status = ""
 
@@ -167,9 +168,15 @@ class RunsScreen(Screen[None]):
             self._shown = None
             self.refresh_runs()
 
+    def show_snapshot(self, snapshot: object) -> None:
+        """Called by the app on every frame: pick up runs that ended meanwhile."""
+        if len(self.bench.runs) != self._shown_count:
+            self.refresh_runs()
+
     def refresh_runs(self) -> None:
         """Show the bench's runs (newest last); repaints only when they changed."""
         runs = self.bench.runs
+        self._shown_count = len(runs)
         rows = tuple(run_cells(run, self.unicode) for run in runs)
         table = self.query_one(DataTable)
         self.query_one("#runs-title", Static).update(
