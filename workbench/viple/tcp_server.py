@@ -189,9 +189,7 @@ class TcpServer:
         finally:
             self._handlers.discard(task)
         if isinstance(outcome, Exception):
-            self.log.error(
-                "connection handling failed: %s", outcome, exc_info=(type(outcome), outcome, None)
-            )
+            self.log.error("connection handling failed: %s", outcome, exc_info=outcome)
 
     async def _connection(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
         peer = _peer_of(writer)
