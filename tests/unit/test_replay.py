@@ -206,3 +206,29 @@ def test_metrics_at_the_end_agree_with_the_summary(tmp_path):
     assert m.reached_exit and m.exit_time == pytest.approx(summary["exit_time"], abs=0.06)
     assert m.distance == pytest.approx(summary["distance"], rel=0.05)
     assert m.turns == summary["turns"] and m.collisions == summary["collisions"]
+
+
+def test_a_binary_file_is_not_a_record(tmp_path):
+    path = tmp_path / "bin.jsonl"
+    path.write_bytes(b"\xff\xfe\x00binary")
+    with pytest.raises(RecordError, match=r"bin\.jsonl: not a text file"):
+        load_replay(path)
+
+
+def test_an_unusable_maze_source_is_explained(tmp_path):
+    header = {"type": "header", "format": FORMAT, "maze": {"source": "bad\0name.txt"}}
+    replay = load_replay(write_record(tmp_path / "r.jsonl", ticks(2), header=header))
+    assert replay_maze(replay, tmp_path / "r.jsonl") == (
+        None,
+        "the run's maze file bad\0name.txt is not found, so the maze cannot be drawn",
+    )
+    (tmp_path / "broken.txt").write_text("---\nname: [\n---\n#S#\n")
+    header["maze"] = {"source": "broken.txt"}
+    replay = load_replay(write_record(tmp_path / "r2.jsonl", ticks(2), header=header))
+    maze, note = replay_maze(replay, tmp_path / "r2.jsonl")
+    assert maze is None and note.startswith("the run's maze ") and "cannot be read" in note
+    header["maze"] = {"name": "x"}
+    replay = load_replay(write_record(tmp_path / "r3.jsonl", ticks(2), header=header))
+    assert replay_maze(replay, tmp_path / "r3.jsonl")[1] == (
+        "the record does not name a maze file, so the maze cannot be drawn"
+    )

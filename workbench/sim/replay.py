@@ -89,14 +89,17 @@ def _tick_line(path: str | os.PathLike, index: int) -> int | None:
                 seen += 1
                 if seen == index:
                     return no
-    except (OSError, RecordError):
+    except (OSError, ValueError):
         return None
     return None
 
 
 def load_replay(path: str | os.PathLike) -> Replay:
     """Read and check a run record; :class:`RecordError` names the file, line and reason."""
-    record = read_record(path)
+    try:
+        record = read_record(path)
+    except UnicodeDecodeError:
+        raise RecordError(f"{path}: not a text file, so not a run record") from None
     try:
         return Replay(record)
     except _TickError as exc:
@@ -384,13 +387,15 @@ def replay_maze(
     if not Path(source).is_absolute():
         candidates.append(Path(record_path).parent / source)
     for candidate in candidates:
-        if not candidate.is_file():
-            continue
         try:
+            if not candidate.is_file():
+                continue
             maze = load_maze(candidate)
         except MazeError as exc:
             first = exc.problems[0].message if exc.problems else "unreadable"
             return None, f"the run's maze {candidate} cannot be read: {first}"
+        except (OSError, ValueError):
+            continue
         if digest and maze.digest() != digest:
             return maze, f"the maze file {candidate} has changed since this run"
         return maze, ""
