@@ -92,6 +92,13 @@ class AlgorithmModal(ModalScreen[None]):
     AlgorithmModal #alg-missing {
         color: $text-warning;
     }
+    AlgorithmModal #alg-params {
+        height: auto;
+        margin-bottom: 1;
+    }
+    AlgorithmModal #alg-description {
+        color: $text-muted;
+    }
     AlgorithmModal #alg-params-head {
         height: 1;
     }
@@ -125,6 +132,7 @@ class AlgorithmModal(ModalScreen[None]):
     def __init__(self, bench: Bench) -> None:
         super().__init__()
         self.bench = bench
+        self._ready = False
 
     # -- layout ----------------------------------------------------------------------------
     def compose(self) -> ComposeResult:
@@ -142,13 +150,13 @@ class AlgorithmModal(ModalScreen[None]):
                     yield Button("Load file", compact=True, id="alg-load")
                 with VerticalScroll(id="alg-details"):
                     yield Static(id="alg-title", markup=False)
-                    yield Static(id="alg-description", markup=False)
-                    yield Static(id="alg-sensors", markup=False)
                     yield Static(id="alg-missing", markup=False)
+                    yield Static(id="alg-sensors", markup=False)
                     with Horizontal(id="alg-params-head"):
                         yield Label("Parameters", classes="heading")
                         yield Button("Defaults", compact=True, id="alg-defaults")
                     yield Vertical(id="alg-params")
+                    yield Static(id="alg-description", markup=False)
             yield Static(id="alg-error", markup=False)
             with Horizontal(id="alg-buttons"):
                 yield Button("Start", variant="primary", compact=True, id="alg-start")
@@ -160,6 +168,7 @@ class AlgorithmModal(ModalScreen[None]):
                 yield Label("", id="alg-live", markup=False)
 
     async def on_mount(self) -> None:
+        self._ready = True
         options = self.query_one("#alg-builtins", OptionList)
         current = self.bench.algorithm
         names = list_algorithms()
@@ -215,14 +224,17 @@ class AlgorithmModal(ModalScreen[None]):
         missing = self.bench.missing_sensors()
         widget = self.query_one("#alg-missing", Static)
         if missing:
+            why = "\n".join(line.split(": add one")[0] for line in missing.splitlines())
             widget.update(
-                f"{missing}\n\nPress f (or Fit sensors) to give the robot the sensors "
+                f"{why}\n\nPress f (or Fit sensors) to give the robot the sensors "
                 "this algorithm reads."
             )
         widget.display = bool(missing)
         self.query_one("#alg-fix", Button).disabled = not missing
 
     def show_snapshot(self, snapshot: Snapshot) -> None:
+        if not self._ready:
+            return  # the app ticks while the dialog is still being built
         bench = self.bench
         paused = " (paused)" if bench.pacer.paused else ""
         if bench.controller is not None:

@@ -88,6 +88,7 @@ class SensorPortsModal(ModalScreen[None]):
     def __init__(self, bench: Bench) -> None:
         super().__init__()
         self.bench = bench
+        self._ready = False
 
     def compose(self) -> ComposeResult:
         dialog = Vertical(id="ports-dialog")
@@ -110,6 +111,7 @@ class SensorPortsModal(ModalScreen[None]):
             yield Static("", id="ports-status", markup=False)
 
     def on_mount(self) -> None:
+        self._ready = True
         self.show_snapshot(self.bench.snapshot())
         self.query(SensorRowEditor).first().query_one(".row-port", Input).focus()
 
@@ -123,6 +125,8 @@ class SensorPortsModal(ModalScreen[None]):
 
     def show_snapshot(self, snapshot: Snapshot) -> None:
         """The live reading of each row's port (when the robot has that sensor there)."""
+        if not self._ready:
+            return  # the app ticks while the dialog is still being built
         profile = get_profile(self.bench.profile)
         live = {spec.port: spec for spec in snapshot.sensors}
         for editor in self.editors:

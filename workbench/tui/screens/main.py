@@ -58,6 +58,7 @@ class MainScreen(Screen[None]):
     def __init__(self, bench: Bench, unicode: bool = False, trail: bool = True) -> None:
         super().__init__()
         self.bench = bench
+        self._ready = False
         self._unicode = unicode
         self._trail = trail
         self._controller: object = None
@@ -86,6 +87,7 @@ class MainScreen(Screen[None]):
         return who() if callable(who) else ""
 
     def on_mount(self) -> None:
+        self._ready = True
         self.show_snapshot(self.bench.snapshot())
 
     def on_screen_resume(self) -> None:
@@ -103,8 +105,8 @@ class MainScreen(Screen[None]):
 
     def show_snapshot(self, snapshot: Snapshot) -> None:
         """Draw one snapshot: each widget repaints only what changed."""
-        if not self.is_attached:
-            return
+        if not self._ready:
+            return  # the app ticks while the screen is still being built
         bench = self.bench
         self.snapshot = snapshot
         unicode = self.unicode

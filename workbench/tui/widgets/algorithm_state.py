@@ -4,8 +4,6 @@ it, and a scrolling log of transitions."""
 
 from __future__ import annotations
 
-from typing import ClassVar
-
 from textual.app import ComposeResult
 from textual.containers import Vertical
 from textual.content import Content
@@ -38,13 +36,7 @@ class AlgorithmState(Vertical):
     AlgorithmState > #algorithm-last {
         color: $text-muted;
     }
-    AlgorithmState > .algorithm-state--current {
-        background: $accent;
-        color: $text;
-        text-style: bold;
-    }
     """
-    COMPONENT_CLASSES: ClassVar[set[str]] = {"algorithm-state--current"}
 
     summary: var[str] = var("", init=False)
     states: var[tuple[tuple[str, ...], str | None]] = var(((), None), init=False)
@@ -136,9 +128,8 @@ class AlgorithmState(Vertical):
 
     def watch_states(self, value: tuple[tuple[str, ...], str | None]) -> None:
         names, current = value
-        style = self.get_visual_style("algorithm-state--current", partial=True)
         parts = [
-            Content.styled(f" {name} ", style) if name == current else Content(f" {name} ")
+            Content.styled(f" {name} ", "bold reverse") if name == current else Content(f" {name} ")
             for name in names
         ]
         widget = self._states

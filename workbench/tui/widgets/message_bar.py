@@ -14,6 +14,9 @@ class MessageBar(Static):
         height: 1;
         padding: 0 1;
         background: $boost;
+        color: $text-muted;
+    }
+    MessageBar.-message {
         color: $text-warning;
     }
     """
@@ -35,6 +38,7 @@ class MessageBar(Static):
         self._paint()
 
     def _paint(self) -> None:
+        self.set_class(bool(self.message), "-message")
         text = self.message or "? help  ctrl+p commands  ctrl+q quit"
         who = self.who
         width = max(self.size.width - 2, 0)

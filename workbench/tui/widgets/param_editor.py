@@ -31,6 +31,7 @@ class ParamEditor(Vertical):
     ParamEditor Input {
         width: 10;
         margin-right: 1;
+        background: $panel;
     }
     ParamEditor .param-range {
         width: 1fr;
@@ -58,34 +59,37 @@ class ParamEditor(Vertical):
     def __init__(self, parameter: Parameter, value: float, default: float) -> None:
         super().__init__()
         self.parameter = parameter
-        self._value = value
         self.default = default
+        self._input = Input(_g(value), compact=True, classes="param-value")
+        self._error = Static("", classes="param-error", markup=False)
+        if parameter.description:
+            self.tooltip = " ".join(parameter.description.split())
 
     def compose(self) -> ComposeResult:
         p = self.parameter
         bounds = []
-        if p.minimum is not None:
-            bounds.append(f"min {_g(p.minimum)}")
-        if p.maximum is not None:
-            bounds.append(f"max {_g(p.maximum)}")
+        if p.minimum is not None and p.maximum is not None:
+            bounds.append(f"{_g(p.minimum)} to {_g(p.maximum)}")
+        elif p.minimum is not None:
+            bounds.append(f"from {_g(p.minimum)}")
+        elif p.maximum is not None:
+            bounds.append(f"up to {_g(p.maximum)}")
         bounds.append(f"default {_g(self.default)}")
         with Horizontal():
             yield Label(p.name, classes="param-name", markup=False)
-            yield Input(_g(self._value), compact=True, classes="param-value")
+            yield self._input
             yield Label(", ".join(bounds), classes="param-range", markup=False)
-        yield Static("", classes="param-error", markup=False)
-        if p.description:
-            self.tooltip = p.description.strip()
+        yield self._error
 
     @property
     def text(self) -> str:
-        return self.query_one(Input).value.strip()
+        return self._input.value.strip()
 
     def set_value(self, value: float) -> None:
-        self.query_one(Input).value = _g(value)
+        self._input.value = _g(value)
 
     def set_error(self, error: str | None) -> None:
-        self.query_one(".param-error", Static).update(error or "")
+        self._error.update(error or "")
         self.set_class(bool(error), "-invalid")
 
     @property

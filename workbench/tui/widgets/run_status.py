@@ -44,7 +44,8 @@ class RunStatus(Static):
                 clock += f" ({m.efficiency:.0%} efficient)"
         travel = f"distance {number(m.distance, unit)} {unit} ({m.distance_cells:.1f} blocks)"
         turning = (
-            f"turned {degrees(m.turn_degrees, unicode)} in {m.turns} turns"
+            f"turned {degrees(m.turn_degrees, unicode)} in {m.turns} "
+            f"turn{'' if m.turns == 1 else 's'}"
             f"{sep}collisions {m.collisions}"
         )
         self.lines = (driver, clock, travel, turning)

@@ -35,6 +35,7 @@ class SensorRowEditor(Vertical):
     SensorRowEditor Input {
         width: 6;
         margin-right: 1;
+        background: $panel;
     }
     SensorRowEditor .row-reading {
         width: 1fr;
@@ -66,53 +67,60 @@ class SensorRowEditor(Vertical):
     def __init__(self, number: int, row: SensorRow) -> None:
         super().__init__()
         self.number = number
-        self._row = row
+        self._number = Label(f"{number}.", classes="row-number")
+        self._kind = Select(
+            [(k, k) for k in KINDS],
+            value=row.kind,
+            allow_blank=False,
+            compact=True,
+            classes="row-kind",
+        )
+        self._port = Input(row.port, compact=True, max_length=4, classes="row-port")
+        self._mount = Select(
+            [(m, m) for m in MOUNT_CHOICES],
+            value=row.mount or "none",
+            allow_blank=False,
+            compact=True,
+            classes="row-mount",
+        )
+        self._reading = Label("", classes="row-reading", markup=False)
+        self._error = Static("", classes="row-error", markup=False)
+        self._error_text: str | None = None
 
     def compose(self) -> ComposeResult:
-        row = self._row
         with Horizontal():
-            yield Label(f"{self.number}.", classes="row-number")
-            yield Select(
-                [(k, k) for k in KINDS],
-                value=row.kind,
-                allow_blank=False,
-                compact=True,
-                classes="row-kind",
-            )
-            yield Input(row.port, compact=True, max_length=4, classes="row-port")
-            yield Select(
-                [(m, m) for m in MOUNT_CHOICES],
-                value=row.mount or "none",
-                allow_blank=False,
-                compact=True,
-                classes="row-mount",
-            )
-            yield Label("", classes="row-reading", markup=False)
+            yield self._number
+            yield self._kind
+            yield self._port
+            yield self._mount
+            yield self._reading
             yield Button("x", compact=True, classes="row-remove", tooltip="remove this row")
-        yield Static("", classes="row-error", markup=False)
+        yield self._error
 
     def row(self) -> SensorRow:
-        kind = self.query_one(".row-kind", Select).value
-        mount = self.query_one(".row-mount", Select).value
-        port = self.query_one(".row-port", Input).value
-        return SensorRow(str(kind), port, None if mount == "none" else str(mount))
+        mount = self._mount.value
+        return SensorRow(
+            str(self._kind.value), self._port.value, None if mount == "none" else str(mount)
+        )
 
     def set_number(self, number: int) -> None:
         self.number = number
-        self.query_one(".row-number", Label).update(f"{number}.")
+        self._number.update(f"{number}.")
 
     def set_error(self, error: str | None) -> None:
-        self.query_one(".row-error", Static).update(error or "")
+        if error == self._error_text:
+            return
+        self._error_text = error
+        self._error.update(error or "")
         self.set_class(bool(error), "-invalid")
 
     @property
     def error(self) -> str | None:
-        return str(self.query_one(".row-error", Static).content) or None
+        return self._error_text
 
     def set_reading(self, text: str) -> None:
-        label = self.query_one(".row-reading", Label)
-        if str(label.content) != text:
-            label.update(text)
+        if str(self._reading.content) != text:
+            self._reading.update(text)
 
     def on_button_pressed(self, event: Button.Pressed) -> None:
         event.stop()

@@ -26,7 +26,7 @@ class TransitionLog(Log):
         height: 1fr;
         min-height: 2;
         padding: 0;
-        background: $surface;
+        background: transparent;
         scrollbar-size-vertical: 1;
         overflow-x: hidden;
     }
