@@ -121,7 +121,12 @@ class MainScreen(Screen[None]):
         self._message.message = bench.message
 
     def refresh_views(self) -> None:
-        self.show_snapshot(self.bench.snapshot())
+        """Redraw after an action: through the app, so open dialogs follow too."""
+        refresh = getattr(self.app, "refresh_views", None)
+        if refresh is not None:
+            refresh()
+        else:
+            self.show_snapshot(self.bench.snapshot())
 
     def say(self, message: str) -> None:
         self.bench.message = message
