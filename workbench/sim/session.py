@@ -63,6 +63,7 @@ class Session:
         recorder: Recorder | None = None,
     ) -> None:
         self.world = World(maze, profile, sensors, noise, seed, dt)
+        self._world_step = self.world.step
         self.maze = maze
         self.profile = self.world.profile
         self.recorder = recorder
@@ -128,16 +129,16 @@ class Session:
     # -- time ----------------------------------------------------------------------------
     def step(self) -> tuple[str, ...]:
         """One physics step (and a control tick every ``every`` steps)."""
-        events = self.world.step()
+        events = self._world_step()
         if events:
             self._events.extend(events)
-        self._steps += 1
-        if self._scheduled is not None and self._steps >= self._scheduled[0]:
+        self._steps = n = self._steps + 1
+        if self._scheduled is not None and n >= self._scheduled[0]:
             cmd = self._scheduled[1]
             self._scheduled = None
             self.world.apply(cmd)
             self._commands.append(cmd)
-        if self._steps % self.every == 0:
+        if n % self.every == 0:
             self._control_tick()
         return events
 
@@ -152,15 +153,15 @@ class Session:
         events = self._events
         controller = self.controller
         if controller is not None and run_controller:
-            if not self._started:
-                self._started = True
-                commands = controller.start(t)
-            else:
+            if self._started:
                 named = {name: readings[port] for name, port in self.binding.items()}
                 commands = controller.tick(t, named, frozenset(events) if events else _NONE)
-            for cmd in commands:
-                world.apply(cmd)
+            else:
+                self._started = True
+                commands = controller.start(t)
             if commands:
+                for cmd in commands:
+                    world.apply(cmd)
                 self._commands.extend(commands)
         if self.recorder is not None:
             self.recorder.tick(
@@ -172,9 +173,11 @@ class Session:
                 events,
                 controller.variables if controller is not None else None,
             )
-        self.last_events = tuple(events)
-        self._events = []
-        self._commands = []
+        if events or self.last_events:
+            self.last_events = tuple(events)
+            self._events = []
+        if self._commands:
+            self._commands = []
 
     @property
     def reached_exit(self) -> bool:

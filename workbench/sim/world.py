@@ -561,10 +561,11 @@ class World:
     def read_sensors(self) -> dict[int, float | int]:
         """Readings by port for the current step: distances in world units, touch 0/1.
 
-        Read twice in one step, the readings (and their noise) are the same.
+        Read twice in one step, the readings (and their noise) are the same: the same dict,
+        which callers must not change.
         """
         if self._readings is not None:
-            return dict(self._readings)
+            return self._readings
         a = self._angle
         c = math.cos(a)
         s = math.sin(a)
@@ -605,7 +606,7 @@ class World:
                     any(vx * ux + vy * uy >= _COS45 * math.hypot(vx, vy) for vx, vy in contacts)
                 )
         self._readings = out
-        return dict(out)
+        return out
 
     def _wall_contacts(self) -> list[tuple[float, float]]:
         """Vectors from the centre to the nearest point of each wall block within reach."""
