@@ -32,6 +32,15 @@ def run(app: WorkbenchApp, body: Callable[[Pilot], Awaitable[None]], size=(80, 2
     asyncio.run(go())
 
 
+async def click(pilot: Pilot, selector: str) -> None:
+    """Click a button once its last press has finished (a pressed button ignores clicks)."""
+    for _ in range(20):
+        if not any(w.has_class("-active") for w in pilot.app.screen.query(selector)):
+            break
+        await pilot.pause(0.05)
+    await pilot.click(selector)
+
+
 def unity_app(tmp_path=None, **kw) -> WorkbenchApp:
     return make_app(paused=True, noise="off", **kw)
 
@@ -90,7 +99,7 @@ def test_duplicate_and_out_of_range_ports_are_shown_inline_and_nothing_is_applie
         set_row(second, port="1")
         set_row(third, port="120", mount="front")
         await pilot.pause()
-        await pilot.click("#ports-apply")
+        await click(pilot, "#ports-apply")
         await pilot.pause()
         assert first.error == "port 1 is also used by row 2"
         assert second.error == "port 1 is already used by row 1"
@@ -140,7 +149,7 @@ def test_presets_add_and_remove_rows():
 
     async def body(pilot: Pilot) -> None:
         screen = await open_ports(pilot)
-        await pilot.click("#preset-web-two-distance")
+        await click(pilot, "#preset-web-two-distance")
         await pilot.pause()
         assert app.bench.sensors == [SensorSpec("distance", 3, "front")]
         assert [(r.kind, r.port, r.mount) for r in screen.rows()] == [
@@ -148,20 +157,20 @@ def test_presets_add_and_remove_rows():
             ("distance", "1", None),
             ("touch", "2", None),
         ]
-        await pilot.click("#preset-web-wall-following")
+        await click(pilot, "#preset-web-wall-following")
         await pilot.pause()
         assert app.bench.sensors == [
             SensorSpec("distance", 1, "right"),
             SensorSpec("touch", 2, "front"),
         ]
-        await pilot.click("#ports-add")
+        await click(pilot, "#ports-add")
         await pilot.pause()
         assert len(screen.rows()) == 4 and screen.rows()[-1].port == "4"
-        await pilot.click(".row-remove")
+        await click(pilot, ".row-remove")
         await pilot.pause()
         assert [r.port for r in screen.rows()] == ["2", "3", "4"]
         assert [e.number for e in row_editors(screen)] == [1, 2, 3]
-        await pilot.click("#ports-apply")
+        await click(pilot, "#ports-apply")
         assert app.bench.sensors == [SensorSpec("touch", 2, "front")]
 
     run(app, body)
@@ -211,7 +220,7 @@ def test_start_and_the_state_display_follows_the_engine():
     async def body(pilot: Pilot) -> None:
         screen = await open_algorithms(pilot)
         await choose_builtin(pilot, screen, "right-wall")
-        await pilot.click("#alg-start")
+        await click(pilot, "#alg-start")
         await pilot.pause()
         assert isinstance(app.screen, MainScreen)
         assert bench.controller is not None and not bench.pacer.paused
@@ -242,16 +251,16 @@ def test_pause_step_and_reset_from_the_dialog():
     async def body(pilot: Pilot) -> None:
         screen = await open_algorithms(pilot)
         await choose_builtin(pilot, screen, "right-wall")
-        await pilot.click("#alg-start")
+        await click(pilot, "#alg-start")
         await pilot.pause()
         screen = await open_algorithms(pilot)
-        await pilot.click("#alg-pause")
+        await click(pilot, "#alg-pause")
         assert bench.pacer.paused
         t = bench.snapshot().time
-        await pilot.click("#alg-step")
+        await click(pilot, "#alg-step")
         assert bench.snapshot().time == pytest.approx(t + bench.session.every / 60)
         assert "running, in" in str(screen.query_one("#alg-live").render())
-        await pilot.click("#alg-reset")
+        await click(pilot, "#alg-reset")
         assert bench.controller is None and bench.snapshot().time == 0
         assert bench.runs[-1].ended == "reset"
 
@@ -305,12 +314,12 @@ def test_the_dialog_explains_a_missing_sensor_and_f_fixes_it():
         await choose_builtin(pilot, screen, "right-wall")
         missing = screen.query_one("#alg-missing", Static)
         assert missing.display and "needs a distance sensor mounted right" in text_of(missing)
-        await pilot.click("#alg-start")
+        await click(pilot, "#alg-start")
         assert app.bench.controller is None
         assert "press f" in text_of(screen.query_one("#alg-error", Static))
         await pilot.press("f")
         assert app.bench.missing_sensors() is None and not missing.display
-        await pilot.click("#alg-start")
+        await click(pilot, "#alg-start")
         assert app.bench.controller is not None
 
     run(app, body, size=(120, 40))
@@ -348,7 +357,7 @@ def test_a_good_fsm_file_loads(tmp_path):
     async def body(pilot: Pilot) -> None:
         screen = await open_algorithms(pilot)
         screen.query_one("#alg-path", Input).value = str(good)
-        await pilot.click("#alg-load")
+        await click(pilot, "#alg-load")
         await pilot.pause()
         assert app.bench.algorithm is not None and app.bench.algorithm.name == "mine"
         assert text_of(screen.query_one("#alg-title", Static)) == f"mine  ({good})"
@@ -368,13 +377,13 @@ def test_parameters_are_checked_as_typed_and_reset_to_defaults():
         await pilot.pause()
         assert editor.invalid
         assert "above its maximum 1" in text_of(editor.query_one(".param-error", Static))
-        await pilot.click("#alg-start")
+        await click(pilot, "#alg-start")
         assert app.bench.controller is None
         assert "forward_power" in text_of(screen.query_one("#alg-error", Static))
         editor.query_one(Input).value = "0.5"
         await pilot.pause()
         assert not editor.invalid and app.bench.params()["forward_power"] == 0.5
-        await pilot.click("#alg-defaults")
+        await click(pilot, "#alg-defaults")
         await pilot.pause()
         assert app.bench.params()["forward_power"] == 1.0
         fresh = next(e for e in screen.query(ParamEditor) if e.parameter.name == "forward_power")
