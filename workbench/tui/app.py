@@ -88,6 +88,7 @@ class WorkbenchApp(App[None]):
         return MainScreen(self.bench, unicode=self.unicode)
 
     def on_mount(self) -> None:
+        self.set_class(not self.unicode, "-ascii")
         self.sub_title = f"{self.bench.maze.name} ({self.bench.profile})"
         self._last_tick = perf_counter()
         self.set_interval(1.0 / self.tick_hz, self._tick, name="simulation")
@@ -137,6 +138,7 @@ class WorkbenchApp(App[None]):
 
     # -- view settings -------------------------------------------------------------------------
     def watch_unicode(self, unicode: bool) -> None:
+        self.set_class(not unicode, "-ascii")
         for screen in self.screen_stack:
             setter = getattr(screen, "set_unicode", None)
             if setter is not None:
