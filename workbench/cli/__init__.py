@@ -14,7 +14,7 @@ from . import maze as maze_cmd
 from . import run as run_cmd
 from . import serve as serve_cmd
 from . import viple_client as viple_client_cmd
-from .common import default_maze_path, error
+from .common import default_maze_path, error, new_runs_dir, runs_home
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -28,6 +28,20 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--seed", type=int, default=0, help="noise seed (default 0)")
     parser.add_argument("--noise", help="off, low or realistic (default: the profile's)")
     parser.add_argument("--unicode", action="store_true", help="draw the maze with Unicode lines")
+    parser.add_argument(
+        "--tcp-port",
+        type=int,
+        default=1350,
+        help="VIPLE (Unity-simulator role) connects here on localhost; 0 turns it off "
+        "(default 1350)",
+    )
+    parser.add_argument(
+        "--ws-url", help="connect to VIPLE's WebSocket server too (Web-Simulator role)"
+    )
+    parser.add_argument(
+        "--record-dir",
+        help=f"keep each run's record here for replay (default: a new folder under {runs_home()})",
+    )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     maze_cmd.register(sub)
     algorithms_cmd.register(sub)
@@ -63,7 +77,14 @@ def open_app(args: argparse.Namespace) -> int:
 
     try:
         app = make_app(
-            args.maze, args.profile, seed=args.seed, noise=args.noise, unicode=args.unicode
+            args.maze,
+            args.profile,
+            seed=args.seed,
+            noise=args.noise,
+            unicode=args.unicode,
+            tcp_port=args.tcp_port or None,
+            ws_url=args.ws_url,
+            record_dir=args.record_dir or new_runs_dir(),
         )
     except AppSetupError as exc:
         error(str(exc))

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import os
 import sys
+import time
 from pathlib import Path
 
 import workbench
@@ -12,6 +14,19 @@ MAZE_DIR = Path(workbench.__file__).resolve().parent.parent / "mazes"
 
 def default_maze_path() -> Path:
     return MAZE_DIR / "unity-default.txt"
+
+
+def runs_home() -> Path:
+    """Where the app keeps run records: $XDG_DATA_HOME/viple-workbench/runs."""
+    base = os.environ.get("XDG_DATA_HOME") or os.path.join(
+        os.path.expanduser("~"), ".local", "share"
+    )
+    return Path(base) / "viple-workbench" / "runs"
+
+
+def new_runs_dir() -> str:
+    """A folder for this app session's run records (created when the first run starts)."""
+    return str(runs_home() / time.strftime("%Y%m%d-%H%M%S"))
 
 
 def error(message: str) -> None:

@@ -115,6 +115,8 @@ class Bench:
     runs: list[RunEntry] = field(default_factory=list)
     keys_used: set[str] = field(default_factory=set)
     message: str = ""
+    #: the VIPLE endpoints' status line, kept up to date by the front end that hosts them
+    connection: str = ""
     _run_open: bool = False
     _recorder: Recorder | None = None
     _record_path: str | None = None

@@ -24,6 +24,10 @@ from workbench.sim.maze import Maze, MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.noise import NOISE_LEVELS
 from workbench.sim.profiles import PROFILES
+from workbench.viple.hosting import Endpoints
+from workbench.viple.link import REPORT_MS_DEFAULT
+from workbench.viple.tcp_server import TcpConfig
+from workbench.viple.ws_client import WsConfig
 
 from .commands import WorkbenchCommands
 from .modals.help import HelpScreen
@@ -69,8 +73,12 @@ class WorkbenchApp(App[None]):
         role: str = "student",
         tick_hz: float = 20.0,
         unicode: bool = False,
+        tcp: TcpConfig | None = None,
+        ws: WsConfig | None = None,
     ) -> None:
         super().__init__()
+        self._viple_configs = (tcp, ws)
+        self.endpoints: Endpoints | None = None
         self.bench = bench
         self.maze_path = maze_path
         self.user = user
@@ -87,7 +95,10 @@ class WorkbenchApp(App[None]):
     def get_default_screen(self) -> Screen:
         return MainScreen(self.bench, unicode=self.unicode)
 
-    def on_mount(self) -> None:
+    async def on_mount(self) -> None:
+        tcp, ws = self._viple_configs
+        if tcp is not None or ws is not None:
+            self.endpoints = await Endpoints.open(self.bench.session, tcp, ws)
         self.set_class(not self.unicode, "-ascii")
         self.sub_title = f"{self.bench.maze.name} ({self.bench.profile})"
         self._last_tick = perf_counter()
@@ -100,6 +111,9 @@ class WorkbenchApp(App[None]):
         elapsed = now - self._last_tick
         self._last_tick = now
         bench = self.bench
+        if self.endpoints is not None:
+            self.endpoints.follow(bench.session)
+            bench.connection = self.endpoints.summary()
         steps = bench.advance(elapsed)
         state = (bench.pacer.paused, bench.message, bench.controller, len(bench.runs))
         if steps or state != self._drawn:
@@ -167,6 +181,8 @@ class WorkbenchApp(App[None]):
 
     async def action_quit(self) -> None:
         self.bench.close()
+        if self.endpoints is not None:
+            await self.endpoints.close()
         self.exit()
 
 
@@ -181,8 +197,14 @@ def make_app(
     tick_hz: float = 20,
     unicode: bool = False,
     record_dir: str | None = None,
+    tcp_port: int | None = None,
+    ws_url: str | None = None,
+    report_ms: int = REPORT_MS_DEFAULT,
 ) -> WorkbenchApp:
     """The workbench app on a maze file (default: the bundled Unity maze).
+
+    ``tcp_port`` hosts the Unity-simulator role (VIPLE connects to it) and ``ws_url`` the
+    Web-Simulator role (the app connects to VIPLE); neither runs unless asked for.
 
     Raises :class:`AppSetupError` with a message for the user when the maze cannot be read or
     an argument is not one the workbench knows.
@@ -201,6 +223,11 @@ def make_app(
     if not tick_hz > 0:
         raise AppSetupError(f"the tick rate must be above 0 Hz, not {tick_hz}")
     try:
+        tcp = TcpConfig(port=tcp_port, report_ms=report_ms) if tcp_port else None
+        ws = WsConfig(url=ws_url, report_ms=report_ms) if ws_url else None
+    except ValueError as exc:
+        raise AppSetupError(str(exc)) from None
+    try:
         maze = load_maze(path)
     except MazeError as exc:
         problems = "\n".join(f"  {p}" for p in exc.problems)
@@ -213,5 +240,12 @@ def make_app(
     # max speed may use at most 60 % of each frame, so keys and drawing stay responsive
     bench.pacer.budget = 0.6 / tick_hz
     return WorkbenchApp(
-        bench, maze_path=path, user=user, role=role, tick_hz=tick_hz, unicode=unicode
+        bench,
+        maze_path=path,
+        user=user,
+        role=role,
+        tick_hz=tick_hz,
+        unicode=unicode,
+        tcp=tcp,
+        ws=ws,
     )

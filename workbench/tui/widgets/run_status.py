@@ -17,7 +17,7 @@ class RunStatus(Static):
 
     DEFAULT_CSS = """
     RunStatus {
-        height: 5;
+        height: auto;
         padding: 0 1;
         border-top: solid $primary;
         border-title-color: $text-primary;
@@ -48,7 +48,8 @@ class RunStatus(Static):
             f"turn{'' if m.turns == 1 else 's'}"
             f"{sep}collisions {m.collisions}"
         )
-        self.lines = (driver, clock, travel, turning)
+        connection = (bench.connection,) if bench.connection else ()
+        self.lines = (driver, clock, travel, turning, *connection)
 
-    def watch_lines(self, lines: tuple[str, ...]) -> None:
-        self.update("\n".join(lines), layout=False)
+    def watch_lines(self, old: tuple[str, ...], lines: tuple[str, ...]) -> None:
+        self.update("\n".join(lines), layout=len(old) != len(lines))

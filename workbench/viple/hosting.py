@@ -1,0 +1,80 @@
+"""The VIPLE endpoints an interactive front end hosts on its live session.
+
+Unlike ``workbench serve``, a front end keeps running when an endpoint cannot start (a port
+in use, say): the reason is shown in the status line instead.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from workbench.sim.session import Session
+
+from .link import LinkStatus, Seat
+from .tcp_server import EndpointError, TcpConfig, TcpServer
+from .ws_client import WsClient, WsConfig
+
+
+@dataclass
+class Endpoints:
+    tcp: TcpServer | None = None
+    ws: WsClient | None = None
+    seat: Seat = field(default_factory=Seat)
+    #: endpoints that could not start, with the reason
+    problems: list[str] = field(default_factory=list)
+
+    @classmethod
+    async def open(
+        cls, session: Session, tcp: TcpConfig | None = None, ws: WsConfig | None = None
+    ) -> Endpoints:
+        hosted = cls()
+        if tcp is not None:
+            server = TcpServer(session, tcp, hosted.seat)
+            try:
+                await server.start()
+            except EndpointError as exc:
+                hosted.problems.append(f"VIPLE tcp not listening: {exc}")
+            else:
+                hosted.tcp = server
+        if ws is not None:
+            hosted.ws = WsClient(session, ws, hosted.seat)
+            await hosted.ws.start()
+        return hosted
+
+    @property
+    def active(self) -> list[TcpServer | WsClient]:
+        return [e for e in (self.tcp, self.ws) if e is not None]
+
+    def follow(self, session: Session) -> None:
+        """Serve ``session`` from now on (the front end replaced its session: a new maze)."""
+        for endpoint in self.active:
+            if endpoint.link.session is not session:
+                endpoint.link.session = session
+
+    def statuses(self) -> list[LinkStatus]:
+        return [e.status for e in self.active]
+
+    def summary(self) -> str:
+        """One line for a status bar: each endpoint, its peer and its counters."""
+        parts = [describe(s) for s in self.statuses()]
+        return " | ".join(parts + self.problems)
+
+    async def close(self) -> None:
+        for endpoint in self.active:
+            await endpoint.close()
+        self.tcp = self.ws = None
+
+
+def describe(status: LinkStatus) -> str:
+    if status.peer is None:
+        where = "listening on" if status.role == "tcp" else "waiting for"
+        line = f"VIPLE {status.role} {where} {status.address}"
+    else:
+        line = (
+            f"VIPLE {status.role} {status.peer}: in {status.messages_in} out {status.messages_out}"
+        )
+    if status.invalid:
+        line += f", {status.invalid} rejected"
+        if status.last_rejection:
+            line += f" (last: {status.last_rejection})"
+    return line
