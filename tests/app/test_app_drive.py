@@ -22,6 +22,7 @@ from workbench.tui.modals.too_small import TooSmallScreen
 from workbench.tui.screens.editor import EditorScreen
 from workbench.tui.screens.main import MainScreen
 from workbench.tui.screens.runs import RunsScreen
+from workbench.tui.screens.unsaved_dialog import UnsavedDialog
 from workbench.tui.widgets.key_legend import KeyLegend
 from workbench.tui.widgets.maze_view import MazeView
 from workbench.tui.widgets.run_status import RunStatus
@@ -258,6 +259,27 @@ def test_a_terminal_below_80x24_gets_a_message_instead_of_the_layout(tmp_path):
         assert isinstance(app.screen, TooSmallScreen)
 
     run(app, body, size=(70, 20))
+
+
+def test_ctrl_q_in_the_editor_with_unsaved_changes_asks_first(tmp_path):
+    app = make_app(maze_file(tmp_path, ROOM, "unity"), paused=True)
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.press("e")
+        await pilot.press("right", "space")  # an unsaved wall
+        await pilot.press("ctrl+q")
+        await pilot.pause()
+        assert isinstance(app.screen, UnsavedDialog) and app.is_running
+        await pilot.press("escape")  # cancel: back in the editor, nothing lost
+        await pilot.pause()
+        assert isinstance(app.screen, EditorScreen) and app.screen.dirty
+        await pilot.press("ctrl+q")
+        await pilot.pause()
+        await pilot.press("d")  # discard, then quit
+        await pilot.pause()
+
+    run(app, body)
+    assert app.return_code == 0
 
 
 def test_ctrl_q_quits_and_keeps_the_open_run(tmp_path):

@@ -180,6 +180,14 @@ class WorkbenchApp(App[None]):
         self.refresh_views()
 
     async def action_quit(self) -> None:
+        """Quit; an editor with unsaved changes asks first (save / discard / cancel)."""
+        editors = [s for s in self.screen_stack if isinstance(s, EditorScreen) and s.dirty]
+        if editors:
+            editors[-1].ask_before(lambda: self.run_worker(self._shut_down()))
+        else:
+            await self._shut_down()
+
+    async def _shut_down(self) -> None:
         self.bench.close()
         if self.endpoints is not None:
             await self.endpoints.close()

@@ -16,7 +16,7 @@ from textual.widgets import Static
 
 from workbench.control.manual import key_legend
 
-from ..commands import COMMANDS
+from ..commands import COMMANDS, CommandInfo
 
 
 def _table() -> Table:
@@ -26,24 +26,35 @@ def _table() -> Table:
     return table
 
 
-def help_text(bindings: list[Binding], profile: str, key_name: Callable[[Binding], str]) -> Group:
-    """Every key grouped as in :data:`COMMANDS`, after the profile's drive keys."""
+def help_text(
+    screens: list[tuple[str, list[Binding]]], profile: str, key_name: Callable[[Binding], str]
+) -> Group:
+    """Every key: the profile's drive keys, then each screen's keys grouped as in
+    :data:`COMMANDS` (bindings without an entry there explain themselves)."""
     sections: list[tuple[str, Table]] = []
     drive = _table()
     for key, text in key_legend(profile):
         drive.add_row(key, text)
     sections.append((f"Drive ({profile} key program)", drive))
     tables: dict[str, Table] = {}
-    for binding in bindings:
-        info = COMMANDS.get(binding.id or "")
-        name = binding.key_display or key_name(binding)
-        if info is None or info.group == "Drive":
-            continue
-        if info.group not in tables:
-            tables[info.group] = _table()
-            sections.append((info.group, tables[info.group]))
-        what = Text.assemble((info.title, "bold"), ": ", info.explanation)
-        tables[info.group].add_row(name, what)
+    for screen_group, bindings in screens:
+        for binding in bindings:
+            if not binding.id:
+                continue
+            info = COMMANDS.get(binding.id)
+            if info is None:
+                info = CommandInfo(
+                    screen_group,
+                    binding.description.lower(),
+                    binding.tooltip or f"{binding.description}.",
+                )
+            if info.group == "Drive":
+                continue
+            if info.group not in tables:
+                tables[info.group] = _table()
+                sections.append((info.group, tables[info.group]))
+            what = Text.assemble((info.title, "bold"), ": ", info.explanation)
+            tables[info.group].add_row(binding.key_display or key_name(binding), what)
     dialogs = _table()
     dialogs.add_row("tab", "Move between the fields and buttons of a dialog.")
     dialogs.add_row("enter", "Press the focused button; in a field, apply it.")
@@ -89,15 +100,24 @@ class HelpScreen(ModalScreen[None]):
         self.profile = profile
 
     def compose(self) -> ComposeResult:
+        from ..screens.editor import EditorScreen
         from ..screens.main import MainScreen
+        from ..screens.replay import ReplayScreen
+        from ..screens.runs import RunsScreen
 
         app = self.app
         dialog = Vertical(id="help-dialog")
         dialog.border_title = "Help: keys of the workbench"
         dialog.border_subtitle = "escape closes, arrows scroll"
         with dialog, VerticalScroll(id="help-scroll"):
-            bindings = [b for b in [*MainScreen.BINDINGS, *app.BINDINGS] if isinstance(b, Binding)]
-            yield Static(help_text(bindings, self.profile, app.get_key_display), id="help-text")
+            screens = [
+                ("Workbench", [*MainScreen.BINDINGS, *app.BINDINGS]),
+                ("Maze editor (e)", EditorScreen.BINDINGS),
+                ("Runs (R)", RunsScreen.BINDINGS),
+                ("Replay (enter on a run)", ReplayScreen.BINDINGS),
+            ]
+            keys = [(name, [b for b in found if isinstance(b, Binding)]) for name, found in screens]
+            yield Static(help_text(keys, self.profile, app.get_key_display), id="help-text")
 
     def on_mount(self) -> None:
         self.query_one("#help-scroll").focus()
