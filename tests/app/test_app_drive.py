@@ -3,9 +3,7 @@ the command palette, a terminal that is too small, quitting, and the command lin
 
 from __future__ import annotations
 
-import asyncio
 import io
-from collections.abc import Awaitable, Callable
 
 import pytest
 from rich.console import Console
@@ -13,6 +11,7 @@ from textual.command import CommandList
 from textual.pilot import Pilot
 from textual.widgets import Static
 
+from tests.app.support import run
 from workbench.cli import main
 from workbench.control.manual import key_legend
 from workbench.tui.app import AppSetupError, WorkbenchApp, make_app
@@ -35,19 +34,6 @@ def maze_file(tmp_path, text: str, profile: str) -> str:
     path = tmp_path / f"{profile}.txt"
     path.write_text(f"---\nname: test {profile}\nprofile: {profile}\n---\n{text}")
     return str(path)
-
-
-def run(
-    app: WorkbenchApp,
-    body: Callable[[Pilot], Awaitable[None]],
-    size: tuple[int, int] = (80, 24),
-) -> None:
-    async def go() -> None:
-        async with app.run_test(size=size) as pilot:
-            await pilot.pause()
-            await body(pilot)
-
-    asyncio.run(go())
 
 
 def status(app: WorkbenchApp) -> str:

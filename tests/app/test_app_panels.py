@@ -2,13 +2,11 @@
 
 from __future__ import annotations
 
-import asyncio
-from collections.abc import Awaitable, Callable
-
 import pytest
 from textual.pilot import Pilot
 from textual.widgets import Input, OptionList, Select, Static
 
+from tests.app.support import run
 from workbench.sim.sensors import SensorSpec
 from workbench.tui.app import WorkbenchApp, make_app
 from workbench.tui.modals.algorithm import AlgorithmModal
@@ -21,15 +19,6 @@ from workbench.tui.widgets.sensor_row_editor import SensorRowEditor
 from workbench.tui.widgets.transition_log import TransitionLog
 
 ROOM = "#######\n#.....#\n#..S..#\n#.....#\n#######\n"
-
-
-def run(app: WorkbenchApp, body: Callable[[Pilot], Awaitable[None]], size=(80, 24)) -> None:
-    async def go() -> None:
-        async with app.run_test(size=size) as pilot:
-            await pilot.pause()
-            await body(pilot)
-
-    asyncio.run(go())
 
 
 async def click(pilot: Pilot, selector: str) -> None:

@@ -2,15 +2,11 @@
 
 from __future__ import annotations
 
-import asyncio
-import functools
-from collections.abc import Callable, Coroutine
-from typing import Any
-
 from textual.app import App
 from textual.screen import Screen
 from textual.widgets import Input, OptionList, Select
 
+from tests.app.support import sync
 from workbench.control.bench import Bench
 from workbench.sim.mazefile import write_maze
 from workbench.sim.mazeio import load_maze
@@ -23,16 +19,6 @@ from workbench.tui.widgets import MazeView
 
 ROOM_TEXT = "#######\n#S....#\n#.....#\n#....E#\n#######\n"
 SIZE = (80, 24)
-
-
-def sync(test: Callable[..., Coroutine[Any, Any, None]]) -> Callable[..., None]:
-    """Run an async test body with asyncio (the suite has no async test plugin)."""
-
-    @functools.wraps(test)
-    def run(*args: Any, **kwargs: Any) -> None:
-        asyncio.run(test(*args, **kwargs))
-
-    return run
 
 
 class Host(App):

@@ -2,13 +2,10 @@
 
 from __future__ import annotations
 
-import asyncio
-from collections.abc import Callable, Coroutine
-from typing import Any
-
 from textual import events
 from textual.app import App, ComposeResult
 
+from tests.app.support import sync
 from workbench.sim.generate import generate
 from workbench.sim.maze import Maze
 from workbench.sim.metrics import Metrics
@@ -72,17 +69,6 @@ class Host(App):
 
     def on_maze_view_block_clicked(self, message: MazeView.BlockClicked) -> None:
         self.clicked.append(message.cell)
-
-
-def sync(test: Callable[[], Coroutine[Any, Any, None]]) -> Callable[[], None]:
-    """Run an async test body with asyncio (the suite has no async test plugin)."""
-
-    def run() -> None:
-        asyncio.run(test())
-
-    run.__name__ = test.__name__
-    run.__doc__ = test.__doc__
-    return run
 
 
 def lines(view: MazeView) -> list[str]:

@@ -2,16 +2,13 @@
 
 from __future__ import annotations
 
-import asyncio
-import functools
 import json
-from collections.abc import Callable, Coroutine
-from typing import Any
 
 from textual.app import App
 from textual.screen import Screen
 from textual.widgets import DataTable, Input, Static
 
+from tests.app.support import sync
 from workbench.control.bench import Bench
 from workbench.sim.mazefile import parse_maze
 from workbench.sim.record import FORMAT
@@ -24,16 +21,6 @@ BEND = parse_maze(
     "---\nname: Bend\n---\n#######\n#S....#\n#####.#\n#E....#\n#######\n", source="bend.txt"
 )
 SIZE = (80, 24)
-
-
-def sync(test: Callable[..., Coroutine[Any, Any, None]]) -> Callable[..., None]:
-    """Run an async test body with asyncio (the suite has no async test plugin)."""
-
-    @functools.wraps(test)
-    def run(*args: Any, **kwargs: Any) -> None:
-        asyncio.run(test(*args, **kwargs))
-
-    return run
 
 
 class Host(App):

@@ -1,0 +1,36 @@
+"""What the app tests share: running async test bodies and driving an app with a Pilot."""
+
+from __future__ import annotations
+
+import asyncio
+import functools
+from collections.abc import Awaitable, Callable, Coroutine
+from typing import Any
+
+from textual.app import App
+from textual.pilot import Pilot
+
+
+def sync(test: Callable[..., Coroutine[Any, Any, None]]) -> Callable[..., None]:
+    """Run an ``async def`` test body with asyncio (the suite has no async test plugin)."""
+
+    @functools.wraps(test)
+    def run(*args: Any, **kwargs: Any) -> None:
+        asyncio.run(test(*args, **kwargs))
+
+    return run
+
+
+def run(
+    app: App,
+    body: Callable[[Pilot], Awaitable[None]],
+    size: tuple[int, int] = (80, 24),
+) -> None:
+    """Start ``app`` headless at ``size``, let it settle, then run ``body`` with its pilot."""
+
+    async def go() -> None:
+        async with app.run_test(size=size) as pilot:
+            await pilot.pause()
+            await body(pilot)
+
+    asyncio.run(go())
