@@ -208,3 +208,53 @@ def test_a_new_maze_keeps_pause_speed_and_frame_budget():
     b.load_maze(CORRIDOR)
     assert (b.pacer.paused, b.pacer.speed, b.pacer.budget) == (True, 2.0, 0.03)
     assert b.pacer.session is b.session and b.snapshot().block == CORRIDOR.start
+
+
+MOVE = '{"servos":[{"isTurn":false,"servoId":-1,"servoSpeed":1}]}'
+
+
+def test_a_viple_program_that_drives_is_recorded_with_its_role_and_a_run():
+    from workbench.viple.link import Link
+
+    b = bench(CORRIDOR, profile="unity")
+    b.key("w")
+    b.step(10)
+    link = Link(b.session, "tcp")
+    assert link.connect("127.0.0.1:50312")
+    b.step(1)
+    assert [(c.role, c.peer, c.drove) for c in b.viple] == [("tcp", "127.0.0.1:50312", False)]
+    assert b.runs[-1].driver == "keys" and b.runs[-1].ended == "stopped"
+    assert link.apply(MOVE)
+    b.step(60)
+    assert b.viple[0].drove and b.viple[0].distance > 0.5
+    link.disconnect()
+    b.step(1)
+    run = b.runs[-1]
+    assert (run.driver, run.ended, run.source) == ("VIPLE tcp 127.0.0.1:50312", "stopped", None)
+    assert len(b.viple) == 1
+
+
+def test_a_viple_program_that_only_connects_has_not_driven():
+    from workbench.viple.link import Link
+
+    b = bench(CORRIDOR, profile="unity")
+    link = Link(b.session, "ws", "ws://localhost:8124/")
+    link.connect("ws://localhost:8124/")
+    b.step(30)
+    link.disconnect()
+    b.step(1)
+    assert [(c.role, c.drove) for c in b.viple] == [("ws", False)]
+
+
+def test_a_viple_program_that_takes_the_robot_from_an_algorithm_ends_its_run():
+    from workbench.viple.link import Link
+
+    b = bench(CORRIDOR, profile="unity")
+    b.select_algorithm("right-wall")
+    b.start_algorithm()
+    b.step(20)
+    Link(b.session, "tcp").connect("127.0.0.1:1")
+    b.step(1)
+    assert b.controller is None
+    assert b.runs[-1].driver == "algorithm right-wall"
+    assert b.runs[-1].source.endswith("right-wall.yaml")

@@ -41,6 +41,8 @@ PRESETS: dict[str, tuple[SensorSpec, ...]] = {
     "web-two-distance": (SensorSpec("distance", 3, "front"),),
 }
 KEYS_DRIVER = "keys"
+#: how a session names a connected VIPLE program as its driver: "VIPLE ROLE PEER"
+VIPLE_PREFIX = "VIPLE "
 #: the rows the Web Simulator's sensor panel always offers: two distance sensors and one touch
 PANEL_KINDS = ("distance", "distance", "touch")
 
@@ -66,6 +68,23 @@ class RunEntry:
     metrics: Metrics
     ended: str  # "exit", "stopped", "reset", "maze changed"
     record: str | None = None
+    #: the FSM file of the algorithm that drove (None for keys and VIPLE)
+    source: str | None = None
+
+
+@dataclass
+class VipleConnection:
+    """A VIPLE program that held the robot: its role (tcp / ws), where it was, what it did."""
+
+    role: str
+    peer: str
+    #: distance travelled and degrees turned while it drove, in the profile's units
+    distance: float = 0.0
+    turn_degrees: float = 0.0
+
+    @property
+    def drove(self) -> bool:
+        return self.distance > 0 or self.turn_degrees > 0
 
 
 def check_sensor_rows(rows: Sequence[SensorRow]) -> tuple[list[SensorSpec], dict[int, str]]:
@@ -117,7 +136,13 @@ class Bench:
     message: str = ""
     #: the VIPLE endpoints' status line, kept up to date by the front end that hosts them
     connection: str = ""
+    #: every VIPLE program seen driving this bench, oldest first
+    viple: list[VipleConnection] = field(default_factory=list)
     _run_open: bool = False
+    _run_driver: str = KEYS_DRIVER
+    _run_source: str | None = None
+    _viple_now: VipleConnection | None = None
+    _odometry_seen: tuple[float, float] = (0.0, 0.0)
     _recorder: Recorder | None = None
     _record_path: str | None = None
 
@@ -176,10 +201,41 @@ class Bench:
         self.message = f"algorithm stopped: {exc}"
 
     def _after_steps(self) -> None:
+        self._watch_viple()
         if self._run_open and self.maze.exits and self.session.reached_exit:
             self._close_run("exit")
             self.pacer.paused = True
             self.message = "the robot is out: run finished (r resets the robot)"
+
+    def _watch_viple(self) -> None:
+        """Notice a VIPLE program taking or leaving the robot; its driving is a run."""
+        odometry = self.session.world.odometry
+        seen = (odometry.distance, odometry.turn_degrees)
+        last = self._odometry_seen
+        if seen[0] < last[0] or seen[1] < last[1]:  # the robot was reset in between
+            last = (0.0, 0.0)
+        self._odometry_seen = seen
+        driver = self.session.driver
+        if not driver.startswith(VIPLE_PREFIX):
+            self._viple_now = None
+            if self._run_open and self._run_driver.startswith(VIPLE_PREFIX):
+                self._close_run("stopped")
+            return
+        if self._viple_now is None:
+            role, _, peer = driver[len(VIPLE_PREFIX) :].partition(" ")
+            self._viple_now = VipleConnection(role, peer)
+            self.viple.append(self._viple_now)
+        else:
+            self._viple_now.distance += seen[0] - last[0]
+            self._viple_now.turn_degrees += seen[1] - last[1]
+        if self.controller is not None and self.session.controller is None:
+            self.controller = None  # the program took the robot from the algorithm
+            if self._run_open:
+                self._close_run("stopped")
+        if self._run_open and self._run_driver != driver:
+            self._close_run("stopped")
+        if not self._run_open and not self.session.reached_exit:
+            self._open_run(driver)
 
     def toggle_pause(self) -> bool:
         self.pacer.paused = not self.pacer.paused
@@ -196,8 +252,10 @@ class Bench:
             return False
         if self.controller is not None:
             self.stop_algorithm("stopped")
+        if self._run_open and self._run_driver != KEYS_DRIVER:
+            self._close_run("stopped")  # the keys take the robot from a VIPLE program
         if not self._run_open and not self.session.reached_exit:
-            self._open_run()  # a run starts at the robot's last reset
+            self._open_run(KEYS_DRIVER)  # a run starts at the robot's last reset
         self.keys_used.add(key)
         self.session.command(cmd, driver=KEYS_DRIVER)
         if exact_move(self.profile, key):
@@ -300,7 +358,7 @@ class Bench:
         self.session.reset()
         self.controller = controller
         self.session.attach(controller, binding, f"algorithm {self.algorithm.name}")
-        self._open_run()
+        self._open_run(self.session.driver)
         self.pacer.paused = False
         self.message = ""
 
@@ -333,8 +391,10 @@ class Bench:
         self._build_session()
 
     # -- runs ----------------------------------------------------------------------------
-    def _open_run(self) -> None:
+    def _open_run(self, driver: str) -> None:
         self._run_open = True
+        self._run_driver = driver
+        self._run_source = self.algorithm.source if self.controller and self.algorithm else None
         if self.record_dir:
             Path(self.record_dir).mkdir(parents=True, exist_ok=True)
             path = os.path.join(self.record_dir, f"run-{len(self.runs) + 1:03d}.jsonl")
@@ -342,7 +402,7 @@ class Bench:
             self._record_path = path
             self.session.recorder = self._recorder
             self.session.record_header(
-                algorithm=self.algorithm.name if self.controller else KEYS_DRIVER,
+                algorithm=self.algorithm.name if self.controller else driver,
                 params=self.params() if self.controller else {},
             )
 
@@ -350,13 +410,14 @@ class Bench:
         self._run_open = False
         entry = RunEntry(
             number=len(self.runs) + 1,
-            driver=self.session.driver,
+            driver=self._run_driver,
             maze=self.maze.name,
             profile=self.profile,
             seed=self.seed,
             metrics=self.session.metrics(),
             ended=ended,
             record=self._record_path,
+            source=self._run_source,
         )
         self.runs.append(entry)
         if self._recorder is not None:
