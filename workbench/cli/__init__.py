@@ -10,9 +10,11 @@ from collections.abc import Sequence
 from workbench import __version__
 
 from . import algorithms as algorithms_cmd
+from . import instructor as instructor_cmd
 from . import maze as maze_cmd
 from . import run as run_cmd
 from . import serve as serve_cmd
+from . import signoff as signoff_cmd
 from . import viple_client as viple_client_cmd
 from .common import default_maze_path, error, new_runs_dir, runs_home
 
@@ -48,6 +50,8 @@ def build_parser() -> argparse.ArgumentParser:
     run_cmd.register(sub)
     serve_cmd.register(sub)
     viple_client_cmd.register(sub)
+    instructor_cmd.register(sub)
+    signoff_cmd.register(sub)
     return parser
 
 

@@ -1,0 +1,168 @@
+"""`workbench instructor` and `workbench signoff` as an instructor runs them."""
+
+from __future__ import annotations
+
+import csv
+import io
+import sqlite3
+import sys
+from datetime import UTC, datetime
+from pathlib import Path
+
+import pytest
+
+from workbench.cli import main
+from workbench.labs import signoff as so
+from workbench.labs.store import DB_NAME, Store
+
+PASS = "correct horse battery"
+FAST = so.KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only; defaults are untouched
+
+
+def add_instructor(monkeypatch, data_dir: Path, name: str, passphrase: str = PASS) -> int:
+    monkeypatch.setattr(sys, "stdin", io.StringIO(passphrase + "\n"))
+    return main(["instructor", "add", name, "--passphrase-stdin", "--data-dir", str(data_dir)])
+
+
+def sign(data_dir: Path, student: str, exercise: str, partner: str = "", when: int = 0) -> None:
+    fields = so.RecordFields(
+        student=student,
+        partner=partner,
+        driver=student,
+        lab="web-simulator",
+        exercise=exercise,
+        evidence=so.Evidence("", "", {"collisions": 1}),
+        objectives_passed=True,
+    )
+    moment = datetime(2026, 3, 2, 10, when, tzinfo=UTC)
+    with Store.open(data_dir) as store:
+        so.sign_off(store, "Dr Chen", PASS, fields, clock=lambda: moment)
+
+
+@pytest.fixture
+def data_dir(tmp_path, monkeypatch) -> Path:
+    d = tmp_path / "data"
+    d.mkdir()
+    so.create_instructor(d, "Dr Chen", PASS, kdf=FAST)
+    monkeypatch.delenv("WORKBENCH_DATA", raising=False)
+    return d
+
+
+def test_instructor_add_with_the_default_kdf_and_list(tmp_path, monkeypatch, capsys):
+    d = tmp_path / "fresh"
+    assert add_instructor(monkeypatch, d, "Prof. Ada Lovelace") == 0
+    out = capsys.readouterr().out
+    assert "added Prof. Ada Lovelace" in out and "encrypted" in out
+    assert so.unlock_instructor(d, "Prof. Ada Lovelace", PASS).name == "Prof. Ada Lovelace"
+    assert main(["instructor", "list", "--data-dir", str(d)]) == 0
+    assert "Prof. Ada Lovelace" in capsys.readouterr().out
+
+
+def test_instructor_add_reads_the_environment_data_dir(tmp_path, monkeypatch, capsys):
+    monkeypatch.setenv("WORKBENCH_DATA", str(tmp_path / "env"))
+    monkeypatch.setattr(sys, "stdin", io.StringIO(PASS + "\n"))
+    assert main(["instructor", "add", "Dr Env", "--passphrase-stdin"]) == 0
+    assert "Dr Env" in so.load_roster(tmp_path / "env" / "roster.json")
+
+
+def test_instructor_add_refuses_short_passphrases_and_duplicates(data_dir, monkeypatch, capsys):
+    assert add_instructor(monkeypatch, data_dir, "Dr Lee", "short") == 2
+    assert "at least 10 characters" in capsys.readouterr().err
+    assert add_instructor(monkeypatch, data_dir, "Dr Chen") == 2
+    assert "already in the roster" in capsys.readouterr().err
+
+
+def test_instructor_add_asks_twice_on_a_terminal(data_dir, monkeypatch, capsys):
+    answers = iter([PASS, PASS + "x"])
+    monkeypatch.setattr(sys, "stdin", io.StringIO(""))
+    monkeypatch.setattr(sys.stdin, "isatty", lambda: True)
+    monkeypatch.setattr("getpass.getpass", lambda prompt="": next(answers))
+    assert main(["instructor", "add", "Dr Lee", "--data-dir", str(data_dir)]) == 2
+    assert "the two passphrases differ" in capsys.readouterr().err
+    assert "Dr Lee" not in so.load_roster(so.roster_path(data_dir))
+
+
+def test_instructor_add_without_a_terminal_says_what_to_do(data_dir, monkeypatch, capsys):
+    monkeypatch.setattr(sys, "stdin", io.StringIO(""))
+    assert main(["instructor", "add", "Dr Lee", "--data-dir", str(data_dir)]) == 2
+    assert "--passphrase-stdin" in capsys.readouterr().err
+
+
+def test_list_filters_by_student_and_lab(data_dir, capsys):
+    sign(data_dir, "alice", "sensors", partner="bob")
+    sign(data_dir, "carol", "sensors")
+    assert main(["signoff", "list", "--student", "bob", "--data-dir", str(data_dir)]) == 0
+    out = capsys.readouterr().out
+    assert "alice & bob" in out and "carol" not in out
+    assert main(["signoff", "list", "--lab", "unity-simulator", "--data-dir", str(data_dir)]) == 0
+    assert "no sign-off records match" in capsys.readouterr().out
+
+
+def test_verify_says_what_it_checks_and_lists_every_failure(data_dir, capsys):
+    sign(data_dir, "alice", "sensors")
+    sign(data_dir, "bob", "sensors")
+    sign(data_dir, "carol", "sensors")
+    assert main(["signoff", "verify", "--data-dir", str(data_dir)]) == 0
+    out = capsys.readouterr().out
+    assert "signature" in out and "digest" in out and "all 3 record(s) verify" in out
+    with sqlite3.connect(data_dir / DB_NAME) as conn:
+        conn.execute("UPDATE signoffs SET signed_at = '2026-01-01T00:00:00Z' WHERE id = 1")
+        conn.execute("UPDATE signoffs SET student = 'mallory' WHERE id = 3")
+    assert main(["signoff", "verify", "--data-dir", str(data_dir)]) == 1
+    out = capsys.readouterr().out
+    assert "FAIL #1 alice" in out and "FAIL #3 mallory" in out and "#2" not in out
+    assert "2 of 3 record(s) do NOT verify" in out
+
+
+def test_verify_against_another_roster(data_dir, tmp_path, capsys):
+    sign(data_dir, "alice", "sensors")
+    course = tmp_path / "course"
+    so.create_instructor(course, "Dr Chen", PASS, kdf=FAST)  # same name, different key
+    roster = str(so.roster_path(course))
+    assert main(["signoff", "verify", "--roster", roster, "--data-dir", str(data_dir)]) == 1
+    assert "signature does not match" in capsys.readouterr().out
+    assert main(["signoff", "verify", "--roster", "nope.json", "--data-dir", str(data_dir)]) == 2
+    assert "no such roster file" in capsys.readouterr().err
+
+
+def test_export_contains_exactly_the_verifying_records(data_dir, tmp_path, capsys):
+    sign(data_dir, "alice", "sensors", partner="bob", when=1)
+    sign(data_dir, "alice", "sensors", partner="bob", when=2)
+    sign(data_dir, "carol", "wall-following")
+    sign(data_dir, "dave", "sensors")
+    with sqlite3.connect(data_dir / DB_NAME) as conn:
+        conn.execute("UPDATE signoffs SET note = 'all done' WHERE student = 'dave'")
+    target = tmp_path / "grades.csv"
+    code = main(["signoff", "export", "--csv", str(target), "--data-dir", str(data_dir)])
+    captured = capsys.readouterr()
+    assert code == 0
+    assert "wrote 3 row(s)" in captured.out and "1 record(s) do not verify" in captured.err
+    rows = list(csv.DictReader(target.open()))
+    assert [(r["student"], r["exercise"]) for r in rows] == [
+        ("alice", "sensors"),
+        ("bob", "sensors"),
+        ("carol", "wall-following"),
+    ]
+    assert rows[0]["signed_at"] == "2026-03-02T10:02:00Z" and rows[0]["instructor"] == "Dr Chen"
+
+
+def test_bad_input_is_a_clear_message_and_exit_2(data_dir, tmp_path, capsys):
+    broken = tmp_path / "broken"
+    broken.mkdir()
+    (broken / DB_NAME).write_text("not a database " * 100)
+    assert main(["signoff", "verify", "--data-dir", str(broken)]) == 2
+    assert f"{broken / DB_NAME}: not a readable workbench database" in capsys.readouterr().err
+    (data_dir / "roster.json").write_text("[]")
+    assert main(["instructor", "list", "--data-dir", str(data_dir)]) == 2
+    assert "not a roster" in capsys.readouterr().err
+    target = tmp_path / "no-such-dir" / "g.csv"
+    assert main(["signoff", "export", "--csv", str(target), "--data-dir", str(broken)]) == 2
+    with pytest.raises(SystemExit) as exc:
+        main(["signoff"])
+    assert exc.value.code == 2
+
+
+def test_export_to_an_unwritable_place_exits_2(data_dir, tmp_path, capsys):
+    target = tmp_path / "no-such-dir" / "g.csv"
+    assert main(["signoff", "export", "--csv", str(target), "--data-dir", str(data_dir)]) == 2
+    assert "cannot write" in capsys.readouterr().err

@@ -1,0 +1,409 @@
+"""Instructor keys, signed sign-off records, lockout and the SQLite store."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import sqlite3
+import subprocess
+import sys
+import threading
+from dataclasses import replace
+from datetime import UTC, datetime, timedelta
+from pathlib import Path
+
+import pytest
+
+from workbench.labs import signoff as so
+from workbench.labs.store import DB_NAME, Store, StoreError, resolve_data_dir
+
+FAST = so.KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only; defaults are untouched
+PASS = "correct horse battery"
+T0 = datetime(2026, 3, 2, 14, 5, 9, tzinfo=UTC)
+
+
+class Clock:
+    def __init__(self, start: datetime = T0):
+        self.now = start
+
+    def __call__(self) -> datetime:
+        return self.now
+
+    def advance(self, seconds: float) -> None:
+        self.now += timedelta(seconds=seconds)
+
+
+@pytest.fixture
+def data_dir(tmp_path: Path) -> Path:
+    return tmp_path / "data"
+
+
+@pytest.fixture
+def store(data_dir: Path):
+    so.create_instructor(data_dir, "Dr Chen", PASS, kdf=FAST)
+    with Store.open(data_dir) as s:
+        yield s
+
+
+@pytest.fixture
+def run_record(tmp_path: Path) -> Path:
+    p = tmp_path / "run.jsonl"
+    p.write_text('{"type":"header","format":"workbench-run/1"}\n{"type":"summary"}\n')
+    return p
+
+
+def fields(run_record: Path | None = None, passed: bool = True, **kw) -> so.RecordFields:
+    evidence = so.Evidence(
+        str(run_record) if run_record else "", "", {"exit_time": 41.5, "collisions": 0}
+    )
+    base = dict(
+        student="alice",
+        partner="bob",
+        driver="alice",
+        lab="unity-simulator",
+        exercise="wall-following",
+        evidence=evidence,
+        objectives_passed=passed,
+    )
+    base.update(kw)
+    return so.RecordFields(**base)
+
+
+def roster(data_dir: Path) -> dict[str, so.RosterEntry]:
+    return so.load_roster(so.roster_path(data_dir))
+
+
+def problems(store: Store, data_dir: Path) -> list[tuple[str, ...]]:
+    return [v.problems for v in so.verify_all(store, roster(data_dir))]
+
+
+# keys and roster
+
+
+def test_default_kdf_is_memory_hard():
+    assert so.KdfParams() == so.KdfParams(n=2**17, r=8, p=1)
+
+
+def test_instructor_key_is_encrypted_and_the_public_key_joins_the_roster(data_dir):
+    entry = so.create_instructor(data_dir, "Dr Chen", PASS, kdf=FAST, now=T0)
+    key_file = so.key_path(data_dir, "Dr Chen")
+    data = json.loads(key_file.read_text())
+    assert data["kdf"]["name"] == "scrypt" and data["kdf"]["n"] == 2**10
+    assert data["cipher"]["name"] == "AES-256-GCM"
+    assert oct(key_file.stat().st_mode & 0o777) == "0o600"
+    assert roster(data_dir)["Dr Chen"] == entry
+    assert entry.added == "2026-03-02T14:05:09Z"
+    unlocked = so.unlock_instructor(data_dir, "Dr Chen", PASS)
+    assert unlocked.public_key_b64() == entry.public_key
+
+
+def test_short_passphrase_is_refused_with_the_minimum(data_dir):
+    with pytest.raises(so.PassphraseTooShort, match="at least 10 characters"):
+        so.create_instructor(data_dir, "Dr Chen", "short", kdf=FAST)
+    assert not so.roster_path(data_dir).exists()
+
+
+def test_same_instructor_twice_and_bad_names_are_refused(data_dir):
+    so.create_instructor(data_dir, "Dr Chen", PASS, kdf=FAST)
+    with pytest.raises(so.SignoffError, match="already in the roster"):
+        so.create_instructor(data_dir, "Dr Chen", PASS, kdf=FAST)
+    for bad in ("", "  ", " Dr Chen", "a\tb", "x" * 65):
+        with pytest.raises(so.SignoffError):
+            so.create_instructor(data_dir, bad, PASS, kdf=FAST)
+
+
+def test_wrong_passphrase_is_a_specific_error(data_dir):
+    so.create_instructor(data_dir, "Dr Chen", PASS, kdf=FAST)
+    with pytest.raises(so.WrongPassphrase, match="wrong passphrase for Dr Chen"):
+        so.unlock_instructor(data_dir, "Dr Chen", "not the passphrase")
+    with pytest.raises(so.UnknownInstructor, match="no key for instructor Dr Who"):
+        so.unlock_instructor(data_dir, "Dr Who", PASS)
+
+
+def test_a_damaged_roster_is_reported_with_its_file(data_dir):
+    data_dir.mkdir()
+    so.roster_path(data_dir).write_text("{not json")
+    with pytest.raises(so.SignoffError, match=r"roster.json: the roster is not JSON"):
+        roster(data_dir)
+
+
+# signing
+
+
+def test_happy_path_signs_stores_and_verifies(store, data_dir, run_record):
+    clock = Clock()
+    row_id, record = so.sign_off(store, "Dr Chen", PASS, fields(run_record), clock=clock)
+    assert record.signed_at == "2026-03-02T14:05:09Z"
+    assert record.evidence.digest == so.record_digest(run_record)
+    assert record.evidence.digest.startswith("sha256:") and not record.override
+    [row] = store.signoffs()
+    assert row.id == row_id and row.student == "alice" and row.partner == "bob"
+    assert so.record_from_stored(row) == record
+    assert problems(store, data_dir) == [()]
+
+
+def test_canonical_bytes_are_stable_and_cover_every_field(run_record):
+    record = so.SignoffRecord(
+        "alice", "", "alice", "lab", "ex", "Dr Chen", "2026-03-02T14:05:09Z", "", False,
+        so.Evidence("r.jsonl", "sha256:00", {"b": 1, "a": 0.5}),
+    )  # fmt: skip
+    again = replace(record, evidence=so.Evidence("r.jsonl", "sha256:00", {"a": 0.5, "b": 1}))
+    assert record.canonical() == again.canonical()
+    data = json.loads(record.canonical())
+    assert data["format"] == so.RECORD_FORMAT
+    assert set(data) >= {"student", "partner", "driver", "lab", "exercise", "instructor"}
+    assert set(data) >= {"signed_at", "note", "override", "evidence"}
+
+
+def test_signing_needs_passed_objectives_or_an_override_with_a_note(store, data_dir):
+    with pytest.raises(so.SignoffError, match="objectives have not all passed"):
+        so.sign_off(store, "Dr Chen", PASS, fields(passed=False))
+    with pytest.raises(so.SignoffError, match="override needs a note"):
+        so.sign_off(store, "Dr Chen", PASS, fields(passed=False), override=True, note="  ")
+    assert store.signoffs() == []
+    _, record = so.sign_off(
+        store, "Dr Chen", PASS, fields(passed=False), override=True, note="timer was off"
+    )
+    assert record.override and record.note == "timer was off"
+    assert problems(store, data_dir) == [()]
+
+
+def test_bad_record_fields_are_refused(store, tmp_path):
+    with pytest.raises(so.SignoffError, match="student is missing"):
+        so.sign_off(store, "Dr Chen", PASS, fields(student=""))
+    with pytest.raises(so.SignoffError, match="driver carol is neither"):
+        so.sign_off(store, "Dr Chen", PASS, fields(driver="carol"))
+    with pytest.raises(so.SignoffError, match="cannot read the run record"):
+        so.sign_off(store, "Dr Chen", PASS, fields(tmp_path / "missing.jsonl"))
+    with pytest.raises(so.SignoffError, match="cannot be recorded"):
+        bad = replace(fields(), evidence=so.Evidence("", "", {"t": float("nan")}))
+        so.sign_off(store, "Dr Chen", PASS, bad)
+
+
+def test_a_run_record_changed_before_signing_is_refused(store, run_record):
+    ev = so.Evidence(str(run_record), "sha256:" + "0" * 64, {})
+    with pytest.raises(so.SignoffError, match="changed since it was checked"):
+        so.sign_off(store, "Dr Chen", PASS, replace(fields(), evidence=ev))
+
+
+# lockout
+
+
+def test_wrong_passphrase_is_rejected_and_logged(store):
+    with pytest.raises(so.WrongPassphrase):
+        so.sign_off(store, "Dr Chen", "wrong wrong wrong", fields(), clock=Clock())
+    assert store.signoffs() == []
+    assert [e.event for e in store.events("Dr Chen")] == ["wrong-passphrase"]
+
+
+def test_five_failures_lock_for_a_minute_even_across_restarts(store, data_dir):
+    clock = Clock()
+    for _ in range(4):
+        with pytest.raises(so.WrongPassphrase):
+            so.sign_off(store, "Dr Chen", "wrong wrong wrong", fields(), clock=clock)
+    with pytest.raises(so.LockedOut, match="locked for 60 s"):
+        so.sign_off(store, "Dr Chen", "wrong wrong wrong", fields(), clock=clock)
+    clock.advance(30)
+    with Store.open(data_dir) as reopened, pytest.raises(so.LockedOut, match="30 s more"):
+        so.sign_off(reopened, "Dr Chen", PASS, fields(), clock=clock)
+    assert store.signoffs() == []
+    events = [e.event for e in store.events("Dr Chen")]
+    assert events == ["wrong-passphrase"] * 5 + ["locked"]
+    clock.advance(31)
+    so.sign_off(store, "Dr Chen", PASS, fields(), clock=clock)
+    assert len(store.signoffs()) == 1
+
+
+def test_the_lockout_is_per_instructor_and_a_success_resets_the_count(store, data_dir):
+    so.create_instructor(data_dir, "Dr Lee", "another long passphrase", kdf=FAST)
+    clock = Clock()
+    for _ in range(5):
+        with pytest.raises(so.SignoffError):
+            so.sign_off(store, "Dr Chen", "wrong wrong wrong", fields(), clock=clock)
+    so.sign_off(store, "Dr Lee", "another long passphrase", fields(), clock=clock)
+    clock.advance(61)
+    for _ in range(4):
+        with pytest.raises(so.WrongPassphrase):
+            so.sign_off(store, "Dr Chen", "wrong wrong wrong", fields(), clock=clock)
+    so.sign_off(store, "Dr Chen", PASS, fields(), clock=clock)
+    assert store.lockout("Dr Chen").failures == 0
+    with pytest.raises(so.WrongPassphrase):
+        so.sign_off(store, "Dr Chen", "wrong wrong wrong", fields(), clock=clock)
+
+
+# verification
+
+
+@pytest.mark.parametrize(
+    ("column", "value"),
+    [
+        ("note", "great work"),
+        ("signed_at", "2026-03-01T09:00:00Z"),
+        ("student", "mallory"),
+        ("partner", "mallory"),
+        ("driver", "bob"),
+        ("exercise", "another-exercise"),
+        ("override", 1),
+        ("evidence_digest", "sha256:" + "1" * 64),
+        ("metrics", '{"collisions":0,"exit_time":12.0}'),
+        ("instructor", "Dr Lee"),
+    ],
+)
+def test_a_record_edited_in_the_database_fails_verify(store, data_dir, column, value):
+    so.create_instructor(data_dir, "Dr Lee", "another long passphrase", kdf=FAST)
+    so.sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+    assert problems(store, data_dir) == [()]
+    with sqlite3.connect(store.path) as conn:
+        conn.execute(f"UPDATE signoffs SET {column} = ?", (value,))
+    [found] = problems(store, data_dir)
+    assert any("signature does not match" in p for p in found)
+
+
+def test_a_changed_run_record_fails_and_a_missing_one_is_only_noted(store, data_dir, run_record):
+    so.sign_off(store, "Dr Chen", PASS, fields(run_record), clock=Clock())
+    run_record.write_text(run_record.read_text() + '{"t":1}\n')
+    [verdict] = so.verify_all(store, roster(data_dir))
+    assert not verdict.ok and "no longer has the signed digest" in verdict.problems[0]
+    run_record.unlink()
+    [verdict] = so.verify_all(store, roster(data_dir))
+    assert verdict.ok and "not present" in verdict.notes[0]
+
+
+def test_a_key_not_in_the_roster_fails(store, data_dir, tmp_path):
+    other = tmp_path / "elsewhere"
+    so.create_instructor(other, "Dr Fake", PASS, kdf=FAST)
+    so.create_instructor(other, "Dr Chen", PASS, kdf=FAST)
+    with Store.open(other) as rogue:
+        so.sign_off(rogue, "Dr Fake", PASS, fields(), clock=Clock())
+        so.sign_off(rogue, "Dr Chen", PASS, fields(), clock=Clock())
+        rows = rogue.signoffs()
+    for row in rows:
+        store.add_signoff({k: v for k, v in row.__dict__.items() if k != "id"})
+    found = problems(store, data_dir)
+    assert "not in the roster" in found[0][0]
+    assert "signature does not match" in found[1][0]
+
+
+def test_gradebook_has_one_row_per_student_and_exercise_from_verified_records(store, data_dir):
+    clock = Clock()
+    so.sign_off(store, "Dr Chen", PASS, fields(), clock=clock)
+    clock.advance(60)
+    so.sign_off(store, "Dr Chen", PASS, fields(), clock=clock)
+    so.sign_off(
+        store, "Dr Chen", PASS, fields(student="carol", partner="", driver="", exercise="x")
+    )
+    so.sign_off(store, "Dr Chen", PASS, fields(student="dave", partner="", driver=""))
+    with sqlite3.connect(store.path) as conn:
+        conn.execute("UPDATE signoffs SET note = 'edited' WHERE student = 'dave'")
+    rows = so.gradebook_rows(so.verified_rows(store, roster(data_dir)))
+    keys = [(r["student"], r["exercise"]) for r in rows]
+    assert keys == [("alice", "wall-following"), ("bob", "wall-following"), ("carol", "x")]
+    assert rows[0]["signed_at"] == "2026-03-02T14:06:09Z"
+    assert rows[1]["partner"] == "alice"
+
+
+# the store
+
+
+def test_data_dir_comes_from_the_option_then_the_environment(monkeypatch, tmp_path):
+    monkeypatch.setenv("WORKBENCH_DATA", str(tmp_path / "env"))
+    assert resolve_data_dir(str(tmp_path / "opt")) == tmp_path / "opt"
+    assert resolve_data_dir(None) == tmp_path / "env"
+    monkeypatch.delenv("WORKBENCH_DATA")
+    assert resolve_data_dir(None).name == "viple-workbench"
+
+
+def test_store_uses_wal_and_a_schema_version(data_dir):
+    with Store.open(data_dir) as s:
+        assert s.schema_version() == 1
+    with sqlite3.connect(data_dir / DB_NAME) as conn:
+        assert conn.execute("PRAGMA journal_mode").fetchone()[0] == "wal"
+
+
+def test_a_corrupt_or_newer_database_is_named_in_the_error(tmp_path):
+    bad = tmp_path / "bad"
+    bad.mkdir()
+    (bad / DB_NAME).write_bytes(b"this is not sqlite at all, just some text" * 50)
+    with pytest.raises(StoreError, match=rf"{DB_NAME}: not a readable workbench database"):
+        Store.open(bad)
+    newer = tmp_path / "newer"
+    Store.open(newer).close()
+    with sqlite3.connect(newer / DB_NAME) as conn:
+        conn.execute("UPDATE meta SET value = '99' WHERE key = 'schema_version'")
+    with pytest.raises(StoreError, match="newer workbench"):
+        Store.open(newer)
+
+
+def test_progress_and_drivers_are_saved_and_replaced(data_dir):
+    with Store.open(data_dir) as s:
+        s.save_progress("alice", "web", "ex1", {"objectives": {"keys": True}}, now=T0)
+        s.save_progress("alice", "web", "ex1", {"objectives": {"keys": True, "maze": False}})
+        s.save_progress("alice", "unity", "ex2", {"answers": [1]})
+        s.set_driver("alice", "bob", "web", "ex1", "alice")
+        s.set_driver("alice", "bob", "web", "ex1", "bob")
+    with Store.open(data_dir) as s:
+        assert s.progress("alice", "web") == {
+            ("web", "ex1"): {"objectives": {"keys": True, "maze": False}}
+        }
+        assert len(s.progress("alice")) == 2
+        assert s.drivers("alice", "bob") == {("web", "ex1"): "bob"}
+        with pytest.raises(ValueError):
+            s.save_progress("alice", "web", "ex1", {"t": float("inf")})
+
+
+def test_two_connections_can_write_at_the_same_time(data_dir):
+    Store.open(data_dir).close()
+    errors: list[BaseException] = []
+
+    def writer(who: str) -> None:
+        try:
+            with Store.open(data_dir) as s:
+                for i in range(40):
+                    s.save_progress(who, "lab", f"ex{i}", {"i": i})
+                    s.log_event(who, "tick", str(i), T0)
+        except BaseException as exc:
+            errors.append(exc)
+
+    threads = [threading.Thread(target=writer, args=(w,)) for w in ("alice", "bob")]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert errors == []
+    with Store.open(data_dir) as s:
+        assert len(s.progress("alice")) == 40 and len(s.progress("bob")) == 40
+        assert len(s.events()) == 80
+
+
+WRITER = """
+import sys
+from workbench.labs.store import Store
+s = Store.open(sys.argv[1])
+i = 0
+while True:
+    s.save_progress("alice", "lab", f"ex{i}", {"i": i})
+    print(i, flush=True)
+    i += 1
+"""
+
+
+def test_a_killed_process_keeps_what_it_committed(data_dir):
+    proc = subprocess.Popen(
+        [sys.executable, "-c", WRITER, str(data_dir)],
+        stdout=subprocess.PIPE,
+        text=True,
+        env={**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[2])},
+    )
+    assert proc.stdout is not None
+    last = -1
+    for line in proc.stdout:
+        last = int(line)
+        if last >= 30:
+            break
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    with Store.open(data_dir) as s:
+        saved = s.progress("alice")
+    assert last >= 30
+    assert all(("lab", f"ex{i}") in saved for i in range(last + 1))

@@ -1,0 +1,99 @@
+"""``workbench instructor``: instructors' signing keys and the roster."""
+
+from __future__ import annotations
+
+import argparse
+import getpass
+import sys
+
+from workbench.labs.signoff import (
+    MIN_PASSPHRASE,
+    SignoffError,
+    check_name,
+    check_passphrase,
+    create_instructor,
+    key_path,
+    load_roster,
+    roster_path,
+)
+from workbench.labs.store import resolve_data_dir
+
+
+def data_dir_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--data-dir",
+        help="the workbench's data folder (default: $WORKBENCH_DATA, else the user data folder)",
+    )
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("instructor", help="instructors' signing keys and the roster")
+    inner = p.add_subparsers(dest="instructor_command", metavar="ACTION", required=True)
+
+    add = inner.add_parser(
+        "add", help="create an instructor's key pair and add the public key to the roster"
+    )
+    add.add_argument("name", help="the instructor's name as shown in sign-off records")
+    add.add_argument(
+        "--passphrase-stdin",
+        action="store_true",
+        help="read the passphrase from the first line of standard input (for scripts)",
+    )
+    data_dir_option(add)
+    add.set_defaults(func=cmd_add)
+
+    ls = inner.add_parser("list", help="list the instructors in the roster")
+    data_dir_option(ls)
+    ls.set_defaults(func=cmd_list)
+
+
+def fail(message: str) -> int:
+    print(f"workbench instructor: {message}", file=sys.stderr)
+    return 2
+
+
+def read_new_passphrase(from_stdin: bool) -> str:
+    if from_stdin:
+        line = sys.stdin.readline()
+        return line[:-1] if line.endswith("\n") else line
+    if not sys.stdin.isatty():
+        raise SignoffError("no terminal to ask for the passphrase: use --passphrase-stdin")
+    print(f"Choose a passphrase of at least {MIN_PASSPHRASE} characters.", file=sys.stderr)
+    first = getpass.getpass("Passphrase: ")
+    check_passphrase(first)
+    if getpass.getpass("Passphrase again: ") != first:
+        raise SignoffError("the two passphrases differ; nothing was created")
+    return first
+
+
+def cmd_add(args: argparse.Namespace) -> int:
+    data_dir = resolve_data_dir(args.data_dir)
+    try:
+        name = check_name(args.name)
+        if name in load_roster(roster_path(data_dir)):
+            raise SignoffError(f"{name} is already in the roster {roster_path(data_dir)}")
+        passphrase = read_new_passphrase(args.passphrase_stdin)
+        entry = create_instructor(data_dir, name, passphrase)
+    except (SignoffError, EOFError) as exc:
+        return fail(str(exc) or "no passphrase given")
+    except OSError as exc:
+        return fail(f"cannot write to {data_dir}: {exc.strerror}")
+    print(f"added {entry.name} (key {entry.fingerprint()}) to {roster_path(data_dir)}")
+    print(f"the private key is encrypted in {key_path(data_dir, name)}")
+    return 0
+
+
+def cmd_list(args: argparse.Namespace) -> int:
+    data_dir = resolve_data_dir(args.data_dir)
+    try:
+        roster = load_roster(roster_path(data_dir))
+    except SignoffError as exc:
+        return fail(str(exc))
+    if not roster:
+        print(f"no instructors in {roster_path(data_dir)} (add one: workbench instructor add NAME)")
+        return 0
+    width = max(len(n) for n in roster)
+    for entry in roster.values():
+        unlockable = "key here" if key_path(data_dir, entry.name).exists() else "public key only"
+        print(f"{entry.name:<{width}}  {entry.fingerprint()}  added {entry.added}  {unlockable}")
+    return 0

@@ -1,0 +1,405 @@
+"""The workbench's own database: sign-off records, exercise progress, drivers, lockouts.
+
+One SQLite file in the data folder, in WAL mode so that the app and a command-line tool can
+use it at the same time. Every write is one transaction, committed before the call returns,
+so a process killed afterwards loses nothing that was already saved.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sqlite3
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+import platformdirs
+
+APP_NAME = "viple-workbench"
+DB_NAME = "workbench.sqlite3"
+ENV_DATA_DIR = "WORKBENCH_DATA"
+SCHEMA_VERSION = 1
+BUSY_TIMEOUT_MS = 10_000
+
+SCHEMA = """
+CREATE TABLE IF NOT EXISTS meta (
+    key TEXT PRIMARY KEY,
+    value TEXT NOT NULL
+);
+CREATE TABLE IF NOT EXISTS signoffs (
+    id INTEGER PRIMARY KEY AUTOINCREMENT,
+    student TEXT NOT NULL,
+    partner TEXT NOT NULL,
+    driver TEXT NOT NULL,
+    lab TEXT NOT NULL,
+    exercise TEXT NOT NULL,
+    instructor TEXT NOT NULL,
+    signed_at TEXT NOT NULL,
+    note TEXT NOT NULL,
+    override INTEGER NOT NULL,
+    run_record TEXT NOT NULL,
+    evidence_digest TEXT NOT NULL,
+    metrics TEXT NOT NULL,
+    signature TEXT NOT NULL
+);
+CREATE INDEX IF NOT EXISTS signoffs_by_student ON signoffs (student, lab, exercise);
+CREATE TABLE IF NOT EXISTS progress (
+    student TEXT NOT NULL,
+    lab TEXT NOT NULL,
+    exercise TEXT NOT NULL,
+    progress TEXT NOT NULL,
+    updated_at TEXT NOT NULL,
+    PRIMARY KEY (student, lab, exercise)
+);
+CREATE TABLE IF NOT EXISTS drivers (
+    student TEXT NOT NULL,
+    partner TEXT NOT NULL,
+    lab TEXT NOT NULL,
+    exercise TEXT NOT NULL,
+    driver TEXT NOT NULL,
+    updated_at TEXT NOT NULL,
+    PRIMARY KEY (student, partner, lab, exercise)
+);
+CREATE TABLE IF NOT EXISTS lockouts (
+    instructor TEXT PRIMARY KEY,
+    failures INTEGER NOT NULL,
+    locked_until REAL NOT NULL,
+    updated_at TEXT NOT NULL
+);
+CREATE TABLE IF NOT EXISTS events (
+    id INTEGER PRIMARY KEY AUTOINCREMENT,
+    at TEXT NOT NULL,
+    instructor TEXT NOT NULL,
+    event TEXT NOT NULL,
+    detail TEXT NOT NULL
+);
+"""
+
+
+class StoreError(Exception):
+    """The database cannot be opened, read or written; the message names the file."""
+
+
+def default_data_dir() -> Path:
+    """The per-user data folder (e.g. ~/.local/share/viple-workbench on Linux)."""
+    return Path(platformdirs.user_data_dir(APP_NAME, appauthor=False))
+
+
+def resolve_data_dir(option: str | os.PathLike | None = None) -> Path:
+    """``--data-dir`` if given, else ``$WORKBENCH_DATA``, else the per-user data folder."""
+    if option:
+        return Path(option).expanduser()
+    env = os.environ.get(ENV_DATA_DIR)
+    if env:
+        return Path(env).expanduser()
+    return default_data_dir()
+
+
+def utc_iso(moment: datetime) -> str:
+    """A moment as UTC ISO 8601 to the second, e.g. ``2026-02-03T14:05:09Z``."""
+    if moment.tzinfo is None:
+        raise ValueError("times must carry a time zone")
+    return moment.astimezone(UTC).isoformat(timespec="seconds").replace("+00:00", "Z")
+
+
+def _now() -> datetime:
+    return datetime.now(UTC)
+
+
+@dataclass(frozen=True)
+class StoredSignoff:
+    """One row of the sign-off table, exactly as stored (it may have been edited since)."""
+
+    id: int
+    student: str
+    partner: str
+    driver: str
+    lab: str
+    exercise: str
+    instructor: str
+    signed_at: str
+    note: str
+    override: bool
+    run_record: str
+    evidence_digest: str
+    metrics: str
+    signature: str
+
+
+@dataclass(frozen=True)
+class LockoutState:
+    failures: int
+    locked_until: float
+
+
+@dataclass(frozen=True)
+class Event:
+    at: str
+    instructor: str
+    event: str
+    detail: str
+
+
+class Store:
+    """The database in one data folder. Use :meth:`open`; close it (or use ``with``)."""
+
+    def __init__(self, data_dir: Path, conn: sqlite3.Connection):
+        self.data_dir = data_dir
+        self.path = data_dir / DB_NAME
+        self._conn = conn
+
+    @classmethod
+    def open(cls, data_dir: str | os.PathLike | None = None) -> Store:
+        folder = resolve_data_dir(data_dir)
+        path = folder / DB_NAME
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise StoreError(f"{folder}: cannot create the data folder: {exc.strerror}") from None
+        try:
+            conn = sqlite3.connect(path, timeout=BUSY_TIMEOUT_MS / 1000, isolation_level=None)
+        except sqlite3.Error as exc:
+            raise StoreError(f"{path}: cannot open the database: {exc}") from None
+        store = cls(folder, conn)
+        try:
+            store._prepare()
+        except sqlite3.DatabaseError as exc:
+            conn.close()
+            raise StoreError(
+                f"{path}: not a readable workbench database ({exc}); move it aside to start a "
+                "new one, or restore it from a backup"
+            ) from None
+        except StoreError:
+            conn.close()
+            raise
+        return store
+
+    def _prepare(self) -> None:
+        conn = self._conn
+        conn.execute(f"PRAGMA busy_timeout = {BUSY_TIMEOUT_MS}")
+        mode = conn.execute("PRAGMA journal_mode = WAL").fetchone()[0]
+        if str(mode).lower() != "wal":
+            raise StoreError(f"{self.path}: the database cannot use WAL mode (got {mode})")
+        conn.execute("PRAGMA synchronous = FULL")
+        with self._write() as cur:
+            for statement in SCHEMA.split(";"):
+                if statement.strip():
+                    cur.execute(statement)
+            row = cur.execute("SELECT value FROM meta WHERE key = 'schema_version'").fetchone()
+            if row is None:
+                cur.execute(
+                    "INSERT INTO meta (key, value) VALUES ('schema_version', ?)",
+                    (str(SCHEMA_VERSION),),
+                )
+            elif not str(row[0]).isdigit():
+                raise StoreError(f"{self.path}: the schema version {row[0]!r} is not a number")
+            elif int(row[0]) > SCHEMA_VERSION:
+                raise StoreError(
+                    f"{self.path}: written by a newer workbench (schema {row[0]}, this one "
+                    f"knows {SCHEMA_VERSION}); update the workbench"
+                )
+
+    def close(self) -> None:
+        self._conn.close()
+
+    def __enter__(self) -> Store:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    @contextmanager
+    def _write(self) -> Iterator[sqlite3.Cursor]:
+        """One write transaction; taken at once (IMMEDIATE) so concurrent writers queue."""
+        cur = self._conn.cursor()
+        try:
+            cur.execute("BEGIN IMMEDIATE")
+        except sqlite3.OperationalError as exc:
+            raise StoreError(f"{self.path}: cannot write: {exc}") from None
+        try:
+            yield cur
+        except BaseException:
+            self._conn.rollback()
+            raise
+        else:
+            try:
+                cur.execute("COMMIT")
+            except sqlite3.Error as exc:
+                self._conn.rollback()
+                raise StoreError(f"{self.path}: cannot write: {exc}") from None
+
+    def _read(self, sql: str, params: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
+        try:
+            return self._conn.execute(sql, params).fetchall()
+        except sqlite3.DatabaseError as exc:
+            raise StoreError(f"{self.path}: cannot read: {exc}") from None
+
+    def schema_version(self) -> int:
+        rows = self._read("SELECT value FROM meta WHERE key = 'schema_version'")
+        return int(rows[0][0])
+
+    # sign-off records
+
+    def add_signoff(self, row: dict[str, Any]) -> int:
+        """Store a signed record (the columns of :class:`StoredSignoff` but ``id``)."""
+        columns = [f for f in StoredSignoff.__dataclass_fields__ if f != "id"]
+        values = tuple(int(row[c]) if c == "override" else row[c] for c in columns)
+        with self._write() as cur:
+            cur.execute(
+                f"INSERT INTO signoffs ({', '.join(columns)}) "
+                f"VALUES ({', '.join('?' for _ in columns)})",
+                values,
+            )
+            return int(cur.lastrowid or 0)
+
+    def signoffs(self, student: str | None = None, lab: str | None = None) -> list[StoredSignoff]:
+        """Records in the order they were signed; ``student`` matches either member of a pair."""
+        sql = f"SELECT {', '.join(StoredSignoff.__dataclass_fields__)} FROM signoffs"
+        where: list[str] = []
+        params: list[Any] = []
+        if student:
+            where.append("(student = ? OR partner = ?)")
+            params += [student, student]
+        if lab:
+            where.append("lab = ?")
+            params.append(lab)
+        if where:
+            sql += " WHERE " + " AND ".join(where)
+        sql += " ORDER BY id"
+        rows = self._read(sql, tuple(params))
+        return [_signoff_from_row(r) for r in rows]
+
+    # exercise progress
+
+    def save_progress(
+        self,
+        student: str,
+        lab: str,
+        exercise: str,
+        progress: dict[str, Any],
+        now: datetime | None = None,
+    ) -> None:
+        """Replace the saved progress of one student in one exercise (any JSON object)."""
+        text = json.dumps(progress, sort_keys=True, allow_nan=False)
+        with self._write() as cur:
+            cur.execute(
+                "INSERT INTO progress (student, lab, exercise, progress, updated_at) "
+                "VALUES (?, ?, ?, ?, ?) ON CONFLICT (student, lab, exercise) DO UPDATE SET "
+                "progress = excluded.progress, updated_at = excluded.updated_at",
+                (student, lab, exercise, text, utc_iso(now or _now())),
+            )
+
+    def progress(self, student: str, lab: str | None = None) -> dict[tuple[str, str], dict]:
+        """Saved progress by (lab, exercise)."""
+        sql = "SELECT lab, exercise, progress FROM progress WHERE student = ?"
+        params: tuple[Any, ...] = (student,)
+        if lab:
+            sql += " AND lab = ?"
+            params += (lab,)
+        out: dict[tuple[str, str], dict] = {}
+        for lab_id, exercise, text in self._read(sql, params):
+            try:
+                out[(lab_id, exercise)] = json.loads(text)
+            except json.JSONDecodeError:
+                raise StoreError(
+                    f"{self.path}: the saved progress of {student} in {lab_id}/{exercise} is "
+                    "not JSON"
+                ) from None
+        return out
+
+    # drivers
+
+    def set_driver(
+        self,
+        student: str,
+        partner: str,
+        lab: str,
+        exercise: str,
+        driver: str,
+        now: datetime | None = None,
+    ) -> None:
+        """Record who drove (did the typing in) an exercise for a student or a pair."""
+        with self._write() as cur:
+            cur.execute(
+                "INSERT INTO drivers (student, partner, lab, exercise, driver, updated_at) "
+                "VALUES (?, ?, ?, ?, ?, ?) ON CONFLICT (student, partner, lab, exercise) "
+                "DO UPDATE SET driver = excluded.driver, updated_at = excluded.updated_at",
+                (student, partner, lab, exercise, driver, utc_iso(now or _now())),
+            )
+
+    def drivers(self, student: str, partner: str = "") -> dict[tuple[str, str], str]:
+        rows = self._read(
+            "SELECT lab, exercise, driver FROM drivers WHERE student = ? AND partner = ?",
+            (student, partner),
+        )
+        return {(lab, exercise): driver for lab, exercise, driver in rows}
+
+    # passphrase lockout
+
+    def lockout(self, instructor: str) -> LockoutState:
+        rows = self._read(
+            "SELECT failures, locked_until FROM lockouts WHERE instructor = ?", (instructor,)
+        )
+        if not rows:
+            return LockoutState(0, 0.0)
+        return LockoutState(int(rows[0][0]), float(rows[0][1]))
+
+    def record_failure(
+        self, instructor: str, now: datetime, limit: int, lock_seconds: float
+    ) -> LockoutState:
+        """Count a wrong passphrase; the ``limit``-th in a row locks until now + lock_seconds."""
+        with self._write() as cur:
+            row = cur.execute(
+                "SELECT failures FROM lockouts WHERE instructor = ?", (instructor,)
+            ).fetchone()
+            failures = (int(row[0]) if row else 0) + 1
+            locked_until = 0.0
+            if failures >= limit:
+                locked_until = now.timestamp() + lock_seconds
+                failures = 0
+            cur.execute(
+                "INSERT INTO lockouts (instructor, failures, locked_until, updated_at) "
+                "VALUES (?, ?, ?, ?) ON CONFLICT (instructor) DO UPDATE SET "
+                "failures = excluded.failures, locked_until = excluded.locked_until, "
+                "updated_at = excluded.updated_at",
+                (instructor, failures, locked_until, utc_iso(now)),
+            )
+        return LockoutState(failures, locked_until)
+
+    def clear_failures(self, instructor: str, now: datetime) -> None:
+        with self._write() as cur:
+            cur.execute(
+                "UPDATE lockouts SET failures = 0, locked_until = 0, updated_at = ? "
+                "WHERE instructor = ?",
+                (utc_iso(now), instructor),
+            )
+
+    def log_event(self, instructor: str, event: str, detail: str, now: datetime) -> None:
+        with self._write() as cur:
+            cur.execute(
+                "INSERT INTO events (at, instructor, event, detail) VALUES (?, ?, ?, ?)",
+                (utc_iso(now), instructor, event, detail),
+            )
+
+    def events(self, instructor: str | None = None) -> list[Event]:
+        sql = "SELECT at, instructor, event, detail FROM events"
+        params: tuple[Any, ...] = ()
+        if instructor:
+            sql += " WHERE instructor = ?"
+            params = (instructor,)
+        return [Event(*r) for r in self._read(sql + " ORDER BY id", params)]
+
+
+def _signoff_from_row(row: tuple[Any, ...]) -> StoredSignoff:
+    values = list(row)
+    names = list(StoredSignoff.__dataclass_fields__)
+    data = dict(zip(names, values, strict=True))
+    data["override"] = bool(data["override"])
+    for name in names:
+        if name not in ("id", "override"):
+            data[name] = "" if data[name] is None else str(data[name])
+    return StoredSignoff(**data)
