@@ -19,7 +19,9 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import os
 import statistics
+import tempfile
 import time
 from dataclasses import dataclass, field
 
@@ -32,7 +34,9 @@ from workbench.control.fsm import FsmController, bind_sensors, preset_sensors
 from workbench.sim.clock import Pacer
 from workbench.sim.generate import generate
 from workbench.sim.maze import Maze
+from workbench.sim.mazefile import write_maze
 from workbench.sim.session import Session
+from workbench.tui.app import make_app
 from workbench.tui.widgets import MazeView
 
 SIZE = (80, 24)
@@ -197,6 +201,45 @@ async def measure(
     }
 
 
+async def measure_app(maze: Maze, seconds: float, hz: float, speed: float) -> dict[str, float]:
+    """The whole workbench app (maze view, side panels, run status) with right-wall running."""
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "bench-maze.txt")
+        write_maze(path, maze)
+        app = make_app(path, PROFILE, noise="off", tick_hz=hz)
+        async with app.run_test(size=SIZE) as pilot:
+            await pilot.pause()
+            bench = app.bench
+            bench.pacer.speed = speed
+            bench.select_algorithm(ALGORITHM)
+            bench.apply_algorithm_preset()
+            bench.start_algorithm()
+            stats = Stats()
+            _Timing.stats = stats
+            driver = app._driver
+            assert isinstance(driver, HeadlessDriver)
+            driver.__class__ = CountingDriver
+            CountingDriver.stats = stats
+            stats.measuring = True
+            frames_before = app.frames
+            t0 = time.perf_counter()
+            await asyncio.sleep(seconds)
+            elapsed = time.perf_counter() - t0
+            stats.measuring = False
+            _Timing.stats = None
+            CountingDriver.stats = None
+            return {
+                "elapsed": elapsed,
+                "bytes": stats.written,
+                "bytes_per_s": stats.written / elapsed,
+                "ticks": app.frames - frames_before,
+                "frames": len(stats.frames),
+                "frame_mean_ms": 1000 * statistics.fmean(stats.frames) if stats.frames else 0.0,
+                "frame_p95_ms": 1000 * p95(stats.frames),
+                "sim_time": bench.session.world.time,
+            }
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=10.0, help="real time per variant")
@@ -233,8 +276,20 @@ def main() -> None:
     def verdict(ok: bool) -> str:
         return "ok" if ok else "MISSED"
 
+    full = asyncio.run(measure_app(maze, args.seconds, args.hz, args.speed))
     print(
-        f"  targets: <= 5 KB/s {verdict(cached['bytes_per_s'] <= 5000)}, "
+        f"  whole app      {full['bytes_per_s'] / 1000:7.2f} KB/s"
+        f"  frame mean {full['frame_mean_ms']:5.2f} ms  p95 {full['frame_p95_ms']:5.2f} ms"
+        f"  ({full['ticks']} ticks, {full['frames']} frames: maze view, sensor readings, "
+        f"algorithm state and run status all live; {full['sim_time']:.1f} s simulated)"
+    )
+
+    print(
+        f"  whole app targets: <= 5 KB/s {verdict(full['bytes_per_s'] <= 5000)}, "
+        f"p95 frame <= 8 ms {verdict(full['frame_p95_ms'] <= 8.0)}"
+    )
+    print(
+        f"  maze view targets: <= 5 KB/s {verdict(cached['bytes_per_s'] <= 5000)}, "
         f"p95 frame <= 8 ms {verdict(cached['frame_p95_ms'] <= 8.0)}, "
         f">= 5x fewer bytes than naive {verdict(ratio >= 5.0)}"
     )

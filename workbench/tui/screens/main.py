@@ -7,6 +7,7 @@ footer. Every action here calls the bench; the screen only draws what the bench 
 
 from __future__ import annotations
 
+from time import monotonic
 from typing import ClassVar
 
 from textual.app import ComposeResult
@@ -27,6 +28,9 @@ from ..widgets.maze_view import MazeView
 from ..widgets.message_bar import MessageBar
 from ..widgets.run_status import RunStatus
 from ..widgets.sensor_readings import SensorReadings
+
+#: how often the text panels follow a running robot (the maze view follows every tick)
+PANEL_HZ = 4.0
 
 
 class MainScreen(Screen[None]):
@@ -62,6 +66,8 @@ class MainScreen(Screen[None]):
         self._unicode = unicode
         self._trail = trail
         self._controller: object = None
+        self._moment: tuple[object, ...] = ()
+        self._panels_at = 0.0
 
     def compose(self) -> ComposeResult:
         bench = self.bench
@@ -115,10 +121,23 @@ class MainScreen(Screen[None]):
             if bench.controller is not None:
                 self._maze_view.clear_trail()  # a new run starts from the start block
         self._maze_view.show(snapshot, bench.session.world.cell)
-        self._readings.show(snapshot, bench.profile)
-        self._run_status.show(snapshot, bench, unicode)
-        self._algorithm.show(bench, unicode)
-        self._message.message = bench.message
+        # the text panels follow at PANEL_HZ while the robot runs (every byte counts over SSH);
+        # at once when paused (steps, snapshots) and when who drives or the state changes
+        now = monotonic()
+        moment = (
+            bench.pacer.paused,
+            bench.message,
+            snapshot.driver,
+            snapshot.state,
+            bench.connection,
+        )
+        if bench.pacer.paused or moment != self._moment or now - self._panels_at >= 1 / PANEL_HZ:
+            self._moment = moment
+            self._panels_at = now
+            self._readings.show(snapshot, bench.profile)
+            self._run_status.show(snapshot, bench, unicode)
+            self._algorithm.show(bench, unicode)
+            self._message.message = bench.message
 
     def refresh_views(self) -> None:
         """Redraw after an action: through the app, so open dialogs follow too."""

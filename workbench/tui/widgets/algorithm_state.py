@@ -13,7 +13,7 @@ from textual.widgets import Static
 from workbench.control.bench import Bench
 from workbench.sim.profiles import get_profile
 
-from .text import arrow, number
+from .text import arrow, number, set_border_title
 from .transition_log import TransitionLog, values_text
 
 
@@ -45,7 +45,7 @@ class AlgorithmState(Vertical):
 
     def __init__(self, *, id: str | None = None, classes: str | None = None) -> None:
         super().__init__(id=id, classes=classes)
-        self.border_title = "Algorithm"
+        set_border_title(self, "Algorithm")
         self._summary = Static(id="algorithm-summary", markup=False)
         self._states = Static(id="algorithm-states", markup=False)
         self._vars = Static(id="algorithm-vars", markup=False)
@@ -76,7 +76,7 @@ class AlgorithmState(Vertical):
         unit = get_profile(bench.profile).unit
         log = self._log
         if definition is None:
-            self.border_title = "Algorithm"
+            set_border_title(self, "Algorithm")
             self.summary = "none chosen: the keys drive. g chooses one."
             self.states = ((), None)
             self.variables = ""
@@ -84,7 +84,7 @@ class AlgorithmState(Vertical):
             log.show(None, (), unit, unicode)
             log.display = False
             return
-        self.border_title = f"Algorithm {definition.name}"
+        set_border_title(self, f"Algorithm {definition.name}")
         names = tuple(s.name for s in definition.states)
         if controller is None:
             missing = bench.missing_sensors()

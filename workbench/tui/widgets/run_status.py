@@ -2,17 +2,15 @@
 
 from __future__ import annotations
 
-from textual.reactive import var
-from textual.widgets import Static
-
 from workbench.control.bench import Bench
 from workbench.sim.profiles import get_profile
 from workbench.sim.session import Snapshot
 
-from .text import degrees, number, separator, speed
+from .text import degrees, number, separator, set_border_title, speed
+from .text_lines import TextLines
 
 
-class RunStatus(Static):
+class RunStatus(TextLines):
     """Who drives; pause, speed and time; distance; turning and collisions."""
 
     DEFAULT_CSS = """
@@ -24,18 +22,16 @@ class RunStatus(Static):
     }
     """
 
-    lines: var[tuple[str, ...]] = var(())
-
     def __init__(self, *, id: str | None = None, classes: str | None = None) -> None:
-        super().__init__(id=id, classes=classes, markup=False)
-        self.border_title = "Run"
+        super().__init__(id=id, classes=classes)
+        set_border_title(self, "Run")
 
     def show(self, snapshot: Snapshot, bench: Bench, unicode: bool) -> None:
         sep = separator(unicode)
         unit = get_profile(bench.profile).unit
         m = snapshot.metrics
         state = "PAUSED" if bench.pacer.paused else "running"
-        self.border_title = f"Run: {bench.maze.name} ({bench.profile})"
+        set_border_title(self, f"Run: {bench.maze.name} ({bench.profile})")
         driver = f"driver: {snapshot.driver}"
         clock = f"{state} at {speed(bench.pacer.speed)}{sep}t {snapshot.time:.1f} s"
         if m.reached_exit and m.exit_time is not None:
@@ -49,7 +45,4 @@ class RunStatus(Static):
             f"{sep}collisions {m.collisions}"
         )
         connection = (bench.connection,) if bench.connection else ()
-        self.lines = (driver, clock, travel, turning, *connection)
-
-    def watch_lines(self, old: tuple[str, ...], lines: tuple[str, ...]) -> None:
-        self.update("\n".join(lines), layout=len(old) != len(lines))
+        self.set_lines([driver, clock, travel, turning, *connection])

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from textual.widget import Widget
+
 from workbench.sim.sensors import SensorSpec
 
 
@@ -43,3 +45,9 @@ def reading(spec: SensorSpec, value: float | int | None, unit: str, no_echo: flo
 
 def speed(value: float | None) -> str:
     return "max" if value is None else f"{value:g}x"
+
+
+def set_border_title(widget: Widget, title: str) -> None:
+    """Set a panel's border title; setting it at all repaints the whole panel, so only on change."""
+    if widget.border_title != title:
+        widget.border_title = title

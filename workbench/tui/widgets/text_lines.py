@@ -1,0 +1,85 @@
+"""A few lines of text that repaint line by line: only the lines whose text changed are sent.
+
+Panels that follow a running robot (time, distance, sensor readings) change one or two lines at
+a time; a ``Static`` would repaint its whole region on every change.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from rich.segment import Segment
+from rich.style import Style
+from rich.text import Text
+from textual.geometry import Region, Size
+from textual.strip import Strip
+from textual.widget import Widget
+
+
+class TextLines(Widget):
+    """Lines of plain text (or Rich ``Text``), one per row, cached as strips."""
+
+    DEFAULT_CSS = """
+    TextLines {
+        height: auto;
+    }
+    """
+
+    def __init__(
+        self,
+        lines: Sequence[str | Text] = (),
+        *,
+        id: str | None = None,
+        classes: str | None = None,
+    ) -> None:
+        super().__init__(id=id, classes=classes)
+        self._lines: list[str | Text] = list(lines)
+        self._strips: list[Strip | None] = [None] * len(self._lines)
+        self._width = 0
+
+    @property
+    def lines(self) -> tuple[str | Text, ...]:
+        return tuple(self._lines)
+
+    def set_lines(self, lines: Sequence[str | Text]) -> None:
+        """Show ``lines``; repaint only the rows that changed (re-layout when the count does)."""
+        lines = list(lines)
+        if len(lines) != len(self._lines):
+            self._lines = lines
+            self._strips = [None] * len(lines)
+            self.refresh(layout=True)
+            return
+        width = self.size.width
+        for y, (old, new) in enumerate(zip(self._lines, lines, strict=True)):
+            if old != new:
+                self._lines[y] = new
+                self._strips[y] = None
+                if self.is_mounted:
+                    self.refresh(Region(0, y, width, 1))
+
+    def get_content_height(self, container: Size, viewport: Size, width: int) -> int:
+        return len(self._lines)
+
+    def get_content_width(self, container: Size, viewport: Size) -> int:
+        return max((len(str(line)) for line in self._lines), default=0)
+
+    def render_line(self, y: int) -> Strip:
+        width = self.size.width
+        if width != self._width:
+            self._width = width
+            self._strips = [None] * len(self._lines)
+        if not 0 <= y < len(self._lines):
+            return Strip.blank(width, self.rich_style)
+        strip = self._strips[y]
+        if strip is None:
+            line = self._lines[y]
+            text = line if isinstance(line, Text) else Text(line, no_wrap=True, overflow="crop")
+            base: Style = self.rich_style
+            segments = [
+                Segment(seg.text, base + seg.style if seg.style else base)
+                for seg in text.render(self.app.console)
+                if seg.text != "\n"
+            ]
+            strip = Strip(segments).adjust_cell_length(width, base)
+            self._strips[y] = strip
+        return strip
