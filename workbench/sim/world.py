@@ -220,6 +220,7 @@ class World:
                 exits[(y + 1) * wp + x + 1] = 1
         self._solid = bytes(solid)
         self._exits = bytes(exits)
+        self._has_exits = any(exits)
         c = self.cell
         self._boxes: dict[int, tuple[float, float, float, float]] = {}
         self._segments = [
@@ -278,6 +279,8 @@ class World:
         self._readings = None
         self._free_w = 0.0
         self._physics_stale = False
+        self._step_angle = self._step_v = math.nan  # the cached step of straight driving
+        self._step_dx = self._step_dy = 0.0
         self._box = (math.inf, -math.inf, math.inf, -math.inf)
 
     def _build_space(self) -> None:
@@ -408,8 +411,17 @@ class World:
             else:
                 v = self._v
                 w = self._w
-            x = x0 + v * math.cos(a0) * dt if v else x0
-            y = y0 + v * math.sin(a0) * dt if v else y0
+            if v:
+                if a0 != self._step_angle or v != self._step_v:
+                    self._step_angle = a0
+                    self._step_v = v
+                    self._step_dx = v * math.cos(a0) * dt
+                    self._step_dy = v * math.sin(a0) * dt
+                x = x0 + self._step_dx
+                y = y0 + self._step_dy
+            else:
+                x = x0
+                y = y0
             box = self._box
             if not (box[0] <= x0 <= box[1] and box[2] <= y0 <= box[3]):
                 box = self._box = self._free_box(x0, y0)
@@ -459,7 +471,7 @@ class World:
         if self._new_collision:
             self._new_collision = False
             events = (*events, COLLISION)
-        if self._exit_time is None:
+        if self._exit_time is None and self._has_exits:
             inv = self._inv_cell
             if self._exits[(int(y * inv) + 1) * self._wp + int(x * inv) + 1]:
                 self._exit_time = t
