@@ -44,6 +44,7 @@ def data_dir(tmp_path, monkeypatch) -> Path:
     d = tmp_path / "data"
     d.mkdir()
     so.create_instructor(d, "Dr Chen", PASS, kdf=FAST)
+    Store.open(d).close()
     monkeypatch.delenv("WORKBENCH_DATA", raising=False)
     return d
 
@@ -166,3 +167,10 @@ def test_export_to_an_unwritable_place_exits_2(data_dir, tmp_path, capsys):
     target = tmp_path / "no-such-dir" / "g.csv"
     assert main(["signoff", "export", "--csv", str(target), "--data-dir", str(data_dir)]) == 2
     assert "cannot write" in capsys.readouterr().err
+
+
+def test_a_data_folder_without_a_database_is_reported_not_created(tmp_path, capsys):
+    missing = tmp_path / "typo"
+    assert main(["signoff", "list", "--data-dir", str(missing)]) == 2
+    assert "no workbench database here" in capsys.readouterr().err
+    assert not missing.exists()

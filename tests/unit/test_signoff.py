@@ -181,6 +181,14 @@ def test_bad_record_fields_are_refused(store, tmp_path):
         so.sign_off(store, "Dr Chen", PASS, bad)
 
 
+def test_a_bare_hex_digest_of_the_run_record_is_accepted(store, run_record):
+    bare = so.record_digest(run_record).removeprefix("sha256:")
+    ev = so.Evidence(str(run_record), bare, {"runs": [{"t": 1.5}]})
+    _, record = so.sign_off(store, "Dr Chen", PASS, replace(fields(), evidence=ev))
+    assert record.evidence.digest == f"sha256:{bare}"
+    assert so.record_from_stored(store.signoffs()[0]) == record
+
+
 def test_a_run_record_changed_before_signing_is_refused(store, run_record):
     ev = so.Evidence(str(run_record), "sha256:" + "0" * 64, {})
     with pytest.raises(so.SignoffError, match="changed since it was checked"):

@@ -65,7 +65,7 @@ def fail(message: str) -> int:
 
 
 def _open(args: argparse.Namespace) -> Store:
-    return Store.open(args.data_dir)
+    return Store.open(args.data_dir, create=False)
 
 
 def _roster(args: argparse.Namespace, store: Store):

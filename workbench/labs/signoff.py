@@ -447,16 +447,18 @@ def _check_fields(fields: RecordFields) -> Evidence:
     ev = fields.evidence
     if not isinstance(ev.metrics, dict):
         raise SignoffError("the evidence metrics must be a mapping")
-    canonical_json(ev.metrics)
+    metrics = json.loads(canonical_json(ev.metrics))
+    digest = ev.digest
     if ev.run_record:
         actual = record_digest(ev.run_record)
-        if ev.digest and ev.digest != actual:
+        expected = digest if not digest or digest.startswith("sha256:") else f"sha256:{digest}"
+        if expected and expected != actual:
             raise SignoffError(
                 f"{ev.run_record}: the run record changed since it was checked "
-                f"(digest {actual}, expected {ev.digest})"
+                f"(digest {actual}, expected {expected})"
             )
-        ev = Evidence(str(ev.run_record), actual, dict(ev.metrics))
-    return ev
+        digest = actual
+    return Evidence(str(ev.run_record), digest, metrics)
 
 
 def sign_off(

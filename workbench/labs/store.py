@@ -153,9 +153,15 @@ class Store:
         self._conn = conn
 
     @classmethod
-    def open(cls, data_dir: str | os.PathLike | None = None) -> Store:
+    def open(cls, data_dir: str | os.PathLike | None = None, *, create: bool = True) -> Store:
+        """Open (and with ``create``, make if needed) the database in the data folder."""
         folder = resolve_data_dir(data_dir)
         path = folder / DB_NAME
+        if not create and not path.is_file():
+            raise StoreError(
+                f"{path}: no workbench database here (nothing was signed off or saved with "
+                "this data folder; see --data-dir)"
+            )
         try:
             folder.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
