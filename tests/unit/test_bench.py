@@ -219,6 +219,8 @@ def test_a_viple_program_that_drives_is_recorded_with_its_role_and_a_run():
     b = bench(CORRIDOR, profile="unity")
     b.key("w")
     b.step(10)
+    b.key("space")
+    b.step(10)
     link = Link(b.session, "tcp")
     assert link.connect("127.0.0.1:50312")
     b.step(1)
@@ -231,6 +233,7 @@ def test_a_viple_program_that_drives_is_recorded_with_its_role_and_a_run():
     b.step(1)
     run = b.runs[-1]
     assert (run.driver, run.ended, run.source) == ("VIPLE tcp 127.0.0.1:50312", "stopped", None)
+    assert run.maze_digest == CORRIDOR.digest()
     assert len(b.viple) == 1
 
 

@@ -70,6 +70,8 @@ class RunEntry:
     record: str | None = None
     #: the FSM file of the algorithm that drove (None for keys and VIPLE)
     source: str | None = None
+    #: the layout digest of the maze the run was on (see ``Maze.digest``)
+    maze_digest: str = ""
 
 
 @dataclass
@@ -225,9 +227,8 @@ class Bench:
             role, _, peer = driver[len(VIPLE_PREFIX) :].partition(" ")
             self._viple_now = VipleConnection(role, peer)
             self.viple.append(self._viple_now)
-        else:
-            self._viple_now.distance += seen[0] - last[0]
-            self._viple_now.turn_degrees += seen[1] - last[1]
+        self._viple_now.distance += seen[0] - last[0]
+        self._viple_now.turn_degrees += seen[1] - last[1]
         if self.controller is not None and self.session.controller is None:
             self.controller = None  # the program took the robot from the algorithm
             if self._run_open:
@@ -418,6 +419,7 @@ class Bench:
             ended=ended,
             record=self._record_path,
             source=self._run_source,
+            maze_digest=self.maze.digest(),
         )
         self.runs.append(entry)
         if self._recorder is not None:

@@ -1,0 +1,238 @@
+"""Every exercise of every bundled lab can be completed through the bench, as a student would:
+keys, the sensor panel, the maze editor, a completed starter FSM or a built-in algorithm, and a
+scripted VIPLE program over the real endpoints. Wrong set-ups show the expected reason."""
+
+from __future__ import annotations
+
+import asyncio
+import socket
+from decimal import Decimal
+from pathlib import Path
+
+import pytest
+from websockets.asyncio.server import serve
+
+from workbench.control.bench import Bench
+from workbench.labs.checks import apply_setup, evaluate, maze_of
+from workbench.labs.model import Exercise, Objective, Question, load_labs
+from workbench.viple.tcp_server import TcpConfig, TcpServer
+from workbench.viple.ws_client import WsClient, WsConfig
+
+LABS = {lab.id: lab for lab in load_labs()}
+EXERCISES = [(lab.id, ex) for lab in LABS.values() for ex in lab.exercises]
+MOVE = '{"servos":[{"isTurn":false,"servoId":-1,"servoSpeed":1}]}'
+#: Robot Drive on the Web Simulator's wheel ports (3 and 5), both at 0.5
+DRIVE = (
+    '{"servos":[{"isTurn":false,"servoId":3,"servoSpeed":0.5},'
+    '{"isTurn":false,"servoId":5,"servoSpeed":0.5}]}'
+)
+#: the values a student fills in to complete each starter
+SOLUTIONS = {
+    "starter-unity-wall-following": ["open_right=1.0", "front_blocked=0.9", "right_turn=90",
+                                     "left_turn=-90"],
+    "starter-unity-two-distance": ["front_blocked=1.0", "look_right=90", "look_left=-180",
+                                   "back_right=180"],
+    "starter-web-wall-following": ["base_distance=25", "open_margin=50", "turn90_time=1.5"],
+    "starter-web-two-distance": ["front_blocked=25", "turn90_time=1.5", "turn180_time=3"],
+}  # fmt: skip
+
+
+def fresh_bench(ex: Exercise) -> Bench:
+    bench = Bench.open(maze_of(ex.setup.maze), ex.setup.profile, noise="off")
+    apply_setup(bench, ex.setup)
+    return bench
+
+
+def run_to_exit(bench: Bench, limit_s: int = 600) -> None:
+    bench.start_algorithm()
+    done = len(bench.runs)
+    for _ in range(limit_s):
+        bench.step(60)
+        if len(bench.runs) > done:
+            assert bench.runs[-1].ended == "exit", bench.runs[-1]
+            return
+    raise AssertionError(f"{bench.algorithm.name} did not get out of {bench.maze.name}")
+
+
+def run_on(bench: Bench, maze: Path, algorithm: str, params: list[str] | None = None) -> None:
+    bench.load_maze(maze_of(maze))
+    bench.select_algorithm(algorithm)
+    if params:
+        bench.set_params(params)
+    else:
+        bench.apply_algorithm_preset()
+    run_to_exit(bench)
+
+
+def reach_exit(bench: Bench, ex: Exercise, obj: Objective) -> None:
+    assert obj.maze is not None
+    if "fsm" in obj.drivers:
+        starter = ex.setup.controller
+        assert starter.kind == "starter", "an fsm exit objective needs a starter to complete"
+        bench.select_algorithm(starter.value)
+        run_on(bench, obj.maze, starter.value, SOLUTIONS[bench.algorithm.name])
+    else:
+        name = next(d.split(" ", 1)[1] for d in obj.drivers if d.startswith("algorithm "))
+        run_on(bench, obj.maze, name)
+
+
+def free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+async def until(predicate, timeout: float = 3.0) -> None:
+    loop = asyncio.get_running_loop()
+    end = loop.time() + timeout
+    while not predicate():
+        assert loop.time() < end, "timed out"
+        await asyncio.sleep(0.01)
+
+
+async def drive_over_tcp(bench: Bench) -> None:
+    """A scripted VIPLE program in the Unity-simulator role: connect, move, leave."""
+    async with TcpServer(bench.session, TcpConfig(port=0)) as server:
+        reader, writer = await asyncio.open_connection("127.0.0.1", server.port)
+        writer.write(MOVE.encode() + b"\r\n")
+        await writer.drain()
+        await asyncio.wait_for(reader.readline(), 3)
+        bench.step(30)
+        writer.close()
+        await until(lambda: server.status.peer is None)
+        bench.step(1)
+
+
+async def drive_over_ws(bench: Bench) -> None:
+    """A scripted VIPLE WebSocket server: the workbench connects to it; it sends a move."""
+    arrived: asyncio.Queue = asyncio.Queue()
+
+    async def robot(ws) -> None:
+        await ws.send(DRIVE)
+        await arrived.put(await ws.recv())
+        await ws.wait_closed()
+
+    port = free_port()
+    async with serve(robot, "127.0.0.1", port):
+        client = WsClient(bench.session, WsConfig(url=f"ws://127.0.0.1:{port}/"))
+        await client.start()
+        try:
+            await asyncio.wait_for(arrived.get(), 3)
+            await until(lambda: client.status.messages_in >= 1)
+            assert client.status.invalid == 0, client.status.last_rejection
+            bench.step(30)
+        finally:
+            await client.close()
+        bench.step(1)
+
+
+def viple_drive(bench: Bench, role: str) -> None:
+    asyncio.run(drive_over_tcp(bench) if role == "tcp" else drive_over_ws(bench))
+
+
+def answer(q: Question) -> str:
+    """Find the accepted answer from the hashes alone, as the tests keep no answer key."""
+    if q.choices:
+        right = [c for c in q.choices if q.check(c)[0]]
+        assert len(right) == 1, (q.id, right)
+        return right[0]
+    step = Decimal(q.step or "1")
+    for k in range(int(-1000 / step), int(20000 / step)):
+        text = str(k * step)
+        if q.check(text)[0]:
+            return text
+    raise AssertionError(f"no answer to {q.id} in the searched range")
+
+
+def complete(bench: Bench, ex: Exercise) -> dict[str, str]:
+    kinds = {o.kind for o in ex.objectives}
+    for obj in ex.objectives:
+        if obj.kind == "exit":
+            reach_exit(bench, ex, obj)
+        elif obj.kind == "compare":
+            for maze in obj.mazes:
+                for name in obj.algorithms:
+                    run_on(bench, maze, name)
+    apply_setup(bench, ex.setup)  # back to the exercise's maze and sensors
+    for obj in ex.objectives:
+        if obj.kind == "sensors":
+            bench.apply_sensors(obj.sensors)
+        elif obj.kind == "keys":
+            for key in obj.keys:
+                bench.key(key)
+                bench.step(10)
+        elif obj.kind == "viple":
+            viple_drive(bench, obj.role)
+    if "maze-edited" in kinds:
+        maze = bench.maze
+        inner = next((x, y) for y in range(1, maze.height - 1) for x in range(1, maze.width - 1)
+                     if maze.is_wall(x, y))  # fmt: skip
+        bench.load_maze(maze.with_block(*inner, wall=False))
+    return {q.id: answer(q) for q in ex.questions}
+
+
+@pytest.mark.parametrize(("lab_id", "ex"), EXERCISES, ids=[f"{lab}/{e.id}" for lab, e in EXERCISES])
+def test_every_exercise_can_be_completed(lab_id, ex):
+    bench = fresh_bench(ex)
+    before = evaluate(lab_id, ex, bench)
+    assert not before.passed
+    answers = complete(bench, ex)
+    progress = evaluate(lab_id, ex, bench, answers)
+    failed = [(o.text, o.reason) for o in progress.objectives if not o.passed]
+    assert failed == [], failed
+    assert progress.passed
+
+
+def reasons(lab_id: str, ex_id: str, bench: Bench | None = None, answers=None) -> list[str]:
+    ex = LABS[lab_id].exercise(ex_id)
+    progress = evaluate(lab_id, ex, bench or fresh_bench(ex), answers)
+    return [("✓ " if o.passed else "✗ ") + o.reason for o in progress.objectives]
+
+
+def test_web_sensors_left_at_the_default_show_what_is_missing():
+    assert reasons("web-simulator", "sensors")[0] == "✗ missing distance:3:left"
+
+
+def test_a_starter_run_as_given_does_not_count_as_getting_out():
+    ex = LABS["unity-simulator"].exercise("wall-following")
+    bench = fresh_bench(ex)
+    bench.start_algorithm()
+    bench.step(60 * 120)
+    assert reasons("unity-simulator", "wall-following", bench)[:2] == [
+        "✓ sensors are distance:1:right, distance:2:front",
+        "✗ no run by viple or fsm has reached the exit of 'eRobotic lab maze' yet",
+    ]
+
+
+def test_the_wrong_sensor_for_local_best_on_the_web():
+    ex = LABS["web-simulator"].exercise("local-best-activities")
+    bench = fresh_bench(ex)
+    bench.apply_sensors(LABS["web-simulator"].exercise("wall-main").setup.sensors)
+    assert reasons("web-simulator", "local-best-activities", bench)[0] == (
+        "✗ missing distance:3:front; not wanted distance:1:right, touch:2:front"
+    )
+
+
+def test_viple_in_the_unity_role_does_not_count_for_the_web_connection():
+    ex = LABS["web-simulator"].exercise("connect")
+    bench = fresh_bench(ex)
+    viple_drive(bench, "tcp")
+    assert reasons("web-simulator", "connect", bench)[0] == (
+        "✗ VIPLE connected over tcp; this exercise needs WebSocket (the Web Simulator's)"
+    )
+
+
+def test_a_built_in_algorithm_does_not_stand_in_for_the_students_program():
+    ex = LABS["web-simulator"].exercise("wall-main")
+    bench = fresh_bench(ex)
+    run_on(bench, ex.setup.maze, "web-wall-following")
+    assert reasons("web-simulator", "wall-main", bench)[1] == (
+        "✗ no run by viple or fsm has reached the exit of 'Web Simulator lab maze' yet"
+    )
+
+
+def test_wrong_answers_are_counted_without_saying_which_value_is_right():
+    got = reasons("maze-algorithms", "erobotic-rules", answers={
+        "slower": "farthest-distance", "open-right": "100",
+        "why-no-states": "the maze has no dead ends"})  # fmt: skip
+    assert got[1] == "✗ 2 of 3 not right yet: slower, why-no-states"

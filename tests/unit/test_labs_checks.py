@@ -1,0 +1,263 @@
+"""Each objective kind passes and fails with the one-line reason the app shows."""
+
+import json
+from pathlib import Path
+
+import pytest
+
+from workbench.control.bench import Bench
+from workbench.labs.checks import (
+    ExerciseProgress,
+    apply_setup,
+    check_objective,
+    evaluate,
+    maze_of,
+)
+from workbench.labs.model import (
+    Controller,
+    Exercise,
+    Objective,
+    Question,
+    Setup,
+    hash_answer,
+)
+from workbench.sim.sensors import SensorSpec
+from workbench.viple.link import Link
+
+MAZES = Path("mazes").resolve()
+EROBOTIC = MAZES / "erobotic.txt"
+RANK = MAZES / "rank-wall-wins.txt"
+MOVE = '{"servos":[{"isTurn":false,"servoId":-1,"servoSpeed":1}]}'
+RIGHT_WALL = ["distance:1:right", "distance:2:front"]
+
+
+def exercise(*objectives, questions=(), maze=EROBOTIC, profile="unity", controller="keys"):
+    kind, _, value = controller.partition(" ")
+    setup = Setup(profile, maze, tuple(SensorSpec.parse(s) for s in RIGHT_WALL),
+                  Controller(kind, value))  # fmt: skip
+    return Exercise("ex", "Ex", "do it", setup, tuple(objectives), tuple(questions))
+
+
+def bench_for(ex):
+    b = Bench.open(maze_of(ex.setup.maze), ex.setup.profile, noise="off")
+    apply_setup(b, ex.setup)
+    return b
+
+
+def check(obj, ex, b, answers=None):
+    result = check_objective(obj, ex, b, answers)
+    return result.passed, result.reason
+
+
+def run_to_exit(b, limit_s=400):
+    b.start_algorithm()
+    done = len(b.runs)
+    for _ in range(limit_s):
+        b.step(60)
+        if len(b.runs) > done and b.runs[-1].ended == "exit":
+            return b.runs[-1]
+    raise AssertionError("the run did not get out")
+
+
+def test_keys_objective_names_the_keys_still_to_use():
+    obj = Objective("keys", "drove", keys=("w", "a", "s", "d", "space"))
+    ex = exercise(obj)
+    b = bench_for(ex)
+    for key in ("w", "d"):
+        b.key(key)
+    assert check(obj, ex, b) == (False, "not used yet: a, s, space")
+    for key in ("a", "s", "space"):
+        b.key(key)
+    assert check(obj, ex, b) == (True, "used w, a, s, d, space")
+
+
+def test_sensors_objective_lists_what_is_missing_and_what_is_extra():
+    want = (SensorSpec("distance", 1, "right"), SensorSpec("touch", 2, "front"))
+    obj = Objective("sensors", "sensors", sensors=want)
+    ex = exercise(obj)
+    b = bench_for(ex)
+    assert check(obj, ex, b) == (False, "missing touch:2:front; not wanted distance:2:front")
+    b.apply_sensors(want)
+    assert check(obj, ex, b) == (True, "sensors are distance:1:right, touch:2:front")
+    result = check_objective(obj, ex, b)
+    assert result.evidence == {"sensors": ["distance:1:right", "touch:2:front"]}
+
+
+def test_viple_objective_needs_the_role_and_real_driving():
+    obj = Objective("viple", "connected", role="tcp")
+    ex = exercise(obj)
+    b = bench_for(ex)
+    assert check(obj, ex, b) == (
+        False,
+        "no VIPLE program has connected over TCP (the Unity simulator's role) yet",
+    )
+    ws = Link(b.session, "ws")
+    ws.connect("ws://localhost:8124/")
+    ws.apply(MOVE)
+    b.step(30)
+    ws.disconnect()
+    b.step(1)
+    assert check(obj, ex, b) == (
+        False,
+        "VIPLE connected over ws; this exercise needs TCP (the Unity simulator's role)",
+    )
+    tcp = Link(b.session, "tcp")
+    tcp.connect("127.0.0.1:50000")
+    b.step(5)
+    assert check(obj, ex, b) == (False, "VIPLE tcp program connected but has not moved the robot")
+    tcp.apply(MOVE)
+    b.step(30)
+    passed, reason = check(obj, ex, b)
+    assert (passed, reason) == (True, "VIPLE tcp program at 127.0.0.1:50000 drove the robot")
+    assert check_objective(obj, ex, b).evidence["distance"] > 0
+
+
+def test_exit_objective_wants_the_right_kind_of_driver_on_the_right_maze():
+    obj = Objective("exit", "out", maze=EROBOTIC, drivers=("fsm",))
+    ex = exercise(obj)
+    b = bench_for(ex)
+    assert check(obj, ex, b) == (
+        False,
+        "no run by fsm has reached the exit of 'eRobotic lab maze' yet",
+    )
+    b.select_algorithm("right-wall")
+    run_to_exit(b)
+    assert check(obj, ex, b)[0] is False  # a built-in is not the student's FSM
+    b.select_algorithm("labs/starters/unity-wall-following.yaml")
+    b.set_params(["open_right=1.0", "front_blocked=0.9", "right_turn=90", "left_turn=-90"])
+    run = run_to_exit(b)
+    passed, reason = check(obj, ex, b)
+    assert passed and reason.startswith(
+        f"run {run.number} (algorithm starter-unity-wall-following)"
+    )
+    evidence = check_objective(obj, ex, b).evidence
+    assert evidence["run"] == run.number and evidence["metrics"]["reached_exit"] is True
+    assert evidence["maze_digest"] == maze_of(EROBOTIC).digest()
+
+
+def test_exit_objective_accepts_a_named_algorithm_and_reports_a_broken_limit():
+    obj = Objective("exit", "out", maze=RANK, drivers=("algorithm right-wall",), max_time=5)
+    ex = exercise(obj, maze=RANK)
+    b = bench_for(ex)
+    b.select_algorithm("right-wall")
+    run = run_to_exit(b)
+    passed, reason = check(obj, ex, b)
+    assert not passed
+    assert (
+        reason
+        == f"run 1 (algorithm right-wall) took {run.metrics.exit_time:.1f} s, over the 5 s limit"
+    )
+    roomy = Objective("exit", "out", maze=RANK, drivers=("algorithm right-wall",), max_time=60,
+                      max_turn_degrees=45)  # fmt: skip
+    assert check(roomy, ex, b) == (
+        False,
+        "run 1 (algorithm right-wall) turned 90°, over the 45° limit",
+    )
+    fine = Objective("exit", "out", maze=RANK, drivers=("algorithm right-wall",), max_time=60,
+                     max_turn_degrees=90, max_collisions=0)  # fmt: skip
+    assert check(fine, ex, b)[0]
+
+
+def test_exit_objective_with_a_record_keeps_its_digest(tmp_path):
+    obj = Objective("exit", "out", maze=RANK, drivers=("any",))
+    ex = exercise(obj, maze=RANK)
+    b = Bench.open(maze_of(RANK), "unity", noise="off", record_dir=str(tmp_path))
+    apply_setup(b, ex.setup)
+    b.select_algorithm("right-wall")
+    run_to_exit(b)
+    evidence = check_objective(obj, ex, b).evidence
+    assert evidence["record"].endswith("run-001.jsonl") and len(evidence["record_sha256"]) == 64
+
+
+def test_maze_edited_objective_wants_a_change_and_a_valid_maze():
+    obj = Objective("maze-edited", "edited")
+    ex = exercise(obj)
+    b = bench_for(ex)
+    assert check(obj, ex, b) == (
+        False,
+        "the maze is still 'eRobotic lab maze' as set up: add or remove a block",
+    )
+    maze = b.maze
+    b.load_maze(maze.with_block(0, 0, wall=False))  # a hole in the outer wall
+    passed, reason = check(obj, ex, b)
+    assert not passed and reason.startswith("the edited maze has 1 problem(s):")
+    inner = next((x, y) for y in range(1, maze.height - 1) for x in range(1, maze.width - 1)
+                 if maze.is_wall(x, y))  # fmt: skip
+    b.load_maze(maze.with_block(*inner, wall=False))
+    assert check(obj, ex, b) == (True, "the maze was edited and is valid")
+
+
+def test_compare_objective_names_the_missing_runs():
+    obj = Objective("compare", "compared", algorithms=("right-wall", "two-distance-local-best"),
+                    mazes=(RANK,))  # fmt: skip
+    ex = exercise(obj, maze=RANK)
+    b = bench_for(ex)
+    assert check(obj, ex, b) == (
+        False,
+        "no run to the exit yet: right-wall on 'Ranking - right wall wins' (+1 more)",
+    )
+    b.select_algorithm("right-wall")
+    run_to_exit(b)
+    assert check(obj, ex, b) == (
+        False,
+        "no run to the exit yet: two-distance-local-best on 'Ranking - right wall wins'",
+    )
+    b.select_algorithm("two-distance-local-best")
+    run_to_exit(b)
+    assert check(obj, ex, b) == (True, "2 runs to compare")
+    table = check_objective(obj, ex, b).evidence["runs"]
+    assert [r["algorithm"] for r in table] == ["right-wall", "two-distance-local-best"]
+
+
+def question(qid, answer, **kw):
+    stored = hash_answer(answer, salt="s", **kw)
+    return Question(qid, "?", "s", frozenset(stored["sha256"]), step=stored.get("step"),
+                    choices=("a", "b") if "step" not in stored else ())  # fmt: skip
+
+
+def test_questions_objective_counts_unanswered_and_wrong_answers():
+    obj = Objective("questions", "answered")
+    qs = (question("one", "a"), question("two", 90, tolerance=0, step="1"))
+    ex = exercise(obj, questions=qs)
+    b = bench_for(ex)
+    assert check(obj, ex, b, {}) == (False, "not answered yet: one, two")
+    assert check(obj, ex, b, {"one": "b", "two": "90"}) == (False, "1 of 2 not right yet: one")
+    assert check(obj, ex, b, {"one": "A", "two": "90"}) == (True, "all 2 answered correctly")
+
+
+def test_progress_round_trips_through_json_and_has_a_stable_digest():
+    keys = Objective("keys", "drove", keys=("w",))
+    ex = exercise(keys)
+    b = bench_for(ex)
+    before = evaluate("lab", ex, b)
+    assert not before.passed and before.objectives[0].reason == "not used yet: w"
+    b.key("w")
+    after = evaluate("lab", ex, b)
+    assert after.passed
+    text = after.to_json()
+    assert json.loads(text)["passed"] is True
+    again = ExerciseProgress.from_json(text)
+    assert again == after and again.evidence_digest() == after.evidence_digest()
+    assert before.evidence_digest() != after.evidence_digest()
+
+
+def test_apply_setup_puts_profile_maze_sensors_and_controller_on_the_bench():
+    ex = exercise(
+        maze=RANK, profile="web", controller="starter labs/starters/web-two-distance.yaml"
+    )
+    b = Bench.open(maze_of(EROBOTIC), "unity", noise="off")
+    apply_setup(b, ex.setup)
+    assert (b.profile, b.maze.name) == ("web", "Ranking - right wall wins")
+    assert [str(s) for s in b.sensors] == RIGHT_WALL
+    assert b.algorithm.name == "starter-web-two-distance"
+
+
+@pytest.mark.parametrize("starter", sorted(Path("labs/starters").glob("*.yaml")))
+def test_every_starter_loads_and_runs_but_does_not_get_out_as_given(starter):
+    b = Bench.open(maze_of(EROBOTIC), "unity" if "unity" in starter.name else "web", noise="off")
+    b.select_algorithm(starter)
+    b.apply_algorithm_preset()
+    b.start_algorithm()
+    b.step(60 * 120)
+    assert b.message == "" and b.controller is not None
+    assert not b.session.reached_exit

@@ -1,0 +1,287 @@
+"""The automatic checks of a lab exercise, read from the live bench and its runs.
+
+Each objective gives a :class:`Check`: passed or not, a one-line reason the app shows next to
+✓ or ✗, and the evidence a sign-off keeps (the run, its metrics and its record's digest).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections.abc import Callable, Mapping
+from dataclasses import asdict, dataclass, field
+from functools import cache
+from pathlib import Path
+from typing import Any
+
+from workbench.control.algorithms import ALGORITHM_DIR
+from workbench.control.bench import VIPLE_PREFIX, Bench, RunEntry
+from workbench.sim.maze import Maze
+from workbench.sim.mazeio import load_maze
+from workbench.sim.profiles import get_profile
+
+from .model import Exercise, Objective, Setup
+
+ROLE_NAMES = {"tcp": "TCP (the Unity simulator's role)", "ws": "WebSocket (the Web Simulator's)"}
+
+
+@dataclass(frozen=True)
+class Check:
+    passed: bool
+    reason: str
+    evidence: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass
+class ObjectiveState:
+    kind: str
+    text: str
+    passed: bool
+    reason: str
+    evidence: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass
+class ExerciseProgress:
+    """Where one exercise stands: every objective's state (and the answers given)."""
+
+    lab: str
+    exercise: str
+    objectives: list[ObjectiveState]
+    answers: dict[str, str] = field(default_factory=dict)
+
+    @property
+    def passed(self) -> bool:
+        return all(o.passed for o in self.objectives)
+
+    def to_json(self) -> str:
+        return json.dumps({**asdict(self), "passed": self.passed}, sort_keys=True)
+
+    @classmethod
+    def from_json(cls, text: str) -> ExerciseProgress:
+        data = json.loads(text)
+        data.pop("passed", None)
+        data["objectives"] = [ObjectiveState(**o) for o in data["objectives"]]
+        return cls(**data)
+
+    def evidence_digest(self) -> str:
+        """sha256 of the objectives' states and evidence, in a canonical JSON form."""
+        states = [asdict(o) for o in self.objectives]
+        text = json.dumps(states, sort_keys=True, separators=(",", ":"))
+        return hashlib.sha256(text.encode()).hexdigest()
+
+
+# -- set-up --------------------------------------------------------------------------------
+@cache
+def _maze(path: str) -> Maze:
+    return load_maze(path)
+
+
+def maze_of(path: Path) -> Maze:
+    return _maze(str(path))
+
+
+def apply_setup(bench: Bench, setup: Setup) -> None:
+    """The exercise's one-key set-up: profile, maze, sensors and the controller to use."""
+    bench.profile = setup.profile
+    bench.load_maze(maze_of(setup.maze))
+    bench.apply_sensors(setup.sensors or get_profile(setup.profile).sensors)
+    kind, value = setup.controller.kind, setup.controller.value
+    if kind in ("algorithm", "starter"):
+        bench.select_algorithm(value)
+
+
+# -- evidence ------------------------------------------------------------------------------
+def record_digest(path: str | None) -> str | None:
+    """sha256 of a run record file, or None when the run was not recorded (or is gone)."""
+    if not path:
+        return None
+    try:
+        return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+    except OSError:
+        return None
+
+
+def run_evidence(run: RunEntry) -> dict[str, Any]:
+    return {
+        "run": run.number,
+        "driver": run.driver,
+        "maze": run.maze,
+        "maze_digest": run.maze_digest,
+        "profile": run.profile,
+        "ended": run.ended,
+        "metrics": run.metrics.as_dict(),
+        "record": run.record,
+        "record_sha256": record_digest(run.record),
+    }
+
+
+def driver_kinds(run: RunEntry) -> set[str]:
+    """What kinds of driver an ``exit`` objective would see in ``run``."""
+    kinds = {"any"}
+    if run.driver.startswith(VIPLE_PREFIX):
+        kinds.add("viple")
+    elif run.driver.startswith("algorithm ") and run.source:
+        if Path(run.source).resolve().parent == ALGORITHM_DIR:
+            kinds.add(f"algorithm {run.driver.removeprefix('algorithm ')}")
+        else:
+            kinds.add("fsm")
+    return kinds
+
+
+# -- the objective kinds -------------------------------------------------------------------
+def check_keys(obj: Objective, bench: Bench) -> Check:
+    missing = [k for k in obj.keys if k not in bench.keys_used]
+    evidence = {"keys_used": sorted(bench.keys_used)}
+    if missing:
+        return Check(False, f"not used yet: {', '.join(missing)}", evidence)
+    return Check(True, f"used {', '.join(obj.keys)}", evidence)
+
+
+def check_sensors(obj: Objective, bench: Bench) -> Check:
+    have = {str(s) for s in bench.sensors}
+    want = {str(s) for s in obj.sensors}
+    evidence = {"sensors": sorted(have)}
+    if have == want:
+        return Check(True, f"sensors are {', '.join(sorted(want)) or 'none'}", evidence)
+    parts = []
+    if want - have:
+        parts.append(f"missing {', '.join(sorted(want - have))}")
+    if have - want:
+        parts.append(f"not wanted {', '.join(sorted(have - want))}")
+    return Check(False, "; ".join(parts), evidence)
+
+
+def check_viple(obj: Objective, bench: Bench) -> Check:
+    mine = [c for c in bench.viple if c.role == obj.role]
+    drove = [c for c in mine if c.drove]
+    if drove:
+        c = drove[-1]
+        evidence = {"role": c.role, "peer": c.peer, "distance": round(c.distance, 4),
+                    "turn_degrees": round(c.turn_degrees, 4)}  # fmt: skip
+        return Check(True, f"VIPLE {c.role} program at {c.peer} drove the robot", evidence)
+    if mine:
+        return Check(False, f"VIPLE {obj.role} program connected but has not moved the robot")
+    others = sorted({c.role for c in bench.viple})
+    if others:
+        return Check(
+            False,
+            f"VIPLE connected over {', '.join(others)}; this exercise needs {ROLE_NAMES[obj.role]}",
+        )
+    return Check(False, f"no VIPLE program has connected over {ROLE_NAMES[obj.role]} yet")
+
+
+def _limits(obj: Objective, run: RunEntry) -> str | None:
+    """What limit ``run`` breaks, or None."""
+    m = run.metrics
+    took = m.exit_time if m.exit_time is not None else m.sim_time
+    # measured to a thousandth, so that a 90.0000001° quarter turn meets a 90° limit
+    if obj.max_time is not None and round(took, 3) > obj.max_time:
+        return f"took {took:.1f} s, over the {obj.max_time:g} s limit"
+    if obj.max_turn_degrees is not None and round(m.turn_degrees, 3) > obj.max_turn_degrees:
+        return f"turned {m.turn_degrees:.0f}°, over the {obj.max_turn_degrees:g}° limit"
+    if obj.max_collisions is not None and m.collisions > obj.max_collisions:
+        return f"hit a wall {m.collisions} times, over the limit of {obj.max_collisions}"
+    return None
+
+
+def check_exit(obj: Objective, bench: Bench) -> Check:
+    assert obj.maze is not None
+    maze = maze_of(obj.maze)
+    wanted = set(obj.drivers)
+    runs = [
+        r
+        for r in bench.runs
+        if r.ended == "exit" and r.maze_digest == maze.digest() and driver_kinds(r) & wanted
+    ]
+    drivers = " or ".join(obj.drivers)
+    if not runs:
+        return Check(False, f"no run by {drivers} has reached the exit of {maze.name!r} yet")
+    for run in runs:
+        if _limits(obj, run) is None:
+            m = run.metrics
+            reason = (
+                f"run {run.number} ({run.driver}) got out in {m.exit_time:.1f} s, "
+                f"{m.turn_degrees:.0f}° turned, {m.collisions} collisions"
+            )
+            return Check(True, reason, run_evidence(run))
+    last = runs[-1]
+    return Check(False, f"run {last.number} ({last.driver}) {_limits(obj, last)}", {})
+
+
+def check_maze_edited(exercise: Exercise, bench: Bench) -> Check:
+    original = maze_of(exercise.setup.maze)
+    evidence = {"maze_digest": bench.maze.digest(), "original_digest": original.digest()}
+    if bench.maze.same_layout(original):
+        return Check(False, f"the maze is still {original.name!r} as set up: add or remove a block")
+    problems = bench.maze.validate()
+    if problems:
+        first = problems[0]
+        return Check(
+            False, f"the edited maze has {len(problems)} problem(s): {first.message}", evidence
+        )
+    return Check(True, "the maze was edited and is valid", evidence)
+
+
+def check_compare(obj: Objective, bench: Bench) -> Check:
+    table: list[dict[str, Any]] = []
+    missing = []
+    for path in obj.mazes:
+        maze = maze_of(path)
+        for name in obj.algorithms:
+            runs = [
+                r
+                for r in bench.runs
+                if r.ended == "exit"
+                and r.maze_digest == maze.digest()
+                and f"algorithm {name}" in driver_kinds(r)
+            ]
+            if runs:
+                table.append({"algorithm": name, **run_evidence(runs[-1])})
+            else:
+                missing.append(f"{name} on {maze.name!r}")
+    if missing:
+        more = f" (+{len(missing) - 1} more)" if len(missing) > 1 else ""
+        return Check(False, f"no run to the exit yet: {missing[0]}{more}", {"runs": table})
+    return Check(True, f"{len(table)} runs to compare", {"runs": table})
+
+
+def check_questions(exercise: Exercise, answers: Mapping[str, str]) -> Check:
+    unanswered = [q.id for q in exercise.questions if not str(answers.get(q.id, "")).strip()]
+    wrong = [q.id for q in exercise.questions if q.id not in unanswered
+             and not q.check(answers[q.id])[0]]  # fmt: skip
+    total = len(exercise.questions)
+    evidence = {"correct": total - len(unanswered) - len(wrong), "of": total}
+    if unanswered:
+        return Check(False, f"not answered yet: {', '.join(unanswered)}", evidence)
+    if wrong:
+        return Check(False, f"{len(wrong)} of {total} not right yet: {', '.join(wrong)}", evidence)
+    return Check(True, f"all {total} answered correctly", evidence)
+
+
+def check_objective(
+    obj: Objective, exercise: Exercise, bench: Bench, answers: Mapping[str, str] | None = None
+) -> Check:
+    by_kind: dict[str, Callable[[], Check]] = {
+        "keys": lambda: check_keys(obj, bench),
+        "sensors": lambda: check_sensors(obj, bench),
+        "viple": lambda: check_viple(obj, bench),
+        "exit": lambda: check_exit(obj, bench),
+        "maze-edited": lambda: check_maze_edited(exercise, bench),
+        "compare": lambda: check_compare(obj, bench),
+        "questions": lambda: check_questions(exercise, answers or {}),
+    }
+    return by_kind[obj.kind]()
+
+
+def evaluate(
+    lab_id: str, exercise: Exercise, bench: Bench, answers: Mapping[str, str] | None = None
+) -> ExerciseProgress:
+    """Every objective of ``exercise`` checked against the bench now."""
+    states = []
+    for obj in exercise.objectives:
+        check = check_objective(obj, exercise, bench, answers)
+        states.append(
+            ObjectiveState(obj.kind, obj.text, check.passed, check.reason, check.evidence)
+        )
+    return ExerciseProgress(lab_id, exercise.id, states, dict(answers or {}))

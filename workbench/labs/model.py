@@ -1,0 +1,452 @@
+"""Guided labs: the exercises of ``labs/*.yaml``, read with line numbers for clear errors.
+
+The file format is described in ``docs/labs.md``. Every problem names the file, the line and
+the key, and says what to write instead.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import math
+import secrets
+from dataclasses import dataclass, field
+from decimal import Decimal
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from workbench.control.algorithms import list_algorithms
+from workbench.sim.profiles import PROFILES
+from workbench.sim.sensors import SensorConfigError, SensorSpec, check_ports
+
+#: the folder of the bundled labs (next to ``mazes/``)
+LABS_DIR = Path(__file__).resolve().parents[2] / "labs"
+OBJECTIVE_KINDS = ("keys", "sensors", "viple", "exit", "maze-edited", "compare", "questions")
+CONTROLLER_KINDS = ("keys", "algorithm", "starter", "viple")
+#: what an ``exit`` objective may require of the driver
+DRIVER_KINDS = ("viple", "fsm", "algorithm", "any")
+DRIVE_KEYS = ("w", "a", "s", "d", "space")
+VIPLE_ROLES = ("tcp", "ws")
+
+
+class LabFileError(ValueError):
+    """A lab file that cannot be used: ``file:line: where: what (fix)``."""
+
+
+# -- answers --------------------------------------------------------------------------------
+def normalise_choice(text: str) -> str:
+    return " ".join(str(text).split()).casefold()
+
+
+def _digest(salt: str, text: str) -> str:
+    return hashlib.sha256(f"{salt}\n{text}".encode()).hexdigest()
+
+
+def _grid_text(value: float, step: str) -> str:
+    """``value`` rounded to the nearest multiple of ``step``, written with step's decimals."""
+    quantum = Decimal(step)
+    k = round(Decimal(repr(float(value))) / quantum)
+    return str((k * quantum).quantize(quantum.normalize() if quantum < 1 else Decimal(1)))
+
+
+def hash_answer(
+    answer: str | float,
+    salt: str | None = None,
+    tolerance: float | None = None,
+    step: str | None = None,
+) -> dict[str, Any]:
+    """The ``answer:`` mapping a lab file stores for a question (for authors of labs).
+
+    A choice answer stores the hash of its normalised text. A numeric answer stores the
+    rounding ``step`` and one hash per multiple of ``step`` within ``tolerance`` of the answer;
+    a student's number is rounded to the step and its hash looked up.
+    """
+    salt = salt or secrets.token_hex(8)
+    if tolerance is None:
+        return {"salt": salt, "sha256": [_digest(salt, normalise_choice(str(answer)))]}
+    if step is None or Decimal(step) <= 0:
+        raise ValueError("a numeric answer needs a positive rounding step, e.g. step='0.1'")
+    quantum = float(Decimal(step))
+    low = math.ceil((float(answer) - tolerance) / quantum - 1e-9)
+    high = math.floor((float(answer) + tolerance) / quantum + 1e-9)
+    if high - low > 1000:
+        raise ValueError("tolerance / step accepts more than 1000 values: use a coarser step")
+    texts = {_grid_text(k * quantum, step) for k in range(low, high + 1)}
+    return {"salt": salt, "step": step, "sha256": sorted(_digest(salt, t) for t in texts)}
+
+
+@dataclass(frozen=True)
+class Question:
+    id: str
+    text: str
+    salt: str
+    hashes: frozenset[str]
+    choices: tuple[str, ...] = ()
+    #: the rounding step of a numeric answer ("0.1"); None for multiple choice
+    step: str | None = None
+    unit: str = ""
+
+    @property
+    def numeric(self) -> bool:
+        return self.step is not None
+
+    def check(self, answer: str) -> tuple[bool, str]:
+        """(correct, reason); a malformed answer is not correct and the reason says why."""
+        if self.numeric:
+            try:
+                value = float(str(answer).strip())
+            except ValueError:
+                return False, f"{answer!r} is not a number"
+            if not math.isfinite(value):
+                return False, f"{answer!r} is not a number"
+            text = _grid_text(value, self.step or "1")
+        else:
+            text = normalise_choice(answer)
+            if self.choices and text not in {normalise_choice(c) for c in self.choices}:
+                return False, f"{answer!r} is not one of the choices"
+        if _digest(self.salt, text) in self.hashes:
+            return True, "correct"
+        return False, "not the expected answer"
+
+
+# -- set-up, objectives, exercises ---------------------------------------------------------
+@dataclass(frozen=True)
+class Controller:
+    """Who drives in the set-up: keys, a built-in algorithm, a starter FSM, or VIPLE."""
+
+    kind: str
+    #: algorithm name, starter file path, or VIPLE role (tcp / ws)
+    value: str = ""
+
+    def __str__(self) -> str:
+        return f"{self.kind} {self.value}".strip()
+
+
+@dataclass(frozen=True)
+class Setup:
+    profile: str
+    maze: Path
+    sensors: tuple[SensorSpec, ...]
+    controller: Controller
+
+
+@dataclass(frozen=True)
+class Objective:
+    kind: str
+    text: str
+    keys: tuple[str, ...] = ()
+    sensors: tuple[SensorSpec, ...] = ()
+    role: str = ""
+    maze: Path | None = None
+    #: accepted drivers for ``exit``: "viple", "fsm", "algorithm NAME", "any"
+    drivers: tuple[str, ...] = ()
+    max_time: float | None = None
+    max_turn_degrees: float | None = None
+    max_collisions: int | None = None
+    algorithms: tuple[str, ...] = ()
+    mazes: tuple[Path, ...] = ()
+
+
+@dataclass(frozen=True)
+class Exercise:
+    id: str
+    title: str
+    instructions: str
+    setup: Setup
+    objectives: tuple[Objective, ...]
+    questions: tuple[Question, ...] = ()
+    signoff: bool = True
+
+
+@dataclass(frozen=True)
+class Lab:
+    id: str
+    title: str
+    summary: str
+    exercises: tuple[Exercise, ...]
+    path: Path = field(compare=False, default=Path("."))
+
+    def exercise(self, exercise_id: str) -> Exercise:
+        for ex in self.exercises:
+            if ex.id == exercise_id:
+                return ex
+        known = ", ".join(e.id for e in self.exercises)
+        raise KeyError(f"lab {self.id!r} has no exercise {exercise_id!r} (it has: {known})")
+
+
+# -- reading -------------------------------------------------------------------------------
+class _Reader:
+    def __init__(self, path: Path, label: str):
+        self.path = path
+        self.label = label
+        self.base = path.parent
+
+    def fail(self, node: yaml.Node | None, where: str, message: str, hint: str = "") -> None:
+        line = node.start_mark.line + 1 if node is not None else 1
+        fix = f" ({hint})" if hint else ""
+        prefix = f"{where}: " if where else ""
+        raise LabFileError(f"{self.label}:{line}: {prefix}{message}{fix}")
+
+    def mapping(
+        self, node: yaml.Node, where: str, required: tuple[str, ...], optional: tuple[str, ...]
+    ) -> dict[str, yaml.Node]:
+        if not isinstance(node, yaml.MappingNode):
+            self.fail(node, where, "must be a mapping of keys to values", "write 'key: value'")
+        out: dict[str, yaml.Node] = {}
+        allowed = required + optional
+        for key_node, value in node.value:
+            key = key_node.value if isinstance(key_node, yaml.ScalarNode) else None
+            if key not in allowed:
+                self.fail(
+                    key_node, where, f"unknown key {key!r}", f"use one of {', '.join(allowed)}"
+                )
+            if key in out:
+                self.fail(key_node, where, f"key {key!r} is given twice", "keep one")
+            out[key] = value
+        for key in required:
+            if key not in out:
+                self.fail(node, where, f"missing key {key!r}", f"add '{key}: ...'")
+        return out
+
+    def text(self, node: yaml.Node, where: str) -> str:
+        if not isinstance(node, yaml.ScalarNode) or not str(node.value).strip():
+            self.fail(node, where, "must be a non-empty text", "write it on the same line")
+        return str(node.value)
+
+    def number(self, node: yaml.Node, where: str, minimum: float = 0.0) -> float:
+        value = yaml.safe_load(yaml.serialize(node)) if isinstance(node, yaml.ScalarNode) else None
+        if isinstance(value, bool) or not isinstance(value, int | float) or value < minimum:
+            self.fail(node, where, f"{node.value!r} is not a number of at least {minimum:g}")
+        return float(value)
+
+    def items(self, node: yaml.Node, where: str) -> list[yaml.Node]:
+        if isinstance(node, yaml.ScalarNode):
+            return [node]
+        if not isinstance(node, yaml.SequenceNode) or not node.value:
+            self.fail(node, where, "must be a list with at least one item", "write [a, b]")
+        return list(node.value)
+
+    def texts(self, node: yaml.Node, where: str) -> tuple[str, ...]:
+        return tuple(self.text(n, where) for n in self.items(node, where))
+
+    def file(self, node: yaml.Node, where: str) -> Path:
+        path = (self.base / self.text(node, where)).resolve()
+        if not path.is_file():
+            self.fail(
+                node, where, f"no file {node.value!r}", f"paths are relative to {self.base.name}/"
+            )
+        return path
+
+    def sensors(self, node: yaml.Node, where: str) -> tuple[SensorSpec, ...]:
+        if isinstance(node, yaml.SequenceNode) and not node.value:
+            return ()
+        specs = []
+        for item in self.items(node, where):
+            try:
+                specs.append(SensorSpec.parse(self.text(item, where)))
+            except SensorConfigError as exc:
+                self.fail(item, where, str(exc))
+        try:
+            check_ports(specs)
+        except SensorConfigError as exc:
+            self.fail(node, where, str(exc))
+        return tuple(specs)
+
+    def choice(self, node: yaml.Node, where: str, allowed: tuple[str, ...], what: str) -> str:
+        value = self.text(node, where)
+        if value not in allowed:
+            self.fail(node, where, f"unknown {what} {value!r}", f"use one of {', '.join(allowed)}")
+        return value
+
+
+def load_lab(path: str | Path) -> Lab:
+    """Read and check one lab file; raises :class:`LabFileError` naming the line and the fix."""
+    path = Path(path)
+    label = _label(path)
+    try:
+        root = yaml.compose(path.read_text(encoding="utf-8"))
+    except OSError as exc:
+        raise LabFileError(f"{label}: cannot read: {exc.strerror}") from None
+    except yaml.MarkedYAMLError as exc:
+        line = exc.problem_mark.line + 1 if exc.problem_mark else 1
+        raise LabFileError(f"{label}:{line}: not valid YAML: {exc.problem}") from None
+    r = _Reader(path, label)
+    if root is None:
+        raise LabFileError(f"{label}:1: empty file (a lab needs 'lab', 'title' and 'exercises')")
+    top = r.mapping(root, "", ("lab", "title", "exercises"), ("summary",))
+    lab_id = r.text(top["lab"], "lab")
+    if lab_id != path.stem:
+        r.fail(top["lab"], "lab", f"id {lab_id!r} differs from the file name", f"use {path.stem!r}")
+    exercises: list[Exercise] = []
+    for node in r.items(top["exercises"], "exercises"):
+        ex = _exercise(r, node)
+        if any(e.id == ex.id for e in exercises):
+            r.fail(node, f"exercise {ex.id!r}", "id is used twice", "give each exercise its own id")
+        exercises.append(ex)
+    summary = r.text(top["summary"], "summary") if "summary" in top else ""
+    return Lab(lab_id, r.text(top["title"], "title"), summary, tuple(exercises), path)
+
+
+def load_labs(folder: str | Path = LABS_DIR) -> list[Lab]:
+    """Every ``*.yaml`` lab in ``folder`` (starters live in a subfolder and are not labs)."""
+    return [load_lab(p) for p in sorted(Path(folder).glob("*.yaml"))]
+
+
+def _label(path: Path) -> str:
+    try:
+        return str(path.resolve().relative_to(Path.cwd()))
+    except ValueError:
+        return str(path)
+
+
+def _exercise(r: _Reader, node: yaml.Node) -> Exercise:
+    keys = r.mapping(
+        node,
+        "exercise",
+        ("id", "title", "instructions", "setup", "objectives"),
+        ("questions", "signoff"),
+    )
+    ex_id = r.text(keys["id"], "exercise")
+    where = f"exercise {ex_id!r}"
+    questions = (
+        tuple(_question(r, q, where) for q in r.items(keys["questions"], f"{where}: questions"))
+        if "questions" in keys
+        else ()
+    )
+    ids = [q.id for q in questions]
+    if len(set(ids)) != len(ids):
+        r.fail(keys["questions"], where, "two questions share an id", "give each its own id")
+    objectives = tuple(
+        _objective(r, o, where) for o in r.items(keys["objectives"], f"{where}: objectives")
+    )
+    if any(o.kind == "questions" for o in objectives) and not questions:
+        r.fail(keys["objectives"], where, "a 'questions' objective but no questions", "add them")
+    if "signoff" in keys and keys["signoff"].value != "required":
+        r.fail(keys["signoff"], where, "sign-off can only be 'required'", "write it so")
+    return Exercise(
+        ex_id,
+        r.text(keys["title"], where),
+        r.text(keys["instructions"], where),
+        _setup(r, keys["setup"], where),
+        objectives,
+        questions,
+    )
+
+
+def _setup(r: _Reader, node: yaml.Node, where: str) -> Setup:
+    keys = r.mapping(node, f"{where}: setup", ("profile", "maze", "controller"), ("sensors",))
+    profile = r.choice(keys["profile"], f"{where}: setup", tuple(PROFILES), "profile")
+    sensors = r.sensors(keys["sensors"], f"{where}: setup") if "sensors" in keys else ()
+    return Setup(
+        profile, r.file(keys["maze"], f"{where}: setup"), sensors, _controller(r, keys, where)
+    )
+
+
+def _controller(r: _Reader, keys: dict[str, yaml.Node], where: str) -> Controller:
+    node = keys["controller"]
+    parts = r.text(node, f"{where}: controller").split(None, 1)
+    kind = parts[0]
+    value = parts[1].strip() if len(parts) > 1 else ""
+    here = f"{where}: controller"
+    if kind not in CONTROLLER_KINDS:
+        r.fail(node, here, f"unknown controller {kind!r}", "use keys, algorithm NAME, "
+               "starter FILE or viple tcp|ws")  # fmt: skip
+    if kind == "keys" and value:
+        r.fail(node, here, "'keys' takes nothing after it", "write just 'keys'")
+    if kind == "algorithm" and value not in list_algorithms():
+        r.fail(node, here, f"no built-in algorithm {value!r}",
+               f"use one of {', '.join(list_algorithms())}")  # fmt: skip
+    if kind == "starter":
+        path = (r.base / value).resolve()
+        if not value or not path.is_file():
+            r.fail(node, here, f"no starter file {value!r}", "write 'starter starters/NAME.yaml'")
+        value = str(path)
+    if kind == "viple" and value not in VIPLE_ROLES:
+        r.fail(node, here, f"unknown VIPLE role {value!r}", "use 'viple tcp' or 'viple ws'")
+    return Controller(kind, value)
+
+
+_OBJECTIVE_KEYS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
+    "keys": ((), ("keys",)),
+    "sensors": (("sensors",), ()),
+    "viple": (("role",), ()),
+    "exit": (("maze", "driver"), ("max_time", "max_turn_degrees", "max_collisions")),
+    "maze-edited": ((), ()),
+    "compare": (("algorithms", "mazes"), ()),
+    "questions": ((), ()),
+}
+
+
+def _objective(r: _Reader, node: yaml.Node, where: str) -> Objective:
+    if not isinstance(node, yaml.MappingNode):
+        r.fail(node, where, "an objective must be a mapping", "start it with 'kind: ...'")
+    kind_node = next((v for k, v in node.value if k.value == "kind"), None)
+    if kind_node is None:
+        r.fail(node, where, "objective without 'kind'", f"use one of {', '.join(OBJECTIVE_KINDS)}")
+    kind = r.choice(kind_node, where, OBJECTIVE_KINDS, "objective kind")
+    required, optional = _OBJECTIVE_KEYS[kind]
+    here = f"{where}: objective {kind!r}"
+    keys = r.mapping(node, here, ("kind", "text", *required), optional)
+    text = r.text(keys["text"], here)
+    if kind == "keys":
+        chosen = r.texts(keys["keys"], here) if "keys" in keys else DRIVE_KEYS
+        for key in chosen:
+            if key not in DRIVE_KEYS:
+                r.fail(keys["keys"], here, f"{key!r} is not a drive key",
+                       f"use {', '.join(DRIVE_KEYS)}")  # fmt: skip
+        return Objective(kind, text, keys=chosen)
+    if kind == "sensors":
+        return Objective(kind, text, sensors=r.sensors(keys["sensors"], here))
+    if kind == "viple":
+        return Objective(kind, text, role=r.choice(keys["role"], here, VIPLE_ROLES, "role"))
+    if kind == "exit":
+        drivers = r.texts(keys["driver"], here)
+        for d in drivers:
+            head, _, name = d.partition(" ")
+            if head not in DRIVER_KINDS or (head == "algorithm") != bool(name):
+                r.fail(keys["driver"], here, f"unknown driver {d!r}",
+                       "use viple, fsm, algorithm NAME or any")  # fmt: skip
+        limits = {k: r.number(keys[k], f"{here}: {k}") for k in optional if k in keys}
+        if "max_collisions" in limits:
+            limits["max_collisions"] = int(limits["max_collisions"])
+        return Objective(kind, text, maze=r.file(keys["maze"], here), drivers=drivers, **limits)
+    if kind == "compare":
+        mazes = tuple(r.file(n, here) for n in r.items(keys["mazes"], here))
+        return Objective(kind, text, algorithms=r.texts(keys["algorithms"], here), mazes=mazes)
+    return Objective(kind, text)
+
+
+def _question(r: _Reader, node: yaml.Node, where: str) -> Question:
+    keys = r.mapping(node, f"{where}: question", ("id", "text", "answer"), ("choices", "unit"))
+    q_id = r.text(keys["id"], f"{where}: question")
+    here = f"{where}: question {q_id!r}"
+    answer = r.mapping(keys["answer"], f"{here}: answer", ("salt", "sha256"), ("step",))
+    hashes = r.texts(answer["sha256"], f"{here}: answer")
+    for h, n in zip(hashes, r.items(answer["sha256"], here), strict=True):
+        if len(h) != 64 or any(c not in "0123456789abcdef" for c in h):
+            r.fail(n, f"{here}: answer", "not a sha256 hex digest",
+                   "make it with workbench.labs.model.hash_answer")  # fmt: skip
+    step = None
+    if "step" in answer:
+        step = r.text(answer["step"], f"{here}: answer")
+        try:
+            ok = Decimal(step) > 0
+        except ArithmeticError:
+            ok = False
+        if not ok:
+            r.fail(answer["step"], f"{here}: answer", f"step {step!r} is not a positive number")
+    choices = r.texts(keys["choices"], here) if "choices" in keys else ()
+    if step is None and not choices:
+        r.fail(node, here, "neither choices nor a numeric step", "add 'choices:' or answer 'step:'")
+    if step is not None and choices:
+        r.fail(keys["choices"], here, "a numeric question has no choices", "drop one of them")
+    return Question(
+        q_id,
+        r.text(keys["text"], here),
+        r.text(answer["salt"], f"{here}: answer"),
+        frozenset(hashes),
+        choices,
+        step,
+        r.text(keys["unit"], here) if "unit" in keys else "",
+    )
