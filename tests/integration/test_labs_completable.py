@@ -200,7 +200,7 @@ def test_a_starter_run_as_given_does_not_count_as_getting_out():
     bench.step(60 * 120)
     assert reasons("unity-simulator", "wall-following", bench)[:2] == [
         "✓ sensors are distance:1:right, distance:2:front",
-        "✗ no run by viple or fsm has reached the exit of 'eRobotic lab maze' yet",
+        "✗ no run by viple or fsm has reached the exit of 'eRobotic lab maze' (unity) yet",
     ]
 
 
@@ -227,7 +227,7 @@ def test_a_built_in_algorithm_does_not_stand_in_for_the_students_program():
     bench = fresh_bench(ex)
     run_on(bench, ex.setup.maze, "web-wall-following")
     assert reasons("web-simulator", "wall-main", bench)[1] == (
-        "✗ no run by viple or fsm has reached the exit of 'Web Simulator lab maze' yet"
+        "✗ no run by viple or fsm has reached the exit of 'Web Simulator lab maze' (web) yet"
     )
 
 

@@ -118,7 +118,7 @@ def test_exit_objective_wants_the_right_kind_of_driver_on_the_right_maze():
     b = bench_for(ex)
     assert check(obj, ex, b) == (
         False,
-        "no run by fsm has reached the exit of 'eRobotic lab maze' yet",
+        "no run by fsm has reached the exit of 'eRobotic lab maze' (unity) yet",
     )
     b.select_algorithm("right-wall")
     run_to_exit(b)
@@ -194,13 +194,13 @@ def test_compare_objective_names_the_missing_runs():
     b = bench_for(ex)
     assert check(obj, ex, b) == (
         False,
-        "no run to the exit yet: right-wall on 'Ranking - right wall wins' (+1 more)",
+        "no run to the exit yet: right-wall on 'Ranking - right wall wins' (unity) (+1 more)",
     )
     b.select_algorithm("right-wall")
     run_to_exit(b)
     assert check(obj, ex, b) == (
         False,
-        "no run to the exit yet: two-distance-local-best on 'Ranking - right wall wins'",
+        "no run to the exit yet: two-distance-local-best on 'Ranking - right wall wins' (unity)",
     )
     b.select_algorithm("two-distance-local-best")
     run_to_exit(b)
@@ -261,3 +261,20 @@ def test_every_starter_loads_and_runs_but_does_not_get_out_as_given(starter):
     b.step(60 * 120)
     assert b.message == "" and b.controller is not None
     assert not b.session.reached_exit
+
+
+def test_runs_on_another_profile_do_not_count():
+    obj = Objective("exit", "out", maze=RANK, drivers=("algorithm right-wall",))
+    ex = exercise(obj, maze=RANK, profile="web")
+    b = Bench.open(maze_of(RANK), "unity", noise="off")
+    b.select_algorithm("right-wall")
+    run_to_exit(b)
+    assert check(obj, ex, b) == (
+        False,
+        "no run by algorithm right-wall has reached the exit of 'Ranking - right wall wins' "
+        "(web) yet",
+    )
+    apply_setup(b, ex.setup)
+    b.select_algorithm("right-wall")
+    run_to_exit(b)
+    assert check(obj, ex, b)[0]

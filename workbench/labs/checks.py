@@ -185,18 +185,27 @@ def _limits(obj: Objective, run: RunEntry) -> str | None:
     return None
 
 
-def check_exit(obj: Objective, bench: Bench) -> Check:
-    assert obj.maze is not None
-    maze = maze_of(obj.maze)
-    wanted = set(obj.drivers)
-    runs = [
+def _exits(bench: Bench, maze: Maze, profile: str) -> list[RunEntry]:
+    """Runs that reached the exit of exactly ``maze`` on ``profile``."""
+    digest = maze.digest()
+    return [
         r
         for r in bench.runs
-        if r.ended == "exit" and r.maze_digest == maze.digest() and driver_kinds(r) & wanted
+        if r.ended == "exit" and r.maze_digest == digest and r.profile == profile
     ]
+
+
+def check_exit(obj: Objective, exercise: Exercise, bench: Bench) -> Check:
+    assert obj.maze is not None
+    maze = maze_of(obj.maze)
+    profile = exercise.setup.profile
+    wanted = set(obj.drivers)
+    runs = [r for r in _exits(bench, maze, profile) if driver_kinds(r) & wanted]
     drivers = " or ".join(obj.drivers)
     if not runs:
-        return Check(False, f"no run by {drivers} has reached the exit of {maze.name!r} yet")
+        return Check(
+            False, f"no run by {drivers} has reached the exit of {maze.name!r} ({profile}) yet"
+        )
     for run in runs:
         if _limits(obj, run) is None:
             m = run.metrics
@@ -223,7 +232,7 @@ def check_maze_edited(exercise: Exercise, bench: Bench) -> Check:
     return Check(True, "the maze was edited and is valid", evidence)
 
 
-def check_compare(obj: Objective, bench: Bench) -> Check:
+def check_compare(obj: Objective, exercise: Exercise, bench: Bench) -> Check:
     table: list[dict[str, Any]] = []
     missing = []
     for path in obj.mazes:
@@ -231,15 +240,13 @@ def check_compare(obj: Objective, bench: Bench) -> Check:
         for name in obj.algorithms:
             runs = [
                 r
-                for r in bench.runs
-                if r.ended == "exit"
-                and r.maze_digest == maze.digest()
-                and f"algorithm {name}" in driver_kinds(r)
+                for r in _exits(bench, maze, exercise.setup.profile)
+                if f"algorithm {name}" in driver_kinds(r)
             ]
             if runs:
                 table.append({"algorithm": name, **run_evidence(runs[-1])})
             else:
-                missing.append(f"{name} on {maze.name!r}")
+                missing.append(f"{name} on {maze.name!r} ({exercise.setup.profile})")
     if missing:
         more = f" (+{len(missing) - 1} more)" if len(missing) > 1 else ""
         return Check(False, f"no run to the exit yet: {missing[0]}{more}", {"runs": table})
@@ -266,9 +273,9 @@ def check_objective(
         "keys": lambda: check_keys(obj, bench),
         "sensors": lambda: check_sensors(obj, bench),
         "viple": lambda: check_viple(obj, bench),
-        "exit": lambda: check_exit(obj, bench),
+        "exit": lambda: check_exit(obj, exercise, bench),
         "maze-edited": lambda: check_maze_edited(exercise, bench),
-        "compare": lambda: check_compare(obj, bench),
+        "compare": lambda: check_compare(obj, exercise, bench),
         "questions": lambda: check_questions(exercise, answers or {}),
     }
     return by_kind[obj.kind]()
