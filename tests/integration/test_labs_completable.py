@@ -13,7 +13,7 @@ import pytest
 from websockets.asyncio.server import serve
 
 from workbench.control.bench import Bench
-from workbench.labs.checks import apply_setup, evaluate, maze_of
+from workbench.labs.checks import ExerciseProgress, apply_setup, evaluate, maze_of
 from workbench.labs.model import Exercise, Objective, Question, load_labs
 from workbench.viple.tcp_server import TcpConfig, TcpServer
 from workbench.viple.ws_client import WsClient, WsConfig
@@ -181,6 +181,7 @@ def test_every_exercise_can_be_completed(lab_id, ex):
     failed = [(o.text, o.reason) for o in progress.objectives if not o.passed]
     assert failed == [], failed
     assert progress.passed
+    assert ExerciseProgress.from_json(progress.to_json()) == progress
 
 
 def reasons(lab_id: str, ex_id: str, bench: Bench | None = None, answers=None) -> list[str]:
