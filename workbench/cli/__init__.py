@@ -44,6 +44,13 @@ def build_parser() -> argparse.ArgumentParser:
         "--record-dir",
         help=f"keep each run's record here for replay (default: a new folder under {runs_home()})",
     )
+    parser.add_argument("--student", help="who does the labs (default: the login name)")
+    parser.add_argument("--partner", default="", help="the student's lab partner, if any")
+    parser.add_argument(
+        "--data-dir",
+        help="where lab progress and sign-offs are kept (default: $WORKBENCH_DATA "
+        "or the user data folder)",
+    )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     maze_cmd.register(sub)
     algorithms_cmd.register(sub)
@@ -89,6 +96,9 @@ def open_app(args: argparse.Namespace) -> int:
             tcp_port=args.tcp_port or None,
             ws_url=args.ws_url,
             record_dir=args.record_dir or new_runs_dir(),
+            student=args.student,
+            partner=args.partner,
+            data_dir=args.data_dir,
         )
     except AppSetupError as exc:
         error(str(exc))

@@ -8,6 +8,7 @@ snapshot on every screen that shows it.
 
 from __future__ import annotations
 
+import getpass
 import os
 from pathlib import Path
 from time import perf_counter
@@ -20,6 +21,7 @@ from textual.reactive import var
 from textual.screen import Screen
 
 from workbench.control.bench import Bench
+from workbench.labs.store import Store
 from workbench.sim.maze import Maze, MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.noise import NOISE_LEVELS
@@ -33,6 +35,7 @@ from .commands import WorkbenchCommands
 from .modals.help import HelpScreen
 from .modals.too_small import TooSmallScreen
 from .screens.editor import EditorScreen
+from .screens.labs import LabsScreen
 from .screens.main import MainScreen
 from .screens.runs import RunsScreen
 
@@ -75,8 +78,17 @@ class WorkbenchApp(App[None]):
         unicode: bool = False,
         tcp: TcpConfig | None = None,
         ws: WsConfig | None = None,
+        student: str = "",
+        partner: str = "",
+        data_dir: str | os.PathLike | None = None,
     ) -> None:
         super().__init__()
+        self.student = student or user or _login_name()
+        self.partner = partner
+        self.data_dir = data_dir
+        self.store: Store | None = None
+        self.store_problem = ""
+        self._labs: LabsScreen | None = None
         self._viple_configs = (tcp, ws)
         self.endpoints: Endpoints | None = None
         self.bench = bench
@@ -128,6 +140,9 @@ class WorkbenchApp(App[None]):
             show = getattr(screen, "show_snapshot", None)
             if show is not None:
                 show(snapshot)
+        labs = self._labs
+        if labs is not None and labs not in self.screen_stack:
+            labs.track()  # the exercise's progress is saved while the student drives
         self.frames += 1
 
     # -- size --------------------------------------------------------------------------------
@@ -175,6 +190,31 @@ class WorkbenchApp(App[None]):
     def open_runs(self) -> None:
         self.push_screen(RunsScreen(self.bench, unicode=self.unicode))
 
+    def open_labs(self) -> None:
+        if self._labs is None:
+            self._open_store()
+            self._labs = LabsScreen(
+                self.bench,
+                self.store,
+                self.student,
+                self.partner,
+                store_problem=self.store_problem,
+            )
+            self.install_screen(self._labs, name="labs")
+        self.push_screen("labs")
+
+    def _open_store(self) -> None:
+        try:
+            self.store = Store.open(self.data_dir)
+        except Exception as exc:  # the labs work without saving rather than not at all
+            self.store = None
+            self.store_problem = f"cannot open the data folder, so nothing is saved: {exc}"
+
+    def set_up_done(self) -> None:
+        """A lab's set-up changed the bench: follow its maze and profile."""
+        self.sub_title = f"{self.bench.maze.name} ({self.bench.profile})"
+        self.refresh_views()
+
     def _say(self, message: str) -> None:
         self.bench.message = message
         self.refresh_views()
@@ -189,6 +229,8 @@ class WorkbenchApp(App[None]):
 
     async def _shut_down(self) -> None:
         self.bench.close()
+        if self.store is not None:
+            self.store.close()
         if self.endpoints is not None:
             await self.endpoints.close()
         self.exit()
@@ -208,11 +250,16 @@ def make_app(
     tcp_port: int | None = None,
     ws_url: str | None = None,
     report_ms: int = REPORT_MS_DEFAULT,
+    student: str | None = None,
+    partner: str = "",
+    data_dir: str | os.PathLike | None = None,
 ) -> WorkbenchApp:
     """The workbench app on a maze file (default: the bundled Unity maze).
 
     ``tcp_port`` hosts the Unity-simulator role (VIPLE connects to it) and ``ws_url`` the
     Web-Simulator role (the app connects to VIPLE); neither runs unless asked for.
+    ``student`` (default: the login name) and ``partner`` do the labs; their progress and
+    sign-offs are kept in ``data_dir`` (default: ``$WORKBENCH_DATA`` or the user data folder).
 
     Raises :class:`AppSetupError` with a message for the user when the maze cannot be read or
     an argument is not one the workbench knows.
@@ -256,4 +303,14 @@ def make_app(
         unicode=unicode,
         tcp=tcp,
         ws=ws,
+        student=student or "",
+        partner=partner,
+        data_dir=data_dir,
     )
+
+
+def _login_name() -> str:
+    try:
+        return getpass.getuser()
+    except (KeyError, OSError):
+        return "student"

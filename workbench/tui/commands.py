@@ -93,6 +93,22 @@ COMMANDS: dict[str, CommandInfo] = {
             "runs",
             "Compare the last runs side by side; replay a recorded run.",
         ),
+        "screen.labs": (
+            "Screens",
+            "labs",
+            "The lab exercises: instructions, set-up, live objectives, questions, sign-off.",
+        ),
+        "labs.close": ("Labs", "back", "Back to the maze (the exercise keeps being checked)."),
+        "labs.setup": (
+            "Labs",
+            "set up the exercise",
+            "Put the exercise's profile, maze, sensors and controller on the bench.",
+        ),
+        "labs.signoff": (
+            "Labs",
+            "instructor sign-off",
+            "The instructor signs the exercise off with their passphrase; then change driver.",
+        ),
         "app.help": ("App", "help", "This help: every key and what it does."),
         "app.commands": ("App", "command palette", "Search every command by name."),
         "app.quit": ("App", "quit", "Quit the workbench (ctrl+c does not quit)."),

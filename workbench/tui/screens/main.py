@@ -54,6 +54,7 @@ class MainScreen(Screen[None]):
         Binding("t", "trail", "Trail", show=False, id="view.trail"),
         Binding("e", "editor", "Editor", show=False, id="screen.editor"),
         Binding("R", "runs", "Runs", show=False, id="screen.runs"),
+        Binding("l", "labs", "Labs", show=False, id="screen.labs"),
     ]
 
     #: the last snapshot drawn (per-tick state: never repaints by itself)
@@ -243,3 +244,6 @@ class MainScreen(Screen[None]):
 
     def action_runs(self) -> None:
         self.app.open_runs()  # type: ignore[attr-defined]
+
+    def action_labs(self) -> None:
+        self.app.open_labs()  # type: ignore[attr-defined]

@@ -1,0 +1,252 @@
+"""The labs screen and the sign-off dialog, driven with a Pilot."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from textual.pilot import Pilot
+from textual.widgets import Button, Checkbox, Input, OptionList, Select, Static
+
+from workbench.labs import signoff as so
+from workbench.labs.store import Store
+from workbench.tui.app import WorkbenchApp, make_app
+from workbench.tui.modals.signoff import SignoffModal
+from workbench.tui.screens.labs import LabsScreen
+from workbench.tui.screens.main import MainScreen
+
+from .support import run
+
+FAST = so.KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
+PASS = "correct horse battery"
+DRIVE = "unity-simulator/drive-by-wire"
+
+
+def lab_app(data_dir: Path, **kw) -> WorkbenchApp:
+    return make_app(paused=True, student="ana", partner="ben", data_dir=data_dir, **kw)
+
+
+def text(screen, selector: str) -> str:
+    return str(screen.query_one(selector, Static).render())
+
+
+async def open_exercise(pilot: Pilot, option_id: str = DRIVE) -> LabsScreen:
+    await pilot.press("l")
+    await pilot.pause()
+    screen = pilot.app.screen
+    assert isinstance(screen, LabsScreen)
+    listing = screen.query_one("#labs-list", OptionList)
+    listing.highlighted = listing.get_option_index(option_id)
+    await pilot.pause()
+    return screen
+
+
+async def complete_drive_by_wire(pilot: Pilot, screen: LabsScreen) -> None:
+    """Everything drive-by-wire asks: the five keys, an edited maze, the TCP port."""
+    await pilot.press("a")  # the set-up
+    await pilot.press("escape")
+    await pilot.press("w", "a", "s", "d", "space")
+    bench = pilot.app.bench
+    maze = bench.maze
+    inner = next((x, y) for y in range(1, maze.height - 1) for x in range(1, maze.width - 1)
+                 if maze.is_wall(x, y))  # fmt: skip
+    bench.load_maze(maze.with_block(*inner, wall=False))  # what the editor puts on the bench
+    await pilot.press("l")
+    await pilot.pause()
+    screen.query_one("#q-tcp-port", Input).value = "1350"
+    await pilot.pause()
+
+
+def test_l_opens_the_labs_and_escape_goes_back(tmp_path):
+    app = lab_app(tmp_path / "data")
+
+    async def body(pilot: Pilot) -> None:
+        screen = await open_exercise(pilot)
+        ids = [o.id for o in screen.query_one("#labs-list", OptionList).options]
+        assert "lab:unity-simulator" in ids and DRIVE in ids
+        assert "web-simulator/placing-sensors" in ids or len(ids) > 12
+        assert text(screen, "#labs-title") == "Unity simulator: Drive by wire"
+        await pilot.press("escape")
+        assert isinstance(app.screen, MainScreen)
+
+    run(app, body)
+
+
+def test_set_up_then_driving_flips_the_keys_objective_and_saves_progress(tmp_path):
+    data = tmp_path / "data"
+    app = lab_app(data, profile="web")
+
+    async def body(pilot: Pilot) -> None:
+        screen = await open_exercise(pilot)
+        assert text(screen, "#labs-objectives").startswith("✗ drove with w, a, s, d and space")
+        await pilot.press("a")
+        assert app.bench.profile == "unity"
+        assert "set up: unity" in text(screen, "#labs-message")
+        await pilot.press("escape")
+        await pilot.press("w", "a", "s", "d", "space")
+        await pilot.pause()
+        progress = app.store.progress("ana")[("unity-simulator", "drive-by-wire")]
+        assert progress["objectives"][0]["passed"] is True  # saved while the labs were closed
+        await pilot.press("l")
+        await pilot.pause()
+        lines = text(screen, "#labs-objectives").splitlines()
+        assert lines[0].startswith("✓ drove with w, a, s, d and space")
+        assert lines[1].startswith("✗ edited the maze")
+
+    run(app, body)
+
+
+def test_a_question_is_checked_as_it_is_answered(tmp_path):
+    app = lab_app(tmp_path / "data")
+
+    async def body(pilot: Pilot) -> None:
+        screen = await open_exercise(pilot)
+        reason = screen.query_one(".question-reason", Static)
+        assert str(reason.render()) == "not answered yet"
+        screen.query_one("#q-tcp-port", Input).focus()
+        await pilot.press("1", "3", "5", "1")
+        await pilot.pause()
+        assert str(reason.render()).startswith("✗")
+        await pilot.press("backspace", "0")
+        await pilot.pause()
+        assert str(reason.render()) == "✓ correct"
+        assert "✓ question answered" in text(screen, "#labs-objectives")
+        saved = app.store.progress("ana")[("unity-simulator", "drive-by-wire")]
+        assert saved["answers"] == {"tcp-port": "1350"}
+
+    run(app, body)
+
+
+def test_sign_off_happy_path_then_the_driver_changes(tmp_path):
+    data = tmp_path / "data"
+    so.create_instructor(data, "Dr Chen", PASS, kdf=FAST)
+    app = lab_app(data)
+
+    async def body(pilot: Pilot) -> None:
+        screen = await open_exercise(pilot)
+        await complete_drive_by_wire(pilot, screen)
+        assert screen.progress is not None and screen.progress.passed
+        await pilot.press("i")
+        await pilot.pause()
+        modal = app.screen
+        assert isinstance(modal, SignoffModal)
+        assert modal.query_one("#signoff-instructor", Select).value == "Dr Chen"
+        field = modal.query_one("#signoff-passphrase", Input)
+        assert field.password
+        field.value = PASS
+        field.focus()
+        await pilot.press("enter")
+        await pilot.pause()
+        assert "Signed off by Dr Chen" in text(modal, "#signoff-done")
+        await pilot.click("#signoff-driver-1")
+        await pilot.pause()
+        assert app.screen is screen
+        assert screen.driver == "ben"
+        assert text(screen, "#labs-message") == "signed off; ben drives next"
+        with Store.open(data) as store:
+            (row,) = store.signoffs(student="ana")
+            drivers = store.drivers("ana", "ben")
+        assert (row.lab, row.exercise, row.driver, row.override) == (
+            "unity-simulator",
+            "drive-by-wire",
+            "ana",
+            False,
+        )
+        assert row.evidence_digest == screen.progress.evidence_digest()
+        assert drivers[("unity-simulator", "drive-by-wire")] == "ana"
+        assert drivers[("unity-simulator", "reading-wall-following")] == "ben"
+        listing = screen.query_one("#labs-list", OptionList)
+        option = listing.get_option(DRIVE)
+        assert "✓" in str(option.prompt)
+
+    run(app, body)
+
+
+def test_a_wrong_passphrase_is_shown_and_nothing_is_signed(tmp_path):
+    data = tmp_path / "data"
+    so.create_instructor(data, "Dr Chen", PASS, kdf=FAST)
+    app = lab_app(data)
+
+    async def body(pilot: Pilot) -> None:
+        screen = await open_exercise(pilot)
+        await complete_drive_by_wire(pilot, screen)
+        await pilot.press("i")
+        await pilot.pause()
+        modal = app.screen
+        modal.query_one("#signoff-passphrase", Input).value = "not the passphrase"
+        await pilot.click("#signoff-sign")
+        await pilot.pause()
+        assert text(modal, "#signoff-status") == "wrong passphrase for Dr Chen"
+        assert modal.query_one("#signoff-passphrase", Input).value == ""
+        assert app.store.signoffs() == []
+        await pilot.press("escape")
+        assert app.screen is screen
+
+    run(app, body)
+
+
+def test_an_override_without_a_note_is_refused(tmp_path):
+    data = tmp_path / "data"
+    so.create_instructor(data, "Dr Chen", PASS, kdf=FAST)
+    app = lab_app(data)
+
+    async def body(pilot: Pilot) -> None:
+        await open_exercise(pilot)
+        await pilot.press("i")
+        await pilot.pause()
+        modal = app.screen
+        assert "override is needed" in text(modal, "#signoff-state")
+        note = modal.query_one("#signoff-note", Input)
+        modal.query_one("#signoff-passphrase", Input).value = PASS
+        note.focus()
+        await pilot.press("enter")  # as the Sign off button does
+        await pilot.pause()
+        assert "sign off with an override" in text(modal, "#signoff-status")
+        modal.query_one("#signoff-override", Checkbox).value = True
+        modal.query_one("#signoff-passphrase", Input).value = PASS
+        await pilot.press("enter")
+        await pilot.pause()
+        assert text(modal, "#signoff-status") == "an override needs a note saying why"
+        note.value = "showed it on the lab robot"
+        modal.query_one("#signoff-passphrase", Input).value = PASS
+        await pilot.press("enter")
+        await pilot.pause()
+        assert "(override)" in text(modal, "#signoff-done")
+        (row,) = app.store.signoffs()
+        assert row.override and row.note == "showed it on the lab robot"
+
+    run(app, body)
+
+
+def test_without_a_roster_the_dialog_says_how_to_add_an_instructor(tmp_path):
+    app = lab_app(tmp_path / "data")
+
+    async def body(pilot: Pilot) -> None:
+        await open_exercise(pilot)
+        await pilot.press("i")
+        await pilot.pause()
+        modal = app.screen
+        assert "workbench instructor add NAME" in text(modal, "#signoff-status")
+        await pilot.click("#signoff-sign")
+        assert isinstance(app.screen, SignoffModal)
+        assert not modal.query_one("#signoff-next").display
+        assert isinstance(modal.query_one("#signoff-cancel"), Button)
+
+    run(app, body)
+
+
+def test_a_data_folder_that_cannot_open_is_reported_and_the_labs_still_work(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    app = lab_app(blocker)
+
+    async def body(pilot: Pilot) -> None:
+        screen = await open_exercise(pilot)
+        assert app.store is None
+        assert text(screen, "#labs-message").startswith("cannot open the data folder")
+        await pilot.press("a")
+        assert app.bench.profile == "unity"
+        await pilot.press("i")
+        assert app.screen is screen
+        assert "cannot open the data folder" in text(screen, "#labs-message")
+
+    run(app, body)

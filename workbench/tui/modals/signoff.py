@@ -1,0 +1,261 @@
+"""The instructor's sign-off of one exercise, at the student's terminal.
+
+The instructor picks their name from the roster and types their passphrase; a note is optional
+unless the sign-off overrides objectives that have not passed. Problems (a wrong passphrase, a
+lock after too many, no roster) are shown in the dialog. After a sign-off the dialog asks who
+drives next and records it; it returns that driver (None when closed without signing).
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+from textual import on
+from textual.app import ComposeResult
+from textual.binding import Binding, BindingType
+from textual.containers import Horizontal, Vertical
+from textual.screen import ModalScreen
+from textual.widgets import Button, Checkbox, Input, Label, Select, Static
+
+from workbench.labs.checks import ExerciseProgress
+from workbench.labs.signoff import (
+    Evidence,
+    LockedOut,
+    RecordFields,
+    SignoffError,
+    load_roster,
+    roster_path,
+    sign_off,
+)
+from workbench.labs.store import Store
+
+
+class SignoffModal(ModalScreen[str | None]):
+    """Sign off an exercise; then choose who drives next."""
+
+    DEFAULT_CSS = """
+    SignoffModal {
+        align: center middle;
+    }
+    SignoffModal > #signoff-dialog {
+        width: 70;
+        height: auto;
+        max-height: 100%;
+        border: round $primary;
+        border-title-color: $text-primary;
+        border-subtitle-color: $text-muted;
+        background: $surface;
+        padding: 0 1;
+    }
+    SignoffModal #signoff-form, SignoffModal #signoff-next {
+        height: auto;
+    }
+    SignoffModal .field-row {
+        height: 1;
+        margin-top: 1;
+    }
+    SignoffModal .field-row Label {
+        width: 13;
+    }
+    SignoffModal #signoff-override {
+        margin-top: 1;
+    }
+    SignoffModal .field-row Input, SignoffModal .field-row Select {
+        width: 1fr;
+    }
+    SignoffModal #signoff-state {
+        height: auto;
+        color: $text-muted;
+    }
+    SignoffModal .button-row {
+        height: 1;
+        margin-top: 1;
+    }
+    SignoffModal .button-row Button {
+        margin-right: 2;
+        min-width: 0;
+        width: auto;
+    }
+    SignoffModal .spacer {
+        width: 1fr;
+    }
+    SignoffModal #signoff-status {
+        height: auto;
+        color: $text-warning;
+    }
+    SignoffModal #signoff-done {
+        height: auto;
+        color: $text-success;
+    }
+    """
+
+    BINDINGS: ClassVar[list[BindingType]] = [
+        Binding("escape", "close", "Close", id="dialog.close"),
+    ]
+
+    def __init__(
+        self,
+        store: Store,
+        progress: ExerciseProgress,
+        student: str,
+        partner: str = "",
+        driver: str = "",
+    ) -> None:
+        super().__init__()
+        self.store = store
+        self.progress = progress
+        self.student = student
+        self.partner = partner
+        self.driver = driver or student
+        self.signed = False
+        try:
+            self.roster = sorted(load_roster(roster_path(store.data_dir)))
+            self.roster_problem = "" if self.roster else "the roster has no instructors yet"
+        except SignoffError as exc:
+            self.roster = []
+            self.roster_problem = str(exc)
+        if self.roster_problem:
+            self.roster_problem += ": add one with 'workbench instructor add NAME'"
+
+    def compose(self) -> ComposeResult:
+        progress = self.progress
+        dialog = Vertical(id="signoff-dialog")
+        dialog.border_title = f"Sign off {progress.lab}/{progress.exercise}"
+        dialog.border_subtitle = "escape closes"
+        who = self.student + (f" and {self.partner}" if self.partner else "")
+        passed = sum(o.passed for o in progress.objectives)
+        state = (
+            "all objectives pass"
+            if progress.passed
+            else f"{passed} of {len(progress.objectives)} objectives pass: an override is needed"
+        )
+        with dialog:
+            yield Static(f"{who}, driver {self.driver}; {state}", id="signoff-state", markup=False)
+            with Vertical(id="signoff-form"):
+                with Horizontal(classes="field-row"):
+                    yield Label("Instructor")
+                    yield Select(
+                        [(name, name) for name in self.roster],
+                        prompt="choose",
+                        value=self.roster[0] if len(self.roster) == 1 else Select.NULL,
+                        id="signoff-instructor",
+                        compact=True,
+                    )
+                with Horizontal(classes="field-row"):
+                    yield Label("Passphrase")
+                    yield Input(password=True, id="signoff-passphrase", compact=True)
+                with Horizontal(classes="field-row"):
+                    yield Label("Note")
+                    yield Input(
+                        placeholder="optional; required with an override",
+                        id="signoff-note",
+                        compact=True,
+                    )
+                yield Checkbox(
+                    "Override: sign off although objectives have not passed",
+                    value=False,
+                    id="signoff-override",
+                    compact=True,
+                )
+                with Horizontal(classes="button-row"):
+                    yield Static(classes="spacer")
+                    yield Button("Sign off", id="signoff-sign", variant="primary", compact=True)
+                    yield Button("Cancel", id="signoff-cancel", compact=True)
+            with Vertical(id="signoff-next"):
+                yield Static("", id="signoff-done", markup=False)
+                yield Label("Who drives the next exercise?")
+                with Horizontal(classes="button-row"):
+                    for i, person in enumerate(self._people()):
+                        yield Button(person, id=f"signoff-driver-{i}", compact=True)
+            yield Static(self.roster_problem, id="signoff-status", markup=False)
+
+    def _people(self) -> list[str]:
+        return [self.student, self.partner] if self.partner else [self.student]
+
+    def on_mount(self) -> None:
+        self.query_one("#signoff-next").display = False
+        if self.roster:
+            field = "#signoff-passphrase" if len(self.roster) == 1 else "#signoff-instructor"
+            self.query_one(field).focus()
+
+    # -- signing ---------------------------------------------------------------------------
+    def _say(self, message: str) -> None:
+        self.query_one("#signoff-status", Static).update(message)
+
+    @on(Input.Submitted, "#signoff-passphrase")
+    @on(Input.Submitted, "#signoff-note")
+    @on(Button.Pressed, "#signoff-sign")
+    def _sign(self) -> None:
+        if self.signed:
+            return
+        if not self.roster:
+            self._say(self.roster_problem)
+            return
+        instructor = self.query_one("#signoff-instructor", Select).value
+        if instructor is Select.NULL or not isinstance(instructor, str):
+            self._say("choose the instructor")
+            return
+        passphrase = self.query_one("#signoff-passphrase", Input)
+        note = self.query_one("#signoff-note", Input).value
+        override = self.query_one("#signoff-override", Checkbox).value
+        progress = self.progress
+        fields = RecordFields(
+            student=self.student,
+            lab=progress.lab,
+            exercise=progress.exercise,
+            driver=self.driver,
+            partner=self.partner,
+            evidence=evidence_of(progress),
+            objectives_passed=progress.passed,
+        )
+        try:
+            sign_off(self.store, instructor, passphrase.value, fields, override, note)
+        except LockedOut as exc:
+            passphrase.value = ""
+            self._say(f"locked: try again in {exc.seconds:.0f} s ({exc})")
+            return
+        except SignoffError as exc:
+            passphrase.value = ""
+            self._say(str(exc))
+            return
+        except Exception as exc:
+            self._say(f"not signed: {exc}")
+            return
+        self.signed = True
+        try:
+            self.store.set_driver(
+                self.student, self.partner, progress.lab, progress.exercise, self.driver
+            )
+        except Exception as exc:
+            self._say(f"signed, but the driver was not recorded: {exc}")
+        self.query_one("#signoff-form").display = False
+        self.query_one("#signoff-done", Static).update(
+            f"Signed off by {instructor}{' (override)' if override else ''}."
+        )
+        self.query_one("#signoff-next").display = True
+        if not self.roster_problem:
+            self._say("")
+        self.query_one("#signoff-driver-0", Button).focus()
+
+    @on(Button.Pressed, "#signoff-cancel")
+    def action_close(self) -> None:
+        self.dismiss(self.driver if self.signed else None)
+
+    @on(Button.Pressed, ".button-row Button")
+    def _driver(self, event: Button.Pressed) -> None:
+        button_id = event.button.id or ""
+        if not button_id.startswith("signoff-driver-"):
+            return
+        self.dismiss(self._people()[int(button_id.rsplit("-", 1)[1])])
+
+
+def evidence_of(progress: ExerciseProgress) -> Evidence:
+    """What a sign-off keeps of the checks: their digest and each objective's evidence."""
+    metrics = {
+        "objectives": [
+            {"kind": o.kind, "passed": o.passed, "evidence": o.evidence}
+            for o in progress.objectives
+        ],
+        "evidence_digest": progress.evidence_digest(),
+    }
+    return Evidence(run_record="", digest=progress.evidence_digest(), metrics=metrics)

@@ -1,0 +1,347 @@
+"""The labs screen: the course's lab exercises, their instructions and their live checks.
+
+On the left, every lab and its exercises (✓ once an exercise's objectives pass or it has been
+signed off); on the right, the chosen exercise: its instructions, its objectives with ✓/✗ and
+a one-line reason that follow the bench as the student works, and its questions. ``a`` puts
+the exercise's set-up on the bench, ``i`` opens the instructor's sign-off. Progress is saved
+in the store each time an objective changes state.
+"""
+
+from __future__ import annotations
+
+import json
+from typing import ClassVar
+
+from textual import on
+from textual.app import ComposeResult
+from textual.binding import Binding, BindingType
+from textual.containers import Horizontal, Vertical, VerticalScroll
+from textual.screen import Screen
+from textual.widgets import Footer, Input, Label, Markdown, OptionList, Static
+from textual.widgets.option_list import Option
+
+from workbench.control.bench import Bench
+from workbench.labs.checks import ExerciseProgress, apply_setup, evaluate
+from workbench.labs.model import Exercise, Lab, LabFileError, load_labs
+from workbench.labs.store import Store
+from workbench.sim.session import Snapshot
+
+PASS, FAIL, OPEN = "✓", "✗", "·"
+
+
+class LabsScreen(Screen[None]):
+    """Choose an exercise, set it up, watch its objectives, answer its questions."""
+
+    DEFAULT_CSS = """
+    LabsScreen #labs-body {
+        height: 1fr;
+    }
+    LabsScreen #labs-list {
+        width: 28;
+        height: 1fr;
+    }
+    LabsScreen #labs-exercise {
+        width: 1fr;
+        height: 1fr;
+        padding: 0 0 0 1;
+    }
+    LabsScreen #labs-scroll {
+        height: 1fr;
+    }
+    LabsScreen #labs-title {
+        text-style: bold;
+        color: $text-primary;
+    }
+    LabsScreen #labs-instructions {
+        margin: 0;
+        padding: 0;
+        height: auto;
+    }
+    LabsScreen #labs-objectives {
+        height: auto;
+        max-height: 8;
+        margin-bottom: 1;
+    }
+    LabsScreen #labs-questions {
+        height: auto;
+    }
+    LabsScreen .question {
+        height: auto;
+    }
+    LabsScreen .question Input {
+        width: 1fr;
+    }
+    LabsScreen .question-reason {
+        color: $text-muted;
+    }
+    LabsScreen #labs-message {
+        height: 1;
+        padding: 0 1;
+        color: $text-warning;
+    }
+    """
+
+    BINDINGS: ClassVar[list[BindingType]] = [
+        Binding("escape", "close", "Back", id="labs.close"),
+        Binding("a", "apply_setup", "Set up", id="labs.setup"),
+        Binding("i", "sign_off", "Sign off", id="labs.signoff"),
+    ]
+
+    def __init__(
+        self,
+        bench: Bench,
+        store: Store | None,
+        student: str,
+        partner: str = "",
+        labs: list[Lab] | None = None,
+        store_problem: str = "",
+    ) -> None:
+        super().__init__()
+        self.bench = bench
+        self.store = store
+        self.student = student
+        self.partner = partner
+        self.driver = student
+        self._problem = ""
+        if labs is None:
+            try:
+                labs = load_labs()
+            except LabFileError as exc:
+                labs = []
+                self._problem = str(exc)
+        self.labs = labs
+        self._store_problem = store_problem
+        self._ready = False
+        self.selected: tuple[Lab, Exercise] | None = None
+        self.answers: dict[tuple[str, str], dict[str, str]] = {}
+        self.progress: ExerciseProgress | None = None
+        self._states: dict[tuple[str, str], tuple[bool, ...]] = {}
+        self._done: set[tuple[str, str]] = set()
+        self._signed: set[tuple[str, str]] = set()
+        self._load_saved()
+
+    # -- store ---------------------------------------------------------------------------
+    def _load_saved(self) -> None:
+        if self.store is None:
+            return
+        try:
+            saved = self.store.progress(self.student)
+            signed = self.store.signoffs(student=self.student)
+        except Exception as exc:  # a damaged database must not stop the lab
+            self._store_problem = f"cannot read saved progress: {exc}"
+            return
+        for key, data in saved.items():
+            if data.get("passed"):
+                self._done.add(key)
+            answers = data.get("answers")
+            if isinstance(answers, dict):
+                self.answers[key] = {str(k): str(v) for k, v in answers.items()}
+        self._signed = {(row.lab, row.exercise) for row in signed}
+
+    def _save(self, progress: ExerciseProgress) -> None:
+        key = (progress.lab, progress.exercise)
+        if progress.passed:
+            self._done.add(key)
+        if self.store is None:
+            return
+        try:
+            self.store.save_progress(self.student, progress.lab, progress.exercise, _json(progress))
+        except Exception as exc:
+            self.say(f"progress not saved: {exc}")
+
+    # -- layout --------------------------------------------------------------------------
+    def compose(self) -> ComposeResult:
+        with Horizontal(id="labs-body"):
+            yield OptionList(*self._options(), id="labs-list")
+            with Vertical(id="labs-exercise"):
+                yield Label("", id="labs-title", markup=False)
+                yield Static("", id="labs-objectives", markup=False)
+                with VerticalScroll(id="labs-scroll"):
+                    yield Markdown("", id="labs-instructions")
+                    yield Vertical(id="labs-questions")
+        yield Static("", id="labs-message", markup=False)
+        yield Footer(compact=True, show_command_palette=False)
+
+    def _options(self) -> list[Option]:
+        options: list[Option] = []
+        for lab in self.labs:
+            options.append(Option(lab.title, id=f"lab:{lab.id}", disabled=True))
+            for ex in lab.exercises:
+                key = (lab.id, ex.id)
+                mark = PASS if key in self._done or key in self._signed else OPEN
+                options.append(Option(f"{mark} {ex.title}", id=f"{lab.id}/{ex.id}"))
+        return options
+
+    def on_mount(self) -> None:
+        self._ready = True
+        problem = self._problem or self._store_problem
+        if problem:
+            self.say(problem)
+        listing = self.query_one("#labs-list", OptionList)
+        for index, option in enumerate(listing.options):
+            if not option.disabled:
+                listing.highlighted = index
+                break
+        listing.focus()
+
+    def on_screen_resume(self) -> None:
+        self.show_snapshot(self.bench.snapshot())
+
+    def _refresh_list(self) -> None:
+        listing = self.query_one("#labs-list", OptionList)
+        highlighted = listing.highlighted
+        listing.clear_options()
+        listing.add_options(self._options())
+        listing.highlighted = highlighted
+
+    # -- choosing ------------------------------------------------------------------------
+    @on(OptionList.OptionHighlighted, "#labs-list")
+    def _chosen(self, event: OptionList.OptionHighlighted) -> None:
+        option_id = event.option.id or ""
+        if "/" not in option_id:
+            return
+        lab_id, ex_id = option_id.split("/", 1)
+        lab = next(lab for lab in self.labs if lab.id == lab_id)
+        exercise = lab.exercise(ex_id)
+        if self.selected == (lab, exercise):
+            return
+        self.selected = (lab, exercise)
+        self.progress = None
+        self.query_one("#labs-title", Label).update(f"{lab.title}: {exercise.title}")
+        self.query_one("#labs-instructions", Markdown).update(exercise.instructions)
+        box = self.query_one("#labs-questions", Vertical)
+        box.remove_children()
+        answers = self.answers.get((lab.id, exercise.id), {})
+        for q in exercise.questions:
+            field = Input(
+                answers.get(q.id, ""),
+                placeholder=" / ".join(q.choices) if q.choices else q.unit or "answer",
+                id=f"q-{q.id}",
+            )
+            box.mount(
+                Vertical(
+                    Label(q.text, markup=False),
+                    field,
+                    Static(self._answer_reason(exercise, q.id), classes="question-reason"),
+                    classes="question",
+                )
+            )
+        self.show_snapshot(self.bench.snapshot())
+
+    def _answer_reason(self, exercise: Exercise, question_id: str) -> str:
+        lab = self.selected[0] if self.selected else None
+        answers = self.answers.get((lab.id, exercise.id), {}) if lab else {}
+        text = answers.get(question_id, "").strip()
+        if not text:
+            return "not answered yet"
+        q = next(q for q in exercise.questions if q.id == question_id)
+        ok, reason = q.check(text)
+        return f"{PASS if ok else FAIL} {reason}"
+
+    @on(Input.Submitted)
+    @on(Input.Changed)
+    def _answered(self, event: Input.Changed | Input.Submitted) -> None:
+        field_id = event.input.id or ""
+        if not field_id.startswith("q-") or self.selected is None:
+            return
+        lab, exercise = self.selected
+        question_id = field_id[2:]
+        self.answers.setdefault((lab.id, exercise.id), {})[question_id] = event.value
+        box = event.input.parent
+        if box is not None:
+            box.query_one(".question-reason", Static).update(
+                self._answer_reason(exercise, question_id)
+            )
+        self.show_snapshot(self.bench.snapshot())
+
+    # -- live checks ---------------------------------------------------------------------
+    def track(self) -> ExerciseProgress | None:
+        """Check the chosen exercise against the bench; save it when an objective changed."""
+        if self.selected is None:
+            return None
+        lab, exercise = self.selected
+        key = (lab.id, exercise.id)
+        progress = evaluate(lab.id, exercise, self.bench, self.answers.get(key, {}))
+        states = tuple(o.passed for o in progress.objectives)
+        if self._states.get(key) != states:
+            first = key not in self._states
+            self._states[key] = states
+            if not first or any(states):
+                was_done = key in self._done
+                self._save(progress)
+                if self._ready and (key in self._done) != was_done:
+                    self._refresh_list()
+        self.progress = progress
+        return progress
+
+    def show_snapshot(self, snapshot: Snapshot) -> None:
+        if not self._ready:
+            return
+        progress = self.track()
+        if progress is None:
+            return
+        lines = [f"{PASS if o.passed else FAIL} {o.text}: {o.reason}" for o in progress.objectives]
+        self.query_one("#labs-objectives", Static).update("\n".join(lines))
+
+    def say(self, message: str) -> None:
+        if self._ready:
+            self.query_one("#labs-message", Static).update(message)
+        else:
+            self._problem = message
+
+    # -- actions -------------------------------------------------------------------------
+    def action_close(self) -> None:
+        self.app.pop_screen()
+
+    def action_apply_setup(self) -> None:
+        if self.selected is None:
+            self.say("choose an exercise first")
+            return
+        exercise = self.selected[1]
+        try:
+            apply_setup(self.bench, exercise.setup)
+        except Exception as exc:
+            self.say(f"cannot set up {exercise.title}: {exc}")
+            return
+        refresh = getattr(self.app, "set_up_done", None)
+        if refresh is not None:
+            refresh()
+        setup = exercise.setup
+        self.say(f"set up: {setup.profile}, {setup.maze.name}, {setup.controller}")
+        self.show_snapshot(self.bench.snapshot())
+
+    def action_sign_off(self) -> None:
+        if self.selected is None:
+            self.say("choose an exercise first")
+            return
+        if self.store is None:
+            self.say(self._store_problem or "no data folder: sign-off is not available")
+            return
+        from ..modals.signoff import SignoffModal
+
+        progress = self.track()
+        assert progress is not None
+        self.app.push_screen(
+            SignoffModal(self.store, progress, self.student, self.partner, self.driver),
+            self._signed_off,
+        )
+
+    def _signed_off(self, driver: str | None) -> None:
+        if driver is None or self.selected is None:
+            return
+        lab, exercise = self.selected
+        self._signed.add((lab.id, exercise.id))
+        self.driver = driver
+        following = list(lab.exercises)[list(lab.exercises).index(exercise) + 1 :]
+        if following and self.store is not None:
+            try:
+                self.store.set_driver(self.student, self.partner, lab.id, following[0].id, driver)
+            except Exception as exc:
+                self.say(f"signed off; the next driver was not recorded: {exc}")
+                return
+        self._refresh_list()
+        self.say(f"signed off; {driver} drives next")
+
+
+def _json(progress: ExerciseProgress) -> dict:
+    return json.loads(progress.to_json())
