@@ -1,0 +1,79 @@
+"""SVG snapshots of the labs screen, the sign-off dialog and the driver-change prompt at 80x24.
+
+The app is paused, the student and partner are named, the data folder is a fresh temporary
+one, input cursors do not blink and buttons are pressed by keys, so the pictures are the same
+on every run.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from textual.pilot import Pilot
+from textual.widgets import Checkbox, Input, OptionList
+
+from workbench.labs import signoff as so
+from workbench.tui.app import WorkbenchApp, make_app
+
+FAST = so.KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
+PASS = "correct horse battery"
+SIZE = (80, 24)
+
+
+def lab_app(data_dir: Path, instructor: bool = True) -> WorkbenchApp:
+    if instructor:
+        so.create_instructor(data_dir, "Dr Chen", PASS, kdf=FAST)
+    return make_app(paused=True, student="ana", partner="ben", data_dir=data_dir)
+
+
+def still(pilot: Pilot) -> None:
+    for field in pilot.app.screen.query(Input):
+        field.cursor_blink = False
+
+
+async def open_drive_by_wire(pilot: Pilot) -> None:
+    await pilot.press("l")
+    await pilot.pause()
+    listing = pilot.app.screen.query_one("#labs-list", OptionList)
+    listing.highlighted = listing.get_option_index("unity-simulator/drive-by-wire")
+    await pilot.pause()
+    await pilot.press("a")
+    await pilot.press("escape", "w", "a", "s", "d", "space", "l")
+    await pilot.pause()
+    still(pilot)
+    await pilot.pause()
+
+
+def test_labs_exercise_with_objectives_in_both_states(snap_compare, tmp_path):
+    app = lab_app(tmp_path / "data", instructor=False)
+    assert snap_compare(app, terminal_size=SIZE, run_before=open_drive_by_wire)
+
+
+def test_signoff_dialog(snap_compare, tmp_path):
+    async def before(pilot: Pilot) -> None:
+        await open_drive_by_wire(pilot)
+        await pilot.press("i")
+        await pilot.pause()
+        still(pilot)
+        await pilot.pause()
+
+    assert snap_compare(lab_app(tmp_path / "data"), terminal_size=SIZE, run_before=before)
+
+
+def test_driver_change_prompt_after_an_override(snap_compare, tmp_path):
+    async def before(pilot: Pilot) -> None:
+        await open_drive_by_wire(pilot)
+        await pilot.press("i")
+        await pilot.pause()
+        modal = pilot.app.screen
+        modal.query_one("#signoff-override", Checkbox).value = True
+        modal.query_one("#signoff-note", Input).value = "showed it on the lab robot"
+        field = modal.query_one("#signoff-passphrase", Input)
+        field.value = PASS
+        field.focus()
+        await pilot.press("enter")
+        await pilot.pause()
+        still(pilot)
+        await pilot.pause()
+
+    assert snap_compare(lab_app(tmp_path / "data"), terminal_size=SIZE, run_before=before)
