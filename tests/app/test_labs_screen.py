@@ -4,9 +4,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
 from textual.pilot import Pilot
 from textual.widgets import Button, Checkbox, Input, OptionList, Select, Static
 
+from workbench.cli import build_parser
 from workbench.labs import signoff as so
 from workbench.labs.store import Store
 from workbench.tui.app import WorkbenchApp, make_app
@@ -182,6 +184,47 @@ def test_a_wrong_passphrase_is_shown_and_nothing_is_signed(tmp_path):
         assert app.screen is screen
 
     run(app, body)
+
+
+def test_a_locked_out_instructor_is_told_for_how_long(tmp_path):
+    data = tmp_path / "data"
+    so.create_instructor(data, "Dr Chen", PASS, kdf=FAST)
+    fields = so.RecordFields("ana", "unity-simulator", "drive-by-wire", objectives_passed=True)
+    with Store.open(data) as store:
+        for _ in range(so.FAILURE_LIMIT - 1):
+            with pytest.raises(so.WrongPassphrase):
+                so.sign_off(store, "Dr Chen", "not the passphrase", fields)
+    app = lab_app(data)
+
+    async def body(pilot: Pilot) -> None:
+        await open_exercise(pilot)
+        await pilot.press("i")
+        await pilot.pause()
+        modal = app.screen
+        modal.query_one("#signoff-override", Checkbox).value = True
+        modal.query_one("#signoff-note", Input).value = "checked by hand"
+        field = modal.query_one("#signoff-passphrase", Input)
+        field.value = "still not the passphrase"
+        field.focus()
+        await pilot.press("enter")
+        await pilot.pause()
+        assert text(modal, "#signoff-status").startswith(
+            "sign-off by Dr Chen is locked for 60 s more"
+        )
+        field.value = PASS
+        await pilot.press("enter")
+        await pilot.pause()
+        assert "is locked for" in text(modal, "#signoff-status")
+        assert app.store.signoffs() == []
+
+    run(app, body)
+
+
+def test_the_command_line_names_the_student_partner_and_data_folder():
+    args = build_parser().parse_args(["--student", "ana", "--partner", "ben", "--data-dir", "d"])
+    assert (args.student, args.partner, args.data_dir) == ("ana", "ben", "d")
+    args = build_parser().parse_args([])
+    assert (args.student, args.partner, args.data_dir) == (None, "", None)
 
 
 def test_an_override_without_a_note_is_refused(tmp_path):

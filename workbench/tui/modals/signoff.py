@@ -212,7 +212,7 @@ class SignoffModal(ModalScreen[str | None]):
             sign_off(self.store, instructor, passphrase.value, fields, override, note)
         except LockedOut as exc:
             passphrase.value = ""
-            self._say(f"locked: try again in {exc.seconds:.0f} s ({exc})")
+            self._say(str(exc))
             return
         except SignoffError as exc:
             passphrase.value = ""
@@ -229,6 +229,7 @@ class SignoffModal(ModalScreen[str | None]):
         except Exception as exc:
             self._say(f"signed, but the driver was not recorded: {exc}")
         self.query_one("#signoff-form").display = False
+        self.query_one("#signoff-state").display = False
         self.query_one("#signoff-done", Static).update(
             f"Signed off by {instructor}{' (override)' if override else ''}."
         )
