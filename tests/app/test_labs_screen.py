@@ -162,6 +162,17 @@ def test_sign_off_happy_path_then_the_driver_changes(tmp_path):
 
     run(app, body)
 
+    again = lab_app(data)
+
+    async def later(pilot: Pilot) -> None:
+        screen = await open_exercise(pilot, DRIVE)
+        assert screen.driver == "ana"  # who drove it, from the store
+        assert "✓" in str(screen.query_one("#labs-list", OptionList).get_option(DRIVE).prompt)
+        await open_exercise(pilot, "unity-simulator/reading-wall-following")
+        assert screen.driver == "ben"
+
+    run(again, later)
+
 
 def test_a_wrong_passphrase_is_shown_and_nothing_is_signed(tmp_path):
     data = tmp_path / "data"

@@ -118,6 +118,7 @@ class LabsScreen(Screen[None]):
         self._states: dict[tuple[str, str], tuple[bool, ...]] = {}
         self._done: set[tuple[str, str]] = set()
         self._signed: set[tuple[str, str]] = set()
+        self._drivers: dict[tuple[str, str], str] = {}
         self._load_saved()
 
     # -- store ---------------------------------------------------------------------------
@@ -127,6 +128,7 @@ class LabsScreen(Screen[None]):
         try:
             saved = self.store.progress(self.student)
             signed = self.store.signoffs(student=self.student)
+            self._drivers = self.store.drivers(self.student, self.partner)
         except Exception as exc:  # a damaged database must not stop the lab
             self._store_problem = f"cannot read saved progress: {exc}"
             return
@@ -206,6 +208,7 @@ class LabsScreen(Screen[None]):
         if self.selected == (lab, exercise):
             return
         self.selected = (lab, exercise)
+        self.driver = self._drivers.get((lab.id, exercise.id), self.driver)
         self.progress = None
         self.query_one("#labs-title", Label).update(f"{lab.title}: {exercise.title}")
         self.query_one("#labs-instructions", Markdown).update(exercise.instructions)
@@ -331,8 +334,11 @@ class LabsScreen(Screen[None]):
             return
         lab, exercise = self.selected
         self._signed.add((lab.id, exercise.id))
+        self._drivers[(lab.id, exercise.id)] = self.driver
         self.driver = driver
         following = list(lab.exercises)[list(lab.exercises).index(exercise) + 1 :]
+        if following:
+            self._drivers[(lab.id, following[0].id)] = driver
         if following and self.store is not None:
             try:
                 self.store.set_driver(self.student, self.partner, lab.id, following[0].id, driver)
