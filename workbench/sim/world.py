@@ -402,6 +402,7 @@ class World:
         x0 = self._x
         y0 = self._y
         a0 = self._angle
+        free = False
         if self._contacts == 0:
             if target is not None:
                 v = 0.0
@@ -427,9 +428,35 @@ class World:
                 box = self._box = self._free_box(x0, y0)
             if box[0] <= x <= box[1] and box[2] <= y <= box[3]:
                 # free motion: no wall within reach, so no contact can start this step
+                free = True
                 self._free_w = w
                 self._physics_stale = True
-                return self._advance(x, y, a0 + w * dt, target, abs(v) * dt, abs(w) * dt)
+                a = a0 + w * dt
+                moved = abs(v) * dt
+                turned = abs(w) * dt
+        if not free:
+            x, y, a = self._physics_step(target, a0)
+            moved = math.hypot(x - x0, y - y0)
+            turned = abs(a - a0)
+        self._steps += 1
+        self.time = t = self._steps * dt
+        self._distance += moved
+        self._turned += turned
+        self._x = x
+        self._y = y
+        self._angle = a
+        self._readings = None
+        if (
+            target is None
+            and not self._new_collision
+            and (self._exit_time is not None or not self._has_exits)
+        ):
+            return _NO_EVENTS  # nothing can have happened: the common step ends here
+        return self._events(t, x, y, a, target)
+
+    def _physics_step(self, target: float | None, a0: float) -> tuple[float, float, float]:
+        """One pymunk step; the robot's new x, y and angle."""
+        dt = self.dt
         if self._physics_stale:
             self._sync_body()
         if target is not None:
@@ -445,23 +472,12 @@ class World:
         # mass checks) has nothing to do for this space after it is built
         _space_step(self._space_ptr, dt)
         pos = _get_position(self._body_ptr)
-        x = pos.x
-        y = pos.y
-        a = _get_angle(self._body_ptr)
-        return self._advance(x, y, a, target, math.hypot(x - x0, y - y0), abs(a - a0))
+        return pos.x, pos.y, _get_angle(self._body_ptr)
 
-    def _advance(
-        self, x: float, y: float, a: float, target: float | None, moved: float, turned: float
+    def _events(
+        self, t: float, x: float, y: float, a: float, target: float | None
     ) -> tuple[str, ...]:
-        """Take the new pose and odometry; the step's events."""
-        self._steps += 1
-        self.time = t = self._steps * self.dt
-        self._distance += moved
-        self._turned += turned
-        self._x = x
-        self._y = y
-        self._angle = a
-        self._readings = None
+        """What the step that just ended brought: a finished turn, a collision, the exit."""
         events = _NO_EVENTS
         if target is not None and abs(target - a) < _TURN_EPS:
             self._turn_target = None
