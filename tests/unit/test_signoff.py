@@ -415,3 +415,28 @@ def test_a_killed_process_keeps_what_it_committed(data_dir):
         saved = s.progress("alice")
     assert last >= 30
     assert all(("lab", f"ex{i}") in saved for i in range(last + 1))
+
+
+def test_evidence_of_an_exercise_points_at_the_run_record_it_rests_on(tmp_path):
+    from types import SimpleNamespace
+
+    from workbench.labs.signoff import Evidence, record_digest
+
+    record = tmp_path / "run-001.jsonl"
+    record.write_text('{"type":"header"}\n')
+    sha = record_digest(record).removeprefix("sha256:")
+    progress = SimpleNamespace(
+        objectives=[
+            SimpleNamespace(kind="keys", passed=True, evidence={"keys": ["w"]}),
+            SimpleNamespace(
+                kind="exit", passed=True, evidence={"record": str(record), "record_sha256": sha}
+            ),
+        ],
+        evidence_digest=lambda: "abc",
+    )
+    evidence = Evidence.of_progress(progress)
+    assert (evidence.run_record, evidence.digest) == (str(record), sha)
+    assert evidence.metrics["evidence_digest"] == "abc"
+    assert [o["kind"] for o in evidence.metrics["objectives"]] == ["keys", "exit"]
+    progress.objectives[1].passed = False
+    assert Evidence.of_progress(progress).run_record == ""

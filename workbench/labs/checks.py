@@ -19,6 +19,7 @@ from workbench.control.bench import VIPLE_PREFIX, Bench, RunEntry
 from workbench.sim.maze import Maze
 from workbench.sim.mazeio import load_maze
 from workbench.sim.profiles import get_profile
+from workbench.sim.record import file_sha256
 
 from .model import Exercise, Objective, Setup
 
@@ -97,7 +98,7 @@ def record_digest(path: str | None) -> str | None:
     if not path:
         return None
     try:
-        return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+        return file_sha256(path)
     except OSError:
         return None
 

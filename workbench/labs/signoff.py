@@ -31,6 +31,7 @@ from cryptography.hazmat.primitives.ciphers.aead import AESGCM
 from cryptography.hazmat.primitives.kdf.scrypt import Scrypt
 
 from workbench.sim.mazefile import write_text_atomic
+from workbench.sim.record import file_sha256
 
 from .store import Store, StoredSignoff, utc_iso
 
@@ -327,6 +328,22 @@ class Evidence:
     digest: str = ""
     metrics: dict[str, Any] = field(default_factory=dict)
 
+    @classmethod
+    def of_progress(cls, progress: Any) -> Evidence:
+        """The evidence of an exercise's checks (an ``ExerciseProgress``): the run record of
+        the first passing objective that rests on one, and every objective's evidence with
+        the digest of them all."""
+        objectives = [
+            {"kind": o.kind, "passed": o.passed, "evidence": o.evidence}
+            for o in progress.objectives
+        ]
+        metrics = {"objectives": objectives, "evidence_digest": progress.evidence_digest()}
+        for o in progress.objectives:
+            record, sha = o.evidence.get("record"), o.evidence.get("record_sha256")
+            if o.passed and record and sha:
+                return cls(run_record=str(record), digest=sha, metrics=metrics)
+        return cls(run_record="", digest=progress.evidence_digest(), metrics=metrics)
+
 
 @dataclass(frozen=True)
 class RecordFields:
@@ -404,14 +421,10 @@ def canonical_json(value: Any) -> str:
 
 def record_digest(path: str | os.PathLike) -> str:
     """The evidence digest of a run record: ``sha256:`` and the hex SHA-256 of its bytes."""
-    h = hashlib.sha256()
     try:
-        with open(path, "rb") as fh:
-            for chunk in iter(lambda: fh.read(1 << 16), b""):
-                h.update(chunk)
+        return f"sha256:{file_sha256(path)}"
     except OSError as exc:
         raise SignoffError(f"{path}: cannot read the run record: {exc.strerror}") from None
-    return f"sha256:{h.hexdigest()}"
 
 
 def record_from_stored(row: StoredSignoff) -> SignoffRecord:

@@ -6,6 +6,7 @@ flushed regularly, so a crash loses at most the last second of a run.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import platform
@@ -117,6 +118,15 @@ class RunRecord:
     header: dict[str, Any]
     ticks: list[dict[str, Any]] = field(default_factory=list)
     summary: dict[str, Any] | None = None
+
+
+def file_sha256(path: str | os.PathLike) -> str:
+    """Hex SHA-256 of a run record file's bytes (raises OSError when it cannot be read)."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for chunk in iter(lambda: fh.read(1 << 16), b""):
+            h.update(chunk)
+    return h.hexdigest()
 
 
 def iter_lines(path: str | os.PathLike) -> Iterator[tuple[int, dict[str, Any]]]:

@@ -205,7 +205,7 @@ class SignoffModal(ModalScreen[str | None]):
             exercise=progress.exercise,
             driver=self.driver,
             partner=self.partner,
-            evidence=evidence_of(progress),
+            evidence=Evidence.of_progress(progress),
             objectives_passed=progress.passed,
         )
         try:
@@ -248,15 +248,3 @@ class SignoffModal(ModalScreen[str | None]):
         if not button_id.startswith("signoff-driver-"):
             return
         self.dismiss(self._people()[int(button_id.rsplit("-", 1)[1])])
-
-
-def evidence_of(progress: ExerciseProgress) -> Evidence:
-    """What a sign-off keeps of the checks: their digest and each objective's evidence."""
-    metrics = {
-        "objectives": [
-            {"kind": o.kind, "passed": o.passed, "evidence": o.evidence}
-            for o in progress.objectives
-        ],
-        "evidence_digest": progress.evidence_digest(),
-    }
-    return Evidence(run_record="", digest=progress.evidence_digest(), metrics=metrics)
