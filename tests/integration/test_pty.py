@@ -100,6 +100,10 @@ def line_with(text: str, needle: str) -> str:
 def test_workbench_opens_the_app_drives_and_quits_with_ctrl_q():
     term = Terminal(workbench_command())
     try:
+        # first the names: the student's is the login name, filled in; the partner is typed
+        term.wait_for("Who is at this robot?", "Student", "Partner")
+        term.send("\t")
+        term.send("Bea Partner\r")
         screen = term.wait_for(
             "Keys (unity)",
             "w   forward (Move at Power 1)",
@@ -109,6 +113,7 @@ def test_workbench_opens_the_app_drives_and_quits_with_ctrl_q():
             "^q Quit",
         )
         assert "##" in screen.splitlines()[0]  # the maze, in ASCII
+        assert "& Bea Partner (student)" in screen
         term.send("w")  # Move at Power 1: the robot drives down the corridor in real time
         screen = term.wait_for("running at 1x")
         end = time.monotonic() + 10

@@ -44,8 +44,28 @@ def build_parser() -> argparse.ArgumentParser:
         "--record-dir",
         help=f"keep each run's record here for replay (default: a new folder under {runs_home()})",
     )
-    parser.add_argument("--student", help="who does the labs (default: the login name)")
+    parser.add_argument(
+        "--student",
+        help="who does the labs (default: asked at start, the login name filled in)",
+    )
     parser.add_argument("--partner", default="", help="the student's lab partner, if any")
+    parser.add_argument(
+        "--ask-partner",
+        action="store_true",
+        help="with --student: still ask for the partner at start (the name stays as given)",
+    )
+    parser.add_argument(
+        "--role",
+        default="student",
+        choices=("student", "instructor"),
+        help="shown beside the name (default student)",
+    )
+    parser.add_argument(
+        "--connect-hint",
+        default="",
+        help="how VIPLE reaches this app from elsewhere, shown at start and in the help "
+        "(the SSH server sets it)",
+    )
     parser.add_argument(
         "--data-dir",
         help="where lab progress and sign-offs are kept (default: $WORKBENCH_DATA "
@@ -99,6 +119,11 @@ def open_app(args: argparse.Namespace) -> int:
             student=args.student,
             partner=args.partner,
             data_dir=args.data_dir,
+            role=args.role,
+            ask_names=not args.student or args.ask_partner,
+            # over SSH (OpenSSH's ForceCommand, say) the login name is the student's
+            student_fixed=bool(args.student) or "SSH_CONNECTION" in os.environ,
+            connect_hint=args.connect_hint,
         )
     except AppSetupError as exc:
         error(str(exc))

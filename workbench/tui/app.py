@@ -21,6 +21,7 @@ from textual.reactive import var
 from textual.screen import Screen
 
 from workbench.control.bench import Bench
+from workbench.labs.names import NameProblem, check_pair
 from workbench.labs.store import Store
 from workbench.sim.maze import Maze, MazeError
 from workbench.sim.mazeio import load_maze
@@ -81,10 +82,17 @@ class WorkbenchApp(App[None]):
         student: str = "",
         partner: str = "",
         data_dir: str | os.PathLike | None = None,
+        ask_names: bool = False,
+        student_fixed: bool = False,
+        connect_hint: str = "",
     ) -> None:
         super().__init__()
         self.student = student or user or _login_name()
         self.partner = partner
+        self._ask_names = ask_names
+        self.student_fixed = student_fixed
+        #: how to reach this app's VIPLE endpoints from elsewhere (the SSH server sets it)
+        self.connect_hint = connect_hint
         self.data_dir = data_dir
         self.store: Store | None = None
         self.store_problem = ""
@@ -102,7 +110,11 @@ class WorkbenchApp(App[None]):
         self._too_small: TooSmallScreen | None = None
 
     def who(self) -> str:
-        return f"{self.user} ({self.role})" if self.user else ""
+        """Who is at the robot, for the message line ("" when nobody was named)."""
+        if not (self.user or self._ask_names):
+            return ""
+        names = self.student + (f" & {self.partner}" if self.partner else "")
+        return f"{names} ({self.role})"
 
     def get_default_screen(self) -> Screen:
         return MainScreen(self.bench, unicode=self.unicode)
@@ -115,7 +127,26 @@ class WorkbenchApp(App[None]):
         self.sub_title = f"{self.bench.maze.name} ({self.bench.profile})"
         self._last_tick = perf_counter()
         self.set_interval(1.0 / self.tick_hz, self._tick, name="simulation")
+        if self.connect_hint:
+            self.bench.message = self.connect_hint
         self._check_size(self.size.width, self.size.height)
+        if self._ask_names:
+            from .modals.identity import IdentityDialog
+
+            dialog = IdentityDialog(self.student, self.partner, student_fixed=self.student_fixed)
+            self.push_screen(dialog, self._named)
+
+    def _named(self, names: tuple[str, str] | None) -> None:
+        if names is None:
+            return
+        self.student, self.partner = names
+        if self._labs is not None:  # opened before the names were given: follow them
+            self.uninstall_screen(self._labs)
+            self._labs = None
+        for screen in self.screen_stack:
+            bar = screen.query("#message")
+            if bar:
+                bar.first().who = self.who()
 
     # -- time --------------------------------------------------------------------------------
     def _tick(self) -> None:
@@ -253,6 +284,9 @@ def make_app(
     student: str | None = None,
     partner: str = "",
     data_dir: str | os.PathLike | None = None,
+    ask_names: bool = False,
+    student_fixed: bool = False,
+    connect_hint: str = "",
 ) -> WorkbenchApp:
     """The workbench app on a maze file (default: the bundled Unity maze).
 
@@ -260,6 +294,9 @@ def make_app(
     Web-Simulator role (the app connects to VIPLE); neither runs unless asked for.
     ``student`` (default: the login name) and ``partner`` do the labs; their progress and
     sign-offs are kept in ``data_dir`` (default: ``$WORKBENCH_DATA`` or the user data folder).
+    ``ask_names`` asks for them when the app starts (the student's name cannot be changed there
+    when ``student_fixed``, as for an SSH login); ``connect_hint`` tells the user how to reach the
+    VIPLE endpoints (shown at start and in the help).
 
     Raises :class:`AppSetupError` with a message for the user when the maze cannot be read or
     an argument is not one the workbench knows.
@@ -275,6 +312,10 @@ def make_app(
         raise AppSetupError(f"unknown noise level {noise!r}: use one of {', '.join(NOISE_LEVELS)}")
     if role not in ROLES:
         raise AppSetupError(f"unknown role {role!r}: use one of {', '.join(ROLES)}")
+    try:
+        student, partner = check_pair(student or user or _login_name(), partner)
+    except NameProblem as exc:
+        raise AppSetupError(str(exc)) from None
     if not tick_hz > 0:
         raise AppSetupError(f"the tick rate must be above 0 Hz, not {tick_hz}")
     try:
@@ -303,9 +344,12 @@ def make_app(
         unicode=unicode,
         tcp=tcp,
         ws=ws,
-        student=student or "",
+        student=student,
         partner=partner,
         data_dir=data_dir,
+        ask_names=ask_names,
+        student_fixed=student_fixed,
+        connect_hint=connect_hint,
     )
 
 

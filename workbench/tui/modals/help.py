@@ -117,6 +117,12 @@ class HelpScreen(ModalScreen[None]):
                 ("Replay (enter on a run)", ReplayScreen.BINDINGS),
             ]
             keys = [(name, [b for b in found if isinstance(b, Binding)]) for name, found in screens]
+            hint = getattr(app, "connect_hint", "")
+            if hint:
+                yield Static(
+                    Text.assemble(("Connect VIPLE", "bold underline"), "\n", hint, "\n"),
+                    id="help-connect",
+                )
             yield Static(help_text(keys, self.profile, app.get_key_display), id="help-text")
 
     def on_mount(self) -> None:
