@@ -31,7 +31,7 @@ def workbench_command() -> list[str]:
 
 
 def clean_env() -> dict[str, str]:
-    env = {k: v for k, v in os.environ.items() if not k.startswith("TEXTUAL")}
+    env = {k: v for k, v in os.environ.items() if not k.startswith(("TEXTUAL", "SSH_"))}
     env.update(TERM="xterm-256color", COLUMNS=str(COLUMNS), LINES=str(LINES), LANG="C.UTF-8")
     # run records go to a throwaway data folder, not the home of whoever runs the tests
     env["XDG_DATA_HOME"] = DATA_HOME
