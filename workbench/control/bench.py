@@ -238,6 +238,15 @@ class Bench:
         if not self._run_open and not self.session.reached_exit:
             self._open_run(driver)
 
+    def start_exercise(self) -> None:
+        """Forget the drive keys and VIPLE programs seen so far (a lab exercise starts afresh);
+        a VIPLE program driving right now counts from here on."""
+        self.keys_used.clear()
+        self.viple.clear()
+        if self._viple_now is not None:
+            self._viple_now = VipleConnection(self._viple_now.role, self._viple_now.peer)
+            self.viple.append(self._viple_now)
+
     def toggle_pause(self) -> bool:
         self.pacer.paused = not self.pacer.paused
         return self.pacer.paused

@@ -60,16 +60,48 @@ class ExerciseProgress:
 
     @classmethod
     def from_json(cls, text: str) -> ExerciseProgress:
-        data = json.loads(text)
-        data.pop("passed", None)
-        data["objectives"] = [ObjectiveState(**o) for o in data["objectives"]]
-        return cls(**data)
+        return cls.from_dict(json.loads(text))
+
+    @classmethod
+    def from_dict(cls, data: Mapping[str, Any]) -> ExerciseProgress:
+        """Progress as saved (:meth:`to_json`); ValueError when it is not in that shape."""
+        try:
+            objectives = [ObjectiveState(**o) for o in data["objectives"]]
+            answers = {str(k): str(v) for k, v in dict(data.get("answers") or {}).items()}
+            return cls(str(data["lab"]), str(data["exercise"]), objectives, answers)
+        except (KeyError, TypeError, ValueError) as exc:
+            raise ValueError(f"saved progress is not in the expected shape: {exc}") from None
 
     def evidence_digest(self) -> str:
         """sha256 of the objectives' states and evidence, in a canonical JSON form."""
         states = [asdict(o) for o in self.objectives]
         text = json.dumps(states, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(text.encode()).hexdigest()
+
+
+KEPT = "passed earlier: "
+
+
+def keep_passed(saved: ExerciseProgress | None, live: ExerciseProgress) -> ExerciseProgress:
+    """``live`` with every objective that passed in ``saved`` still passed, with its evidence.
+
+    What was checked once is not lost: after a restart (or a new robot, a new maze) the bench
+    no longer shows the run that passed, but the saved progress does. Objectives are matched
+    by kind and text, so a changed lab file does not carry over a different objective. The
+    questions follow the answers as they stand (those are saved and shown again).
+    """
+    if saved is None:
+        return live
+    earlier = {(o.kind, o.text): o for o in saved.objectives if o.passed and o.kind != "questions"}
+    objectives = []
+    for o in live.objectives:
+        before = earlier.get((o.kind, o.text))
+        if o.passed or before is None:
+            objectives.append(o)
+        else:
+            reason = before.reason if before.reason.startswith(KEPT) else KEPT + before.reason
+            objectives.append(ObjectiveState(o.kind, o.text, True, reason, before.evidence))
+    return ExerciseProgress(live.lab, live.exercise, objectives, live.answers)
 
 
 # -- set-up --------------------------------------------------------------------------------
@@ -90,6 +122,7 @@ def apply_setup(bench: Bench, setup: Setup) -> None:
     kind, value = setup.controller.kind, setup.controller.value
     if kind in ("algorithm", "starter"):
         bench.select_algorithm(value)
+    bench.start_exercise()
 
 
 # -- evidence ------------------------------------------------------------------------------

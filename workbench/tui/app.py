@@ -21,6 +21,7 @@ from textual.reactive import var
 from textual.screen import Screen
 
 from workbench.control.bench import Bench
+from workbench.labs.model import Setup
 from workbench.labs.names import NameProblem, check_pair
 from workbench.labs.store import Store
 from workbench.sim.maze import Maze, MazeError
@@ -79,6 +80,7 @@ class WorkbenchApp(App[None]):
         unicode: bool = False,
         tcp: TcpConfig | None = None,
         ws: WsConfig | None = None,
+        report_ms: int = REPORT_MS_DEFAULT,
         student: str = "",
         partner: str = "",
         data_dir: str | os.PathLike | None = None,
@@ -98,6 +100,7 @@ class WorkbenchApp(App[None]):
         self.store_problem = ""
         self._labs: LabsScreen | None = None
         self._viple_configs = (tcp, ws)
+        self._report_ms = report_ms
         self.endpoints: Endpoints | None = None
         self.bench = bench
         self.maze_path = maze_path
@@ -241,10 +244,37 @@ class WorkbenchApp(App[None]):
             self.store = None
             self.store_problem = f"cannot open the data folder, so nothing is saved: {exc}"
 
-    def set_up_done(self) -> None:
-        """A lab's set-up changed the bench: follow its maze and profile."""
+    def set_up_done(self, setup: Setup | None = None) -> None:
+        """A lab's set-up changed the bench: follow its maze and profile, and start the VIPLE
+        endpoint an exercise done from VIPLE needs."""
         self.sub_title = f"{self.bench.maze.name} ({self.bench.profile})"
         self.refresh_views()
+        if setup is not None and setup.controller.kind == "viple":
+            self.run_worker(self.open_endpoint(setup.controller.value), group="endpoints")
+
+    async def open_endpoint(self, role: str) -> str:
+        """Start the VIPLE endpoint of ``role`` (tcp or ws) if it is not running; says how to
+        connect (also returned)."""
+        tcp, ws = self._viple_configs
+        if self.endpoints is None:
+            self.endpoints = Endpoints()
+        session = self.bench.session
+        if role == "tcp":
+            config = tcp or TcpConfig(report_ms=self._report_ms)
+            if await self.endpoints.start_tcp(session, config):
+                text = f"VIPLE: connect your program (TCP) to localhost:{self.endpoints.tcp.port}"
+            else:
+                text = self.endpoints.problems[-1]
+        else:
+            config = ws or WsConfig(report_ms=self._report_ms)
+            await self.endpoints.start_ws(session, config)
+            url = self.endpoints.ws.config.url
+            text = f"VIPLE: start your program's WebSocket server; the robot connects to {url}"
+        if self.connect_hint:
+            text = self.connect_hint
+        self.bench.connection = self.endpoints.summary()
+        self._say(text)
+        return text
 
     def _say(self, message: str) -> None:
         self.bench.message = message
@@ -344,6 +374,7 @@ def make_app(
         unicode=unicode,
         tcp=tcp,
         ws=ws,
+        report_ms=report_ms,
         student=student,
         partner=partner,
         data_dir=data_dir,

@@ -29,17 +29,32 @@ class Endpoints:
     ) -> Endpoints:
         hosted = cls()
         if tcp is not None:
-            server = TcpServer(session, tcp, hosted.seat)
-            try:
-                await server.start()
-            except EndpointError as exc:
-                hosted.problems.append(f"VIPLE tcp not listening: {exc}")
-            else:
-                hosted.tcp = server
+            await hosted.start_tcp(session, tcp)
         if ws is not None:
-            hosted.ws = WsClient(session, ws, hosted.seat)
-            await hosted.ws.start()
+            await hosted.start_ws(session, ws)
         return hosted
+
+    async def start_tcp(self, session: Session, config: TcpConfig) -> bool:
+        """Listen for VIPLE (Unity-simulator role) unless already listening; False if it cannot."""
+        if self.tcp is not None:
+            return True
+        server = TcpServer(session, config, self.seat)
+        try:
+            await server.start()
+        except EndpointError as exc:
+            problem = f"VIPLE tcp not listening: {exc}"
+            if problem not in self.problems:
+                self.problems.append(problem)
+            return False
+        self.problems = [p for p in self.problems if not p.startswith("VIPLE tcp")]
+        self.tcp = server
+        return True
+
+    async def start_ws(self, session: Session, config: WsConfig) -> None:
+        """Keep connecting to VIPLE's WebSocket server (Web-Simulator role), unless already."""
+        if self.ws is None:
+            self.ws = WsClient(session, config, self.seat)
+            await self.ws.start()
 
     @property
     def active(self) -> list[TcpServer | WsClient]:

@@ -4,7 +4,8 @@ On the left, every lab and its exercises (✓ once an exercise's objectives pass
 signed off); on the right, the chosen exercise: its instructions, its objectives with ✓/✗ and
 a one-line reason that follow the bench as the student works, and its questions. ``a`` puts
 the exercise's set-up on the bench, ``i`` opens the instructor's sign-off. Progress is saved
-in the store each time an objective changes state.
+in the store as soon as an exercise is opened and each time an objective or an answer
+changes; an objective that passed once stays passed, with its evidence, after a restart.
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from textual.widgets import Footer, Input, Label, Markdown, OptionList, Static
 from textual.widgets.option_list import Option
 
 from workbench.control.bench import Bench
-from workbench.labs.checks import ExerciseProgress, apply_setup, evaluate
+from workbench.labs.checks import ExerciseProgress, apply_setup, evaluate, keep_passed
 from workbench.labs.model import Exercise, Lab, LabFileError, load_labs
 from workbench.labs.store import Store
 from workbench.sim.session import Snapshot
@@ -115,7 +116,8 @@ class LabsScreen(Screen[None]):
         self.selected: tuple[Lab, Exercise] | None = None
         self.answers: dict[tuple[str, str], dict[str, str]] = {}
         self.progress: ExerciseProgress | None = None
-        self._states: dict[tuple[str, str], tuple[bool, ...]] = {}
+        #: the progress last saved (or read back) for each exercise
+        self._saved: dict[tuple[str, str], ExerciseProgress] = {}
         self._done: set[tuple[str, str]] = set()
         self._signed: set[tuple[str, str]] = set()
         self._drivers: dict[tuple[str, str], str] = {}
@@ -132,16 +134,24 @@ class LabsScreen(Screen[None]):
         except Exception as exc:  # a damaged database must not stop the lab
             self._store_problem = f"cannot read saved progress: {exc}"
             return
+        damaged = []
         for key, data in saved.items():
-            if data.get("passed"):
+            try:
+                progress = ExerciseProgress.from_dict(data)
+            except ValueError:
+                damaged.append("/".join(key))
+                continue
+            self._saved[key] = progress
+            if progress.passed:
                 self._done.add(key)
-            answers = data.get("answers")
-            if isinstance(answers, dict):
-                self.answers[key] = {str(k): str(v) for k, v in answers.items()}
+            self.answers[key] = dict(progress.answers)
+        if damaged:
+            self._store_problem = f"saved progress unreadable (starts afresh): {', '.join(damaged)}"
         self._signed = {(row.lab, row.exercise) for row in signed}
 
     def _save(self, progress: ExerciseProgress) -> None:
         key = (progress.lab, progress.exercise)
+        self._saved[key] = progress
         if progress.passed:
             self._done.add(key)
         if self.store is None:
@@ -259,21 +269,20 @@ class LabsScreen(Screen[None]):
 
     # -- live checks ---------------------------------------------------------------------
     def track(self) -> ExerciseProgress | None:
-        """Check the chosen exercise against the bench; save it when an objective changed."""
+        """Check the chosen exercise against the bench (objectives that passed before stay
+        passed); save it when it is new or an objective or an answer changed."""
         if self.selected is None:
             return None
         lab, exercise = self.selected
         key = (lab.id, exercise.id)
-        progress = evaluate(lab.id, exercise, self.bench, self.answers.get(key, {}))
-        states = tuple(o.passed for o in progress.objectives)
-        if self._states.get(key) != states:
-            first = key not in self._states
-            self._states[key] = states
-            if not first or any(states):
-                was_done = key in self._done
-                self._save(progress)
-                if self._ready and (key in self._done) != was_done:
-                    self._refresh_list()
+        saved = self._saved.get(key)
+        live = evaluate(lab.id, exercise, self.bench, self.answers.get(key, {}))
+        progress = keep_passed(saved, live)
+        if saved is None or _changed(saved, progress):
+            was_done = key in self._done
+            self._save(progress)
+            if self._ready and (key in self._done) != was_done:
+                self._refresh_list()
         self.progress = progress
         return progress
 
@@ -306,11 +315,11 @@ class LabsScreen(Screen[None]):
         except Exception as exc:
             self.say(f"cannot set up {exercise.title}: {exc}")
             return
-        refresh = getattr(self.app, "set_up_done", None)
-        if refresh is not None:
-            refresh()
         setup = exercise.setup
         self.say(f"set up: {setup.profile}, {setup.maze.name}, {setup.controller}")
+        refresh = getattr(self.app, "set_up_done", None)
+        if refresh is not None:
+            refresh(setup)
         self.show_snapshot(self.bench.snapshot())
 
     def action_sign_off(self) -> None:
@@ -347,6 +356,15 @@ class LabsScreen(Screen[None]):
                 return
         self._refresh_list()
         self.say(f"signed off; {driver} drives next")
+
+
+def _changed(before: ExerciseProgress, now: ExerciseProgress) -> bool:
+    """Worth a save: an objective passed or failed, or an answer changed."""
+
+    def states(p: ExerciseProgress) -> list[tuple[str, bool]]:
+        return [(o.text, o.passed) for o in p.objectives]
+
+    return states(before) != states(now) or before.answers != now.answers
 
 
 def _json(progress: ExerciseProgress) -> dict:

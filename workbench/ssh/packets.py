@@ -1,0 +1,97 @@
+"""Textual's web-driver packets, the protocol between the server and an app process.
+
+The app (run with ``TEXTUAL_DRIVER=textual.drivers.web_driver:WebDriver``) writes the line
+``__GANGLION__`` on its standard output, then packets: one type byte (``D`` terminal output,
+``M`` JSON meta data, ``P`` binary-encoded data), a 4-byte big-endian length and the payload.
+The server writes packets of the same form to the app's standard input: ``D`` with the raw
+bytes the user typed, ``M`` with ``{"type": "resize", ...}`` or ``{"type": "quit"}``.
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+GANGLION = b"__GANGLION__\n"
+DATA, META, BINARY = b"D", b"M", b"P"
+TYPES = (DATA, META, BINARY)
+HEADER = 5
+#: a packet larger than this is a broken stream, not a screen update
+MAX_PAYLOAD = 64 * 1024 * 1024
+
+
+class PacketError(ValueError):
+    """The app's output does not follow the packet protocol."""
+
+
+def encode(kind: bytes, payload: bytes) -> bytes:
+    """One packet: type byte, 4-byte big-endian length, payload."""
+    if kind not in TYPES:
+        raise PacketError(f"unknown packet type {kind!r}")
+    return kind + len(payload).to_bytes(4, "big") + payload
+
+
+def data(payload: bytes) -> bytes:
+    """Terminal input (or output) bytes as a ``D`` packet."""
+    return encode(DATA, payload)
+
+
+def meta(message: dict[str, Any]) -> bytes:
+    """A JSON meta message as an ``M`` packet."""
+    return encode(META, json.dumps(message, separators=(",", ":")).encode())
+
+
+def resize(width: int, height: int) -> bytes:
+    return meta({"type": "resize", "width": int(width), "height": int(height)})
+
+
+def quit_message() -> bytes:
+    return meta({"type": "quit"})
+
+
+class PacketReader:
+    """Splits the app's output stream into ``(type, payload)`` packets, fed in any chunks.
+
+    Output before the ``__GANGLION__`` line (a warning printed by a library, say) is kept in
+    :attr:`preamble` and not treated as packets.
+    """
+
+    def __init__(self) -> None:
+        self._buffer = bytearray()
+        self.started = False
+        self.preamble = b""
+
+    def feed(self, chunk: bytes) -> list[tuple[bytes, bytes]]:
+        """The packets completed by ``chunk``, in order."""
+        packets: list[tuple[bytes, bytes]] = []
+        buffer = self._buffer
+        buffer += chunk
+        if not self.started:
+            at = buffer.find(GANGLION)
+            if at < 0:
+                # keep only what could still be the start of the marker
+                keep = len(GANGLION) - 1
+                if len(buffer) > keep:
+                    self.preamble += bytes(buffer[:-keep])
+                    del buffer[:-keep]
+                return packets
+            self.preamble += bytes(buffer[:at])
+            del buffer[: at + len(GANGLION)]
+            self.started = True
+        while len(buffer) >= HEADER:
+            kind = bytes(buffer[:1])
+            if kind not in TYPES:
+                raise PacketError(f"unknown packet type {kind!r} in the app's output")
+            size = int.from_bytes(buffer[1:HEADER], "big")
+            if size > MAX_PAYLOAD:
+                raise PacketError(f"a packet of {size} bytes in the app's output")
+            if len(buffer) < HEADER + size:
+                break
+            packets.append((kind, bytes(buffer[HEADER : HEADER + size])))
+            del buffer[: HEADER + size]
+        return packets
+
+    @property
+    def pending(self) -> int:
+        """Bytes received but not yet returned as a packet."""
+        return len(self._buffer)
