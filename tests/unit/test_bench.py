@@ -261,3 +261,25 @@ def test_a_viple_program_that_takes_the_robot_from_an_algorithm_ends_its_run():
     assert b.controller is None
     assert b.runs[-1].driver == "algorithm right-wall"
     assert b.runs[-1].source.endswith("right-wall.yaml")
+
+
+def test_starting_an_exercise_forgets_keys_and_viple_seen_before_but_not_the_one_driving():
+    from workbench.viple.link import Link
+
+    b = bench(CORRIDOR, profile="unity")
+    for key in ("w", "a"):
+        b.key(key)
+    old = Link(b.session, "ws", "ws://localhost:8124/")
+    old.connect("ws://localhost:8124/")
+    old.apply(MOVE)
+    b.step(30)
+    old.disconnect()
+    link = Link(b.session, "tcp")
+    link.connect("127.0.0.1:50400")
+    b.step(1)
+    b.start_exercise()
+    assert b.keys_used == set()
+    assert [(c.role, c.peer, c.drove) for c in b.viple] == [("tcp", "127.0.0.1:50400", False)]
+    link.apply(MOVE)
+    b.step(60)
+    assert b.viple[0].drove and b.viple[0].distance > 0.5  # the driving after the start counts

@@ -11,6 +11,7 @@ from workbench.labs.checks import (
     apply_setup,
     check_objective,
     evaluate,
+    keep_passed,
     maze_of,
 )
 from workbench.labs.model import (
@@ -278,3 +279,45 @@ def test_runs_on_another_profile_do_not_count():
     b.select_algorithm("right-wall")
     run_to_exit(b)
     assert check(obj, ex, b)[0]
+
+
+def test_objectives_that_passed_before_stay_passed_with_their_evidence():
+    keys = Objective("keys", "drove", keys=("w", "a"))
+    sensors = Objective("sensors", "sensors", sensors=(SensorSpec("touch", 2, "front"),))
+    asked = Objective("questions", "answers")
+    ex = exercise(keys, sensors, asked, questions=[question("q", "a")])
+    first = bench_for(ex)
+    first.key("w")
+    first.key("a")
+    earlier = evaluate("lab", ex, first, {"q": "a"})
+    assert [o.passed for o in earlier.objectives] == [True, False, True]
+    saved = ExerciseProgress.from_dict(json.loads(earlier.to_json()))  # as the store keeps it
+
+    again = bench_for(ex)  # a new app: no keys used yet, the answer changed to a wrong one
+    progress = keep_passed(saved, evaluate("lab", ex, again, {"q": "b"}))
+    drove, sensed, answered = progress.objectives
+    assert (drove.passed, drove.reason) == (True, "passed earlier: used w, a")
+    assert drove.evidence == {"keys_used": ["a", "w"]}
+    assert not sensed.passed  # it never passed
+    assert not answered.passed  # answers are judged as they stand now
+    assert keep_passed(progress, progress).objectives[0].reason == "passed earlier: used w, a"
+    renamed = Exercise(ex.id, ex.title, ex.instructions, ex.setup,
+                       (Objective("keys", "drove all", keys=("w", "a")),), ())  # fmt: skip
+    assert not keep_passed(saved, evaluate("lab", renamed, again)).objectives[0].passed
+
+
+def test_saved_progress_in_the_wrong_shape_is_refused_with_a_reason():
+    with pytest.raises(ValueError, match="not in the expected shape"):
+        ExerciseProgress.from_dict({"lab": "x", "exercise": "y", "objectives": [{"kind": 1}]})
+    with pytest.raises(ValueError, match="not in the expected shape"):
+        ExerciseProgress.from_dict({"lab": "x"})
+
+
+def test_the_set_up_starts_the_exercise_afresh():
+    obj = Objective("keys", "drove", keys=("w",))
+    ex = exercise(obj)
+    b = bench_for(ex)
+    b.key("w")
+    assert check(obj, ex, b)[0]
+    apply_setup(b, ex.setup)
+    assert check(obj, ex, b) == (False, "not used yet: w")

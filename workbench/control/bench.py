@@ -223,8 +223,9 @@ class Bench:
             if self._run_open and self._run_driver.startswith(VIPLE_PREFIX):
                 self._close_run("stopped")
             return
-        if self._viple_now is None:
-            role, _, peer = driver[len(VIPLE_PREFIX) :].partition(" ")
+        role, _, peer = driver[len(VIPLE_PREFIX) :].partition(" ")
+        now = self._viple_now
+        if now is None or (now.role, now.peer) != (role, peer):  # another program took over
             self._viple_now = VipleConnection(role, peer)
             self.viple.append(self._viple_now)
         self._viple_now.distance += seen[0] - last[0]

@@ -1,0 +1,179 @@
+"""What a student keeps across app restarts, the names asked at start, and the VIPLE endpoint
+a VIPLE exercise's set-up starts."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from textual.pilot import Pilot
+from textual.widgets import Input, OptionList, Static
+
+from workbench.labs.store import Store
+from workbench.tui.app import WorkbenchApp, make_app
+from workbench.tui.modals.identity import IdentityDialog
+from workbench.tui.screens.labs import LabsScreen
+from workbench.tui.screens.main import MainScreen
+from workbench.viple.tcp_server import TcpConfig
+
+from .support import run
+
+DRIVE = "unity-simulator/drive-by-wire"
+CONNECT = "web-simulator/connect"
+
+
+def lab_app(data_dir: Path, **kw) -> WorkbenchApp:
+    return make_app(paused=True, student="ana", partner="ben", data_dir=data_dir, **kw)
+
+
+def text(screen, selector: str) -> str:
+    return str(screen.query_one(selector, Static).render())
+
+
+async def open_exercise(pilot: Pilot, option_id: str) -> LabsScreen:
+    await pilot.press("l")
+    await pilot.pause()
+    screen = pilot.app.screen
+    assert isinstance(screen, LabsScreen)
+    listing = screen.query_one("#labs-list", OptionList)
+    listing.highlighted = listing.get_option_index(option_id)
+    await pilot.pause()
+    return screen
+
+
+def test_an_exercise_is_saved_as_soon_as_it_is_opened(tmp_path):
+    app = lab_app(tmp_path / "data")
+
+    async def body(pilot: Pilot) -> None:
+        await open_exercise(pilot, DRIVE)
+        saved = app.store.progress("ana")[("unity-simulator", "drive-by-wire")]
+        assert saved["passed"] is False
+        assert [o["passed"] for o in saved["objectives"]] == [False, False, False]
+
+    run(app, body)
+
+
+def test_what_passed_before_a_restart_is_still_passed_after_it(tmp_path):
+    data = tmp_path / "data"
+    first = lab_app(data)
+
+    async def drive(pilot: Pilot) -> None:
+        screen = await open_exercise(pilot, DRIVE)
+        await pilot.press("a", "escape", "w", "a", "s", "d", "space", "l")
+        await pilot.pause()
+        assert text(screen, "#labs-objectives").startswith("✓ drove with w, a, s, d and space")
+        screen.query_one("#q-tcp-port", Input).value = "13"  # half typed when the app dies
+        await pilot.pause()
+
+    run(first, drive)
+    again = lab_app(data)  # a new process: a fresh robot that has not moved
+
+    async def resume(pilot: Pilot) -> None:
+        screen = await open_exercise(pilot, DRIVE)
+        lines = text(screen, "#labs-objectives").splitlines()
+        kept = "✓ drove with w, a, s, d and space: passed earlier: used w, a, s, d, space"
+        assert lines[0] == kept
+        assert lines[1].startswith("✗ edited the maze")
+        assert screen.query_one("#q-tcp-port", Input).value == "13"
+        saved = again.store.progress("ana")[("unity-simulator", "drive-by-wire")]
+        assert saved["objectives"][0]["evidence"]["keys_used"] == ["a", "d", "s", "space", "w"]
+
+    run(again, resume)
+
+
+def test_the_names_are_asked_at_start_and_shown_on_the_message_line(tmp_path):
+    app = make_app(paused=True, student="ana", data_dir=tmp_path, ask_names=True)
+
+    async def body(pilot: Pilot) -> None:
+        assert isinstance(app.screen, IdentityDialog)
+        assert app.screen.query_one("#student", Input).value == "ana"
+        app.screen.query_one("#partner", Input).value = "Ana"
+        await pilot.press("enter")
+        await pilot.pause()
+        assert "the partner is the student" in text(app.screen, "#error")
+        app.screen.query_one("#partner", Input).value = "Ben Ortiz"
+        app.screen.query_one("#partner", Input).focus()
+        await pilot.press("enter")
+        await pilot.pause()
+        assert isinstance(app.screen, MainScreen)
+        assert (app.student, app.partner) == ("ana", "Ben Ortiz")
+        assert text(app.screen, "#message").rstrip().endswith("ana & Ben Ortiz (student)")
+        await pilot.press("l")
+        await pilot.pause()
+        assert app.screen.partner == "Ben Ortiz"
+
+    run(app, body)
+
+
+def test_over_ssh_the_student_name_is_fixed_and_escape_keeps_the_defaults(tmp_path):
+    app = make_app(paused=True, student="ana", data_dir=tmp_path, ask_names=True,
+                   student_fixed=True)  # fmt: skip
+
+    async def body(pilot: Pilot) -> None:
+        assert app.screen.query_one("#student", Input).disabled
+        await pilot.press("escape")
+        await pilot.pause()
+        assert isinstance(app.screen, MainScreen)
+        assert (app.student, app.partner) == ("ana", "")
+
+    run(app, body)
+
+
+def test_a_connect_hint_is_shown_at_start_and_in_the_help(tmp_path):
+    hint = "VIPLE: on your computer run  ssh -N -p 2222 -L 1350:localhost:41000 ana@lab"
+    app = make_app(paused=True, student="ana", data_dir=tmp_path, connect_hint=hint)
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.pause()
+        assert text(app.screen, "#message").startswith("VIPLE: on your computer run")
+        await pilot.press("question_mark")
+        await pilot.pause()
+        assert hint in str(app.screen.query_one("#help-connect", Static).render())
+
+    run(app, body, size=(100, 30))
+
+
+def test_the_set_up_of_a_websocket_exercise_starts_the_websocket_client(tmp_path):
+    app = lab_app(tmp_path / "data")
+
+    async def body(pilot: Pilot) -> None:
+        assert app.endpoints is None
+        screen = await open_exercise(pilot, CONNECT)
+        await pilot.press("a")
+        await app.workers.wait_for_complete()
+        await pilot.pause()
+        assert app.endpoints is not None and app.endpoints.ws is not None
+        assert app.endpoints.ws.config.url == "ws://localhost:8124/"
+        assert "robot connects to ws://localhost:8124/" in app.bench.message
+        assert "VIPLE ws waiting for ws://localhost:8124/" in app.bench.connection
+        assert screen is app.screen
+
+    run(app, body)
+
+
+def test_the_set_up_of_a_tcp_exercise_starts_listening(tmp_path):
+    app = lab_app(tmp_path / "data")
+
+    async def body(pilot: Pilot) -> None:
+        app._viple_configs = (TcpConfig(port=0), None)  # any free port, not 1350
+        text_shown = await app.open_endpoint("tcp")
+        port = app.endpoints.tcp.port
+        assert port > 0 and text_shown == f"VIPLE: connect your program (TCP) to localhost:{port}"
+        assert f"VIPLE tcp listening on 127.0.0.1:{port}" in app.bench.connection
+        assert await app.open_endpoint("tcp") == text_shown  # already listening: the same
+
+    run(app, body)
+
+
+def test_a_store_with_unreadable_progress_says_so_and_starts_that_exercise_afresh(tmp_path):
+    data = tmp_path / "data"
+    with Store.open(data) as store:
+        store.save_progress("ana", "unity-simulator", "drive-by-wire", {"objectives": 3})
+    app = lab_app(data)
+
+    async def body(pilot: Pilot) -> None:
+        screen = await open_exercise(pilot, DRIVE)
+        message = text(screen, "#labs-message")
+        assert message == "saved progress unreadable (starts afresh): unity-simulator/drive-by-wire"
+        assert text(screen, "#labs-objectives").startswith("✗ drove")
+
+    run(app, body)
