@@ -15,6 +15,7 @@ from . import maze as maze_cmd
 from . import run as run_cmd
 from . import serve as serve_cmd
 from . import signoff as signoff_cmd
+from . import ssh as ssh_cmd
 from . import viple_client as viple_client_cmd
 from .common import default_maze_path, error, new_runs_dir, runs_home
 
@@ -79,6 +80,7 @@ def build_parser() -> argparse.ArgumentParser:
     viple_client_cmd.register(sub)
     instructor_cmd.register(sub)
     signoff_cmd.register(sub)
+    ssh_cmd.register(sub)
     return parser
 
 

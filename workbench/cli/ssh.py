@@ -1,0 +1,222 @@
+"""``workbench serve-ssh`` (the SSH lab server) and ``workbench ssh`` (its users)."""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import getpass
+import signal
+import sys
+from pathlib import Path
+
+from workbench.labs.store import resolve_data_dir
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    serve = sub.add_parser(
+        "serve-ssh",
+        help="the SSH lab server: every student's workbench over SSH, each with own VIPLE ports",
+        description="Serve the workbench over SSH: users from the users file log in with a key "
+        "or a password and each session runs its own workbench with its own VIPLE ports. "
+        "See docs/ssh.md.",
+    )
+    serve.add_argument("--port", type=int, default=2222, help="SSH port (default 2222)")
+    serve.add_argument("--bind", default="", help="address to listen on (default: all)")
+    serve.add_argument(
+        "--host-key", help="the server's private key (default <data-dir>/ssh_host_ed25519_key, "
+        "made on first start)"
+    )  # fmt: skip
+    serve.add_argument("--users", help="users file (default <data-dir>/ssh-users.yaml)")
+    _data_dir(serve)
+    serve.add_argument(
+        "--port-range", default="41000-41999",
+        help="VIPLE ports for sessions, two each (default 41000-41999)",
+    )  # fmt: skip
+    serve.add_argument(
+        "--public-host", default="",
+        help="the server's name as students type it, for the forwarding command shown in the "
+        "app (default: this machine's full name)",
+    )  # fmt: skip
+    serve.add_argument("--max-per-user", type=int, default=2, help="sessions per user (default 2)")
+    serve.add_argument("--max-sessions", type=int, default=60, help="sessions in all (default 60)")
+    serve.add_argument(
+        "--idle-timeout", type=float, default=7200,
+        help="seconds without input before a session is closed (default 7200)",
+    )  # fmt: skip
+    serve.set_defaults(func=cmd_serve)
+
+    users = sub.add_parser("ssh", help="users of the SSH lab server")
+    inner = users.add_subparsers(dest="ssh_command", metavar="ACTION", required=True)
+    add = inner.add_parser(
+        "add-user", help="add a user or change one (role, more keys, a new password)"
+    )
+    add.add_argument("name", help="the login name, also the student's name in the labs")
+    add.add_argument("--role", required=True, choices=("student", "instructor"))
+    add.add_argument(
+        "--key", action="append", default=[], metavar="PUBFILE",
+        help="a public key file (e.g. id_ed25519.pub) whose keys may log in; repeatable",
+    )  # fmt: skip
+    add.add_argument(
+        "--password", action="store_true",
+        help="set a password (asked twice; without a terminal: read from standard input)",
+    )  # fmt: skip
+    add.add_argument("--users", help="users file (default <data-dir>/ssh-users.yaml)")
+    _data_dir(add)
+    add.set_defaults(func=cmd_add_user)
+
+    ls = inner.add_parser("list-users", help="list the users, their roles and credentials")
+    ls.add_argument("--users", help="users file (default <data-dir>/ssh-users.yaml)")
+    _data_dir(ls)
+    ls.set_defaults(func=cmd_list_users)
+
+
+def _data_dir(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--data-dir",
+        help="the workbench's data folder (default: $WORKBENCH_DATA, else the user data folder)",
+    )
+
+
+def fail(command: str, message: str) -> int:
+    print(f"workbench {command}: {message}", file=sys.stderr)
+    return 2
+
+
+def _users_file(args: argparse.Namespace) -> Path:
+    from workbench.ssh.users import users_path
+
+    return Path(args.users) if args.users else users_path(resolve_data_dir(args.data_dir))
+
+
+# -- users --------------------------------------------------------------------------------------
+def read_new_password() -> str:
+    """Asked twice on a terminal; without one, the first line of standard input (for scripts;
+    a second line, if given, must repeat it)."""
+    from workbench.ssh.passwords import MIN_PASSWORD, PasswordError, check_password
+
+    if not sys.stdin.isatty():
+        lines = sys.stdin.read().splitlines()
+        if not lines:
+            raise PasswordError("no password on standard input")
+        if len(lines) > 1 and lines[1] and lines[1] != lines[0]:
+            raise PasswordError("the two passwords on standard input differ")
+        return check_password(lines[0])
+    print(f"Choose a password of at least {MIN_PASSWORD} characters.", file=sys.stderr)
+    first = check_password(getpass.getpass("Password: "))
+    if getpass.getpass("Password again: ") != first:
+        raise PasswordError("the two passwords differ; nothing was changed")
+    return first
+
+
+def cmd_add_user(args: argparse.Namespace) -> int:
+    from workbench.ssh.passwords import PasswordError, hash_password
+    from workbench.ssh.users import UsersFileError, add_user, parse_public_key
+
+    path = _users_file(args)
+    keys: list[str] = []
+    for name in args.key:
+        try:
+            lines = Path(name).expanduser().read_text(encoding="utf-8").splitlines()
+        except (OSError, UnicodeDecodeError) as exc:
+            return fail("ssh add-user", f"cannot read the key file {name}: {exc}")
+        found = [ln.strip() for ln in lines if ln.strip() and not ln.lstrip().startswith("#")]
+        if not found:
+            return fail("ssh add-user", f"{name} has no public key in it")
+        for number, line in enumerate(found, 1):
+            try:
+                parse_public_key(line)
+            except ValueError as exc:
+                hint = " (give the .pub file, not the private key)" if "PRIVATE" in line else ""
+                return fail("ssh add-user", f"{name}: key {number}: {exc}{hint}")
+            keys.append(line)
+    try:
+        password = hash_password(read_new_password()) if args.password else None
+        user = add_user(path, args.name, args.role, keys, password)
+    except (PasswordError, UsersFileError, EOFError) as exc:
+        return fail("ssh add-user", str(exc) or "no password given")
+    except OSError as exc:
+        return fail("ssh add-user", f"cannot write {path}: {exc.strerror}")
+    what = [f"{len(user.keys)} key{'s' if len(user.keys) != 1 else ''}"]
+    if user.password:
+        what.append("a password")
+    print(f"{user.name} ({user.role}) can log in with {' and '.join(what)}; saved in {path}")
+    return 0
+
+
+def cmd_list_users(args: argparse.Namespace) -> int:
+    from workbench.ssh.users import UsersFileError, load_users
+
+    path = _users_file(args)
+    try:
+        users = load_users(path)
+    except UsersFileError as exc:
+        return fail("ssh list-users", str(exc))
+    if not users:
+        print(f"no users in {path} (add one: workbench ssh add-user NAME --role student --key "
+              "FILE.pub)")  # fmt: skip
+        return 0
+    width = max(len(n) for n in users)
+    for user in sorted(users.values(), key=lambda u: u.name):
+        parts = user.fingerprints() or ["no keys"]
+        if user.password:
+            parts.append("password")
+        print(f"{user.name:<{width}}  {user.role:<10}  {', '.join(parts)}")
+    return 0
+
+
+# -- the server -------------------------------------------------------------------------------
+def cmd_serve(args: argparse.Namespace) -> int:
+    from workbench.ssh.hostkey import HostKeyError
+    from workbench.ssh.limits import SessionLimits
+    from workbench.ssh.ports import parse_range
+    from workbench.ssh.server import LabServer, ServerConfig, setup_logging
+    from workbench.ssh.users import UsersFileError
+
+    try:
+        port_range = parse_range(args.port_range)
+    except ValueError as exc:
+        return fail("serve-ssh", f"--port-range {exc}")
+    if args.max_per_user < 1 or args.max_sessions < 1 or args.idle_timeout <= 0:
+        return fail("serve-ssh", "--max-per-user, --max-sessions and --idle-timeout must be > 0")
+    data_dir = resolve_data_dir(args.data_dir)
+    config = ServerConfig(
+        data_dir=data_dir,
+        port=args.port,
+        bind=args.bind,
+        host_key=Path(args.host_key) if args.host_key else None,
+        users_file=Path(args.users) if args.users else None,
+        port_range=port_range,
+        public_host=args.public_host,
+        limits=SessionLimits(args.max_per_user, args.max_sessions, args.idle_timeout),
+    )
+    try:
+        log_path = setup_logging(data_dir)
+        server = LabServer(config)
+    except (UsersFileError, HostKeyError) as exc:
+        return fail("serve-ssh", f"{exc}\nthe server did not start")
+    except OSError as exc:
+        return fail("serve-ssh", f"cannot use the data folder {data_dir}: {exc}")
+    if not server.users.users:
+        print(
+            f"workbench serve-ssh: no users yet in {config.users_file}: add one with "
+            "'workbench ssh add-user NAME --role student --key FILE.pub'",
+            file=sys.stderr,
+        )
+    print(f"workbench serve-ssh: logging to {log_path}", file=sys.stderr)
+    try:
+        return asyncio.run(_serve(server))
+    except OSError as exc:
+        return fail("serve-ssh", f"cannot listen on port {args.port}: {exc.strerror or exc}")
+
+
+async def _serve(server) -> int:
+    stop = asyncio.Event()
+    loop = asyncio.get_running_loop()
+    for sig in (signal.SIGINT, signal.SIGTERM):
+        loop.add_signal_handler(sig, stop.set)
+    await server.start()
+    try:
+        await stop.wait()
+    finally:
+        await server.close()
+    return 0

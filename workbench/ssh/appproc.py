@@ -1,0 +1,233 @@
+"""One workbench app process per SSH session, spoken to in Textual's web-driver packets.
+
+The process runs ``python -m workbench`` with the web driver: its screen output arrives as
+``D`` packets on its standard output, keys and resizes go in as packets on its standard input
+(see :mod:`.packets`). It runs in its own process group so that ending a session ends the app
+and anything it started.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import json
+import logging
+import os
+import signal
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+from . import packets
+
+log = logging.getLogger("workbench.ssh")
+
+DRIVER = "textual.drivers.web_driver:WebDriver"
+#: what the terminal is set back to when an app ends (the web driver leaves it to the server)
+RESTORE_TERMINAL = (
+    b"\x1b[?1000l\x1b[?1003l\x1b[?1015l\x1b[?1006l"  # mouse reporting off
+    b"\x1b[?2004l"  # bracketed paste off
+    b"\x1b[0m\x1b[?25h"  # plain text, cursor shown
+    b"\x1b[?1049l"  # back from the alternate screen
+)
+READ_SIZE = 65536
+
+
+@dataclass(frozen=True)
+class AppSpec:
+    """What one session's app is started with."""
+
+    user: str
+    role: str
+    tcp_port: int
+    ws_port: int
+    hint: str
+    data_dir: Path
+    record_dir: Path
+    width: int = 80
+    height: int = 24
+    term: str = "xterm-256color"
+
+    def argv(self, command: tuple[str, ...] | None = None) -> list[str]:
+        base = list(command or (sys.executable, "-m", "workbench"))
+        return [
+            *base,
+            "--student", self.user,
+            "--ask-partner",
+            "--role", self.role,
+            "--tcp-port", str(self.tcp_port),
+            "--ws-url", f"ws://127.0.0.1:{self.ws_port}/",
+            "--connect-hint", self.hint,
+            "--data-dir", str(self.data_dir),
+            "--record-dir", str(self.record_dir),
+        ]  # fmt: skip
+
+    def env(self, base: dict[str, str] | None = None) -> dict[str, str]:
+        env = {
+            k: v
+            for k, v in (os.environ if base is None else base).items()
+            if not k.startswith(("TEXTUAL", "SSH_", "COLUMNS", "LINES", "ROWS"))
+        }
+        env.update(
+            TEXTUAL_DRIVER=DRIVER,
+            COLUMNS=str(self.width),
+            ROWS=str(self.height),
+            TERM=self.term or "xterm-256color",
+            LANG=env.get("LANG") or "C.UTF-8",
+        )
+        return env
+
+
+def forward_hint(user: str, host: str, ssh_port: int, tcp_port: int, ws_port: int) -> str:
+    """The one line that tells a student how their VIPLE reaches their robot."""
+    port = "" if ssh_port == 22 else f"-p {ssh_port} "
+    return (
+        f"VIPLE: on your computer run  ssh -N {port}-L 1350:localhost:{tcp_port} "
+        f"-R {ws_port}:localhost:8124 {user}@{host}  then VIPLE uses localhost:1350"
+    )
+
+
+class AppProcess:
+    """A running app: feed it keys and sizes, receive its screen output, stop it for sure."""
+
+    def __init__(
+        self,
+        argv: list[str],
+        env: dict[str, str],
+        log_path: Path,
+        on_output: Callable[[bytes], None],
+    ) -> None:
+        self.argv = argv
+        self.env = env
+        self.log_path = log_path
+        self.on_output = on_output
+        self.process: asyncio.subprocess.Process | None = None
+        self.said_exit = False  # the app announced its end itself
+        self._flowing = asyncio.Event()
+        self._flowing.set()
+        self._reader: asyncio.Task[None] | None = None
+        self._pending: list[bytes] = []
+
+    @property
+    def pid(self) -> int | None:
+        return self.process.pid if self.process else None
+
+    @property
+    def returncode(self) -> int | None:
+        return self.process.returncode if self.process else None
+
+    async def start(self) -> None:
+        self.log_path.parent.mkdir(parents=True, exist_ok=True)
+        with open(self.log_path, "ab") as errors:
+            self.process = await asyncio.create_subprocess_exec(
+                *self.argv,
+                stdin=asyncio.subprocess.PIPE,
+                stdout=asyncio.subprocess.PIPE,
+                stderr=errors,
+                env=self.env,
+                start_new_session=True,
+            )
+        for packet in self._pending:
+            self._write(packet)
+        self._pending.clear()
+        self._reader = asyncio.create_task(self._read(), name=f"app-output-{self.pid}")
+
+    # -- input -------------------------------------------------------------------------------
+    def _write(self, packet: bytes) -> None:
+        process = self.process
+        if process is None:
+            self._pending.append(packet)
+            return
+        if process.stdin is None or process.stdin.is_closing():
+            return
+        with contextlib.suppress(BrokenPipeError, ConnectionResetError):
+            process.stdin.write(packet)
+
+    def send_keys(self, data: bytes) -> None:
+        if data:
+            self._write(packets.data(data))
+
+    def resize(self, width: int, height: int) -> None:
+        if width > 0 and height > 0:
+            self._write(packets.resize(width, height))
+
+    # -- output ------------------------------------------------------------------------------
+    def pause_output(self) -> None:
+        """Stop reading the app's screen output (the client is behind); the app then waits."""
+        self._flowing.clear()
+
+    def resume_output(self) -> None:
+        self._flowing.set()
+
+    async def _read(self) -> None:
+        assert self.process is not None and self.process.stdout is not None
+        stdout = self.process.stdout
+        reader = packets.PacketReader()
+        try:
+            while True:
+                await self._flowing.wait()
+                chunk = await stdout.read(READ_SIZE)
+                if not chunk:
+                    break
+                for kind, payload in reader.feed(chunk):
+                    if kind == packets.DATA:
+                        self.on_output(payload)
+                    elif kind == packets.META:
+                        self._on_meta(payload)
+        except packets.PacketError as exc:
+            log.error("app %s: %s; ending it", self.pid, exc)
+            self._kill(signal.SIGKILL)
+        if reader.preamble.strip():
+            log.info("app %s printed before starting: %r", self.pid, reader.preamble[:200])
+
+    def _on_meta(self, payload: bytes) -> None:
+        try:
+            message = json.loads(payload)
+        except ValueError:
+            return
+        if isinstance(message, dict) and message.get("type") == "exit":
+            self.said_exit = True
+
+    # -- the end -----------------------------------------------------------------------------
+    async def wait(self) -> int:
+        """The exit code, once the app has ended and all its output was handed on."""
+        assert self.process is not None
+        if self._reader is not None:
+            await self._reader
+        return await self.process.wait()
+
+    def _kill(self, sig: int) -> None:
+        process = self.process
+        if process is None or process.returncode is not None:
+            return
+        with contextlib.suppress(ProcessLookupError, PermissionError):
+            os.killpg(process.pid, sig)
+
+    async def stop(self, grace: float = 2.0) -> int | None:
+        """End the app: ask it to quit, then SIGTERM its group, then SIGKILL; always reaped."""
+        process = self.process
+        if process is None:
+            return None
+        self._flowing.set()  # a paused reader must not hold the end up
+        if process.returncode is None:
+            self._write(packets.quit_message())
+            for sig in (signal.SIGTERM, signal.SIGKILL):
+                try:
+                    await asyncio.wait_for(asyncio.shield(process.wait()), grace)
+                    break
+                except TimeoutError:
+                    log.info(
+                        "app %s did not end in %.1f s: sending %s",
+                        process.pid,
+                        grace,
+                        signal.Signals(sig).name,
+                    )
+                    self._kill(sig)
+        code = await process.wait()
+        if process.stdin is not None:
+            process.stdin.close()
+        if self._reader is not None:
+            with contextlib.suppress(Exception):
+                await asyncio.wait_for(self._reader, grace)
+        return code

@@ -1,0 +1,39 @@
+"""Which SSH port forwards a user may open: only to the VIPLE ports of their own sessions.
+
+- Local forwarding (``ssh -L 1350:localhost:TCP``): the destination must be this machine's
+  loopback and the port the VIPLE TCP port of one of the user's live sessions.
+- Remote forwarding (``ssh -R WS:localhost:8124``): the server may listen only on loopback, on
+  the WebSocket port of one of the user's live sessions (the app connects there to reach the
+  VIPLE on the student's computer).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Collection
+
+LOOPBACK = frozenset({"localhost", "127.0.0.1", "::1"})
+LISTEN_HOSTS = frozenset({"localhost", "127.0.0.1"})
+
+
+def local_forward_refusal(host: str, port: int, own_tcp_ports: Collection[int]) -> str | None:
+    """Why ``-L`` to ``host:port`` is refused, or None when it is allowed."""
+    if host.lower() not in LOOPBACK:
+        return f"destination {host}:{port} is not this server's loopback"
+    if port not in own_tcp_ports:
+        if not own_tcp_ports:
+            return f"port {port}: the user has no workbench session running"
+        mine = ", ".join(str(p) for p in sorted(own_tcp_ports))
+        return f"port {port} is not the VIPLE port of the user's sessions ({mine})"
+    return None
+
+
+def remote_forward_refusal(host: str, port: int, own_ws_ports: Collection[int]) -> str | None:
+    """Why ``-R`` listening on ``host:port`` is refused, or None when it is allowed."""
+    if host.lower() not in LISTEN_HOSTS:
+        return f"listening on {host or 'all addresses'!s}:{port} (only 127.0.0.1 is allowed)"
+    if port not in own_ws_ports:
+        if not own_ws_ports:
+            return f"port {port}: the user has no workbench session running"
+        mine = ", ".join(str(p) for p in sorted(own_ws_ports))
+        return f"port {port} is not the WebSocket port of the user's sessions ({mine})"
+    return None

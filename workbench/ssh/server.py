@@ -1,0 +1,574 @@
+"""The SSH lab server: logins from the users file, one app process per terminal session,
+forwarding only to the user's own VIPLE ports, limits and a clean stop.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import itertools
+import logging
+import socket
+import sys
+import time
+from collections import Counter
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import asyncssh
+
+from .appproc import RESTORE_TERMINAL, AppProcess, AppSpec, forward_hint
+from .forwarding import local_forward_refusal, remote_forward_refusal
+from .hostkey import host_key_path, load_or_create_host_key
+from .limits import FailureDelay, SessionLimits, describe_duration
+from .passwords import hash_password, verify_password
+from .ports import PoolExhausted, PortPool
+from .users import User, UsersFile, users_path
+
+log = logging.getLogger("workbench.ssh")
+
+NOT_A_TERMINAL = (
+    "This lab server runs the workbench only, in a terminal: "
+    "connect with plain 'ssh -p {port} {user}@{host}'."
+)
+NO_COMMANDS = "This lab server runs the workbench only: no commands ({what} refused)."
+NO_FILES = "This lab server runs the workbench only: no file transfer ({what} refused)."
+#: checked against when a user is unknown, so a wrong name costs the same time as a wrong password
+_DUMMY_HASH = hash_password("not a real password")
+
+
+@dataclass
+class ServerConfig:
+    data_dir: Path
+    port: int = 2222
+    bind: str = ""
+    host_key: Path | None = None
+    users_file: Path | None = None
+    port_range: tuple[int, int] = (41000, 41999)
+    public_host: str = ""
+    limits: SessionLimits = field(default_factory=SessionLimits)
+    #: the app's command before its options (default: this Python's ``-m workbench``)
+    app_command: tuple[str, ...] | None = None
+    #: seconds between the stop steps of an app (quit, SIGTERM, SIGKILL)
+    stop_grace: float = 2.0
+    failure_delay: FailureDelay = field(default_factory=FailureDelay)
+    keepalive_interval: float = 30.0
+
+    def __post_init__(self) -> None:
+        self.data_dir = Path(self.data_dir)
+        self.host_key = Path(self.host_key or host_key_path(self.data_dir))
+        self.users_file = Path(self.users_file or users_path(self.data_dir))
+        self.public_host = self.public_host or socket.getfqdn()
+
+
+def setup_logging(data_dir: Path, stream: bool = True) -> Path:
+    """Log the server's events to ``<data-dir>/ssh.log`` (and stderr); returns the log's path."""
+    data_dir.mkdir(parents=True, exist_ok=True)
+    path = data_dir / "ssh.log"
+    formatter = logging.Formatter("%(asctime)s %(levelname)s %(message)s")
+    handlers: list[logging.Handler] = [logging.FileHandler(path, encoding="utf-8")]
+    if stream:
+        handlers.append(logging.StreamHandler(sys.stderr))
+    for handler in handlers:
+        handler.setFormatter(formatter)
+        log.addHandler(handler)
+    log.setLevel(logging.INFO)
+    logging.getLogger("asyncssh").setLevel(logging.WARNING)
+    return path
+
+
+class LabServer:
+    """The running server: its users, port pool, live sessions and the asyncssh acceptor."""
+
+    def __init__(self, config: ServerConfig) -> None:
+        self.config = config
+        # a users file that cannot be read stops the server here, before it listens
+        self.users = UsersFile(config.users_file)
+        self.host_key = load_or_create_host_key(config.host_key)
+        self.pool = PortPool(*config.port_range)
+        self.sessions: dict[int, LabSession] = {}
+        self.connections: set[LabConnection] = set()
+        self.remote_listens: dict[str, Counter[int]] = {}
+        self._ids = itertools.count(1)
+        self._acceptor: asyncssh.SSHAcceptor | None = None
+        self._sweeper: asyncio.Task[None] | None = None
+        self._closing = False
+
+    @property
+    def port(self) -> int:
+        assert self._acceptor is not None
+        return self._acceptor.get_port()
+
+    async def start(self) -> None:
+        config = self.config
+        self._acceptor = await asyncssh.create_server(
+            lambda: LabConnection(self),
+            config.bind or None,
+            config.port,
+            server_host_keys=[self.host_key],
+            encoding=None,
+            line_editor=False,
+            allow_scp=False,
+            agent_forwarding=False,
+            x11_forwarding=False,
+            login_timeout=60,
+            keepalive_interval=config.keepalive_interval,
+            keepalive_count_max=4,
+            server_version="workbench",
+        )
+        self._sweeper = asyncio.create_task(self._sweep_idle(), name="ssh-idle-sweeper")
+        log.info(
+            "serving on %s port %d for %d users (%s); VIPLE ports %d-%d; host key %s",
+            config.bind or "all addresses", self.port, len(self.users.users),
+            config.users_file, *config.port_range, self.host_key.get_fingerprint(),
+        )  # fmt: skip
+
+    async def close(self) -> None:
+        """End every session (their apps stopped and reaped), then stop listening."""
+        self._closing = True
+        if self._sweeper is not None:
+            self._sweeper.cancel()
+        if self._acceptor is not None:
+            self._acceptor.close()
+        sessions = list(self.sessions.values())
+        if sessions:
+            log.info("stopping: ending %d sessions", len(sessions))
+        await asyncio.gather(*(s.end("The lab server is stopping.") for s in sessions))
+        connections = [c.conn for c in self.connections if c.conn is not None]
+        for conn in connections:  # forwarding-only connections too
+            conn.close()
+        for conn in connections:
+            with contextlib.suppress(Exception):
+                await asyncio.wait_for(conn.wait_closed(), 5)
+        if self._acceptor is not None:
+            await self._acceptor.wait_closed()
+
+    async def __aenter__(self) -> LabServer:
+        await self.start()
+        return self
+
+    async def __aexit__(self, *exc: object) -> None:
+        await self.close()
+
+    # -- sessions ----------------------------------------------------------------------------
+    def live(self, user: str) -> list[LabSession]:
+        return [s for s in self.sessions.values() if s.user.name == user and s.running]
+
+    def held_remote_ports(self, user: str) -> set[int]:
+        return {p for p, n in self.remote_listens.get(user, Counter()).items() if n > 0}
+
+    async def _sweep_idle(self) -> None:
+        timeout = self.config.limits.idle_timeout
+        period = max(0.2, min(timeout / 4, 30.0))
+        while True:
+            await asyncio.sleep(period)
+            now = time.monotonic()
+            idle = [
+                s for s in self.sessions.values() if s.running and now - s.last_input >= timeout
+            ]
+            for session in idle:
+                log.info(
+                    "session %d of %s idle for %s: ending it",
+                    session.id,
+                    session.user.name,
+                    describe_duration(timeout),
+                )
+            message = (
+                f"No input for {describe_duration(timeout)}: the session was closed. "
+                "Your lab progress is saved; log in again to go on."
+            )
+            if idle:
+                await asyncio.gather(*(s.end(message) for s in idle))
+
+
+class LabConnection(asyncssh.SSHServer):
+    """One SSH connection: who logs in, and which forwards and sessions it may open."""
+
+    def __init__(self, server: LabServer) -> None:
+        self.server = server
+        self.conn: asyncssh.SSHServerConnection | None = None
+        self.peer = "?"
+        self.username = ""
+        self.user: User | None = None
+        self.failed = False
+        self.remote_ports: Counter[int] = Counter()
+
+    # -- connection --------------------------------------------------------------------------
+    def connection_made(self, conn: asyncssh.SSHServerConnection) -> None:
+        self.conn = conn
+        self.server.connections.add(self)
+        peer = conn.get_extra_info("peername")
+        self.peer = str(peer[0]) if peer else "?"
+
+    def connection_lost(self, exc: Exception | None) -> None:
+        self.server.connections.discard(self)
+        if self.username and self.user is None and not self.failed:
+            # every offered key was refused and the client gave up
+            self.server.config.failure_delay.failed(self.peer)
+            log.warning("login failed: %s from %s (no accepted key)", self.username, self.peer)
+        if self.user is not None and self.remote_ports:
+            held = self.server.remote_listens.get(self.user.name)
+            if held is not None:
+                held.subtract(self.remote_ports)
+
+    # -- authentication ----------------------------------------------------------------------
+    async def begin_auth(self, username: str) -> bool:
+        self.username = username
+        delay = self.server.config.failure_delay.delay(self.peer)
+        if delay:
+            await asyncio.sleep(delay)
+        return True
+
+    def _known(self, username: str) -> User | None:
+        users = self.server.users
+        user = users.get(username)
+        if users.problem:
+            log.error("users file not read again, the earlier users stay: %s", users.problem)
+        return user
+
+    def _refused(self, username: str, why: str) -> None:
+        self.failed = True
+        self.server.config.failure_delay.failed(self.peer)
+        log.warning("login refused: %s from %s: %s", username, self.peer, why)
+
+    def _accepted(self, user: User, how: str) -> None:
+        self.user = user
+        self.server.config.failure_delay.succeeded(self.peer)
+        log.info("login: %s (%s) from %s with %s", user.name, user.role, self.peer, how)
+
+    def public_key_auth_supported(self) -> bool:
+        return True
+
+    def validate_public_key(self, username: str, key: asyncssh.SSHKey) -> bool:
+        user = self._known(username)
+        if user is not None and user.keys and user.accepts_key(key):
+            self._pending_key = key.get_fingerprint()
+            return True
+        return False
+
+    def auth_completed(self) -> None:
+        if self.user is None:  # by key: validate_public_key cannot tell a query from a login
+            user = self._known(self.username)
+            if user is not None:
+                self._accepted(user, f"key {getattr(self, '_pending_key', '?')}")
+
+    def password_auth_supported(self) -> bool:
+        return True
+
+    async def validate_password(self, username: str, password: str) -> bool:
+        delay = self.server.config.failure_delay.delay(self.peer)
+        if delay:
+            await asyncio.sleep(delay)
+        user = self._known(username)
+        stored = user.password if user is not None and user.password else _DUMMY_HASH
+        ok = await asyncio.to_thread(verify_password, password, stored)
+        if user is None:
+            self._refused(username, "unknown user")
+            return False
+        if not (ok and user.password):
+            self._refused(username, "wrong password")
+            return False
+        self._accepted(user, "password")
+        return True
+
+    # -- channels ----------------------------------------------------------------------------
+    def session_requested(self) -> LabSession | bool:
+        if self.user is None or self.server._closing:
+            return False
+        return LabSession(self.server, self, self.user)
+
+    def connection_requested(
+        self, dest_host: str, dest_port: int, orig_host: str, orig_port: int
+    ) -> bool:
+        user = self.user
+        if user is None:
+            return False
+        ports = {s.spec.tcp_port for s in self.server.live(user.name) if s.spec}
+        why = local_forward_refusal(dest_host, dest_port, ports)
+        if why is not None:
+            log.warning(
+                "forward refused: %s from %s to %s:%d: %s",
+                user.name,
+                self.peer,
+                dest_host,
+                dest_port,
+                why,
+            )
+            raise asyncssh.ChannelOpenError(
+                asyncssh.OPEN_ADMINISTRATIVELY_PROHIBITED, f"forward refused: {why}"
+            )
+        log.info("forward: %s to %s:%d", user.name, dest_host, dest_port)
+        return True
+
+    def server_requested(self, listen_host: str, listen_port: int) -> bool:
+        user = self.user
+        if user is None:
+            return False
+        ports = {s.spec.ws_port for s in self.server.live(user.name) if s.spec}
+        why = remote_forward_refusal(listen_host, listen_port, ports)
+        if why is not None:
+            log.warning(
+                "remote forward refused: %s from %s on %s:%d: %s",
+                user.name,
+                self.peer,
+                listen_host,
+                listen_port,
+                why,
+            )
+            return False
+        log.info("remote forward: %s listens on %s:%d", user.name, listen_host, listen_port)
+        self.remote_ports[listen_port] += 1
+        self.server.remote_listens.setdefault(user.name, Counter())[listen_port] += 1
+        return True
+
+    def unix_connection_requested(self, dest_path: str) -> bool:
+        log.warning("forward refused: %s to socket %s", self.username, dest_path)
+        return False
+
+    def unix_server_requested(self, listen_path: str) -> bool:
+        log.warning("remote forward refused: %s on socket %s", self.username, listen_path)
+        return False
+
+
+class LabSession(asyncssh.SSHServerSession):
+    """One SSH session channel: a terminal running the workbench app, or a clear refusal."""
+
+    def __init__(self, server: LabServer, connection: LabConnection, user: User) -> None:
+        self.server = server
+        self.connection = connection
+        self.user = user
+        self.id = next(server._ids)
+        self.chan: asyncssh.SSHServerChannel | None = None
+        self.term = ""
+        self.size = (80, 24)
+        self.has_pty = False
+        self.request = ""  # shell, or what was refused
+        self.spec: AppSpec | None = None
+        self.app: AppProcess | None = None
+        self.ports: tuple[int, ...] = ()
+        self.last_input = time.monotonic()
+        self.started_at = time.monotonic()
+        self._ending: asyncio.Task[None] | None = None
+        self._runner: asyncio.Task[None] | None = None
+        self._closed = False
+
+    @property
+    def running(self) -> bool:
+        return self.app is not None and self.app.returncode is None and self._ending is None
+
+    # -- requests ----------------------------------------------------------------------------
+    def connection_made(self, chan: asyncssh.SSHServerChannel) -> None:
+        self.chan = chan
+
+    def pty_requested(self, term_type: str, term_size, term_modes) -> bool:
+        self.has_pty = True
+        self.term = term_type or "xterm-256color"
+        width, height = term_size[0], term_size[1]
+        if width > 0 and height > 0:
+            self.size = (width, height)
+        return True
+
+    def shell_requested(self) -> bool:
+        self.request = "shell"
+        return True
+
+    def exec_requested(self, command: str) -> bool:
+        self.request = f"command {command[:60]!r}"
+        return True
+
+    def subsystem_requested(self, subsystem: str) -> bool:
+        self.request = f"subsystem {subsystem[:30]!r}"
+        return True
+
+    def session_started(self) -> None:
+        if self.request != "shell" or not self.has_pty:
+            self._refuse_request()
+            return
+        why = self.server.config.limits.refusal(
+            len([s for s in self.server.sessions.values() if s.user.name == self.user.name]),
+            len(self.server.sessions),
+        )
+        if why is not None:
+            log.warning(
+                "session refused: %s from %s: %s", self.user.name, self.connection.peer, why
+            )
+            self._say_and_exit(why, 1)
+            return
+        self.server.sessions[self.id] = self
+        self._runner = asyncio.create_task(self._run(), name=f"ssh-session-{self.id}")
+
+    def _refuse_request(self) -> None:
+        config = self.server.config
+        if self.request.startswith("subsystem"):
+            message = NO_FILES.format(what=self.request)
+        elif self.request.startswith("command"):
+            message = NO_COMMANDS.format(what=self.request)
+        else:
+            message = NOT_A_TERMINAL.format(
+                port=config.port, user=self.user.name, host=config.public_host
+            )
+        log.warning(
+            "%s refused: %s from %s",
+            self.request or "session without terminal",
+            self.user.name,
+            self.connection.peer,
+        )
+        assert self.chan is not None
+        self.chan.write_stderr(message.encode() + b"\r\n")
+        self.chan.exit(1)
+
+    def _say_and_exit(self, message: str, status: int) -> None:
+        chan = self.chan
+        if chan is None or self._closed:
+            return
+        self._closed = True
+        with contextlib.suppress(Exception):
+            chan.write(message.encode() + b"\r\n")
+            chan.exit(status)
+
+    # -- the app -----------------------------------------------------------------------------
+    async def _run(self) -> None:
+        server, config = self.server, self.server.config
+        user = self.user.name
+        try:
+            self.ports = server.pool.allocate(user, 2, owned=server.held_remote_ports(user))
+        except PoolExhausted as exc:
+            log.error("session refused: %s: %s", user, exc)
+            server.sessions.pop(self.id, None)
+            self._say_and_exit(
+                "The lab server has no free VIPLE ports left; try again in a few minutes.", 1
+            )
+            return
+        tcp_port, ws_port = self.ports
+        stamp = time.strftime("%Y%m%d-%H%M%S")
+        runs = config.data_dir / "runs" / user
+        record_dir = runs / stamp
+        if record_dir.exists() or any(
+            s.spec and s.spec.record_dir == record_dir for s in server.sessions.values()
+        ):
+            record_dir = runs / f"{stamp}-{self.id}"
+        hint = forward_hint(user, config.public_host, server.port, tcp_port, ws_port)
+        width, height = self.size
+        self.spec = AppSpec(
+            user,
+            self.user.role,
+            tcp_port,
+            ws_port,
+            hint,
+            config.data_dir,
+            record_dir,
+            width,
+            height,
+            self.term,
+        )
+        log_path = config.data_dir / "logs" / user / f"{stamp}-{self.id}.log"
+        self.app = AppProcess(
+            self.spec.argv(config.app_command), self.spec.env(), log_path, self._output
+        )
+        try:
+            await self.app.start()
+        except OSError as exc:
+            log.error("app for %s did not start: %s", user, exc)
+            await self._finish("The workbench could not be started; tell the instructor.", 1)
+            return
+        if self._ending is not None:  # the client left while the app was starting
+            await self.app.stop(config.stop_grace)
+            return
+        log.info(
+            "session %d: %s (%s) from %s, pid %s, VIPLE tcp %d ws %d, %dx%d",
+            self.id,
+            user,
+            self.user.role,
+            self.connection.peer,
+            self.app.pid,
+            tcp_port,
+            ws_port,
+            width,
+            height,
+        )
+        code = await self.app.wait()
+        if self._ending is None:  # the app ended by itself (ctrl+q, or a crash)
+            message = "" if code == 0 else f"The workbench ended with an error ({code})."
+            await self._finish(message, code)
+
+    def _output(self, data: bytes) -> None:
+        if self.chan is not None and not self._closed:
+            self.chan.write(data)
+
+    async def end(self, message: str = "") -> None:
+        """Stop this session's app (quit, SIGTERM, SIGKILL), release its ports, close."""
+        if self._ending is None:
+            self._ending = asyncio.create_task(self._stop(message))
+        await asyncio.shield(self._ending)
+
+    async def _stop(self, message: str) -> None:
+        code = None
+        if self.app is not None:
+            code = await self.app.stop(self.server.config.stop_grace)
+        if self._runner is not None:
+            with contextlib.suppress(Exception, asyncio.CancelledError):
+                await self._runner
+        await self._finish(message, 1 if message else (code or 0))
+
+    async def _finish(self, message: str, status: int) -> None:
+        server = self.server
+        if server.sessions.pop(self.id, None) is not None and self.app is not None:
+            log.info(
+                "session %d: %s ended (exit %s) after %.0f s",
+                self.id,
+                self.user.name,
+                self.app.returncode,
+                time.monotonic() - self.started_at,
+            )
+        server.pool.release(self.ports)
+        self.ports = ()
+        if self.chan is not None and not self._closed:
+            with contextlib.suppress(Exception):
+                self.chan.write(RESTORE_TERMINAL)
+            if message:
+                self._say_and_exit(message, status)
+            else:
+                self._exit(status)
+
+    def _exit(self, status: int) -> None:
+        self._closed = True
+        with contextlib.suppress(Exception):
+            assert self.chan is not None
+            self.chan.exit(status)
+
+    # -- the client --------------------------------------------------------------------------
+    def data_received(self, data: bytes, datatype: asyncssh.DataType) -> None:
+        self.last_input = time.monotonic()
+        if self.app is not None:
+            self.app.send_keys(data)
+
+    def terminal_size_changed(self, width: int, height: int, pixwidth: int, pixheight: int) -> None:
+        self.size = (width, height)
+        if self.app is not None:
+            self.app.resize(width, height)
+
+    def eof_received(self) -> bool:
+        self._client_gone("end of input")
+        return False
+
+    def break_received(self, msec: int) -> bool:
+        return False
+
+    def pause_writing(self) -> None:
+        if self.app is not None:
+            self.app.pause_output()
+
+    def resume_writing(self) -> None:
+        if self.app is not None:
+            self.app.resume_output()
+
+    def connection_lost(self, exc: Exception | None) -> None:
+        self._closed = True
+        self._client_gone(str(exc) if exc else "disconnected")
+
+    def _client_gone(self, why: str) -> None:
+        if self.id in self.server.sessions and self._ending is None:
+            log.info("session %d: %s: %s", self.id, self.user.name, why)
+            self._ending = asyncio.create_task(self._stop(""))
+        elif self._runner is None:
+            self.server.sessions.pop(self.id, None)

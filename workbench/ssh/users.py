@@ -1,0 +1,322 @@
+"""Who may log in to the lab server: the users file, read with line numbers for clear errors.
+
+The file (YAML, written by ``workbench ssh add-user``)::
+
+    users:
+      alice:
+        role: student                 # or instructor
+        keys:                         # authorized OpenSSH public keys, one a line
+          - ssh-ed25519 AAAAC3Nz... alice@laptop
+        password: scrypt$16384$8$1$...  # a hash made by add-user, never the password
+
+Every problem names the file, the line, the key and the fix; the server does not start with a
+file it cannot read.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from collections.abc import Iterable
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import asyncssh
+import yaml
+
+from .passwords import PasswordError, parse_hash, verify_password
+
+ROLES = ("student", "instructor")
+USERS_FILE = "ssh-users.yaml"
+NAME_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,31}")
+FIELDS = ("role", "keys", "password")
+HEADER = (
+    "# Users of the workbench SSH lab server.\n"
+    "# Change it with: workbench ssh add-user NAME --role student|instructor "
+    "[--key FILE.pub] [--password]\n"
+)
+
+
+class UsersFileError(ValueError):
+    """A users file that cannot be used: ``file:line: where: what (fix: ...)``."""
+
+
+def users_path(data_dir: str | os.PathLike) -> Path:
+    """The users file of a data folder."""
+    return Path(data_dir) / USERS_FILE
+
+
+def check_user_name(name: str) -> str:
+    if not NAME_PATTERN.fullmatch(name):
+        raise UsersFileError(
+            f"{name!r} cannot be an SSH login name: use 1-32 letters, digits, '_', '.' or '-', "
+            "not starting with '.' or '-'"
+        )
+    return name
+
+
+def parse_public_key(text: str) -> asyncssh.SSHKey:
+    """One OpenSSH public key line (``type base64 [comment]``); ValueError says what is wrong."""
+    text = text.strip()
+    if not text or text.startswith("#"):
+        raise ValueError("an empty key")
+    try:
+        return asyncssh.import_public_key(text)
+    except (asyncssh.KeyImportError, ValueError) as exc:
+        raise ValueError(f"not an OpenSSH public key ({exc})") from None
+
+
+@dataclass(frozen=True)
+class User:
+    name: str
+    role: str
+    keys: tuple[str, ...] = ()
+    password: str | None = None
+    _public: tuple[bytes, ...] = field(default=(), compare=False, repr=False)
+
+    def with_keys(self) -> User:
+        """The user with its keys parsed once (for quick checks at login)."""
+        blobs = tuple(parse_public_key(k).public_data for k in self.keys)
+        return replace(self, _public=blobs)
+
+    def accepts_key(self, key: asyncssh.SSHKey) -> bool:
+        blobs = self._public or tuple(parse_public_key(k).public_data for k in self.keys)
+        return key.public_data in blobs
+
+    def accepts_password(self, password: str) -> bool:
+        return self.password is not None and verify_password(password, self.password)
+
+    def fingerprints(self) -> list[str]:
+        return [parse_public_key(k).get_fingerprint() for k in self.keys]
+
+
+class _Reader:
+    def __init__(self, path: Path) -> None:
+        self.path = path
+
+    def fail(self, node: yaml.Node | None, where: str, message: str, fix: str) -> None:
+        line = node.start_mark.line + 1 if node is not None else 1
+        prefix = f"{where}: " if where else ""
+        raise UsersFileError(f"{self.path}:{line}: {prefix}{message} (fix: {fix})")
+
+    def mapping(self, node: yaml.Node, where: str, what: str) -> list[tuple[str, yaml.Node]]:
+        if not isinstance(node, yaml.MappingNode):
+            self.fail(node, where, f"must be {what}", "indent it as 'key: value' lines")
+        items: list[tuple[str, yaml.Node]] = []
+        seen: set[str] = set()
+        for key, value in node.value:
+            if not isinstance(key, yaml.ScalarNode):
+                self.fail(key, where, "a key must be a plain name", "write 'name:'")
+            if key.value in seen:
+                self.fail(key, where, f"{key.value!r} is given twice", "keep one of them")
+            seen.add(key.value)
+            items.append((key.value, value))
+        return items
+
+    def text(self, node: yaml.Node, where: str, fix: str) -> str:
+        if not isinstance(node, yaml.ScalarNode) or not str(node.value).strip():
+            self.fail(node, where, "must be a text on the same line", fix)
+        return str(node.value).strip()
+
+
+def parse_users(text: str, path: str | os.PathLike = USERS_FILE) -> dict[str, User]:
+    """The users of a users file's text; :class:`UsersFileError` names line, key and fix."""
+    reader = _Reader(Path(path))
+    try:
+        root = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        line = mark.line + 1 if mark is not None else 1
+        problem = getattr(exc, "problem", None) or str(exc)
+        raise UsersFileError(
+            f"{path}:{line}: not valid YAML: {problem} (fix: compare with docs/ssh.md)"
+        ) from None
+    if root is None:
+        return {}
+    top = dict(reader.mapping(root, "", "a mapping with one key, 'users'"))
+    for key in top:
+        if key != "users":
+            node = next(k for k, _ in root.value if k.value == key)
+            reader.fail(node, key, "is not a known key", "the file has one key, 'users:'")
+    node = top.get("users")
+    if node is None or (isinstance(node, yaml.ScalarNode) and node.value in ("", "~", "null")):
+        return {}
+    users: dict[str, User] = {}
+    for name, entry in reader.mapping(node, "users", "a mapping of login names"):
+        where = f"users.{name}"
+        if not NAME_PATTERN.fullmatch(name):
+            reader.fail(
+                entry,
+                where,
+                "is not a usable login name",
+                "use 1-32 letters, digits, '_', '.' or '-'",
+            )
+        fields = dict(reader.mapping(entry, where, "a mapping with role, keys and/or password"))
+        for key, value in fields.items():
+            if key not in FIELDS:
+                reader.fail(
+                    value,
+                    f"{where}.{key}",
+                    "is not a known key",
+                    "use role, keys and password only",
+                )
+        if "role" not in fields:
+            reader.fail(entry, where, "has no role", "add 'role: student' or 'role: instructor'")
+        role = reader.text(fields["role"], f"{where}.role", "write 'role: student'")
+        if role not in ROLES:
+            reader.fail(
+                fields["role"],
+                f"{where}.role",
+                f"{role!r} is not a role",
+                "write student or instructor",
+            )
+        keys = _keys(reader, fields.get("keys"), f"{where}.keys")
+        password = None
+        if "password" in fields:
+            password = reader.text(
+                fields["password"],
+                f"{where}.password",
+                f"make one with: workbench ssh add-user {name} --password",
+            )
+            try:
+                parse_hash(password)
+            except PasswordError as exc:
+                reader.fail(
+                    fields["password"],
+                    f"{where}.password",
+                    str(exc),
+                    f"set it again with: workbench ssh add-user {name} --password",
+                )
+        if not keys and password is None:
+            reader.fail(
+                entry,
+                where,
+                "has neither keys nor a password, so cannot log in",
+                f"workbench ssh add-user {name} --key FILE.pub (or --password)",
+            )
+        users[name] = User(name, role, keys, password)
+    return users
+
+
+def _keys(reader: _Reader, node: yaml.Node | None, where: str) -> tuple[str, ...]:
+    if node is None:
+        return ()
+    if isinstance(node, yaml.ScalarNode) and node.value in ("", "~", "null"):
+        return ()
+    if not isinstance(node, yaml.SequenceNode):
+        reader.fail(node, where, "must be a list", "write each key on its own '- ' line")
+    keys: list[str] = []
+    for index, item in enumerate(node.value, 1):
+        text = reader.text(item, f"{where}[{index}]", "paste one line of the user's .pub file")
+        try:
+            parse_public_key(text)
+        except ValueError as exc:
+            reader.fail(
+                item,
+                f"{where}[{index}]",
+                str(exc),
+                "paste the whole line of the user's .pub file (e.g. ~/.ssh/id_ed25519.pub)",
+            )
+        keys.append(text)
+    return tuple(keys)
+
+
+def load_users(path: str | os.PathLike) -> dict[str, User]:
+    """The users of the file at ``path`` (none when it does not exist)."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        return {}
+    except (OSError, UnicodeDecodeError) as exc:
+        raise UsersFileError(f"{path}: cannot be read: {exc}") from None
+    return {name: user.with_keys() for name, user in parse_users(text, path).items()}
+
+
+def dump_users(users: Iterable[User]) -> str:
+    """The text of a users file holding ``users`` (sorted by name)."""
+    entries: dict[str, dict[str, object]] = {}
+    for user in sorted(users, key=lambda u: u.name):
+        entry: dict[str, object] = {"role": user.role}
+        if user.keys:
+            entry["keys"] = list(user.keys)
+        if user.password:
+            entry["password"] = user.password
+        entries[user.name] = entry
+    body = yaml.safe_dump({"users": entries}, sort_keys=False, width=10_000)
+    return HEADER + body
+
+
+def save_users(path: str | os.PathLike, users: Iterable[User]) -> None:
+    """Write the users file in one step, readable by its owner only (it holds hashes)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    temp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    fd = os.open(temp, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as out:
+            out.write(dump_users(users))
+        os.replace(temp, path)
+    except BaseException:
+        temp.unlink(missing_ok=True)
+        raise
+
+
+def add_user(
+    path: str | os.PathLike,
+    name: str,
+    role: str,
+    keys: Iterable[str] = (),
+    password_hash: str | None = None,
+) -> User:
+    """Create or update one user (keys are added, a password replaces the old one)."""
+    check_user_name(name)
+    if role not in ROLES:
+        raise UsersFileError(f"{role!r} is not a role: use student or instructor")
+    users = load_users(path)
+    old = users.get(name)
+    have = list(old.keys) if old else []
+    blobs = {parse_public_key(k).public_data for k in have}
+    for text in keys:
+        key = parse_public_key(text)
+        if key.public_data not in blobs:
+            blobs.add(key.public_data)
+            have.append(text.strip())
+    password = password_hash or (old.password if old else None)
+    if not have and not password:
+        raise UsersFileError(f"{name} needs a key (--key FILE.pub) or a password (--password)")
+    user = User(name, role, tuple(have), password)
+    users[name] = user
+    save_users(path, users.values())
+    return user
+
+
+class UsersFile:
+    """The users file as the server reads it: read again when it changes on disk.
+
+    A broken edit while the server runs is logged and the users read before stay in force.
+    """
+
+    def __init__(self, path: str | os.PathLike) -> None:
+        self.path = Path(path)
+        self._stamp = self._stat()
+        self.users = load_users(self.path)
+        self.problem = ""
+
+    def _stat(self) -> tuple[int, int] | None:
+        try:
+            st = self.path.stat()
+        except OSError:
+            return None
+        return st.st_mtime_ns, st.st_size
+
+    def get(self, name: str) -> User | None:
+        stamp = self._stat()
+        if stamp != self._stamp:
+            self._stamp = stamp
+            try:
+                self.users = load_users(self.path)
+                self.problem = ""
+            except UsersFileError as exc:
+                self.problem = str(exc)
+        return self.users.get(name)
