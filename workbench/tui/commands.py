@@ -83,6 +83,11 @@ COMMANDS: dict[str, CommandInfo] = {
             "Draw the maze with plain ASCII (any terminal) or Unicode lines and arrows.",
         ),
         "view.trail": ("View", "trail", "Show or hide the blocks the robot has driven through."),
+        "maze.load": (
+            "Set-up",
+            "load a maze",
+            "Put a maze file on the bench (the robot starts over on it, same profile).",
+        ),
         "screen.editor": (
             "Screens",
             "maze editor",

@@ -7,6 +7,7 @@ footer. Every action here calls the bench; the screen only draws what the bench 
 
 from __future__ import annotations
 
+from pathlib import Path
 from time import monotonic
 from typing import ClassVar
 
@@ -19,6 +20,8 @@ from textual.widgets import Footer
 
 from workbench.control.bench import Bench
 from workbench.control.fsm import FsmError
+from workbench.sim.maze import MazeError
+from workbench.sim.mazeio import load_maze
 from workbench.sim.sensors import SensorConfigError
 from workbench.sim.session import Snapshot
 
@@ -52,6 +55,7 @@ class MainScreen(Screen[None]):
         Binding("f", "fix_sensors", "Fix sensors", show=False, id="algorithm.fix"),
         Binding("u", "unicode", "Unicode", show=False, id="view.unicode"),
         Binding("t", "trail", "Trail", show=False, id="view.trail"),
+        Binding("m", "maze", "Maze", show=False, id="maze.load"),
         Binding("e", "editor", "Editor", show=False, id="screen.editor"),
         Binding("R", "runs", "Runs", show=False, id="screen.runs"),
         Binding("l", "labs", "Labs", show=False, id="screen.labs"),
@@ -238,6 +242,38 @@ class MainScreen(Screen[None]):
     def action_trail(self) -> None:
         view = self._maze_view
         view.set_trail(not view.trail)
+
+    def action_maze(self, value: str | None = None, error: str = "") -> None:
+        """Ask for a maze file and put it on the bench (the robot starts over on it)."""
+        from .path_dialog import PathDialog
+
+        if value is None:
+            current = getattr(self.app, "maze_path", None)
+            value = f"{Path(current).parent}/" if current else ""
+
+        def chosen(path: str | None) -> None:
+            if path is not None:
+                self._load_maze(path)
+
+        hint = "A maze file: the workbench text format or a micromouse .maz."
+        dialog = PathDialog("Load a maze", hint, value=value, action="Load", error=error)
+        self.app.push_screen(dialog, chosen)
+
+    def _load_maze(self, path: str) -> None:
+        try:
+            maze = load_maze(Path(path).expanduser())
+        except MazeError as exc:
+            self.action_maze(path, "\n".join(str(p) for p in exc.problems))
+            return
+        bench = self.bench
+        bench.load_maze(maze)
+        self._maze_view.set_maze(maze)
+        self._maze_view.clear_trail()
+        app = self.app
+        if hasattr(app, "maze_path"):
+            app.maze_path = Path(path).expanduser()  # the editor saves it there
+        app.sub_title = f"{maze.name} ({bench.profile})"
+        self.say(f"the robot is on {maze.name}")
 
     def action_editor(self) -> None:
         self.app.open_editor()  # type: ignore[attr-defined]

@@ -1,0 +1,57 @@
+"""The maze key (m): a maze file typed in a dialog goes on the bench."""
+
+from __future__ import annotations
+
+from textual.pilot import Pilot
+from textual.widgets import Input, Static
+
+from workbench.labs.checks import maze_of
+from workbench.labs.model import LABS_DIR
+from workbench.tui.app import make_app
+from workbench.tui.screens.main import MainScreen
+from workbench.tui.screens.path_dialog import PathDialog
+
+from .support import run
+
+RANKING = LABS_DIR.parent / "mazes" / "rank-local-best-wins.txt"
+
+
+def test_m_loads_a_maze_file_onto_the_bench_and_keeps_the_profile(tmp_path):
+    app = make_app(paused=True, profile="unity")
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.press("m")
+        dialog = app.screen
+        assert isinstance(dialog, PathDialog)
+        field = dialog.query_one("#path", Input)
+        assert field.value.endswith("mazes/")  # the folder of the maze on the bench
+        field.value = str(RANKING)
+        await pilot.press("enter")
+        await pilot.pause()
+        assert isinstance(app.screen, MainScreen)
+        assert app.bench.maze.same_layout(maze_of(RANKING))
+        assert app.bench.profile == "unity"
+        assert app.maze_path == RANKING  # the editor saves there
+        assert app.sub_title == f"{app.bench.maze.name} (unity)"
+
+    run(app, body)
+
+
+def test_a_maze_that_cannot_be_read_is_shown_in_the_dialog(tmp_path):
+    app = make_app(paused=True)
+
+    async def body(pilot: Pilot) -> None:
+        before = app.bench.maze
+        await pilot.press("m")
+        app.screen.query_one("#path", Input).value = str(tmp_path / "missing.txt")
+        await pilot.press("enter")
+        await pilot.pause()
+        dialog = app.screen
+        assert isinstance(dialog, PathDialog)  # asked again, with the reason
+        assert dialog.query_one("#path", Input).value == str(tmp_path / "missing.txt")
+        assert "cannot read" in str(dialog.query_one("#error", Static).render())
+        await pilot.press("escape")
+        assert isinstance(app.screen, MainScreen)
+        assert app.bench.maze is before
+
+    run(app, body)
