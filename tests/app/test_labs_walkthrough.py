@@ -1,0 +1,406 @@
+"""A pair of students does every lab exercise in one app, and the instructor signs each off.
+
+Ana and Ben open the labs (l), pick each exercise in turn, set it up (a) and do the work the
+way the app offers it: drive keys, the sensor panel, the maze editor, the maze key, the
+algorithm dialog (built-ins, and the starter FSMs completed in its parameter editor), a
+VIPLE program on the WebSocket server the app connects to, and the question fields. Every
+objective must show ✓ on the labs screen without an override; then the instructor signs the
+exercise off (i) and the pair swaps the driver. At the end the store holds one signed record
+per exercise, the records verify and the gradebook has a row per student per exercise.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import csv
+from pathlib import Path
+
+from textual.pilot import Pilot
+from textual.widgets import Input, OptionList, Select, Static
+from websockets.asyncio.server import serve
+
+from tests.integration.test_labs_completable import DRIVE, SOLUTIONS, answer, free_port
+from workbench.cli import main
+from workbench.control.algorithms import list_algorithms
+from workbench.labs import signoff as so
+from workbench.labs.checks import maze_of
+from workbench.labs.model import Exercise, Lab, Objective, load_labs
+from workbench.labs.store import Store
+from workbench.tui.app import WorkbenchApp, make_app
+from workbench.tui.modals.algorithm import AlgorithmModal
+from workbench.tui.modals.sensor_ports import SensorPortsModal
+from workbench.tui.modals.signoff import SignoffModal
+from workbench.tui.screens.editor import EditorScreen
+from workbench.tui.screens.labs import LabsScreen
+from workbench.tui.screens.main import MainScreen
+from workbench.tui.screens.path_dialog import PathDialog
+from workbench.tui.widgets.param_editor import ParamEditor
+from workbench.tui.widgets.sensor_row_editor import SensorRowEditor
+from workbench.viple.tcp_server import TcpConfig
+from workbench.viple.ws_client import WsConfig
+
+from .support import run
+
+FAST = so.KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
+INSTRUCTOR = "Dr Chen"
+PASS = "correct horse battery"
+PAIR = ("ana", "ben")
+LABS = load_labs()
+EXERCISES = [(lab, ex) for lab in LABS for ex in lab.exercises]
+
+
+class Walkthrough:
+    """The pair at the keyboard of one app."""
+
+    def __init__(self, pilot: Pilot, tmp: Path) -> None:
+        self.pilot = pilot
+        self.app: WorkbenchApp = pilot.app  # type: ignore[assignment]
+        self.tmp = tmp
+        #: the built-in algorithms picked in the dialog so far
+        self.met: set[str] = set()
+
+    @property
+    def bench(self):
+        return self.app.bench
+
+    async def press(self, *keys: str) -> None:
+        await self.pilot.press(*keys)
+        await self.pilot.pause()
+
+    # -- screens ---------------------------------------------------------------------------
+    async def labs(self) -> LabsScreen:
+        if not isinstance(self.app.screen, LabsScreen):
+            await self.press("l")
+        screen = self.app.screen
+        assert isinstance(screen, LabsScreen)
+        return screen
+
+    async def main_screen(self) -> MainScreen:
+        if isinstance(self.app.screen, LabsScreen):
+            await self.press("escape")
+        screen = self.app.screen
+        assert isinstance(screen, MainScreen), screen
+        return screen
+
+    async def open(self, lab: Lab, ex: Exercise) -> LabsScreen:
+        screen = await self.labs()
+        listing = screen.query_one("#labs-list", OptionList)
+        listing.highlighted = listing.get_option_index(f"{lab.id}/{ex.id}")
+        await self.pilot.pause()
+        assert str(screen.query_one("#labs-title").render()) == f"{lab.title}: {ex.title}"
+        return screen
+
+    # -- the work --------------------------------------------------------------------------
+    async def load_maze(self, path: Path) -> None:
+        """The maze key: type the file's path in the dialog."""
+        if self.bench.maze.same_layout(maze_of(path)):
+            return
+        await self.main_screen()
+        await self.press("m")
+        dialog = self.app.screen
+        assert isinstance(dialog, PathDialog)
+        dialog.query_one("#path", Input).value = str(path)
+        await self.press("enter")
+        assert isinstance(self.app.screen, MainScreen)
+        assert self.bench.maze.same_layout(maze_of(path)), self.bench.message
+
+    async def algorithm_dialog(self) -> AlgorithmModal:
+        await self.main_screen()
+        await self.press("g")
+        modal = self.app.screen
+        assert isinstance(modal, AlgorithmModal)
+        return modal
+
+    async def run_builtin(self, name: str) -> None:
+        """A built-in algorithm: picked in the algorithm dialog the first time the pair meets
+        it, its sensors fitted (f), started; later through the bench, as the dialog does."""
+        bench = self.bench
+        if name in self.met:
+            bench.select_algorithm(name)
+            bench.apply_algorithm_preset()
+            bench.start_algorithm()
+            await self.run_to_exit()
+            return
+        self.met.add(name)
+        modal = await self.algorithm_dialog()
+        options = modal.query_one("#alg-builtins", OptionList)
+        options.highlighted = list_algorithms().index(name)
+        options.focus()
+        await self.press("enter")
+        assert bench.algorithm is not None and bench.algorithm.name == name
+        if bench.missing_sensors():
+            await self.press("f")  # fit the sensors the algorithm reads
+        await self.start(modal)
+
+    async def run_starter(self, path: str) -> None:
+        """The exercise's starter FSM, completed in the parameter editor and started; once it
+        is complete, x runs it again (on another maze, say)."""
+        bench = self.bench
+        definition = bench.algorithm
+        if definition is not None and definition.source == path and self.completed(definition):
+            await self.main_screen()
+            await self.press("x")
+            assert bench.controller is not None, bench.message
+            await self.run_to_exit()
+            return
+        modal = await self.algorithm_dialog()
+        if definition is None or definition.source != path:
+            field = modal.query_one("#alg-path", Input)
+            field.value = path
+            await field.action_submit()
+            await self.pilot.pause()
+        definition = bench.algorithm
+        assert definition is not None and definition.source == path
+        editors = {e.parameter.name: e for e in modal.query(ParamEditor)}
+        for item in SOLUTIONS[definition.name]:
+            name, value = item.split("=")
+            editors[name].query_one(Input).value = value
+        await self.pilot.pause()
+        assert self.completed(definition), bench.params()
+        await self.start(modal)
+
+    def completed(self, definition) -> bool:
+        params = self.bench.params()
+        return all(
+            params[name] == float(value)
+            for name, value in (item.split("=") for item in SOLUTIONS[definition.name])
+        )
+
+    async def start(self, modal: AlgorithmModal) -> None:
+        await self.pilot.click("#alg-start")
+        await self.pilot.pause()
+        assert self.app.screen is not modal, str(modal.query_one("#alg-error").render())
+        assert self.bench.controller is not None
+        await self.run_to_exit()
+
+    async def run_to_exit(self) -> None:
+        """Step the running algorithm in large batches until its run ends."""
+        bench = self.bench
+        done = len(bench.runs)
+        for _ in range(600):
+            bench.step(60)
+            if len(bench.runs) > done:
+                break
+        last = bench.runs[-1]
+        assert len(bench.runs) > done and last.ended == "exit", (last, bench.message)
+        await self.pilot.pause()
+
+    async def reach_exit(self, ex: Exercise, obj: Objective) -> None:
+        assert obj.maze is not None
+        await self.load_maze(obj.maze)
+        if "fsm" in obj.drivers:
+            assert ex.setup.controller.kind == "starter"
+            await self.run_starter(ex.setup.controller.value)
+        else:
+            name = next(d.split(" ", 1)[1] for d in obj.drivers if d.startswith("algorithm "))
+            await self.run_builtin(name)
+
+    async def compare(self, obj: Objective) -> None:
+        for path in obj.mazes:
+            await self.load_maze(path)
+            for name in obj.algorithms:
+                await self.run_builtin(name)
+
+    async def drive_keys(self, obj: Objective) -> None:
+        await self.main_screen()
+        for key in obj.keys:
+            await self.press(key)
+            self.bench.step(10)
+
+    async def set_sensors(self, obj: Objective) -> None:
+        """The sensor panel (o): kinds, ports and mounts typed in its rows, then Apply."""
+        await self.main_screen()
+        await self.press("o")
+        modal = self.app.screen
+        assert isinstance(modal, SensorPortsModal)
+        wanted = list(obj.sensors)
+        for row in modal.query(SensorRowEditor):
+            kind = row.query_one(".row-kind", Select).value
+            spec = next((s for s in wanted if s.kind == kind), None)
+            if spec is None:
+                row.query_one(".row-mount", Select).value = "none"
+                continue
+            wanted.remove(spec)
+            row.query_one(".row-port", Input).value = str(spec.port)
+            row.query_one(".row-mount", Select).value = spec.mount
+        await self.pilot.pause()
+        assert wanted == []
+        await self.pilot.click("#ports-apply")
+        await self.pilot.pause()
+        assert str(modal.query_one("#ports-status").render()).startswith("applied:")
+        await self.press("escape")
+        assert {str(s) for s in self.bench.sensors} == {str(s) for s in obj.sensors}
+
+    async def edit_maze(self) -> None:
+        """The maze editor: open an inner wall, save the maze as a new file, go back."""
+        await self.main_screen()
+        await self.press("e")
+        editor = self.app.screen
+        assert isinstance(editor, EditorScreen)
+        maze = self.bench.maze
+        target = next((x, y) for y in range(1, maze.height - 1) for x in range(1, maze.width - 1)
+                      if maze.is_wall(x, y))  # fmt: skip
+        x, y = editor.editor.cursor
+        keys = ["right" if target[0] > x else "left"] * abs(target[0] - x)
+        keys += ["down" if target[1] > y else "up"] * abs(target[1] - y)
+        await self.press(*keys, "space")
+        assert editor.dirty
+        await self.press("a")  # save as: a file of the students' own
+        dialog = self.app.screen
+        assert isinstance(dialog, PathDialog)
+        dialog.query_one("#path", Input).value = str(self.tmp / "edited.txt")
+        await self.press("enter")
+        assert not editor.dirty, editor.status
+        await self.press("escape")
+        assert isinstance(self.app.screen, MainScreen)
+        assert not self.bench.maze.same_layout(maze)
+
+    async def answer_questions(self, ex: Exercise) -> None:
+        screen = await self.labs()
+        for q in ex.questions:
+            screen.query_one(f"#q-{q.id}", Input).value = answer(q)
+        await self.pilot.pause()
+        reasons = [str(s.render()) for s in screen.query(".question-reason").results(Static)]
+        assert reasons == ["✓ correct"] * len(ex.questions), reasons
+
+    async def do(self, lab: Lab, ex: Exercise) -> None:
+        """Everything the exercise asks, in the order a pair would do it."""
+        kinds = [o.kind for o in ex.objectives]
+        for obj in ex.objectives:
+            if obj.kind == "exit":
+                await self.reach_exit(ex, obj)
+            elif obj.kind == "compare":
+                await self.compare(obj)
+        if {"keys", "maze-edited"} & set(kinds):  # those work on the exercise's own maze
+            await self.load_maze(ex.setup.maze)
+        for obj in ex.objectives:
+            if obj.kind == "sensors":
+                if {str(s) for s in self.bench.sensors} != {str(s) for s in obj.sensors}:
+                    await self.set_sensors(obj)
+            elif obj.kind == "keys":
+                await self.drive_keys(obj)
+            elif obj.kind == "maze-edited":
+                await self.edit_maze()
+        await self.answer_questions(ex)
+
+    # -- sign-off --------------------------------------------------------------------------
+    async def sign_off(self, screen: LabsScreen, next_driver: str) -> None:
+        await self.press("i")
+        modal = self.app.screen
+        assert isinstance(modal, SignoffModal)
+        assert "all objectives pass" in str(modal.query_one("#signoff-state").render())
+        modal.query_one("#signoff-note", Input).value = "seen at the bench"
+        field = modal.query_one("#signoff-passphrase", Input)
+        field.value = PASS
+        field.focus()
+        await self.press("enter")
+        done = str(modal.query_one("#signoff-done").render())
+        assert done == f"Signed off by {INSTRUCTOR}.", str(
+            modal.query_one("#signoff-status").render()
+        )
+        await self.pilot.click(f"#signoff-driver-{PAIR.index(next_driver)}")
+        await self.pilot.pause()
+        assert self.app.screen is screen
+        assert screen.driver == next_driver
+
+
+def objectives(screen: LabsScreen) -> list[str]:
+    return str(screen.query_one("#labs-objectives", Static).render()).splitlines()
+
+
+async def viple_over_websocket(w: Walkthrough, screen: LabsScreen, lab: Lab, ex: Exercise) -> None:
+    """The students start their VIPLE program (a WebSocket server), then set the exercise up:
+    the set-up starts the app's WebSocket client, which connects; the program drives."""
+    arrived: asyncio.Queue[str] = asyncio.Queue()
+
+    async def program(ws) -> None:
+        await ws.send(DRIVE)
+        await arrived.put(await ws.recv())
+        await ws.wait_closed()
+
+    url = w.app._viple_configs[1].url  # the URL the app's WebSocket client uses
+    port = int(url.rsplit(":", 1)[1].strip("/"))
+    async with serve(program, "127.0.0.1", port) as server:
+        assert w.app.endpoints is None or w.app.endpoints.ws is None
+        await w.press("a")
+        await asyncio.wait_for(arrived.get(), 5)  # the app connected and sent a report
+        client = w.app.endpoints.ws
+        assert client is not None
+        for _ in range(300):
+            if client.status.messages_in >= 1:
+                break
+            await asyncio.sleep(0.01)
+        assert client.status.invalid == 0, client.status.last_rejection
+        w.bench.step(30)  # the program's move, simulated
+        await w.pilot.pause()
+        assert w.bench.viple and w.bench.viple[-1].drove
+        server.close()  # the students stop their program
+    for _ in range(300):
+        if not w.bench.session.driver.startswith("VIPLE"):
+            break
+        await asyncio.sleep(0.01)
+    w.bench.step(1)
+    await w.open(lab, ex)
+
+
+def test_a_pair_completes_and_signs_off_every_exercise_in_the_app(tmp_path):
+    data = tmp_path / "data"
+    so.create_instructor(data, INSTRUCTOR, PASS, kdf=FAST)
+    # paused and noise off: every run is stepped by the test, in large batches, and comes out
+    # the same each time; the app ticks only to draw, so slowly
+    app = make_app(paused=True, noise="off", tick_hz=2, student="ana", partner="ben", data_dir=data)
+
+    async def body(pilot: Pilot) -> None:
+        assert app.endpoints is None  # none asked for at start: a set-up starts what it needs
+        # ... on free ports here, so the test never depends on the course's 1350 / 8124
+        app._viple_configs = (
+            TcpConfig(port=free_port()),
+            WsConfig(url=f"ws://127.0.0.1:{free_port()}/", retry_seconds=0.2),
+        )
+        w = Walkthrough(pilot, tmp_path)
+        for n, (lab, ex) in enumerate(EXERCISES):
+            driver = PAIR[n % 2]
+            screen = await w.open(lab, ex)
+            assert screen.driver == driver, (lab.id, ex.id)
+            assert not all(line.startswith("✓") for line in objectives(screen))
+            if ex.setup.controller.kind == "viple":
+                await viple_over_websocket(w, screen, lab, ex)
+            else:
+                await w.press("a")
+            message = str(screen.query_one("#labs-message").render())
+            assert message.startswith(f"set up: {ex.setup.profile}"), message
+            assert w.bench.profile == ex.setup.profile
+            await w.do(lab, ex)
+            screen = await w.labs()
+            lines = objectives(screen)
+            assert len(lines) == len(ex.objectives)
+            assert all(line.startswith("✓") for line in lines), (lab.id, ex.id, lines)
+            assert screen.progress is not None and screen.progress.passed
+            await w.sign_off(screen, PAIR[(n + 1) % 2])
+        listing = screen.query_one("#labs-list", OptionList)
+        for lab, ex in EXERCISES:
+            assert str(listing.get_option(f"{lab.id}/{ex.id}").prompt).startswith("✓")
+        await pilot.press("ctrl+q")
+
+    run(app, body)
+
+    with Store.open(data) as store:
+        rows = sorted(store.signoffs(), key=lambda r: r.id)
+        roster = so.load_roster(so.roster_path(data))
+        verdicts = so.verify_all(store, roster)
+    assert [(r.lab, r.exercise) for r in rows] == [(lab.id, ex.id) for lab, ex in EXERCISES]
+    assert not any(r.override for r in rows)
+    assert [r.driver for r in rows] == [PAIR[n % 2] for n in range(len(rows))]
+    assert {(r.student, r.partner, r.instructor) for r in rows} == {("ana", "ben", INSTRUCTOR)}
+    assert all(v.ok for v in verdicts), [(v.row.exercise, v.problems) for v in verdicts]
+
+    assert main(["signoff", "verify", "--data-dir", str(data)]) == 0
+    gradebook = tmp_path / "gradebook.csv"
+    assert main(["signoff", "export", "--csv", str(gradebook), "--data-dir", str(data)]) == 0
+    with gradebook.open(newline="") as f:
+        table = list(csv.DictReader(f))
+    assert len(table) == 2 * len(EXERCISES) == 28
+    assert {(r["student"], r["lab"], r["exercise"]) for r in table} == {
+        (who, lab.id, ex.id) for who in PAIR for lab, ex in EXERCISES
+    }
+    assert {r["override"] for r in table} == {"no"}
