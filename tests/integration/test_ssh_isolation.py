@@ -1,0 +1,87 @@
+"""Two students on the lab server at once: each has their own robot and VIPLE ports, and SSH
+forwarding reaches only the student's own."""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import json
+import re
+
+import asyncssh
+import pytest
+
+from tests.app.support import sync
+
+from .ssh_support import Account, lab_host, moved
+
+MOVE = b'{"servos":[{"isTurn":false,"servoId":-1,"servoSpeed":1}]}\r\n'
+
+
+def tcp_port_shown(screen: str) -> int:
+    """The VIPLE TCP port from the forwarding command the app shows."""
+    found = re.search(r"-L 1350:localhost:(\d+)", screen)
+    assert found, f"no forwarding command on the screen:\n{screen}"
+    return int(found.group(1))
+
+
+@sync
+async def test_each_student_sees_only_their_robot_and_forwards_only_to_their_own_ports(tmp_path):
+    async with lab_host(tmp_path, [Account("ann"), Account("ben")]) as host:
+        ann, ben = await asyncio.gather(host.terminal("ann"), host.terminal("ben"))
+        screen_a, screen_b = await asyncio.gather(ann.start_app(), ben.start_app())
+        port_a, port_b = tcp_port_shown(screen_a), tcp_port_shown(screen_b)
+        assert port_a != port_b
+        ws_a = host.server.live("ann")[0].spec.ws_port
+        ws_b = host.server.live("ben")[0].spec.ws_port
+
+        # A drives; B's robot stays where it is
+        ann.send("w")
+        await ann.wait_until(moved, "ann's robot moving")
+        ben.send(" ")  # a key for ben too, so both apps are equally awake
+        await asyncio.sleep(0.5)
+        assert "distance 0.00 unit" in ben.text()
+
+        # a second connection of A's, like `ssh -N -L ...` on the student's computer
+        tunnel = await host.connect("ann")
+        with pytest.raises(asyncssh.ChannelOpenError, match="forward refused"):
+            await tunnel.open_connection("localhost", port_b)
+        with pytest.raises(asyncssh.ChannelOpenError, match="forward refused"):
+            await tunnel.open_connection("10.1.2.3", port_a)
+        with pytest.raises(asyncssh.ChannelListenError):
+            await tunnel.forward_remote_port("localhost", ws_b, "localhost", 8124)
+
+        # A's own port works: a VIPLE-style client through the forward drives A's robot
+        ann.send(" ")  # stop the keys' run first
+        listener = await tunnel.forward_local_port("127.0.0.1", 0, "localhost", port_a)
+        reader, writer = await asyncio.open_connection("127.0.0.1", listener.get_port())
+        report = json.loads(await asyncio.wait_for(reader.readline(), 10))
+        assert [entry["id"] for entry in report["sensors"]] == [1, 2]
+        writer.write(MOVE)
+        await writer.drain()
+        screen = await ann.wait_for("driver: VIPLE tcp", timeout=10)
+        before = screen
+        await ann.wait_until(lambda t: t != before and moved(t), "ann's robot driven by VIPLE")
+        assert "distance 0.00 unit" in ben.text()
+        assert "driver: keys" in ben.text()  # nobody's VIPLE drives ben's robot
+
+        writer.close()  # VIPLE over TCP lets go of the robot
+        with contextlib.suppress(Exception):
+            await writer.wait_closed()
+
+        # then the app reaches A's VIPLE WebSocket server through A's own remote forward
+        arrived = asyncio.Event()
+
+        async def viple_ws(r: asyncio.StreamReader, w: asyncio.StreamWriter) -> None:
+            arrived.set()
+            w.close()
+
+        local = await asyncio.start_server(viple_ws, "127.0.0.1", 0)
+        local_port = local.sockets[0].getsockname()[1]
+        await tunnel.forward_remote_port("localhost", ws_a, "127.0.0.1", local_port)
+        await asyncio.wait_for(arrived.wait(), 15)
+
+        local.close()
+        listener.close()
+        tunnel.close()
+        await asyncio.gather(ann.close(), ben.close())
