@@ -42,15 +42,22 @@ class LabHost:
     def port(self) -> int:
         return self.server.port
 
-    async def connect(self, name: str, *, password: str | None = None, key: bool = True,
-                      **options) -> asyncssh.SSHClientConnection:  # fmt: skip
+    async def connect(
+        self, name: str, *, password: str | None = None, key: bool = True, **options
+    ) -> asyncssh.SSHClientConnection:
         account = self.accounts.get(name)
         keys = [account.key] if key and account is not None and account.key else []
         return await asyncssh.connect(
-            "127.0.0.1", self.port, username=name, client_keys=keys, password=password,
-            known_hosts=None, agent_path=None, preferred_auth=["publickey", "password"]
-            if keys else ["password"], **options,
-        )  # fmt: skip
+            "127.0.0.1",
+            self.port,
+            username=name,
+            client_keys=keys,
+            password=password,
+            known_hosts=None,
+            agent_path=None,
+            preferred_auth=["publickey", "password"] if keys else ["password"],
+            **options,
+        )
 
     async def terminal(self, name: str, size: tuple[int, int] = (80, 24), **kw) -> Terminal:
         conn = await self.connect(name, **kw)
@@ -139,8 +146,9 @@ class Terminal:
     def text(self) -> str:
         return "\n".join(self.screen.display)
 
-    async def wait_until(self, check: Callable[[str], bool], what: str, timeout: float = 20.0
-                         ) -> str:  # fmt: skip
+    async def wait_until(
+        self, check: Callable[[str], bool], what: str, timeout: float = 20.0
+    ) -> str:
         deadline = time.monotonic() + timeout
         while True:
             text = self.text()
@@ -203,3 +211,18 @@ def distance(text: str) -> str:
 
 def moved(text: str) -> bool:
     return distance(text) not in ("", "0.00 unit")
+
+
+async def open_exercise(term: Terminal, title: str, presses: int = 20) -> str:
+    """Open the labs (``l``) and move down the list until ``title`` is the exercise shown."""
+    term.send("l")
+    screen = await term.wait_for("esc Back", "Sign off")
+    for _ in range(presses):
+        if title in screen.splitlines()[0]:
+            return screen
+        before = screen.splitlines()[0]
+        term.send("\x1b[B")  # down
+        screen = await term.wait_until(
+            lambda t, before=before: t.splitlines()[0] != before, "the next exercise"
+        )
+    raise AssertionError(f"{title!r} not found in the labs list:\n{screen}")

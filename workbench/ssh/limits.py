@@ -16,7 +16,8 @@ class SessionLimits:
     def refusal(self, user_sessions: int, all_sessions: int) -> str | None:
         """The message for a user who would open one more session, or None when it may."""
         if all_sessions >= self.total:
-            return f"The lab server is full ({self.total} sessions); try again in a few minutes."
+            many = "session" if self.total == 1 else "sessions"
+            return f"The lab server is full ({self.total} {many}); try again in a few minutes."
         if user_sessions >= self.per_user:
             many = "session" if self.per_user == 1 else "sessions"
             return (

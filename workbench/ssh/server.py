@@ -423,7 +423,7 @@ class LabSession(asyncssh.SSHServerSession):
             return
         self._closed = True
         with contextlib.suppress(Exception):
-            chan.write(message.encode() + b"\r\n")
+            chan.write(b"\r" + message.encode() + b"\r\n")
             chan.exit(status)
 
     # -- the app -----------------------------------------------------------------------------

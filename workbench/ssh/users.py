@@ -99,10 +99,12 @@ class _Reader:
         prefix = f"{where}: " if where else ""
         raise UsersFileError(f"{self.path}:{line}: {prefix}{message} (fix: {fix})")
 
-    def mapping(self, node: yaml.Node, where: str, what: str) -> list[tuple[str, yaml.Node]]:
+    def mapping(
+        self, node: yaml.Node, where: str, what: str
+    ) -> list[tuple[str, yaml.Node, yaml.Node]]:
         if not isinstance(node, yaml.MappingNode):
             self.fail(node, where, f"must be {what}", "indent it as 'key: value' lines")
-        items: list[tuple[str, yaml.Node]] = []
+        items: list[tuple[str, yaml.Node, yaml.Node]] = []
         seen: set[str] = set()
         for key, value in node.value:
             if not isinstance(key, yaml.ScalarNode):
@@ -110,7 +112,7 @@ class _Reader:
             if key.value in seen:
                 self.fail(key, where, f"{key.value!r} is given twice", "keep one of them")
             seen.add(key.value)
-            items.append((key.value, value))
+            items.append((key.value, key, value))
         return items
 
     def text(self, node: yaml.Node, where: str, fix: str) -> str:
@@ -133,25 +135,27 @@ def parse_users(text: str, path: str | os.PathLike = USERS_FILE) -> dict[str, Us
         ) from None
     if root is None:
         return {}
-    top = dict(reader.mapping(root, "", "a mapping with one key, 'users'"))
-    for key in top:
-        if key != "users":
-            node = next(k for k, _ in root.value if k.value == key)
-            reader.fail(node, key, "is not a known key", "the file has one key, 'users:'")
+    top = {name: value for name, _, value in reader.mapping(root, "", "a 'users:' mapping")}
+    for name, key, _ in reader.mapping(root, "", "a 'users:' mapping"):
+        if name != "users":
+            reader.fail(key, name, "is not a known key", "the file has one key, 'users:'")
     node = top.get("users")
     if node is None or (isinstance(node, yaml.ScalarNode) and node.value in ("", "~", "null")):
         return {}
     users: dict[str, User] = {}
-    for name, entry in reader.mapping(node, "users", "a mapping of login names"):
+    for name, name_node, entry in reader.mapping(node, "users", "a mapping of login names"):
         where = f"users.{name}"
         if not NAME_PATTERN.fullmatch(name):
             reader.fail(
-                entry,
+                name_node,
                 where,
                 "is not a usable login name",
                 "use 1-32 letters, digits, '_', '.' or '-'",
             )
-        fields = dict(reader.mapping(entry, where, "a mapping with role, keys and/or password"))
+        fields = {
+            key: value
+            for key, _, value in reader.mapping(entry, where, "role, keys and/or password")
+        }
         for key, value in fields.items():
             if key not in FIELDS:
                 reader.fail(
@@ -161,7 +165,9 @@ def parse_users(text: str, path: str | os.PathLike = USERS_FILE) -> dict[str, Us
                     "use role, keys and password only",
                 )
         if "role" not in fields:
-            reader.fail(entry, where, "has no role", "add 'role: student' or 'role: instructor'")
+            reader.fail(
+                name_node, where, "has no role", "add 'role: student' or 'role: instructor'"
+            )
         role = reader.text(fields["role"], f"{where}.role", "write 'role: student'")
         if role not in ROLES:
             reader.fail(
@@ -189,7 +195,7 @@ def parse_users(text: str, path: str | os.PathLike = USERS_FILE) -> dict[str, Us
                 )
         if not keys and password is None:
             reader.fail(
-                entry,
+                name_node,
                 where,
                 "has neither keys nor a password, so cannot log in",
                 f"workbench ssh add-user {name} --key FILE.pub (or --password)",

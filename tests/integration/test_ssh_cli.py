@@ -1,0 +1,129 @@
+"""``workbench ssh add-user/list-users`` and ``workbench serve-ssh`` as an administrator uses
+them: scripted passwords, key files, a clear refusal of a broken users file, the host key."""
+
+from __future__ import annotations
+
+import os
+import signal
+import socket
+import stat
+import subprocess
+import sys
+import time
+
+import asyncssh
+
+from workbench.ssh.users import load_users
+
+
+def workbench(*args: str, stdin: str = "", timeout: float = 60) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "workbench", *args],
+        input=stdin,
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
+
+
+def test_add_user_reads_a_password_from_a_script_and_keys_from_pub_files(tmp_path):
+    data = tmp_path / "data"
+    pub = tmp_path / "id_ed25519.pub"
+    pub.write_bytes(asyncssh.generate_private_key("ssh-ed25519").export_public_key())
+    done = workbench(
+        "ssh",
+        "add-user",
+        "ann",
+        "--role",
+        "student",
+        "--key",
+        str(pub),
+        "--password",
+        "--data-dir",
+        str(data),
+        stdin="lab-password\nlab-password\n",
+    )
+    assert done.returncode == 0, done.stderr
+    assert "ann (student) can log in with 1 key and a password" in done.stdout
+    user = load_users(data / "ssh-users.yaml")["ann"]
+    assert user.accepts_password("lab-password") and len(user.keys) == 1
+
+    short = workbench(
+        "ssh",
+        "add-user",
+        "bo",
+        "--role",
+        "student",
+        "--password",
+        "--data-dir",
+        str(data),
+        stdin="short\n",
+    )
+    assert short.returncode == 2 and "at least 8 characters" in short.stderr
+    private = tmp_path / "id_ed25519"
+    private.write_bytes(asyncssh.generate_private_key("ssh-ed25519").export_private_key())
+    wrong = workbench(
+        "ssh", "add-user", "bo", "--role", "student", "--key", str(private), "--data-dir", str(data)
+    )
+    assert wrong.returncode == 2 and "give the .pub file" in wrong.stderr
+
+    listed = workbench("ssh", "list-users", "--data-dir", str(data))
+    assert listed.returncode == 0
+    assert listed.stdout.startswith("ann  student     SHA256:") and "password" in listed.stdout
+
+
+def test_serve_ssh_refuses_a_broken_users_file_naming_line_and_fix(tmp_path):
+    users = tmp_path / "users.yaml"
+    users.write_text("users:\n  ann:\n    role: pupil\n    password: x\n")
+    done = workbench(
+        "serve-ssh", "--users", str(users), "--data-dir", str(tmp_path / "d"), "--port", "0"
+    )
+    assert done.returncode == 2
+    assert f"{users}:3: users.ann.role: 'pupil' is not a role" in done.stderr
+    assert "(fix: write student or instructor)" in done.stderr
+    assert "the server did not start" in done.stderr
+
+
+def free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+def test_serve_ssh_makes_a_private_host_key_logs_and_stops_on_sigterm(tmp_path):
+    data = tmp_path / "data"
+    port = free_port()
+    server = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "workbench",
+            "serve-ssh",
+            "--bind",
+            "127.0.0.1",
+            "--port",
+            str(port),
+            "--data-dir",
+            str(data),
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        log = data / "ssh.log"
+        deadline = time.monotonic() + 30
+        while "serving on 127.0.0.1 port" not in (log.read_text() if log.exists() else ""):
+            assert server.poll() is None and time.monotonic() < deadline, server.stderr.read()
+            time.sleep(0.1)
+        key = data / "ssh_host_ed25519_key"
+        assert stat.S_IMODE(os.stat(key).st_mode) == 0o600
+        fingerprint = asyncssh.read_private_key(key).get_fingerprint()
+        assert fingerprint in log.read_text()
+        server.send_signal(signal.SIGTERM)
+        assert server.wait(15) == 0
+        assert "no users yet" in server.stderr.read()
+    finally:
+        if server.poll() is None:
+            server.kill()
+            server.wait()

@@ -1,0 +1,72 @@
+"""What the lab server refuses, with a message the user can read: commands, file transfer, a
+session without a terminal, and sessions past the limits; idle sessions are closed."""
+
+from __future__ import annotations
+
+import asyncio
+import os
+
+import asyncssh
+import pytest
+
+from tests.app.support import sync
+from workbench.ssh.limits import SessionLimits
+
+from .ssh_support import Account, lab_host
+
+
+@sync
+async def test_commands_file_transfer_and_sessions_without_a_terminal_are_refused(tmp_path):
+    async with lab_host(tmp_path, [Account("ann")]) as host:
+        conn = await host.connect("ann")
+        result = await conn.run("cat /etc/passwd", check=False)
+        assert result.exit_status == 1
+        assert result.stdout == ""
+        assert "runs the workbench only: no commands" in result.stderr
+
+        result = await conn.run(subsystem="sftp", check=False)
+        assert result.exit_status == 1
+        assert "no file transfer" in result.stderr
+        with pytest.raises((asyncssh.Error, OSError)):
+            await conn.start_sftp_client()
+
+        result = await conn.run(check=False)  # a shell, but no pty
+        assert result.exit_status == 1
+        assert "in a terminal" in result.stderr
+        assert not host.server.sessions  # no app was started for any of them
+        conn.close()
+
+
+@sync
+async def test_the_limits_give_a_message_and_a_non_zero_exit_instead_of_a_hang(tmp_path):
+    accounts = [Account("ann"), Account("ben"), Account("cy")]
+    limits = SessionLimits(per_user=1, total=2)
+    async with lab_host(tmp_path, accounts, limits=limits) as host:
+        ann = await host.terminal("ann")
+        await ann.start_app()
+        again = await host.terminal("ann")
+        await again.wait_for("You already have 1 workbench session open")
+        assert await again.exit_status() == 1
+
+        ben = await host.terminal("ben")
+        await ben.start_app()
+        cy = await host.terminal("cy")
+        await cy.wait_for("The lab server is full (2 sessions); try again in a few minutes.")
+        assert await cy.exit_status() == 1
+        assert len(host.server.sessions) == 2
+        await asyncio.gather(*(t.close() for t in (ann, again, ben, cy)))
+
+
+@sync
+async def test_an_idle_session_is_closed_with_a_message(tmp_path):
+    limits = SessionLimits(idle_timeout=2.0)
+    async with lab_host(tmp_path, [Account("ann")], limits=limits) as host:
+        term = await host.terminal("ann")
+        await term.start_app()
+        pid = host.server.live("ann")[0].app.pid
+        await term.wait_for("No input for 2 s: the session was closed.", timeout=15)
+        assert await term.exit_status() == 1
+        assert b"Your lab progress is saved; log in again to go on." in term.raw
+        with pytest.raises(ProcessLookupError):
+            os.kill(pid, 0)  # the app process is gone
+        await term.close()

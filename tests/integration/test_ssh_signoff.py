@@ -1,0 +1,54 @@
+"""An instructor signs off a student's exercise at the student's SSH session: the record is
+signed with the instructor's key and names the SSH student."""
+
+from __future__ import annotations
+
+import asyncio
+import subprocess
+import sys
+
+from tests.app.support import sync
+from workbench.labs import signoff as so
+from workbench.labs.store import Store
+
+from .ssh_support import Account, lab_host, open_exercise
+
+PASSPHRASE = "correct horse battery"
+FAST = so.KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
+
+
+@sync
+async def test_an_instructor_signs_off_an_exercise_from_the_students_session(tmp_path):
+    accounts = [Account("ann"), Account("ito", role="instructor")]
+    async with lab_host(tmp_path, accounts) as host:
+        so.create_instructor(host.data_dir, "ito", PASSPHRASE, kdf=FAST)
+        term = await host.terminal("ann", size=(100, 30))
+        await term.start_app()
+        await open_exercise(term, "Unity simulator: Drive by wire")
+        term.send("i")
+        await term.wait_for("Sign off unity-simulator/drive-by-wire", "an override is needed")
+        term.send(PASSPHRASE)  # the passphrase field has the focus (one instructor)
+        await term.wait_for("•" * len(PASSPHRASE))
+        term.send("\t")
+        await asyncio.sleep(0.2)  # a person's pace between keys: focus moves first
+        term.send("checked at the bench")
+        await term.wait_for("at the bench")
+        for key in ("\t", " ", "\x1b[Z", "\r"):  # to the override, tick it, back to the note
+            term.send(key)
+            await asyncio.sleep(0.2)  # a person's pace between keys
+        await term.wait_for("Signed off by ito (override).")
+        await term.close()
+
+    verify = subprocess.run(
+        [sys.executable, "-m", "workbench", "signoff", "verify", "--data-dir", str(host.data_dir)],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert verify.returncode == 0, verify.stdout + verify.stderr
+    assert "all 1 record(s) verify" in verify.stdout
+    with Store.open(host.data_dir, create=False) as store:
+        (record,) = store.signoffs()
+    assert (record.instructor, record.student) == ("ito", "ann")
+    assert (record.lab, record.exercise) == ("unity-simulator", "drive-by-wire")
+    assert record.override and record.note == "checked at the bench"

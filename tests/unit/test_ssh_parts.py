@@ -1,0 +1,173 @@
+"""The SSH server's small parts: password hashes, the port pool, web-driver packets, the
+forwarding rules, session limits and the slow-down of failed logins."""
+
+from __future__ import annotations
+
+import json
+import socket
+
+import pytest
+
+from workbench.ssh import packets
+from workbench.ssh.appproc import AppSpec, forward_hint
+from workbench.ssh.forwarding import local_forward_refusal, remote_forward_refusal
+from workbench.ssh.limits import FailureDelay, SessionLimits, describe_duration
+from workbench.ssh.passwords import (
+    PasswordError,
+    check_password,
+    hash_password,
+    parse_hash,
+    verify_password,
+)
+from workbench.ssh.ports import PoolExhausted, PortPool, parse_range, port_is_free
+
+
+# -- passwords ------------------------------------------------------------------------------
+def test_a_password_hash_describes_itself_and_checks_the_password():
+    hashed = hash_password("lab password 1")
+    scheme, n, r, p, salt, digest = hashed.split("$")
+    assert (scheme, n, r, p) == ("scrypt", "16384", "8", "1")
+    assert len(salt) >= 16 and len(digest) >= 32
+    assert verify_password("lab password 1", hashed)
+    assert not verify_password("lab password 2", hashed)
+    assert hash_password("lab password 1") != hashed  # a new salt each time
+    cheap = hash_password("lab password 1", n=2**10, r=4)
+    assert parse_hash(cheap)[:3] == (1024, 4, 1) and verify_password("lab password 1", cheap)
+
+
+def test_short_passwords_and_broken_hashes_are_refused():
+    with pytest.raises(PasswordError, match="at least 8"):
+        check_password("short")
+    with pytest.raises(PasswordError, match="control characters"):
+        check_password("tab\there!!")
+    for bad in (
+        "plain",
+        "bcrypt$1$2$3$4$5",
+        "scrypt$1000$8$1$c2FsdHNhbHQ$aGFzaGhhc2hoYXNoaGFzaA",
+        "scrypt$x$8$1$a$b",
+        "scrypt$16384$8$1$$",
+    ):
+        with pytest.raises(PasswordError):
+            parse_hash(bad)
+
+
+# -- ports --------------------------------------------------------------------------------
+def test_the_pool_hands_out_free_ports_and_prefers_a_users_last_ones():
+    busy = {41001}
+    pool = PortPool(41000, 41009, is_free=lambda p: p not in busy)
+    ann = pool.allocate("ann")
+    assert ann == (41000, 41002)  # 41001 is held by something else
+    ben = pool.allocate("ben")
+    assert not set(ann) & set(ben)
+    pool.release(ann)
+    pool.allocate("cy")  # takes the next free ports, not ann's
+    assert pool.allocate("ann") == ann  # ann reconnects: the same ports again
+    pool.release(ann)
+    busy.add(41000)
+    assert pool.allocate("ann") != ann  # one of them is taken meanwhile: other ports
+    assert pool.allocate("dee", owned={41000})  # a port the user's own forward holds is free
+
+
+def test_the_pool_says_when_it_is_exhausted_and_checks_real_ports():
+    pool = PortPool(41000, 41003, is_free=lambda p: True)
+    pool.allocate("a")
+    pool.allocate("b")
+    with pytest.raises(PoolExhausted, match="no 2 free ports left in 41000-41003"):
+        pool.allocate("c")
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        sock.listen()
+        assert not port_is_free(sock.getsockname()[1])
+    assert parse_range("41000-41999") == (41000, 41999)
+    for bad in ("41000", "80-90", "5-x", "42000-41000"):
+        with pytest.raises(ValueError):
+            parse_range(bad)
+
+
+# -- packets ------------------------------------------------------------------------------
+def test_packets_are_framed_with_a_type_and_a_big_endian_length():
+    assert packets.data(b"hi") == b"D\x00\x00\x00\x02hi"
+    resize = packets.resize(120, 40)
+    assert resize[:1] == b"M" and int.from_bytes(resize[1:5], "big") == len(resize) - 5
+    assert json.loads(resize[5:]) == {"type": "resize", "width": 120, "height": 40}
+    assert json.loads(packets.quit_message()[5:]) == {"type": "quit"}
+
+
+def test_the_reader_splits_any_chunks_and_keeps_what_came_before_the_start():
+    stream = (
+        b"a warning\n"
+        + packets.GANGLION
+        + packets.data("é\x1b[2J".encode())
+        + packets.meta({"type": "exit"})
+    )
+    for size in (1, 3, 7, len(stream)):
+        reader = packets.PacketReader()
+        got = []
+        for at in range(0, len(stream), size):
+            got += reader.feed(stream[at : at + size])
+        assert got == [(b"D", "é\x1b[2J".encode()), (b"M", b'{"type":"exit"}')]
+        assert reader.preamble == b"a warning\n" and reader.pending == 0
+    with pytest.raises(packets.PacketError):
+        packets.PacketReader().feed(packets.GANGLION + b"X\x00\x00\x00\x00")
+
+
+def test_the_app_is_started_with_the_users_name_ports_and_terminal():
+    spec = AppSpec("ann", "student", 41000, 41001, "hint", "/d", "/d/runs/ann/1", 100, 30, "xterm")
+    argv = spec.argv(("workbench",))
+    assert argv[:5] == ["workbench", "--student", "ann", "--ask-partner", "--role"]
+    assert "--tcp-port" in argv and argv[argv.index("--tcp-port") + 1] == "41000"
+    assert argv[argv.index("--ws-url") + 1] == "ws://127.0.0.1:41001/"
+    env = spec.env({"SSH_CONNECTION": "x", "PATH": "/bin", "TEXTUAL_DEBUG": "1"})
+    assert env["TEXTUAL_DRIVER"] == "textual.drivers.web_driver:WebDriver"
+    assert (env["COLUMNS"], env["ROWS"], env["TERM"]) == ("100", "30", "xterm")
+    assert "SSH_CONNECTION" not in env and "TEXTUAL_DEBUG" not in env and env["PATH"] == "/bin"
+    hint = forward_hint("ann", "lab.example", 2222, 41000, 41001)
+    assert hint == (
+        "VIPLE: on your computer run  ssh -N -p 2222 -L 1350:localhost:41000 "
+        "-R 41001:localhost:8124 ann@lab.example  then VIPLE uses localhost:1350"
+    )
+    assert "-p " not in forward_hint("ann", "lab.example", 22, 41000, 41001)
+
+
+# -- forwarding, limits, failed logins ----------------------------------------------------
+def test_forwards_reach_only_the_users_own_session_ports_on_loopback():
+    own = {41000, 41004}
+    for host in ("localhost", "127.0.0.1", "::1", "LOCALHOST"):
+        assert local_forward_refusal(host, 41000, own) is None
+    assert "not the VIPLE port" in local_forward_refusal("localhost", 41002, own)
+    assert "not this server's loopback" in local_forward_refusal("10.0.0.5", 41000, own)
+    assert "not this server's loopback" in local_forward_refusal("example.com", 41000, own)
+    assert "no workbench session" in local_forward_refusal("localhost", 41000, set())
+    assert remote_forward_refusal("localhost", 41001, {41001}) is None
+    assert remote_forward_refusal("127.0.0.1", 41001, {41001}) is None
+    assert "only 127.0.0.1" in remote_forward_refusal("", 41001, {41001})
+    assert "only 127.0.0.1" in remote_forward_refusal("0.0.0.0", 41001, {41001})
+    assert "not the WebSocket port" in remote_forward_refusal("localhost", 22, {41001})
+
+
+def test_limits_say_why_a_session_is_refused():
+    limits = SessionLimits(per_user=2, total=60)
+    assert limits.refusal(1, 59) is None
+    assert limits.refusal(0, 60) == (
+        "The lab server is full (60 sessions); try again in a few minutes."
+    )
+    assert "You already have 2 workbench sessions open" in limits.refusal(2, 3)
+    assert describe_duration(7200) == "2 h" and describe_duration(90) == "90 s"
+    assert describe_duration(120) == "2 min"
+
+
+def test_failed_logins_from_an_address_are_answered_ever_more_slowly_until_quiet():
+    now = [0.0]
+    delay = FailureDelay(first=0.5, most=8.0, quiet=600, clock=lambda: now[0])
+    assert delay.delay("10.0.0.1") == 0
+    waits = []
+    for _ in range(7):
+        delay.failed("10.0.0.1")
+        waits.append(delay.delay("10.0.0.1"))
+    assert waits == [0.5, 1, 2, 4, 8, 8, 8]
+    assert delay.delay("10.0.0.2") == 0  # other addresses are not slowed
+    delay.succeeded("10.0.0.1")
+    assert delay.delay("10.0.0.1") == 0
+    delay.failed("10.0.0.1")
+    now[0] = 601.0
+    assert delay.delay("10.0.0.1") == 0  # a quiet period forgets
