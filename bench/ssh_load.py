@@ -1,0 +1,293 @@
+"""SSH lab server under load: N students at once, each driving their robot at 20 Hz.
+
+Starts `workbench serve-ssh` on loopback (its own process, a throwaway data folder and one
+user per session), then opens N SSH sessions at the same moment, as a lab section does at the
+start of class. Each passes the names dialog and drives its robot for --seconds with keys at
+--hz (w, a, d and space in a pattern; the app simulates at its own 20 Hz tick). Now and then a
+session stops driving for a moment and presses `p` (pause), then `p` again, timing each press
+until the screen shows the change (PAUSED / running): the keypress-to-screen latency through
+SSH, the server and the app process.
+
+Printed for each N: time to first screen (connect to the names dialog on the screen, p50/p95),
+memory per session (RSS of each app process, and PSS from /proc/PID/smaps_rollup, which shares
+out the pages the processes have in common), the server process's own growth, CPU of the server
+and its app processes (as % of one core and of the whole machine), and the keypress latency
+(p50/p95). The SSH clients run in this process on the same machine and their CPU is printed too.
+Targets on a 2-core machine: 30 sessions held; first screen p95 <= 3 s; keypress-to-screen
+p95 <= 150 ms at 30 sessions; <= 60 MB per session. Figures vary from run to run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import os
+import socket
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import asyncssh
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT))
+
+from workbench.ssh.users import add_user  # noqa: E402
+
+PATTERN = "wwwwawwwwdww wwwwdwwwwaww "
+PROBE_EVERY = 2.0  # seconds between latency probes of one session
+CLK_TCK = os.sysconf("SC_CLK_TCK")
+PAGE = os.sysconf("SC_PAGE_SIZE")
+
+
+@dataclass
+class Result:
+    first_screen: list[float] = field(default_factory=list)
+    latency: list[float] = field(default_factory=list)
+    keys_sent: int = 0
+    failures: list[str] = field(default_factory=list)
+
+
+def pct(values: list[float], q: float) -> float:
+    if not values:
+        return float("nan")
+    ordered = sorted(values)
+    return ordered[min(len(ordered) - 1, round(q * (len(ordered) - 1)))]
+
+
+def free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+# -- /proc ---------------------------------------------------------------------------------
+def cpu_seconds(pid: int) -> float:
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return 0.0
+    return (int(fields[11]) + int(fields[12])) / CLK_TCK
+
+
+def rss_bytes(pid: int) -> int:
+    try:
+        return int(Path(f"/proc/{pid}/statm").read_text().split()[1]) * PAGE
+    except OSError:
+        return 0
+
+
+def pss_bytes(pid: int) -> int | None:
+    try:
+        for line in Path(f"/proc/{pid}/smaps_rollup").read_text().splitlines():
+            if line.startswith("Pss:"):
+                return int(line.split()[1]) * 1024
+    except OSError:
+        return None
+    return None
+
+
+def children(pid: int) -> list[int]:
+    found = []
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                stat = (entry / "stat").read_text()
+            except OSError:
+                continue
+            if int(stat.rsplit(")", 1)[1].split()[1]) == pid:
+                found.append(int(entry.name))
+    return found
+
+
+def tree_cpu(pid: int) -> float:
+    """CPU seconds of the server and its live children (children that ended are not seen)."""
+    return cpu_seconds(pid) + sum(cpu_seconds(c) for c in children(pid))
+
+
+# -- one student ---------------------------------------------------------------------------
+class Student:
+    def __init__(self, name: str, key: asyncssh.SSHKey, port: int, result: Result) -> None:
+        self.name, self.key, self.port, self.result = name, key, port, result
+        self.buffer = bytearray()
+        self.arrived = asyncio.Event()
+
+    async def _read(self, stdout) -> None:
+        while chunk := await stdout.read(65536):
+            self.buffer += chunk
+            self.arrived.set()
+
+    async def wait_for(self, needle: bytes, since: int, timeout: float) -> bool:
+        deadline = time.perf_counter() + timeout
+        while needle not in self.buffer[max(0, since - len(needle)) :]:
+            left = deadline - time.perf_counter()
+            if left <= 0:
+                return False
+            self.arrived.clear()
+            try:
+                await asyncio.wait_for(self.arrived.wait(), left)
+            except TimeoutError:
+                return False
+        return True
+
+    async def run(self, start: float, seconds: float, hz: float, offset: float) -> None:
+        t0 = time.perf_counter()
+        conn = await asyncssh.connect(
+            "127.0.0.1", self.port, username=self.name, client_keys=[self.key],
+            known_hosts=None, agent_path=None,
+        )  # fmt: skip
+        try:
+            proc = await conn.create_process(
+                term_type="xterm-256color", term_size=(80, 24), encoding=None
+            )
+            reader = asyncio.create_task(self._read(proc.stdout))
+            if not await self.wait_for(b"Who is at this robot", 0, 120):
+                self.result.failures.append(f"{self.name}: no names dialog")
+                return
+            self.result.first_screen.append(time.perf_counter() - t0)
+            mark = len(self.buffer)
+            proc.stdin.write(b"\r")
+            if not await self.wait_for(b"running", mark, 60):
+                self.result.failures.append(f"{self.name}: no main screen")
+                return
+            await asyncio.sleep(max(0.0, start - time.perf_counter()))  # all drive together
+            end = time.perf_counter() + seconds
+            period = 1.0 / hz
+            next_probe = time.perf_counter() + offset
+            step = 0
+            tick = time.perf_counter()
+            while time.perf_counter() < end:
+                if time.perf_counter() >= next_probe:
+                    await self.probe(proc)
+                    next_probe = time.perf_counter() + PROBE_EVERY
+                    tick = time.perf_counter()
+                proc.stdin.write(PATTERN[step % len(PATTERN)].encode())
+                self.result.keys_sent += 1
+                step += 1
+                tick += period
+                await asyncio.sleep(max(0.0, tick - time.perf_counter()))
+            reader.cancel()
+        finally:
+            conn.close()
+
+    async def probe(self, proc) -> None:
+        for key, shows in ((b"p", b"PAUSED"), (b"p", b"running")):
+            await asyncio.sleep(0.1)  # let the drive keys' output settle
+            mark = len(self.buffer)
+            sent = time.perf_counter()
+            proc.stdin.write(key)
+            if await self.wait_for(shows, mark, 5):
+                self.result.latency.append(time.perf_counter() - sent)
+            else:
+                self.result.failures.append(f"{self.name}: {shows.decode()} not shown in 5 s")
+
+
+# -- one round -----------------------------------------------------------------------------
+def start_server(data: Path, port: int, sessions: int) -> subprocess.Popen:
+    first = 42000 + (port % 100) * 100
+    server = subprocess.Popen(
+        [sys.executable, "-m", "workbench", "serve-ssh", "--bind", "127.0.0.1",
+         "--port", str(port), "--data-dir", str(data), "--public-host", "bench",
+         "--port-range", f"{first}-{first + 2 * sessions + 40}",
+         "--max-sessions", str(max(60, sessions))],
+        cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+    )  # fmt: skip
+    log = data / "ssh.log"
+    deadline = time.monotonic() + 60
+    while "serving on" not in (log.read_text() if log.exists() else ""):
+        if server.poll() is not None or time.monotonic() > deadline:
+            raise SystemExit("the SSH server did not start")
+        time.sleep(0.05)
+    return server
+
+
+async def round_of(n: int, seconds: float, hz: float) -> None:
+    with tempfile.TemporaryDirectory(prefix="ssh-load-") as tmp:
+        data = Path(tmp)
+        keys = {}
+        for i in range(n):
+            name = f"s{i:02d}"
+            keys[name] = asyncssh.generate_private_key("ssh-ed25519")
+            add_user(data / "ssh-users.yaml", name, "student",
+                     [keys[name].export_public_key().decode()])  # fmt: skip
+        port = free_port()
+        server = start_server(data, port, n)
+        base_rss = rss_bytes(server.pid)
+        own_cpu0 = time.process_time()
+        result = Result()
+        # the drive starts for everyone once the slowest could have its first screen
+        start = time.perf_counter() + max(10.0, 0.6 * n)
+        students = [Student(name, key, port, result) for name, key in keys.items()]
+        tasks = [
+            asyncio.create_task(s.run(start, seconds, hz, offset=(i % 20) * PROBE_EVERY / 20))
+            for i, s in enumerate(students)
+        ]
+        await asyncio.sleep(max(0.0, start - time.perf_counter()) + 1.0)
+        cpu0, wall0 = tree_cpu(server.pid), time.perf_counter()
+        await asyncio.sleep(seconds / 2)
+        apps = children(server.pid)
+        rss = [rss_bytes(p) for p in apps]
+        pss = [v for v in (pss_bytes(p) for p in apps) if v is not None]
+        server_growth = rss_bytes(server.pid) - base_rss
+        await asyncio.sleep(max(0.0, seconds / 2 - 2.0))
+        cpu1, wall1 = tree_cpu(server.pid), time.perf_counter()
+        await asyncio.gather(*tasks, return_exceptions=True)
+        own_cpu = time.process_time() - own_cpu0
+        deadline = time.monotonic() + 20
+        while children(server.pid) and time.monotonic() < deadline:
+            await asyncio.sleep(0.1)
+        left = len(children(server.pid))
+        server.terminate()
+        server.wait(30)
+
+    cores = os.cpu_count() or 1
+    used = (cpu1 - cpu0) / (wall1 - wall0)
+    mb = 1024 * 1024
+    print(f"N={n} sessions ({len(apps)} app processes held), {seconds:g} s at {hz:g} Hz:")
+    print(
+        f"  first screen     p50 {pct(result.first_screen, 0.5):.2f} s   "
+        f"p95 {pct(result.first_screen, 0.95):.2f} s   max {max(result.first_screen):.2f} s"
+    )
+    print(
+        f"  key to screen    p50 {1000 * pct(result.latency, 0.5):.0f} ms   "
+        f"p95 {1000 * pct(result.latency, 0.95):.0f} ms   ({len(result.latency)} presses)"
+    )
+    print(
+        f"  memory/session   RSS mean {statistics.mean(rss) / mb:.1f} MB  "
+        f"max {max(rss) / mb:.1f} MB"
+        + (f";  PSS mean {statistics.mean(pss) / mb:.1f} MB" if pss else "")
+    )
+    print(
+        f"  server process   +{server_growth / mb:.1f} MB over its idle "
+        f"{base_rss / mb:.1f} MB ({server_growth / mb / n:.2f} MB/session)"
+    )
+    print(
+        f"  CPU server+apps  {100 * used:.0f}% of one core, {100 * used / cores:.0f}% of the "
+        f"machine ({cores} cores); the SSH clients here: {100 * own_cpu / (wall1 - start):.0f}%"
+        f" of one core"
+    )
+    print(
+        f"  keys sent        {result.keys_sent} ({result.keys_sent / n / seconds:.1f}/s per "
+        f"session); app processes left after disconnect: {left}"
+    )
+    for failure in result.failures[:5]:
+        print(f"  FAILED: {failure}")
+    # fmt: on
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--sessions", type=int, nargs="+", default=[10, 30])
+    parser.add_argument("--seconds", type=float, default=30.0)
+    parser.add_argument("--hz", type=float, default=20.0)
+    args = parser.parse_args()
+    for n in args.sessions:
+        asyncio.run(round_of(n, args.seconds, args.hz))
+
+
+if __name__ == "__main__":
+    main()
