@@ -177,3 +177,34 @@ def test_a_store_with_unreadable_progress_says_so_and_starts_that_exercise_afres
         assert text(screen, "#labs-objectives").startswith("✗ drove")
 
     run(app, body)
+
+
+def test_a_bundled_maze_is_never_saved_over_the_editor_asks_where(tmp_path):
+    from workbench.cli.common import default_maze_path
+    from workbench.tui.screens.editor import EditorScreen
+    from workbench.tui.screens.path_dialog import PathDialog
+
+    bundled = default_maze_path()
+    before = bundled.read_bytes()
+    app = lab_app(tmp_path / "data")
+
+    async def body(pilot: Pilot) -> None:
+        assert app.maze_path == bundled
+        await pilot.press("e")
+        await pilot.pause()
+        assert isinstance(app.screen, EditorScreen) and app.screen.editor.path is None
+        await pilot.press("right", "space", "ctrl+s")
+        await pilot.pause()
+        assert isinstance(app.screen, PathDialog)  # save as, not over the bundled file
+        await pilot.press("escape", "escape")  # no save; leaving asks: discard
+        await pilot.pause()
+        await pilot.press("d")
+        await pilot.pause()
+        await open_exercise(pilot, DRIVE)
+        await pilot.press("a", "escape", "e")  # after a lab's set-up: its maze, still asked
+        await pilot.pause()
+        assert app.maze_path.name == "unity-default.txt"
+        assert app.screen.editor.path is None
+
+    run(app, body)
+    assert bundled.read_bytes() == before

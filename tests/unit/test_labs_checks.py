@@ -321,3 +321,29 @@ def test_the_set_up_starts_the_exercise_afresh():
     assert check(obj, ex, b)[0]
     apply_setup(b, ex.setup)
     assert check(obj, ex, b) == (False, "not used yet: w")
+
+
+def test_keys_objective_with_a_role_accepts_a_viple_program_making_the_five_motions():
+    obj = Objective("keys", "drove", keys=("w", "a", "s", "d", "space"), role="tcp")
+    ex = exercise(obj)
+    b = bench_for(ex)
+    assert check(obj, ex, b) == (False, "not used yet: w, a, s, d, space")
+    link = Link(b.session, "tcp")
+    link.connect("127.0.0.1:50500")
+    turn = '{"servos":[{"isTurn":true,"servoId":-1,"servoSpeed":%d}]}'
+    for message in (MOVE, turn % 90, MOVE.replace(":1}", ":-1}")):
+        assert link.apply(message)
+        b.step(20)
+    assert check(obj, ex, b) == (False, "VIPLE has not asked for left, stop yet")
+    for message in (turn % -90, MOVE.replace(":1}", ":0}")):
+        assert link.apply(message)
+        b.step(20)
+    assert check(obj, ex, b) == (
+        True,
+        "VIPLE tcp program asked for forward, left, backward, right, stop",
+    )
+    evidence = check_objective(obj, ex, b).evidence
+    assert evidence == {"role": "tcp", "peer": "127.0.0.1:50500",
+                        "motions": ["backward", "forward", "left", "right", "stop"]}  # fmt: skip
+    other = Objective("keys", "drove", keys=("w",), role="ws")
+    assert check(other, exercise(other), b) == (False, "not used yet: w")  # tcp is not ws

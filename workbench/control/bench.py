@@ -29,7 +29,7 @@ from workbench.sim.sensors import (
 from workbench.sim.session import Session, Snapshot
 
 from .algorithms import load_algorithm
-from .commands import Stop
+from .commands import Command, Stop, motion_of
 from .fsm import FsmController, FsmDefinition, FsmRuntimeError, bind_sensors, preset_sensors
 from .fsmfile import parse_param_overrides
 from .manual import exact_move, key_command
@@ -83,6 +83,8 @@ class VipleConnection:
     #: distance travelled and degrees turned while it drove, in the profile's units
     distance: float = 0.0
     turn_degrees: float = 0.0
+    #: the motions its commands asked for, named as the drive keys' (forward, left, ...)
+    motions: set[str] = field(default_factory=set)
 
     @property
     def drove(self) -> bool:
@@ -172,6 +174,7 @@ class Bench:
             self.pacer.speed = old.speed
             self.pacer.budget = old.budget
         self.session.driver = KEYS_DRIVER
+        self.session.on_command = self._commanded
 
     # -- time ----------------------------------------------------------------------------
     def advance(self, wall_seconds: float) -> int:
@@ -247,6 +250,15 @@ class Bench:
         if self._viple_now is not None:
             self._viple_now = VipleConnection(self._viple_now.role, self._viple_now.peer)
             self.viple.append(self._viple_now)
+
+    def _commanded(self, cmd: Command, driver: str) -> None:
+        """A VIPLE program's command: remember the motion it asked for (its drive keys)."""
+        if not driver.startswith(VIPLE_PREFIX):
+            return
+        self._watch_viple()  # the connection that sent it is the current one
+        motion = motion_of(cmd)
+        if motion is not None and self._viple_now is not None:
+            self._viple_now.motions.add(motion)
 
     def toggle_pause(self) -> bool:
         self.pacer.paused = not self.pacer.paused

@@ -60,3 +60,20 @@ class Stop:
 
 
 Command = WheelPowers | MotorPower | MoveAtPower | TurnByDegrees | Stop
+
+
+def motion_of(cmd: object) -> str | None:
+    """What a command asks the robot to do, as a drive key's name: forward, backward, left,
+    right or stop (None for one wheel alone, which says nothing about the whole robot)."""
+    if isinstance(cmd, Stop):
+        return "stop"
+    if isinstance(cmd, MoveAtPower):
+        return "forward" if cmd.power > 0 else "backward" if cmd.power < 0 else "stop"
+    if isinstance(cmd, TurnByDegrees):
+        return "right" if cmd.degrees > 0 else "left" if cmd.degrees < 0 else None
+    if isinstance(cmd, WheelPowers):
+        left, right = cmd.left, cmd.right
+        if left == right:
+            return "forward" if left > 0 else "backward" if left < 0 else "stop"
+        return "right" if left > right else "left"
+    return None

@@ -16,6 +16,7 @@ from typing import Any
 
 from workbench.control.algorithms import ALGORITHM_DIR
 from workbench.control.bench import VIPLE_PREFIX, Bench, RunEntry
+from workbench.control.manual import KEY_NAMES
 from workbench.sim.maze import Maze
 from workbench.sim.mazeio import load_maze
 from workbench.sim.profiles import get_profile
@@ -165,11 +166,24 @@ def driver_kinds(run: RunEntry) -> set[str]:
 
 # -- the objective kinds -------------------------------------------------------------------
 def check_keys(obj: Objective, bench: Bench) -> Check:
+    """The drive keys pressed on the bench, or (with ``role``) the same motions asked for by a
+    VIPLE program over that role: its own key bindings turned into commands."""
     missing = [k for k in obj.keys if k not in bench.keys_used]
-    evidence = {"keys_used": sorted(bench.keys_used)}
-    if missing:
-        return Check(False, f"not used yet: {', '.join(missing)}", evidence)
-    return Check(True, f"used {', '.join(obj.keys)}", evidence)
+    evidence: dict[str, Any] = {"keys_used": sorted(bench.keys_used)}
+    if not missing:
+        return Check(True, f"used {', '.join(obj.keys)}", evidence)
+    if obj.role:
+        wanted = [KEY_NAMES[k] for k in obj.keys]
+        for c in reversed([c for c in bench.viple if c.role == obj.role]):
+            if all(m in c.motions for m in wanted):
+                evidence = {"role": c.role, "peer": c.peer, "motions": sorted(c.motions)}
+                reason = f"VIPLE {c.role} program asked for {', '.join(wanted)}"
+                return Check(True, reason, evidence)
+        motions = set().union(*(c.motions for c in bench.viple if c.role == obj.role))
+        if motions:
+            lacking = [m for m in wanted if m not in motions]
+            return Check(False, f"VIPLE has not asked for {', '.join(lacking)} yet", evidence)
+    return Check(False, f"not used yet: {', '.join(missing)}", evidence)
 
 
 def check_sensors(obj: Objective, bench: Bench) -> Check:

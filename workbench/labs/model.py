@@ -368,7 +368,7 @@ def _controller(r: _Reader, keys: dict[str, yaml.Node], where: str) -> Controlle
 
 
 _OBJECTIVE_KEYS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
-    "keys": ((), ("keys",)),
+    "keys": ((), ("keys", "role")),
     "sensors": (("sensors",), ()),
     "viple": (("role",), ()),
     "exit": (("maze", "driver"), ("max_time", "max_turn_degrees", "max_collisions")),
@@ -395,7 +395,8 @@ def _objective(r: _Reader, node: yaml.Node, where: str) -> Objective:
             if key not in DRIVE_KEYS:
                 r.fail(keys["keys"], here, f"{key!r} is not a drive key",
                        f"use {', '.join(DRIVE_KEYS)}")  # fmt: skip
-        return Objective(kind, text, keys=chosen)
+        role = r.choice(keys["role"], here, VIPLE_ROLES, "role") if "role" in keys else ""
+        return Objective(kind, text, keys=chosen, role=role)
     if kind == "sensors":
         return Objective(kind, text, sensors=r.sensors(keys["sensors"], here))
     if kind == "viple":

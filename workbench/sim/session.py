@@ -9,7 +9,7 @@ commands to :meth:`Session.command`, and read :meth:`Session.snapshot`.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
@@ -72,6 +72,8 @@ class Session:
         self.controller: Controller | None = None
         self.binding: dict[str, int] = {}
         self.driver = "nobody"
+        #: told of every command from outside the controller, with the driver that sent it
+        self.on_command: Callable[[Any, str], None] | None = None
         self._reset_run_state()
 
     def _reset_run_state(self) -> None:
@@ -109,6 +111,8 @@ class Session:
         self._commands.append(cmd)
         if driver is not None:
             self.driver = driver
+        if self.on_command is not None:
+            self.on_command(cmd, self.driver)
 
     def command_after(self, seconds: float, cmd: Any) -> None:
         """Apply ``cmd`` after exactly ``seconds`` of simulated time (to the step)."""

@@ -213,7 +213,12 @@ class WorkbenchApp(App[None]):
             self.push_screen(HelpScreen(self.bench.profile))
 
     def open_editor(self) -> None:
-        path = str(self.maze_path) if self.maze_path is not None else None
+        # the bundled mazes (and the labs' set-up mazes) are never overwritten: saving one
+        # asks where to keep the student's copy
+        path = self.maze_path
+        if path is not None and _bundled(Path(path)):
+            path = None
+        path = str(path) if path is not None else None
         self.push_screen(EditorScreen(self.bench, path, unicode=self.unicode), self._edited)
 
     def _edited(self, maze: Maze | None) -> None:
@@ -249,6 +254,8 @@ class WorkbenchApp(App[None]):
         endpoint an exercise done from VIPLE needs."""
         self.sub_title = f"{self.bench.maze.name} ({self.bench.profile})"
         self.refresh_views()
+        if setup is not None:
+            self.maze_path = setup.maze
         if setup is not None and setup.controller.kind == "viple":
             self.run_worker(self.open_endpoint(setup.controller.value), group="endpoints")
 
@@ -382,6 +389,17 @@ def make_app(
         student_fixed=student_fixed,
         connect_hint=connect_hint,
     )
+
+
+def _bundled(path: Path) -> bool:
+    """A maze that ships with the workbench (``mazes/``) or with its labs (``labs/``)."""
+    from workbench.cli.common import MAZE_DIR
+
+    try:
+        where = path.resolve()
+    except OSError:
+        return False
+    return where.is_relative_to(MAZE_DIR) or where.is_relative_to(MAZE_DIR.parent / "labs")
 
 
 def _login_name() -> str:
