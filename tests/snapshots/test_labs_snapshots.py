@@ -77,3 +77,15 @@ def test_driver_change_prompt_after_an_override(snap_compare, tmp_path):
         await pilot.pause()
 
     assert snap_compare(lab_app(tmp_path / "data"), terminal_size=SIZE, run_before=before)
+
+
+def test_names_dialog_at_start(snap_compare, tmp_path):
+    app = make_app(paused=True, student="ana", data_dir=tmp_path / "data", ask_names=True)
+
+    async def before(pilot: Pilot) -> None:
+        await pilot.pause()
+        pilot.app.screen.query_one("#partner", Input).value = "Ben Ortiz"
+        still(pilot)
+        await pilot.pause()
+
+    assert snap_compare(app, terminal_size=SIZE, run_before=before)
