@@ -132,6 +132,26 @@ def test_a_connect_hint_is_shown_at_start_and_in_the_help(tmp_path):
     run(app, body, size=(100, 30))
 
 
+def test_a_connect_hint_too_long_for_the_message_line_points_to_the_help(tmp_path):
+    hint = ("VIPLE: on your computer run  ssh -N -p 2222 -L 1350:localhost:41000 "
+            "-R 41001:localhost:8124 ana@lab.example.edu  then VIPLE uses localhost:1350")  # fmt: skip
+    app = make_app(paused=True, student="ana", data_dir=tmp_path, connect_hint=hint,
+                   ask_names=True, student_fixed=True)  # fmt: skip
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.press("enter")  # the names dialog
+        await pilot.pause()
+        line = text(app.screen, "#message")
+        assert line.startswith("VIPLE from your computer: press ? for the ssh command")
+        assert line.rstrip().endswith("ana (student)")
+        await pilot.press("question_mark")
+        await pilot.pause()
+        shown = str(app.screen.query_one("#help-connect", Static).render())
+        assert "-R 41001:localhost:8124" in shown.replace("\n", " ")
+
+    run(app, body)
+
+
 def test_the_set_up_of_a_websocket_exercise_starts_the_websocket_client(tmp_path):
     app = lab_app(tmp_path / "data")
 
@@ -208,3 +228,27 @@ def test_a_bundled_maze_is_never_saved_over_the_editor_asks_where(tmp_path):
 
     run(app, body)
     assert bundled.read_bytes() == before
+
+
+def test_the_labs_reopen_at_the_exercise_the_student_had_open(tmp_path):
+    data = tmp_path / "data"
+    first = lab_app(data)
+
+    async def browse(pilot: Pilot) -> None:
+        await open_exercise(pilot, "unity-simulator/wall-following")
+
+    run(first, browse)
+    with Store.open(data) as store:
+        assert store.place("ana") == ("unity-simulator", "wall-following")
+        assert store.place("ben") is None
+    again = lab_app(data)
+
+    async def resume(pilot: Pilot) -> None:
+        await pilot.press("l")
+        await pilot.pause()
+        screen = again.screen
+        assert "Wall following" in text(screen, "#labs-title")
+        listing = screen.query_one("#labs-list", OptionList)
+        assert listing.highlighted_option.id == "unity-simulator/wall-following"
+
+    run(again, resume)

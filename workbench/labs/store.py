@@ -55,6 +55,12 @@ CREATE TABLE IF NOT EXISTS progress (
     updated_at TEXT NOT NULL,
     PRIMARY KEY (student, lab, exercise)
 );
+CREATE TABLE IF NOT EXISTS places (
+    student TEXT PRIMARY KEY,
+    lab TEXT NOT NULL,
+    exercise TEXT NOT NULL,
+    updated_at TEXT NOT NULL
+);
 CREATE TABLE IF NOT EXISTS drivers (
     student TEXT NOT NULL,
     partner TEXT NOT NULL,
@@ -316,6 +322,23 @@ class Store:
                     "not JSON"
                 ) from None
         return out
+
+    # where each student was
+
+    def set_place(self, student: str, lab: str, exercise: str, now: datetime | None = None) -> None:
+        """Remember the exercise ``student`` has open (the labs reopen there)."""
+        with self._write() as cur:
+            cur.execute(
+                "INSERT INTO places (student, lab, exercise, updated_at) VALUES (?, ?, ?, ?) "
+                "ON CONFLICT (student) DO UPDATE SET lab = excluded.lab, "
+                "exercise = excluded.exercise, updated_at = excluded.updated_at",
+                (student, lab, exercise, utc_iso(now or _now())),
+            )
+
+    def place(self, student: str) -> tuple[str, str] | None:
+        """The (lab, exercise) ``student`` had open last, if any."""
+        rows = self._read("SELECT lab, exercise FROM places WHERE student = ?", (student,))
+        return (rows[0][0], rows[0][1]) if rows else None
 
     # drivers
 

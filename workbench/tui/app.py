@@ -131,13 +131,21 @@ class WorkbenchApp(App[None]):
         self._last_tick = perf_counter()
         self.set_interval(1.0 / self.tick_hz, self._tick, name="simulation")
         if self.connect_hint:
-            self.bench.message = self.connect_hint
+            self.bench.message = self.hint_line()
         self._check_size(self.size.width, self.size.height)
         if self._ask_names:
             from .modals.identity import IdentityDialog
 
             dialog = IdentityDialog(self.student, self.partner, student_fixed=self.student_fixed)
             self.push_screen(dialog, self._named)
+
+    def hint_line(self) -> str:
+        """The connect hint for the message line: all of it when it fits beside the names,
+        else where to find it (the help shows it whole, wrapped)."""
+        room = self.size.width - 4 - len(self.who())
+        if len(self.connect_hint) <= room:
+            return self.connect_hint
+        return "VIPLE from your computer: press ? for the ssh command"
 
     def _named(self, names: tuple[str, str] | None) -> None:
         if names is None:
@@ -278,7 +286,7 @@ class WorkbenchApp(App[None]):
             url = self.endpoints.ws.config.url
             text = f"VIPLE: start your program's WebSocket server; the robot connects to {url}"
         if self.connect_hint:
-            text = self.connect_hint
+            text = self.hint_line()
         self.bench.connection = self.endpoints.summary()
         self._say(text)
         return text

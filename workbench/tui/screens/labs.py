@@ -190,11 +190,26 @@ class LabsScreen(Screen[None]):
         if problem:
             self.say(problem)
         listing = self.query_one("#labs-list", OptionList)
+        place = self._place()
         for index, option in enumerate(listing.options):
-            if not option.disabled:
+            if not option.disabled and (place is None or option.id == place):
                 listing.highlighted = index
                 break
         listing.focus()
+
+    def _place(self) -> str | None:
+        """The option of the exercise the student had open last (None: the first)."""
+        if self.store is None:
+            return None
+        try:
+            place = self.store.place(self.student)
+        except Exception:  # where the student was is a convenience, never a reason to fail
+            return None
+        if place is None:
+            return None
+        option = "/".join(place)
+        known = {f"{lab.id}/{ex.id}" for lab in self.labs for ex in lab.exercises}
+        return option if option in known else None
 
     def on_screen_resume(self) -> None:
         self.show_snapshot(self.bench.snapshot())
@@ -218,6 +233,11 @@ class LabsScreen(Screen[None]):
         if self.selected == (lab, exercise):
             return
         self.selected = (lab, exercise)
+        if self.store is not None:
+            try:
+                self.store.set_place(self.student, lab.id, exercise.id)
+            except Exception as exc:
+                self.say(f"cannot save where you are: {exc}")
         self.driver = self._drivers.get((lab.id, exercise.id), self.driver)
         self.progress = None
         self.query_one("#labs-title", Label).update(f"{lab.title}: {exercise.title}")
