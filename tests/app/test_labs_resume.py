@@ -133,8 +133,10 @@ def test_a_connect_hint_is_shown_at_start_and_in_the_help(tmp_path):
 
 
 def test_a_connect_hint_too_long_for_the_message_line_points_to_the_help(tmp_path):
-    hint = ("VIPLE: on your computer run  ssh -N -p 2222 -L 1350:localhost:41000 "
-            "-R 41001:localhost:8124 ana@lab.example.edu  then VIPLE uses localhost:1350")  # fmt: skip
+    hint = (
+        "VIPLE: on your computer run  ssh -N -p 2222 -L 1350:localhost:41000 "
+        "-R 41001:localhost:8124 ana@lab.example.edu  then VIPLE uses localhost:1350"
+    )
     app = make_app(paused=True, student="ana", data_dir=tmp_path, connect_hint=hint,
                    ask_names=True, student_fixed=True)  # fmt: skip
 
