@@ -43,6 +43,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--idle-timeout", type=float, default=7200,
         help="seconds without input before a session is closed (default 7200)",
     )  # fmt: skip
+    serve.add_argument(
+        "--no-fork-server", action="store_true",
+        help="start each session's app as a new Python process instead of forking it from a "
+        "fork server that has the app imported (slower to start, more memory)",
+    )  # fmt: skip
     serve.set_defaults(func=cmd_serve)
 
     users = sub.add_parser("ssh", help="users of the SSH lab server")
@@ -188,6 +193,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
         port_range=port_range,
         public_host=args.public_host,
         limits=SessionLimits(args.max_per_user, args.max_sessions, args.idle_timeout),
+        fork_server=not args.no_fork_server,
     )
     try:
         log_path = setup_logging(data_dir)

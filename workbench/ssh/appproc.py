@@ -1,9 +1,10 @@
 """One workbench app process per SSH session, spoken to in Textual's web-driver packets.
 
-The process runs ``python -m workbench`` with the web driver: its screen output arrives as
-``D`` packets on its standard output, keys and resizes go in as packets on its standard input
-(see :mod:`.packets`). It runs in its own process group so that ending a session ends the app
-and anything it started.
+The process runs the workbench app with the web driver: its screen output arrives as ``D``
+packets on its standard output, keys and resizes go in as packets on its standard input (see
+:mod:`.packets`). It is forked by the fork server (:mod:`.forkserver`) when one runs, else
+started as ``python -m workbench``. It runs in its own process group so that ending a session
+ends the app and anything it started.
 """
 
 from __future__ import annotations
@@ -18,8 +19,12 @@ import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from . import packets
+
+if TYPE_CHECKING:
+    from .forkserver import ForkedApp, ForkServer
 
 log = logging.getLogger("workbench.ssh")
 
@@ -50,9 +55,11 @@ class AppSpec:
     term: str = "xterm-256color"
 
     def argv(self, command: tuple[str, ...] | None = None) -> list[str]:
-        base = list(command or (sys.executable, "-m", "workbench"))
+        return [*(command or (sys.executable, "-m", "workbench")), *self.options()]
+
+    def options(self) -> list[str]:
+        """The app's options (its command line without the command)."""
         return [
-            *base,
             "--student", self.user,
             "--ask-partner",
             "--role", self.role,
@@ -64,19 +71,25 @@ class AppSpec:
         ]  # fmt: skip
 
     def env(self, base: dict[str, str] | None = None) -> dict[str, str]:
-        env = {
-            k: v
-            for k, v in (os.environ if base is None else base).items()
-            if not k.startswith(("TEXTUAL", "SSH_", "COLUMNS", "LINES", "ROWS"))
-        }
+        env = app_env(base)
         env.update(
-            TEXTUAL_DRIVER=DRIVER,
             COLUMNS=str(self.width),
             ROWS=str(self.height),
             TERM=self.term or "xterm-256color",
-            LANG=env.get("LANG") or "C.UTF-8",
         )
         return env
+
+
+def app_env(base: dict[str, str] | None = None) -> dict[str, str]:
+    """The environment every app shares: the server's, without its terminal and Textual
+    settings, with the web driver (also the fork server's, which imports Textual with it)."""
+    env = {
+        k: v
+        for k, v in (os.environ if base is None else base).items()
+        if not k.startswith(("TEXTUAL", "SSH_", "COLUMNS", "LINES", "ROWS"))
+    }
+    env.update(TEXTUAL_DRIVER=DRIVER, LANG=env.get("LANG") or "C.UTF-8")
+    return env
 
 
 def forward_hint(user: str, host: str, ssh_port: int, tcp_port: int, ws_port: int) -> str:
@@ -97,12 +110,20 @@ class AppProcess:
         env: dict[str, str],
         log_path: Path,
         on_output: Callable[[bytes], None],
+        *,
+        forkserver: ForkServer | None = None,
+        options: list[str] | None = None,
     ) -> None:
+        """``argv`` starts the app as a new process; with a running ``forkserver`` the app is
+        forked from it with ``options`` instead (``argv`` stays the way if that fails)."""
         self.argv = argv
         self.env = env
         self.log_path = log_path
         self.on_output = on_output
-        self.process: asyncio.subprocess.Process | None = None
+        self.forkserver = forkserver
+        self.options = options
+        self.forked = False
+        self.process: asyncio.subprocess.Process | ForkedApp | None = None
         self.said_exit = False  # the app announced its end itself
         self._flowing = asyncio.Event()
         self._flowing.set()
@@ -119,15 +140,25 @@ class AppProcess:
 
     async def start(self) -> None:
         self.log_path.parent.mkdir(parents=True, exist_ok=True)
-        with open(self.log_path, "ab") as errors:
-            self.process = await asyncio.create_subprocess_exec(
-                *self.argv,
-                stdin=asyncio.subprocess.PIPE,
-                stdout=asyncio.subprocess.PIPE,
-                stderr=errors,
-                env=self.env,
-                start_new_session=True,
-            )
+        forkserver = self.forkserver
+        if forkserver is not None and forkserver.running and self.options is not None:
+            from .forkserver import ForkServerError
+
+            try:
+                self.process = await forkserver.spawn(self.options, self.env, self.log_path)
+                self.forked = True
+            except ForkServerError as exc:
+                log.warning("app not forked (%s): starting it as a new process", exc)
+        if self.process is None:
+            with open(self.log_path, "ab") as errors:
+                self.process = await asyncio.create_subprocess_exec(
+                    *self.argv,
+                    stdin=asyncio.subprocess.PIPE,
+                    stdout=asyncio.subprocess.PIPE,
+                    stderr=errors,
+                    env=self.env,
+                    start_new_session=True,
+                )
         for packet in self._pending:
             self._write(packet)
         self._pending.clear()
@@ -195,7 +226,14 @@ class AppProcess:
         assert self.process is not None
         if self._reader is not None:
             await self._reader
-        return await self.process.wait()
+        code = await self.process.wait()
+        self._close_input()
+        return code
+
+    def _close_input(self) -> None:
+        process = self.process
+        if process is not None and process.stdin is not None:
+            process.stdin.close()
 
     def _kill(self, sig: int) -> None:
         process = self.process
@@ -225,8 +263,7 @@ class AppProcess:
                     )
                     self._kill(sig)
         code = await process.wait()
-        if process.stdin is not None:
-            process.stdin.close()
+        self._close_input()
         if self._reader is not None:
             with contextlib.suppress(Exception):
                 await asyncio.wait_for(self._reader, grace)

@@ -17,7 +17,8 @@ from pathlib import Path
 
 import asyncssh
 
-from .appproc import RESTORE_TERMINAL, AppProcess, AppSpec, forward_hint
+from .appproc import RESTORE_TERMINAL, AppProcess, AppSpec, app_env, forward_hint
+from .forkserver import ForkServer, ForkServerError
 from .forwarding import local_forward_refusal, remote_forward_refusal
 from .hostkey import host_key_path, load_or_create_host_key
 from .limits import FailureDelay, SessionLimits, describe_duration
@@ -49,6 +50,8 @@ class ServerConfig:
     limits: SessionLimits = field(default_factory=SessionLimits)
     #: the app's command before its options (default: this Python's ``-m workbench``)
     app_command: tuple[str, ...] | None = None
+    #: fork each app from a fork server that has the app imported (not with ``app_command``)
+    fork_server: bool = True
     #: seconds between the stop steps of an app (quit, SIGTERM, SIGKILL)
     stop_grace: float = 2.0
     failure_delay: FailureDelay = field(default_factory=FailureDelay)
@@ -93,6 +96,7 @@ class LabServer:
         self._acceptor: asyncssh.SSHAcceptor | None = None
         self._sweeper: asyncio.Task[None] | None = None
         self._closing = False
+        self.forkserver: ForkServer | None = None
 
     @property
     def port(self) -> int:
@@ -101,7 +105,23 @@ class LabServer:
 
     async def start(self) -> None:
         config = self.config
-        self._acceptor = await asyncssh.create_server(
+        await self._start_forkserver()
+        try:
+            self._acceptor = await self._listen()
+        except BaseException:
+            if self.forkserver is not None:
+                await self.forkserver.close()
+            raise
+        self._sweeper = asyncio.create_task(self._sweep_idle(), name="ssh-idle-sweeper")
+        log.info(
+            "serving on %s port %d for %d users (%s); VIPLE ports %d-%d; host key %s",
+            config.bind or "all addresses", self.port, len(self.users.users),
+            config.users_file, *config.port_range, self.host_key.get_fingerprint(),
+        )  # fmt: skip
+
+    async def _listen(self) -> asyncssh.SSHAcceptor:
+        config = self.config
+        return await asyncssh.create_server(
             lambda: LabConnection(self),
             config.bind or None,
             config.port,
@@ -116,12 +136,27 @@ class LabServer:
             keepalive_count_max=4,
             server_version="workbench",
         )
-        self._sweeper = asyncio.create_task(self._sweep_idle(), name="ssh-idle-sweeper")
+
+    async def _start_forkserver(self) -> None:
+        """Start the fork server, or say why apps start as new processes."""
+        config = self.config
+        if config.app_command is not None or not config.fork_server:
+            why = "--no-fork-server" if not config.fork_server else "an app command is set"
+            log.info("apps start as new processes (%s)", why)
+            return
+        forkserver = ForkServer(app_env())
+        try:
+            await forkserver.start()
+        except ForkServerError as exc:
+            log.error("the fork server did not start (%s): apps start as new processes", exc)
+            return
+        self.forkserver = forkserver
         log.info(
-            "serving on %s port %d for %d users (%s); VIPLE ports %d-%d; host key %s",
-            config.bind or "all addresses", self.port, len(self.users.users),
-            config.users_file, *config.port_range, self.host_key.get_fingerprint(),
-        )  # fmt: skip
+            "apps are forked from a fork server (pid %s, %d modules preloaded in %.2f s)",
+            forkserver.pid,
+            forkserver.modules,
+            forkserver.seconds,
+        )
 
     async def close(self) -> None:
         """End every session (their apps stopped and reaped), then stop listening."""
@@ -142,6 +177,8 @@ class LabServer:
                 await asyncio.wait_for(conn.wait_closed(), 5)
         if self._acceptor is not None:
             await self._acceptor.wait_closed()
+        if self.forkserver is not None:
+            await self.forkserver.close()
 
     async def __aenter__(self) -> LabServer:
         await self.start()
@@ -463,7 +500,12 @@ class LabSession(asyncssh.SSHServerSession):
         )
         log_path = config.data_dir / "logs" / user / f"{stamp}-{self.id}.log"
         self.app = AppProcess(
-            self.spec.argv(config.app_command), self.spec.env(), log_path, self._output
+            self.spec.argv(config.app_command),
+            self.spec.env(),
+            log_path,
+            self._output,
+            forkserver=server.forkserver,
+            options=self.spec.options(),
         )
         try:
             await self.app.start()
@@ -475,12 +517,13 @@ class LabSession(asyncssh.SSHServerSession):
             await self.app.stop(config.stop_grace)
             return
         log.info(
-            "session %d: %s (%s) from %s, pid %s, VIPLE tcp %d ws %d, %dx%d",
+            "session %d: %s (%s) from %s, pid %s (%s), VIPLE tcp %d ws %d, %dx%d",
             self.id,
             user,
             self.user.role,
             self.connection.peer,
             self.app.pid,
+            "forked" if self.app.forked else "new process",
             tcp_port,
             ws_port,
             width,

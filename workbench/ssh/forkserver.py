@@ -1,0 +1,427 @@
+"""A fork server for session apps: one process that has imported the workbench once, forks
+a copy of itself for each session, and so starts an app in a fraction of the time and memory
+a fresh ``python -m workbench`` takes.
+
+Two halves live here:
+
+- the fork server process (``python -m workbench.ssh.forkserver FD``): started by the lab
+  server with the apps' environment, it imports the app's modules (the :data:`PRELOAD` list and
+  every module of the workbench packages the app uses), freezes them out of the garbage
+  collector's reach (so the pages stay shared with the children) and waits on a Unix socket.
+  Each request carries the app's options and environment and two file descriptors (SCM_RIGHTS):
+  the socket that becomes the app's standard input and output, and its error log. It forks; the
+  child starts a new session (its own process group), puts the descriptors on 0, 1 and 2, sets
+  the environment and runs :func:`workbench.cli.main`, ending with the interpreter's ordinary
+  exit. The fork server answers with the child's pid, reaps children as they end and reports
+  each one's exit status.
+- :class:`ForkServer`, the lab server's side: starts that process, sends requests and turns the
+  answers into :class:`ForkedApp` objects that look like an ``asyncio.subprocess.Process``
+  (``pid``, ``returncode``, ``stdin``, ``stdout``, ``wait()``).
+
+The fork server is a separate process started from scratch, not a fork of the lab server, so
+its children inherit nothing of the server's event loop, asyncssh connections or threads.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import collections
+import contextlib
+import gc
+import importlib
+import json
+import logging
+import os
+import pkgutil
+import selectors
+import signal
+import socket
+import sys
+import threading
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+log = logging.getLogger("workbench.ssh")
+
+#: modules the app imports, loaded once in the fork server
+PRELOAD = ("workbench.cli", "workbench.tui.app", "textual.drivers.web_driver")
+#: packages whose every module is loaded too (the app imports many of them only when used)
+PRELOAD_PACKAGES = (
+    "workbench.sim",
+    "workbench.control",
+    "workbench.viple",
+    "workbench.labs",
+    "workbench.tui",
+)
+MAX_MESSAGE = 1 << 20
+#: exit status given for an app whose end could not be learnt (the fork server was lost)
+UNKNOWN_STATUS = 1
+
+
+class ForkServerError(Exception):
+    """The fork server cannot start an app (not running, or it refused)."""
+
+
+# -- the fork server process -----------------------------------------------------------------
+def _send(control: socket.socket, message: dict) -> None:
+    with contextlib.suppress(OSError):
+        control.send(json.dumps(message).encode())
+
+
+def preload() -> int:
+    """Import what the app will import; the number of modules loaded in all."""
+    for name in PRELOAD:
+        importlib.import_module(name)
+    for package in PRELOAD_PACKAGES:
+        path = importlib.import_module(package).__path__
+        for info in pkgutil.walk_packages(path, package + "."):
+            if info.name.rsplit(".", 1)[-1] == "__main__":
+                continue
+            try:
+                importlib.import_module(info.name)
+            except Exception as exc:  # the app itself will report it, if it uses the module
+                print(f"fork server: not preloaded: {info.name}: {exc}", file=sys.stderr)
+    return len(sys.modules)
+
+
+class _Zygote:
+    """The fork server's loop: fork on request, reap and report the children's ends."""
+
+    def __init__(self, control: socket.socket) -> None:
+        self.control = control
+
+    def serve(self) -> Callable[[], int] | None:
+        """Serve until the lab server goes (``None``); in a forked child, return its app."""
+        wake_r, wake_w = os.pipe2(os.O_NONBLOCK | os.O_CLOEXEC)
+        signal.set_wakeup_fd(wake_w)
+        signal.signal(signal.SIGCHLD, lambda *_: None)
+        selector = selectors.DefaultSelector()
+        selector.register(self.control, selectors.EVENT_READ)
+        selector.register(wake_r, selectors.EVENT_READ)
+        try:
+            while True:
+                for key, _ in selector.select():
+                    if key.fileobj is self.control:
+                        message, fds, _, _ = socket.recv_fds(self.control, MAX_MESSAGE, 4)
+                        if not message:
+                            return None  # the lab server closed its end: stop
+                        app = self._fork(message, fds)
+                        if app is not None:  # this is the child
+                            selector.close()
+                            for fd in (wake_r, wake_w):
+                                os.close(fd)
+                            self.control.close()
+                            signal.set_wakeup_fd(-1)
+                            return app
+                    else:
+                        with contextlib.suppress(BlockingIOError):
+                            while os.read(wake_r, 512):
+                                pass
+                self._reap()
+        finally:
+            with contextlib.suppress(ValueError, OSError):
+                signal.signal(signal.SIGCHLD, signal.SIG_DFL)
+
+    def _fork(self, message: bytes, fds: list[int]) -> Callable[[], int] | None:
+        try:
+            request = json.loads(message)
+            options = [str(o) for o in request["argv"]]
+            env = {str(k): str(v) for k, v in request["env"].items()}
+            if len(fds) != 2:
+                raise ValueError(f"{len(fds)} descriptors instead of 2")
+        except (ValueError, KeyError, TypeError, AttributeError) as exc:
+            for fd in fds:
+                os.close(fd)
+            _send(self.control, {"error": f"bad request: {exc}"})
+            return None
+        ready_r, ready_w = os.pipe()
+        try:
+            pid = os.fork()
+        except OSError as exc:
+            for fd in (*fds, ready_r, ready_w):
+                os.close(fd)
+            _send(self.control, {"error": f"fork: {exc}"})
+            return None
+        if pid == 0:
+            os.setsid()  # its own session and process group, before the server learns its pid
+            os.close(ready_r)
+            os.close(ready_w)
+            return lambda: _run_app(options, env, fds, request.get("cwd"))
+        for fd in (*fds, ready_w):
+            os.close(fd)
+        with contextlib.suppress(OSError):
+            os.read(ready_r, 1)  # end of file once the child has its own process group
+        os.close(ready_r)
+        _send(self.control, {"pid": pid})
+        return None
+
+    def _reap(self) -> None:
+        while True:
+            try:
+                pid, status = os.waitpid(-1, os.WNOHANG)
+            except ChildProcessError:
+                return
+            if pid == 0:
+                return
+            _send(self.control, {"exit": pid, "code": os.waitstatus_to_exitcode(status)})
+
+
+def _run_app(options: list[str], env: dict[str, str], fds: list[int], cwd: str | None) -> int:
+    """In the forked child: become the session's app."""
+    io, errors = fds
+    os.dup2(io, 0)
+    os.dup2(io, 1)
+    os.dup2(errors, 2)
+    for fd in fds:
+        if fd > 2:
+            os.close(fd)
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    os.environ.clear()
+    os.environ.update(env)
+    if cwd:
+        with contextlib.suppress(OSError):
+            os.chdir(cwd)
+    sys.argv = ["workbench", *options]
+    from workbench.cli import main
+
+    return main(options)
+
+
+def serve_main(argv: list[str] | None = None) -> int:
+    """The fork server process: preload, report ready, serve; a forked child runs its app."""
+    args = sys.argv[1:] if argv is None else argv
+    control = socket.socket(fileno=int(args[0]))
+    control.setblocking(True)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the lab server decides when this ends
+    started = time.perf_counter()
+    try:
+        modules = preload()
+    except Exception as exc:
+        _send(control, {"failed": f"{type(exc).__name__}: {exc}"})
+        return 1
+    if threading.active_count() > 1:
+        _send(control, {"failed": "a thread was started while preloading; forking is unsafe"})
+        return 1
+    gc.collect()
+    gc.freeze()  # the children leave the preloaded objects alone, so their pages stay shared
+    _send(control, {"ready": modules, "seconds": round(time.perf_counter() - started, 3)})
+    app = _Zygote(control).serve()
+    if app is None:
+        return 0
+    return app()
+
+
+# -- the lab server's side ------------------------------------------------------------------
+class ForkedApp:
+    """An app forked by the fork server, with the face of ``asyncio.subprocess.Process``."""
+
+    def __init__(
+        self,
+        pid: int,
+        reader: asyncio.StreamReader,
+        writer: asyncio.StreamWriter,
+        ended: asyncio.Future[int],
+    ) -> None:
+        self.pid = pid
+        self.stdout = reader
+        self.stdin = writer
+        self._ended = ended
+
+    @property
+    def returncode(self) -> int | None:
+        ended = self._ended
+        return ended.result() if ended.done() and not ended.cancelled() else None
+
+    async def wait(self) -> int:
+        return await asyncio.shield(self._ended)
+
+
+class ForkServer:
+    """Starts the fork server process and asks it for apps."""
+
+    def __init__(self, env: dict[str, str], *, start_timeout: float = 60.0) -> None:
+        self.env = env
+        self.start_timeout = start_timeout
+        self.process: asyncio.subprocess.Process | None = None
+        self.modules = 0
+        self.seconds = 0.0
+        self._sock: socket.socket | None = None
+        self._ready: asyncio.Future[dict] | None = None
+        self._answers: collections.deque[asyncio.Future[tuple[int, asyncio.Future[int]]]] = (
+            collections.deque()
+        )
+        self._ended: dict[int, asyncio.Future[int]] = {}
+        self._watching: dict[int, int] = {}  # pidfd per child, once the fork server is lost
+        self._running = False
+
+    @property
+    def running(self) -> bool:
+        return self._running
+
+    @property
+    def pid(self) -> int | None:
+        return self.process.pid if self.process else None
+
+    async def start(self) -> None:
+        """Start the process and wait until it has preloaded; ForkServerError if it cannot."""
+        loop = asyncio.get_running_loop()
+        ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
+        try:
+            self.process = await asyncio.create_subprocess_exec(
+                sys.executable, "-m", "workbench.ssh.forkserver", str(theirs.fileno()),
+                pass_fds=[theirs.fileno()], stdin=asyncio.subprocess.DEVNULL,
+                stdout=asyncio.subprocess.DEVNULL, env=self.env, start_new_session=True,
+            )  # fmt: skip
+        except OSError as exc:
+            ours.close()
+            raise ForkServerError(f"cannot start it: {exc}") from exc
+        finally:
+            theirs.close()
+        ours.setblocking(False)
+        self._sock = ours
+        self._ready = loop.create_future()
+        self._running = True
+        loop.add_reader(ours.fileno(), self._readable)
+        try:
+            ready = await asyncio.wait_for(asyncio.shield(self._ready), self.start_timeout)
+        except (TimeoutError, ForkServerError) as exc:
+            await self.close()
+            if isinstance(exc, TimeoutError):
+                raise ForkServerError(f"not ready after {self.start_timeout:g} s") from None
+            raise
+        self.modules = int(ready.get("ready", 0))
+        self.seconds = float(ready.get("seconds", 0.0))
+
+    def _readable(self) -> None:
+        sock = self._sock
+        while sock is not None:
+            try:
+                message = sock.recv(MAX_MESSAGE)
+            except (BlockingIOError, InterruptedError):
+                return
+            except OSError:
+                message = b""
+            if not message:
+                self._lost("it ended")
+                return
+            try:
+                self._answer(json.loads(message))
+            except (ValueError, TypeError, AttributeError) as exc:
+                log.error("fork server: unreadable message %r: %s", message[:200], exc)
+
+    def _answer(self, message: dict) -> None:
+        loop = asyncio.get_running_loop()
+        if "exit" in message:
+            ended = self._ended.pop(int(message["exit"]), None)
+            if ended is not None and not ended.done():
+                ended.set_result(int(message["code"]))
+        elif "pid" in message or "error" in message:
+            waiter = self._answers.popleft() if self._answers else None
+            if "pid" in message:
+                pid = int(message["pid"])
+                ended = self._ended[pid] = loop.create_future()
+                if waiter is not None and not waiter.done():
+                    waiter.set_result((pid, ended))
+                else:  # nobody waits for it any more (the session went while it started)
+                    with contextlib.suppress(ProcessLookupError, PermissionError):
+                        os.killpg(pid, signal.SIGKILL)
+            elif waiter is not None and not waiter.done():
+                waiter.set_exception(ForkServerError(str(message["error"])))
+        elif self._ready is not None and not self._ready.done():
+            if "ready" in message:
+                self._ready.set_result(message)
+            else:
+                self._ready.set_exception(ForkServerError(str(message.get("failed", message))))
+
+    def _lost(self, why: str) -> None:
+        """The fork server is gone: no more apps from it; its running apps are watched."""
+        if not self._running:
+            return
+        self._running = False
+        if self._sock is not None:
+            with contextlib.suppress(Exception):
+                asyncio.get_running_loop().remove_reader(self._sock.fileno())
+            self._sock.close()
+            self._sock = None
+        error = ForkServerError(f"the fork server is gone ({why})")
+        if self._ready is not None and not self._ready.done():
+            self._ready.set_exception(error)
+        while self._answers:
+            waiter = self._answers.popleft()
+            if not waiter.done():
+                waiter.set_exception(error)
+        if self._ended:
+            log.error(
+                "fork server gone (%s) with %d apps running; their exit status is not known",
+                why,
+                len(self._ended),
+            )
+        for pid in list(self._ended):
+            self._watch(pid)
+
+    def _watch(self, pid: int) -> None:
+        """Learn the end of an app whose parent is gone, from a pidfd."""
+        loop = asyncio.get_running_loop()
+        ended = self._ended[pid]
+
+        def gone() -> None:
+            fd = self._watching.pop(pid, None)
+            if fd is not None:
+                loop.remove_reader(fd)
+                os.close(fd)
+            self._ended.pop(pid, None)
+            if not ended.done():
+                ended.set_result(UNKNOWN_STATUS)
+
+        try:
+            fd = os.pidfd_open(pid)
+        except OSError:  # already gone
+            gone()
+            return
+        self._watching[pid] = fd
+        loop.add_reader(fd, gone)
+
+    async def spawn(
+        self, options: list[str], env: dict[str, str], log_path: Path, cwd: str | None = None
+    ) -> ForkedApp:
+        """A new app with these options and environment, its errors appended to ``log_path``."""
+        if not self._running or self._sock is None:
+            raise ForkServerError("the fork server is not running")
+        loop = asyncio.get_running_loop()
+        request = json.dumps({"argv": options, "env": env, "cwd": cwd or os.getcwd()}).encode()
+        ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_STREAM)
+        try:
+            with open(log_path, "ab") as errors:
+                socket.send_fds(self._sock, [request], [theirs.fileno(), errors.fileno()])
+        except OSError as exc:
+            ours.close()
+            raise ForkServerError(f"the request was not sent: {exc}") from exc
+        finally:
+            theirs.close()
+        answer: asyncio.Future[tuple[int, asyncio.Future[int]]] = loop.create_future()
+        self._answers.append(answer)
+        try:
+            pid, ended = await answer
+        except BaseException:
+            ours.close()
+            raise
+        reader, writer = await asyncio.open_unix_connection(sock=ours)
+        return ForkedApp(pid, reader, writer, ended)
+
+    async def close(self, timeout: float = 5.0) -> None:
+        """Stop the fork server (apps already running are not touched)."""
+        self._lost("closed")
+        process = self.process
+        if process is None or process.returncode is not None:
+            return
+        try:
+            await asyncio.wait_for(process.wait(), timeout)
+        except TimeoutError:
+            with contextlib.suppress(ProcessLookupError):
+                process.kill()
+            await process.wait()
+
+
+if __name__ == "__main__":
+    raise SystemExit(serve_main())
