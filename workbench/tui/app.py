@@ -46,6 +46,15 @@ MIN_SIZE = (80, 24)
 ROLES = ("student", "instructor")
 
 
+#: tab and shift+tab move the focus before the next key is delivered: over SSH a typist's tab
+#: and the characters after it arrive together, and the characters belong in the new field
+#: (the help's Dialogs section explains them)
+FOCUS_BINDINGS = (
+    Binding("tab", "focus_next", show=False, priority=True),
+    Binding("shift+tab", "focus_previous", show=False, priority=True),
+)
+
+
 class AppSetupError(ValueError):
     """The app cannot start with these arguments; the message says what to change."""
 
@@ -63,6 +72,7 @@ class WorkbenchApp(App[None]):
         Binding(
             "ctrl+p", "command_palette", "Commands", show=False, priority=True, id="app.commands"
         ),
+        *FOCUS_BINDINGS,
     ]
 
     #: draw the maze with Unicode lines and arrows (False: plain ASCII)

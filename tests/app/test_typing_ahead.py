@@ -1,0 +1,31 @@
+"""Keys typed ahead (over SSH a burst arrives in one read) land where the user meant them."""
+
+from __future__ import annotations
+
+from textual import events
+from textual.pilot import Pilot
+from textual.widgets import Input
+
+from workbench.tui.app import make_app
+from workbench.tui.screens.size_dialog import SizeDialog
+
+from .support import run
+
+
+def test_characters_typed_right_after_tab_go_into_the_next_field(tmp_path):
+    app = make_app(paused=True, student="ana", data_dir=tmp_path)
+
+    async def body(pilot: Pilot) -> None:
+        app.push_screen(SizeDialog(10, 10))
+        await pilot.pause()
+        width = app.screen.query_one("#width", Input)
+        height = app.screen.query_one("#height", Input)
+        width.value = "30"
+        # one burst, as a terminal delivers "\t12": nothing waits between the keys
+        for key, char in (("tab", "\t"), ("1", "1"), ("2", "2"), ("shift+tab", None), ("7", "7")):
+            app.post_message(events.Key(key, char))
+        await pilot.pause()
+        await pilot.pause()
+        assert (width.value, height.value) == ("7", "12")
+
+    run(app, body)
