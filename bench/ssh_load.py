@@ -1,20 +1,24 @@
 """SSH lab server under load: N students at once, each driving their robot at 20 Hz.
 
 Starts `workbench serve-ssh` on loopback (its own process, a throwaway data folder and one
-user per session), then opens N SSH sessions at the same moment, as a lab section does at the
-start of class. Each passes the names dialog and drives its robot for --seconds with keys at
---hz (w, a, d and space in a pattern; the app simulates at its own 20 Hz tick). Now and then a
-session stops driving for a moment and presses `p` (pause), then `p` again, timing each press
-until the screen shows the change (PAUSED / running): the keypress-to-screen latency through
-SSH, the server and the app process.
+user per session), then opens N SSH sessions at the same moment, the worst case of a lab
+section at the start of class; then (--spread, on by default) again with the N students
+arriving evenly over --spread seconds, as they do walking in. Each passes the names dialog and
+drives its robot for --seconds with keys at --hz (w, a, d and space in a pattern; the app
+simulates at its own 20 Hz tick). Now and then a session stops driving for a moment and
+presses `p` (pause), then `p` again, timing each press until the screen shows the change
+(PAUSED / running): the keypress-to-screen latency through SSH, the server and the app process.
 
-Printed for each N: time to first screen (connect to the names dialog on the screen, p50/p95),
-memory per session (RSS of each app process, and PSS from /proc/PID/smaps_rollup, which shares
-out the pages the processes have in common), the server process's own growth, CPU of the server
-and its app processes (as % of one core and of the whole machine), and the keypress latency
-(p50/p95). The SSH clients run in this process on the same machine and their CPU is printed too.
-Targets on a 2-core machine: 30 sessions held; first screen p95 <= 3 s; keypress-to-screen
-p95 <= 150 ms at 30 sessions; <= 60 MB per session. Figures vary from run to run.
+Printed for each N and arrival: time to first screen (connect to the names dialog on the
+screen, p50/p95), memory per session (RSS of each app process, and PSS from
+/proc/PID/smaps_rollup, which shares out the pages the processes have in common), the server
+process's own growth, CPU of the server and its app processes (as % of one core and of the
+whole machine), and the keypress latency (p50/p95). The SSH clients run in this process on the
+same machine and their CPU is printed too. The apps are forked from the server's fork server
+unless --no-fork-server (the fork server's own memory is printed apart; the pages it shares
+with the apps count in their PSS too). Targets on a 2-core machine: 30 sessions held; first
+screen p95 <= 3 s; keypress-to-screen p95 <= 150 ms at 30 sessions; <= 60 MB per session.
+Figures vary from run to run.
 """
 
 from __future__ import annotations
@@ -91,22 +95,49 @@ def pss_bytes(pid: int) -> int | None:
     return None
 
 
-def children(pid: int) -> list[int]:
-    found = []
+def children_by_parent() -> dict[int, list[int]]:
+    parents: dict[int, list[int]] = {}
     for entry in Path("/proc").iterdir():
         if entry.name.isdigit():
             try:
                 stat = (entry / "stat").read_text()
             except OSError:
                 continue
-            if int(stat.rsplit(")", 1)[1].split()[1]) == pid:
-                found.append(int(entry.name))
+            parents.setdefault(int(stat.rsplit(")", 1)[1].split()[1]), []).append(int(entry.name))
+    return parents
+
+
+def descendants(pid: int) -> list[int]:
+    parents = children_by_parent()
+    found, todo = [], [pid]
+    while todo:
+        kids = parents.get(todo.pop(), [])
+        found += kids
+        todo += kids
     return found
 
 
+def is_forkserver(pid: int) -> bool:
+    try:
+        return b"workbench.ssh.forkserver" in Path(f"/proc/{pid}/cmdline").read_bytes()
+    except OSError:
+        return False
+
+
+def apps_of(server: int) -> tuple[list[int], list[int]]:
+    """The server's app processes (its children, or its fork server's), and its fork server."""
+    parents = children_by_parent()
+    kids = parents.get(server, [])
+    forkservers = [p for p in kids if is_forkserver(p)]
+    apps = [p for p in kids if p not in forkservers]
+    for forkserver in forkservers:
+        apps += parents.get(forkserver, [])
+    return apps, forkservers
+
+
 def tree_cpu(pid: int) -> float:
-    """CPU seconds of the server and its live children (children that ended are not seen)."""
-    return cpu_seconds(pid) + sum(cpu_seconds(c) for c in children(pid))
+    """CPU seconds of the server and its live descendants (those that ended are not seen)."""
+    return cpu_seconds(pid) + sum(cpu_seconds(c) for c in descendants(pid))
 
 
 # -- one student ---------------------------------------------------------------------------
@@ -134,7 +165,10 @@ class Student:
                 return False
         return True
 
-    async def run(self, start: float, seconds: float, hz: float, offset: float) -> None:
+    async def run(
+        self, start: float, seconds: float, hz: float, offset: float, arrive: float
+    ) -> None:
+        await asyncio.sleep(max(0.0, arrive - time.perf_counter()))
         t0 = time.perf_counter()
         conn = await asyncssh.connect(
             "127.0.0.1", self.port, username=self.name, client_keys=[self.key],
@@ -187,13 +221,13 @@ class Student:
 
 
 # -- one round -----------------------------------------------------------------------------
-def start_server(data: Path, port: int, sessions: int) -> subprocess.Popen:
+def start_server(data: Path, port: int, sessions: int, fork: bool) -> subprocess.Popen:
     first = 42000 + (port % 100) * 100
     server = subprocess.Popen(
         [sys.executable, "-m", "workbench", "serve-ssh", "--bind", "127.0.0.1",
          "--port", str(port), "--data-dir", str(data), "--public-host", "bench",
          "--port-range", f"{first}-{first + 2 * sessions + 40}",
-         "--max-sessions", str(max(60, sessions))],
+         "--max-sessions", str(max(60, sessions)), *([] if fork else ["--no-fork-server"])],
         cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
     )  # fmt: skip
     log = data / "ssh.log"
@@ -205,7 +239,7 @@ def start_server(data: Path, port: int, sessions: int) -> subprocess.Popen:
     return server
 
 
-async def round_of(n: int, seconds: float, hz: float) -> None:
+async def round_of(n: int, seconds: float, hz: float, spread: float, fork: bool) -> None:
     with tempfile.TemporaryDirectory(prefix="ssh-load-") as tmp:
         data = Path(tmp)
         keys = {}
@@ -215,39 +249,58 @@ async def round_of(n: int, seconds: float, hz: float) -> None:
             add_user(data / "ssh-users.yaml", name, "student",
                      [keys[name].export_public_key().decode()])  # fmt: skip
         port = free_port()
-        server = start_server(data, port, n)
+        server = start_server(data, port, n, fork)
+        started = "forked from a fork server" if fork else "new processes"
+        if fork and "apps are forked" not in (data / "ssh.log").read_text():
+            started = "new processes: THE FORK SERVER DID NOT START"
+        time.sleep(0.5)
         base_rss = rss_bytes(server.pid)
         own_cpu0 = time.process_time()
         result = Result()
         # the drive starts for everyone once the slowest could have its first screen
-        start = time.perf_counter() + max(10.0, 0.6 * n)
+        t0 = time.perf_counter()
+        start = t0 + spread + max(10.0, 0.6 * n)
         students = [Student(name, key, port, result) for name, key in keys.items()]
         tasks = [
-            asyncio.create_task(s.run(start, seconds, hz, offset=(i % 20) * PROBE_EVERY / 20))
+            asyncio.create_task(
+                s.run(
+                    start,
+                    seconds,
+                    hz,
+                    offset=(i % 20) * PROBE_EVERY / 20,
+                    arrive=t0 + spread * i / n,
+                )
+            )
             for i, s in enumerate(students)
         ]
         await asyncio.sleep(max(0.0, start - time.perf_counter()) + 1.0)
         cpu0, wall0 = tree_cpu(server.pid), time.perf_counter()
         await asyncio.sleep(seconds / 2)
-        apps = children(server.pid)
+        apps, forkservers = apps_of(server.pid)
         rss = [rss_bytes(p) for p in apps]
         pss = [v for v in (pss_bytes(p) for p in apps) if v is not None]
+        fs_rss = sum(rss_bytes(p) for p in forkservers)
+        fs_pss = sum(pss_bytes(p) or 0 for p in forkservers)
         server_growth = rss_bytes(server.pid) - base_rss
         await asyncio.sleep(max(0.0, seconds / 2 - 2.0))
         cpu1, wall1 = tree_cpu(server.pid), time.perf_counter()
         await asyncio.gather(*tasks, return_exceptions=True)
         own_cpu = time.process_time() - own_cpu0
         deadline = time.monotonic() + 20
-        while children(server.pid) and time.monotonic() < deadline:
+        while apps_of(server.pid)[0] and time.monotonic() < deadline:
             await asyncio.sleep(0.1)
-        left = len(children(server.pid))
+        left = len(apps_of(server.pid)[0])
         server.terminate()
         server.wait(30)
 
     cores = os.cpu_count() or 1
     used = (cpu1 - cpu0) / (wall1 - wall0)
     mb = 1024 * 1024
-    print(f"N={n} sessions ({len(apps)} app processes held), {seconds:g} s at {hz:g} Hz:")
+    arrival = f"arriving over {spread:g} s" if spread else "ALL AT ONCE"
+    print(
+        f"N={n} sessions, {arrival} ({len(apps)} app processes held, {started}), "
+        f"{seconds:g} s at {hz:g} Hz:"
+    )
     print(
         f"  first screen     p50 {pct(result.first_screen, 0.5):.2f} s   "
         f"p95 {pct(result.first_screen, 0.95):.2f} s   max {max(result.first_screen):.2f} s"
@@ -261,6 +314,8 @@ async def round_of(n: int, seconds: float, hz: float) -> None:
         f"max {max(rss) / mb:.1f} MB"
         + (f";  PSS mean {statistics.mean(pss) / mb:.1f} MB" if pss else "")
     )
+    if forkservers:
+        print(f"  fork server      RSS {fs_rss / mb:.1f} MB;  PSS {fs_pss / mb:.1f} MB")
     print(
         f"  server process   +{server_growth / mb:.1f} MB over its idle "
         f"{base_rss / mb:.1f} MB ({server_growth / mb / n:.2f} MB/session)"
@@ -284,9 +339,19 @@ def main() -> None:
     parser.add_argument("--sessions", type=int, nargs="+", default=[10, 30])
     parser.add_argument("--seconds", type=float, default=30.0)
     parser.add_argument("--hz", type=float, default=20.0)
+    parser.add_argument(
+        "--spread", type=float, default=30.0,
+        help="also a round with the students arriving evenly over this many seconds, after the "
+        "all-at-once round (0: all at once only; default 30)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--no-fork-server", action="store_true",
+        help="the server starts each app as a new process (as before the fork server)",
+    )  # fmt: skip
     args = parser.parse_args()
     for n in args.sessions:
-        asyncio.run(round_of(n, args.seconds, args.hz))
+        for spread in (0.0, args.spread) if args.spread > 0 else (0.0,):
+            asyncio.run(round_of(n, args.seconds, args.hz, spread, not args.no_fork_server))
 
 
 if __name__ == "__main__":
