@@ -254,3 +254,20 @@ def test_the_labs_reopen_at_the_exercise_the_student_had_open(tmp_path):
         assert listing.highlighted_option.id == "unity-simulator/wall-following"
 
     run(again, resume)
+
+
+def test_a_websocket_url_can_wait_until_asked_and_v_connects(tmp_path):
+    url = "ws://127.0.0.1:9/"  # nothing listens: the client keeps trying, as it should
+    app = make_app(paused=True, student="ana", data_dir=tmp_path, ws_url=url, ws_at_start=False)
+
+    async def body(pilot: Pilot) -> None:
+        assert app.endpoints is None  # no connection attempts until asked
+        await pilot.press("v")
+        await app.workers.wait_for_complete()
+        await pilot.pause()
+        assert app.endpoints.ws is not None and app.endpoints.ws.config.url == url
+        assert app.bench.message == (
+            f"VIPLE: start your program's WebSocket server; the robot connects to {url}"
+        )
+
+    run(app, body)

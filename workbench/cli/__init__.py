@@ -42,6 +42,12 @@ def build_parser() -> argparse.ArgumentParser:
         "--ws-url", help="connect to VIPLE's WebSocket server too (Web-Simulator role)"
     )
     parser.add_argument(
+        "--ws-when-asked",
+        action="store_true",
+        help="with --ws-url: connect only when a WebSocket lab exercise is set up or v is "
+        "pressed, not from the start",
+    )
+    parser.add_argument(
         "--record-dir",
         help=f"keep each run's record here for replay (default: a new folder under {runs_home()})",
     )
@@ -117,6 +123,7 @@ def open_app(args: argparse.Namespace) -> int:
             unicode=args.unicode,
             tcp_port=args.tcp_port or None,
             ws_url=args.ws_url,
+            ws_at_start=not args.ws_when_asked,
             record_dir=args.record_dir or new_runs_dir(),
             student=args.student,
             partner=args.partner,

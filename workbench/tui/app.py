@@ -91,6 +91,7 @@ class WorkbenchApp(App[None]):
         tcp: TcpConfig | None = None,
         ws: WsConfig | None = None,
         report_ms: int = REPORT_MS_DEFAULT,
+        ws_at_start: bool = True,
         student: str = "",
         partner: str = "",
         data_dir: str | os.PathLike | None = None,
@@ -110,6 +111,7 @@ class WorkbenchApp(App[None]):
         self.store_problem = ""
         self._labs: LabsScreen | None = None
         self._viple_configs = (tcp, ws)
+        self._ws_at_start = ws_at_start
         self._report_ms = report_ms
         self.endpoints: Endpoints | None = None
         self.bench = bench
@@ -134,6 +136,8 @@ class WorkbenchApp(App[None]):
 
     async def on_mount(self) -> None:
         tcp, ws = self._viple_configs
+        if not self._ws_at_start:
+            ws = None  # later: a WebSocket exercise's set-up or the v key starts it
         if tcp is not None or ws is not None:
             self.endpoints = await Endpoints.open(self.bench.session, tcp, ws)
         self.set_class(not self.unicode, "-ascii")
@@ -336,6 +340,7 @@ def make_app(
     tcp_port: int | None = None,
     ws_url: str | None = None,
     report_ms: int = REPORT_MS_DEFAULT,
+    ws_at_start: bool = True,
     student: str | None = None,
     partner: str = "",
     data_dir: str | os.PathLike | None = None,
@@ -346,7 +351,9 @@ def make_app(
     """The workbench app on a maze file (default: the bundled Unity maze).
 
     ``tcp_port`` hosts the Unity-simulator role (VIPLE connects to it) and ``ws_url`` the
-    Web-Simulator role (the app connects to VIPLE); neither runs unless asked for.
+    Web-Simulator role (the app connects to VIPLE: from the start, or with ``ws_at_start``
+    False once a WebSocket exercise is set up or the user presses ``v``); neither runs unless
+    asked for (a lab exercise's set-up starts the one it needs).
     ``student`` (default: the login name) and ``partner`` do the labs; their progress and
     sign-offs are kept in ``data_dir`` (default: ``$WORKBENCH_DATA`` or the user data folder).
     ``ask_names`` asks for them when the app starts (the student's name cannot be changed there
@@ -400,6 +407,7 @@ def make_app(
         tcp=tcp,
         ws=ws,
         report_ms=report_ms,
+        ws_at_start=ws_at_start,
         student=student,
         partner=partner,
         data_dir=data_dir,

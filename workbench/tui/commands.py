@@ -103,6 +103,12 @@ COMMANDS: dict[str, CommandInfo] = {
             "labs",
             "The lab exercises: instructions, set-up, live objectives, questions, sign-off.",
         ),
+        "viple.ws": (
+            "VIPLE",
+            "connect over WebSocket",
+            "Connect to VIPLE's WebSocket server (the Web Simulator's role) at --ws-url or "
+            "ws://localhost:8124/; it tries every second until the VIPLE program runs.",
+        ),
         "labs.close": ("Labs", "back", "Back to the maze (the exercise keeps being checked)."),
         "labs.setup": (
             "Labs",

@@ -59,6 +59,7 @@ class MainScreen(Screen[None]):
         Binding("e", "editor", "Editor", show=False, id="screen.editor"),
         Binding("R", "runs", "Runs", show=False, id="screen.runs"),
         Binding("l", "labs", "Labs", show=False, id="screen.labs"),
+        Binding("v", "viple_ws", "WebSocket", show=False, id="viple.ws"),
     ]
 
     #: the last snapshot drawn (per-tick state: never repaints by itself)
@@ -283,3 +284,6 @@ class MainScreen(Screen[None]):
 
     def action_labs(self) -> None:
         self.app.open_labs()  # type: ignore[attr-defined]
+
+    def action_viple_ws(self) -> None:
+        self.app.run_worker(self.app.open_endpoint("ws"), group="endpoints")  # type: ignore[attr-defined]
