@@ -228,6 +228,8 @@ class AppProcess:
             await self._reader
         code = await self.process.wait()
         self._close_input()
+        if not getattr(self.process, "status_known", True) and self.said_exit:
+            code = 0  # its fork server was lost, but the app said it ended by itself
         return code
 
     def _close_input(self) -> None:

@@ -55,8 +55,12 @@ PRELOAD_PACKAGES = (
     "workbench.tui",
 )
 MAX_MESSAGE = 1 << 20
-#: exit status given for an app whose end could not be learnt (the fork server was lost)
+#: exit status given for an app whose status could not be learnt (the fork server was lost)
 UNKNOWN_STATUS = 1
+
+
+#: an app's exit status, None when it could not be learnt
+Ended = asyncio.Future[int | None]
 
 
 class ForkServerError(Exception):
@@ -221,7 +225,7 @@ class ForkedApp:
         pid: int,
         reader: asyncio.StreamReader,
         writer: asyncio.StreamWriter,
-        ended: asyncio.Future[int],
+        ended: Ended,
     ) -> None:
         self.pid = pid
         self.stdout = reader
@@ -231,10 +235,19 @@ class ForkedApp:
     @property
     def returncode(self) -> int | None:
         ended = self._ended
-        return ended.result() if ended.done() and not ended.cancelled() else None
+        if not ended.done() or ended.cancelled():
+            return None
+        code = ended.result()
+        return UNKNOWN_STATUS if code is None else code
+
+    @property
+    def status_known(self) -> bool:
+        """False for an app that ended after the fork server was lost: its status is a guess."""
+        return not self._ended.done() or self._ended.result() is not None
 
     async def wait(self) -> int:
-        return await asyncio.shield(self._ended)
+        code = await asyncio.shield(self._ended)
+        return UNKNOWN_STATUS if code is None else code
 
 
 class ForkServer:
@@ -248,10 +261,8 @@ class ForkServer:
         self.seconds = 0.0
         self._sock: socket.socket | None = None
         self._ready: asyncio.Future[dict] | None = None
-        self._answers: collections.deque[asyncio.Future[tuple[int, asyncio.Future[int]]]] = (
-            collections.deque()
-        )
-        self._ended: dict[int, asyncio.Future[int]] = {}
+        self._answers: collections.deque[asyncio.Future[tuple[int, Ended]]] = collections.deque()
+        self._ended: dict[int, Ended] = {}
         self._watching: dict[int, int] = {}  # pidfd per child, once the fork server is lost
         self._running = False
 
@@ -372,7 +383,7 @@ class ForkServer:
                 os.close(fd)
             self._ended.pop(pid, None)
             if not ended.done():
-                ended.set_result(UNKNOWN_STATUS)
+                ended.set_result(None)
 
         try:
             fd = os.pidfd_open(pid)
@@ -399,7 +410,7 @@ class ForkServer:
             raise ForkServerError(f"the request was not sent: {exc}") from exc
         finally:
             theirs.close()
-        answer: asyncio.Future[tuple[int, asyncio.Future[int]]] = loop.create_future()
+        answer: asyncio.Future[tuple[int, Ended]] = loop.create_future()
         self._answers.append(answer)
         try:
             pid, ended = await answer
