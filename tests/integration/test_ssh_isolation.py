@@ -18,8 +18,12 @@ from .ssh_support import Account, lab_host, moved
 MOVE = b'{"servos":[{"isTurn":false,"servoId":-1,"servoSpeed":1}]}\r\n'
 
 
-def tcp_port_shown(screen: str) -> int:
-    """The VIPLE TCP port from the forwarding command the app shows."""
+async def tcp_port_shown(term) -> int:
+    """The VIPLE TCP port from the forwarding command the app shows in its help."""
+    term.send("?")
+    screen = await term.wait_for("Connect VIPLE", "-L 1350:localhost:")
+    term.send("\x1b")
+    await term.wait_gone("Connect VIPLE")
     found = re.search(r"-L 1350:localhost:(\d+)", screen)
     assert found, f"no forwarding command on the screen:\n{screen}"
     return int(found.group(1))
@@ -29,8 +33,8 @@ def tcp_port_shown(screen: str) -> int:
 async def test_each_student_sees_only_their_robot_and_forwards_only_to_their_own_ports(tmp_path):
     async with lab_host(tmp_path, [Account("ann"), Account("ben")]) as host:
         ann, ben = await asyncio.gather(host.terminal("ann"), host.terminal("ben"))
-        screen_a, screen_b = await asyncio.gather(ann.start_app(), ben.start_app())
-        port_a, port_b = tcp_port_shown(screen_a), tcp_port_shown(screen_b)
+        await asyncio.gather(ann.start_app(), ben.start_app())
+        port_a, port_b = await asyncio.gather(tcp_port_shown(ann), tcp_port_shown(ben))
         assert port_a != port_b
         ws_a = host.server.live("ann")[0].spec.ws_port
         ws_b = host.server.live("ben")[0].spec.ws_port

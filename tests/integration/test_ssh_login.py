@@ -20,7 +20,11 @@ async def test_a_student_logs_in_with_a_key_drives_and_the_layout_follows_a_resi
         term = await host.terminal("ann")
         await term.wait_for("Who is at this robot?", "Student  ann", timeout=30)
         screen = await term.start_app()
-        assert "VIPLE: on your computer run  ssh -N -p" in screen  # the forwarding hint
+        assert "VIPLE from your computer: press ? for the ssh command" in screen
+        term.send("?")  # the help has the forwarding command whole
+        await term.wait_for("Connect VIPLE", "VIPLE: on your computer run  ssh -N -p")
+        term.send("\x1b")
+        await term.wait_gone("Connect VIPLE")
         term.send("w")  # Move at Power 1
         await term.wait_until(moved, "the robot moving")
         screen = await term.wait_for("ann (student)", "driver: keys")
