@@ -83,6 +83,9 @@ async def test_each_student_sees_only_their_robot_and_forwards_only_to_their_own
         local = await asyncio.start_server(viple_ws, "127.0.0.1", 0)
         local_port = local.sockets[0].getsockname()[1]
         await tunnel.forward_remote_port("localhost", ws_a, "127.0.0.1", local_port)
+        await asyncio.sleep(1.5)
+        assert not arrived.is_set()  # no attempts (and no errors in ssh -N) until asked
+        ann.send("v")  # connect over WebSocket
         await asyncio.wait_for(arrived.wait(), 15)
 
         local.close()

@@ -117,6 +117,7 @@ def test_the_app_is_started_with_the_users_name_ports_and_terminal():
     assert argv[:5] == ["workbench", "--student", "ann", "--ask-partner", "--role"]
     assert "--tcp-port" in argv and argv[argv.index("--tcp-port") + 1] == "41000"
     assert argv[argv.index("--ws-url") + 1] == "ws://127.0.0.1:41001/"
+    assert "--ws-when-asked" in argv  # no WebSocket attempts until the student asks
     env = spec.env({"SSH_CONNECTION": "x", "PATH": "/bin", "TEXTUAL_DEBUG": "1"})
     assert env["TEXTUAL_DRIVER"] == "textual.drivers.web_driver:WebDriver"
     assert (env["COLUMNS"], env["ROWS"], env["TERM"]) == ("100", "30", "xterm")

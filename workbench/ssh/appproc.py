@@ -65,6 +65,7 @@ class AppSpec:
             "--role", self.role,
             "--tcp-port", str(self.tcp_port),
             "--ws-url", f"ws://127.0.0.1:{self.ws_port}/",
+            "--ws-when-asked",
             "--connect-hint", self.hint,
             "--data-dir", str(self.data_dir),
             "--record-dir", str(self.record_dir),
