@@ -25,6 +25,7 @@ from workbench.sim.mazeio import load_maze
 from workbench.sim.sensors import SensorConfigError
 from workbench.sim.session import Snapshot
 
+from ..compositor import LiveCompositor
 from ..widgets.algorithm_state import AlgorithmState
 from ..widgets.key_legend import KeyLegend
 from ..widgets.maze_view import MazeView
@@ -67,6 +68,8 @@ class MainScreen(Screen[None]):
 
     def __init__(self, bench: Bench, unicode: bool = False, trail: bool = True) -> None:
         super().__init__()
+        # the maze and the panels change a few cells at a time, many times a second
+        self._compositor = LiveCompositor()
         self.bench = bench
         self._ready = False
         self._unicode = unicode

@@ -328,22 +328,26 @@ class MazeView(ScrollView, can_focus=False):
         scroll_x, scroll_y = self.scroll_offset
         width = self.size.width
         row = scroll_y + y
+        base = self._style("")
         if row >= self._maze.height:
-            return Strip.blank(width, self.rich_style)
+            return Strip.blank(width, base)
         strip = self._strips[row]
         if strip is None:
             strip = self._build_strip(row)
-        return strip.crop_extend(scroll_x, scroll_x + width, self.rich_style)
+        return strip.crop_extend(scroll_x, scroll_x + width, base)
 
     def _style(self, key: str) -> Style:
+        """The widget's own style (``key`` ""), or it with the named components' (``"ray"``,
+        ``"wall+cursor"``); kept until the styles change."""
         style = self._styles.get(key)
         if style is None:
-            names = key.split("+")
             base = self.rich_style
-            style = base + Style.combine(
-                self.get_component_rich_style(f"maze-view--{n}", partial=True) for n in names
-            )
-            self._styles[key] = style
+            if key:
+                base += Style.combine(
+                    self.get_component_rich_style(f"maze-view--{n}", partial=True)
+                    for n in key.split("+")
+                )
+            style = self._styles[key] = base
         return style
 
     def _make_base_row(self, y: int) -> list[Token]:

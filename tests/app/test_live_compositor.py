@@ -1,0 +1,130 @@
+"""The main screen's compositor: every partial update leaves the screen as a full render draws it.
+
+The updates the app sends while the robot drives are applied, one by one, to a grid of cells
+(character and style) the way a terminal applies them; after each one the grid must equal a full
+render of the screen at that moment. And a redraw of a snapshot that did not change refreshes
+nothing at all.
+"""
+
+from __future__ import annotations
+
+import asyncio
+
+import pytest
+from rich.cells import cell_len
+from rich.segment import ControlType, Segment
+from rich.style import Style
+from textual.pilot import Pilot
+from textual.strip import Strip
+
+from tests.app.support import run
+from workbench.tui.app import WorkbenchApp, make_app
+from workbench.tui.compositor import GroupedUpdate, LiveCompositor
+from workbench.tui.screens.main import MainScreen
+from workbench.tui.widgets.maze_view import MazeView
+
+Cell = tuple[str, Style | None]
+
+
+def cells(strips: list[Strip], width: int) -> list[list[Cell]]:
+    grid = []
+    for strip in strips:
+        row: list[Cell] = []
+        for segment in strip:
+            for char in segment.text:
+                row.extend([(char, segment.style)] * max(cell_len(char), 1))
+        grid.append((row + [(" ", None)] * width)[:width])
+    return grid
+
+
+def apply(grid: list[list[Cell]], segments: list[Segment]) -> None:
+    """Write an update's segments on ``grid`` as a terminal would (cursor moves and text)."""
+    x = y = 0
+    for segment in segments:
+        if segment.control:
+            for code in segment.control:
+                if code[0] == ControlType.CURSOR_MOVE_TO:
+                    x, y = code[1], code[2]
+            continue
+        if segment.text == "\n":
+            continue
+        for char in segment.text:
+            grid[y][x] = (char, segment.style)
+            x += max(cell_len(char), 1)
+
+
+class Checker:
+    """Applies each partial update of ``screen`` to a grid and compares it with a full render."""
+
+    def __init__(self, app: WorkbenchApp, screen: MainScreen) -> None:
+        self.app = app
+        self.compositor = screen._compositor
+        assert isinstance(self.compositor, LiveCompositor)
+        self.width = self.compositor.size.width
+        self.grid = cells(self.compositor.render_strips(), self.width)
+        self.updates = 0
+        self.grouped = 0
+        self.mismatches: list[str] = []
+        partial = self.compositor.render_partial_update
+
+        def checked():
+            update = partial()
+            if update is not None:
+                self.check(update)
+            return update
+
+        self.compositor.render_partial_update = checked  # type: ignore[method-assign]
+
+    def check(self, update) -> None:
+        console = self.app.console
+        self.updates += 1
+        self.grouped += isinstance(update, GroupedUpdate)
+        apply(self.grid, list(update.__rich_console__(console, console.options)))
+        full = cells(self.compositor.render_strips(), self.width)
+        for y, (got, want) in enumerate(zip(self.grid, full, strict=True)):
+            if got != want:
+                text = "".join(c for c, _ in got)
+                self.mismatches.append(f"update {self.updates}, line {y}: {text!r}")
+        self.grid = full  # report each difference once
+
+
+@pytest.mark.parametrize("size", [(80, 24), (120, 40)])
+def test_partial_updates_match_a_full_render_while_the_robot_drives(size):
+    app = make_app(noise="off")
+
+    async def body(pilot: Pilot) -> None:
+        screen = app.screen
+        assert isinstance(screen, MainScreen)
+        checker = Checker(app, screen)
+        await pilot.press("w")
+        for keys in ("", "d", "", "u", "a", "t", "", "p", "n", "p", "a", "u", "", "d"):
+            for key in keys:
+                await pilot.press(key)
+            await asyncio.sleep(0.25)
+        await pilot.pause()
+        assert checker.mismatches == []
+        assert checker.updates >= 20
+        assert checker.grouped >= 1  # the maze and a panel changed in the same frame
+
+    run(app, body, size=size)
+
+
+def test_redrawing_an_unchanged_snapshot_refreshes_nothing():
+    app = make_app(noise="off", paused=True)
+
+    async def body(pilot: Pilot) -> None:
+        screen = app.screen
+        assert isinstance(screen, MainScreen)
+        await pilot.press("w")
+        app.bench.step(30)
+        app.refresh_views()
+        await pilot.pause()
+        view = screen.query_one(MazeView)
+        built = view.strips_built
+        screen._panels_at = 0.0  # the panels are due as well
+        app.refresh_views()
+        assert not screen._dirty_widgets
+        assert not screen._compositor._dirty_regions
+        assert view.strips_built == built
+
+    run(app, body)
