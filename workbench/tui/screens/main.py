@@ -40,14 +40,17 @@ PANEL_HZ = 4.0
 class MainScreen(Screen[None]):
     """Drive, watch and set up the robot."""
 
+    # the keys pressed again and again while driving are priority bindings: the screen takes
+    # them before the focused widget (the transition log, which has no use for them) would, so
+    # a key press runs its action at once instead of bubbling up through the side panel
     BINDINGS: ClassVar[list[BindingType]] = [
-        Binding("w", "drive('w')", "Forward", show=False, id="drive.forward"),
-        Binding("a", "drive('a')", "Left", show=False, id="drive.left"),
-        Binding("s", "drive('s')", "Backward", show=False, id="drive.backward"),
-        Binding("d", "drive('d')", "Right", show=False, id="drive.right"),
-        Binding("space", "drive('space')", "Stop", show=False, id="drive.stop"),
-        Binding("p", "pause", "Pause", id="sim.pause"),
-        Binding("n", "step", "Step", id="sim.step"),
+        Binding("w", "drive('w')", "Forward", show=False, priority=True, id="drive.forward"),
+        Binding("a", "drive('a')", "Left", show=False, priority=True, id="drive.left"),
+        Binding("s", "drive('s')", "Backward", show=False, priority=True, id="drive.backward"),
+        Binding("d", "drive('d')", "Right", show=False, priority=True, id="drive.right"),
+        Binding("space", "drive('space')", "Stop", show=False, priority=True, id="drive.stop"),
+        Binding("p", "pause", "Pause", priority=True, id="sim.pause"),
+        Binding("n", "step", "Step", priority=True, id="sim.step"),
         Binding("plus,equals_sign", "speed", "Speed", key_display="+", id="sim.speed"),
         Binding("r", "reset", "Reset", id="sim.reset"),
         Binding("o", "sensors", "Ports", id="panel.sensors"),
