@@ -3,41 +3,19 @@ a VIPLE exercise's set-up starts."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 from textual.pilot import Pilot
 from textual.widgets import Input, OptionList, Static
 
 from workbench.labs.store import Store
-from workbench.tui.app import WorkbenchApp, make_app
+from workbench.tui.app import make_app
 from workbench.tui.modals.identity import IdentityDialog
-from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
 from workbench.viple.tcp_server import TcpConfig
 
+from .labs_support import DRIVE, lab_app, open_exercise, text
 from .support import run
 
-DRIVE = "unity-simulator/drive-by-wire"
 CONNECT = "web-simulator/connect"
-
-
-def lab_app(data_dir: Path, **kw) -> WorkbenchApp:
-    return make_app(paused=True, student="ana", partner="ben", data_dir=data_dir, **kw)
-
-
-def text(screen, selector: str) -> str:
-    return str(screen.query_one(selector, Static).render())
-
-
-async def open_exercise(pilot: Pilot, option_id: str) -> LabsScreen:
-    await pilot.press("l")
-    await pilot.pause()
-    screen = pilot.app.screen
-    assert isinstance(screen, LabsScreen)
-    listing = screen.query_one("#labs-list", OptionList)
-    listing.highlighted = listing.get_option_index(option_id)
-    await pilot.pause()
-    return screen
 
 
 def test_an_exercise_is_saved_as_soon_as_it_is_opened(tmp_path):

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
 from textual.pilot import Pilot
 from textual.widgets import Button, Checkbox, Input, OptionList, Select, Static
@@ -11,35 +9,15 @@ from textual.widgets import Button, Checkbox, Input, OptionList, Select, Static
 from workbench.cli import build_parser
 from workbench.labs import signoff as so
 from workbench.labs.store import Store
-from workbench.tui.app import WorkbenchApp, make_app
 from workbench.tui.modals.signoff import SignoffModal
 from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
 
+from .labs_support import DRIVE, lab_app, open_exercise, text
 from .support import run
 
 FAST = so.KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
 PASS = "correct horse battery"
-DRIVE = "unity-simulator/drive-by-wire"
-
-
-def lab_app(data_dir: Path, **kw) -> WorkbenchApp:
-    return make_app(paused=True, student="ana", partner="ben", data_dir=data_dir, **kw)
-
-
-def text(screen, selector: str) -> str:
-    return str(screen.query_one(selector, Static).render())
-
-
-async def open_exercise(pilot: Pilot, option_id: str = DRIVE) -> LabsScreen:
-    await pilot.press("l")
-    await pilot.pause()
-    screen = pilot.app.screen
-    assert isinstance(screen, LabsScreen)
-    listing = screen.query_one("#labs-list", OptionList)
-    listing.highlighted = listing.get_option_index(option_id)
-    await pilot.pause()
-    return screen
 
 
 async def complete_drive_by_wire(pilot: Pilot, screen: LabsScreen) -> None:

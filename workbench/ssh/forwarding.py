@@ -19,21 +19,21 @@ def local_forward_refusal(host: str, port: int, own_tcp_ports: Collection[int]) 
     """Why ``-L`` to ``host:port`` is refused, or None when it is allowed."""
     if host.lower() not in LOOPBACK:
         return f"destination {host}:{port} is not this server's loopback"
-    if port not in own_tcp_ports:
-        if not own_tcp_ports:
-            return f"port {port}: the user has no workbench session running"
-        mine = ", ".join(str(p) for p in sorted(own_tcp_ports))
-        return f"port {port} is not the VIPLE port of the user's sessions ({mine})"
-    return None
+    return _not_own(port, own_tcp_ports, "VIPLE")
 
 
 def remote_forward_refusal(host: str, port: int, own_ws_ports: Collection[int]) -> str | None:
     """Why ``-R`` listening on ``host:port`` is refused, or None when it is allowed."""
     if host.lower() not in LISTEN_HOSTS:
         return f"listening on {host or 'all addresses'!s}:{port} (only 127.0.0.1 is allowed)"
-    if port not in own_ws_ports:
-        if not own_ws_ports:
-            return f"port {port}: the user has no workbench session running"
-        mine = ", ".join(str(p) for p in sorted(own_ws_ports))
-        return f"port {port} is not the WebSocket port of the user's sessions ({mine})"
-    return None
+    return _not_own(port, own_ws_ports, "WebSocket")
+
+
+def _not_own(port: int, own_ports: Collection[int], what: str) -> str | None:
+    """Why ``port`` is not one of the user's own session ports of kind ``what``, or None."""
+    if port in own_ports:
+        return None
+    if not own_ports:
+        return f"port {port}: the user has no workbench session running"
+    mine = ", ".join(str(p) for p in sorted(own_ports))
+    return f"port {port} is not the {what} port of the user's sessions ({mine})"

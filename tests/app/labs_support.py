@@ -1,0 +1,34 @@
+"""What the labs screen tests share: an app for a pair, opening an exercise, reading a line."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from textual.pilot import Pilot
+from textual.widgets import OptionList, Static
+
+from workbench.tui.app import WorkbenchApp, make_app
+from workbench.tui.screens.labs import LabsScreen
+
+DRIVE = "unity-simulator/drive-by-wire"
+
+
+def lab_app(data_dir: Path, **kw) -> WorkbenchApp:
+    """The app, paused, for the pair ana and ben, keeping its data in ``data_dir``."""
+    return make_app(paused=True, student="ana", partner="ben", data_dir=data_dir, **kw)
+
+
+def text(screen, selector: str) -> str:
+    return str(screen.query_one(selector, Static).render())
+
+
+async def open_exercise(pilot: Pilot, option_id: str = DRIVE) -> LabsScreen:
+    """``l``, then the exercise ``option_id`` ("lab/exercise") highlighted in the list."""
+    await pilot.press("l")
+    await pilot.pause()
+    screen = pilot.app.screen
+    assert isinstance(screen, LabsScreen)
+    listing = screen.query_one("#labs-list", OptionList)
+    listing.highlighted = listing.get_option_index(option_id)
+    await pilot.pause()
+    return screen
