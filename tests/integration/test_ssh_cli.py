@@ -12,6 +12,7 @@ import sys
 import time
 
 import asyncssh
+import pytest
 
 from workbench.ssh.users import load_users
 
@@ -82,6 +83,22 @@ def test_serve_ssh_refuses_a_broken_users_file_naming_line_and_fix(tmp_path):
     assert f"{users}:3: users.ann.role: 'pupil' is not a role" in done.stderr
     assert "(fix: write student or instructor)" in done.stderr
     assert "the server did not start" in done.stderr
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        (["--port", "99999"], "--port 99999 is not a port: use 1-65535"),
+        (["--port", "41500"], "--port 41500 lies inside --port-range 41000-41999"),
+        (["--port-range", "5-3"], "--port-range '5-3': ports must be 1024-65535"),
+        (["--max-sessions", "0"], "must be > 0"),
+    ],
+)
+def test_serve_ssh_refuses_bad_options_before_it_starts(tmp_path, options, message):
+    done = workbench("serve-ssh", "--data-dir", str(tmp_path / "d"), *options)
+    assert done.returncode == 2
+    assert message in done.stderr
+    assert not (tmp_path / "d").exists()  # nothing made: no host key, no log
 
 
 def free_port() -> int:

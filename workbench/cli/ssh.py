@@ -177,10 +177,20 @@ def cmd_serve(args: argparse.Namespace) -> int:
     from workbench.ssh.server import LabServer, ServerConfig, setup_logging
     from workbench.ssh.users import UsersFileError
 
+    if not 0 <= args.port <= 65535:
+        return fail(
+            "serve-ssh", f"--port {args.port} is not a port: use 1-65535 (default 2222; 0: any)"
+        )
     try:
         port_range = parse_range(args.port_range)
     except ValueError as exc:
         return fail("serve-ssh", f"--port-range {exc}")
+    if port_range[0] <= args.port <= port_range[1]:
+        return fail(
+            "serve-ssh",
+            f"--port {args.port} lies inside --port-range {args.port_range}, which is kept for "
+            "the sessions' VIPLE ports: choose a port outside it",
+        )
     if args.max_per_user < 1 or args.max_sessions < 1 or args.idle_timeout <= 0:
         return fail("serve-ssh", "--max-per-user, --max-sessions and --idle-timeout must be > 0")
     data_dir = resolve_data_dir(args.data_dir)
