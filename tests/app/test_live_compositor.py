@@ -64,6 +64,7 @@ class Checker:
         self.grid = cells(self.compositor.render_strips(), self.width)
         self.updates = 0
         self.grouped = 0
+        self.full = 0
         self.mismatches: list[str] = []
         partial = self.compositor.render_partial_update
 
@@ -74,6 +75,17 @@ class Checker:
             return update
 
         self.compositor.render_partial_update = checked  # type: ignore[method-assign]
+        full_update = self.compositor.render_full_update
+
+        def repainted(simplify: bool = False):
+            # a full update (a layout change, say) repaints every cell: the terminal shows a
+            # full render from here on, so that is what the next partial update builds on
+            update = full_update(simplify=simplify)
+            self.grid = cells(self.compositor.render_strips(), self.width)
+            self.full += 1
+            return update
+
+        self.compositor.render_full_update = repainted  # type: ignore[method-assign]
 
     def check(self, update) -> None:
         console = self.app.console
