@@ -21,7 +21,7 @@ from textual.reactive import var
 from textual.screen import Screen
 
 from workbench.control.bench import Bench
-from workbench.labs.model import Setup
+from workbench.labs.model import LABS_DIR, Setup
 from workbench.labs.names import NameProblem, check_pair
 from workbench.labs.store import Store
 from workbench.sim.maze import Maze, MazeError
@@ -141,7 +141,7 @@ class WorkbenchApp(App[None]):
         if tcp is not None or ws is not None:
             self.endpoints = await Endpoints.open(self.bench.session, tcp, ws)
         self.set_class(not self.unicode, "-ascii")
-        self.sub_title = f"{self.bench.maze.name} ({self.bench.profile})"
+        self._show_maze_title()
         self._last_tick = perf_counter()
         self.set_interval(1.0 / self.tick_hz, self._tick, name="simulation")
         if self.connect_hint:
@@ -164,10 +164,7 @@ class WorkbenchApp(App[None]):
     def _named(self, names: tuple[str, str] | None) -> None:
         if names is None:
             return
-        self.student, self.partner = names
-        if self._labs is not None:  # opened before the names were given: follow them
-            self.uninstall_screen(self._labs)
-            self._labs = None
+        self.student, self.partner = names  # before the labs open: the dialog is modal
         for screen in self.screen_stack:
             bar = screen.query("#message")
             if bar:
@@ -244,9 +241,18 @@ class WorkbenchApp(App[None]):
         self.push_screen(EditorScreen(self.bench, path, unicode=self.unicode), self._edited)
 
     def _edited(self, maze: Maze | None) -> None:
-        if maze is not None:
-            self.sub_title = f"{maze.name} ({self.bench.profile})"
+        self.maze_changed()
+
+    def maze_changed(self, path: str | os.PathLike | None = None) -> None:
+        """The bench has a new maze (or profile): follow it, and its file when one is given
+        (the editor saves there unless it is a bundled maze)."""
+        if path is not None:
+            self.maze_path = Path(path)
+        self._show_maze_title()
         self.refresh_views()
+
+    def _show_maze_title(self) -> None:
+        self.sub_title = f"{self.bench.maze.name} ({self.bench.profile})"
 
     def open_runs(self) -> None:
         self.push_screen(RunsScreen(self.bench, unicode=self.unicode))
@@ -274,10 +280,7 @@ class WorkbenchApp(App[None]):
     def set_up_done(self, setup: Setup | None = None) -> None:
         """A lab's set-up changed the bench: follow its maze and profile, and start the VIPLE
         endpoint an exercise done from VIPLE needs."""
-        self.sub_title = f"{self.bench.maze.name} ({self.bench.profile})"
-        self.refresh_views()
-        if setup is not None:
-            self.maze_path = setup.maze
+        self.maze_changed(setup.maze if setup is not None else None)
         if setup is not None and setup.controller.kind == "viple":
             self.run_worker(self.open_endpoint(setup.controller.value), group="endpoints")
 
@@ -425,7 +428,7 @@ def _bundled(path: Path) -> bool:
         where = path.resolve()
     except OSError:
         return False
-    return where.is_relative_to(MAZE_DIR) or where.is_relative_to(MAZE_DIR.parent / "labs")
+    return where.is_relative_to(MAZE_DIR) or where.is_relative_to(LABS_DIR)
 
 
 def _login_name() -> str:

@@ -262,7 +262,7 @@ class MainScreen(Screen[None]):
             if path is not None:
                 self._load_maze(path)
 
-        hint = "A maze file: the workbench text format or a micromouse .maz."
+        hint = "A maze file: the workbench text format, micromouse text or .maz, or mms."
         dialog = PathDialog("Load a maze", hint, value=value, action="Load", error=error)
         self.app.push_screen(dialog, chosen)
 
@@ -272,15 +272,11 @@ class MainScreen(Screen[None]):
         except MazeError as exc:
             self.action_maze(path, "\n".join(str(p) for p in exc.problems))
             return
-        bench = self.bench
-        bench.load_maze(maze)
+        self.bench.load_maze(maze)
         self._maze_view.set_maze(maze)
         self._maze_view.clear_trail()
-        app = self.app
-        if hasattr(app, "maze_path"):
-            app.maze_path = Path(path).expanduser()  # the editor saves it there
-        app.sub_title = f"{maze.name} ({bench.profile})"
-        self.say(f"the robot is on {maze.name}")
+        self.bench.message = f"the robot is on {maze.name}"
+        self.app.maze_changed(Path(path).expanduser())  # type: ignore[attr-defined]
 
     def action_editor(self) -> None:
         self.app.open_editor()  # type: ignore[attr-defined]
