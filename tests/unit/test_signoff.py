@@ -16,7 +16,8 @@ from pathlib import Path
 import pytest
 
 from workbench.labs import signoff as so
-from workbench.labs.store import DB_NAME, Store, StoreError, resolve_data_dir
+from workbench.labs.signlog import GENESIS
+from workbench.labs.store import DB_NAME, Store, StoreError, read_signoffs, resolve_data_dir
 
 FAST = so.KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only; defaults are untouched
 PASS = "correct horse battery"
@@ -150,10 +151,15 @@ def test_canonical_bytes_are_stable_and_cover_every_field(run_record):
     )  # fmt: skip
     again = replace(record, evidence=so.Evidence("r.jsonl", "sha256:00", {"a": 0.5, "b": 1}))
     assert record.canonical() == again.canonical()
-    data = json.loads(record.canonical())
-    assert data["format"] == so.RECORD_FORMAT
+    assert json.loads(record.canonical())["format"] == "workbench-signoff/1"  # legacy: no place
+    placed = replace(record, seq=3, prev=GENESIS)
+    data = json.loads(placed.canonical())
+    assert data["format"] == so.RECORD_FORMAT == "workbench-signoff/2"
+    assert (data["seq"], data["prev"]) == (3, GENESIS)
     assert set(data) >= {"student", "partner", "driver", "lab", "exercise", "instructor"}
     assert set(data) >= {"signed_at", "note", "override", "evidence"}
+    assert placed.canonical() != replace(placed, seq=4).canonical()
+    assert placed.canonical() != replace(placed, prev="sha256:" + "1" * 64).canonical()
 
 
 def test_signing_needs_passed_objectives_or_an_override_with_a_note(store, data_dir):
@@ -285,12 +291,10 @@ def test_a_key_not_in_the_roster_fails(store, data_dir, tmp_path):
     with Store.open(other) as rogue:
         so.sign_off(rogue, "Dr Fake", PASS, fields(), clock=Clock())
         so.sign_off(rogue, "Dr Chen", PASS, fields(), clock=Clock())
-        rows = rogue.signoffs()
-    for row in rows:
-        store.add_signoff({k: v for k, v in row.__dict__.items() if k != "id"})
-    found = problems(store, data_dir)
-    assert "not in the roster" in found[0][0]
-    assert "signature does not match" in found[1][0]
+    rogue_log = so.verify_log(read_signoffs(other), roster(data_dir))  # chain and all
+    found = [v.problems for v in rogue_log.verdicts]
+    assert found[0] == ("instructor 'Dr Fake' is not in the trusted roster",)
+    assert len(found[1]) == 1 and "signature does not match" in found[1][0]
 
 
 def test_gradebook_has_one_row_per_student_and_exercise_from_verified_records(store, data_dir):
@@ -304,11 +308,14 @@ def test_gradebook_has_one_row_per_student_and_exercise_from_verified_records(st
     so.sign_off(store, "Dr Chen", PASS, fields(student="dave", partner="", driver=""))
     with sqlite3.connect(store.path) as conn:
         conn.execute("UPDATE signoffs SET note = 'edited' WHERE student = 'dave'")
-    rows = so.gradebook_rows(so.verified_rows(store, roster(data_dir)))
+    log = so.verify_log(store.signoffs(), roster(data_dir))
+    rows = so.gradebook_rows(log.verified_rows(), log.head)
     keys = [(r["student"], r["exercise"]) for r in rows]
     assert keys == [("alice", "wall-following"), ("bob", "wall-following"), ("carol", "x")]
     assert rows[0]["signed_at"] == "2026-03-02T14:06:09Z"
     assert rows[1]["partner"] == "alice"
+    assert [r["seq"] for r in rows] == ["2", "2", "3"]
+    assert {r["log_head"] for r in rows} == {str(log.head)} and log.head.seq == 4
 
 
 # the store
@@ -324,7 +331,7 @@ def test_data_dir_comes_from_the_option_then_the_environment(monkeypatch, tmp_pa
 
 def test_store_uses_wal_and_a_schema_version(data_dir):
     with Store.open(data_dir) as s:
-        assert s.schema_version() == 1
+        assert s.schema_version() == 2
     with sqlite3.connect(data_dir / DB_NAME) as conn:
         assert conn.execute("PRAGMA journal_mode").fetchone()[0] == "wal"
 

@@ -148,7 +148,7 @@ def check_chain(entries: Sequence[Entry], kept: Head | None = None) -> ChainRepo
     and, given the head an instructor kept, that the log still holds that head."""
     breaks: list[str] = []
     by_row: dict[int, list[str]] = {e.id: [] for e in entries}
-    prev_hash = GENESIS
+    prev_hash = head_hash = GENESIS
     expected_seq = 1
     seen_chained = False
     signatures: dict[str, int] = {}
@@ -185,10 +185,13 @@ def check_chain(entries: Sequence[Entry], kept: Head | None = None) -> ChainRepo
         if e.signature in signatures:
             problems.append(f"it is a copy of the record with id {signatures[e.signature]}")
         signatures.setdefault(e.signature, e.id)
-        prev_hash = actual
+        # the next record links to this one's stored hash, so a record changed in place
+        # fails alone; one changed and re-hashed breaks the next record's link as well
+        prev_hash = e.stored_hash or actual
+        head_hash = actual
         expected_seq = max(expected_seq, e.seq + 1)
     last = entries[-1] if entries else None
-    head = Head(last.seq or 0, prev_hash) if last is not None else EMPTY_HEAD
+    head = Head(last.seq or 0, head_hash) if last is not None else EMPTY_HEAD
     if kept is not None:
         breaks.extend(_check_kept(entries, head, kept))
     return ChainReport(head, tuple(breaks), {k: tuple(v) for k, v in by_row.items()})
