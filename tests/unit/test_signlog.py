@@ -88,9 +88,7 @@ def test_an_untouched_log_verifies_and_its_head_is_the_last_record():
 def test_a_deleted_record_breaks_the_chain_where_it_was():
     log = so.verify_log(LOG[:2] + LOG[3:], ROSTER)
     assert not log.ok
-    assert log.breaks == (
-        "the log breaks before sequence 4: record(s) 3 are missing (deleted)",
-    )
+    assert log.breaks == ("the log breaks before sequence 4: record(s) 3 are missing (deleted)",)
     [problem] = log.verdicts[2].problems
     assert "does not follow the record before it" in problem
     assert [v.ok for v in log.verdicts] == [True, True, False, True]
@@ -212,9 +210,9 @@ def mutations(draw) -> tuple[str, list[StoredSignoff]]:
 @given(mutations())
 def test_any_single_change_to_the_log_is_found_with_the_kept_head(case):
     kind, rows = case
-    same = [
-        (r.seq, r.prev_hash, r.entry_hash, r.signature, r.signed_bytes()) for r in rows
-    ] == [(r.seq, r.prev_hash, r.entry_hash, r.signature, r.signed_bytes()) for r in LOG]
+    same = [(r.seq, r.prev_hash, r.entry_hash, r.signature, r.signed_bytes()) for r in rows] == [
+        (r.seq, r.prev_hash, r.entry_hash, r.signature, r.signed_bytes()) for r in LOG
+    ]
     log = so.verify_log(rows, ROSTER, kept=HEAD)
     assert log.ok == same, (kind, log.breaks, [v.problems for v in log.verdicts])
 
@@ -236,3 +234,37 @@ def test_heads_print_and_parse_as_seq_colon_hash():
     for bad in ("12", "x:" + "0" * 64, "12:" + "0" * 63, "-1:" + "0" * 64):
         with pytest.raises(LogError, match="is not SEQ:HASH"):
             Head.parse(bad)
+
+
+row_text = st.text(max_size=30)
+
+
+@st.composite
+def hostile_rows(draw) -> StoredSignoff:
+    """A row as anyone who can write the database might leave it."""
+    genuine = draw(st.sampled_from(LOG))
+    metrics = draw(
+        st.sampled_from(
+            ['{"n":1}', "NaN", '{"n":1e999}', "[" * 5000 + "]" * 5000, "9" * 5000, "{"]
+        )
+        | row_text
+    )
+    return replace(
+        genuine,
+        student=draw(row_text | st.just(genuine.student)),
+        instructor=draw(st.sampled_from(["Dr Chen", "Dr Сhen", ""]) | row_text),
+        metrics=metrics,
+        signature=draw(st.sampled_from([genuine.signature, "", "!!", "AAAA"]) | row_text),
+        seq=draw(st.none() | st.integers(-(2**63), 2**63 - 1)),
+        prev_hash=draw(st.sampled_from([genuine.prev_hash, GENESIS, ""]) | row_text),
+        entry_hash=draw(st.sampled_from([genuine.entry_hash, ""]) | row_text),
+        legacy=draw(st.booleans()),
+    )
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(hostile_rows(), max_size=6))
+def test_whatever_the_rows_hold_checking_gives_a_verdict(rows):
+    log = so.verify_log(rows, ROSTER, kept=HEAD)
+    assert len(log.verdicts) == len(rows)
+    assert not log.ok  # none of these is the kept log

@@ -40,6 +40,7 @@ FIELDS = (
 )
 
 _HASH = re.compile(r"(?:sha256:)?([0-9a-f]{64})")
+_SEQ = re.compile(r"[0-9]{1,18}")
 
 
 class LogError(ValueError):
@@ -103,7 +104,7 @@ class Head:
         ``sha256:``)."""
         seq_text, _, hash_text = text.strip().partition(":")
         match = _HASH.fullmatch(hash_text.strip().lower())
-        if not seq_text.strip().isdigit() or not match:
+        if not _SEQ.fullmatch(seq_text.strip()) or not match:
             raise LogError(
                 f"{where} {text.strip()[:80]!r} is not SEQ:HASH (a number, a colon and 64 hex "
                 "digits, as 'workbench signoff verify' prints it)"
@@ -164,8 +165,7 @@ def check_chain(entries: Sequence[Entry], kept: Head | None = None) -> ChainRepo
                 f"{expected_seq}" if e.seq == expected_seq + 1 else f"{expected_seq}-{e.seq - 1}"
             )
             breaks.append(
-                f"the log breaks before sequence {e.seq}: record(s) {missing} are missing "
-                "(deleted)"
+                f"the log breaks before sequence {e.seq}: record(s) {missing} are missing (deleted)"
             )
         if e.prev != prev_hash:
             problems.append(

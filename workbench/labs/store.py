@@ -15,6 +15,7 @@ checking and exporting.
 from __future__ import annotations
 
 import json
+import math
 import os
 import sqlite3
 import urllib.request
@@ -168,10 +169,11 @@ class StoredSignoff:
     legacy: bool = False
 
     def metrics_value(self) -> Any:
-        """The metrics as signed (stored as canonical JSON text)."""
+        """The metrics as signed (stored as canonical JSON text); text that is not JSON the
+        workbench writes (not JSON, NaN, nested too deep) as ``{"unreadable": text}``."""
         try:
-            return json.loads(self.metrics)
-        except json.JSONDecodeError:
+            return json.loads(self.metrics, parse_constant=_no_constant, parse_float=_finite)
+        except (ValueError, RecursionError):
             return {"unreadable": self.metrics}
 
     def signed_bytes(self) -> bytes:
@@ -520,6 +522,17 @@ class Store:
         return [Event(*r) for r in self._read(sql + " ORDER BY id", params)]
 
 
+def _no_constant(name: str) -> Any:
+    raise ValueError(f"{name} is not a JSON number")
+
+
+def _finite(text: str) -> float:
+    value = float(text)
+    if not math.isfinite(value):
+        raise ValueError(f"{text} is too large")
+    return value
+
+
 def _signoff_from_row(row: tuple[Any, ...], names: tuple[str, ...]) -> StoredSignoff:
     data = dict(zip(names, row, strict=True))
     for name in names:
@@ -580,9 +593,7 @@ def read_signoffs(data_dir: str | os.PathLike) -> list[StoredSignoff]:
     except sqlite3.Error as exc:
         raise StoreError(f"{path}: cannot open the database: {exc}") from None
     try:
-        tables = {
-            r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")
-        }
+        tables = {r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
         if "meta" not in tables:
             raise StoreError(f"{path}: not a workbench database (it has no meta table)")
         version = conn.execute("SELECT value FROM meta WHERE key = 'schema_version'").fetchone()
