@@ -175,13 +175,13 @@ def cmd_verify(args: argparse.Namespace) -> int:
     print(f"  {CHECKS}")
     if args.head or args.head_from:
         print("  and that the log still holds the head you kept")
+    for problem in log.breaks:
+        print(f"FAIL log: {problem}")
     for v in log.verdicts:
         for problem in v.problems:
             print(f"FAIL {_label(v.row)}: {problem}")
         for note in v.notes:
             print(f"note {_label(v.row)}: {note}")
-    for problem in log.breaks:
-        print(f"FAIL log: {problem}")
     bad = sum(1 for v in log.verdicts if not v.ok)
     if log.legacy:
         print(f"{log.legacy} legacy record(s), signed before the log was chained")
@@ -189,7 +189,7 @@ def cmd_verify(args: argparse.Namespace) -> int:
         if bad:
             print(f"{bad} of {total} record(s) do NOT verify")
         if log.breaks:
-            print("the log is broken: records are missing")
+            print(f"the log is broken in {len(log.breaks)} place(s) (FAIL log above)")
         print(f"the log does NOT verify (head as found {log.head})")
         return 1
     if total == 0:

@@ -756,10 +756,6 @@ def verify_all(store: Store, roster: dict[str, RosterEntry]) -> list[Verdict]:
     return list(verify_log(store.signoffs(), roster).verdicts)
 
 
-def verified_rows(store: Store, roster: dict[str, RosterEntry]) -> list[StoredSignoff]:
-    return verify_log(store.signoffs(), roster).verified_rows()
-
-
 def head_from_gradebook(path: Path) -> Head:
     """The log head kept in an exported gradebook (its ``log_head`` column)."""
     try:
