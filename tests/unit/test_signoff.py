@@ -547,3 +547,20 @@ def test_two_processes_signing_at_once_never_fork_the_chain(store, data_dir):
     assert sorted(r.student for r in rows) == ["alice"] * 12 + ["bob"] * 12
     log = so.verify_log(rows, roster(data_dir))
     assert log.ok, (log.breaks, [v.problems for v in log.verdicts if not v.ok])
+
+
+def test_signing_after_a_tampered_sequence_number_goes_on_or_says_why(store, data_dir):
+    so.sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+    so.sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+    with sqlite3.connect(store.path) as conn:
+        conn.execute("UPDATE signoffs SET seq = 'last' WHERE seq = 2")
+    conn.close()
+    _, record = so.sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+    assert record.seq == 2  # after the last numbered record; verify names the damaged one
+    log = so.verify_log(read_signoffs(data_dir), roster(data_dir))
+    assert [v.row.label() for v in log.verdicts if not v.ok] == ["row id 2"]
+    with sqlite3.connect(store.path) as conn:
+        conn.execute("UPDATE signoffs SET seq = ? WHERE id = 3", (2**62,))
+    conn.close()
+    with pytest.raises(StoreError, match="more than it can hold"):
+        so.sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())

@@ -108,6 +108,7 @@ CHAIN_COLUMNS = (
     ("entry_hash", "TEXT"),
     ("legacy", "INTEGER NOT NULL DEFAULT 0"),
 )
+MAX_SEQ = 2**53  # sequence numbers stay exact wherever the log is kept (JSON, any database)
 SEQ_INDEX = "CREATE UNIQUE INDEX IF NOT EXISTS signoffs_by_seq ON signoffs (seq)"
 
 
@@ -338,11 +339,18 @@ class Store:
         the write transaction, so two processes signing at once queue and never take the same
         place. Returns the row as stored."""
         with self._write() as cur:
+            # rows whose seq is not a number were tampered with: verify names them, and the
+            # log goes on after the last numbered record
             last = cur.execute(
-                "SELECT seq, entry_hash FROM signoffs WHERE seq IS NOT NULL "
+                "SELECT seq, entry_hash FROM signoffs WHERE typeof(seq) = 'integer' "
                 "ORDER BY seq DESC LIMIT 1"
             ).fetchone()
             seq, prev = (int(last[0]) + 1, str(last[1] or "")) if last else (1, GENESIS)
+            if seq >= MAX_SEQ:
+                raise StoreError(
+                    f"{self.path}: the sign-off log claims {seq - 1} records, more than it can "
+                    "hold; check it with 'workbench signoff verify'"
+                )
             values = sign(seq, prev)
             draft = StoredSignoff(
                 id=0,
