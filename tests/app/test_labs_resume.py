@@ -249,3 +249,27 @@ def test_a_websocket_url_can_wait_until_asked_and_v_connects(tmp_path):
         )
 
     run(app, body)
+
+
+def test_the_names_dialog_refuses_a_look_alike_name_and_normalises_the_rest(tmp_path):
+    app = make_app(paused=True, student="ana", data_dir=tmp_path, ask_names=True)
+
+    async def body(pilot: Pilot) -> None:
+        partner = app.screen.query_one("#partner", Input)
+        partner.value = "Bеn"  # a Cyrillic е
+        partner.focus()
+        await pilot.press("enter")
+        await pilot.pause()
+        assert isinstance(app.screen, IdentityDialog)
+        assert "mixes letters of different scripts (Cyrillic, Latin)" in text(app.screen, "#error")
+        partner.value = "Ben\u200b"  # a zero-width space
+        await pilot.press("enter")
+        await pilot.pause()
+        assert "invisible formatting characters (U+200B" in text(app.screen, "#error")
+        partner.value = "Ｂｅｎ"  # full-width letters: the same name
+        await pilot.press("enter")
+        await pilot.pause()
+        assert isinstance(app.screen, MainScreen)
+        assert (app.student, app.partner) == ("ana", "Ben")
+
+    run(app, body)

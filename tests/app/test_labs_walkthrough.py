@@ -345,7 +345,8 @@ async def viple_over_websocket(w: Walkthrough, screen: LabsScreen, lab: Lab, ex:
 
 def test_a_pair_completes_and_signs_off_every_exercise_in_the_app(tmp_path):
     data = tmp_path / "data"
-    so.create_instructor(data, INSTRUCTOR, PASS, kdf=FAST)
+    kept_roster = tmp_path / "instructor" / "roster.json"  # the instructor's own copy
+    so.create_instructor(data, INSTRUCTOR, PASS, kdf=FAST, trusted=kept_roster)
     # paused and noise off: every run is stepped by the test, in large batches, and comes out
     # the same each time; the app ticks only to draw, so slowly
     app = make_app(paused=True, noise="off", tick_hz=2, student="ana", partner="ben", data_dir=data)
@@ -394,9 +395,10 @@ def test_a_pair_completes_and_signs_off_every_exercise_in_the_app(tmp_path):
     assert {(r.student, r.partner, r.instructor) for r in rows} == {("ana", "ben", INSTRUCTOR)}
     assert all(v.ok for v in verdicts), [(v.row.exercise, v.problems) for v in verdicts]
 
-    assert main(["signoff", "verify", "--data-dir", str(data)]) == 0
+    trusted = ["--roster", str(kept_roster), "--data-dir", str(data)]
+    assert main(["signoff", "verify", *trusted]) == 0
     gradebook = tmp_path / "gradebook.csv"
-    assert main(["signoff", "export", "--csv", str(gradebook), "--data-dir", str(data)]) == 0
+    assert main(["signoff", "export", "--csv", str(gradebook), *trusted]) == 0
     with gradebook.open(newline="") as f:
         table = list(csv.DictReader(f))
     assert len(table) == 2 * len(EXERCISES) == 28

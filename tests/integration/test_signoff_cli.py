@@ -6,7 +6,6 @@ import csv
 import io
 import sqlite3
 import sys
-from datetime import UTC, datetime
 from pathlib import Path
 
 import pytest
@@ -15,46 +14,36 @@ from workbench.cli import main
 from workbench.labs import signoff as so
 from workbench.labs.store import DB_NAME, Store
 
-PASS = "correct horse battery"
-FAST = so.KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only; defaults are untouched
+from .signoff_support import FAST, PASS, add_instructor, sign
 
 
-def add_instructor(monkeypatch, data_dir: Path, name: str, passphrase: str = PASS) -> int:
-    monkeypatch.setattr(sys, "stdin", io.StringIO(passphrase + "\n"))
-    return main(["instructor", "add", name, "--passphrase-stdin", "--data-dir", str(data_dir)])
-
-
-def sign(data_dir: Path, student: str, exercise: str, partner: str = "", when: int = 0) -> None:
-    fields = so.RecordFields(
-        student=student,
-        partner=partner,
-        driver=student,
-        lab="web-simulator",
-        exercise=exercise,
-        evidence=so.Evidence("", "", {"collisions": 1}),
-        objectives_passed=True,
-    )
-    moment = datetime(2026, 3, 2, 10, when, tzinfo=UTC)
-    with Store.open(data_dir) as store:
-        so.sign_off(store, "Dr Chen", PASS, fields, clock=lambda: moment)
+@pytest.fixture(autouse=True)
+def config_dir(tmp_path, monkeypatch) -> Path:
+    """The instructor's configuration folder, where their trusted roster is kept."""
+    d = tmp_path / "config"
+    monkeypatch.setenv("WORKBENCH_CONFIG", str(d))
+    return d
 
 
 @pytest.fixture
-def data_dir(tmp_path, monkeypatch) -> Path:
+def data_dir(tmp_path, monkeypatch, config_dir) -> Path:
     d = tmp_path / "data"
     d.mkdir()
-    so.create_instructor(d, "Dr Chen", PASS, kdf=FAST)
+    so.create_instructor(d, "Dr Chen", PASS, kdf=FAST, trusted=config_dir / "roster.json")
     Store.open(d).close()
     monkeypatch.delenv("WORKBENCH_DATA", raising=False)
     return d
 
 
-def test_instructor_add_with_the_default_kdf_and_list(tmp_path, monkeypatch, capsys):
+def test_instructor_add_with_the_default_kdf_and_list(tmp_path, monkeypatch, capsys, config_dir):
     d = tmp_path / "fresh"
     assert add_instructor(monkeypatch, d, "Prof. Ada Lovelace") == 0
     out = capsys.readouterr().out
     assert "added Prof. Ada Lovelace" in out and "encrypted" in out
+    assert f"trusted roster {config_dir / 'roster.json'}" in out
     assert so.unlock_instructor(d, "Prof. Ada Lovelace", PASS).name == "Prof. Ada Lovelace"
+    kept = so.load_roster(config_dir / "roster.json")["Prof. Ada Lovelace"]
+    assert kept == so.load_roster(so.roster_path(d))["Prof. Ada Lovelace"]
     assert main(["instructor", "list", "--data-dir", str(d)]) == 0
     assert "Prof. Ada Lovelace" in capsys.readouterr().out
 
@@ -121,7 +110,7 @@ def test_verify_against_another_roster(data_dir, tmp_path, capsys):
     so.create_instructor(course, "Dr Chen", PASS, kdf=FAST)  # same name, different key
     roster = str(so.roster_path(course))
     assert main(["signoff", "verify", "--roster", roster, "--data-dir", str(data_dir)]) == 1
-    assert "signature does not match" in capsys.readouterr().out
+    assert "not the trusted one" in capsys.readouterr().out
     assert main(["signoff", "verify", "--roster", "nope.json", "--data-dir", str(data_dir)]) == 2
     assert "no such roster file" in capsys.readouterr().err
 
@@ -147,17 +136,25 @@ def test_export_contains_exactly_the_verifying_records(data_dir, tmp_path, capsy
     assert rows[0]["signed_at"] == "2026-03-02T10:02:00Z" and rows[0]["instructor"] == "Dr Chen"
 
 
-def test_bad_input_is_a_clear_message_and_exit_2(data_dir, tmp_path, capsys):
+def test_a_damaged_database_does_not_verify_and_bad_input_exits_2(data_dir, tmp_path, capsys):
     broken = tmp_path / "broken"
     broken.mkdir()
     (broken / DB_NAME).write_text("not a database " * 100)
-    assert main(["signoff", "verify", "--data-dir", str(broken)]) == 2
-    assert f"{broken / DB_NAME}: not a readable workbench database" in capsys.readouterr().err
+    assert main(["signoff", "verify", "--data-dir", str(broken)]) == 1
+    err = capsys.readouterr().err
+    assert f"{broken / DB_NAME}: not a readable workbench database" in err
+    assert "the log does NOT verify" in err
+    target = tmp_path / "g.csv"
+    assert main(["signoff", "export", "--csv", str(target), "--data-dir", str(broken)]) == 1
+    assert not target.exists()
+    assert main(["signoff", "list", "--data-dir", str(broken)]) == 2
     (data_dir / "roster.json").write_text("[]")
     assert main(["instructor", "list", "--data-dir", str(data_dir)]) == 2
     assert "not a roster" in capsys.readouterr().err
-    target = tmp_path / "no-such-dir" / "g.csv"
-    assert main(["signoff", "export", "--csv", str(target), "--data-dir", str(broken)]) == 2
+    for bad in (["--head", "12"], ["--head-from", str(tmp_path / "none.csv")]):
+        assert main(["signoff", "verify", *bad, "--data-dir", str(data_dir)]) == 2
+    err = capsys.readouterr().err
+    assert "--head '12' is not SEQ:HASH" in err and "cannot read the gradebook" in err
     with pytest.raises(SystemExit) as exc:
         main(["signoff"])
     assert exc.value.code == 2

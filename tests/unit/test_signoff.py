@@ -9,6 +9,7 @@ import sqlite3
 import subprocess
 import sys
 import threading
+import time
 from dataclasses import replace
 from datetime import UTC, datetime, timedelta
 from pathlib import Path
@@ -16,7 +17,8 @@ from pathlib import Path
 import pytest
 
 from workbench.labs import signoff as so
-from workbench.labs.store import DB_NAME, Store, StoreError, resolve_data_dir
+from workbench.labs.signlog import GENESIS
+from workbench.labs.store import DB_NAME, Store, StoreError, read_signoffs, resolve_data_dir
 
 FAST = so.KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only; defaults are untouched
 PASS = "correct horse battery"
@@ -150,10 +152,15 @@ def test_canonical_bytes_are_stable_and_cover_every_field(run_record):
     )  # fmt: skip
     again = replace(record, evidence=so.Evidence("r.jsonl", "sha256:00", {"a": 0.5, "b": 1}))
     assert record.canonical() == again.canonical()
-    data = json.loads(record.canonical())
-    assert data["format"] == so.RECORD_FORMAT
+    assert json.loads(record.canonical())["format"] == "workbench-signoff/1"  # legacy: no place
+    placed = replace(record, seq=3, prev=GENESIS)
+    data = json.loads(placed.canonical())
+    assert data["format"] == so.RECORD_FORMAT == "workbench-signoff/2"
+    assert (data["seq"], data["prev"]) == (3, GENESIS)
     assert set(data) >= {"student", "partner", "driver", "lab", "exercise", "instructor"}
     assert set(data) >= {"signed_at", "note", "override", "evidence"}
+    assert placed.canonical() != replace(placed, seq=4).canonical()
+    assert placed.canonical() != replace(placed, prev="sha256:" + "1" * 64).canonical()
 
 
 def test_signing_needs_passed_objectives_or_an_override_with_a_note(store, data_dir):
@@ -285,12 +292,10 @@ def test_a_key_not_in_the_roster_fails(store, data_dir, tmp_path):
     with Store.open(other) as rogue:
         so.sign_off(rogue, "Dr Fake", PASS, fields(), clock=Clock())
         so.sign_off(rogue, "Dr Chen", PASS, fields(), clock=Clock())
-        rows = rogue.signoffs()
-    for row in rows:
-        store.add_signoff({k: v for k, v in row.__dict__.items() if k != "id"})
-    found = problems(store, data_dir)
-    assert "not in the roster" in found[0][0]
-    assert "signature does not match" in found[1][0]
+    rogue_log = so.verify_log(read_signoffs(other), roster(data_dir))  # chain and all
+    found = [v.problems for v in rogue_log.verdicts]
+    assert found[0] == ("instructor 'Dr Fake' is not in the trusted roster",)
+    assert len(found[1]) == 1 and "signature does not match" in found[1][0]
 
 
 def test_gradebook_has_one_row_per_student_and_exercise_from_verified_records(store, data_dir):
@@ -304,11 +309,14 @@ def test_gradebook_has_one_row_per_student_and_exercise_from_verified_records(st
     so.sign_off(store, "Dr Chen", PASS, fields(student="dave", partner="", driver=""))
     with sqlite3.connect(store.path) as conn:
         conn.execute("UPDATE signoffs SET note = 'edited' WHERE student = 'dave'")
-    rows = so.gradebook_rows(so.verified_rows(store, roster(data_dir)))
+    log = so.verify_log(store.signoffs(), roster(data_dir))
+    rows = so.gradebook_rows(log.verified_rows(), log.head)
     keys = [(r["student"], r["exercise"]) for r in rows]
     assert keys == [("alice", "wall-following"), ("bob", "wall-following"), ("carol", "x")]
     assert rows[0]["signed_at"] == "2026-03-02T14:06:09Z"
     assert rows[1]["partner"] == "alice"
+    assert [r["seq"] for r in rows] == ["2", "2", "3"]
+    assert {r["log_head"] for r in rows} == {str(log.head)} and log.head.seq == 4
 
 
 # the store
@@ -324,7 +332,7 @@ def test_data_dir_comes_from_the_option_then_the_environment(monkeypatch, tmp_pa
 
 def test_store_uses_wal_and_a_schema_version(data_dir):
     with Store.open(data_dir) as s:
-        assert s.schema_version() == 1
+        assert s.schema_version() == 2
     with sqlite3.connect(data_dir / DB_NAME) as conn:
         assert conn.execute("PRAGMA journal_mode").fetchone()[0] == "wal"
 
@@ -440,3 +448,119 @@ def test_evidence_of_an_exercise_points_at_the_run_record_it_rests_on(tmp_path):
     assert [o["kind"] for o in evidence.metrics["objectives"]] == ["keys", "exit"]
     progress.objectives[1].passed = False
     assert Evidence.of_progress(progress).run_record == ""
+
+
+# the chained log in the store
+
+V1_SCHEMA = """
+CREATE TABLE meta (key TEXT PRIMARY KEY, value TEXT NOT NULL);
+INSERT INTO meta VALUES ('schema_version', '1');
+CREATE TABLE signoffs (
+    id INTEGER PRIMARY KEY AUTOINCREMENT, student TEXT NOT NULL, partner TEXT NOT NULL,
+    driver TEXT NOT NULL, lab TEXT NOT NULL, exercise TEXT NOT NULL, instructor TEXT NOT NULL,
+    signed_at TEXT NOT NULL, note TEXT NOT NULL, override INTEGER NOT NULL,
+    run_record TEXT NOT NULL, evidence_digest TEXT NOT NULL, metrics TEXT NOT NULL,
+    signature TEXT NOT NULL
+);
+"""
+
+
+def v1_database(data_dir: Path, students: list[str]) -> None:
+    """A database as the workbench wrote it before the log was chained (schema 1)."""
+    signer = so.unlock_instructor(data_dir, "Dr Chen", PASS)
+    conn = sqlite3.connect(data_dir / DB_NAME)
+    conn.executescript(V1_SCHEMA)
+    for n, student in enumerate(students):
+        record = so.SignoffRecord(
+            student, "", student, "web-simulator", f"ex{n}", "Dr Chen",
+            f"2026-01-0{n + 1}T10:00:00Z", "", False, so.Evidence("", "sha256:00", {"n": n}),
+        )  # fmt: skip
+        columns = record.columns(signer.sign(record.canonical()))
+        columns["override"] = int(columns["override"])
+        conn.execute(
+            f"INSERT INTO signoffs ({', '.join(columns)}) VALUES ({', '.join('?' * len(columns))})",
+            tuple(columns.values()),
+        )
+    conn.commit()
+    conn.close()
+
+
+def test_records_made_before_the_chain_are_read_as_legacy_then_chained_by_the_upgrade(data_dir):
+    so.create_instructor(data_dir, "Dr Chen", PASS, kdf=FAST)
+    v1_database(data_dir, ["ana", "ben"])
+    before = (data_dir / DB_NAME).read_bytes()
+    read_only = so.verify_log(read_signoffs(data_dir), roster(data_dir))
+    assert read_only.ok and read_only.legacy == 2 and read_only.head.seq == 2
+    assert all("legacy record" in v.notes[0] for v in read_only.verdicts)
+    assert (data_dir / DB_NAME).read_bytes() == before  # reading did not upgrade it
+    with Store.open(data_dir) as store:
+        assert store.schema_version() == 2
+        assert store.signoffs() == read_signoffs(data_dir)  # upgraded to what was read
+        so.sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+        log = so.verify_log(store.signoffs(), roster(data_dir), kept=read_only.head)
+    assert log.ok and log.legacy == 2 and log.head.seq == 3
+    assert [v.row.legacy for v in log.verdicts] == [True, True, False]
+    sql_edit = "UPDATE signoffs SET student = 'zed' WHERE seq = 1"
+    with sqlite3.connect(data_dir / DB_NAME) as conn:
+        conn.execute(sql_edit)
+    conn.close()
+    [first, *_] = so.verify_log(read_signoffs(data_dir), roster(data_dir)).verdicts
+    assert any("signature does not match" in p for p in first.problems)
+
+
+def test_a_sequence_number_is_taken_once(store):
+    so.sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+    with sqlite3.connect(store.path) as conn, pytest.raises(sqlite3.IntegrityError):
+        conn.execute(
+            "INSERT INTO signoffs (student, partner, driver, lab, exercise, instructor, "
+            "signed_at, note, override, run_record, evidence_digest, metrics, signature, seq) "
+            "SELECT student, partner, driver, lab, exercise, instructor, signed_at, note, "
+            "override, run_record, evidence_digest, metrics, signature, seq FROM signoffs"
+        )
+    conn.close()
+
+
+SIGNER = """
+import sys, time
+from datetime import UTC, datetime
+from workbench.labs import signoff as so
+from workbench.labs.store import Store
+data_dir, who, start = sys.argv[1], sys.argv[2], float(sys.argv[3])
+fields = so.RecordFields(student=who, lab="lab", exercise="ex", objectives_passed=True)
+with Store.open(data_dir) as store:
+    time.sleep(max(0.0, start - time.time()))
+    for i in range(12):
+        so.sign_off(store, "Dr Chen", "correct horse battery", fields)
+"""
+
+
+def test_two_processes_signing_at_once_never_fork_the_chain(store, data_dir):
+    start = str(time.time() + 1.5)  # both begin at the same moment, once started
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[2])}
+    procs = [
+        subprocess.Popen([sys.executable, "-c", SIGNER, str(data_dir), who, start], env=env)
+        for who in ("alice", "bob")
+    ]
+    assert [p.wait(timeout=120) for p in procs] == [0, 0]
+    rows = read_signoffs(data_dir)
+    assert [r.seq for r in rows] == list(range(1, 25))
+    assert sorted(r.student for r in rows) == ["alice"] * 12 + ["bob"] * 12
+    log = so.verify_log(rows, roster(data_dir))
+    assert log.ok, (log.breaks, [v.problems for v in log.verdicts if not v.ok])
+
+
+def test_signing_after_a_tampered_sequence_number_goes_on_or_says_why(store, data_dir):
+    so.sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+    so.sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+    with sqlite3.connect(store.path) as conn:
+        conn.execute("UPDATE signoffs SET seq = 'last' WHERE seq = 2")
+    conn.close()
+    _, record = so.sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+    assert record.seq == 2  # after the last numbered record; verify names the damaged one
+    log = so.verify_log(read_signoffs(data_dir), roster(data_dir))
+    assert [v.row.label() for v in log.verdicts if not v.ok] == ["row id 2"]
+    with sqlite3.connect(store.path) as conn:
+        conn.execute("UPDATE signoffs SET seq = ? WHERE id = 3", (2**62,))
+    conn.close()
+    with pytest.raises(StoreError, match="more than it can hold"):
+        so.sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())

@@ -5,12 +5,15 @@ from __future__ import annotations
 import argparse
 import getpass
 import sys
+from pathlib import Path
 
 from workbench.labs.signoff import (
     MIN_PASSPHRASE,
+    ROSTER_NAME,
     SignoffError,
     check_name,
     check_passphrase,
+    config_dir,
     create_instructor,
     key_path,
     load_roster,
@@ -39,12 +42,27 @@ def register(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="read the passphrase from the first line of standard input (for scripts)",
     )
+    _trusted_option(add, "add the public key to this roster file too")
     data_dir_option(add)
     add.set_defaults(func=cmd_add)
 
     ls = inner.add_parser("list", help="list the instructors in the roster")
+    _trusted_option(ls, "compare the data folder's roster with this one")
     data_dir_option(ls)
     ls.set_defaults(func=cmd_list)
+
+
+def _trusted_option(parser: argparse.ArgumentParser, what: str) -> None:
+    parser.add_argument(
+        "--roster",
+        metavar="FILE",
+        help=f"your own roster, which checking trusts: {what} (default: {ROSTER_NAME} in "
+        "$WORKBENCH_CONFIG, else the user config folder)",
+    )
+
+
+def _trusted_path(args: argparse.Namespace) -> Path:
+    return Path(args.roster).expanduser() if args.roster else config_dir() / ROSTER_NAME
 
 
 def fail(message: str) -> int:
@@ -68,25 +86,36 @@ def read_new_passphrase(from_stdin: bool) -> str:
 
 def cmd_add(args: argparse.Namespace) -> int:
     data_dir = resolve_data_dir(args.data_dir)
+    trusted = _trusted_path(args)
     try:
         name = check_name(args.name)
         if name in load_roster(roster_path(data_dir)):
             raise SignoffError(f"{name} is already in the roster {roster_path(data_dir)}")
+        if trusted.resolve().is_relative_to(data_dir.resolve()):
+            raise SignoffError(
+                f"{trusted} is inside the data folder {data_dir}: keep your own roster "
+                "elsewhere (--roster FILE or $WORKBENCH_CONFIG)"
+            )
+        if name in load_roster(trusted):
+            raise SignoffError(f"{name} is already in your trusted roster {trusted}")
         passphrase = read_new_passphrase(args.passphrase_stdin)
-        entry = create_instructor(data_dir, name, passphrase)
+        entry = create_instructor(data_dir, name, passphrase, trusted=trusted)
     except (SignoffError, EOFError) as exc:
         return fail(str(exc) or "no passphrase given")
     except OSError as exc:
-        return fail(f"cannot write to {data_dir}: {exc.strerror}")
+        return fail(f"cannot write the key or a roster: {exc}")
     print(f"added {entry.name} (key {entry.fingerprint()}) to {roster_path(data_dir)}")
+    print(f"and to your trusted roster {trusted}, which 'workbench signoff verify' checks with")
     print(f"the private key is encrypted in {key_path(data_dir, name)}")
     return 0
 
 
 def cmd_list(args: argparse.Namespace) -> int:
     data_dir = resolve_data_dir(args.data_dir)
+    trusted_path = _trusted_path(args)
     try:
         roster = load_roster(roster_path(data_dir))
+        trusted = load_roster(trusted_path)
     except SignoffError as exc:
         return fail(str(exc))
     if not roster:
@@ -95,5 +124,16 @@ def cmd_list(args: argparse.Namespace) -> int:
     width = max(len(n) for n in roster)
     for entry in roster.values():
         unlockable = "key here" if key_path(data_dir, entry.name).exists() else "public key only"
-        print(f"{entry.name:<{width}}  {entry.fingerprint()}  added {entry.added}  {unlockable}")
+        kept = trusted.get(entry.name)
+        if kept is None:
+            trust = "NOT in your trusted roster"
+        elif kept.public_key != entry.public_key:
+            trust = f"KEY DIFFERS from your trusted roster ({kept.fingerprint()})"
+        else:
+            trust = "trusted"
+        print(
+            f"{entry.name:<{width}}  {entry.fingerprint()}  added {entry.added}  {unlockable}  "
+            f"{trust}"
+        )
+    print(f"(trusted roster: {trusted_path})")
     return 0

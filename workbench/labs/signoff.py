@@ -4,13 +4,19 @@ An instructor has an Ed25519 key pair. The public key is listed in the roster (a
 anyone may copy and use to check records); the private key is kept in the data folder,
 encrypted with AES-256-GCM under a key derived from the instructor's passphrase by scrypt.
 A sign-off record is turned into canonical JSON bytes and signed; verifying rebuilds the same
-bytes from the stored columns, so changing any of them breaks the signature.
+bytes from the stored columns, so changing any of them breaks the signature. The records form
+the hash-chained log of :mod:`workbench.labs.signlog`.
+
+Checking trusts only an instructor-held roster (:func:`trusted_roster_path`): the copy in the
+data folder is what the app offers to sign with, and anyone who can write the data folder can
+change it.
 """
 
 from __future__ import annotations
 
 import base64
 import binascii
+import csv
 import hashlib
 import json
 import logging
@@ -19,11 +25,12 @@ import os
 import re
 import secrets
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
+import platformdirs
 from cryptography.exceptions import InvalidSignature, InvalidTag
 from cryptography.hazmat.primitives import serialization
 from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey, Ed25519PublicKey
@@ -33,14 +40,18 @@ from cryptography.hazmat.primitives.kdf.scrypt import Scrypt
 from workbench.sim.mazefile import write_text_atomic
 from workbench.sim.record import file_sha256
 
-from .store import Store, StoredSignoff, utc_iso
+from . import signlog
+from .names import NameProblem, check_student, clean_name
+from .signlog import Head, LogError
+from .store import APP_NAME, Store, StoredSignoff, utc_iso
 
 log = logging.getLogger(__name__)
 
 KEY_FORMAT = "workbench-instructor-key/1"
 ROSTER_FORMAT = "workbench-roster/1"
-RECORD_FORMAT = "workbench-signoff/1"
+RECORD_FORMAT = signlog.RECORD_FORMAT
 ROSTER_NAME = "roster.json"
+ENV_CONFIG_DIR = "WORKBENCH_CONFIG"
 KEYS_DIR = "instructors"
 MIN_PASSPHRASE = 10
 MAX_NAME = 64
@@ -71,6 +82,10 @@ class LockedOut(SignoffError):
 
 class UnknownInstructor(SignoffError):
     pass
+
+
+class UntrustedRoster(SignoffError):
+    """No roster that students cannot write was found or given."""
 
 
 @dataclass(frozen=True)
@@ -106,16 +121,12 @@ def _now() -> datetime:
 
 
 def check_name(name: str) -> str:
-    """An instructor's name as shown in records: 1-64 printable characters, no outer spaces."""
-    if not name or not name.strip():
-        raise SignoffError("the instructor's name is empty")
-    if name != name.strip():
-        raise SignoffError(f"the instructor's name {name!r} starts or ends with a space")
-    if len(name) > MAX_NAME:
-        raise SignoffError(f"the instructor's name is longer than {MAX_NAME} characters")
-    if not name.isprintable():
-        raise SignoffError(f"the instructor's name {name!r} has control characters")
-    return name
+    """An instructor's name as shown in records, normalised (see :mod:`workbench.labs.names`):
+    1-64 characters, one script, nothing invisible."""
+    try:
+        return clean_name(name, "the instructor's name", MAX_NAME)
+    except NameProblem as exc:
+        raise SignoffError(str(exc)) from None
 
 
 def _slug(name: str) -> str:
@@ -129,7 +140,53 @@ def key_path(data_dir: Path, name: str) -> Path:
 
 
 def roster_path(data_dir: Path) -> Path:
+    """The data folder's roster: the instructors the app offers to sign with."""
     return data_dir / ROSTER_NAME
+
+
+def config_dir() -> Path:
+    """The instructor's configuration folder: ``$WORKBENCH_CONFIG``, else the user config
+    folder (``~/.config/viple-workbench`` on Linux)."""
+    env = os.environ.get(ENV_CONFIG_DIR)
+    if env:
+        return Path(env).expanduser()
+    return Path(platformdirs.user_config_dir(APP_NAME, appauthor=False))
+
+
+def _inside(path: Path, folder: Path) -> bool:
+    return path.resolve().is_relative_to(folder.resolve())
+
+
+def trusted_roster_path(option: str | os.PathLike | None, data_dir: Path) -> Path:
+    """The roster that checking trusts: ``--roster FILE`` if given, else ``roster.json`` in the
+    configuration folder. Neither may lie inside the data folder (whose roster anyone who can
+    write there can change): :class:`UntrustedRoster` says so, and what to do."""
+    fix = (
+        f"pass your own copy with --roster FILE, or keep it as {config_dir() / ROSTER_NAME} "
+        f"(${ENV_CONFIG_DIR} chooses the folder); 'workbench instructor add' puts your key there"
+    )
+    if option:
+        path = Path(option).expanduser()
+        if not path.is_file():
+            raise SignoffError(f"{path}: no such roster file")
+        if _inside(path, data_dir):
+            raise UntrustedRoster(
+                f"{path} is inside the data folder {data_dir}, where students may be able to "
+                f"write, so it is not trusted: {fix}"
+            )
+        return path
+    path = config_dir() / ROSTER_NAME
+    if _inside(path, data_dir):
+        raise UntrustedRoster(
+            f"the configuration folder {config_dir()} is inside the data folder {data_dir}, "
+            f"so its roster is not trusted: {fix}"
+        )
+    if not path.is_file():
+        raise UntrustedRoster(
+            f"no trusted roster: the data folder's {roster_path(data_dir)} is not trusted on its "
+            f"own (anyone who can write the data folder can change it); {fix}"
+        )
+    return path
 
 
 def check_passphrase(passphrase: str) -> None:
@@ -186,9 +243,18 @@ def load_roster(path: Path) -> dict[str, RosterEntry]:
             isinstance(item.get(k), str) for k in ("name", "public_key")
         ):
             raise SignoffError(f"{path}: instructor #{i + 1} needs a name and a public_key")
-        if item["name"] in roster:
-            raise SignoffError(f"{path}: {item['name']} is listed twice")
-        entry = RosterEntry(item["name"], item["public_key"], str(item.get("added", "")))
+        try:
+            name = check_name(item["name"])
+        except SignoffError as exc:
+            raise SignoffError(f"{path}: instructor #{i + 1} {item['name']!r}: {exc}") from None
+        if name != item["name"]:
+            raise SignoffError(
+                f"{path}: instructor #{i + 1} {item['name']!r} is not written in Unicode's "
+                f"normal form (NFKC, no outer spaces): write it as {name!r}"
+            )
+        if name in roster:
+            raise SignoffError(f"{path}: {name} is listed twice")
+        entry = RosterEntry(name, item["public_key"], str(item.get("added", "")))
         _unb64(entry.public_key, f"the public key of {entry.name}", path)
         roster[entry.name] = entry
     return roster
@@ -240,15 +306,23 @@ def create_instructor(
     passphrase: str,
     kdf: KdfParams | None = None,
     now: datetime | None = None,
+    trusted: Path | None = None,
 ) -> RosterEntry:
-    """Make a key pair: the private key is saved encrypted, the public key joins the roster."""
-    check_name(name)
+    """Make a key pair: the private key is saved encrypted, the public key joins the data
+    folder's roster and, given ``trusted`` (the instructor's own roster file), that one too."""
+    name = check_name(name)
     check_passphrase(passphrase)
     params = kdf or KdfParams()
     roster_file = roster_path(data_dir)
     roster = load_roster(roster_file)
     if name in roster:
         raise SignoffError(f"{name} is already in the roster {roster_file}")
+    kept = load_roster(trusted) if trusted is not None else {}
+    if name in kept:
+        raise SignoffError(
+            f"{name} is already in your trusted roster {trusted} with another key: choose "
+            "another name, or remove the old entry from that file first"
+        )
     target = key_path(data_dir, name)
     if target.exists():
         raise SignoffError(f"{target}: a key for {name} already exists")
@@ -278,6 +352,9 @@ def create_instructor(
     entry = RosterEntry(name, public, utc_iso(now or _now()))
     roster[name] = entry
     save_roster(roster_file, roster)
+    if trusted is not None:
+        kept[name] = entry
+        save_roster(trusted, kept)
     return entry
 
 
@@ -360,6 +437,9 @@ class RecordFields:
 
 @dataclass(frozen=True)
 class SignoffRecord:
+    """What an instructor signs: the fields, the evidence, and the record's place in the log
+    (``seq`` and the hash of the record before it; ``seq`` is ``None`` for a legacy record)."""
+
     student: str
     partner: str
     driver: str
@@ -370,27 +450,17 @@ class SignoffRecord:
     note: str
     override: bool
     evidence: Evidence
+    seq: int | None = None
+    prev: str = ""
 
     def canonical(self) -> bytes:
         """The exact bytes that are signed: sorted-key compact JSON, UTF-8."""
-        data = {
-            "format": RECORD_FORMAT,
-            "student": self.student,
-            "partner": self.partner,
-            "driver": self.driver,
-            "lab": self.lab,
-            "exercise": self.exercise,
-            "instructor": self.instructor,
-            "signed_at": self.signed_at,
-            "note": self.note,
-            "override": self.override,
-            "evidence": {
-                "run_record": self.evidence.run_record,
-                "digest": self.evidence.digest,
-                "metrics": self.evidence.metrics,
-            },
+        evidence = {
+            "run_record": self.evidence.run_record,
+            "digest": self.evidence.digest,
+            "metrics": self.evidence.metrics,
         }
-        return canonical_json(data).encode("utf-8")
+        return signlog.signed_payload(self.__dict__, evidence, self.seq, self.prev)
 
     def columns(self, signature: str) -> dict[str, Any]:
         return {
@@ -412,9 +482,7 @@ class SignoffRecord:
 
 def canonical_json(value: Any) -> str:
     try:
-        return json.dumps(
-            value, sort_keys=True, separators=(",", ":"), ensure_ascii=False, allow_nan=False
-        )
+        return signlog.canonical_json(value)
     except (TypeError, ValueError) as exc:
         raise SignoffError(f"the evidence cannot be recorded: {exc}") from None
 
@@ -428,10 +496,6 @@ def record_digest(path: str | os.PathLike) -> str:
 
 
 def record_from_stored(row: StoredSignoff) -> SignoffRecord:
-    try:
-        metrics = json.loads(row.metrics)
-    except json.JSONDecodeError:
-        metrics = {"unreadable": row.metrics}
     return SignoffRecord(
         student=row.student,
         partner=row.partner,
@@ -442,7 +506,9 @@ def record_from_stored(row: StoredSignoff) -> SignoffRecord:
         signed_at=row.signed_at,
         note=row.note,
         override=row.override,
-        evidence=Evidence(row.run_record, row.evidence_digest, metrics),
+        evidence=Evidence(row.run_record, row.evidence_digest, row.metrics_value()),
+        seq=None if row.legacy else row.seq,
+        prev="" if row.legacy else row.prev_hash,
     )
 
 
@@ -454,6 +520,8 @@ def _check_fields(fields: RecordFields) -> Evidence:
     ):
         if not value.strip():
             raise SignoffError(f"the {label} is missing")
+    for problem in _name_problems(fields.student, fields.partner):
+        raise SignoffError(problem)
     people = {fields.student, fields.partner} - {""}
     if fields.driver and fields.driver not in people:
         raise SignoffError(f"the driver {fields.driver} is neither the student nor the partner")
@@ -527,12 +595,33 @@ def sign_off(
         override=override,
         evidence=evidence,
     )
-    signature = signer.sign(record.canonical())
-    row_id = store.add_signoff(record.columns(signature))
-    return row_id, record
+
+    def sign_at(seq: int, prev: str) -> dict[str, Any]:
+        placed = replace(record, seq=seq, prev=prev)
+        return placed.columns(signer.sign(placed.canonical()))
+
+    stored = store.append_signoff(sign_at)
+    return stored.id, replace(record, seq=stored.seq, prev=stored.prev_hash)
 
 
 # verification
+
+
+def _name_problems(student: str, partner: str) -> list[str]:
+    """Why the names of a record's students are not ones the workbench accepts, if they are
+    not: look-alike, invisible or not normalised."""
+    problems = []
+    for what, value in (("student", student), ("partner", partner)):
+        if not value:
+            continue
+        try:
+            clean = check_student(value, what)
+        except NameProblem as exc:
+            problems.append(f"{exc} ({value!r})")
+            continue
+        if clean != value:
+            problems.append(f"the {what}'s name {value!r} is not in normal form ({clean!r})")
+    return problems
 
 
 @dataclass(frozen=True)
@@ -546,23 +635,76 @@ class Verdict:
         return not self.problems
 
 
-def verify_row(row: StoredSignoff, roster: dict[str, RosterEntry]) -> Verdict:
-    """Check a stored record: its signature by a roster key, and its run record if present."""
-    problems: list[str] = []
-    notes: list[str] = []
+@dataclass(frozen=True)
+class LogVerdict:
+    """The log checked as a whole: its head, breaks in the chain (records missing, a head
+    the instructor kept that the log no longer holds) and each record's verdict."""
+
+    head: Head
+    breaks: tuple[str, ...]
+    verdicts: tuple[Verdict, ...]
+    legacy: int
+
+    @property
+    def ok(self) -> bool:
+        return not self.breaks and all(v.ok for v in self.verdicts)
+
+    def verified_rows(self) -> list[StoredSignoff]:
+        return [v.row for v in self.verdicts if v.ok]
+
+
+def _signature_problem(
+    row: StoredSignoff,
+    roster: dict[str, RosterEntry],
+    local: dict[str, RosterEntry] | None,
+) -> str | None:
     entry = roster.get(row.instructor)
     if entry is None:
-        problems.append(f"instructor {row.instructor!r} is not in the roster")
-    else:
-        record = record_from_stored(row)
-        try:
-            signature = base64.b64decode(row.signature, validate=True)
-            entry.key().verify(signature, record.canonical())
-        except (InvalidSignature, binascii.Error, ValueError):
-            problems.append(
-                f"the signature does not match the record (changed after signing, or not "
-                f"signed by {row.instructor}'s key)"
-            )
+        return f"instructor {row.instructor!r} is not in the trusted roster"
+    if _signed_by(row, entry):
+        return None
+    other = (local or {}).get(row.instructor)
+    if other is not None and other.public_key != entry.public_key and _signed_by(row, other):
+        return (
+            f"signed with a key the data folder's roster gives for {row.instructor} "
+            f"({other.fingerprint()}), not the trusted one ({entry.fingerprint()}): the "
+            "instructor was re-keyed in the data folder"
+        )
+    return (
+        f"the signature does not match the record (changed after signing, or not signed by "
+        f"{row.instructor}'s key in the trusted roster)"
+    )
+
+
+def _signed_by(row: StoredSignoff, entry: RosterEntry) -> bool:
+    try:
+        signature = base64.b64decode(row.signature, validate=True)
+        entry.key().verify(signature, row.signed_bytes())
+    except (InvalidSignature, binascii.Error, ValueError):
+        return False
+    return True
+
+
+def verify_row(
+    row: StoredSignoff,
+    roster: dict[str, RosterEntry],
+    local: dict[str, RosterEntry] | None = None,
+) -> Verdict:
+    """Check one stored record: its signature by the trusted roster's key, its students'
+    names, and its run record if present (its place in the log is checked by
+    :func:`verify_log`). ``local`` is the data folder's roster, used only to explain a
+    signature by a key that is not the trusted one."""
+    problems: list[str] = []
+    notes: list[str] = []
+    signature = _signature_problem(row, roster, local)
+    if signature:
+        problems.append(signature)
+    problems.extend(_name_problems(row.student, row.partner))
+    if row.legacy:
+        notes.append(
+            "legacy record (signed before the log was chained): its signature covers its "
+            "fields, its place in the log was given when the database was upgraded"
+        )
     if row.run_record:
         if os.path.exists(row.run_record):
             try:
@@ -579,16 +721,66 @@ def verify_row(row: StoredSignoff, roster: dict[str, RosterEntry]) -> Verdict:
     return Verdict(row, tuple(problems), tuple(notes))
 
 
+def _entry(row: StoredSignoff) -> signlog.Entry:
+    return signlog.Entry(
+        id=row.id,
+        seq=row.seq,
+        prev=row.prev_hash,
+        stored_hash=row.entry_hash,
+        legacy=row.legacy,
+        signed=row.signed_bytes(),
+        signature=row.signature,
+    )
+
+
+def verify_log(
+    rows: list[StoredSignoff],
+    roster: dict[str, RosterEntry],
+    kept: Head | None = None,
+    local: dict[str, RosterEntry] | None = None,
+) -> LogVerdict:
+    """Check the whole log (``rows`` in the order of the log): every record and the chain
+    that links them, and, given the head the instructor kept, that the log still holds it."""
+    chain = signlog.check_chain([_entry(r) for r in rows], kept)
+    verdicts = []
+    for row in rows:
+        own = verify_row(row, roster, local)
+        linked = chain.by_row.get(row.id, ())
+        verdicts.append(replace(own, problems=(*linked, *own.problems)))
+    legacy = sum(1 for r in rows if r.legacy)
+    return LogVerdict(chain.head, chain.breaks, tuple(verdicts), legacy)
+
+
 def verify_all(store: Store, roster: dict[str, RosterEntry]) -> list[Verdict]:
-    return [verify_row(row, roster) for row in store.signoffs()]
+    """Every record of an open store, checked with its place in the log."""
+    return list(verify_log(store.signoffs(), roster).verdicts)
 
 
-def verified_rows(store: Store, roster: dict[str, RosterEntry]) -> list[StoredSignoff]:
-    return [v.row for v in verify_all(store, roster) if v.ok]
+def head_from_gradebook(path: Path) -> Head:
+    """The log head kept in an exported gradebook (its ``log_head`` column)."""
+    try:
+        with path.open(encoding="utf-8", newline="") as fh:
+            heads = {row.get("log_head") or "" for row in csv.DictReader(fh)}
+    except OSError as exc:
+        raise SignoffError(f"{path}: cannot read the gradebook: {exc.strerror}") from None
+    except (csv.Error, UnicodeDecodeError) as exc:
+        raise SignoffError(f"{path}: not a gradebook CSV ({exc})") from None
+    heads.discard("")
+    if len(heads) != 1:
+        found = "no log_head column" if not heads else "different log heads in its rows"
+        raise SignoffError(
+            f"{path}: {found}; give the head itself with --head SEQ:HASH (as 'workbench "
+            "signoff verify' or 'export' printed it)"
+        )
+    try:
+        return Head.parse(heads.pop(), f"{path}: the log head")
+    except LogError as exc:
+        raise SignoffError(str(exc)) from None
 
 
-def gradebook_rows(rows: list[StoredSignoff]) -> list[dict[str, str]]:
-    """One row per student and exercise (each member of a pair gets one); the latest wins."""
+def gradebook_rows(rows: list[StoredSignoff], head: Head) -> list[dict[str, str]]:
+    """One row per student and exercise (each member of a pair gets one); the latest wins.
+    Every row carries the record's place in the log and the log's head at export."""
     latest: dict[tuple[str, str, str], dict[str, str]] = {}
     for row in rows:
         for person, other in ((row.student, row.partner), (row.partner, row.student)):
@@ -605,6 +797,8 @@ def gradebook_rows(rows: list[StoredSignoff]) -> list[dict[str, str]]:
                 "override": "yes" if row.override else "no",
                 "note": row.note,
                 "evidence_digest": row.evidence_digest,
+                "seq": "" if row.seq is None else str(row.seq),
+                "log_head": str(head),
             }
     return [latest[k] for k in sorted(latest)]
 
@@ -620,4 +814,6 @@ GRADEBOOK_COLUMNS = (
     "override",
     "note",
     "evidence_digest",
+    "seq",
+    "log_head",
 )

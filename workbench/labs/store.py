@@ -3,26 +3,37 @@
 One SQLite file in the data folder, in WAL mode so that the app and a command-line tool can
 use it at the same time. Every write is one transaction, committed before the call returns,
 so a process killed afterwards loses nothing that was already saved.
+
+The sign-off table holds the log of :mod:`workbench.labs.signlog`: each record's fields, its
+signature, its sequence number (unique), the hash of the record before it and its own hash.
+Schema 1 had no chain; opening such a database for writing upgrades it to schema 2, giving
+its records, in the order they were stored, sequence numbers and hashes as *legacy* entries.
+:func:`read_signoffs` reads the table without writing anything (SQLite's read-only mode), for
+checking and exporting.
 """
 
 from __future__ import annotations
 
 import json
+import math
 import os
 import sqlite3
-from collections.abc import Iterator
+import urllib.request
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
 import platformdirs
 
+from .signlog import GENESIS, entry_hash, signed_payload
+
 APP_NAME = "viple-workbench"
 DB_NAME = "workbench.sqlite3"
 ENV_DATA_DIR = "WORKBENCH_DATA"
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 BUSY_TIMEOUT_MS = 10_000
 
 SCHEMA = """
@@ -44,7 +55,11 @@ CREATE TABLE IF NOT EXISTS signoffs (
     run_record TEXT NOT NULL,
     evidence_digest TEXT NOT NULL,
     metrics TEXT NOT NULL,
-    signature TEXT NOT NULL
+    signature TEXT NOT NULL,
+    seq INTEGER,
+    prev_hash TEXT,
+    entry_hash TEXT,
+    legacy INTEGER NOT NULL DEFAULT 0
 );
 CREATE INDEX IF NOT EXISTS signoffs_by_student ON signoffs (student, lab, exercise);
 CREATE TABLE IF NOT EXISTS progress (
@@ -86,8 +101,23 @@ CREATE TABLE IF NOT EXISTS events (
 """
 
 
+# columns added to the sign-off table by schema 2 (the chain)
+CHAIN_COLUMNS = (
+    ("seq", "INTEGER"),
+    ("prev_hash", "TEXT"),
+    ("entry_hash", "TEXT"),
+    ("legacy", "INTEGER NOT NULL DEFAULT 0"),
+)
+MAX_SEQ = 2**53  # sequence numbers stay exact wherever the log is kept (JSON, any database)
+SEQ_INDEX = "CREATE UNIQUE INDEX IF NOT EXISTS signoffs_by_seq ON signoffs (seq)"
+
+
 class StoreError(Exception):
     """The database cannot be opened, read or written; the message names the file."""
+
+
+class LogMissing(StoreError):
+    """There is no sign-off log to read: no database, or no sign-off table in it."""
 
 
 def default_data_dir() -> Path:
@@ -134,6 +164,38 @@ class StoredSignoff:
     evidence_digest: str
     metrics: str
     signature: str
+    seq: int | None = None
+    prev_hash: str = ""
+    entry_hash: str = ""
+    legacy: bool = False
+
+    def metrics_value(self) -> Any:
+        """The metrics as signed (stored as canonical JSON text); text that is not JSON the
+        workbench writes (not JSON, NaN, nested too deep) as ``{"unreadable": text}``."""
+        try:
+            return json.loads(self.metrics, parse_constant=_no_constant, parse_float=_finite)
+        except (ValueError, RecursionError):
+            return {"unreadable": self.metrics}
+
+    def signed_bytes(self) -> bytes:
+        """The bytes the instructor's signature must cover, rebuilt from the columns."""
+        evidence = {
+            "run_record": self.run_record,
+            "digest": self.evidence_digest,
+            "metrics": self.metrics_value(),
+        }
+        chained = not self.legacy
+        return signed_payload(
+            self.__dict__, evidence, self.seq if chained else None, self.prev_hash
+        )
+
+    def label(self) -> str:
+        """``#SEQ`` (the place in the log), or the row id when the row has no place."""
+        return f"#{self.seq}" if self.seq is not None else f"row id {self.id}"
+
+
+SIGNOFF_COLUMNS = tuple(StoredSignoff.__dataclass_fields__)
+RECORD_COLUMNS = SIGNOFF_COLUMNS[1:14]  # the fields, evidence and signature of a record
 
 
 @dataclass(frozen=True)
@@ -202,18 +264,33 @@ class Store:
                 if statement.strip():
                     cur.execute(statement)
             row = cur.execute("SELECT value FROM meta WHERE key = 'schema_version'").fetchone()
-            if row is None:
-                cur.execute(
-                    "INSERT INTO meta (key, value) VALUES ('schema_version', ?)",
-                    (str(SCHEMA_VERSION),),
-                )
-            elif not str(row[0]).isdigit():
-                raise StoreError(f"{self.path}: the schema version {row[0]!r} is not a number")
-            elif int(row[0]) > SCHEMA_VERSION:
-                raise StoreError(
-                    f"{self.path}: written by a newer workbench (schema {row[0]}, this one "
-                    f"knows {SCHEMA_VERSION}); update the workbench"
-                )
+            if row is not None:
+                _check_version(self.path, row[0])
+            if _chain_missing(cur):
+                self._chain_legacy_records(cur)
+            cur.execute(SEQ_INDEX)
+            cur.execute(
+                "INSERT INTO meta (key, value) VALUES ('schema_version', ?) "
+                "ON CONFLICT (key) DO UPDATE SET value = excluded.value",
+                (str(SCHEMA_VERSION),),
+            )
+
+    def _chain_legacy_records(self, cur: sqlite3.Cursor) -> None:
+        """Upgrade a schema 1 sign-off table: add the chain's columns and give every record,
+        in the order stored, its place in the log as a legacy entry."""
+        for name, kind in CHAIN_COLUMNS:
+            cur.execute(f"ALTER TABLE signoffs ADD COLUMN {name} {kind}")
+        columns = ", ".join(("id", *RECORD_COLUMNS))
+        rows = [
+            _signoff_from_row(r, ("id", *RECORD_COLUMNS))
+            for r in cur.execute(f"SELECT {columns} FROM signoffs ORDER BY id").fetchall()
+        ]
+        for row in legacy_chain(rows):
+            cur.execute(
+                "UPDATE signoffs SET seq = ?, prev_hash = ?, entry_hash = ?, legacy = 1 "
+                "WHERE id = ?",
+                (row.seq, row.prev_hash, row.entry_hash, row.id),
+            )
 
     def close(self) -> None:
         self._conn.close()
@@ -256,21 +333,51 @@ class Store:
 
     # sign-off records
 
-    def add_signoff(self, row: dict[str, Any]) -> int:
-        """Store a signed record (the columns of :class:`StoredSignoff` but ``id``)."""
-        columns = [f for f in StoredSignoff.__dataclass_fields__ if f != "id"]
-        values = tuple(int(row[c]) if c == "override" else row[c] for c in columns)
+    def append_signoff(self, sign: Callable[[int, str], dict[str, Any]]) -> StoredSignoff:
+        """Add a record at the end of the log. ``sign(seq, prev_hash)`` returns the record's
+        columns (those of :data:`RECORD_COLUMNS`) signed for that place; it is called inside
+        the write transaction, so two processes signing at once queue and never take the same
+        place. Returns the row as stored."""
         with self._write() as cur:
+            # rows whose seq is not a number were tampered with: verify names them, and the
+            # log goes on after the last numbered record
+            last = cur.execute(
+                "SELECT seq, entry_hash FROM signoffs WHERE typeof(seq) = 'integer' "
+                "ORDER BY seq DESC LIMIT 1"
+            ).fetchone()
+            seq, prev = (int(last[0]) + 1, str(last[1] or "")) if last else (1, GENESIS)
+            if seq >= MAX_SEQ:
+                raise StoreError(
+                    f"{self.path}: the sign-off log claims {seq - 1} records, more than it can "
+                    "hold; check it with 'workbench signoff verify'"
+                )
+            values = sign(seq, prev)
+            draft = StoredSignoff(
+                id=0,
+                **{c: values[c] for c in RECORD_COLUMNS},
+                seq=seq,
+                prev_hash=prev,
+            )
+            digest = entry_hash(seq, prev, draft.signed_bytes(), draft.signature)
+            columns = (*RECORD_COLUMNS, "seq", "prev_hash", "entry_hash", "legacy")
+            row = (
+                *(int(values[c]) if c == "override" else values[c] for c in RECORD_COLUMNS),
+                seq,
+                prev,
+                digest,
+                0,
+            )
             cur.execute(
                 f"INSERT INTO signoffs ({', '.join(columns)}) "
                 f"VALUES ({', '.join('?' for _ in columns)})",
-                values,
+                row,
             )
-            return int(cur.lastrowid or 0)
+            row_id = int(cur.lastrowid or 0)
+        return replace(draft, id=row_id, entry_hash=digest)
 
     def signoffs(self, student: str | None = None, lab: str | None = None) -> list[StoredSignoff]:
         """Records in the order they were signed; ``student`` matches either member of a pair."""
-        sql = f"SELECT {', '.join(StoredSignoff.__dataclass_fields__)} FROM signoffs"
+        sql = f"SELECT {', '.join(SIGNOFF_COLUMNS)} FROM signoffs"
         where: list[str] = []
         params: list[Any] = []
         if student:
@@ -281,9 +388,9 @@ class Store:
             params.append(lab)
         if where:
             sql += " WHERE " + " AND ".join(where)
-        sql += " ORDER BY id"
+        sql += " ORDER BY seq IS NULL, seq, id"
         rows = self._read(sql, tuple(params))
-        return [_signoff_from_row(r) for r in rows]
+        return [_signoff_from_row(r, SIGNOFF_COLUMNS) for r in rows]
 
     # exercise progress
 
@@ -423,12 +530,98 @@ class Store:
         return [Event(*r) for r in self._read(sql + " ORDER BY id", params)]
 
 
-def _signoff_from_row(row: tuple[Any, ...]) -> StoredSignoff:
-    values = list(row)
-    names = list(StoredSignoff.__dataclass_fields__)
-    data = dict(zip(names, values, strict=True))
-    data["override"] = bool(data["override"])
+def _no_constant(name: str) -> Any:
+    raise ValueError(f"{name} is not a JSON number")
+
+
+def _finite(text: str) -> float:
+    value = float(text)
+    if not math.isfinite(value):
+        raise ValueError(f"{text} is too large")
+    return value
+
+
+def _signoff_from_row(row: tuple[Any, ...], names: tuple[str, ...]) -> StoredSignoff:
+    data = dict(zip(names, row, strict=True))
     for name in names:
-        if name not in ("id", "override"):
-            data[name] = "" if data[name] is None else str(data[name])
+        value = data[name]
+        if name in ("override", "legacy"):
+            data[name] = bool(value)
+        elif name == "seq":
+            data[name] = value if isinstance(value, int) else None
+        elif name != "id":
+            data[name] = "" if value is None else str(value)
     return StoredSignoff(**data)
+
+
+def legacy_chain(rows: list[StoredSignoff]) -> list[StoredSignoff]:
+    """Schema 1 records (in the order stored) as the legacy entries that start the log."""
+    out: list[StoredSignoff] = []
+    prev = GENESIS
+    for seq, row in enumerate(rows, 1):
+        entry = replace(row, seq=seq, prev_hash=prev, legacy=True)
+        prev = entry_hash(seq, prev, entry.signed_bytes(), entry.signature)
+        out.append(replace(entry, entry_hash=prev))
+    return out
+
+
+def _check_version(path: Path, value: object) -> int:
+    if not str(value).isdigit():
+        raise StoreError(f"{path}: the schema version {value!r} is not a number")
+    if int(str(value)) > SCHEMA_VERSION:
+        raise StoreError(
+            f"{path}: written by a newer workbench (schema {value}, this one knows "
+            f"{SCHEMA_VERSION}); update the workbench"
+        )
+    return int(str(value))
+
+
+def _columns(conn: sqlite3.Connection | sqlite3.Cursor, table: str) -> set[str]:
+    return {r[1] for r in conn.execute(f"PRAGMA table_info({table})").fetchall()}
+
+
+def _chain_missing(cur: sqlite3.Cursor) -> bool:
+    return "seq" not in _columns(cur, "signoffs")
+
+
+def read_signoffs(data_dir: str | os.PathLike) -> list[StoredSignoff]:
+    """The sign-off log of the database in ``data_dir``, in the order of the log, read in
+    SQLite's read-only mode: nothing is created, upgraded or written. A schema 1 table is
+    read as the legacy entries an upgrade would make. Raises :class:`LogMissing` when there
+    is no database or no sign-off table, :class:`StoreError` when the file cannot be read."""
+    path = Path(data_dir) / DB_NAME
+    if not path.is_file():
+        raise LogMissing(
+            f"{path}: no workbench database here (nothing was signed off with this data "
+            "folder, or the file was deleted; see --data-dir)"
+        )
+    uri = "file:" + urllib.request.pathname2url(str(path.resolve())) + "?mode=ro"
+    try:
+        conn = sqlite3.connect(uri, uri=True, timeout=BUSY_TIMEOUT_MS / 1000)
+    except sqlite3.Error as exc:
+        raise StoreError(f"{path}: cannot open the database: {exc}") from None
+    try:
+        tables = {r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+        if "meta" not in tables:
+            raise StoreError(f"{path}: not a workbench database (it has no meta table)")
+        version = conn.execute("SELECT value FROM meta WHERE key = 'schema_version'").fetchone()
+        if version is None:
+            raise StoreError(f"{path}: not a workbench database (no schema version)")
+        _check_version(path, version[0])
+        if "signoffs" not in tables:
+            raise LogMissing(
+                f"{path}: the sign-off table is missing: the log was deleted from the database"
+            )
+        if "seq" in _columns(conn, "signoffs"):
+            sql = f"SELECT {', '.join(SIGNOFF_COLUMNS)} FROM signoffs"
+            rows = conn.execute(sql + " ORDER BY seq IS NULL, seq, id").fetchall()
+            return [_signoff_from_row(r, SIGNOFF_COLUMNS) for r in rows]
+        names = ("id", *RECORD_COLUMNS)
+        rows = conn.execute(f"SELECT {', '.join(names)} FROM signoffs ORDER BY id").fetchall()
+        return legacy_chain([_signoff_from_row(r, names) for r in rows])
+    except sqlite3.DatabaseError as exc:
+        raise StoreError(
+            f"{path}: not a readable workbench database ({exc}); restore it from a backup"
+        ) from None
+    finally:
+        conn.close()

@@ -1,0 +1,57 @@
+"""Helpers of the sign-off command tests: an instructor, signed records, the database."""
+
+from __future__ import annotations
+
+import io
+import sqlite3
+import sys
+from datetime import UTC, datetime
+from pathlib import Path
+
+from workbench.cli import main
+from workbench.labs import signoff as so
+from workbench.labs.store import DB_NAME, Store
+
+PASS = "correct horse battery"
+FAST = so.KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only; defaults are untouched
+
+
+def add_instructor(monkeypatch, data_dir: Path, name: str, passphrase: str = PASS) -> int:
+    monkeypatch.setattr(sys, "stdin", io.StringIO(passphrase + "\n"))
+    return main(["instructor", "add", name, "--passphrase-stdin", "--data-dir", str(data_dir)])
+
+
+def sign(
+    data_dir: Path,
+    student: str,
+    exercise: str,
+    partner: str = "",
+    when: int = 0,
+    instructor: str = "Dr Chen",
+    passphrase: str = PASS,
+) -> None:
+    fields = so.RecordFields(
+        student=student,
+        partner=partner,
+        driver=student,
+        lab="web-simulator",
+        exercise=exercise,
+        evidence=so.Evidence("", "", {"collisions": 1}),
+        objectives_passed=True,
+    )
+    moment = datetime(2026, 3, 2, 10, when, tzinfo=UTC)
+    with Store.open(data_dir) as store:
+        so.sign_off(store, instructor, passphrase, fields, clock=lambda: moment)
+
+
+def sql(data_dir: Path, *statements: str, params: tuple = ()) -> list[tuple]:
+    """Run statements on the database as someone editing the file would, and close it."""
+    conn = sqlite3.connect(data_dir / DB_NAME)
+    try:
+        rows: list[tuple] = []
+        for statement in statements:
+            rows = conn.execute(statement, params if "?" in statement else ()).fetchall()
+        conn.commit()
+        return rows
+    finally:
+        conn.close()
