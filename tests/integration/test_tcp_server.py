@@ -284,10 +284,12 @@ def test_a_thousand_malformed_lines_are_counted_logged_sparingly_and_then_a_vali
     rejected = [r for r in caplog.records if "rejected" in r.getMessage()]
     assert 1 <= len(rejected) <= 10
     assert any("more invalid messages" in r.getMessage() for r in caplog.records)
-    assert any('line 2: servoSpeed "fast" is not a number' in r.getMessage() for r in rejected)
+    assert any(
+        'line 2: servos[0].servoSpeed "fast" is not a number' in r.getMessage() for r in rejected
+    )
 
 
-def test_an_oversized_line_closes_only_that_connection(caplog):
+def test_an_oversized_line_is_rejected_and_skipped_and_the_connection_goes_on(caplog):
     caplog.set_level(logging.INFO, logger="workbench.viple")
 
     async def scenario():
@@ -295,28 +297,24 @@ def test_an_oversized_line_closes_only_that_connection(caplog):
         async with serve(session) as server:
             hog = await Client.connect(server.port)
             await hog.report()
-            await hog.send(MOVE)
-            await hog.send(b'{"servos":[' + b" " * 70_000)
-            rest = await asyncio.wait_for(hog.reader.read(), 2.0)
-            assert rest.endswith(
-                b'{"error":"line longer than 65536 bytes; closing the connection"}\r\n'
-            )
-            await hog.close()
-            assert not server.status.connected
-            assert session.driver == "nobody"  # and the motors were stopped
-            x = session.world.pose.x
-            steps(session, 10)
-            assert session.world.pose.x == pytest.approx(x)
-
-            next_client = await Client.connect(server.port)
-            await next_client.report()
-            await next_client.send(MOVE)
-            await next_client.report()
+            # a megabyte without a line end, sent in pieces, then its end and a good line
+            for _ in range(16):
+                await hog.send(b'{"servos":[' + b" " * 65_536)
+            await until(lambda: server.status.invalid == 1)
+            assert "longer than the limit of 65536 bytes" in server.status.last_rejection
             assert server.status.connected
-            await next_client.close()
+            await hog.send(b"]}\r\n" + MOVE)
+            await until(lambda: server.status.messages_in == 2)
+            assert server.status.invalid == 1
+            assert session.driver.startswith("VIPLE tcp 127.0.0.1:")
+            x = session.world.pose.x
+            steps(session, 30)
+            assert session.world.pose.x == pytest.approx(x + 0.5, abs=0.02)
+            await hog.close()
+            await until(lambda: not server.status.connected)
 
     asyncio.run(scenario())
-    assert any("longer than 65536 bytes" in r.getMessage() for r in caplog.records)
+    assert any("longer than the limit of 65536 bytes" in r.getMessage() for r in caplog.records)
 
 
 @pytest.mark.parametrize("report_ms", [50, 100])
@@ -372,8 +370,8 @@ def test_a_flood_of_commands_does_not_starve_the_loop_or_the_report_timer():
             elapsed = loop.time() - start
             # the other tasks ran all along: roughly one tick per 5 ms
             assert ticks >= 0.1 * elapsed / 0.005
-            # replies plus periodic pushes
-            await until(lambda: lines >= 20_000)
+            # replies plus periodic pushes, but for any dropped while the client fell behind
+            await until(lambda: lines + server.status.dropped >= 20_000)
             tick_task.cancel()
             read_task.cancel()
             await client.close()
