@@ -12,6 +12,7 @@ import itertools
 import json
 import logging
 import math
+import socket
 
 import pytest
 
@@ -20,7 +21,7 @@ from workbench.sim.sensors import SensorSpec
 from workbench.sim.session import Session
 from workbench.viple.codec import parse_report
 from workbench.viple.link import Link, RateLimitedLog, check_report_ms
-from workbench.viple.tcp_server import EndpointError, TcpConfig, TcpServer
+from workbench.viple.tcp_server import EndpointError, TcpConfig, TcpServer, configure_socket
 
 # a corridor facing east, the far wall 7 blocks ahead; unity blocks are 2 units
 CORRIDOR = parse_maze("##########\n#S.......#\n##########\n", source="corridor.txt")
@@ -461,3 +462,164 @@ def test_report_ids_are_the_ports_configured_for_the_session():
             await client.close()
 
     asyncio.run(scenario())
+
+
+# --- hostile and vanished drivers ------------------------------------------------------------
+
+CONTROL_CHARACTER_LINE = b'{"servos":[{"servoId":3,"servoSpeed":"\\u001e0.5"}]}\r\n'
+
+
+def test_a_number_with_a_control_character_is_rejected_and_the_same_connection_then_drives(
+    caplog,
+):
+    caplog.set_level(logging.INFO, logger="workbench.viple")
+
+    async def scenario():
+        session = session_for()
+        async with serve(session) as server:
+            client = await Client.connect(server.port)
+            await client.report()
+            await client.send(CONTROL_CHARACTER_LINE + MOVE)
+            await until(lambda: server.status.messages_in == 2)
+            assert server.status.invalid == 1 and server.status.connected
+            x = session.world.pose.x
+            steps(session, 30)
+            assert session.world.pose.x == pytest.approx(x + 0.5, abs=0.02)
+            await client.close()
+            await until(lambda: not server.status.connected)
+
+    asyncio.run(scenario())
+    logged = [r.getMessage() for r in caplog.records]
+    assert any(
+        'rejected line 1: servos[0].servoSpeed "\\u001e0.5" is not a number' in m for m in logged
+    )
+    assert any(m.endswith("disconnected (closed by VIPLE); motors stopped") for m in logged)
+    assert not any(r.exc_info for r in caplog.records)
+
+
+def test_stopping_the_server_under_a_driver_says_so(caplog):
+    caplog.set_level(logging.INFO, logger="workbench.viple")
+
+    async def scenario():
+        session = session_for()
+        async with serve(session) as server:
+            client = await Client.connect(server.port)
+            await client.report()
+        assert session.driver == "nobody"
+        await client.close()
+
+    asyncio.run(scenario())
+    assert any("disconnected (server stopping)" in r.getMessage() for r in caplog.records)
+
+
+async def not_reading_client(port: int) -> tuple[asyncio.StreamReader, asyncio.StreamWriter]:
+    """A connection that reads nothing: tiny receive buffers, and a reader that is never read."""
+    sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1024)
+    sock.setblocking(False)
+    await asyncio.get_running_loop().sock_connect(sock, ("127.0.0.1", port))
+    return await asyncio.open_connection(sock=sock, limit=256)
+
+
+async def read_everything(reader: asyncio.StreamReader) -> None:
+    while await reader.read(65536):
+        pass
+
+
+def many_sensors() -> list[SensorSpec]:
+    """Forty sensors: reports of about 2 KB fill the socket buffers in a few dozen reports."""
+    mounts = ("front", "left", "right", "back")
+    return [SensorSpec("distance", port, mounts[port % 4]) for port in range(1, 41)]
+
+
+def test_a_driver_that_stops_sending_and_reading_loses_the_seat_and_the_robot_stops(caplog):
+    caplog.set_level(logging.INFO, logger="workbench.viple")
+
+    async def scenario():
+        session = Session(CORRIDOR, "unity", many_sensors(), noise="off")
+        async with serve(session, report_ms=50, idle_s=0.5) as server:
+            _, writer = await not_reading_client(server.port)
+            writer.write(MOVE)
+            await until(lambda: session.driver.startswith("VIPLE tcp"))
+            await until(lambda: not server.status.connected, timeout=20)
+            assert server.status.idled == 1
+            assert session.driver == "nobody"
+            x = session.world.pose.x
+            steps(session, 30)
+            assert session.world.pose.x == pytest.approx(x)
+            writer.close()
+
+            # the seat is free for the next program
+            client = await Client.connect(server.port)
+            await client.report()
+            await client.send(MOVE)
+            await client.report()
+            assert session.driver.startswith("VIPLE tcp")
+            await client.close()
+
+    asyncio.run(scenario())
+    assert any(
+        "disconnected (idle: sent nothing and read no reports for 0.5 s" in r.getMessage()
+        for r in caplog.records
+    )
+
+
+def test_a_quiet_driver_that_reads_its_reports_keeps_the_seat_past_the_idle_time():
+    async def scenario():
+        session = session_for()
+        async with serve(session, report_ms=50, idle_s=0.3) as server:
+            client = await Client.connect(server.port)
+            await client.send(MOVE)
+            loop = asyncio.get_running_loop()
+            start = loop.time()
+            while loop.time() - start < 1.5:  # five idle times, sending nothing
+                await client.report()
+            assert server.status.connected and server.status.idled == 0
+            assert session.driver.startswith("VIPLE tcp")
+            await client.close()
+
+    asyncio.run(scenario())
+
+
+def test_reports_a_driver_does_not_read_are_dropped_not_queued():
+    async def scenario():
+        session = Session(CORRIDOR, "unity", many_sensors(), noise="off")
+        async with serve(session, report_ms=50, idle_s=None) as server:
+            reader, writer = await not_reading_client(server.port)
+            writer.write(MOVE)
+            await until(lambda: server.status.dropped >= 10, timeout=10)
+            # what waits for the program is bounded by the limit plus one report
+            sent = server.status.messages_out
+            await asyncio.sleep(0.3)
+            assert server.status.messages_out == sent
+            assert server.status.connected  # no idle limit: the seat is kept
+            # a program that reads again gets fresh reports
+            draining = asyncio.create_task(read_everything(reader))
+            await until(lambda: server.status.messages_out > sent, timeout=5)
+            writer.close()
+            await asyncio.gather(draining, return_exceptions=True)
+
+    asyncio.run(scenario())
+
+
+def test_accepted_sockets_have_tcp_keepalive_on_and_a_small_send_buffer():
+    with (
+        socket.create_server(("127.0.0.1", 0)) as listener,
+        socket.create_connection(listener.getsockname()),
+        listener.accept()[0] as sock,
+    ):
+        configure_socket(sock)
+        assert sock.getsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF) <= 2 * 16384
+        assert sock.getsockopt(socket.SOL_SOCKET, socket.SO_KEEPALIVE) == 1
+        if hasattr(socket, "TCP_KEEPIDLE"):
+            assert sock.getsockopt(socket.IPPROTO_TCP, socket.TCP_KEEPIDLE) == 30
+            assert sock.getsockopt(socket.IPPROTO_TCP, socket.TCP_KEEPINTVL) == 10
+            assert sock.getsockopt(socket.IPPROTO_TCP, socket.TCP_KEEPCNT) == 3
+
+
+def test_the_idle_time_is_checked():
+    with pytest.raises(ValueError, match="driver idle time must be a number of seconds above 0"):
+        TcpConfig(idle_s=0)
+    with pytest.raises(ValueError, match="finite"):
+        TcpConfig(idle_s=float("inf"))
+    assert TcpConfig(idle_s=None).idle_s is None

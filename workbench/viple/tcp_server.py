@@ -49,6 +49,10 @@ _GOODBYE_SECONDS = 1.0
 KEEPALIVE_IDLE_S = 30
 KEEPALIVE_INTERVAL_S = 10
 KEEPALIVE_COUNT = 3
+#: the system's send buffer for a connection (Linux doubles it for its bookkeeping). Set, so
+#: that the system does not grow it to megabytes: a program that stops reading then shows as
+#: writes backing up after a few hundred reports instead of tens of thousands
+SOCKET_SEND_BUFFER = 16384
 
 log = logging.getLogger("workbench.viple.tcp")
 
@@ -96,10 +100,13 @@ def _peer_of(writer: asyncio.StreamWriter) -> str:
     return str(peer or "unknown peer")
 
 
-def keep_alive(sock: socket.socket | None) -> None:
-    """Turn TCP keepalive on, with the probe timing where the platform lets us set it."""
+def configure_socket(sock: socket.socket | None) -> None:
+    """An accepted connection: a fixed, small send buffer, and TCP keepalive on with the probe
+    timing where the platform lets us set it."""
     if sock is None:
         return
+    with contextlib.suppress(OSError):
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, SOCKET_SEND_BUFFER)
     with contextlib.suppress(OSError):
         sock.setsockopt(socket.SOL_SOCKET, socket.SO_KEEPALIVE, 1)
     for name, value in (
@@ -242,7 +249,7 @@ class TcpServer:
 
     async def _connection(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
         peer = _peer_of(writer)
-        keep_alive(writer.get_extra_info("socket"))
+        configure_socket(writer.get_extra_info("socket"))
         try:
             if not self.link.connect(peer):
                 await self._goodbye(reader, writer, self.link.busy_message())
