@@ -21,7 +21,8 @@ from workbench.sim.sensors import SensorSpec
 from workbench.sim.session import Session
 from workbench.viple.codec import parse_report
 from workbench.viple.link import Link, RateLimitedLog, check_report_ms
-from workbench.viple.tcp_server import EndpointError, TcpConfig, TcpServer, configure_socket
+from workbench.viple.sockets import configure_socket
+from workbench.viple.tcp_server import EndpointError, TcpConfig, TcpServer
 
 # a corridor facing east, the far wall 7 blocks ahead; unity blocks are 2 units
 CORRIDOR = parse_maze("##########\n#S.......#\n##########\n", source="corridor.txt")

@@ -38,22 +38,13 @@ from .link import (
     check_idle_s,
     check_report_ms,
 )
+from .sockets import configure_socket
 
 DEFAULT_PORT = 1350
 LOOPBACK = ("127.0.0.1", "::1")
 READ_SIZE = 65536
 #: how long a refused or closing client gets to take its last line
 _GOODBYE_SECONDS = 1.0
-#: TCP keepalive: first probe after this many idle seconds, then every INTERVAL, give up after
-#: COUNT unanswered probes (a vanished peer is noticed after about a minute)
-KEEPALIVE_IDLE_S = 30
-KEEPALIVE_INTERVAL_S = 10
-KEEPALIVE_COUNT = 3
-#: the system's send buffer for a connection (Linux doubles it for its bookkeeping). Set, so
-#: that the system does not grow it to megabytes: a program that stops reading then shows as
-#: writes backing up after a few hundred reports instead of tens of thousands
-SOCKET_SEND_BUFFER = 16384
-
 log = logging.getLogger("workbench.viple.tcp")
 
 
@@ -98,27 +89,6 @@ def _peer_of(writer: asyncio.StreamWriter) -> str:
     if isinstance(peer, tuple) and len(peer) >= 2:
         return format_address(str(peer[0]), int(peer[1]))
     return str(peer or "unknown peer")
-
-
-def configure_socket(sock: socket.socket | None) -> None:
-    """An accepted connection: a fixed, small send buffer, and TCP keepalive on with the probe
-    timing where the platform lets us set it."""
-    if sock is None:
-        return
-    with contextlib.suppress(OSError):
-        sock.setsockopt(socket.SOL_SOCKET, socket.SO_SNDBUF, SOCKET_SEND_BUFFER)
-    with contextlib.suppress(OSError):
-        sock.setsockopt(socket.SOL_SOCKET, socket.SO_KEEPALIVE, 1)
-    for name, value in (
-        ("TCP_KEEPIDLE", KEEPALIVE_IDLE_S),
-        ("TCP_KEEPALIVE", KEEPALIVE_IDLE_S),  # macOS calls the idle time this
-        ("TCP_KEEPINTVL", KEEPALIVE_INTERVAL_S),
-        ("TCP_KEEPCNT", KEEPALIVE_COUNT),
-    ):
-        option = getattr(socket, name, None)
-        if option is not None:
-            with contextlib.suppress(OSError):
-                sock.setsockopt(socket.IPPROTO_TCP, option, value)
 
 
 class _Outbox:

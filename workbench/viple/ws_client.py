@@ -36,6 +36,7 @@ from .link import (
     check_idle_s,
     check_report_ms,
 )
+from .sockets import configure_socket
 
 DEFAULT_URL = "ws://localhost:8124/"
 RETRY_SECONDS = 1.0
@@ -195,6 +196,7 @@ class WsClient:
             return None
         self._outage = False
         self.log.info("connected to VIPLE at %s", url)
+        configure_socket(ws.transport.get_extra_info("socket"))
         outbox = _Outbox(ws)
         pusher = asyncio.create_task(link.push_reports(outbox, self.config.report_ms / 1000))
         # an idle driver is cut off at once: nothing it has not read is worth sending
