@@ -20,6 +20,7 @@ from workbench.sim.mazefile import parse_maze
 from workbench.sim.sensors import SensorSpec
 from workbench.sim.session import Session
 from workbench.viple.codec import parse_report
+from workbench.viple.hosting import describe
 from workbench.viple.link import Link, RateLimitedLog, check_report_ms
 from workbench.viple.sockets import configure_socket
 from workbench.viple.tcp_server import EndpointError, TcpConfig, TcpServer
@@ -544,6 +545,7 @@ def test_a_driver_that_stops_sending_and_reading_loses_the_seat_and_the_robot_st
             await until(lambda: session.driver.startswith("VIPLE tcp"))
             await until(lambda: not server.status.connected, timeout=20)
             assert server.status.idled == 1
+            assert describe(server.status).endswith(", 1 idle driver cut off")
             assert session.driver == "nobody"
             x = session.world.pose.x
             steps(session, 30)
