@@ -626,3 +626,42 @@ def test_the_idle_time_is_checked():
     with pytest.raises(ValueError, match="finite"):
         TcpConfig(idle_s=float("inf"))
     assert TcpConfig(idle_s=None).idle_s is None
+
+
+class FakeOutbox:
+    """An outbox whose backlog the test sets: 0 means the program reads everything."""
+
+    def __init__(self, backlog: int = 0) -> None:
+        self.backlog = backlog
+        self.lines: list[str] = []
+
+    def queued(self) -> int:
+        return self.backlog
+
+    async def write(self, line: str) -> None:
+        self.lines.append(line)
+
+
+def test_the_idle_rule_needs_both_silence_and_unread_reports():
+    async def scenario():
+        link = Link(session_for(), "tcp", idle_s=0.1)
+        assert link.connect("127.0.0.1:5000")
+        reading = FakeOutbox(backlog=0)
+        pusher = asyncio.create_task(link.push_reports(reading, 0.02))
+        await asyncio.sleep(0.4)  # silent, but reading: keeps the seat
+        assert not pusher.done() and link.idled == 0
+
+        stuck = FakeOutbox(backlog=100_000)
+        pusher.cancel()
+        await asyncio.gather(pusher, return_exceptions=True)
+        pusher = asyncio.create_task(link.push_reports(stuck, 0.02))
+        for _ in range(8):  # not reading, but sending: keeps the seat
+            await asyncio.sleep(0.05)
+            link.heard()
+        assert not pusher.done()
+        assert stuck.lines == [] and link.dropped >= 5  # nothing queued for it
+        reason = await asyncio.wait_for(pusher, 1.0)  # silent and not reading
+        assert reason.startswith("idle: sent nothing and read no reports for 0.1 s")
+        assert link.idled == 1
+
+    asyncio.run(scenario())
