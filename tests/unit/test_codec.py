@@ -792,3 +792,10 @@ def test_near_valid_reports_give_readings_or_a_codec_error(sensor_entries):
 def test_arbitrary_bytes_as_a_line_give_only_codec_errors(data):
     check_only_codec_errors(data.decode("utf-8", errors="replace"))
     check_only_codec_errors(data.decode("latin-1"))
+
+
+def test_a_reason_stays_short_however_many_entries_the_line_has():
+    line = servos(*({"servoId": n, "servoSpeed": 1} for n in range(6, 2000)))
+    message = rejection(line)
+    assert message.startswith("servos has 1994 wheel entries (servoId 6, 7, 8, 9, 10, …)")
+    assert len(message) < 200

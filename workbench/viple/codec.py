@@ -483,7 +483,7 @@ def _match_wheels(servos: list[_Servo], wheels: WheelPorts) -> dict[str, float]:
 
 def _in_array_order(servos: list[_Servo], wheels: WheelPorts) -> dict[str, float]:
     if len(servos) > 2:
-        ids = ", ".join(str(s.servo_id) for s in servos)
+        ids = ", ".join(_show(s.servo_id) for s in servos[:5]) + (", …" if len(servos) > 5 else "")
         raise CodecError(
             f"servos has {len(servos)} wheel entries (servoId {ids}) and none matches the wheel "
             f"ports; expected the left ({wheels.left}) and right ({wheels.right}) wheel ports"
