@@ -177,3 +177,13 @@ def test_an_address_that_is_not_on_this_machine_is_a_clear_error(capsys):
     assert main(["serve", "--tcp-port", str(free_port()), "--bind", "192.0.2.1"]) == 1
     err = capsys.readouterr().err
     assert "cannot listen on 192.0.2.1 port" in err and "cannot assign requested address" in err
+
+
+@pytest.mark.parametrize(
+    ("argv", "idle_s"),
+    [([], 30.0), (["--driver-idle", "2.5"], 2.5), (["--driver-idle", "0"], None)],
+)
+def test_the_driver_idle_time_reaches_both_endpoints(argv, idle_s):
+    args = build_parser().parse_args(["serve", "--ws-url", "ws://localhost:8124/", *argv])
+    the_plan = plan(args)
+    assert the_plan.tcp.idle_s == idle_s and the_plan.ws.idle_s == idle_s
