@@ -307,7 +307,7 @@ class Link:
         """Write a report unless the program is too far behind in reading; False if dropped."""
         queued = outbox.queued()
         if queued == 0:
-            self._active_at = max(self._active_at, time.monotonic())
+            self._active_at = time.monotonic()
         elif queued > SEND_BUFFER_BYTES:
             self.dropped += 1
             return False
