@@ -138,6 +138,9 @@ def test_serve_in_process_with_the_websocket_role_runs_in_real_time(tmp_path):
         (["--ws-url", "ws://localhost:99999/"], "out of range"),
         (["--tcp-port", "0"], "--tcp-port 0 turns TCP off: give --ws-url"),
         (["--tcp-port", "0", "--ws-url", "ws://x/", "--bind", "0.0.0.0"], "--bind needs TCP"),
+        (["--driver-idle", "-5"], "--driver-idle -5 is not a usable time: give seconds above 0"),
+        (["--driver-idle", "nan"], "--driver-idle nan is not a usable time"),
+        (["--driver-idle", "inf"], "--driver-idle inf is not a usable time"),
     ],
 )
 def test_bad_input_is_a_clear_message_and_exit_2(capsys, argv, message):
@@ -148,7 +151,8 @@ def test_bad_input_is_a_clear_message_and_exit_2(capsys, argv, message):
 
 
 @pytest.mark.parametrize(
-    "argv", [["--profile", "nope"], ["--report-ms", "fast"], ["--noise", "loud"]]
+    "argv",
+    [["--profile", "nope"], ["--report-ms", "fast"], ["--noise", "loud"], ["--driver-idle", "x"]],
 )
 def test_unparseable_options_exit_2(capsys, argv):
     with pytest.raises(SystemExit) as caught:
@@ -173,3 +177,13 @@ def test_an_address_that_is_not_on_this_machine_is_a_clear_error(capsys):
     assert main(["serve", "--tcp-port", str(free_port()), "--bind", "192.0.2.1"]) == 1
     err = capsys.readouterr().err
     assert "cannot listen on 192.0.2.1 port" in err and "cannot assign requested address" in err
+
+
+@pytest.mark.parametrize(
+    ("argv", "idle_s"),
+    [([], 30.0), (["--driver-idle", "2.5"], 2.5), (["--driver-idle", "0"], None)],
+)
+def test_the_driver_idle_time_reaches_both_endpoints(argv, idle_s):
+    args = build_parser().parse_args(["serve", "--ws-url", "ws://localhost:8124/", *argv])
+    the_plan = plan(args)
+    assert the_plan.tcp.idle_s == idle_s and the_plan.ws.idle_s == idle_s

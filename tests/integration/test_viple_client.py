@@ -299,6 +299,30 @@ def test_reports_split_across_writes_and_bad_lines_are_handled():
     assert robot.received == MOVE + RIGHT90
 
 
+def test_hostile_report_lines_are_only_rejected_and_the_run_goes_on():
+    lines: list[str] = []
+    robot = ScriptedRobot(
+        [
+            b"[" * 60_000 + b"\r\n",
+            b'{"error":"\\u001b[2Jgone"}\r\n',
+            b'{"sensors":[{"id":1,"value":"\\u001e172"}]}\r\n',
+            report(172.0),
+        ]
+    )
+
+    async def go():
+        server = await asyncio.start_server(robot.serve, "127.0.0.1", 0)
+        port = server.sockets[0].getsockname()[1]
+        async with server:
+            return await run_client(local_best(connect=f"tcp://127.0.0.1:{port}"), lines.append)
+
+    result = asyncio.run(go())
+    assert result.reports == 1 and result.rejected == 3
+    assert any("the simulator says: \\u001b[2Jgone" in x for x in lines)
+    assert not any("\x1b" in x for x in lines)
+    assert any('sensors[0].value "\\u001e172" is not a number' in x for x in lines)
+
+
 def test_a_report_missing_the_fsm_sensor_stops_the_robot_and_exits_1():
     robot = ScriptedRobot([report(172.0, port=4)])
     result = asyncio.run(robot.run())

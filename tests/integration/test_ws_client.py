@@ -12,6 +12,7 @@ from websockets.asyncio.server import ServerConnection, serve
 from websockets.exceptions import ConnectionClosed
 
 from workbench.sim.mazefile import parse_maze
+from workbench.sim.sensors import SensorSpec
 from workbench.sim.session import Session
 from workbench.viple.codec import parse_report
 from workbench.viple.link import Seat
@@ -275,3 +276,127 @@ def test_urls_are_checked_and_the_retry_is_every_second_by_default():
     ]:
         with pytest.raises(ValueError, match=why):
             check_ws_url(bad)
+
+
+# --- hostile and vanished drivers ------------------------------------------------------------
+
+
+def test_a_number_with_a_control_character_is_rejected_and_the_same_connection_then_drives(
+    caplog,
+):
+    caplog.set_level(logging.INFO, logger="workbench.viple")
+
+    async def scenario():
+        viple = await FakeViple(free_port()).start()
+        session = session_for()
+        async with client_for(session, viple.url) as client:
+            robot = await viple.connected()
+            await robot.send('{"servos":[{"servoId":3,"servoSpeed":"\\u001e0.5"}]}')
+            await robot.send(MOVE)
+            await until(lambda: client.status.messages_in == 2)
+            assert client.status.invalid == 1
+            assert client.status.connected and client.status.connections == 1
+            x = session.world.pose.x
+            steps(session, 60)
+            assert session.world.pose.x == pytest.approx(x + 1.0, abs=0.02)
+            # VIPLE ends the connection itself
+            await robot.close()
+            await until(lambda: not client.status.connected)
+        await viple.stop()
+
+    asyncio.run(scenario())
+    assert messages(caplog, 'rejected line 1: servos[0].servoSpeed "\\u001e0.5" is not a number')
+    assert messages(caplog, "disconnected (closed by VIPLE with code 1000")
+    assert not any(r.exc_info for r in caplog.records)
+
+
+def test_stopping_the_workbench_under_a_driver_says_so(caplog):
+    caplog.set_level(logging.INFO, logger="workbench.viple")
+
+    async def scenario():
+        viple = await FakeViple(free_port()).start()
+        session = session_for()
+        async with client_for(session, viple.url):
+            await viple.connected()
+            await viple.report()
+        assert session.driver == "nobody"
+        await viple.stop()
+
+    asyncio.run(scenario())
+    assert messages(caplog, "disconnected (workbench stopping)")
+
+
+class DeafViple(FakeViple):
+    """A VIPLE that accepts the robot, sends it one command (on the first connection only) and
+    then reads nothing at all."""
+
+    commanded = False
+
+    async def start(self) -> DeafViple:
+        self.arrived = asyncio.Event()
+        sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 1024)
+        sock.bind(("127.0.0.1", self.port))
+        self.server = await serve(
+            self._robot, sock=sock, max_queue=1, ping_interval=None, close_timeout=0.2
+        )
+        return self
+
+    async def _robot(self, ws: ServerConnection) -> None:
+        self.robot = ws
+        self.arrived.set()
+        if not self.commanded:
+            self.commanded = True
+            await ws.send(MOVE)
+        await ws.wait_closed()
+
+
+def many_sensors() -> list[SensorSpec]:
+    """Forty sensors: reports of about 2 KB fill the socket buffers in a few dozen reports."""
+    mounts = ("front", "left", "right", "back")
+    return [SensorSpec("distance", port, mounts[port % 4]) for port in range(1, 41)]
+
+
+def test_a_driver_that_stops_sending_and_reading_loses_the_seat_and_the_robot_stops(caplog):
+    caplog.set_level(logging.INFO, logger="workbench.viple")
+
+    async def scenario():
+        viple = await DeafViple(free_port()).start()
+        session = Session(CORRIDOR, "unity", many_sensors(), noise="off")
+        async with client_for(session, viple.url, report_ms=50, idle_s=0.5) as client:
+            await viple.connected()
+            await until(lambda: client.status.messages_in == 1)
+            await until(lambda: client.status.idled == 1, timeout=10)
+            x = session.world.pose.x
+            steps(session, 30)
+            assert session.world.pose.x == pytest.approx(x)  # the motors were stopped
+        await viple.stop()
+
+    asyncio.run(scenario())
+    assert messages(caplog, "disconnected (idle: sent nothing and read no reports for 0.5 s")
+
+
+def test_a_viple_that_stops_answering_pings_is_left_even_without_an_idle_limit(caplog):
+    caplog.set_level(logging.INFO, logger="workbench.viple")
+
+    async def scenario():
+        viple = await DeafViple(free_port()).start()
+        session = session_for()
+        config = {"idle_s": None, "ping_interval_s": 0.1, "ping_timeout_s": 0.3}
+        async with client_for(session, viple.url, **config) as client:
+            await viple.connected()
+            await until(lambda: client.status.messages_in == 1)
+            await until(lambda: "went away" in caplog.text, timeout=5)
+            assert client.status.idled == 0
+        await viple.stop()
+
+    asyncio.run(scenario())
+    assert messages(caplog, "keepalive ping timeout")
+
+
+def test_pings_are_on_by_default():
+    assert WsConfig().ping_interval_s == 20.0 and WsConfig().ping_timeout_s == 20.0
+    assert WsConfig().idle_s == 30.0
+    with pytest.raises(ValueError, match="driver idle time"):
+        WsConfig(idle_s=-1)

@@ -1,6 +1,7 @@
 """VIPLE's JSON protocol: framing, commands from VIPLE, sensor reports to VIPLE."""
 
 import json
+import math
 import re
 
 import pytest
@@ -243,7 +244,8 @@ def test_a_utf8_byte_order_mark_before_the_object_is_ignored():
     [
         (
             servos({"servoSpeed": "fast"}),
-            'line 3: servoSpeed "fast" is not a number (entry 1 of "servos")',
+            'line 3: servos[0].servoSpeed "fast" is not a number; expected a number like 0.5, or a'
+            " string holding one",
         ),
         ("[1, 2]", 'line 3: expected a JSON object with "servos", got a list'),
         ('"servos"', 'line 3: expected a JSON object with "servos", got a string'),
@@ -257,33 +259,47 @@ def test_a_utf8_byte_order_mark_before_the_object_is_ignored():
             "line 3: not JSON: Expecting ',' delimiter at column 27",
         ),
         ("", "line 3: not JSON: the line is empty"),
-        ('{"servos": []}', 'line 3: "servos" is empty'),
-        ('{"servos": {"servoSpeed": 1}}', 'line 3: "servos" must be a list, got an object'),
-        ('{"servos": [0.5]}', 'line 3: entry 1 of "servos" is a number, not an object'),
-        (servos({"servoId": 3}), 'line 3: "servoSpeed" is missing (entry 1 of "servos")'),
+        ('{"servos": []}', "line 3: servos is empty; expected at least one entry"),
+        (
+            '{"servos": {"servoSpeed": 1}}',
+            "line 3: servos is an object; expected a list of entries",
+        ),
+        (
+            '{"servos": [0.5]}',
+            'line 3: servos[0] is a number; expected an object like {"servoId":3,"servoSpeed":0.5}',
+        ),
+        (
+            servos({"servoId": 3}),
+            "line 3: servos[0].servoSpeed is missing; expected a number like 0.5, or a string"
+            " holding one",
+        ),
         (
             servos({"servoSpeed": None}),
-            'line 3: servoSpeed is null, not a number (entry 1 of "servos")',
+            "line 3: servos[0].servoSpeed is null; expected a number like 0.5, or a string"
+            " holding one",
         ),
         (
             servos({"servoSpeed": True}),
-            'line 3: servoSpeed is true/false, not a number (entry 1 of "servos")',
+            "line 3: servos[0].servoSpeed is true/false; expected a number like 0.5, or a string"
+            " holding one",
         ),
         (
             servos({"servoSpeed": [1]}),
-            'line 3: servoSpeed is a list, not a number (entry 1 of "servos")',
+            "line 3: servos[0].servoSpeed is a list; expected a number like 0.5, or a string"
+            " holding one",
         ),
         (
             servos({"servoSpeed": "NaN"}),
-            'line 3: servoSpeed "NaN" is not a number (entry 1 of "servos")',
+            'line 3: servos[0].servoSpeed "NaN" is not a number; expected a number like 0.5, or a'
+            " string holding one",
         ),
         (
             servos({"servoSpeed": "1e999"}),
-            'line 3: servoSpeed "1e999" is out of range (entry 1 of "servos")',
+            'line 3: servos[0].servoSpeed "1e999" is out of range; expected a finite number',
         ),
         (
             '{"servos": [{"servoSpeed": 1e999}]}',
-            'line 3: servoSpeed 1e999 is out of range (entry 1 of "servos")',
+            "line 3: servos[0].servoSpeed 1e999 is out of range; expected a finite number",
         ),
         ('{"servos": [{"servoSpeed": NaN}]}', "line 3: not JSON: NaN is not a JSON value"),
         (
@@ -292,28 +308,32 @@ def test_a_utf8_byte_order_mark_before_the_object_is_ignored():
         ),
         (
             servos({"isTurn": "yes", "servoSpeed": 1}),
-            'line 3: isTurn "yes" is not true or false (entry 1 of "servos")',
+            'line 3: servos[0].isTurn "yes" is not true or false; expected true, false, "true" or'
+            ' "false"',
         ),
         (
             servos({"isTurn": 1, "servoSpeed": 1}),
-            'line 3: isTurn 1 is not true or false (entry 1 of "servos")',
+            "line 3: servos[0].isTurn 1 is not true or false; expected true, false,"
+            ' "true" or "false"',
         ),
         (
             servos({"servoId": 2.5, "servoSpeed": 1}),
-            'line 3: servoId 2.5 is not a whole number (entry 1 of "servos")',
+            "line 3: servos[0].servoId 2.5 is not a whole number; expected a port number like 3, or"
+            " -1 for the Robot+ services",
         ),
         (
             servos({"servoId": -2, "servoSpeed": 1}),
-            'line 3: servoId -2 is not a port; -1 means the Robot+ services (entry 1 of "servos")',
+            "line 3: servos[0].servoId -2 is not a port; expected a port number like 3, or -1 for"
+            " the Robot+ services",
         ),
         (
             servos({"servoId": 3, "servoSpeed": 1}, {"servoId": 3, "servoSpeed": 0}),
-            'line 3: servoId 3 (left wheel) appears twice in "servos"',
+            "line 3: servos[1].servoId 3 is the left wheel again; expected one entry per wheel",
         ),
         (
             servos(*({"servoId": n, "servoSpeed": 1} for n in (1, 2, 4))),
-            "line 3: 3 wheel entries (servoId 1, 2, 4) but none matches the wheel ports"
-            " (left 3, right 5)",
+            "line 3: servos has 3 wheel entries (servoId 1, 2, 4) and none matches the wheel"
+            " ports; expected the left (3) and right (5) wheel ports",
         ),
         ("[" * 100_000, "line 3: not JSON: nested too deeply to read"),
     ],
@@ -328,12 +348,12 @@ def test_the_reason_has_no_line_prefix_without_a_line_number():
 
 def test_long_values_are_shortened_in_the_reason():
     message = rejection(servos({"servoSpeed": "x" * 500}))
-    assert len(message) < 100 and "…" in message
+    assert len(message) < 140 and "x" * 50 not in message and "…" in message
 
 
 def test_a_huge_integer_is_out_of_range_not_a_crash():
     message = rejection('{"servos":[{"servoSpeed":' + "9" * 5000 + "}]}")
-    assert message.startswith("servoSpeed 9999") and "is out of range" in message
+    assert message.startswith("servos[0].servoSpeed 9999") and "is out of range" in message
 
 
 def test_wheel_ports_must_differ():
@@ -407,17 +427,29 @@ def test_a_report_is_read_back_including_numbers_sent_as_strings():
             '{"servos":[]}',
             'line 9: expected a JSON object with "sensors", got an object with keys "servos"',
         ),
-        ('{"sensors":[{"id":1}]}', 'line 9: "value" is missing (entry 1 of "sensors")'),
-        ('{"sensors":[{"value":1}]}', 'line 9: "id" is missing (entry 1 of "sensors")'),
+        (
+            '{"sensors":[{"id":1}]}',
+            "line 9: sensors[0].value is missing; expected a number like 0.5, or a string"
+            " holding one",
+        ),
+        (
+            '{"sensors":[{"value":1}]}',
+            "line 9: sensors[0].id is missing; expected a port number like 1",
+        ),
         (
             '{"sensors":[{"id":1,"value":"far"}]}',
-            'line 9: value "far" is not a number (entry 1 of "sensors")',
+            'line 9: sensors[0].value "far" is not a number; expected a number like 0.5, or a'
+            " string holding one",
         ),
         (
             '{"sensors":[{"id":1,"value":1},{"id":1,"value":2}]}',
-            'line 9: sensor id 1 appears twice in "sensors"',
+            "line 9: sensors[1].id 1 is the port of sensors[0] too; expected one entry per port",
         ),
-        ('{"sensors":["distance"]}', 'line 9: entry 1 of "sensors" is a string, not an object'),
+        (
+            '{"sensors":["distance"]}',
+            "line 9: sensors[0] is a string; expected an object like"
+            ' {"name":"distance","id":1,"value":1.5}',
+        ),
         (
             '{"sensors":[{"id":1,"value":Infinity}]}',
             "line 9: not JSON: Infinity is not a JSON value",
@@ -558,3 +590,212 @@ def test_arbitrary_text_only_ever_gives_codec_errors(text):
     read_everything(text)
     for part in split_frame(text):
         read_everything(part)
+
+
+# --- the whole parse surface ------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("speed", "shown"),
+    [
+        ("\u001e0.5", r'"\u001e0.5"'),
+        ("\u001c1", r'"\u001c1"'),
+        ("0.5\u0000", r'"0.5\u0000"'),
+        ("\u20000.5", r'"\u20000.5"'),
+        ("\u0660", '"\u0660"'),
+        ("1_000", '"1_000"'),
+        ("0x10", '"0x10"'),
+        ("Infinity", '"Infinity"'),
+        ("-inf", '"-inf"'),
+        ("nan", '"nan"'),
+        ("", '""'),
+        ("\ud800", r'"\ud800"'),
+    ],
+)
+def test_a_number_string_with_anything_but_a_plain_number_is_rejected(speed, shown):
+    line = servos({"servoId": 3, "servoSpeed": speed})
+    assert rejection(line, 1) == (
+        f"line 1: servos[0].servoSpeed {shown} is not a number; expected a number like 0.5, "
+        "or a string holding one"
+    )
+
+
+@pytest.mark.parametrize("speed", ["0.5", " 0.5", "0.5\t", "\r\n0.5 ", "+0.5", "5e-1", ".5"])
+def test_a_number_string_may_have_json_blanks_around_it(speed):
+    line = servos({"servoId": 3, "servoSpeed": speed})
+    assert parse_command(line, WHEELS) == [MotorPower("left", 0.5)]
+
+
+@pytest.mark.parametrize(
+    "speed", ["1e999", "-1e999", "9" * 400, "1" + "0" * 309 + ".5", "0." + "0" * 400 + "1e999"]
+)
+def test_a_number_string_too_large_for_a_float_is_out_of_range(speed):
+    message = rejection(servos({"servoId": 3, "servoSpeed": speed}))
+    assert message.startswith("servos[0].servoSpeed ")
+    assert message.endswith("is out of range; expected a finite number")
+
+
+def test_the_wheel_port_of_a_number_string_is_named_when_it_is_not_a_number():
+    message = rejection(servos({"servoId": "three", "servoSpeed": 1}))
+    assert message == (
+        'servos[0].servoId "three" is not a number; expected a port number like 3, or -1 for the '
+        "Robot+ services"
+    )
+
+
+def test_a_lone_surrogate_anywhere_is_read_without_crashing_and_shown_escaped():
+    assert rejection('{"servos":[{"servoId":3,"servoSpeed":"\\ud800"}]}').startswith(
+        'servos[0].servoSpeed "\\ud800" is not a number'
+    )
+    assert rejection('{"\\udfff":1}') == (
+        'expected a JSON object with "servos", got an object with keys "\\udfff"'
+    )
+    line = '{"servos":[{"servoId":3,"servoSpeed":1,"\\ud800":"\\udc00"}]}'
+    assert parse_command(line, WHEELS) == [MotorPower("left", 1)]
+
+
+@pytest.mark.parametrize(
+    ("line", "message"),
+    [
+        (
+            '{"servos":[{"servoId":3,"servoSpeed":1,"servoSpeed":0}]}',
+            'servos[0] has the key "servoSpeed" more than once; expected each key once',
+        ),
+        (
+            '{"servos":[{"servoSpeed":1}],"servos":[{"servoSpeed":0}]}',
+            'the message has the key "servos" more than once; expected each key once',
+        ),
+        (
+            '{"servos":[{"servoSpeed":1},{"isTurn":true,"servoSpeed":9,"isTurn":false}]}',
+            'servos[1] has the key "isTurn" more than once; expected each key once',
+        ),
+    ],
+)
+def test_a_key_given_twice_is_rejected_instead_of_keeping_one_of_its_values(line, message):
+    assert rejection(line) == message
+
+
+def test_a_repeated_key_in_a_sensor_entry_is_rejected():
+    with pytest.raises(CodecError, match=r"sensors\[0\] has the key \"value\" more than once"):
+        parse_report('{"sensors":[{"id":1,"value":1,"value":2}]}')
+
+
+@pytest.mark.parametrize("opening", ["[", '{"a":', '{"servos":['])
+def test_deep_nesting_within_the_line_limit_is_rejected_not_a_crash(opening):
+    line = opening * (65536 // len(opening))
+    assert rejection(line).startswith("not JSON: ")
+
+
+@pytest.mark.parametrize(
+    ("servo_id", "message"),
+    [
+        (True, "servos[0].servoId is true/false; expected a port number like 3"),
+        ({}, "servos[0].servoId is an object; expected a port number like 3"),
+        ("1e999", 'servos[0].servoId "1e999" is out of range; expected a finite number'),
+        ("-2", "servos[0].servoId -2 is not a port; expected a port number like 3"),
+        (" 2.5 ", 'servos[0].servoId " 2.5 " is not a whole number; expected a port number'),
+    ],
+)
+def test_a_bad_servo_id_names_its_place_and_what_is_expected(servo_id, message):
+    assert rejection(servos({"servoId": servo_id, "servoSpeed": 1})).startswith(message)
+
+
+def test_the_reported_control_character_line_is_one_rejection_with_its_place():
+    line = '{"servos":[{"servoId":3,"servoSpeed":"\\u001e0.5"}]}'
+    assert rejection(line, 7) == (
+        'line 7: servos[0].servoSpeed "\\u001e0.5" is not a number; expected a number like 0.5, '
+        "or a string holding one"
+    )
+
+
+# --- near-valid messages, fuzzed ---------------------------------------------------------------
+
+
+class _Raw(str):
+    """A JSON value written out as is (a number literal json.dumps could not write)."""
+
+
+number_texts = st.one_of(
+    st.from_regex(r"[+-]?[0-9]{1,3}(\.[0-9]{0,3})?([eE][+-]?[0-9]{1,4})?", fullmatch=True),
+    st.sampled_from(["NaN", "Infinity", "-Infinity", "nan", "inf", "1e999", "9" * 400, "0x1"]),
+)
+odd_characters = st.sampled_from(
+    ["\u001e", "\u001c", "\u0000", "\u2000", "\u00a0", "\ufeff", "\ud800", "\u0660", " ", "\t"]
+)
+around = st.just("") | odd_characters | st.text(max_size=2)
+number_strings = st.builds(lambda *parts: "".join(parts), around, number_texts, around)
+field_values = st.one_of(
+    number_strings,
+    number_strings,
+    number_texts.map(lambda text: _Raw(text)),
+    json_values,
+    st.sampled_from([True, False, None, "true", " FALSE ", -1, 3, 5, "-1", "3", 5.0]),
+)
+
+
+def json_text(value) -> str:
+    """JSON for ``value``; a list of pairs is an object whose keys may repeat."""
+    if isinstance(value, _Raw):
+        return str(value)
+    if isinstance(value, tuple):
+        return "{" + ",".join(f"{json.dumps(k)}:{json_text(v)}" for k, v in value) + "}"
+    if isinstance(value, list):
+        return "[" + ",".join(json_text(item) for item in value) + "]"
+    return json.dumps(value)
+
+
+def entries(keys: list[str]):
+    pair = st.tuples(st.sampled_from(keys), field_values)
+    return st.lists(pair, min_size=1, max_size=5).map(tuple)
+
+
+def check_only_codec_errors(line: str) -> None:
+    for parse in (lambda: parse_command(line, WHEELS, 1), lambda: parse_report(line, 1)):
+        try:
+            parse()
+        except CodecError as err:
+            reason = str(err)
+            assert reason.startswith("line 1: ")
+            assert reason.isprintable(), reason
+            reason.encode("utf-8")
+
+
+@FUZZ
+@given(st.lists(entries(["servoId", "servoSpeed", "isTurn", "x"]), min_size=1, max_size=4))
+def test_near_valid_commands_give_commands_or_a_codec_error(servo_entries):
+    line = json_text((("servos", list(servo_entries)),))
+    check_only_codec_errors(line)
+    try:
+        commands = parse_command(line, WHEELS)
+    except CodecError:
+        return
+    assert commands and all(
+        isinstance(c, WheelPowers | MotorPower | MoveAtPower | TurnByDegrees) for c in commands
+    )
+    assert all(
+        math.isfinite(value)
+        for c in commands
+        for value in vars(c).values()
+        if isinstance(value, float)
+    )
+
+
+@FUZZ
+@given(st.lists(entries(["name", "id", "value", "x"]), min_size=1, max_size=4))
+def test_near_valid_reports_give_readings_or_a_codec_error(sensor_entries):
+    line = json_text((("sensors", list(sensor_entries)),))
+    check_only_codec_errors(line)
+
+
+@FUZZ
+@given(st.binary(max_size=400))
+def test_arbitrary_bytes_as_a_line_give_only_codec_errors(data):
+    check_only_codec_errors(data.decode("utf-8", errors="replace"))
+    check_only_codec_errors(data.decode("latin-1"))
+
+
+def test_a_reason_stays_short_however_many_entries_the_line_has():
+    line = servos(*({"servoId": n, "servoSpeed": 1} for n in range(6, 2000)))
+    message = rejection(line)
+    assert message.startswith("servos has 1994 wheel entries (servoId 6, 7, 8, 9, 10, …)")
+    assert len(message) < 200

@@ -27,11 +27,13 @@ from workbench.sim.sensors import SensorConfigError, SensorSpec, check_ports
 from workbench.sim.session import Session
 from workbench.sim.world import WorldError
 from workbench.viple.link import (
+    IDLE_S_DEFAULT,
     REPORT_MS_DEFAULT,
     REPORT_MS_MAX,
     REPORT_MS_MIN,
     LinkStatus,
     Seat,
+    check_idle_s,
     check_report_ms,
 )
 from workbench.viple.tcp_server import DEFAULT_PORT, EndpointError, TcpConfig, TcpServer
@@ -109,6 +111,14 @@ def register(sub: argparse._SubParsersAction) -> None:
         metavar="ADDR",
         help="listen on these addresses instead of 127.0.0.1 and ::1 (e.g. 0.0.0.0)",
     )
+    p.add_argument(
+        "--driver-idle",
+        type=float,
+        default=IDLE_S_DEFAULT,
+        metavar="SECONDS",
+        help="a program that sends nothing and reads no reports for this long loses the "
+        f"robot, which stops (default {IDLE_S_DEFAULT:g}; 0 never)",
+    )
     p.add_argument("--record", metavar="FILE.jsonl", help="write the run record")
     p.add_argument("--seed", type=_whole_number("--seed"), default=0)
     p.add_argument(
@@ -167,19 +177,36 @@ def _endpoint_configs(args: argparse.Namespace) -> tuple[TcpConfig | None, WsCon
         raise ServeSetupError("--bind needs TCP: it cannot be used with --tcp-port 0")
     if args.tcp_port == 0 and args.ws_url is None:
         raise ServeSetupError("--tcp-port 0 turns TCP off: give --ws-url, or a TCP port")
+    idle_s = _idle_s(args.driver_idle)
     try:
-        ws = WsConfig(url=args.ws_url, report_ms=report_ms) if args.ws_url is not None else None
+        ws = (
+            WsConfig(url=args.ws_url, report_ms=report_ms, idle_s=idle_s)
+            if args.ws_url is not None
+            else None
+        )
     except ValueError as exc:
         raise ServeSetupError(f"--ws-url: {exc}") from None
     try:
         tcp = (
-            TcpConfig(port=args.tcp_port, bind=tuple(args.bind), report_ms=report_ms)
+            TcpConfig(port=args.tcp_port, bind=tuple(args.bind), report_ms=report_ms, idle_s=idle_s)
             if args.tcp_port
             else None
         )
     except ValueError as exc:
         raise ServeSetupError(f"--bind: {exc}") from None
     return tcp, ws
+
+
+def _idle_s(seconds: float) -> float | None:
+    if seconds == 0:
+        return None
+    try:
+        return check_idle_s(seconds)
+    except ValueError:
+        raise ServeSetupError(
+            f"--driver-idle {seconds:g} is not a usable time: give seconds above 0, or 0 for no "
+            "limit"
+        ) from None
 
 
 # ---------------------------------------------------------------------------------------------

@@ -654,10 +654,13 @@ def _refusal(line: str) -> str | None:
     """The text of a ``{"error": ...}`` line (how a busy simulator refuses a client)."""
     try:
         message = json.loads(line)
-    except ValueError:
+    except (ValueError, RecursionError):
         return None
     if isinstance(message, dict) and isinstance(message.get("error"), str):
-        return f"the simulator says: {message['error']}"
+        text = message["error"]
+        if not text.isprintable():
+            text = json.dumps(text)[1:-1]  # control characters shown escaped, never sent raw
+        return f"the simulator says: {text}"
     return None
 
 

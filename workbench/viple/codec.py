@@ -15,6 +15,12 @@ Receiver choices where the protocol leaves room:
 * ``isTurn`` only matters for Robot+ entries, but a malformed ``isTurn`` is rejected anywhere.
 * ``servoId`` and sensor ``id`` may be whole numbers written as numbers or strings ("3", 3.0);
   negative ports other than -1 are rejected.
+
+Every line that is not a message is refused with ``CodecError`` and nothing else: its reason
+says where (the field path, ``servos[0].servoSpeed``), what was wrong and what is expected.
+Number strings hold only a JSON-style number between JSON blanks (no control characters, no
+NaN or Infinity, nothing that overflows a float); an object that names a key twice is refused
+rather than keeping one of the two values.
 """
 
 from __future__ import annotations
@@ -198,6 +204,23 @@ class _NotJsonConstant(ValueError):
     pass
 
 
+class _RepeatedKeys(dict):
+    """A JSON object that named a key more than once (``json`` would keep only the last)."""
+
+    repeated: str = ""
+
+
+def _object_of(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    obj = dict(pairs)
+    if len(obj) == len(pairs):
+        return obj
+    seen: set[str] = set()
+    repeated = next(key for key, _ in pairs if key in seen or seen.add(key))
+    flagged = _RepeatedKeys(obj)
+    flagged.repeated = repeated
+    return flagged
+
+
 def _parse_float(text: str) -> float | _OutOfRange:
     value = float(text)
     return value if math.isfinite(value) else _OutOfRange(text)
@@ -223,6 +246,7 @@ def _load(line: str) -> Any:
             parse_float=_parse_float,
             parse_int=_parse_int,
             parse_constant=_reject_constant,
+            object_pairs_hook=_object_of,
         )
     except json.JSONDecodeError as err:
         raise CodecError(f"not JSON: {err.msg} at column {err.colno}") from None
@@ -269,60 +293,71 @@ def _has_surrogates(text: str) -> bool:
     return False
 
 
-def _number(value: Any, what: str) -> float:
-    """A finite number given as a JSON number or a numeric string."""
+_A_NUMBER = "a number like 0.5, or a string holding one"
+
+
+def _number(value: Any, path: str, expected: str = _A_NUMBER) -> float:
+    """A finite number given as a JSON number or a numeric string (JSON blanks around it)."""
     if isinstance(value, _OutOfRange):
-        raise CodecError(f"{what} {_show(value)} is out of range")
+        raise CodecError(f"{path} {_show(value)} is out of range; expected a finite number")
     if isinstance(value, bool) or value is None or isinstance(value, dict | list):
-        raise CodecError(f"{what} is {_kind_of(value)}, not a number")
+        raise CodecError(f"{path} is {_kind_of(value)}; expected {expected}")
     if isinstance(value, str):
-        if not _NUMBER_TEXT.fullmatch(value.strip()):
-            raise CodecError(f"{what} {_show(value)} is not a number")
-        number = float(value)
+        text = value.strip(_JSON_SPACE)
+        if not _NUMBER_TEXT.fullmatch(text):
+            raise CodecError(f"{path} {_show(value)} is not a number; expected {expected}")
+        number = float(text)
         if not math.isfinite(number):
-            raise CodecError(f"{what} {_show(value)} is out of range")
+            raise CodecError(f"{path} {_show(value)} is out of range; expected a finite number")
         return number
     return float(value)
 
 
-def _port(value: Any, what: str) -> int:
-    number = _number(value, what)
+def _port(value: Any, path: str, expected: str) -> int:
+    number = _number(value, path, expected)
     if not number.is_integer():
-        raise CodecError(f"{what} {_show(value)} is not a whole number")
+        raise CodecError(f"{path} {_show(value)} is not a whole number; expected {expected}")
     return int(number)
 
 
-def _flag(value: Any, what: str) -> bool:
+def _flag(value: Any, path: str) -> bool:
     if value is None:
         return False
     if isinstance(value, bool):
         return value
-    if isinstance(value, str) and value.strip().lower() in ("true", "false"):
-        return value.strip().lower() == "true"
-    raise CodecError(f"{what} {_show(value)} is not true or false")
+    if isinstance(value, str) and value.strip(_JSON_SPACE).lower() in ("true", "false"):
+        return value.strip(_JSON_SPACE).lower() == "true"
+    raise CodecError(
+        f'{path} {_show(value)} is not true or false; expected true, false, "true" or "false"'
+    )
 
 
 def _object_list(message: Any, key: str) -> list[Any]:
     if not isinstance(message, dict):
         raise CodecError(f'expected a JSON object with "{key}", got {_kind_of(message)}')
+    _check_keys_once(message, "the message")
     if key not in message:
         keys = ", ".join(_show(k) for k in list(message)[:5])
         found = f"an object with keys {keys}" if keys else "an empty object"
         raise CodecError(f'expected a JSON object with "{key}", got {found}')
     items = message[key]
     if not isinstance(items, list):
-        raise CodecError(f'"{key}" must be a list, got {_kind_of(items)}')
+        raise CodecError(f"{key} is {_kind_of(items)}; expected a list of entries")
     return items
 
 
-def _entry_object(item: Any, index: int, key: str) -> dict[str, Any]:
+def _entry_object(item: Any, path: str, example: str) -> dict[str, Any]:
     if not isinstance(item, dict):
-        raise CodecError(f'entry {index + 1} of "{key}" is {_kind_of(item)}, not an object')
+        raise CodecError(f"{path} is {_kind_of(item)}; expected an object like {example}")
+    _check_keys_once(item, path)
     return item
 
 
-def _in_entry(err: CodecError, index: int, key: str) -> CodecError:
-    return CodecError(f'{err.reason} (entry {index + 1} of "{key}")')
+def _check_keys_once(obj: dict[str, Any], path: str) -> None:
+    if isinstance(obj, _RepeatedKeys):
+        raise CodecError(
+            f"{path} has the key {_show(obj.repeated)} more than once; expected each key once"
+        )
 
 
 # ---------------------------------------------------------------------------------------------
@@ -363,38 +398,43 @@ class _Servo:
 
 
 def parse_command(line: str, wheels: WheelPorts, line_no: int | None = None) -> list[Command]:
-    """The commands in one VIPLE message line, in the order to apply them."""
+    """The commands in one VIPLE message line, in the order to apply them.
+
+    Raises ``CodecError`` (and nothing else) for any line that is not such a message.
+    """
     try:
         items = _object_list(_load(line), "servos")
         if not items:
-            raise CodecError('"servos" is empty')
+            raise CodecError("servos is empty; expected at least one entry")
         servos = [_servo(item, index) for index, item in enumerate(items)]
         return _commands(servos, wheels)
     except CodecError as err:
         raise err.at_line(line_no) from None
 
 
+_SERVO_EXAMPLE = '{"servoId":3,"servoSpeed":0.5}'
+_PORT_OR_ROBOT_PLUS = "a port number like 3, or -1 for the Robot+ services"
+
+
 def _servo(item: Any, index: int) -> _Servo:
-    entry = _entry_object(item, index, "servos")
-    try:
-        servo_id = _servo_id(entry.get("servoId"))
-        is_turn = _flag(entry.get("isTurn"), "isTurn")
-        if "servoSpeed" not in entry:
-            raise CodecError('"servoSpeed" is missing')
-        speed = _number(entry["servoSpeed"], "servoSpeed")
-    except CodecError as err:
-        raise _in_entry(err, index, "servos") from None
+    path = f"servos[{index}]"
+    entry = _entry_object(item, path, _SERVO_EXAMPLE)
+    servo_id = _servo_id(entry.get("servoId"), f"{path}.servoId")
+    is_turn = _flag(entry.get("isTurn"), f"{path}.isTurn")
+    if "servoSpeed" not in entry:
+        raise CodecError(f"{path}.servoSpeed is missing; expected {_A_NUMBER}")
+    speed = _number(entry["servoSpeed"], f"{path}.servoSpeed")
     return _Servo(index, servo_id, is_turn, speed)
 
 
-def _servo_id(value: Any) -> int | None:
+def _servo_id(value: Any, path: str) -> int | None:
     if value is None:
         return None
-    port = _port(value, "servoId")
+    port = _port(value, path, _PORT_OR_ROBOT_PLUS)
     if port == ROBOT_PLUS_ID:
         return None
     if port < 0:
-        raise CodecError(f"servoId {port} is not a port; -1 means the Robot+ services")
+        raise CodecError(f"{path} {port} is not a port; expected {_PORT_OR_ROBOT_PLUS}")
     return port
 
 
@@ -433,17 +473,20 @@ def _match_wheels(servos: list[_Servo], wheels: WheelPorts) -> dict[str, float]:
         if wheel is None:
             continue
         if wheel in by_wheel:
-            raise CodecError(f'servoId {servo.servo_id} ({wheel} wheel) appears twice in "servos"')
+            raise CodecError(
+                f"servos[{servo.index}].servoId {servo.servo_id} is the {wheel} wheel again; "
+                "expected one entry per wheel"
+            )
         by_wheel[wheel] = servo.speed
     return by_wheel
 
 
 def _in_array_order(servos: list[_Servo], wheels: WheelPorts) -> dict[str, float]:
     if len(servos) > 2:
-        ids = ", ".join(str(s.servo_id) for s in servos)
+        ids = ", ".join(_show(s.servo_id) for s in servos[:5]) + (", …" if len(servos) > 5 else "")
         raise CodecError(
-            f"{len(servos)} wheel entries (servoId {ids}) but none matches the wheel ports "
-            f"(left {wheels.left}, right {wheels.right})"
+            f"servos has {len(servos)} wheel entries (servoId {ids}) and none matches the wheel "
+            f"ports; expected the left ({wheels.left}) and right ({wheels.right}) wheel ports"
         )
     return dict(zip(("left", "right"), (s.speed for s in servos), strict=False))
 
@@ -526,23 +569,26 @@ def parse_report(line: str, line_no: int | None = None) -> dict[int, float]:
 
 def _readings(items: Iterable[Any]) -> dict[int, float]:
     readings: dict[int, float] = {}
+    first: dict[int, int] = {}
     for index, item in enumerate(items):
-        entry = _entry_object(item, index, "sensors")
-        try:
-            port, value = _reading(entry)
-        except CodecError as err:
-            raise _in_entry(err, index, "sensors") from None
+        path = f"sensors[{index}]"
+        entry = _entry_object(item, path, '{"name":"distance","id":1,"value":1.5}')
+        port, value = _reading(entry, path)
         if port in readings:
-            raise CodecError(f'sensor id {port} appears twice in "sensors"')
+            raise CodecError(
+                f"{path}.id {port} is the port of sensors[{first[port]}] too; "
+                "expected one entry per port"
+            )
         readings[port] = value
+        first[port] = index
     return readings
 
 
-def _reading(entry: dict[str, Any]) -> tuple[int, float]:
-    for key in ("id", "value"):
+def _reading(entry: dict[str, Any], path: str) -> tuple[int, float]:
+    for key, expected in (("id", "a port number like 1"), ("value", _A_NUMBER)):
         if key not in entry:
-            raise CodecError(f'"{key}" is missing')
-    port = _port(entry["id"], "id")
+            raise CodecError(f"{path}.{key} is missing; expected {expected}")
+    port = _port(entry["id"], f"{path}.id", "a port number like 1")
     if port < 0:
-        raise CodecError(f"id {port} is not a port")
-    return port, _number(entry["value"], "value")
+        raise CodecError(f"{path}.id {port} is not a port; expected a port number >= 0")
+    return port, _number(entry["value"], f"{path}.value")

@@ -88,6 +88,8 @@ def describe(status: LinkStatus) -> str:
         line = (
             f"VIPLE {status.role} {status.peer}: in {status.messages_in} out {status.messages_out}"
         )
+    if status.idled:
+        line += f", {status.idled} idle driver{'s' if status.idled > 1 else ''} cut off"
     if status.invalid:
         line += f", {status.invalid} rejected"
         if status.last_rejection:

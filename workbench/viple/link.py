@@ -10,6 +10,14 @@ whoever holds it drives, anyone else is refused (TCP) or waits (WebSocket).
 
 The simulation is stepped by someone else's timer on the same event loop, so a flood of
 commands is handled in bounded batches with a yield to the loop between them.
+
+Reports are never queued behind a peer that does not read: an endpoint writes through an
+:class:`Outbox`, and while more than ``SEND_BUFFER_BYTES`` are still waiting for the system to
+take them, a new report is dropped (the next one carries fresher readings anyway).
+
+A driver that has sent nothing and taken none of its reports for ``idle_s`` seconds loses the
+seat (see :meth:`Link.idle_for`): a VIPLE program that is merely quiet still reads its reports,
+so its writes keep going out and it is never dropped.
 """
 
 from __future__ import annotations
@@ -17,9 +25,11 @@ from __future__ import annotations
 import asyncio
 import json
 import logging
+import math
 import time
-from collections.abc import Awaitable, Callable, Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from typing import Protocol
 
 from workbench.control.commands import Stop
 from workbench.sim.session import Session
@@ -32,10 +42,35 @@ REPORT_MS_MAX = 1000
 REPORT_MS_DEFAULT = 250
 #: lines (and reads) handled before the loop gets a turn
 BATCH = 64
+#: bytes of reports an endpoint holds for a peer that is slow to read; above it reports drop
+SEND_BUFFER_BYTES = 16384
+#: how long a driver may send nothing and read nothing before it loses the seat, seconds
+IDLE_S_DEFAULT = 30.0
 
 NOBODY = "nobody"
 
-Send = Callable[[str], Awaitable[None]]
+
+class Outbox(Protocol):
+    """Where an endpoint's reports go: one connection's writing side."""
+
+    def queued(self) -> int:
+        """Bytes written that the system has not taken yet (0: everything went out)."""
+        ...
+
+    async def write(self, line: str) -> None:
+        """Write one message without waiting for the peer to read it."""
+        ...
+
+
+def check_idle_s(value: object) -> float | None:
+    """The driver idle time in seconds (None: never), or ``ValueError`` saying what is allowed."""
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, int | float) or not value > 0:
+        raise ValueError(f"driver idle time must be a number of seconds above 0, not {value!r}")
+    if not math.isfinite(value):
+        raise ValueError("driver idle time must be finite; use None for no limit")
+    return float(value)
 
 
 def check_report_ms(value: object) -> int:
@@ -67,6 +102,10 @@ class LinkStatus:
     #: connections served so far and connections refused because the robot was busy
     connections: int = 0
     refused: int = 0
+    #: reports dropped because the program was not reading them
+    dropped: int = 0
+    #: connections that lost the driver's seat for being idle
+    idled: int = 0
 
     @property
     def connected(self) -> bool:
@@ -139,9 +178,11 @@ class Link:
         seat: Seat | None = None,
         logger: logging.Logger | None = None,
         batch: int = BATCH,
+        idle_s: float | None = IDLE_S_DEFAULT,
     ) -> None:
         if batch < 1:
             raise ValueError(f"batch must be at least 1, not {batch!r}")
+        self.idle_s = check_idle_s(idle_s)
         self.session = session
         self.seat = seat if seat is not None else Seat()
         self.log = logger or logging.getLogger(f"workbench.viple.{role}")
@@ -155,7 +196,10 @@ class Link:
         self.last_rejection: str | None = None
         self.connections = 0
         self.refused = 0
+        self.dropped = 0
+        self.idled = 0
         self._line_no = 0
+        self._active_at = time.monotonic()
         self._driver: str | None = None
         self._work = 0
         self._bad_log = RateLimitedLog(self.log)
@@ -174,6 +218,8 @@ class Link:
             last_rejection=self.last_rejection,
             connections=self.connections,
             refused=self.refused,
+            dropped=self.dropped,
+            idled=self.idled,
         )
 
     @property
@@ -204,6 +250,7 @@ class Link:
         self._line_no = 0
         self._driver = f"VIPLE {self.role} {peer}"
         self._bad_log = RateLimitedLog(self.log)
+        self._active_at = time.monotonic()
         self.session.detach(self._driver)
         return True
 
@@ -243,9 +290,30 @@ class Link:
         }
         return encode_report({port: readings[port] for port in kinds}, kinds)
 
-    def sent(self, count: int = 1) -> None:
-        """Count reports the endpoint has sent."""
-        self.messages_out += count
+    def heard(self) -> None:
+        """The program sent something (any bytes, even a line that is then rejected)."""
+        self._active_at = time.monotonic()
+
+    def idle_for(self) -> float:
+        """Seconds since the program last sent anything or took a report.
+
+        A report counts as taken when, at the time of the next one, everything written before
+        has gone out to the system; a program that stops reading fills the socket buffers and
+        then its reports stay queued.
+        """
+        return time.monotonic() - self._active_at
+
+    async def offer(self, outbox: Outbox, line: str) -> bool:
+        """Write a report unless the program is too far behind in reading; False if dropped."""
+        queued = outbox.queued()
+        if queued == 0:
+            self._active_at = time.monotonic()
+        elif queued > SEND_BUFFER_BYTES:
+            self.dropped += 1
+            return False
+        await outbox.write(line)
+        self.messages_out += 1
+        return True
 
     def received(self) -> int:
         """Count a received message; its line number in this connection."""
@@ -278,16 +346,15 @@ class Link:
             self.log.debug("%s: line %d: %s", self.peer or "VIPLE", line_no, commands)
         return True
 
-    async def handle(self, lines: Iterable[str], send: Send) -> None:
+    async def handle(self, lines: Iterable[str], outbox: Outbox) -> None:
         """Apply each line and answer each accepted one with a report, yielding between batches."""
         for line in lines:
-            await self.take(line, send)
+            await self.take(line, outbox)
 
-    async def take(self, line: str, send: Send) -> None:
+    async def take(self, line: str, outbox: Outbox) -> None:
         """Apply one line, answer it with a report when it was accepted, and pace."""
         if self.apply(line):
-            await send(self.report())
-            self.messages_out += 1
+            await self.offer(outbox, self.report())
         await self.pace()
 
     async def pace(self, work: int = 1) -> None:
@@ -297,8 +364,9 @@ class Link:
             self._work = 0
             await asyncio.sleep(0)
 
-    async def push_reports(self, send: Send, interval: float) -> None:
-        """Send a report now and then every ``interval`` seconds, until cancelled.
+    async def push_reports(self, outbox: Outbox, interval: float) -> str:
+        """Send a report now and then every ``interval`` seconds, until cancelled or until the
+        driver has been idle for ``idle_s``: then the reason it loses the seat is returned.
 
         The schedule follows the loop's clock; reports missed while the loop was busy are
         skipped, not sent in a burst.
@@ -306,8 +374,13 @@ class Link:
         loop = asyncio.get_running_loop()
         due = loop.time()
         while True:
-            await send(self.report())
-            self.sent()
+            await self.offer(outbox, self.report())
+            if self.idle_s is not None and self.idle_for() >= self.idle_s:
+                self.idled += 1
+                return (
+                    f"idle: sent nothing and read no reports for {self.idle_s:g} s; "
+                    "the seat is free again"
+                )
             due += interval
             now = loop.time()
             if due < now:

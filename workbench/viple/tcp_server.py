@@ -3,8 +3,13 @@
 One JSON object per line each way. A report of every configured sensor is pushed every
 ``report_ms`` from the moment a program connects, and each accepted command line is answered
 at once with a report. One program drives at a time: a second one gets a one-line JSON error
-and is closed. A line over the size limit closes that connection; malformed lines are counted
-and logged and the connection stays open.
+and is closed. Malformed lines, lines that are not UTF-8 and lines over the size limit are
+counted, logged and skipped; the connection stays open. A line over the limit is dropped as it
+arrives, never buffered whole.
+
+Accepted sockets have TCP keepalive on, so a peer whose machine vanished is noticed. Reports are
+written without waiting for the peer (see ``link.Outbox``); a driver that sends nothing and
+reads nothing for ``idle_s`` seconds is disconnected and the robot stops.
 
 By default the server listens on 127.0.0.1 and ::1 (VIPLE resolves ``localhost`` to either);
 other interfaces only when they are named in ``bind``.
@@ -23,15 +28,23 @@ from dataclasses import dataclass
 
 from workbench.sim.session import Session
 
-from .codec import DEFAULT_MAX_LINE_BYTES, FrameError, FrameTooLong, LineSplitter
-from .link import REPORT_MS_DEFAULT, Link, LinkStatus, Seat, check_report_ms
+from .codec import DEFAULT_MAX_LINE_BYTES, FrameError, LineSplitter
+from .link import (
+    IDLE_S_DEFAULT,
+    REPORT_MS_DEFAULT,
+    Link,
+    LinkStatus,
+    Seat,
+    check_idle_s,
+    check_report_ms,
+)
+from .sockets import configure_socket
 
 DEFAULT_PORT = 1350
 LOOPBACK = ("127.0.0.1", "::1")
 READ_SIZE = 65536
 #: how long a refused or closing client gets to take its last line
 _GOODBYE_SECONDS = 1.0
-
 log = logging.getLogger("workbench.viple.tcp")
 
 
@@ -47,10 +60,13 @@ class TcpConfig:
     bind: tuple[str, ...] = ()
     report_ms: int = REPORT_MS_DEFAULT
     max_line_bytes: int = DEFAULT_MAX_LINE_BYTES
+    #: seconds a driver may send nothing and read nothing before it loses the seat (None: never)
+    idle_s: float | None = IDLE_S_DEFAULT
 
     def __post_init__(self) -> None:
         check_port(self.port)
         check_report_ms(self.report_ms)
+        check_idle_s(self.idle_s)
         if not self.max_line_bytes >= 1:
             raise ValueError("max_line_bytes must be at least 1")
         for host in self.bind:
@@ -75,9 +91,19 @@ def _peer_of(writer: asyncio.StreamWriter) -> str:
     return str(peer or "unknown peer")
 
 
-def _too_long(err: FrameError) -> bool:
-    """Whether a framing error dropped a line for its length (maybe after another problem)."""
-    return isinstance(err, FrameTooLong) or any("longer than the limit" in r for r in err.reasons)
+class _Outbox:
+    """A TCP connection's writing side: lines go out with ``\r\n``, never waiting for the peer."""
+
+    def __init__(self, writer: asyncio.StreamWriter) -> None:
+        self.writer = writer
+
+    def queued(self) -> int:
+        return self.writer.transport.get_write_buffer_size()
+
+    async def write(self, line: str) -> None:
+        if self.writer.transport.is_closing():
+            raise ConnectionResetError(errno.ECONNRESET, "connection lost")
+        self.writer.write(line.encode("utf-8") + b"\r\n")
 
 
 class TcpServer:
@@ -92,7 +118,7 @@ class TcpServer:
     ) -> None:
         self.config = config or TcpConfig()
         self.log = logger or log
-        self.link = Link(session, "tcp", seat=seat, logger=self.log)
+        self.link = Link(session, "tcp", seat=seat, logger=self.log, idle_s=self.config.idle_s)
         self._servers: list[asyncio.Server] = []
         self._handlers: set[asyncio.Task] = set()
         self.addresses: list[tuple[str, int]] = []
@@ -193,55 +219,49 @@ class TcpServer:
 
     async def _connection(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
         peer = _peer_of(writer)
+        configure_socket(writer.get_extra_info("socket"))
         try:
             if not self.link.connect(peer):
                 await self._goodbye(reader, writer, self.link.busy_message())
                 return
             self.log.info("VIPLE connected from %s", peer)
-            reason, farewell = "server stopping", None
+            reason = "server stopping"
             try:
-                reason, farewell = await self._serve(reader, writer, peer)
+                reason = await self._serve(reader, writer)
+            except Exception as err:
+                reason = f"connection handling failed: {err}"
+                self.log.error("%s: %s", peer, reason, exc_info=err)
             finally:
                 self.link.disconnect(reason)
-            if farewell is not None:
-                await self._goodbye(reader, writer, farewell)
         finally:
             writer.close()
 
-    async def _serve(
-        self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter, peer: str
-    ) -> tuple[str, str | None]:
-        """Serve one program until it goes: why it ended, and a last line to send it."""
+    async def _serve(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> str:
+        """Serve one program until it goes; why it ended."""
         link = self.link
-
-        async def send(line: str) -> None:
-            writer.write(line.encode("utf-8") + b"\r\n")
-            await writer.drain()
-
-        pusher = asyncio.create_task(link.push_reports(send, self.config.report_ms / 1000))
+        outbox = _Outbox(writer)
+        pusher = asyncio.create_task(link.push_reports(outbox, self.config.report_ms / 1000))
+        # an idle driver is cut off at once: nothing it has not read is worth sending
+        pusher.add_done_callback(lambda task: task.cancelled() or writer.transport.abort())
         splitter = LineSplitter(self.config.max_line_bytes)
         try:
             while True:
-                if pusher.done():
-                    return _ended(pusher), None
                 data = await reader.read(READ_SIZE)
+                if pusher.done():
+                    return _ended(pusher)
                 if not data:
-                    return "closed by VIPLE", None
+                    return "closed by VIPLE"
+                link.heard()
                 for line, err in _in_order(splitter, data):
                     if err is None:
-                        await link.take(line, send)
-                    elif _too_long(err):
-                        why = f"line longer than {self.config.max_line_bytes} bytes"
-                        link.reject(f"{why}; connection closed", link.received(), log=False)
-                        self.log.warning("%s: %s; closing the connection", peer, why)
-                        return why, f'{{"error":"{why}; closing the connection"}}'
+                        await link.take(line, outbox)
                     else:
                         for reason in err.reasons:
                             link.reject(reason, link.received())
                         await link.pace()
                 await link.pace()
         except OSError as err:
-            return _reason(err), None
+            return _ended(pusher) if pusher.done() else _reason(err)
         finally:
             pusher.cancel()
             await asyncio.gather(pusher, return_exceptions=True)
@@ -288,8 +308,13 @@ def _in_order(splitter: LineSplitter, data: bytes) -> Iterator[tuple[str, FrameE
 
 
 def _ended(task: asyncio.Task) -> str:
-    err = task.exception() if not task.cancelled() else None
-    return _reason(err) if isinstance(err, OSError) else "report stream ended"
+    """Why the report pusher ended: the idle rule's reason, or the error that stopped it."""
+    if task.cancelled():
+        return "server stopping"
+    err = task.exception()
+    if err is None:
+        return str(task.result())
+    return _reason(err) if isinstance(err, OSError) else f"report stream failed: {err}"
 
 
 def _unavailable(err: OSError) -> bool:

@@ -6,6 +6,10 @@ once per outage. One JSON object per text frame (several CRLF-separated objects 
 are accepted too); the reports are the same as the TCP role's: one pushed every
 ``report_ms`` and one in answer to each accepted command. Binary frames are rejected and
 counted; a frame over the size limit closes the connection (and the client reconnects).
+
+Keepalive pings go out every ``ping_interval_s``; a server that does not answer one within
+``ping_timeout_s`` is taken as gone. As over TCP, reports are not queued behind a peer that
+does not read, and a driver idle for ``idle_s`` loses the seat (see ``link``).
 """
 
 from __future__ import annotations
@@ -23,10 +27,22 @@ from websockets.uri import parse_uri
 from workbench.sim.session import Session
 
 from .codec import DEFAULT_MAX_LINE_BYTES, split_frame
-from .link import REPORT_MS_DEFAULT, Link, LinkStatus, Seat, check_report_ms
+from .link import (
+    IDLE_S_DEFAULT,
+    REPORT_MS_DEFAULT,
+    Link,
+    LinkStatus,
+    Seat,
+    check_idle_s,
+    check_report_ms,
+)
+from .sockets import configure_socket
 
 DEFAULT_URL = "ws://localhost:8124/"
 RETRY_SECONDS = 1.0
+#: WebSocket keepalive: a ping this often, and the server must answer within the timeout
+PING_INTERVAL_S = 20.0
+PING_TIMEOUT_S = 20.0
 
 log = logging.getLogger("workbench.viple.ws")
 
@@ -57,10 +73,17 @@ class WsConfig:
     report_ms: int = REPORT_MS_DEFAULT
     max_message_bytes: int = DEFAULT_MAX_LINE_BYTES
     retry_seconds: float = RETRY_SECONDS
+    #: seconds a driver may send nothing and read nothing before it loses the seat (None: never)
+    idle_s: float | None = IDLE_S_DEFAULT
+    ping_interval_s: float = PING_INTERVAL_S
+    ping_timeout_s: float = PING_TIMEOUT_S
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "url", check_ws_url(self.url))
         check_report_ms(self.report_ms)
+        check_idle_s(self.idle_s)
+        if not (self.ping_interval_s > 0 and self.ping_timeout_s > 0):
+            raise ValueError("ping_interval_s and ping_timeout_s must be positive")
         if not self.max_message_bytes >= 1:
             raise ValueError("max_message_bytes must be at least 1")
         if not self.retry_seconds > 0:
@@ -79,7 +102,14 @@ class WsClient:
     ) -> None:
         self.config = config or WsConfig()
         self.log = logger or log
-        self.link = Link(session, "ws", address=self.config.url, seat=seat, logger=self.log)
+        self.link = Link(
+            session,
+            "ws",
+            address=self.config.url,
+            seat=seat,
+            logger=self.log,
+            idle_s=self.config.idle_s,
+        )
         self._task: asyncio.Task | None = None
         self._outage = False
         self._waiting = False
@@ -122,7 +152,8 @@ class WsClient:
                     compression=None,
                     max_size=self.config.max_message_bytes,
                     open_timeout=max(2.0, self.config.retry_seconds),
-                    ping_interval=None,
+                    ping_interval=self.config.ping_interval_s,
+                    ping_timeout=self.config.ping_timeout_s,
                     close_timeout=1.0,
                 ) as ws:
                     reason = await self._serve(ws)
@@ -165,11 +196,16 @@ class WsClient:
             return None
         self._outage = False
         self.log.info("connected to VIPLE at %s", url)
-        pusher = asyncio.create_task(link.push_reports(ws.send, self.config.report_ms / 1000))
-        reason = "connection closed"
+        configure_socket(ws.transport.get_extra_info("socket"))
+        outbox = _Outbox(ws)
+        pusher = asyncio.create_task(link.push_reports(outbox, self.config.report_ms / 1000))
+        # an idle driver is cut off at once: nothing it has not read is worth sending
+        pusher.add_done_callback(lambda task: task.cancelled() or ws.transport.abort())
+        reason = "workbench stopping"
         try:
             while True:
                 message = await ws.recv()
+                link.heard()
                 if isinstance(message, bytes):
                     link.reject(
                         f"binary frame of {len(message)} bytes rejected: VIPLE sends JSON "
@@ -177,14 +213,15 @@ class WsClient:
                         link.received(),
                     )
                 else:
-                    await link.handle(split_frame(message), ws.send)
+                    await link.handle(split_frame(message), outbox)
                 await link.pace()
         except ConnectionClosed as closed:
-            reason = self._closed_reason(closed)
+            reason = _ended(pusher) if pusher.done() else self._closed_reason(closed)
             return reason
-        except asyncio.CancelledError:
-            reason = "stopping"
-            raise
+        except Exception as err:
+            reason = f"connection handling failed: {err}"
+            self.log.error("%s: %s", url, reason, exc_info=err)
+            return reason
         finally:
             pusher.cancel()
             await asyncio.gather(pusher, return_exceptions=True)
@@ -200,6 +237,27 @@ class WsClient:
         return _describe(closed)
 
 
+class _Outbox:
+    """A WebSocket connection's writing side: one text frame per report, never waiting."""
+
+    def __init__(self, ws: ClientConnection) -> None:
+        self.ws = ws
+
+    def queued(self) -> int:
+        return self.ws.transport.get_write_buffer_size()
+
+    async def write(self, line: str) -> None:
+        await self.ws.send(line)
+
+
+def _ended(task: asyncio.Task) -> str:
+    """Why the report pusher ended: the idle rule's reason, or the error that stopped it."""
+    if task.cancelled():
+        return "workbench stopping"
+    err = task.exception()
+    return str(task.result()) if err is None else _describe(err)
+
+
 def _describe(err: BaseException) -> str:
     if isinstance(err, ConnectionClosed):
         frame = err.rcvd or err.sent
@@ -207,7 +265,8 @@ def _describe(err: BaseException) -> str:
             return "connection lost"
         code = int(frame.code)
         meaning = frame.reason or CLOSE_CODE_EXPLANATIONS.get(code, "")
-        return f"closed with code {code}{f': {meaning}' if meaning else ''}"
+        who = "VIPLE" if err.rcvd is not None else "the workbench"
+        return f"closed by {who} with code {code}{f': {meaning}' if meaning else ''}"
     if isinstance(err, OSError) and err.strerror:
         return err.strerror
     with contextlib.suppress(Exception):
