@@ -23,8 +23,7 @@ from tests.integration.test_labs_completable import DRIVE, SOLUTIONS, answer, fr
 from workbench.cli import main
 from workbench.control.algorithms import list_algorithms
 from workbench.labs import signoff as so
-from workbench.labs.checks import maze_of
-from workbench.labs.model import Exercise, Lab, Objective, load_labs
+from workbench.labs.model import Exercise, Lab, LabMaze, Objective, load_labs
 from workbench.labs.store import Store
 from workbench.tui.app import WorkbenchApp, make_app
 from workbench.tui.modals.algorithm import AlgorithmModal
@@ -91,18 +90,18 @@ class Walkthrough:
         return screen
 
     # -- the work --------------------------------------------------------------------------
-    async def load_maze(self, path: Path) -> None:
+    async def load_maze(self, lab_maze: LabMaze) -> None:
         """The maze key: type the file's path in the dialog."""
-        if self.bench.maze.same_layout(maze_of(path)):
+        if self.bench.maze.same_layout(lab_maze.maze):
             return
         await self.main_screen()
         await self.press("m")
         dialog = self.app.screen
         assert isinstance(dialog, PathDialog)
-        dialog.query_one("#path", Input).value = str(path)
+        dialog.query_one("#path", Input).value = str(lab_maze.path)
         await self.press("enter")
         assert isinstance(self.app.screen, MainScreen)
-        assert self.bench.maze.same_layout(maze_of(path)), self.bench.message
+        assert self.bench.maze.same_layout(lab_maze.maze), self.bench.message
 
     async def algorithm_dialog(self) -> AlgorithmModal:
         await self.main_screen()
@@ -196,8 +195,8 @@ class Walkthrough:
             await self.run_builtin(name)
 
     async def compare(self, obj: Objective) -> None:
-        for path in obj.mazes:
-            await self.load_maze(path)
+        for lab_maze in obj.mazes:
+            await self.load_maze(lab_maze)
             for name in obj.algorithms:
                 await self.run_builtin(name)
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 from textual.pilot import Pilot
 from textual.widgets import Input, Static
 
-from workbench.labs.checks import maze_of
 from workbench.labs.model import LABS_DIR
+from workbench.sim.mazeio import load_maze
 from workbench.tui.app import make_app
 from workbench.tui.screens.main import MainScreen
 from workbench.tui.screens.path_dialog import PathDialog
@@ -29,7 +29,7 @@ def test_m_loads_a_maze_file_onto_the_bench_and_keeps_the_profile(tmp_path):
         await pilot.press("enter")
         await pilot.pause()
         assert isinstance(app.screen, MainScreen)
-        assert app.bench.maze.same_layout(maze_of(RANKING))
+        assert app.bench.maze.same_layout(load_maze(RANKING))
         assert app.bench.profile == "unity"
         assert app.maze_path == RANKING  # the editor saves there
         assert app.sub_title == f"{app.bench.maze.name} (unity)"

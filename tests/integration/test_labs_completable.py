@@ -7,14 +7,13 @@ from __future__ import annotations
 import asyncio
 import socket
 from decimal import Decimal
-from pathlib import Path
 
 import pytest
 from websockets.asyncio.server import serve
 
 from workbench.control.bench import Bench
-from workbench.labs.checks import ExerciseProgress, apply_setup, evaluate, maze_of
-from workbench.labs.model import Exercise, Objective, Question, load_labs
+from workbench.labs.checks import ExerciseProgress, apply_setup, evaluate
+from workbench.labs.model import Exercise, LabMaze, Objective, Question, load_labs
 from workbench.viple.tcp_server import TcpConfig, TcpServer
 from workbench.viple.ws_client import WsClient, WsConfig
 
@@ -38,7 +37,7 @@ SOLUTIONS = {
 
 
 def fresh_bench(ex: Exercise) -> Bench:
-    bench = Bench.open(maze_of(ex.setup.maze), ex.setup.profile, noise="off")
+    bench = Bench.open(ex.setup.maze.maze, ex.setup.profile, noise="off")
     apply_setup(bench, ex.setup)
     return bench
 
@@ -54,8 +53,8 @@ def run_to_exit(bench: Bench, limit_s: int = 600) -> None:
     raise AssertionError(f"{bench.algorithm.name} did not get out of {bench.maze.name}")
 
 
-def run_on(bench: Bench, maze: Path, algorithm: str, params: list[str] | None = None) -> None:
-    bench.load_maze(maze_of(maze))
+def run_on(bench: Bench, maze: LabMaze, algorithm: str, params: list[str] | None = None) -> None:
+    bench.load_maze(maze.maze)
     bench.select_algorithm(algorithm)
     if params:
         bench.set_params(params)

@@ -6,17 +6,18 @@ from pathlib import Path
 import pytest
 
 from workbench.control.bench import Bench
+from workbench.control.fsmfile import load_fsm
 from workbench.labs.checks import (
     ExerciseProgress,
     apply_setup,
     check_objective,
     evaluate,
     keep_passed,
-    maze_of,
 )
 from workbench.labs.model import (
     Controller,
     Exercise,
+    LabMaze,
     Objective,
     Question,
     Setup,
@@ -26,21 +27,22 @@ from workbench.sim.sensors import SensorSpec
 from workbench.viple.link import Link
 
 MAZES = Path("mazes").resolve()
-EROBOTIC = MAZES / "erobotic.txt"
-RANK = MAZES / "rank-wall-wins.txt"
+EROBOTIC = LabMaze.read(MAZES / "erobotic.txt")
+RANK = LabMaze.read(MAZES / "rank-wall-wins.txt")
 MOVE = '{"servos":[{"isTurn":false,"servoId":-1,"servoSpeed":1}]}'
 RIGHT_WALL = ["distance:1:right", "distance:2:front"]
 
 
 def exercise(*objectives, questions=(), maze=EROBOTIC, profile="unity", controller="keys"):
     kind, _, value = controller.partition(" ")
+    starter = load_fsm(value) if kind == "starter" else None
     setup = Setup(profile, maze, tuple(SensorSpec.parse(s) for s in RIGHT_WALL),
-                  Controller(kind, value))  # fmt: skip
+                  Controller(kind, value, starter))  # fmt: skip
     return Exercise("ex", "Ex", "do it", setup, tuple(objectives), tuple(questions))
 
 
 def bench_for(ex):
-    b = Bench.open(maze_of(ex.setup.maze), ex.setup.profile, noise="off")
+    b = Bench.open(ex.setup.maze.maze, ex.setup.profile, noise="off")
     apply_setup(b, ex.setup)
     return b
 
@@ -133,7 +135,7 @@ def test_exit_objective_wants_the_right_kind_of_driver_on_the_right_maze():
     )
     evidence = check_objective(obj, ex, b).evidence
     assert evidence["run"] == run.number and evidence["metrics"]["reached_exit"] is True
-    assert evidence["maze_digest"] == maze_of(EROBOTIC).digest()
+    assert evidence["maze_digest"] == EROBOTIC.maze.digest()
 
 
 def test_exit_objective_accepts_a_named_algorithm_and_reports_a_broken_limit():
@@ -162,7 +164,7 @@ def test_exit_objective_accepts_a_named_algorithm_and_reports_a_broken_limit():
 def test_exit_objective_with_a_record_keeps_its_digest(tmp_path):
     obj = Objective("exit", "out", maze=RANK, drivers=("any",))
     ex = exercise(obj, maze=RANK)
-    b = Bench.open(maze_of(RANK), "unity", noise="off", record_dir=str(tmp_path))
+    b = Bench.open(RANK.maze, "unity", noise="off", record_dir=str(tmp_path))
     apply_setup(b, ex.setup)
     b.select_algorithm("right-wall")
     run_to_exit(b)
@@ -246,7 +248,7 @@ def test_apply_setup_puts_profile_maze_sensors_and_controller_on_the_bench():
     ex = exercise(
         maze=RANK, profile="web", controller="starter labs/starters/web-two-distance.yaml"
     )
-    b = Bench.open(maze_of(EROBOTIC), "unity", noise="off")
+    b = Bench.open(EROBOTIC.maze, "unity", noise="off")
     apply_setup(b, ex.setup)
     assert (b.profile, b.maze.name) == ("web", "Ranking - right wall wins")
     assert [str(s) for s in b.sensors] == RIGHT_WALL
@@ -255,7 +257,7 @@ def test_apply_setup_puts_profile_maze_sensors_and_controller_on_the_bench():
 
 @pytest.mark.parametrize("starter", sorted(Path("labs/starters").glob("*.yaml")))
 def test_every_starter_loads_and_runs_but_does_not_get_out_as_given(starter):
-    b = Bench.open(maze_of(EROBOTIC), "unity" if "unity" in starter.name else "web", noise="off")
+    b = Bench.open(EROBOTIC.maze, "unity" if "unity" in starter.name else "web", noise="off")
     b.select_algorithm(starter)
     b.apply_algorithm_preset()
     b.start_algorithm()
@@ -267,7 +269,7 @@ def test_every_starter_loads_and_runs_but_does_not_get_out_as_given(starter):
 def test_runs_on_another_profile_do_not_count():
     obj = Objective("exit", "out", maze=RANK, drivers=("algorithm right-wall",))
     ex = exercise(obj, maze=RANK, profile="web")
-    b = Bench.open(maze_of(RANK), "unity", noise="off")
+    b = Bench.open(RANK.maze, "unity", noise="off")
     b.select_algorithm("right-wall")
     run_to_exit(b)
     assert check(obj, ex, b) == (

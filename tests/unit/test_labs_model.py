@@ -66,7 +66,7 @@ def test_every_bundled_lab_loads_with_the_exercises_the_course_has():
     for lab in labs.values():
         for ex in lab.exercises:
             assert ex.signoff and ex.instructions.strip() and ex.objectives
-            assert ex.setup.maze.is_file()
+            assert ex.setup.maze.path.is_file() and ex.setup.maze.maze.validate() == []
 
 
 def test_bundled_labs_keep_no_answer_in_clear():

@@ -331,7 +331,10 @@ class Bench:
     # -- algorithms ----------------------------------------------------------------------
     def select_algorithm(self, name_or_path: str | os.PathLike) -> FsmDefinition:
         """Choose an algorithm (built-in name or YAML file); errors name the line and fix."""
-        definition = load_algorithm(name_or_path)
+        return self.use_algorithm(load_algorithm(name_or_path))
+
+    def use_algorithm(self, definition: FsmDefinition) -> FsmDefinition:
+        """Choose an algorithm already read (a lab's starter as the lab was loaded)."""
         if self.controller is not None:
             self.stop_algorithm("stopped")
         self.algorithm = definition

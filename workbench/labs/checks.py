@@ -10,19 +10,16 @@ import hashlib
 import json
 from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass, field
-from functools import cache
 from pathlib import Path
 from typing import Any
 
 from workbench.control.algorithms import ALGORITHM_DIR
 from workbench.control.bench import VIPLE_PREFIX, Bench, RunEntry
 from workbench.control.manual import KEY_NAMES
-from workbench.sim.maze import Maze
-from workbench.sim.mazeio import load_maze
 from workbench.sim.profiles import get_profile
 from workbench.sim.record import file_sha256
 
-from .model import Exercise, Objective, Setup
+from .model import Exercise, LabMaze, Objective, Setup
 
 ROLE_NAMES = {"tcp": "TCP (the Unity simulator's role)", "ws": "WebSocket (the Web Simulator's)"}
 
@@ -106,23 +103,17 @@ def keep_passed(saved: ExerciseProgress | None, live: ExerciseProgress) -> Exerc
 
 
 # -- set-up --------------------------------------------------------------------------------
-@cache
-def _maze(path: str) -> Maze:
-    return load_maze(path)
-
-
-def maze_of(path: Path) -> Maze:
-    return _maze(str(path))
-
-
 def apply_setup(bench: Bench, setup: Setup) -> None:
-    """The exercise's one-key set-up: profile, maze, sensors and the controller to use."""
+    """The exercise's one-key set-up: profile, maze, sensors and the controller to use, with
+    the maze and starter as they were when the lab was loaded."""
     bench.profile = setup.profile
-    bench.load_maze(maze_of(setup.maze))
+    bench.load_maze(setup.maze.maze)
     bench.apply_sensors(setup.sensors or get_profile(setup.profile).sensors)
-    kind, value = setup.controller.kind, setup.controller.value
-    if kind in ("algorithm", "starter"):
-        bench.select_algorithm(value)
+    controller = setup.controller
+    if controller.starter is not None:
+        bench.use_algorithm(controller.starter)
+    elif controller.kind == "algorithm":
+        bench.select_algorithm(controller.value)
     bench.start_exercise()
 
 
@@ -233,24 +224,41 @@ def _limits(obj: Objective, run: RunEntry) -> str | None:
     return None
 
 
-def _exits(bench: Bench, maze: Maze, profile: str) -> list[RunEntry]:
-    """Runs that reached the exit of exactly ``maze`` on ``profile``."""
-    digest = maze.digest()
+def _exits(bench: Bench, maze: LabMaze, profile: str) -> list[RunEntry]:
+    """Runs that reached the exit of exactly the lab's ``maze`` (same layout) on ``profile``."""
     return [
         r
         for r in bench.runs
-        if r.ended == "exit" and r.maze_digest == digest and r.profile == profile
+        if r.ended == "exit" and r.maze_digest == maze.digest and r.profile == profile
     ]
+
+
+def _not_the_lab_maze(bench: Bench, maze: LabMaze, profile: str) -> RunEntry | None:
+    """The last run that got out of a maze of the same name as the lab's but not its layout."""
+    others = [
+        r
+        for r in bench.runs
+        if r.ended == "exit" and r.maze == maze.name and r.profile == profile
+        and r.maze_digest != maze.digest
+    ]  # fmt: skip
+    return others[-1] if others else None
 
 
 def check_exit(obj: Objective, exercise: Exercise, bench: Bench) -> Check:
     assert obj.maze is not None
-    maze = maze_of(obj.maze)
+    maze = obj.maze
     profile = exercise.setup.profile
     wanted = set(obj.drivers)
     runs = [r for r in _exits(bench, maze, profile) if driver_kinds(r) & wanted]
     drivers = " or ".join(obj.drivers)
     if not runs:
+        other = _not_the_lab_maze(bench, maze, profile)
+        if other is not None:
+            return Check(
+                False,
+                f"run {other.number} got out of a changed copy of {maze.name!r}, not the lab's "
+                "maze: set the exercise up again (a) and drive the maze as it is given",
+            )
         return Check(
             False, f"no run by {drivers} has reached the exit of {maze.name!r} ({profile}) yet"
         )
@@ -267,7 +275,7 @@ def check_exit(obj: Objective, exercise: Exercise, bench: Bench) -> Check:
 
 
 def check_maze_edited(exercise: Exercise, bench: Bench) -> Check:
-    original = maze_of(exercise.setup.maze)
+    original = exercise.setup.maze.maze
     evidence = {"maze_digest": bench.maze.digest(), "original_digest": original.digest()}
     if bench.maze.same_layout(original):
         return Check(False, f"the maze is still {original.name!r} as set up: add or remove a block")
@@ -283,8 +291,7 @@ def check_maze_edited(exercise: Exercise, bench: Bench) -> Check:
 def check_compare(obj: Objective, exercise: Exercise, bench: Bench) -> Check:
     table: list[dict[str, Any]] = []
     missing = []
-    for path in obj.mazes:
-        maze = maze_of(path)
+    for maze in obj.mazes:
         for name in obj.algorithms:
             runs = [
                 r

@@ -17,6 +17,10 @@ from typing import Any
 import yaml
 
 from workbench.control.algorithms import list_algorithms
+from workbench.control.fsmdef import FsmDefinition
+from workbench.control.fsmfile import FsmFileError, load_fsm
+from workbench.sim.maze import Maze, MazeError
+from workbench.sim.mazeio import load_maze
 from workbench.sim.profiles import PROFILES
 from workbench.sim.sensors import SensorConfigError, SensorSpec, check_ports
 
@@ -112,12 +116,40 @@ class Question:
 
 # -- set-up, objectives, exercises ---------------------------------------------------------
 @dataclass(frozen=True)
+class LabMaze:
+    """A maze a lab rests on, as it was read when the lab was loaded.
+
+    The lab's checks compare runs with this layout (by :meth:`Maze.digest`), never with the
+    file as it is later: an edited copy, or the file changed on disk after loading, is another
+    maze and meets no objective on this one.
+    """
+
+    path: Path
+    maze: Maze
+
+    @classmethod
+    def read(cls, path: Path) -> LabMaze:
+        """The maze at ``path`` as it is now (:class:`MazeError` when it cannot be read)."""
+        return cls(path, load_maze(path))
+
+    @property
+    def digest(self) -> str:
+        return self.maze.digest()
+
+    @property
+    def name(self) -> str:
+        return self.maze.name
+
+
+@dataclass(frozen=True)
 class Controller:
     """Who drives in the set-up: keys, a built-in algorithm, a starter FSM, or VIPLE."""
 
     kind: str
     #: algorithm name, starter file path, or VIPLE role (tcp / ws)
     value: str = ""
+    #: a starter as it was read when the lab was loaded (the set-up uses this, not the file)
+    starter: FsmDefinition | None = field(default=None, compare=False)
 
     def __str__(self) -> str:
         return f"{self.kind} {self.value}".strip()
@@ -126,7 +158,7 @@ class Controller:
 @dataclass(frozen=True)
 class Setup:
     profile: str
-    maze: Path
+    maze: LabMaze
     sensors: tuple[SensorSpec, ...]
     controller: Controller
 
@@ -138,14 +170,14 @@ class Objective:
     keys: tuple[str, ...] = ()
     sensors: tuple[SensorSpec, ...] = ()
     role: str = ""
-    maze: Path | None = None
+    maze: LabMaze | None = None
     #: accepted drivers for ``exit``: "viple", "fsm", "algorithm NAME", "any"
     drivers: tuple[str, ...] = ()
     max_time: float | None = None
     max_turn_degrees: float | None = None
     max_collisions: int | None = None
     algorithms: tuple[str, ...] = ()
-    mazes: tuple[Path, ...] = ()
+    mazes: tuple[LabMaze, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -181,6 +213,7 @@ class _Reader:
         self.path = path
         self.label = label
         self.base = path.parent
+        self.mazes: dict[Path, LabMaze] = {}
 
     def fail(self, node: yaml.Node | None, where: str, message: str, hint: str = "") -> None:
         line = node.start_mark.line + 1 if node is not None else 1
@@ -237,6 +270,19 @@ class _Reader:
                 node, where, f"no file {node.value!r}", f"paths are relative to {self.base.name}/"
             )
         return path
+
+    def maze(self, node: yaml.Node, where: str) -> LabMaze:
+        """The maze file ``node`` names, read now (once per lab file) and kept as read."""
+        path = self.file(node, where)
+        if path not in self.mazes:
+            try:
+                self.mazes[path] = LabMaze.read(path)
+            except MazeError as exc:
+                first = exc.problems[0]
+                at = f"line {first.line}: " if first.line else ""
+                self.fail(node, where, f"maze {node.value!r} cannot be read: {at}{first.message}",
+                          "see every problem with 'workbench maze check FILE'")  # fmt: skip
+        return self.mazes[path]
 
     def sensors(self, node: yaml.Node, where: str) -> tuple[SensorSpec, ...]:
         if isinstance(node, yaml.SequenceNode) and not node.value:
@@ -339,7 +385,7 @@ def _setup(r: _Reader, node: yaml.Node, where: str) -> Setup:
     profile = r.choice(keys["profile"], f"{where}: setup", tuple(PROFILES), "profile")
     sensors = r.sensors(keys["sensors"], f"{where}: setup") if "sensors" in keys else ()
     return Setup(
-        profile, r.file(keys["maze"], f"{where}: setup"), sensors, _controller(r, keys, where)
+        profile, r.maze(keys["maze"], f"{where}: setup"), sensors, _controller(r, keys, where)
     )
 
 
@@ -361,7 +407,12 @@ def _controller(r: _Reader, keys: dict[str, yaml.Node], where: str) -> Controlle
         path = (r.base / value).resolve()
         if not value or not path.is_file():
             r.fail(node, here, f"no starter file {value!r}", "write 'starter starters/NAME.yaml'")
-        value = str(path)
+        try:
+            starter = load_fsm(path)
+        except FsmFileError as exc:
+            r.fail(node, here, f"starter {value!r} cannot be read: {exc.problems[0].message}",
+                   "see every problem with 'workbench algorithms FILE'")  # fmt: skip
+        return Controller(kind, str(path), starter)
     if kind == "viple" and value not in VIPLE_ROLES:
         r.fail(node, here, f"unknown VIPLE role {value!r}", "use 'viple tcp' or 'viple ws'")
     return Controller(kind, value)
@@ -411,9 +462,9 @@ def _objective(r: _Reader, node: yaml.Node, where: str) -> Objective:
         limits = {k: r.number(keys[k], f"{here}: {k}") for k in optional if k in keys}
         if "max_collisions" in limits:
             limits["max_collisions"] = int(limits["max_collisions"])
-        return Objective(kind, text, maze=r.file(keys["maze"], here), drivers=drivers, **limits)
+        return Objective(kind, text, maze=r.maze(keys["maze"], here), drivers=drivers, **limits)
     if kind == "compare":
-        mazes = tuple(r.file(n, here) for n in r.items(keys["mazes"], here))
+        mazes = tuple(r.maze(n, here) for n in r.items(keys["mazes"], here))
         return Objective(kind, text, algorithms=r.texts(keys["algorithms"], here), mazes=mazes)
     return Objective(kind, text)
 

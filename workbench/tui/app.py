@@ -280,7 +280,7 @@ class WorkbenchApp(App[None]):
     def set_up_done(self, setup: Setup | None = None) -> None:
         """A lab's set-up changed the bench: follow its maze and profile, and start the VIPLE
         endpoint an exercise done from VIPLE needs."""
-        self.maze_changed(setup.maze if setup is not None else None)
+        self.maze_changed(setup.maze.path if setup is not None else None)
         if setup is not None and setup.controller.kind == "viple":
             self.run_worker(self.open_endpoint(setup.controller.value), group="endpoints")
 
