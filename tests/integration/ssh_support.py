@@ -14,7 +14,8 @@ from pathlib import Path
 import asyncssh
 import pyte
 
-from workbench.ssh.limits import FailureDelay, SessionLimits
+from workbench.ssh.limits import SessionLimits
+from workbench.ssh.logins import LoginPolicy
 from workbench.ssh.passwords import hash_password
 from workbench.ssh.server import LabServer, ServerConfig
 from workbench.ssh.users import add_user, users_path
@@ -47,6 +48,7 @@ class LabHost:
     ) -> asyncssh.SSHClientConnection:
         account = self.accounts.get(name)
         keys = [account.key] if key and account is not None and account.key else []
+        options = {"agent_path": None} | options
         return await asyncssh.connect(
             "127.0.0.1",
             self.port,
@@ -54,7 +56,6 @@ class LabHost:
             client_keys=keys,
             password=password,
             known_hosts=None,
-            agent_path=None,
             preferred_auth=["publickey", "password"] if keys else ["password"],
             **options,
         )
@@ -99,8 +100,7 @@ async def lab_host(
             port_range=port_range(),
             public_host="lab.example",
             limits=limits or SessionLimits(),
-            failure_delay=FailureDelay(first=0.05, most=0.2),
-            **config,
+            **({"logins": LoginPolicy(first_delay=0.05, max_delay=0.2)} | config),
         )
     )
     await server.start()

@@ -11,7 +11,7 @@ import pytest
 from workbench.ssh import packets
 from workbench.ssh.appproc import AppSpec, forward_hint
 from workbench.ssh.forwarding import local_forward_refusal, remote_forward_refusal
-from workbench.ssh.limits import FailureDelay, SessionLimits, describe_duration
+from workbench.ssh.limits import SessionLimits, describe_duration
 from workbench.ssh.passwords import (
     PasswordError,
     check_password,
@@ -155,20 +155,3 @@ def test_limits_say_why_a_session_is_refused():
     assert "You already have 2 workbench sessions open" in limits.refusal(2, 3)
     assert describe_duration(7200) == "2 h" and describe_duration(90) == "90 s"
     assert describe_duration(120) == "2 min"
-
-
-def test_failed_logins_from_an_address_are_answered_ever_more_slowly_until_quiet():
-    now = [0.0]
-    delay = FailureDelay(first=0.5, most=8.0, quiet=600, clock=lambda: now[0])
-    assert delay.delay("10.0.0.1") == 0
-    waits = []
-    for _ in range(7):
-        delay.failed("10.0.0.1")
-        waits.append(delay.delay("10.0.0.1"))
-    assert waits == [0.5, 1, 2, 4, 8, 8, 8]
-    assert delay.delay("10.0.0.2") == 0  # other addresses are not slowed
-    delay.succeeded("10.0.0.1")
-    assert delay.delay("10.0.0.1") == 0
-    delay.failed("10.0.0.1")
-    now[0] = 601.0
-    assert delay.delay("10.0.0.1") == 0  # a quiet period forgets

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import asyncio
 import getpass
+import math
 import signal
 import sys
 from pathlib import Path
@@ -42,6 +43,26 @@ def register(sub: argparse._SubParsersAction) -> None:
     serve.add_argument(
         "--idle-timeout", type=float, default=7200,
         help="seconds without input before a session is closed (default 7200)",
+    )  # fmt: skip
+    serve.add_argument(
+        "--login-timeout", type=float, default=30,
+        help="seconds a connection has to log in (default 30)",
+    )  # fmt: skip
+    serve.add_argument(
+        "--max-unauthenticated", type=int, default=100,
+        help="connections not logged in yet, in all (default 100)",
+    )  # fmt: skip
+    serve.add_argument(
+        "--max-unauthenticated-per-address", type=int, default=10,
+        help="connections not logged in yet from one address (default 10)",
+    )  # fmt: skip
+    serve.add_argument(
+        "--password-lock-after", type=int, default=10,
+        help="wrong passwords for one account before its passwords are locked (default 10)",
+    )  # fmt: skip
+    serve.add_argument(
+        "--password-lock-for", type=float, default=900,
+        help="seconds an account takes no passwords once locked; keys still work (default 900)",
     )  # fmt: skip
     serve.add_argument(
         "--no-fork-server", action="store_true",
@@ -173,6 +194,7 @@ def cmd_list_users(args: argparse.Namespace) -> int:
 def cmd_serve(args: argparse.Namespace) -> int:
     from workbench.ssh.hostkey import HostKeyError
     from workbench.ssh.limits import SessionLimits
+    from workbench.ssh.logins import LoginPolicy
     from workbench.ssh.ports import parse_range
     from workbench.ssh.server import LabServer, ServerConfig, setup_logging
     from workbench.ssh.users import UsersFileError
@@ -191,8 +213,28 @@ def cmd_serve(args: argparse.Namespace) -> int:
             f"--port {args.port} lies inside --port-range {args.port_range}, which is kept for "
             "the sessions' VIPLE ports: choose a port outside it",
         )
-    if args.max_per_user < 1 or args.max_sessions < 1 or args.idle_timeout <= 0:
+    if args.max_per_user < 1 or args.max_sessions < 1 or not args.idle_timeout > 0:
         return fail("serve-ssh", "--max-per-user, --max-sessions and --idle-timeout must be > 0")
+    login_numbers = (
+        args.login_timeout,
+        args.max_unauthenticated,
+        args.max_unauthenticated_per_address,
+        args.password_lock_after,
+        args.password_lock_for,
+    )
+    if not all(math.isfinite(x) and x > 0 for x in login_numbers):
+        return fail(
+            "serve-ssh",
+            "--login-timeout, --max-unauthenticated, --max-unauthenticated-per-address, "
+            "--password-lock-after and --password-lock-for must be > 0",
+        )
+    logins = LoginPolicy(
+        login_timeout=args.login_timeout,
+        max_unauthenticated=args.max_unauthenticated,
+        max_unauthenticated_per_address=args.max_unauthenticated_per_address,
+        lock_after=args.password_lock_after,
+        lock_for=args.password_lock_for,
+    )
     data_dir = resolve_data_dir(args.data_dir)
     config = ServerConfig(
         data_dir=data_dir,
@@ -203,6 +245,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
         port_range=port_range,
         public_host=args.public_host,
         limits=SessionLimits(args.max_per_user, args.max_sessions, args.idle_timeout),
+        logins=logins,
         fork_server=not args.no_fork_server,
     )
     try:

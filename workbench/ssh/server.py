@@ -21,7 +21,8 @@ from .appproc import RESTORE_TERMINAL, AppProcess, AppSpec, app_env, forward_hin
 from .forkserver import ForkServer, ForkServerError
 from .forwarding import local_forward_refusal, remote_forward_refusal
 from .hostkey import host_key_path, load_or_create_host_key
-from .limits import FailureDelay, SessionLimits, describe_duration
+from .limits import SessionLimits, describe_duration
+from .logins import ConnectionGate, LoginGuard, LoginPolicy, QuietLog
 from .passwords import hash_password, verify_password
 from .ports import PoolExhausted, PortPool
 from .users import User, UsersFile, users_path
@@ -54,7 +55,7 @@ class ServerConfig:
     fork_server: bool = True
     #: seconds between the stop steps of an app (quit, SIGTERM, SIGKILL)
     stop_grace: float = 2.0
-    failure_delay: FailureDelay = field(default_factory=FailureDelay)
+    logins: LoginPolicy = field(default_factory=LoginPolicy)
     keepalive_interval: float = 30.0
 
     def __post_init__(self) -> None:
@@ -62,6 +63,11 @@ class ServerConfig:
         self.host_key = Path(self.host_key or host_key_path(self.data_dir))
         self.users_file = Path(self.users_file or users_path(self.data_dir))
         self.public_host = self.public_host or socket.getfqdn()
+
+
+def shown(name: str) -> str:
+    """A login name as the log shows it: at most 64 characters, no control characters."""
+    return "".join(c if c.isprintable() else "?" for c in name[:64])
 
 
 def setup_logging(data_dir: Path, stream: bool = True) -> Path:
@@ -92,6 +98,12 @@ class LabServer:
         self.sessions: dict[int, LabSession] = {}
         self.connections: set[LabConnection] = set()
         self.remote_listens: dict[str, Counter[int]] = {}
+        self.guard = LoginGuard(config.logins)
+        self.gate = ConnectionGate(config.logins)
+        self.quiet_log = QuietLog()
+        #: password checks for one account take turns, so parallel guesses wait in line
+        self._account_turns: dict[str, asyncio.Lock] = {}
+        self._account_queue: Counter[str] = Counter()
         self._ids = itertools.count(1)
         self._acceptor: asyncssh.SSHAcceptor | None = None
         self._sweeper: asyncio.Task[None] | None = None
@@ -118,6 +130,14 @@ class LabServer:
             config.bind or "all addresses", self.port, len(self.users.users),
             config.users_file, *config.port_range, self.host_key.get_fingerprint(),
         )  # fmt: skip
+        logins = config.logins
+        log.info(
+            "logins: %g s to log in; at most %d connections not logged in (%d per address); "
+            "passwords locked for %s after %d failures",
+            logins.login_timeout, logins.max_unauthenticated,
+            logins.max_unauthenticated_per_address, describe_duration(logins.lock_for),
+            logins.lock_after,
+        )  # fmt: skip
 
     async def _listen(self) -> asyncssh.SSHAcceptor:
         config = self.config
@@ -131,7 +151,7 @@ class LabServer:
             allow_scp=False,
             agent_forwarding=False,
             x11_forwarding=False,
-            login_timeout=60,
+            login_timeout=config.logins.login_timeout,
             keepalive_interval=config.keepalive_interval,
             keepalive_count_max=4,
             server_version="workbench",
@@ -187,6 +207,28 @@ class LabServer:
     async def __aexit__(self, *exc: object) -> None:
         await self.close()
 
+    def say_now_and_then(self, key: str, message: str, *args: object) -> None:
+        """Log a warning that an attacker could repeat thousands of times, once per 10 s."""
+        held = self.quiet_log.due(key)
+        if held is None:
+            return
+        if held:
+            message += f" ({held} more like it not logged)"
+        log.warning(message, *args)
+
+    @contextlib.asynccontextmanager
+    async def account_turn(self, account: str):
+        """Wait for the account's turn to have a password checked."""
+        lock = self._account_turns.setdefault(account, asyncio.Lock())
+        self._account_queue[account] += 1
+        try:
+            async with lock:
+                yield
+        finally:
+            self._account_queue[account] -= 1
+            if not self._account_queue[account]:
+                del self._account_queue[account], self._account_turns[account]
+
     # -- sessions ----------------------------------------------------------------------------
     def live(self, user: str) -> list[LabSession]:
         return [s for s in self.sessions.values() if s.user.name == user and s.running]
@@ -229,31 +271,74 @@ class LabConnection(asyncssh.SSHServer):
         self.user: User | None = None
         self.failed = False
         self.remote_ports: Counter[int] = Counter()
+        #: counted among the connections that have not logged in yet
+        self.counted = False
+        #: closed at once: too many connections had not logged in
+        self.turned_away = False
+        self._pending_key = "?"
 
     # -- connection --------------------------------------------------------------------------
     def connection_made(self, conn: asyncssh.SSHServerConnection) -> None:
         self.conn = conn
-        self.server.connections.add(self)
+        server = self.server
+        server.connections.add(self)
         peer = conn.get_extra_info("peername")
         self.peer = str(peer[0]) if peer else "?"
+        why = server.gate.refuse_connection(self.peer)
+        if why is not None:
+            self.turned_away = True
+            server.say_now_and_then(
+                f"turned away {self.peer}", "connection from %s closed: %s", self.peer, why
+            )
+            asyncio.get_running_loop().call_soon(conn.abort)
+            return
+        server.gate.opened(self.peer)
+        self.counted = True
+        # agent and X11 forwarding are off; these make their refusals show in the log
+        conn.create_agent_listener = self._refuse_agent  # type: ignore[method-assign]
+        conn.attach_x11_listener = self._refuse_x11  # type: ignore[method-assign]
+
+    def _settle(self) -> None:
+        if self.counted:
+            self.counted = False
+            self.server.gate.settled(self.peer)
 
     def connection_lost(self, exc: Exception | None) -> None:
+        self._settle()
         self.server.connections.discard(self)
         if self.username and self.user is None and not self.failed:
             # every offered key was refused and the client gave up
-            self.server.config.failure_delay.failed(self.peer)
-            log.warning("login failed: %s from %s (no accepted key)", self.username, self.peer)
+            self.server.guard.key_failed(self.peer)
+            self.server.say_now_and_then(
+                f"no key {self.peer}",
+                "login failed: %s from %s (no accepted key)",
+                shown(self.username),
+                self.peer,
+            )
         if self.user is not None and self.remote_ports:
             held = self.server.remote_listens.get(self.user.name)
             if held is not None:
                 held.subtract(self.remote_ports)
 
+    async def _refuse_agent(self) -> bool:
+        log.warning("agent forwarding refused: %s from %s", shown(self.username), self.peer)
+        return False
+
+    async def _refuse_x11(self, *args: object) -> None:
+        log.warning("X11 forwarding refused: %s from %s", shown(self.username), self.peer)
+        return None
+
+    def tun_requested(self, unit: int | None) -> bool:
+        log.warning("tunnel (tun) refused: %s from %s", shown(self.username), self.peer)
+        return False
+
+    def tap_requested(self, unit: int | None) -> bool:
+        log.warning("tunnel (tap) refused: %s from %s", shown(self.username), self.peer)
+        return False
+
     # -- authentication ----------------------------------------------------------------------
-    async def begin_auth(self, username: str) -> bool:
+    def begin_auth(self, username: str) -> bool:
         self.username = username
-        delay = self.server.config.failure_delay.delay(self.peer)
-        if delay:
-            await asyncio.sleep(delay)
         return True
 
     def _known(self, username: str) -> User | None:
@@ -263,14 +348,19 @@ class LabConnection(asyncssh.SSHServer):
             log.error("users file not read again, the earlier users stay: %s", users.problem)
         return user
 
-    def _refused(self, username: str, why: str) -> None:
+    def _refused(self, username: str, why: str, *, checked: bool = True) -> None:
+        """Log a refused password; unchecked ones (which cost nothing) at most once per 10 s."""
         self.failed = True
-        self.server.config.failure_delay.failed(self.peer)
-        log.warning("login refused: %s from %s: %s", username, self.peer, why)
+        message = "login refused: %s from %s: %s"
+        if checked:
+            log.warning(message, shown(username), self.peer, why)
+        else:
+            key = f"unchecked {username} {self.peer}"
+            self.server.say_now_and_then(key, message, shown(username), self.peer, why)
 
     def _accepted(self, user: User, how: str) -> None:
         self.user = user
-        self.server.config.failure_delay.succeeded(self.peer)
+        self._settle()
         log.info("login: %s (%s) from %s with %s", user.name, user.role, self.peer, how)
 
     def public_key_auth_supported(self) -> bool:
@@ -287,26 +377,51 @@ class LabConnection(asyncssh.SSHServer):
         if self.user is None:  # by key: validate_public_key cannot tell a query from a login
             user = self._known(self.username)
             if user is not None:
-                self._accepted(user, f"key {getattr(self, '_pending_key', '?')}")
+                self._accepted(user, f"key {self._pending_key}")
 
     def password_auth_supported(self) -> bool:
         return True
 
     async def validate_password(self, username: str, password: str) -> bool:
-        delay = self.server.config.failure_delay.delay(self.peer)
+        server, peer = self.server, self.peer
+        if not server.gate.start_waiting(peer):
+            why = "too many password attempts at once, not checked"
+            self._refused(username, why, checked=False)
+            return False
+        try:
+            async with server.account_turn(username):
+                return await self._check_password(username, password)
+        finally:
+            server.gate.stop_waiting(peer)
+
+    async def _check_password(self, username: str, password: str) -> bool:
+        guard = self.server.guard
+        locked = guard.locked_for(username)
+        if locked:
+            why = f"passwords locked for another {describe_duration(round(locked))}"
+            self._refused(username, why, checked=False)
+            return False
+        delay = guard.delay(username, self.peer)
         if delay:
             await asyncio.sleep(delay)
         user = self._known(username)
         stored = user.password if user is not None and user.password else _DUMMY_HASH
         ok = await asyncio.to_thread(verify_password, password, stored)
-        if user is None:
-            self._refused(username, "unknown user")
-            return False
-        if not (ok and user.password):
-            self._refused(username, "wrong password")
-            return False
-        self._accepted(user, "password")
-        return True
+        if user is not None and ok and user.password:
+            guard.password_succeeded(username)
+            self._accepted(user, "password")
+            return True
+        locks = guard.password_failed(username, self.peer)
+        self._refused(username, "unknown user" if user is None else "wrong password")
+        if locks:
+            policy = guard.policy
+            log.warning(
+                "passwords of %s locked for %s after %d failures (keys still work)",
+                shown(username),
+                describe_duration(policy.lock_for),
+                policy.lock_after,
+            )
+        return False
 
     # -- channels ----------------------------------------------------------------------------
     def session_requested(self) -> LabSession | bool:
@@ -359,11 +474,11 @@ class LabConnection(asyncssh.SSHServer):
         return True
 
     def unix_connection_requested(self, dest_path: str) -> bool:
-        log.warning("forward refused: %s to socket %s", self.username, dest_path)
+        log.warning("forward refused: %s to socket %s", self.username, shown(dest_path))
         return False
 
     def unix_server_requested(self, listen_path: str) -> bool:
-        log.warning("remote forward refused: %s on socket %s", self.username, listen_path)
+        log.warning("remote forward refused: %s on socket %s", self.username, shown(listen_path))
         return False
 
 

@@ -1,0 +1,111 @@
+"""The login guard: delays per account and per address, account locks, and the caps on
+connections that have not logged in (all on an injected clock)."""
+
+from __future__ import annotations
+
+from workbench.ssh.logins import ConnectionGate, LoginGuard, LoginPolicy, QuietLog
+
+STUDENT_PC = "10.0.0.7"
+
+
+class Clock:
+    def __init__(self) -> None:
+        self.now = 0.0
+
+    def __call__(self) -> float:
+        return self.now
+
+
+def guard(**numbers) -> tuple[LoginGuard, Clock]:
+    clock = Clock()
+    return LoginGuard(LoginPolicy(**numbers), clock), clock
+
+
+def test_wrong_passwords_for_an_account_are_answered_ever_more_slowly_from_any_address():
+    g, _ = guard(lock_after=100)
+    assert g.delay("rivera", STUDENT_PC) == 0
+    waits = []
+    for n in range(7):
+        g.password_failed("rivera", f"10.0.1.{n}")  # a new address each time
+        waits.append(g.delay("rivera", "10.0.9.9"))
+    assert waits == [0.5, 1, 2, 4, 8, 8, 8]
+    assert g.delay("someone-else", "10.0.9.9") == 0
+
+
+def test_a_success_on_another_account_does_not_forget_the_guesses():
+    g, _ = guard()
+    for _ in range(4):
+        g.password_failed("rivera", STUDENT_PC)
+        g.password_succeeded("mallory")  # the guesser's own login, between guesses
+    assert g.account_failures("rivera") == 4
+    assert g.delay("rivera", STUDENT_PC) == 4.0
+    assert g.address_failures(STUDENT_PC) == 4
+    g.password_succeeded("rivera")  # the owner's own password clears only that account
+    assert g.delay("rivera", "10.0.0.8") == 0
+    assert g.delay("rivera", STUDENT_PC) == 0.5  # the address is still one past its allowance
+
+
+def test_guesses_spread_over_accounts_slow_the_address_past_its_allowance():
+    g, _ = guard()
+    for n in range(6):
+        g.password_failed(f"user{n}", STUDENT_PC)
+    assert g.delay("user99", STUDENT_PC) == 2.0  # 3 past the allowance of 3: 0.5 doubled twice
+    assert g.delay("user99", "10.0.0.8") == 0
+
+
+def test_an_account_takes_no_passwords_for_a_while_after_too_many_failures():
+    g, clock = guard(lock_after=10, lock_for=900)
+    locks = [g.password_failed("rivera", STUDENT_PC) for _ in range(10)]
+    assert locks == [False] * 9 + [True]
+    assert g.locked_for("rivera") == 900
+    clock.now = 600
+    assert g.password_failed("rivera", STUDENT_PC) is False  # a try while locked: no new lock
+    assert g.locked_for("rivera") == 300  # and the lock is not made longer
+    clock.now = 900
+    assert g.locked_for("rivera") == 0
+    assert g.delay("rivera", "10.0.0.8") == 0  # a lock served forgets the account's count
+
+
+def test_failures_are_forgotten_after_a_quiet_period():
+    g, clock = guard(quiet=600)
+    g.password_failed("rivera", STUDENT_PC)
+    g.key_failed(STUDENT_PC)
+    clock.now = 599
+    assert g.account_failures("rivera") == 1 and g.address_failures(STUDENT_PC) == 2
+    clock.now = 600
+    assert g.account_failures("rivera") == 0 and g.address_failures(STUDENT_PC) == 0
+
+
+def test_connections_not_logged_in_are_capped_per_address_and_in_all():
+    gate = ConnectionGate(LoginPolicy(max_unauthenticated=5, max_unauthenticated_per_address=3))
+    for _ in range(3):
+        assert gate.refuse_connection(STUDENT_PC) is None
+        gate.opened(STUDENT_PC)
+    assert "3 connections from this address" in gate.refuse_connection(STUDENT_PC)
+    for host in ("10.0.0.8", "10.0.0.9"):
+        assert gate.refuse_connection(host) is None
+        gate.opened(host)
+    assert "5 connections have not logged in" in gate.refuse_connection("10.0.0.10")
+    gate.settled(STUDENT_PC)  # one of them logged in
+    assert gate.refuse_connection("10.0.0.10") is None
+    assert gate.refuse_connection(STUDENT_PC) is None
+
+
+def test_password_attempts_waiting_at_once_are_capped():
+    gate = ConnectionGate(LoginPolicy(max_waiting=3, max_waiting_per_address=2))
+    assert gate.start_waiting(STUDENT_PC) and gate.start_waiting(STUDENT_PC)
+    assert not gate.start_waiting(STUDENT_PC)
+    assert gate.start_waiting("10.0.0.8")
+    assert not gate.start_waiting("10.0.0.9")  # three in all
+    gate.stop_waiting(STUDENT_PC)
+    assert gate.start_waiting("10.0.0.9")
+
+
+def test_a_repeated_warning_is_said_once_per_period_with_the_count_held_back():
+    clock = Clock()
+    quiet = QuietLog(every=10, clock=clock)
+    assert quiet.due("flood") == 0
+    assert [quiet.due("flood") for _ in range(5)] == [None] * 5
+    assert quiet.due("other") == 0
+    clock.now = 10
+    assert quiet.due("flood") == 5
