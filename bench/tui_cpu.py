@@ -89,6 +89,7 @@ async def one_run(seconds: float, hz: float, keys: str, profile: str | None) -> 
             hint="VIPLE: bench",
             data_dir=data / "data",
             record_dir=data / "runs",
+            workspace=data,
         )
         command = None
         if profile:

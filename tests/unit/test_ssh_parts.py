@@ -112,8 +112,11 @@ def test_the_reader_splits_any_chunks_and_keeps_what_came_before_the_start():
 
 
 def test_the_app_is_started_with_the_users_name_ports_and_terminal():
-    spec = AppSpec("ann", "student", 41000, 41001, "hint", "/d", "/d/runs/ann/1", 100, 30, "xterm")
+    spec = AppSpec(
+        "ann", "student", 41000, 41001, "hint", "/d", "/d/w/ann/runs/1", "/d/w/ann", 100, 30, "xterm"
+    )
     argv = spec.argv(("workbench",))
+    assert argv[argv.index("--workspace") + 1] == "/d/w/ann"  # the student's files only
     assert argv[:5] == ["workbench", "--student", "ann", "--ask-partner", "--role"]
     assert "--tcp-port" in argv and argv[argv.index("--tcp-port") + 1] == "41000"
     assert argv[argv.index("--ws-url") + 1] == "ws://127.0.0.1:41001/"

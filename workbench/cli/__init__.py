@@ -78,6 +78,12 @@ def build_parser() -> argparse.ArgumentParser:
         help="where lab progress and sign-offs are kept (default: $WORKBENCH_DATA "
         "or the user data folder)",
     )
+    parser.add_argument(
+        "--workspace",
+        metavar="DIR",
+        help="open and save files only in DIR and the bundled mazes, labs and starters "
+        "(the SSH server gives each student one; made if missing)",
+    )
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     maze_cmd.register(sub)
     algorithms_cmd.register(sub)
@@ -133,6 +139,7 @@ def open_app(args: argparse.Namespace) -> int:
             # over SSH (OpenSSH's ForceCommand, say) the login name is the student's
             student_fixed=bool(args.student) or "SSH_CONNECTION" in os.environ,
             connect_hint=args.connect_hint,
+            workspace=args.workspace,
         )
     except AppSetupError as exc:
         error(str(exc))

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from workbench.files.workspace import LOCAL, FileAccess
 from workbench.sim.clock import Pacer
 from workbench.sim.maze import Maze
 from workbench.sim.metrics import Metrics
@@ -130,6 +131,8 @@ class Bench:
     seed: int = 0
     noise: NoiseSettings | str | None = None
     record_dir: str | None = None
+    #: which files the student may open (all of them, unless served in a workspace)
+    files: FileAccess = LOCAL
     session: Session = field(init=False)
     pacer: Pacer = field(init=False)
     algorithm: FsmDefinition | None = None
@@ -330,8 +333,11 @@ class Bench:
 
     # -- algorithms ----------------------------------------------------------------------
     def select_algorithm(self, name_or_path: str | os.PathLike) -> FsmDefinition:
-        """Choose an algorithm (built-in name or YAML file); errors name the line and fix."""
-        return self.use_algorithm(load_algorithm(name_or_path))
+        """Choose an algorithm (built-in name or YAML file); errors name the line and fix.
+
+        A file must be one the student may read (:class:`OutsideWorkspace` otherwise).
+        """
+        return self.use_algorithm(load_algorithm(name_or_path, self.files.for_reading))
 
     def use_algorithm(self, definition: FsmDefinition) -> FsmDefinition:
         """Choose an algorithm already read (a lab's starter as the lab was loaded)."""

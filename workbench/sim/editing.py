@@ -12,6 +12,8 @@ import re
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from workbench.files.workspace import LOCAL, FileAccess, OutsideWorkspace
+
 from .generate import EXITS, MAX_CELLS, MIN_CELLS, STYLES, generate
 from .maze import FLOOR, HEADINGS, MAX_SIZE, WALL, Cell, Maze, MazeError, Problem
 from .mazeio import format_for_path, save_maze
@@ -110,7 +112,10 @@ def blank_maze(width: int, height: int) -> Maze:
 class MazeEditor:
     """The maze being edited, where the cursor is, what can be undone, and where it is saved."""
 
-    def __init__(self, maze: Maze, path: str | os.PathLike | None = None) -> None:
+    def __init__(
+        self, maze: Maze, path: str | os.PathLike | None = None, files: FileAccess = LOCAL
+    ) -> None:
+        self.files = files
         self.maze = maze
         self.path: str | None = os.fspath(path) if path is not None else None
         #: the maze the editor was opened with, and the one last saved (or opened)
@@ -177,7 +182,7 @@ class MazeEditor:
     def suggested_path(self) -> str:
         """Where save as proposes to write: the current file, else a name from the title."""
         if self.path:
-            return self.path
+            return self.files.shown(self.path)
         slug = re.sub(r"[^a-z0-9]+", "-", self.title().lower()).strip("-") or "maze"
         return f"{slug}.txt"
 
@@ -289,21 +294,28 @@ class MazeEditor:
         target = os.fspath(path) if path is not None else self.path
         if target is None or not str(target).strip():
             raise EditorError("no file name yet: use save as and type a path")
-        target = os.path.expanduser(str(target).strip())
+        files = self.files
+        try:
+            target = os.fspath(files.for_writing(target))
+        except OutsideWorkspace as exc:
+            raise EditorError(f"cannot save there: {exc}") from None
+        shown = files.shown(target)
         if os.path.isdir(target):
-            raise EditorError(f"{target} is a folder: add a file name, e.g. {target}/maze.txt")
+            raise EditorError(f"{shown} is a folder: add a file name, e.g. {shown}/maze.txt")
         folder = os.path.dirname(target) or "."
         if not os.path.isdir(folder):
-            raise EditorError(f"cannot save to {target}: the folder {folder} does not exist")
+            raise EditorError(
+                f"cannot save to {shown}: the folder {files.shown(folder)} does not exist"
+            )
         try:
             save_maze(target, self.maze, format_for_path(target))
         except MazeError as exc:
             reasons = "; ".join(f"{p.message} ({p.hint})" for p in exc.problems)
-            raise EditorError(f"cannot save as {target}: {reasons}") from None
+            raise EditorError(f"cannot save as {shown}: {reasons}") from None
         except OSError as exc:
             reason = exc.strerror or str(exc)
             raise EditorError(
-                f"cannot save to {target}: {reason}; the maze is still here, "
+                f"cannot save to {shown}: {reason}; the maze is still here, "
                 "try save as with another path"
             ) from None
         self.path = target

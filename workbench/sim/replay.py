@@ -17,6 +17,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from workbench.files.workspace import LOCAL, FileAccess, OutsideWorkspace
+
 from .maze import Maze, MazeError
 from .mazeio import load_maze
 from .metrics import Metrics, TurnCounter, efficiency
@@ -366,13 +368,17 @@ class Replay:
 
 
 def replay_maze(
-    replay: Replay, record_path: str | os.PathLike, known: Sequence[Maze] = ()
+    replay: Replay,
+    record_path: str | os.PathLike,
+    known: Sequence[Maze] = (),
+    files: FileAccess = LOCAL,
 ) -> tuple[Maze | None, str]:
     """The maze the run was on, and a note for the student (empty when all is well).
 
     A maze in ``known`` (e.g. the bench's) with the recorded layout digest wins; otherwise the
     maze file named in the header is read (as given, then beside the record). A file whose
-    layout changed since the run is still used, with a warning.
+    layout changed since the run is still used, with a warning. Only files that ``files``
+    allows are read.
     """
     info = replay.header.get("maze")
     info = info if isinstance(info, dict) else {}
@@ -386,7 +392,11 @@ def replay_maze(
     candidates = [Path(source)]
     if not Path(source).is_absolute():
         candidates.append(Path(record_path).parent / source)
-    for candidate in candidates:
+    for typed in candidates:
+        try:
+            candidate = files.for_reading(typed)
+        except OutsideWorkspace:
+            continue
         try:
             if not candidate.is_file():
                 continue

@@ -50,6 +50,8 @@ class AppSpec:
     hint: str
     data_dir: Path
     record_dir: Path
+    #: the student's own folder: the app opens and saves files only there (and bundled ones)
+    workspace: Path
     width: int = 80
     height: int = 24
     term: str = "xterm-256color"
@@ -69,6 +71,7 @@ class AppSpec:
             "--connect-hint", self.hint,
             "--data-dir", str(self.data_dir),
             "--record-dir", str(self.record_dir),
+            "--workspace", str(self.workspace),
         ]  # fmt: skip
 
     def env(self, base: dict[str, str] | None = None) -> dict[str, str]:

@@ -17,6 +17,8 @@ from pathlib import Path
 
 import asyncssh
 
+from workbench.files.workspace import workspace_folder
+
 from .appproc import RESTORE_TERMINAL, AppProcess, AppSpec, app_env, forward_hint
 from .forkserver import ForkServer, ForkServerError
 from .forwarding import local_forward_refusal, remote_forward_refusal
@@ -593,7 +595,8 @@ class LabSession(asyncssh.SSHServerSession):
             return
         tcp_port, ws_port = self.ports
         stamp = time.strftime("%Y%m%d-%H%M%S")
-        runs = config.data_dir / "runs" / user
+        workspace = workspace_folder(config.data_dir, user)
+        runs = workspace / "runs"
         record_dir = runs / stamp
         if record_dir.exists() or any(
             s.spec and s.spec.record_dir == record_dir for s in server.sessions.values()
@@ -609,6 +612,7 @@ class LabSession(asyncssh.SSHServerSession):
             hint,
             config.data_dir,
             record_dir,
+            workspace,
             width,
             height,
             self.term,

@@ -21,7 +21,8 @@ from textual.reactive import var
 from textual.screen import Screen
 
 from workbench.control.bench import Bench
-from workbench.labs.model import LABS_DIR, Setup
+from workbench.files.workspace import LOCAL, FileAccess
+from workbench.labs.model import Setup
 from workbench.labs.names import NameProblem, check_pair
 from workbench.labs.store import Store
 from workbench.sim.maze import Maze, MazeError
@@ -232,10 +233,10 @@ class WorkbenchApp(App[None]):
             self.push_screen(HelpScreen(self.bench.profile))
 
     def open_editor(self) -> None:
-        # the bundled mazes (and the labs' set-up mazes) are never overwritten: saving one
-        # asks where to keep the student's copy
+        # the bundled mazes (and the labs' set-up mazes) are never overwritten, nor is a file
+        # outside a served student's workspace: saving one asks where to keep the copy
         path = self.maze_path
-        if path is not None and _bundled(Path(path)):
+        if path is not None and not self.bench.files.allows_writing(path):
             path = None
         path = str(path) if path is not None else None
         self.push_screen(EditorScreen(self.bench, path, unicode=self.unicode), self._edited)
@@ -350,6 +351,7 @@ def make_app(
     ask_names: bool = False,
     student_fixed: bool = False,
     connect_hint: str = "",
+    workspace: str | os.PathLike | None = None,
 ) -> WorkbenchApp:
     """The workbench app on a maze file (default: the bundled Unity maze).
 
@@ -361,7 +363,9 @@ def make_app(
     sign-offs are kept in ``data_dir`` (default: ``$WORKBENCH_DATA`` or the user data folder).
     ``ask_names`` asks for them when the app starts (the student's name cannot be changed there
     when ``student_fixed``, as for an SSH login); ``connect_hint`` tells the user how to reach the
-    VIPLE endpoints (shown at start and in the help).
+    VIPLE endpoints (shown at start and in the help). With a ``workspace`` folder (a served
+    student) the app opens files only there and in the bundled mazes, labs and starters, and
+    writes only there.
 
     Raises :class:`AppSetupError` with a message for the user when the maze cannot be read or
     an argument is not one the workbench knows.
@@ -394,7 +398,13 @@ def make_app(
         problems = "\n".join(f"  {p}" for p in exc.problems)
         raise AppSetupError(f"cannot open the maze {str(path)!r}:\n{problems}") from None
     try:
-        bench = Bench.open(maze, profile, seed=seed, noise=noise, record_dir=record_dir)
+        files = FileAccess.confined_to(workspace) if workspace is not None else LOCAL
+    except OSError as exc:
+        raise AppSetupError(f"cannot use the workspace folder {workspace}: {exc}") from None
+    try:
+        bench = Bench.open(
+            maze, profile, seed=seed, noise=noise, record_dir=record_dir, files=files
+        )
     except ValueError as exc:
         raise AppSetupError(f"cannot set up the robot: {exc}") from None
     bench.pacer.paused = paused
@@ -418,17 +428,6 @@ def make_app(
         student_fixed=student_fixed,
         connect_hint=connect_hint,
     )
-
-
-def _bundled(path: Path) -> bool:
-    """A maze that ships with the workbench (``mazes/``) or with its labs (``labs/``)."""
-    from workbench.cli.common import MAZE_DIR
-
-    try:
-        where = path.resolve()
-    except OSError:
-        return False
-    return where.is_relative_to(MAZE_DIR) or where.is_relative_to(LABS_DIR)
 
 
 def _login_name() -> str:

@@ -4,6 +4,7 @@ write, run by the same engine)."""
 from __future__ import annotations
 
 import difflib
+from collections.abc import Callable
 from functools import cache
 from pathlib import Path
 
@@ -32,12 +33,17 @@ def list_algorithms() -> list[str]:
     return ordered + sorted(present - set(COURSE_ORDER))
 
 
-def load_algorithm(name_or_path: str | Path) -> FsmDefinition:
-    """A built-in algorithm by name, or an FSM file by path; raises :class:`FsmFileError`."""
+def load_algorithm(
+    name_or_path: str | Path, resolve: Callable[[str], Path] = Path
+) -> FsmDefinition:
+    """A built-in algorithm by name, or an FSM file by path; raises :class:`FsmFileError`.
+
+    ``resolve`` turns what was typed into the file's path (and may refuse it).
+    """
     text = str(name_or_path)
     if text in list_algorithms():
         return _builtin(text)
-    path = Path(name_or_path)
+    path = resolve(text)
     if path.suffix in (".yaml", ".yml") or path.exists() or "/" in text or "\\" in text:
         return load_fsm(path)
     close = difflib.get_close_matches(text, list_algorithms(), n=1)

@@ -22,6 +22,7 @@ from workbench.control.algorithms import ALGORITHM_DIR, list_algorithms
 from workbench.control.bench import Bench
 from workbench.control.fsm import FsmError, resolve_params
 from workbench.control.fsmfile import FsmFileError
+from workbench.files.workspace import OutsideWorkspace
 from workbench.sim.session import Snapshot
 
 from ..widgets.param_editor import ParamEditor
@@ -146,7 +147,9 @@ class AlgorithmModal(ModalScreen[None]):
                     yield Label("Built-in", classes="heading")
                     yield OptionList(*[Option(n, id=n) for n in names], id="alg-builtins")
                     yield Label("FSM file (YAML)", classes="heading")
-                    yield Input(placeholder="path/to/fsm.yaml", compact=True, id="alg-path")
+                    files = self.bench.files
+                    example = "~/my-fsm.yaml" if files.confined else "path/to/fsm.yaml"
+                    yield Input(placeholder=example, compact=True, id="alg-path")
                     yield Button("Load file", compact=True, id="alg-load")
                 with VerticalScroll(id="alg-details"):
                     yield Static(id="alg-title", markup=False)
@@ -175,7 +178,7 @@ class AlgorithmModal(ModalScreen[None]):
         if current is not None and _source(current.source) == "built-in":
             options.highlighted = names.index(current.name)
         elif current is not None and current.source:
-            self.query_one("#alg-path", Input).value = current.source
+            self.query_one("#alg-path", Input).value = self.bench.files.shown(current.source)
             options.highlighted = 0
         else:
             options.highlighted = 0
@@ -262,7 +265,7 @@ class AlgorithmModal(ModalScreen[None]):
         except FsmFileError as exc:
             self._error("\n".join(str(p) for p in exc.problems))
             return False
-        except (FsmError, OSError) as exc:
+        except (FsmError, OSError, OutsideWorkspace) as exc:
             self._error(str(exc))
             return False
         self._error("")
@@ -283,7 +286,7 @@ class AlgorithmModal(ModalScreen[None]):
         if not text:
             self._error("type the path of a YAML FSM file first")
             return
-        await self.choose(Path(text).expanduser())
+        await self.choose(text)
 
     @on(ParamEditor.Edited)
     def _param_edited(self, event: ParamEditor.Edited) -> None:

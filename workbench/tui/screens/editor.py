@@ -218,7 +218,7 @@ class EditorScreen(Screen[Maze | None]):
     ) -> None:
         super().__init__(name=name, id=id, classes=classes)
         self.bench = bench
-        self.editor = MazeEditor(bench.maze, path)
+        self.editor = MazeEditor(bench.maze, path, bench.files)
         self._unicode = unicode
         self._generate_options = GenerateOptions()
         self._shown_problems: tuple[bool, tuple[str, ...]] | None = None
@@ -273,7 +273,7 @@ class EditorScreen(Screen[Maze | None]):
             view.set_maze(editor.maze)
         view.set_cursor(editor.cursor)
         marker = " (modified)" if editor.dirty else ""
-        where = editor.path or "not saved yet"
+        where = editor.files.shown(editor.path) if editor.path else "not saved yet"
         self.query_one("#editor-title", Static).update(
             f"Maze editor: {editor.title()}{marker}  [{where}]"
         )
@@ -433,7 +433,7 @@ class EditorScreen(Screen[Maze | None]):
             return False
         count = len(self.editor.problems)
         extra = f" (with {count} problem{'s' * (count != 1)} still to fix)" if count else ""
-        self._status(f"saved to {written}{extra}")
+        self._status(f"saved to {self.editor.files.shown(written)}{extra}")
         self._refresh()
         return True
 
@@ -464,6 +464,7 @@ class EditorScreen(Screen[Maze | None]):
             "Save maze as",
             SAVE_HELP,
             value=self.editor.suggested_path() if value is None else value,
+            note=self.bench.files.note(),
             action="Save",
             error=error,
         )

@@ -20,6 +20,7 @@ from textual.widgets import Footer
 
 from workbench.control.bench import Bench
 from workbench.control.fsm import FsmError
+from workbench.files.workspace import OutsideWorkspace
 from workbench.sim.maze import MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.sensors import SensorConfigError
@@ -254,21 +255,29 @@ class MainScreen(Screen[None]):
         """Ask for a maze file and put it on the bench (the robot starts over on it)."""
         from .path_dialog import PathDialog
 
+        files = self.bench.files
         if value is None:
             current = getattr(self.app, "maze_path", None)
-            value = f"{Path(current).parent}/" if current else ""
+            value = f"{files.shown(Path(current).parent)}/" if current else files.home()
+            value = value.replace("~//", "~/")
 
         def chosen(path: str | None) -> None:
             if path is not None:
                 self._load_maze(path)
 
         hint = "A maze file: the workbench text format, micromouse text or .maz, or mms."
-        dialog = PathDialog("Load a maze", hint, value=value, action="Load", error=error)
+        dialog = PathDialog(
+            "Load a maze", hint, value=value, action="Load", error=error, note=files.note()
+        )
         self.app.push_screen(dialog, chosen)
 
     def _load_maze(self, path: str) -> None:
         try:
-            maze = load_maze(Path(path).expanduser())
+            real = self.bench.files.for_reading(path)
+            maze = load_maze(real)
+        except OutsideWorkspace as exc:
+            self.action_maze(path, str(exc))
+            return
         except MazeError as exc:
             self.action_maze(path, "\n".join(str(p) for p in exc.problems))
             return
@@ -276,7 +285,7 @@ class MainScreen(Screen[None]):
         self._maze_view.set_maze(maze)
         self._maze_view.clear_trail()
         self.bench.message = f"the robot is on {maze.name}"
-        self.app.maze_changed(Path(path).expanduser())  # type: ignore[attr-defined]
+        self.app.maze_changed(real)  # type: ignore[attr-defined]
 
     def action_editor(self) -> None:
         self.app.open_editor()  # type: ignore[attr-defined]

@@ -24,8 +24,10 @@ class PathDialog(Dialog[str | None]):
         value: str = "",
         action: str = "OK",
         error: str = "",
+        note: str = "",
     ) -> None:
         super().__init__()
+        self._note = note
         self._title = title
         self._help = help
         self._value = value
@@ -36,6 +38,8 @@ class PathDialog(Dialog[str | None]):
         with Vertical(id="dialog") as box:
             box.border_title = self._title
             yield Static(self._help, classes="help")
+            if self._note:
+                yield Static(self._note, classes="help", id="note")
             with Horizontal(classes="field"):
                 yield Label("Path")
                 yield Input(self._value, id="path", compact=True)

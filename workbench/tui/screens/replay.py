@@ -22,6 +22,7 @@ from textual.screen import Screen
 from textual.timer import Timer
 from textual.widgets import Footer, Static
 
+from workbench.files.workspace import LOCAL, FileAccess
 from workbench.sim.maze import Maze
 from workbench.sim.replay import Replay, load_replay, replay_maze
 
@@ -186,17 +187,19 @@ class ReplayScreen(Screen[None]):
         mazes: Sequence[Maze] = (),
         unicode: bool | None = None,
         *,
+        files: FileAccess = LOCAL,
         name: str | None = None,
         id: str | None = None,
         classes: str | None = None,
     ) -> None:
         """``replay`` is the record already loaded (else it is loaded here and a malformed
         record raises :class:`~workbench.sim.record.RecordError`); ``mazes`` are mazes the run
-        may have been on (the bench's), found again by their layout digest."""
+        may have been on (the bench's), found again by their layout digest; a maze file named
+        by the record is read only where ``files`` allows."""
         super().__init__(name=name, id=id, classes=classes)
         self.record_path = os.fspath(record_path)
         self.replay = replay if replay is not None else load_replay(record_path)
-        self.maze, self.note = replay_maze(self.replay, record_path, mazes)
+        self.maze, self.note = replay_maze(self.replay, record_path, mazes, files)
         self._unicode = unicode
         self._timer: Timer | None = None
         self._last_time = 0.0

@@ -7,7 +7,6 @@ any run record (JSONL) by path.
 
 from __future__ import annotations
 
-import os
 from typing import ClassVar
 
 from textual import on
@@ -17,6 +16,7 @@ from textual.screen import Screen
 from textual.widgets import DataTable, Footer, Static
 
 from workbench.control.bench import Bench, RunEntry
+from workbench.files.workspace import OutsideWorkspace
 from workbench.sim.record import RecordError
 from workbench.sim.replay import load_replay
 
@@ -242,9 +242,12 @@ class RunsScreen(Screen[None]):
     def open_record(self, path: str) -> bool:
         """Open the replay of the record at ``path``; a bad record is reported here."""
         try:
-            replay = load_replay(path)
-            screen = ReplayScreen(path, replay, mazes=(self.bench.maze,), unicode=self.unicode)
-        except RecordError as exc:
+            real = self.bench.files.for_reading(path)
+            replay = load_replay(real)
+            screen = ReplayScreen(
+                real, replay, mazes=(self.bench.maze,), unicode=self.unicode, files=self.bench.files
+            )
+        except (OutsideWorkspace, RecordError) as exc:
             self._status(str(exc), error=True)
             return False
         self._status("")
@@ -255,12 +258,18 @@ class RunsScreen(Screen[None]):
         def chosen(path: str | None) -> None:
             if path is None:
                 return
-            path = os.path.expanduser(path)
             if not self.open_record(path):
                 self.action_open(self.status, path)
 
         self.app.push_screen(
-            PathDialog("Open a run record", OPEN_HELP, value=value, action="Open", error=error),
+            PathDialog(
+                "Open a run record",
+                OPEN_HELP,
+                value=value or self.bench.files.home(),
+                action="Open",
+                error=error,
+                note=self.bench.files.note(),
+            ),
             chosen,
         )
 
