@@ -7,6 +7,7 @@ from textual.pilot import Pilot
 from textual.widgets import Input
 
 from workbench.tui.app import make_app
+from workbench.tui.screens.path_dialog import PathDialog
 from workbench.tui.screens.size_dialog import SizeDialog
 
 from .support import run
@@ -27,5 +28,28 @@ def test_characters_typed_right_after_tab_go_into_the_next_field(tmp_path):
         await pilot.pause()
         await pilot.pause()
         assert (width.value, height.value) == ("7", "12")
+
+    run(app, body)
+
+
+def test_editing_keys_typed_ahead_act_in_the_order_typed(tmp_path):
+    app = make_app(paused=True, student="ana", data_dir=tmp_path)
+
+    async def body(pilot: Pilot) -> None:
+        app.push_screen(PathDialog("Load a maze", "help", value="maze3"))
+        await pilot.pause()
+        field = app.screen.query_one("#path", Input)
+        # one burst: end (the text is selected on focus), backspace 5, then left x
+        burst = [("end", None), ("backspace", "\x7f"), ("5", "5"), ("left", None), ("x", "x")]
+        for key, char in burst:
+            app.post_message(events.Key(key, char))
+        await pilot.pause()
+        await pilot.pause()
+        assert field.value == "mazex5"
+        for key, char in [("ctrl+u", "\x15"), ("a", "a"), ("b", "b"), ("backspace", "\x7f")]:
+            app.post_message(events.Key(key, char))
+        await pilot.pause()
+        await pilot.pause()
+        assert field.value == "a5"  # ctrl+u cleared what was left of the cursor
 
     run(app, body)

@@ -6,14 +6,17 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import json
+import os
 import re
 
 import asyncssh
 import pytest
 
 from tests.app.support import sync
+from workbench.files.workspace import BUNDLED
+from workbench.labs.store import Store
 
-from .ssh_support import Account, lab_host, moved
+from .ssh_support import PASSWORD, Account, lab_host, moved
 
 MOVE = b'{"servos":[{"isTurn":false,"servoId":-1,"servoSpeed":1}]}\r\n'
 
@@ -92,3 +95,62 @@ async def test_each_student_sees_only_their_robot_and_forwards_only_to_their_own
         listener.close()
         tunnel.close()
         await asyncio.gather(ann.close(), ben.close())
+
+
+def dialog_says(phrase: str):
+    """A check that a dialog's text holds ``phrase``, however its lines are wrapped."""
+
+    def check(screen: str) -> bool:
+        inside = [line.split("│")[1] for line in screen.splitlines() if line.count("│") >= 2]
+        return phrase in " ".join(" ".join(inside).split())
+
+    return check
+
+
+async def type_in(term, text: str) -> None:
+    """Clear the focused field (ctrl+u), type ``text`` and Enter in one burst, as SSH sends."""
+    term.send("\x15" + text + "\r")
+
+
+@sync
+async def test_a_student_reaches_only_their_workspace_and_cannot_change_the_server_s_files(
+    tmp_path,
+):
+    async with lab_host(tmp_path, [Account("ann"), Account("ben", password=PASSWORD)]) as host:
+        data = host.data_dir
+        users = data / "ssh-users.yaml"
+        Store.open(data).close()  # the section's progress and sign-offs
+        database = data / "workbench.sqlite3"
+        ben_space = data / "workspaces" / "ben"
+        ben_space.mkdir(parents=True)
+        (ben_space / "ben.txt").write_text("#####\n#S  #\n#  E#\n#####\n")
+        term = await host.terminal("ann")
+        await term.start_app()
+        ann_space = data / "workspaces" / "ann"
+        assert ann_space.is_dir() and ann_space.stat().st_mode & 0o777 == 0o700
+        os.symlink(users, ann_space / "notes.txt")  # however a link got there, it leads nowhere
+        before = {p: p.read_bytes() for p in (users, database, ben_space / "ben.txt")}
+
+        for attempt in ("../../ssh-users.yaml", str(users), "../ben/ben.txt", "notes.txt"):
+            term.send("m")
+            await term.wait_for("Load a maze", "your workspace, ~/")
+            await type_in(term, attempt)
+            await term.wait_until(dialog_says("is outside your workspace"), attempt)
+            screen = term.text()
+            assert "scrypt" not in screen and "ssh-ed25519" not in screen, screen
+            term.send("\x1b")
+            await term.wait_gone("Load a maze")
+
+        term.send("e")  # the editor, on the bundled maze
+        await term.wait_for("Maze editor")
+        term.send(" \x13")  # a change, then ctrl+s: asks where to keep the copy
+        await term.wait_for("Save maze as")
+        await type_in(term, str(BUNDLED[0] / "unity-default.txt"))
+        await term.wait_until(dialog_says("is a bundled file, kept as shipped"), "bundled")
+        await type_in(term, "../../workbench.sqlite3")
+        await term.wait_until(dialog_says("is outside your workspace"), "database")
+        await type_in(term, "~/copy.txt")
+        await term.wait_for("saved to ~/copy.txt")
+        assert (ann_space / "copy.txt").is_file()
+        await term.close()
+        assert {p: p.read_bytes() for p in before} == before

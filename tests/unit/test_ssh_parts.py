@@ -113,8 +113,9 @@ def test_the_reader_splits_any_chunks_and_keeps_what_came_before_the_start():
 
 def test_the_app_is_started_with_the_users_name_ports_and_terminal():
     spec = AppSpec(
-        "ann", "student", 41000, 41001, "hint", "/d", "/d/w/ann/runs/1", "/d/w/ann", 100, 30, "xterm"
-    )
+        "ann", "student", 41000, 41001, "hint", "/d", "/d/w/ann/runs/1", "/d/w/ann",
+        100, 30, "xterm",
+    )  # fmt: skip
     argv = spec.argv(("workbench",))
     assert argv[argv.index("--workspace") + 1] == "/d/w/ann"  # the student's files only
     assert argv[:5] == ["workbench", "--student", "ann", "--ask-partner", "--role"]

@@ -64,9 +64,7 @@ class FileAccess:
         if text == "~" or text.startswith("~/"):
             text = text[2:]
         elif text.startswith("~"):
-            raise OutsideWorkspace(
-                f"{text.split('/')[0]!r} is another user's home: {self.where()}"
-            )
+            raise OutsideWorkspace(f"{text.split('/')[0]!r} is another user's home: {self.where()}")
         path = Path(text)
         if not path.is_absolute():
             path = self.workspace / path

@@ -25,6 +25,7 @@ from workbench.control.fsmfile import FsmFileError
 from workbench.files.workspace import OutsideWorkspace
 from workbench.sim.session import Snapshot
 
+from ..widgets.field import Field
 from ..widgets.param_editor import ParamEditor
 
 
@@ -149,7 +150,7 @@ class AlgorithmModal(ModalScreen[None]):
                     yield Label("FSM file (YAML)", classes="heading")
                     files = self.bench.files
                     example = "~/my-fsm.yaml" if files.confined else "path/to/fsm.yaml"
-                    yield Input(placeholder=example, compact=True, id="alg-path")
+                    yield Field(placeholder=example, compact=True, id="alg-path")
                     yield Button("Load file", compact=True, id="alg-load")
                 with VerticalScroll(id="alg-details"):
                     yield Static(id="alg-title", markup=False)

@@ -15,6 +15,7 @@ from textual.widgets import Button, Input, Label, Static
 from workbench.labs.names import NameProblem, check_pair
 
 from ..screens.dialog import Dialog
+from ..widgets.field import Field
 
 
 class IdentityDialog(Dialog[tuple[str, str] | None]):
@@ -40,12 +41,12 @@ class IdentityDialog(Dialog[tuple[str, str] | None]):
             )
             with Horizontal(classes="field"):
                 yield Label("Student")
-                yield Input(
+                yield Field(
                     self._student, id="student", compact=True, disabled=self._fixed, max_length=40
                 )
             with Horizontal(classes="field"):
                 yield Label("Partner")
-                yield Input(
+                yield Field(
                     self._partner,
                     id="partner",
                     compact=True,

@@ -29,6 +29,8 @@ from workbench.labs.signoff import (
 )
 from workbench.labs.store import Store
 
+from ..widgets.field import Field
+
 
 class SignoffModal(ModalScreen[str | None]):
     """Sign off an exercise; then choose who drives next."""
@@ -143,10 +145,10 @@ class SignoffModal(ModalScreen[str | None]):
                     )
                 with Horizontal(classes="field-row"):
                     yield Label("Passphrase")
-                    yield Input(password=True, id="signoff-passphrase", compact=True)
+                    yield Field(password=True, id="signoff-passphrase", compact=True)
                 with Horizontal(classes="field-row"):
                     yield Label("Note")
-                    yield Input(
+                    yield Field(
                         placeholder="optional; required with an override",
                         id="signoff-note",
                         compact=True,

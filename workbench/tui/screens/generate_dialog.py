@@ -10,6 +10,7 @@ from textual.widgets import Button, Input, Label, Select, Static
 from workbench.sim.editing import EditorError, GenerateOptions
 from workbench.sim.generate import EXITS, MAX_CELLS, MIN_CELLS, STYLES
 
+from ..widgets.field import Field
 from .dialog import Dialog
 
 STYLE_HELP = {"perfect": "perfect (one path)", "braid": "braid (loops, no dead ends)"}
@@ -38,13 +39,13 @@ class GenerateDialog(Dialog[GenerateOptions | None]):
             )
             with Horizontal(classes="field"):
                 yield Label("Width")
-                yield Input(str(o.width), id="width", compact=True, restrict=r"\d*")
+                yield Field(str(o.width), id="width", compact=True, restrict=r"\d*")
             with Horizontal(classes="field"):
                 yield Label("Height")
-                yield Input(str(o.height), id="height", compact=True, restrict=r"\d*")
+                yield Field(str(o.height), id="height", compact=True, restrict=r"\d*")
             with Horizontal(classes="field"):
                 yield Label("Seed")
-                yield Input(str(o.seed), id="seed", compact=True, restrict=r"\d*")
+                yield Field(str(o.seed), id="seed", compact=True, restrict=r"\d*")
             with Horizontal(classes="field"):
                 yield Label("Style")
                 yield Select(

@@ -27,6 +27,8 @@ from workbench.labs.model import Exercise, Lab, LabFileError, load_labs
 from workbench.labs.store import Store
 from workbench.sim.session import Snapshot
 
+from ..widgets.field import Field
+
 PASS, FAIL, OPEN = "✓", "✗", "·"
 
 
@@ -246,7 +248,7 @@ class LabsScreen(Screen[None]):
         box.remove_children()
         answers = self.answers.get((lab.id, exercise.id), {})
         for q in exercise.questions:
-            field = Input(
+            field = Field(
                 answers.get(q.id, ""),
                 placeholder=" / ".join(q.choices) if q.choices else q.unit or "answer",
                 id=f"q-{q.id}",
@@ -336,7 +338,7 @@ class LabsScreen(Screen[None]):
             self.say(f"cannot set up {exercise.title}: {exc}")
             return
         setup = exercise.setup
-        self.say(f"set up: {setup.profile}, {setup.maze.name}, {setup.controller}")
+        self.say(f"set up: {setup.profile}, {setup.maze.path.name}, {setup.controller}")
         refresh = getattr(self.app, "set_up_done", None)
         if refresh is not None:
             refresh(setup)

@@ -7,6 +7,7 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical
 from textual.widgets import Button, Input, Label, Static
 
+from ..widgets.field import Field
 from .dialog import Dialog
 
 
@@ -42,7 +43,7 @@ class PathDialog(Dialog[str | None]):
                 yield Static(self._note, classes="help", id="note")
             with Horizontal(classes="field"):
                 yield Label("Path")
-                yield Input(self._value, id="path", compact=True)
+                yield Field(self._value, id="path", compact=True)
             yield Static(self._error, id="error", classes="" if self._error else "-empty")
             with Horizontal(id="buttons"):
                 yield Button(self._action, id="ok", variant="primary", compact=True)

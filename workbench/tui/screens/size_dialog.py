@@ -10,6 +10,7 @@ from textual.widgets import Button, Input, Label, Static
 from workbench.sim.editing import MIN_BLOCKS, EditorError, parse_size
 from workbench.sim.maze import MAX_SIZE
 
+from ..widgets.field import Field
 from .dialog import Dialog
 
 
@@ -31,10 +32,10 @@ class SizeDialog(Dialog[tuple[int, int] | None]):
             )
             with Horizontal(classes="field"):
                 yield Label("Width")
-                yield Input(str(self._width), id="width", compact=True, restrict=r"\d*")
+                yield Field(str(self._width), id="width", compact=True, restrict=r"\d*")
             with Horizontal(classes="field"):
                 yield Label("Height")
-                yield Input(str(self._height), id="height", compact=True, restrict=r"\d*")
+                yield Field(str(self._height), id="height", compact=True, restrict=r"\d*")
             yield Static("", id="error", classes="-empty")
             with Horizontal(id="buttons"):
                 yield Button("Create", id="ok", variant="primary", compact=True)

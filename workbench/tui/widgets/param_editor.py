@@ -10,6 +10,8 @@ from textual.widgets import Input, Label, Static
 
 from workbench.control.fsm import Parameter
 
+from .field import Field
+
 
 def _g(value: float) -> str:
     return f"{value:g}"
@@ -60,7 +62,7 @@ class ParamEditor(Vertical):
         super().__init__()
         self.parameter = parameter
         self.default = default
-        self._input = Input(_g(value), compact=True, classes="param-value")
+        self._input = Field(_g(value), compact=True, classes="param-value")
         self._error = Static("", classes="param-error", markup=False)
         if parameter.description:
             self.tooltip = " ".join(parameter.description.split())

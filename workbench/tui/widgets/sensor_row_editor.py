@@ -6,10 +6,12 @@ from __future__ import annotations
 from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical
 from textual.message import Message
-from textual.widgets import Button, Input, Label, Select, Static
+from textual.widgets import Button, Label, Select, Static
 
 from workbench.control.bench import SensorRow
 from workbench.sim.sensors import KINDS
+
+from .field import Field
 
 MOUNT_CHOICES = ("front", "left", "right", "back", "none")
 
@@ -75,7 +77,7 @@ class SensorRowEditor(Vertical):
             compact=True,
             classes="row-kind",
         )
-        self._port = Input(row.port, compact=True, max_length=4, classes="row-port")
+        self._port = Field(row.port, compact=True, max_length=4, classes="row-port")
         self._mount = Select(
             [(m, m) for m in MOUNT_CHOICES],
             value=row.mount or "none",

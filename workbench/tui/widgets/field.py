@@ -1,0 +1,34 @@
+"""A text field whose editing keys act in the order they were typed.
+
+Textual's ``Input`` inserts a printable key as soon as it arrives but runs its editing keys
+(backspace, arrows, ctrl+u...) as bindings once the key has bubbled up to the app. Over SSH
+a typist's keys arrive together, so "backspace 5" became "5, then backspace" and the 5 was
+lost. :class:`Field` runs its own editing bindings when the key reaches it, in order.
+"""
+
+from __future__ import annotations
+
+from textual import events
+from textual.binding import Binding
+from textual.widgets import Input
+
+#: every key Input binds, and the action it runs
+_EDITING = {
+    key.strip(): binding.action
+    for binding in Input.BINDINGS
+    if isinstance(binding, Binding)
+    for key in binding.key.split(",")
+}
+
+
+class Field(Input):
+    """``Input`` with typed-ahead editing keys kept in order."""
+
+    async def _on_key(self, event: events.Key) -> None:
+        action = _EDITING.get(event.key)
+        if action is None:
+            await super()._on_key(event)
+            return
+        event.stop()
+        event.prevent_default()
+        await self.run_action(action)
