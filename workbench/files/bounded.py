@@ -103,7 +103,9 @@ def read_bytes(path: str | os.PathLike, limits: Limits, source: str | None = Non
             data = fh.read(limits.max_bytes + 1)
     except OSError as exc:
         reason = exc.strerror or type(exc).__name__
-        raise BoundedFileError(source, f"cannot read: {reason}", "check the path") from None
+        raise BoundedFileError(
+            source, f"cannot read the file: {reason}", "check the path"
+        ) from None
     if len(data) > limits.max_bytes:
         raise _too_big(source, len(data), limits)
     return data
