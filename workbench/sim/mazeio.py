@@ -84,15 +84,16 @@ def load_maze(path: str | os.PathLike, fmt: str | None = None) -> Maze:
 def _binary(data: bytes, source: str) -> MazeError:
     """The error for a file that is neither text nor a .maz maze, at its first binary byte."""
     line = column = None
+    reason = ""
     try:
         decode_text(data, source, MAZE_LIMITS)
     except BoundedFileError as exc:
-        line, column = exc.line, exc.column
+        line, column, reason = exc.line, exc.column, f": {exc.message}"
     return MazeError(
         [
             Problem(
                 "a binary file, neither UTF-8 text nor a .maz maze "
-                f"(256 bytes; this one is {len(data)} bytes)",
+                f"(256 bytes; this one is {len(data)} bytes){reason}",
                 f"check the file; the formats read are {', '.join(FORMATS)}",
                 source,
                 line,
