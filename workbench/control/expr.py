@@ -12,6 +12,7 @@ import ast
 import difflib
 import math
 import operator
+import warnings
 from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass
 
@@ -130,7 +131,9 @@ def compile_expr(
         raise ExprError("empty expression", text, None, "write a value or a condition")
     _prescan(text, lead)
     try:
-        tree = ast.parse(body, mode="eval")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", SyntaxWarning)  # e.g. "1and x": never printed
+            tree = ast.parse(body, mode="eval")
     except SyntaxError as exc:
         col = (exc.offset or 1) + lead if (exc.lineno or 1) == 1 else exc.offset
         raise ExprError(f"bad syntax: {exc.msg}", text, col, _syntax_hint(body)) from None
