@@ -152,3 +152,66 @@ def write_corpus(folder: Path) -> list[tuple[BadFile, Path]]:
         path.write_bytes(bad.data)
         out.append((bad, path))
     return out
+
+
+# -- running the command line on the corpus -----------------------------------------------------
+
+ROOT = Path(__file__).resolve().parents[1]
+#: the commands that read each kind of file ({} is the file)
+COMMANDS: dict[str, list[list[str]]] = {
+    "maze": [["maze", "check", "{}"], ["run", "--maze", "{}", "--algorithm", "right-wall"]],
+    "fsm": [
+        ["algorithms", "{}"],
+        ["run", "--maze", "mazes/unity-default.txt", "--algorithm", "{}"],
+    ],
+    "lab": [["labs", "check", "{}"]],
+    "users": [["ssh", "list-users", "--users", "{}"]],
+}
+
+
+@dataclass(frozen=True)
+class Outcome:
+    bad: BadFile
+    args: list[str]
+    code: int
+    output: str
+    seconds: float
+    #: the peak resident memory of the command's process, in KiB (Linux ru_maxrss)
+    max_rss_kib: int
+
+
+def run_command(bad: BadFile, path: Path, args: list[str], timeout: float = 60.0) -> Outcome:
+    """``workbench ARGS`` in a child process, timed, with the child's own peak memory."""
+    import os
+    import subprocess
+    import sys
+    import tempfile
+    import threading
+    import time
+
+    argv = [a.replace("{}", str(path)) for a in args]
+    with tempfile.TemporaryFile() as out:
+        start = time.perf_counter()
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "workbench", *argv], cwd=ROOT, stdout=out, stderr=out
+        )
+        timer = threading.Timer(timeout, proc.kill)
+        timer.start()
+        try:
+            _pid, status, usage = os.wait4(proc.pid, 0)
+        finally:
+            timer.cancel()
+        seconds = time.perf_counter() - start
+        proc.returncode = os.waitstatus_to_exitcode(status)
+        out.seek(0)
+        output = out.read().decode("utf-8", "replace")
+    return Outcome(bad, argv, proc.returncode, output, seconds, usage.ru_maxrss)
+
+
+def run_corpus(folder: Path, jobs: int = 8) -> list[Outcome]:
+    """Every command of :data:`COMMANDS` on every bad file written into ``folder``."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    work = [(bad, path, args) for bad, path in write_corpus(folder) for args in COMMANDS[bad.kind]]
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
+        return list(pool.map(lambda job: run_command(*job), work))
