@@ -97,10 +97,16 @@ def test_maze_without_exits_is_valid_and_says_so():
     assert maze.shortest_path_length() is None
 
 
-def test_oversized_maze_is_rejected():
+def test_oversized_maze_is_rejected_before_its_blocks_are_read():
     row = "#" * 201
-    maze = parse_maze("\n".join([row, "#S" + "." * 198 + "#", row]))
-    assert any("larger than 200x200" in p.message for p in maze.validate())
+    with pytest.raises(MazeError) as info:
+        parse_maze("\n".join([row, "#S" + "." * 198 + "#", row]))
+    (problem,) = info.value.problems
+    assert "201 blocks wide, wider than the largest maze (200x200 blocks)" in problem.message
+    assert (problem.line, problem.col) == (1, 201)
+    tall = "\n".join(["#" * 5] * 201)
+    with pytest.raises(MazeError, match=r"<maze>:201:1: the grid has 201 rows"):
+        parse_maze(tall)
 
 
 @pytest.mark.parametrize(

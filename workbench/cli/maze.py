@@ -7,7 +7,7 @@ import json
 import sys
 
 from workbench.sim.generate import EXITS, STYLES, check_seed, check_size, generate
-from workbench.sim.maze import Maze, MazeError, Problem
+from workbench.sim.maze import Maze, MazeError, Problem, cap_problems
 from workbench.sim.mazefile import format_maze, write_maze
 from workbench.sim.mazeio import format_for_path, load_maze, save_maze
 from workbench.sim.mazeview import render
@@ -87,7 +87,7 @@ def check_one(path: str, fmt: str | None = None) -> tuple[Maze | None, list[Prob
         maze = load_maze(path, fmt)
     except MazeError as exc:
         return None, exc.problems
-    return maze, maze.validate()
+    return maze, cap_problems(maze.validate())
 
 
 def describe(report: dict) -> str:

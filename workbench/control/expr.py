@@ -10,9 +10,13 @@ from __future__ import annotations
 
 import ast
 import difflib
+import math
 import operator
+import warnings
 from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass
+
+from workbench.files.bounded import digits_problem
 
 Value = float | int | bool | str
 Env = Mapping[str, Value]
@@ -62,6 +66,16 @@ _REFUSED_NODES = {
 }
 _ALLOWED_SUMMARY = "numbers, names, + - * /, comparisons, and/or/not, abs() min() max()"
 
+#: the longest expression, in characters
+MAX_LENGTH = 2_000
+#: the most levels of brackets, unary operators and operators inside each other
+MAX_DEPTH = 50
+#: the most values, names and operators (AST expression nodes) in one expression
+MAX_TERMS = 200
+_SIMPLER = "split it: keep parts in variables with a set: action"
+#: an expression shown in a message is cut to this many characters
+_SHOWN = 60
+
 
 class ExprError(ValueError):
     """An expression that cannot be compiled or evaluated; ``column`` is 1-based in ``text``."""
@@ -78,7 +92,8 @@ class ExprError(ValueError):
     def __str__(self) -> str:
         where = ""
         if self.text:
-            where = f" in {self.text!r}"
+            shown = self.text if len(self.text) <= _SHOWN else self.text[: _SHOWN - 3] + "..."
+            where = f" in {shown!r}"
             if self.column is not None:
                 where += f" at column {self.column}"
         return f"{self.message}{where}" + (f" ({self.hint})" if self.hint else "")
@@ -114,18 +129,138 @@ def compile_expr(
     lead = len(text) - len(body)
     if not body.strip():
         raise ExprError("empty expression", text, None, "write a value or a condition")
+    _prescan(text, lead)
     try:
-        tree = ast.parse(body, mode="eval")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", SyntaxWarning)  # e.g. "1and x": never printed
+            tree = ast.parse(body, mode="eval")
     except SyntaxError as exc:
         col = (exc.offset or 1) + lead if (exc.lineno or 1) == 1 else exc.offset
         raise ExprError(f"bad syntax: {exc.msg}", text, col, _syntax_hint(body)) from None
+    except (RecursionError, MemoryError):
+        raise ExprError("the expression is too complex to read", text, None, _SIMPLER) from None
     compiler = _Compiler(text, lead, names, constants or {})
-    kind, payload = compiler.node(tree.body)
+    _check_size(compiler, tree.body)
+    try:
+        kind, payload = compiler.node(tree.body)
+    except (RecursionError, MemoryError):
+        raise ExprError("the expression is too complex to read", text, None, _SIMPLER) from None
     if kind == "const":
         value = payload
         return Expr(text, frozenset(compiler.read), lambda env: value, True)
     fn = _as_fn(kind, payload)
     return Expr(text, frozenset(compiler.read), fn, False)
+
+
+def _prescan(text: str, lead: int) -> None:
+    """Refuse, before :func:`ast.parse` recurses into it, an expression that is too long, nests
+    brackets and unary operators too deeply, or writes a number with too many digits."""
+    if len(text) > MAX_LENGTH:
+        raise ExprError(
+            f"the expression is {len(text):,} characters long; at most {MAX_LENGTH:,}",
+            text,
+            MAX_LENGTH + 1,
+            _SIMPLER,
+        )
+    pending = [0]  # unary operators not yet closed, per open bracket
+    operand_before = False
+    i = lead
+    while i < len(text):
+        ch = text[i]
+        start = i
+        if ch in "'\"":
+            i = _string_end(text, i)
+            operand_before = True
+            continue
+        if ch.isdigit() or (ch == "." and text[i + 1 : i + 2].isdigit()):
+            i = _number_end(text, i)
+            reason = digits_problem(text[start:i])
+            if reason is not None:
+                raise ExprError(reason, text, start + 1, "write the value with fewer digits")
+            operand_before = True
+            continue
+        if ch.isalpha() or ch == "_":
+            while i < len(text) and (text[i].isalnum() or text[i] == "_"):
+                i += 1
+            word = text[start:i]
+            if word == "not":
+                pending[-1] += 1
+                operand_before = False
+            elif word in ("and", "or"):
+                pending[-1] = 0
+                operand_before = False
+            else:
+                operand_before = True
+        elif ch in "([{":
+            pending.append(0)
+            operand_before = False
+            i += 1
+        elif ch in ")]}":
+            if len(pending) > 1:
+                pending.pop()
+            operand_before = True
+            i += 1
+        elif ch in "-+~" and not operand_before:
+            pending[-1] += 1
+            i += 1
+        else:
+            if not ch.isspace():
+                operand_before = False
+                pending[-1] = 0
+            i += 1
+            continue
+        if len(pending) - 1 + sum(pending) > MAX_DEPTH:
+            raise ExprError(
+                f"brackets and unary operators nest more than {MAX_DEPTH} deep",
+                text,
+                start + 1,
+                _SIMPLER,
+            )
+
+
+def _string_end(text: str, i: int) -> int:
+    """The index after the string literal that starts at ``text[i]`` (or the end of text)."""
+    quote = text[i]
+    i += 1
+    while i < len(text) and text[i] != quote:
+        i += 2 if text[i] == "\\" else 1
+    return i + 1
+
+
+def _number_end(text: str, i: int) -> int:
+    """The index after the number literal that starts at ``text[i]``."""
+    while i < len(text) and (text[i].isalnum() or text[i] in "._"):
+        if text[i] in "eE" and text[i + 1 : i + 2] in ("+", "-"):
+            i += 1
+        i += 1
+    return i
+
+
+def _check_size(compiler: _Compiler, root: ast.expr) -> None:
+    """Refuse a parsed expression with too many terms or nested too deeply (checked without
+    recursion, before the compiler recurses into it)."""
+    terms = sum(isinstance(node, ast.expr) for node in ast.walk(root))
+    if terms > MAX_TERMS:
+        raise compiler.fail(
+            root,
+            f"the expression has {terms:,} values and operators; at most {MAX_TERMS}",
+            _SIMPLER,
+        )
+    stack = [(root, 1)]
+    while stack:
+        node, depth = stack.pop()
+        if depth > MAX_DEPTH:
+            raise compiler.fail(
+                node,
+                f"the expression nests more than {MAX_DEPTH} levels of operators, brackets "
+                "and calls",
+                _SIMPLER,
+            )
+        stack.extend(
+            (child, depth + 1)
+            for child in ast.iter_child_nodes(node)
+            if isinstance(child, ast.expr)
+        )
 
 
 def _syntax_hint(text: str) -> str:
@@ -199,6 +334,8 @@ class _Compiler:
 
     def _Constant(self, node: ast.Constant) -> _Node:
         value = node.value
+        if isinstance(value, float) and not math.isfinite(value):
+            raise self.fail(node, "the number is too large (not finite)", "write a smaller number")
         if isinstance(value, bool | int | float | str):
             return ("const", value)
         raise self.fail(
@@ -303,11 +440,16 @@ class _Compiler:
 
     def fold(self, node: ast.AST, fn: Callable[..., Value], *args: object) -> Value:
         try:
-            return fn(*args)
+            value = fn(*args)
         except ZeroDivisionError:
             raise self.fail(node, "division by zero", "check the divisor") from None
         except TypeError as exc:
             raise self.fail(node, f"values do not fit together: {exc}", "") from None
+        except OverflowError:
+            value = math.inf
+        if isinstance(value, float) and not math.isfinite(value):
+            raise self.fail(node, "the result is too large (not finite)", "use smaller numbers")
+        return value
 
 
 def _binary(op: Callable[[Value, Value], Value], left: _Node, right: _Node) -> Fn:

@@ -37,6 +37,15 @@ from workbench.control.fsm import (
     WheelsAction,
     check_definition,
 )
+from workbench.files.bounded import (
+    FSM_LIMITS,
+    BoundedFileError,
+    capped,
+    check_text,
+    compose_yaml,
+    more_problems,
+    read_text,
+)
 
 TOP_KEYS = ("name", "description", "sensors", "parameters", "variables", "initial", "states")
 SENSOR_KEYS = ("kind", "mount", "port")
@@ -79,29 +88,40 @@ class FileProblem:
 
 
 class FsmFileError(ValueError):
-    """An FSM file that cannot be used; ``problems`` lists every problem found."""
+    """An FSM file that cannot be used; ``problems`` lists every problem found (a long list
+    is cut after :data:`~workbench.files.bounded.MAX_PROBLEMS`, saying how many more)."""
 
     def __init__(self, problems: list[FileProblem]) -> None:
-        self.problems = problems
-        super().__init__("\n".join(str(p) for p in problems))
+        file = problems[0].file if problems else "<text>"
+        self.problems = capped(
+            list(problems),
+            lambda n: FileProblem(file, 0, 0, more_problems(n), "fix the problems above first"),
+        )
+        super().__init__("\n".join(str(p) for p in self.problems))
+
+    @classmethod
+    def refused(cls, exc: BoundedFileError) -> FsmFileError:
+        """The error of a file refused by the bounded reader."""
+        line, column = exc.line or 0, exc.column or (1 if exc.line else 0)
+        return cls([FileProblem(exc.path, line, column, exc.message, exc.hint)])
 
 
 def load_fsm(path: str | Path) -> FsmDefinition:
     """Read an FSM file, or raise :class:`FsmFileError`."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc)
-        problem = FileProblem(str(path), 0, 0, f"cannot read the file: {reason}")
-        raise FsmFileError([problem]) from None
+        text = read_text(path, FSM_LIMITS)
+    except BoundedFileError as exc:
+        raise FsmFileError.refused(exc) from None
     return loads_fsm(text, str(path))
 
 
 def loads_fsm(text: str, filename: str = "<text>") -> FsmDefinition:
     """Read FSM YAML from a string; ``filename`` is used in messages and as the default name."""
     try:
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
+        root = compose_yaml(check_text(text, filename, FSM_LIMITS), filename, FSM_LIMITS)
+    except BoundedFileError as exc:
+        raise FsmFileError.refused(exc) from None
     except yaml.MarkedYAMLError as exc:
         raise FsmFileError([_yaml_problem(filename, exc)]) from None
     except yaml.YAMLError as exc:

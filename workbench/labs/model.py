@@ -19,6 +19,7 @@ import yaml
 from workbench.control.algorithms import list_algorithms
 from workbench.control.fsmdef import FsmDefinition
 from workbench.control.fsmfile import FsmFileError, load_fsm
+from workbench.files.bounded import LAB_LIMITS, BoundedFileError, compose_yaml, read_text
 from workbench.sim.maze import Maze, MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.profiles import PROFILES
@@ -311,12 +312,15 @@ def load_lab(path: str | Path) -> Lab:
     path = Path(path)
     label = _label(path)
     try:
-        root = yaml.compose(path.read_text(encoding="utf-8"))
-    except OSError as exc:
-        raise LabFileError(f"{label}: cannot read: {exc.strerror}") from None
-    except yaml.MarkedYAMLError as exc:
-        line = exc.problem_mark.line + 1 if exc.problem_mark else 1
-        raise LabFileError(f"{label}:{line}: not valid YAML: {exc.problem}") from None
+        root = compose_yaml(read_text(path, LAB_LIMITS, label), label, LAB_LIMITS)
+    except BoundedFileError as exc:
+        line = f":{exc.line}" if exc.line is not None else ""
+        raise LabFileError(f"{label}{line}: {exc.message} ({exc.hint})") from None
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        line = mark.line + 1 if mark is not None else 1
+        problem = getattr(exc, "problem", None) or "cannot be parsed"
+        raise LabFileError(f"{label}:{line}: not valid YAML: {problem}") from None
     r = _Reader(path, label)
     if root is None:
         raise LabFileError(f"{label}:1: empty file (a lab needs 'lab', 'title' and 'exercises')")

@@ -12,6 +12,8 @@ from collections import deque
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field, replace
 
+from workbench.files.bounded import BoundedFileError, capped, more_problems
+
 Cell = tuple[int, int]
 
 WALL = "#"
@@ -54,11 +56,27 @@ class Problem:
 
 
 class MazeError(ValueError):
-    """A maze could not be read; carries every problem found, not just the first."""
+    """A maze could not be read; carries every problem found, not just the first (a long list
+    is cut after :data:`~workbench.files.bounded.MAX_PROBLEMS`, saying how many more)."""
 
     def __init__(self, problems: list[Problem]):
-        self.problems = list(problems)
+        self.problems = cap_problems(problems)
         super().__init__("\n".join(str(p) for p in self.problems))
+
+    @classmethod
+    def refused(cls, exc: BoundedFileError, hint: str = "") -> MazeError:
+        """The error of a file refused by the bounded reader, in maze-problem form."""
+        return cls([Problem(exc.message, hint or exc.hint, exc.path, exc.line, exc.column)])
+
+
+def cap_problems(problems: list[Problem]) -> list[Problem]:
+    """At most :data:`~workbench.files.bounded.MAX_PROBLEMS` problems, then one saying how
+    many more there are."""
+    source = problems[0].source if problems else "<maze>"
+    return capped(
+        list(problems),
+        lambda n: Problem(more_problems(n), "fix the problems above and check again", source),
+    )
 
 
 @dataclass(frozen=True)

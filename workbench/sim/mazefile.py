@@ -21,7 +21,9 @@ from pathlib import Path
 
 import yaml
 
-from .maze import FLOOR, PROFILES, WALL, Maze, MazeError, Problem
+from workbench.files.bounded import MAZE_LIMITS, BoundedFileError, check_text, load_yaml
+
+from .maze import FLOOR, MAX_SIZE, PROFILES, WALL, Maze, MazeError, Problem
 
 START_CHARS = {"S": "right", "^": "up", ">": "right", "v": "down", "<": "left"}
 HEADING_CHARS = {"up": "^", "right": "S", "down": "v", "left": "<"}
@@ -52,7 +54,9 @@ def _front_matter(lines: list[str], source: str) -> tuple[dict, int, list[Proble
         )
     text = "\n".join(lines[1:end])
     try:
-        meta = yaml.safe_load(text) if text.strip() else {}
+        meta = load_yaml(text, source, MAZE_LIMITS, first_line=2) if text.strip() else {}
+    except BoundedFileError as exc:
+        return {}, end + 1, MazeError.refused(exc).problems
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         line = mark.line + 2 if mark is not None else 2
@@ -131,7 +135,13 @@ def parse_maze(text: str, source: str = "<maze>") -> Maze:
     """Parse the workbench format; raise :class:`MazeError` with every problem found.
 
     Structural checks (boundary, reachability) are not done here: see :meth:`Maze.validate`.
+    The text's size and characters are checked first, and a grid larger than the largest maze
+    is refused before any block is read.
     """
+    try:
+        text = check_text(text, source, MAZE_LIMITS)
+    except BoundedFileError as exc:
+        raise MazeError.refused(exc) from None
     lines = text.splitlines()
     meta, first, problems = _front_matter(lines, source)
     body = lines[first:]
@@ -147,6 +157,7 @@ def parse_maze(text: str, source: str = "<maze>") -> Maze:
             Problem("no maze grid found", "draw the maze with # and . after the header", source)
         )
         raise MazeError(problems)
+    _check_grid_size(body, body_line, source)
     width = max(len(r) for r in body)
     rows: list[str] = []
     starts: list[tuple[int, int, str]] = []
@@ -206,6 +217,37 @@ def parse_maze(text: str, source: str = "<maze>") -> Maze:
         source=source,
         body_line=body_line,
     )
+
+
+def _check_grid_size(body: list[str], body_line: int, source: str) -> None:
+    """Refuse a grid with more rows or columns than a maze may have, before reading it."""
+    if len(body) > MAX_SIZE:
+        raise MazeError(
+            [
+                Problem(
+                    f"the grid has {len(body):,} rows, more than the largest maze "
+                    f"({MAX_SIZE}x{MAX_SIZE} blocks)",
+                    "split the maze or use larger cells",
+                    source,
+                    body_line + MAX_SIZE,
+                    1,
+                )
+            ]
+        )
+    for y, raw in enumerate(body):
+        if len(raw) > MAX_SIZE:
+            raise MazeError(
+                [
+                    Problem(
+                        f"the row is {len(raw):,} blocks wide, wider than the largest maze "
+                        f"({MAX_SIZE}x{MAX_SIZE} blocks)",
+                        "split the maze or use larger cells",
+                        source,
+                        body_line + y,
+                        MAX_SIZE + 1,
+                    )
+                ]
+            )
 
 
 def format_maze(maze: Maze, front_matter: bool = True) -> str:

@@ -9,6 +9,14 @@ import re
 from dataclasses import replace
 from pathlib import Path
 
+from workbench.files.bounded import (
+    MAZE_LIMITS,
+    BoundedFileError,
+    decode_text,
+    read_bytes,
+    strip_bom,
+)
+
 from .maz import format_maz, parse_maz
 from .maze import Maze, MazeError, Problem
 from .mazefile import format_maze, parse_maze, write_bytes_atomic, write_text_atomic
@@ -24,6 +32,7 @@ _CONTROL = set(range(32)) - {9, 10, 13}
 
 def detect_format(data: bytes) -> str:
     """The format of a file's content: binary -> maz, then by the first non-blank line."""
+    data = strip_bom(data)
     try:
         text = data.decode("utf-8")
     except UnicodeDecodeError:
@@ -51,38 +60,47 @@ def load_maze(path: str | os.PathLike, fmt: str | None = None) -> Maze:
     if fmt is not None and fmt not in FORMATS:
         raise _unknown(fmt, FORMATS, source)
     try:
-        data = p.read_bytes()
-    except OSError as exc:
-        raise MazeError(
-            [Problem(f"cannot read: {exc.strerror}", "check the path", source)]
-        ) from None
+        data = read_bytes(p, MAZE_LIMITS, source)
+    except BoundedFileError as exc:
+        raise MazeError.refused(exc) from None
     if fmt is None:
         fmt = detect_format(data)
         if fmt == "maz" and len(data) != 256:
-            raise MazeError(
-                [
-                    Problem(
-                        "a binary file, neither UTF-8 text nor a .maz maze "
-                        f"(256 bytes; this one is {len(data)} bytes)",
-                        f"check the file; the formats read are {', '.join(FORMATS)}",
-                        source,
-                    )
-                ]
-            )
+            raise _binary(data, source)
     if fmt == "maz":
         maze = to_blocks(parse_maz(data, source))
     else:
         try:
-            text = data.decode("utf-8")
-        except UnicodeDecodeError:
-            raise MazeError(
-                [Problem("not a UTF-8 text file", f"check that it is a {fmt} maze", source)]
-            ) from None
+            text = decode_text(data, source, MAZE_LIMITS)
+        except BoundedFileError as exc:
+            raise MazeError.refused(exc) from None
         if fmt == "workbench":
             maze = parse_maze(text, source=source)
         else:
             maze = to_blocks(WALL_READERS[fmt](text, source))
     return maze if maze.name else replace(maze, name=p.stem)
+
+
+def _binary(data: bytes, source: str) -> MazeError:
+    """The error for a file that is neither text nor a .maz maze, at its first binary byte."""
+    line = column = None
+    reason = ""
+    try:
+        decode_text(data, source, MAZE_LIMITS)
+    except BoundedFileError as exc:
+        line, column, reason = exc.line, exc.column, f": {exc.message}"
+    return MazeError(
+        [
+            Problem(
+                "a binary file, neither UTF-8 text nor a .maz maze "
+                f"(256 bytes; this one is {len(data)} bytes){reason}",
+                f"check the file; the formats read are {', '.join(FORMATS)}",
+                source,
+                line,
+                column,
+            )
+        ]
+    )
 
 
 def format_for_path(path: str | os.PathLike) -> str:

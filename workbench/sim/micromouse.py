@@ -28,6 +28,8 @@ import itertools
 import re
 from dataclasses import dataclass, field
 
+from workbench.files.bounded import MAZE_LIMITS, BoundedFileError, check_text, digits_problem
+
 from .maze import Cell, Maze, MazeError, Problem
 from .wallmaze import MAX_CELLS, E, N, S, W, WallMaze, from_blocks, wall_problems
 
@@ -174,8 +176,30 @@ class _Picture:
         )
 
 
+def _checked_lines(text: str, source: str) -> list[str]:
+    """The lines of ``text`` once its size and characters are known to be fine."""
+    try:
+        return check_text(text, source, MAZE_LIMITS).splitlines()
+    except BoundedFileError as exc:
+        raise MazeError.refused(exc) from None
+
+
+def _too_large(what: str, count: int, source: str, line: int, col: int) -> MazeError:
+    return MazeError(
+        [
+            Problem(
+                f"the maze has {count:,} {what}; a maze has at most {MAX_CELLS} cells a side",
+                "split the maze",
+                source,
+                line,
+                col,
+            )
+        ]
+    )
+
+
 def _parse_posts(text: str, source: str, post: str, fixed: bool) -> WallMaze:
-    raw = text.splitlines()
+    raw = _checked_lines(text, source)
     top = 0
     while top < len(raw) and not raw[top].strip():
         top += 1
@@ -188,6 +212,13 @@ def _parse_posts(text: str, source: str, post: str, fixed: bool) -> WallMaze:
             [Problem("the file holds no maze", f"draw the maze with {post} posts", source)]
         )
     cols = _first_line_posts(lines[0], post, fixed, source, top + 1)
+    if len(cols) - 1 > MAX_CELLS:
+        raise _too_large(
+            "columns of cells", len(cols) - 1, source, top + 1, cols[MAX_CELLS + 1] + 1
+        )
+    if len(lines) > 2 * MAX_CELLS + 1:
+        rows = (len(lines) - 1) // 2
+        raise _too_large("rows of cells", rows, source, top + 2 * MAX_CELLS + 2, 1)
     if len(lines) < 3 or len(lines) % 2 == 0:
         raise MazeError(
             [
@@ -246,8 +277,11 @@ def _num_values(raw: str, ln: int, source: str, problems: list[Problem]) -> list
         return None
     values, ok = [], True
     for (tok, col), name in zip(tokens, NUM_FIELDS, strict=True):
-        value = int(tok) if re.fullmatch(r"[0-9]+", tok) else None
-        if value is None:
+        long = digits_problem(tok)
+        value = int(tok) if re.fullmatch(r"[0-9]+", tok) and long is None else None
+        if long is not None:
+            wrong = (f"{name} is {long}", "check the coordinate")
+        elif value is None:
             wrong = (f"{name} is {tok!r}, not a whole number", "use digits only")
         elif name in "xy" and value >= MAX_CELLS:
             wrong = (
@@ -268,7 +302,7 @@ def parse_mms_num(text: str, source: str = "<maze>") -> WallMaze:
     """The mms "num" format: one ``x y N E S W`` line per cell, origin bottom-left."""
     problems: list[Problem] = []
     cells: dict[Cell, tuple[int, int]] = {}
-    for ln, raw in enumerate(text.splitlines(), start=1):
+    for ln, raw in enumerate(_checked_lines(text, source), start=1):
         values = _num_values(raw, ln, source, problems) if raw.strip() else None
         if values is None:
             continue

@@ -24,6 +24,14 @@ from pathlib import Path
 import asyncssh
 import yaml
 
+from workbench.files.bounded import (
+    USERS_LIMITS,
+    BoundedFileError,
+    check_text,
+    compose_yaml,
+    read_text,
+)
+
 from .passwords import PasswordError, parse_hash, verify_password
 
 ROLES = ("student", "instructor")
@@ -125,7 +133,9 @@ def parse_users(text: str, path: str | os.PathLike = USERS_FILE) -> dict[str, Us
     """The users of a users file's text; :class:`UsersFileError` names line, key and fix."""
     reader = _Reader(Path(path))
     try:
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
+        root = compose_yaml(check_text(text, str(path), USERS_LIMITS), str(path), USERS_LIMITS)
+    except BoundedFileError as exc:
+        raise _refused(exc) from None
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         line = mark.line + 1 if mark is not None else 1
@@ -230,13 +240,19 @@ def _keys(reader: _Reader, node: yaml.Node | None, where: str) -> tuple[str, ...
 def load_users(path: str | os.PathLike) -> dict[str, User]:
     """The users of the file at ``path`` (none when it does not exist)."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
+    if not path.exists():
         return {}
-    except (OSError, UnicodeDecodeError) as exc:
-        raise UsersFileError(f"{path}: cannot be read: {exc}") from None
+    try:
+        text = read_text(path, USERS_LIMITS)
+    except BoundedFileError as exc:
+        raise _refused(exc) from None
     return {name: user.with_keys() for name, user in parse_users(text, path).items()}
+
+
+def _refused(exc: BoundedFileError) -> UsersFileError:
+    """The error of a users file refused by the bounded reader, in this file's style."""
+    line = f":{exc.line}" if exc.line is not None else ""
+    return UsersFileError(f"{exc.path}{line}: {exc.message} (fix: {exc.hint})")
 
 
 def dump_users(users: Iterable[User]) -> str:
