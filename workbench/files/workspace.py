@@ -133,7 +133,7 @@ class FileAccess:
     def where(self) -> str:
         """What a confined student may open, for refusals and dialog hints."""
         bundled = ", ".join(str(p) + "/" for p in self.bundled)
-        return f"you can open files in your workspace, ~/ , and the bundled files in {bundled}"
+        return f"you can open files in your workspace (~/) and the bundled files in {bundled}"
 
     def _in_workspace(self) -> str:
         return ", e.g. in ~/" if self.workspace is not None else ""

@@ -272,12 +272,15 @@ class Link:
         if peer is None:
             return
         self._bad_log.flush()
-        if self.session.driver == self._driver:
-            self.session.command(Stop(), driver=NOBODY)
+        self._stop_motors()
         self.seat.release(peer)
         self._driver = None
         self.peer = None
         self.log.info("%s disconnected%s; motors stopped", peer, f" ({reason})" if reason else "")
+
+    def _stop_motors(self) -> None:
+        if self._driver is not None and self.session.driver == self._driver:
+            self.session.command(Stop(), driver=NOBODY)
 
     # -- messages ------------------------------------------------------------------------
     def report(self) -> str:
@@ -376,6 +379,7 @@ class Link:
         while True:
             await self.offer(outbox, self.report())
             if self.idle_s is not None and self.idle_for() >= self.idle_s:
+                self._stop_motors()  # at once: the connection may take a while to close
                 self.idled += 1
                 return (
                     f"idle: sent nothing and read no reports for {self.idle_s:g} s; "
