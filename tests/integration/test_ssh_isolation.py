@@ -147,8 +147,10 @@ async def test_a_student_reaches_only_their_workspace_and_cannot_change_the_serv
         await term.wait_for("Save maze as")
         await type_in(term, str(BUNDLED[0] / "unity-default.txt"))
         await term.wait_until(dialog_says("is a bundled file, kept as shipped"), "bundled")
-        await type_in(term, "../../workbench.sqlite3")
-        await term.wait_until(dialog_says("is outside your workspace"), "database")
+        for attempt in ("../../workbench.sqlite3", str(users), "notes.txt"):
+            await type_in(term, attempt)
+            await term.wait_until(dialog_says(f"{attempt} is outside your workspace"), attempt)
+            assert "scrypt" not in term.text()
         await type_in(term, "~/copy.txt")
         await term.wait_for("saved to ~/copy.txt")
         assert (ann_space / "copy.txt").is_file()
