@@ -84,3 +84,11 @@ def test_bundled_files_are_read_but_never_written(served, tmp_path):
         LOCAL.for_writing(BUNDLED_MAZE)
     assert LOCAL.for_writing(tmp_path / "mine.txt") == tmp_path / "mine.txt"
     assert LOCAL.for_reading("~/x.txt") == LOCAL.resolve("~/x.txt")
+
+
+@pytest.mark.parametrize("access", [LOCAL, None])
+def test_a_path_with_control_characters_is_refused_not_crashed_on(served, access):
+    files = access or served[0]
+    for typed in ("maze\x00.txt", "a\nb", "x\x1b[2J"):
+        with pytest.raises(OutsideWorkspace, match="control characters"):
+            files.for_reading(typed)

@@ -28,7 +28,7 @@ _FOLDER_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,63}")
 
 
 class OutsideWorkspace(ValueError):
-    """A path the app may not open for this student; the message says what may be opened."""
+    """A path the app may not open (for this student, or at all); the message says why."""
 
 
 @dataclass(frozen=True)
@@ -57,8 +57,12 @@ class FileAccess:
 
     # -- resolving ---------------------------------------------------------------------------
     def resolve(self, typed: str | os.PathLike) -> Path:
-        """The absolute path ``typed`` means (not checked)."""
+        """The absolute path ``typed`` means (not checked, but never with control characters)."""
         text = os.fspath(typed).strip()
+        if not text.isprintable():
+            raise OutsideWorkspace(
+                "a path cannot hold control characters: type the path again, without them"
+            )
         if self.workspace is None:
             return Path(text).expanduser()
         if text == "~" or text.startswith("~/"):
