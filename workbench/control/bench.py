@@ -440,6 +440,8 @@ class Bench:
 
     def _close_run(self, ended: str) -> None:
         self._run_open = False
+        if ended == "exit":  # the run is over as a headless one ends: same numbers, same record
+            self.session.settle()
         entry = RunEntry(
             number=len(self.runs) + 1,
             driver=self._run_driver,

@@ -3,7 +3,9 @@
 Front ends (the app, ``workbench serve``) call :meth:`Pacer.advance` with the wall time that has
 passed; the pacer runs as many fixed ``dt`` steps as that time (times the speed factor) holds,
 carrying the remainder, so the trajectory is the same as a headless run's whatever the frame
-rate. Timers that skip ticks do not lose simulated time.
+rate. Timers that skip ticks do not lose simulated time. Stepping stops at the step on which
+the robot gets out of a maze with exits, at every speed and in single steps, as a headless run
+does: a run's numbers do not depend on how fast it is shown.
 """
 
 from __future__ import annotations
@@ -13,6 +15,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from .session import Session
+from .world import EXIT
 
 SPEEDS = (1.0, 2.0, 4.0, 10.0, None)  # None = as fast as the budget allows ("max")
 
@@ -36,13 +39,15 @@ class Pacer:
             return 0
         dt = self.session.world.dt
         step = self.session.step
+        out = self._exits()
         if self.speed is None:
             deadline = self.clock() + self.budget
             n = 0
             while True:
                 for _ in range(30):
-                    step()
-                n += 30
+                    n += 1
+                    if EXIT in step() and out:
+                        return n
                 if self.clock() >= deadline:
                     return n
         self._debt = min(self._debt + wall_seconds * self.speed, self.max_lag * self.speed)
@@ -50,16 +55,26 @@ class Pacer:
         self._debt -= n * dt
         deadline = self.clock() + self.budget
         for i in range(n):
-            step()
+            if EXIT in step() and out:
+                self._debt = 0.0
+                return i + 1
             if (i & 31) == 31 and self.clock() > deadline:
                 self._debt = 0.0
                 return i + 1
         return n
 
-    def single_step(self, steps: int = 1) -> None:
-        """Advance exactly ``steps`` physics steps (for pause + step, and for tests)."""
-        for _ in range(steps):
-            self.session.step()
+    def single_step(self, steps: int = 1) -> int:
+        """Advance ``steps`` physics steps (for pause + step, and for tests), fewer when the
+        robot gets out first; returns how many ran."""
+        out = self._exits()
+        for i in range(steps):
+            if EXIT in self.session.step() and out:
+                return i + 1
+        return steps
+
+    def _exits(self) -> bool:
+        """Whether getting out ends the run: the maze has exits."""
+        return bool(self.session.maze.exits)
 
     def next_speed(self) -> float | None:
         i = SPEEDS.index(self.speed) if self.speed in SPEEDS else 0

@@ -195,9 +195,14 @@ class Session:
         for _ in range(steps - self._steps):
             if EXIT in step() and stop:
                 break
-        if self._steps % self.every:
-            self._control_tick(run_controller=False)  # the last steps reach the record too
+        self.settle()
         return self.metrics()
+
+    def settle(self) -> None:
+        """At the end of a run: the steps since the last control tick reach the readings, the
+        turn count and the record (a tick without the controller)."""
+        if self._steps % self.every:
+            self._control_tick(run_controller=False)
 
     # -- reading -------------------------------------------------------------------------
     def metrics(self) -> Metrics:
