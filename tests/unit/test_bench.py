@@ -283,3 +283,27 @@ def test_starting_an_exercise_forgets_keys_and_viple_seen_before_but_not_the_one
     link.apply(MOVE)
     b.step(60)
     assert b.viple[0].drove and b.viple[0].distance > 0.5  # the driving after the start counts
+
+
+def test_after_a_run_ends_at_the_exit_the_next_drive_key_drives():
+    b = bench(load_maze("mazes/rank-wall-wins.txt"), "unity")
+    b.select_algorithm("right-wall")
+    b.apply_algorithm_preset()
+    b.start_algorithm()
+    while not b.runs:
+        b.step(60)
+    assert b.pacer.paused and "run finished" in b.message
+    b.reset_robot()
+    b.load_maze(load_maze("mazes/rank-local-best-wins.txt"))
+    assert not b.pacer.paused  # reset and a new maze: time runs again
+    b.key("w")
+    b.advance(0.5)
+    assert b.snapshot().metrics.distance > 0
+
+
+def test_a_pause_the_user_chose_stays_until_they_resume():
+    b = bench(profile="unity")
+    assert b.toggle_pause()
+    b.key("w")
+    b.advance(0.5)
+    assert b.pacer.paused and b.snapshot().metrics.distance == 0

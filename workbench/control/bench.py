@@ -152,6 +152,8 @@ class Bench:
     _odometry_seen: tuple[float, float] = (0.0, 0.0)
     _recorder: Recorder | None = None
     _record_path: str | None = None
+    #: paused because the robot got out: the next drive, reset, start or maze goes on
+    _held_at_exit: bool = False
 
     @classmethod
     def open(
@@ -213,6 +215,7 @@ class Bench:
         if self._run_open and self.maze.exits and self.session.reached_exit:
             self._close_run("exit")
             self.pacer.paused = True
+            self._held_at_exit = True
             self.message = "the robot is out: run finished (r resets the robot)"
 
     def _watch_viple(self) -> None:
@@ -265,7 +268,15 @@ class Bench:
 
     def toggle_pause(self) -> bool:
         self.pacer.paused = not self.pacer.paused
+        self._held_at_exit = False
         return self.pacer.paused
+
+    def _go_on_after_exit(self) -> None:
+        """The run that ended at the exit paused the robot; a new action lets time run again
+        (keys would otherwise seem dead after a run)."""
+        if self._held_at_exit:
+            self._held_at_exit = False
+            self.pacer.paused = False
 
     def snapshot(self) -> Snapshot:
         return self.session.snapshot()
@@ -276,6 +287,7 @@ class Bench:
         cmd = key_command(self.profile, key)
         if cmd is None:
             return False
+        self._go_on_after_exit()
         if self.controller is not None:
             self.stop_algorithm("stopped")
         if self._run_open and self._run_driver != KEYS_DRIVER:
@@ -387,6 +399,7 @@ class Bench:
         controller = FsmController(self.algorithm, self.overrides, self.profile)
         if self._run_open:
             self._close_run("stopped")
+        self._go_on_after_exit()
         self.session.reset()
         self.controller = controller
         self.session.attach(controller, binding, f"algorithm {self.algorithm.name}")
@@ -406,6 +419,7 @@ class Bench:
     # -- maze and robot ------------------------------------------------------------------
     def reset_robot(self) -> None:
         """Like the Unity simulator's reset button: the robot back at the start, stopped."""
+        self._go_on_after_exit()
         if self._run_open:
             self._close_run("reset")
         if self.controller is not None:
@@ -416,6 +430,7 @@ class Bench:
 
     def load_maze(self, maze: Maze) -> None:
         """Put a (new or edited) maze on the bench; the robot starts over on it."""
+        self._go_on_after_exit()
         if self._run_open:
             self._close_run("maze changed")
         self.stop_algorithm("maze changed")
