@@ -137,3 +137,10 @@ class TestRealPrograms:
         assert data["distance_cells"] > 10 and data["turns"] >= 4 and not data["errors"]
         assert data["events"][0]["event"] == "key a"
         assert len(data["printed"]) > 500  # every distance report is printed
+
+
+def test_the_shipped_example_leaves_the_web_maze(capsys):
+    example = str(Path(WEB_MAZE).parents[1] / "programs" / "right-wall.viple")
+    assert main(["program", "run", example, "--maze", WEB_MAZE, "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["reached_exit"] and not data["errors"]
