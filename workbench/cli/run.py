@@ -89,9 +89,15 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 def describe_run(result) -> str:
     d = result.as_dict()
+    head = f"{result.spec.algorithm} on {result.maze.name} ({result.profile}, seed {d['seed']})"
+    return "\n".join([head, *describe_measures(result)])
+
+
+def describe_measures(result) -> list[str]:
+    """The measures of a run, one per line (an algorithm's or a VIPLE program's)."""
+    d = result.as_dict()
     m = result.metrics
     unit = PROFILES[result.profile].unit
-    head = f"{result.spec.algorithm} on {result.maze.name} ({result.profile}, seed {d['seed']})"
     if d["reached_exit"]:
         outcome = f"reached the exit after {m['exit_time']:.1f} s"
     elif result.maze.exits:
@@ -102,17 +108,14 @@ def describe_run(result) -> str:
     else:
         outcome = f"free exploration for {result.max_time:g} s (the maze has no exit)"
     eff = f"{d['efficiency']:.0%}" if d["efficiency"] is not None else "n/a"
-    return "\n".join(
-        [
-            head,
-            f"  {outcome}",
-            f"  distance travelled  {d['distance']:.1f} {unit} ({d['distance_cells']:.1f} blocks)",
-            f"  turning degrees     {d['turn_degrees']:.0f} deg in {d['turns']} turns",
-            f"  collisions          {d['collisions']}",
-            f"  efficiency          {eff} (shortest path / distance travelled)",
-            f"  simulated time      {d['sim_time']:.1f} s",
-        ]
-    )
+    return [
+        f"  {outcome}",
+        f"  distance travelled  {d['distance']:.1f} {unit} ({d['distance_cells']:.1f} blocks)",
+        f"  turning degrees     {d['turn_degrees']:.0f} deg in {d['turns']} turns",
+        f"  collisions          {d['collisions']}",
+        f"  efficiency          {eff} (shortest path / distance travelled)",
+        f"  simulated time      {d['sim_time']:.1f} s",
+    ]
 
 
 def cmd_eval(args: argparse.Namespace) -> int:

@@ -1,0 +1,146 @@
+"""`workbench program check` and `run` as a user runs them, and the real VIPLE programs."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from tests.program.builder import ProgramBuilder
+from workbench.cli import main
+
+REAL = Path(__file__).resolve().parents[3] / "shared" / "viple-programs"
+WEB_MAZE = str(Path(__file__).resolve().parents[2] / "mazes" / "web.txt")
+
+
+def forward_program(tmp_path) -> str:
+    b = ProgramBuilder()
+    main_panel = b.panel("Main")
+    b.robot(main_panel)
+    key = main_panel.add(13, "22")
+    drive = main_panel.add(20, "0.5", "0.5", "Robot/IoT Controller 0", "3", "5")
+    text = main_panel.add(3, '"going"')
+    show = main_panel.add(28, "")
+    main_panel.chain(key, drive, text, show)
+    return b.write(tmp_path / "forward.viple")
+
+
+def test_check_exit_codes_and_problem_lines(tmp_path, capsys):
+    good = forward_program(tmp_path)
+    bad = tmp_path / "bad.viple"
+    bad.write_bytes(b"<Program><Version>4.0</Version>")
+    assert main(["program", "check", good]) == 0
+    assert "ok (VIPLE 4.0.0.1, 5 activities" in capsys.readouterr().out
+    assert main(["program", "check", good, str(bad)]) == 1
+    out = capsys.readouterr().out
+    assert f"{bad}: line 1, column 32: the XML is not well formed" in out
+    with pytest.raises(SystemExit) as info:
+        main(["program", "check"])
+    assert info.value.code == 2
+
+
+def test_run_prints_measures_prints_and_events(tmp_path, capsys):
+    path = forward_program(tmp_path)
+    code = main(["program", "run", path, "--maze", WEB_MAZE, "--keys", "w@0.5", "--seconds", "3"])
+    out = capsys.readouterr().out
+    assert code == 1  # the maze has an exit the robot did not reach
+    assert "forward.viple on" in out and "distance travelled" in out and "turning degrees" in out
+    assert "0.50 s  going" in out and "0.50 s  key w" in out
+
+
+def test_run_json_is_deterministic(tmp_path, capsys):
+    path = forward_program(tmp_path)
+    args = ["program", "run", path, "--maze", WEB_MAZE, "--keys", "w@0.2", "--seconds", "4"]
+    outs = []
+    for _ in range(2):
+        main([*args, "--json", "--seed", "3", "--noise", "realistic"])
+        outs.append(capsys.readouterr().out)
+    assert outs[0] == outs[1]
+    data = json.loads(outs[0])
+    assert data["distance"] > 0 and data["printed"] == [{"time": 0.2, "text": "going"}]
+    assert len(data["program_sha256"]) == 64
+
+
+def test_missing_sensor_is_an_error_before_the_run(tmp_path, capsys):
+    b = ProgramBuilder()
+    m = b.panel("Main")
+    b.robot(m)
+    sensor = m.add(23, "Robot/IoT Controller 0", "7")
+    path = b.write(tmp_path / "s.viple")
+    assert main(["program", "run", path, "--maze", WEB_MAZE, "--seconds", "1"]) == 2
+    err = capsys.readouterr().err
+    assert f"activity {sensor} (kind 23, Robot Distance Sensor): it reads port 7" in err
+    assert "add --sensor distance:7:MOUNT" in err
+
+
+@pytest.mark.skipif(not REAL.is_dir(), reason="the real VIPLE programs (../shared) are not here")
+class TestRealPrograms:
+    def test_each_real_program_loads(self, capsys):
+        files = sorted(str(p) for p in REAL.iterdir() if p.suffix in (".viple", ".xml"))
+        assert files and main(["program", "check", *files]) == 0
+
+    @pytest.mark.parametrize(
+        ("key", "powers"),
+        [("w", (0.5, 0.5)), ("a", (-1.0, 1.0)), ("d", (1.0, -1.0)), ("s", (-0.5, -0.5))],
+    )
+    def test_drive_by_wire_answers_its_keys(self, key, powers):
+        from workbench.program.headless import load_compiled
+        from workbench.program.interp import ProgramController
+        from workbench.program.keys import parse_key_script
+
+        compiled = load_compiled(str(REAL / "DriveByWire.viple"))
+        c = ProgramController(compiled, parse_key_script(f"{key}@0.1 release@0.2"))
+        c.start(0.0)
+        commands = [cmd for t in (0.1, 0.2) for cmd in c.tick(t, {}, frozenset())]
+        assert [(cmd.left, cmd.right) for cmd in commands] == [powers, (0.0, 0.0)]
+
+    def test_servo_control_arrow_keys(self):
+        from workbench.program.headless import load_compiled
+        from workbench.program.interp import ProgramController
+        from workbench.program.keys import parse_key_script
+
+        compiled = load_compiled(str(REAL / "servo-control.xml"))
+        script = (
+            "up@0.1 release@0.15 left@0.2 release@0.25 right@0.3 release@0.35 down@0.4 space@0.5"
+        )
+        c = ProgramController(compiled, parse_key_script(script))
+        c.start(0.0)
+        commands = [cmd for i in range(1, 11) for cmd in c.tick(i * 0.05, {}, frozenset())]
+        assert [(cmd.left, cmd.right) for cmd in commands] == [
+            (1, 1),
+            (-1, 1),
+            (1, -1),
+            (-1, -1),
+            (0, 0),
+        ]
+
+    def test_wall_follower_follows_a_wall(self, capsys):
+        args = [
+            "program",
+            "run",
+            str(REAL / "WallFollower.viple"),
+            "--maze",
+            WEB_MAZE,
+            "--sensor",
+            "touch:1:front",
+            "--sensor",
+            "distance:3:right",
+            "--keys",
+            "a@0.2",
+            "--seconds",
+            "30",
+            "--json",
+        ]
+        main(args)
+        data = json.loads(capsys.readouterr().out)
+        assert data["distance_cells"] > 10 and data["turns"] >= 4 and not data["errors"]
+        assert data["events"][0]["event"] == "key a"
+        assert len(data["printed"]) > 500  # every distance report is printed
+
+
+def test_the_shipped_example_leaves_the_web_maze(capsys):
+    example = str(Path(WEB_MAZE).parents[1] / "programs" / "right-wall.viple")
+    assert main(["program", "run", example, "--maze", WEB_MAZE, "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["reached_exit"] and not data["errors"]

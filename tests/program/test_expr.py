@@ -1,0 +1,218 @@
+"""VIPLE's expression language: precedence, keywords in any case, text, C# numbers, errors."""
+
+from __future__ import annotations
+
+import contextlib
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from workbench.program.expr import MAX_DEPTH, ExprError, Scope, literal, parse, show
+
+SCOPE = Scope(
+    value=25,
+    state={"status": "Forward", "basedistance": 20, "left": 6.0},
+    instance={"time": 200},
+    parts={"leftpower": 0.5, "rightpower": -0.5},
+)
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        ("1 + 2 * 3", 7),
+        ("(1 + 2) * 3", 9),
+        ("10 - 4 - 3", 3),
+        ("7 / 2", 3),
+        ("-7 / 2", -3),
+        ("7 % -2", 1),
+        ("7 mod 4", 3),
+        ("7 / 2.0", 3.5),
+        ("1 + 2 < 4 && 2 * 2 == 4", True),
+        ("true || false && false", True),
+        ("!true || true", True),
+        ("not (1 = 1) or 2 <> 3", True),
+        ('1 < 2 ? "yes" : "no"', "yes"),
+        ("iif(value > 30, 1, 2)", 2),
+        ("false ? 1 : true ? 2 : 3", 2),
+        ("-value + 5", -20),
+        ("Math.Abs(-2.5) + Math.Max(1, 2)", 4.5),
+        ('Convert.ToInt32("42") + 1', 43),
+    ],
+)
+def test_precedence_and_numbers(text, expected):
+    result = parse(text)(SCOPE)
+    assert result == expected and type(result) is type(expected)
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        ('state.Status == "Forward" AND value < state.BaseDistance - 5', False),
+        ('STATE.status == "Forward" and VALUE > state.basedistance + 4', True),
+        ("state.left<6.5", True),
+        ("instance.time + 1", 201),
+        ("leftPower - RightPower", 1.0),
+        ("IT == 25 And True", True),
+    ],
+)
+def test_names_and_keywords_ignore_case(text, expected):
+    assert parse(text)(SCOPE) == expected
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        ('"Front sensor value: " + value', "Front sensor value: 25"),
+        ('state.left + " " + 1.5', "6 1.5"),
+        ('"a" + 1 + 2', "a12"),
+        ('1 + 2 + "a"', "3a"),
+        ('"x" & true', "xTrue"),
+        ('\'c\' + """q"""', 'c"q"'),
+    ],
+)
+def test_plus_with_text_joins_text_as_csharp_shows_values(text, expected):
+    assert parse(text)(SCOPE) == expected
+
+
+@pytest.mark.parametrize(
+    ("text", "column", "message"),
+    [
+        ("value < ", 9, "expected a value but found the end"),
+        ("value # 3", 7, "has no meaning here"),
+        ("(1 + 2", 7, "expected ')'"),
+        ("1 2", 3, "unexpected '2'"),
+        ("Math.Cube(2)", 6, "unknown function 'Cube'"),
+        ("iif(true, 1)", 1, "iif takes 3 values, not 2"),
+        ("", 1, "the expression is empty"),
+    ],
+)
+def test_syntax_errors_give_the_column(text, column, message):
+    with pytest.raises(ExprError) as info:
+        parse(text)
+    assert info.value.column == column and message in str(info.value)
+
+
+@pytest.mark.parametrize(
+    ("text", "column", "message"),
+    [
+        ("value / 0", 7, "division by zero"),
+        ('value < "x"', 7, "< cannot compare Int32 with String"),
+        ("value && true", 7, "&& needs true or false, not Int32"),
+        ("state.nothing", 7, "there is no global variable 'nothing'"),
+        ("speed + 1", 1, "unknown name 'speed'"),
+    ],
+)
+def test_evaluation_errors_give_the_column(text, column, message):
+    expression = parse(text)
+    with pytest.raises(ExprError) as info:
+        expression(Scope(value=3))
+    assert info.value.column == column and message in str(info.value)
+
+
+def test_sizes_are_bounded_before_parsing():
+    with pytest.raises(ExprError, match="nested more than"):
+        parse("(" * (MAX_DEPTH + 5) + "1" + ")" * (MAX_DEPTH + 5))
+    with pytest.raises(ExprError, match="at most 2,000"):
+        parse("1+" * 1500 + "1")
+    with pytest.raises(ExprError, match="digits"):
+        parse("1" * 40)
+
+
+def test_names_read_are_listed_for_the_checks():
+    e = parse('state.Status == "x" && instance.Time > leftPower')
+    assert e.state_names == {"status"} and e.instance_names == {"time"}
+    assert e.bare_names == {"leftpower"}
+
+
+@pytest.mark.parametrize(
+    ("text", "value"),
+    [
+        ("20", 20),
+        ("0.0", 0.0),
+        ("-1.5", -1.5),
+        ('"look"', "look"),
+        ("look", "look"),
+        ('""', ""),
+        ("true", True),
+        ("Turning left 90", "Turning left 90"),
+    ],
+)
+def test_data_literals(text, value):
+    result = literal(text)
+    assert result == value and type(result) is type(value)
+
+
+def test_values_show_as_csharp_prints_them():
+    assert [show(1.0), show(0.5), show(True), show(None), show(7)] == ["1", "0.5", "True", "", "7"]
+
+
+_ATOMS = st.sampled_from(
+    [
+        "value",
+        "state.x",
+        "instance.y",
+        "1",
+        "2.5",
+        '"s"',
+        "'c'",
+        "true",
+        "null",
+        "iif",
+        "Math.Abs",
+        "Convert.ToInt32",
+        "joinName",
+        "it",
+    ]
+)
+_OPS = st.sampled_from(
+    [
+        "+",
+        "-",
+        "*",
+        "/",
+        "%",
+        "mod",
+        "&&",
+        "||",
+        "and",
+        "or",
+        "not",
+        "!",
+        "==",
+        "=",
+        "<>",
+        "!=",
+        "<",
+        "<=",
+        ">",
+        ">=",
+        "?",
+        ":",
+        "(",
+        ")",
+        ",",
+        ".",
+        "&",
+        " ",
+    ]
+)
+
+
+@settings(max_examples=400, deadline=None)
+@given(st.lists(st.one_of(_ATOMS, _OPS), max_size=30))
+def test_fuzz_token_soup_raises_only_expr_error(parts):
+    text = " ".join(parts)
+    try:
+        expression = parse(text)
+        expression(Scope(value=3, state={"x": 2.0}, instance={"y": "t"}, parts={"joinname": 1}))
+    except ExprError:
+        pass
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.text(max_size=120))
+def test_fuzz_any_text_raises_only_expr_error(text):
+    with contextlib.suppress(ExprError):
+        parse(text)(Scope(value="v"))

@@ -1,0 +1,267 @@
+"""Running VIPLE programs: each semantic rule on a small program written for the test."""
+
+from __future__ import annotations
+
+import pytest
+
+from tests.program.builder import ProgramBuilder
+from workbench.control.commands import MoveAtPower, WheelPowers
+from workbench.program.compiled import compile_program
+from workbench.program.interp import ProgramController
+from workbench.program.keys import KeyScriptError, parse_key_script
+from workbench.program.kinds import parse_kind_map
+from workbench.program.loader import load_program
+from workbench.program.model import ELSE
+from workbench.program.problems import ProgramError
+
+TICK = 0.05
+
+
+def controller(b: ProgramBuilder, tmp_path, keys: str = "", kinds=None) -> ProgramController:
+    path = b.write(tmp_path / "p.viple")
+    return ProgramController(compile_program(load_program(path, kinds)), parse_key_script(keys))
+
+
+def run(c: ProgramController, seconds: float, readings=None) -> list:
+    commands = list(c.start(0.0))
+    for i in range(1, round(seconds / TICK) + 1):
+        r = readings(i * TICK) if callable(readings) else (readings or {})
+        commands += c.tick(i * TICK, {f"port {p}": v for p, v in r.items()}, frozenset())
+    return commands
+
+
+def texts(c: ProgramController) -> list[str]:
+    return [p.text for p in c.printed]
+
+
+def test_data_without_input_starts_and_fans_out_to_every_target(tmp_path):
+    b = ProgramBuilder()
+    main = b.panel("Main")
+    data = main.add(3, "7")
+    calc = main.add(2, "value * 2")
+    p1, p2 = main.add(28, ""), main.add(28, "")
+    b.link(data, calc)
+    b.link(data, p1)
+    b.link(calc, p2)
+    c = controller(b, tmp_path)
+    run(c, 0.1)
+    assert sorted(texts(c)) == ["14", "7"]
+
+
+def test_if_takes_the_first_true_condition_else_the_else_pin(tmp_path):
+    b = ProgramBuilder()
+    main = b.panel("Main")
+    b.robot(main)
+    sensor = main.add(23, "Robot/IoT Controller 0", "1")
+    cond = main.add(6, "value > 10", "value > 5", "value > 0")
+    outs = [main.add(2, f'"pin {k}"') for k in range(3)]
+    other = main.add(2, '"else"')
+    prints = [main.add(28, "") for _ in range(4)]
+    b.link(sensor, cond)
+    for k, out in enumerate(outs):
+        b.link(cond, out, pin=k)
+    b.link(cond, other, pin=ELSE)
+    for src, dst in zip([*outs, other], prints, strict=True):
+        b.link(src, dst)
+    c = controller(b, tmp_path)
+    values = iter([20, 7, 3, -1])
+    run(c, 0.2, lambda t: {1: next(values)})
+    assert texts(c) == ["pin 0", "pin 1", "pin 2", "else"]
+
+
+def test_merge_loop_counts_and_the_variable_is_global(tmp_path):
+    b = ProgramBuilder()
+    b.var("n")
+    main = b.panel("Main")
+    start = main.add(3, "0")
+    merge = main.add(5)
+    var = main.add(1, "n")
+    cond = main.add(6, "state.n < 5")
+    calc = main.add(2, "value + 1")
+    show = main.add(28, "")
+    main.chain(start, merge, var, cond, calc, merge)
+    b.link(cond, show, pin=ELSE)
+    c = controller(b, tmp_path)
+    run(c, 0.1)
+    assert texts(c) == ["5"] and c.variables == {"n": 5}
+
+
+def test_join_waits_for_every_input_and_names_its_parts(tmp_path):
+    b = ProgramBuilder()
+    main = b.panel("Main")
+    b.robot(main)
+    left = main.add(13, "0")  # a
+    right = main.add(13, "3")  # d
+    join = main.add(4, "leftPower", "rightPower")
+    drive = main.add(20, "leftPower", "rightPower", "Robot/IoT Controller 0", "3", "5")
+    lval, rval = main.add(3, "0.25"), main.add(3, "-0.5")
+    b.link(left, lval)
+    b.link(right, rval)
+    b.link(lval, join, in_pin=0)
+    b.link(rval, join, in_pin=1)
+    b.link(join, drive)
+    c = controller(b, tmp_path, keys="a@0.1 d@0.5")
+    commands = run(c, 0.3)
+    assert commands == []  # one input alone does not pass the Join
+    commands = [cmd for i in range(7, 13) for cmd in c.tick(i * TICK, {}, frozenset())]
+    assert commands == [WheelPowers(0.25, -0.5)]
+
+
+def test_a_busy_while_never_starves_other_flows(tmp_path):
+    b = ProgramBuilder()
+    b.var("go", "System.Boolean")
+    main = b.panel("Main")
+    start = main.add(3, "1")
+    loop = main.add(8, "!state.go")
+    end = main.add(10, "")
+    done = main.add(2, '"left the loop"')
+    show = main.add(28, "")
+    main.chain(start, loop, end, done, show)
+    key = main.add(13, "18")  # s
+    true = main.add(3, "true")
+    var = main.add(1, "go")
+    main.chain(key, true, var)
+    c = controller(b, tmp_path, keys="s@1.0")
+    run(c, 0.9)
+    assert texts(c) == [] and c.steps < 2_000  # the idle loop waits for a change
+    run_more = [c.tick(t, {}, frozenset()) for t in (1.0, 1.05)]
+    assert run_more and texts(c) == ["left the loop"]
+
+
+def test_a_timer_sleeps_in_its_own_flow_only(tmp_path):
+    b = ProgramBuilder()
+    main = b.panel("Main")
+    start = main.add(3, "500")
+    timer = main.add(15, "")
+    late = main.add(2, '"after 500 ms"')
+    p1 = main.add(28, "")
+    main.chain(start, timer, late, p1)
+    b.robot(main)
+    sensor = main.add(23, "Robot/IoT Controller 0", "2")
+    p2 = main.add(28, "")
+    b.link(sensor, p2)
+    c = controller(b, tmp_path)
+    run(c, 0.7, {2: 9})
+    times = {p.text: p.time for p in c.printed}
+    assert times["after 500 ms"] == pytest.approx(0.5)
+    assert sum(p.text == "9" for p in c.printed if p.time < 0.5) == 9
+
+
+def test_block_parameters_output_pin_and_event_pin(tmp_path):
+    b = ProgramBuilder()
+    main = b.panel("Main")
+    straight = b.panel("Twice", inputs=(("times", "System.Int32"),))
+    calc = straight.add(2, "value * instance.times")
+    b.link(straight.pin_in, calc)
+    b.link(calc, straight.pin_out)
+    b.link(calc, straight.pin_event)
+    start = main.add(3, "21")
+    block = main.add(0, "times", "1 + 1", name="Twice")
+    out = main.add(2, '"output " + value')
+    p1 = main.add(28, "")
+    main.chain(start, block, out, p1)
+    event = main.add(33, "Twice")
+    p2 = main.add(2, '"event " + value')
+    p3 = main.add(28, "")
+    main.chain(event, p2, p3)
+    kinds = parse_kind_map({"kinds": {33: {"activity": "custom-event", "value": 0}}}, "k.yaml")
+    c = controller(b, tmp_path, kinds=kinds)
+    run(c, 0.1)
+    assert sorted(texts(c)) == ["event 42", "output 42"]
+    assert [f.what for f in c.fired] == ["custom event Twice"]
+
+
+def test_touch_fires_on_press_only_and_key_release_stops(tmp_path):
+    b = ProgramBuilder()
+    main = b.panel("Main")
+    b.robot(main)
+    touch = main.add(22, "Robot/IoT Controller 0", "1")
+    p = main.add(28, "")
+    b.link(touch, p)
+    key = main.add(13, "22")
+    go = main.add(20, "0.5", "0.5", "Robot/IoT Controller 0", "3", "5")
+    b.link(key, go)
+    release = main.add(29, "")
+    stop = main.add(20, "0", "0", "Robot/IoT Controller 0", "3", "5")
+    b.link(release, stop)
+    c = controller(b, tmp_path, keys="w@0.1 release@0.3")
+    pressed = lambda t: {1: 1 if 0.15 < t < 0.4 else 0}  # noqa: E731
+    commands = run(c, 0.5, pressed)
+    assert texts(c) == ["1"]
+    assert commands == [WheelPowers(0.5, 0.5), WheelPowers(0.0, 0.0)]
+    assert [f.what for f in c.fired] == ["key w", "touch 1", "key release"]
+
+
+def test_mapped_move_at_power_uses_the_message(tmp_path):
+    b = ProgramBuilder()
+    main = b.panel("Main")
+    b.robot(main)
+    start = main.add(3, "0.8")
+    move = main.add(47, "Robot/IoT Controller 0")
+    b.link(start, move)
+    kinds = parse_kind_map({"kinds": {47: "move-at-power"}}, "k.yaml")
+    c = controller(b, tmp_path, kinds=kinds)
+    assert run(c, 0.1) == [MoveAtPower(0.8)]
+
+
+def test_runtime_errors_name_the_activity_and_end_only_that_flow(tmp_path):
+    b = ProgramBuilder()
+    main = b.panel("Main")
+    start = main.add(3, '"text"')
+    calc = main.add(2, "value * 2")
+    main.chain(start, calc)
+    other = main.add(3, '"still here"')
+    p = main.add(28, "")
+    main.chain(other, p)
+    c = controller(b, tmp_path)
+    run(c, 0.1)
+    assert texts(c) == ["still here"]
+    assert f"activity {calc} (Calculate): column 7: * needs numbers" in str(c.errors[0])
+
+
+def test_compile_problems_name_activity_value_and_column(tmp_path):
+    b = ProgramBuilder()
+    main = b.panel("Main")
+    bad = main.add(2, "value +")
+    ghost = main.add(6, "state.nobody > 1")
+    code = main.add(44, "Sum", "public class Sum { }")
+    path = b.write(tmp_path / "p.viple")
+    with pytest.raises(ProgramError) as info:
+        compile_program(load_program(path))
+    found = [str(p) for p in info.value.problems]
+    assert found[0] == (
+        f"{path}: panel Main: activity {bad} (kind 2, Calculate): Values[0] 'value +': "
+        "expected a value but found the end (column 8)"
+    )
+    assert any(f"activity {ghost} (kind 6, If): Values[0] reads state.nobody" in p for p in found)
+    assert any(f"activity {code} (kind 44, Code Activity): the C# class 'Sum'" in p for p in found)
+
+
+def test_the_sensor_json_code_activity_runs_as_a_builtin(tmp_path):
+    body = (
+        "public class Parse : CodeUtilities.CodeBase { public override void Execute() {"
+        ' var o = JObject.Parse((string)Input); Output = o["sensors"][0]["value"]; } }'
+    )
+    b = ProgramBuilder()
+    main = b.panel("Main")
+    b.robot(main)
+    raw = main.add(52, "Robot/IoT Controller 0", "-1")
+    code = main.add(44, "Parse", body)
+    p = main.add(28, "")
+    main.chain(raw, code, p)
+    c = controller(b, tmp_path)
+    run(c, 0.05, {4: 12.5})
+    assert texts(c) == ["12.5"]
+
+
+def test_key_scripts():
+    events = parse_key_script("release@3 w@0.5 a+d@4")
+    assert [(e.time, sorted(e.keys)) for e in events] == [
+        (0.5, ["w"]),
+        (3.0, []),
+        (4.0, ["a", "d"]),
+    ]
+    with pytest.raises(KeyScriptError, match="'x1' is not a key"):
+        parse_key_script("x1@2")
+    with pytest.raises(KeyScriptError, match="must be KEY@SECONDS"):
+        parse_key_script("w")

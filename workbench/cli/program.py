@@ -1,0 +1,117 @@
+"""``workbench program``: check VIPLE program files, and run one on a maze headless."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+from workbench.control.headless import RunSetupError
+from workbench.program.headless import ProgramRunSpec, load_compiled, run_program
+from workbench.program.problems import ProgramError
+
+from .run import _simulation_options, describe_measures
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("program", help="check or run VIPLE programs (.viple, VIPLE 3.x .xml)")
+    psub = p.add_subparsers(dest="program_command", metavar="ACTION", required=True)
+
+    c = psub.add_parser("check", help="load and check programs; list every problem")
+    c.add_argument("files", nargs="+", metavar="FILE")
+    c.add_argument("--kinds", metavar="MAP.yaml", help="names for unknown activity kinds")
+    c.set_defaults(func=cmd_check)
+
+    r = psub.add_parser("run", help="run a program on a maze and print its measures")
+    r.add_argument("file", metavar="FILE")
+    r.add_argument("--maze", required=True, help="maze file (any supported format)")
+    _simulation_options(r)
+    r.add_argument(
+        "--sensor",
+        action="append",
+        default=[],
+        metavar="KIND:PORT:MOUNT",
+        help="the robot's sensors, e.g. distance:3:right (default: the profile's)",
+    )
+    r.add_argument("--keys", default="", metavar="SCRIPT", help='e.g. "w@0.5 release@3 a@4.2"')
+    r.add_argument("--kinds", metavar="MAP.yaml", help="names for unknown activity kinds")
+    r.add_argument("--seed", type=int, default=0)
+    r.add_argument("--seconds", type=float, help="simulated seconds (default: from maze size)")
+    r.add_argument("--record", metavar="FILE.jsonl", help="write the run record")
+    r.add_argument("--json", action="store_true", help="one JSON object")
+    r.set_defaults(func=cmd_run)
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    bad = 0
+    for path in args.files:
+        try:
+            compiled = load_compiled(path, args.kinds)
+        except ProgramError as exc:
+            bad += 1
+            for problem in exc.problems:
+                print(problem)
+            continue
+        program = compiled.program
+        print(
+            f"{path}: ok (VIPLE {program.version}, {len(program.activities)} activities, "
+            f"{len(program.panels)} panels, {len(program.links)} links)"
+        )
+    return 1 if bad else 0
+
+
+def cmd_run(args: argparse.Namespace) -> int:
+    if args.seconds is not None and not 0 < args.seconds <= 24 * 3600:
+        print("workbench program run: --seconds must be above 0 and at most a day", file=sys.stderr)
+        return 2
+    spec = ProgramRunSpec(
+        program=args.file,
+        maze=args.maze,
+        profile=args.profile,
+        sensors=tuple(args.sensor),
+        keys=args.keys,
+        kinds=args.kinds,
+        seed=args.seed,
+        noise=args.noise,
+        noise_params=tuple(args.noise_set),
+        max_time=args.seconds,
+        record=args.record,
+    )
+    try:
+        result = run_program(spec)
+    except ProgramError as exc:
+        for problem in exc.problems:
+            print(problem, file=sys.stderr)
+        return 2
+    except RunSetupError as exc:
+        print(f"workbench program run: {exc}", file=sys.stderr)
+        return 2
+    data = result.as_dict()
+    if args.json:
+        print(json.dumps(data, sort_keys=False))
+    else:
+        print(describe_program_run(result))
+    if not result.maze.exits:
+        return 0
+    return 0 if data["reached_exit"] else 1
+
+
+def describe_program_run(result) -> str:
+    d = result.as_dict()
+    head = f"{result.program_name} on {result.maze.name} ({result.profile}, seed {d['seed']})"
+    lines = [head, *describe_measures(result)]
+    shown = result.printed[-10:]
+    if result.printed:
+        more = len(result.printed) + result.printed_dropped - len(shown)
+        lines.append(
+            f"  printed {len(result.printed) + result.printed_dropped} lines"
+            + (f"; the last {len(shown)}:" if more else ":")
+        )
+        lines += [f"    {p.time:7.2f} s  {p.text[:60]}" for p in shown]
+    if result.fired:
+        lines.append(f"  events: {len(result.fired)}")
+        lines += [f"    {f.time:7.2f} s  {f.what}" for f in result.fired[:10]]
+    if result.errors:
+        lines.append(f"  errors: {len(result.errors)}")
+        lines += [f"    {e}" for e in result.errors[:10]]
+    return "\n".join(lines)

@@ -1,0 +1,505 @@
+"""Running a compiled VIPLE program as the controller of a simulation session.
+
+The model is VIPLE's dataflow: a message arrives at an activity, the activity runs once and
+sends one message to every target of the output pin it chose. Each event (a key, a sensor
+report, a start message) and each extra branch of a fan-out is a *flow* of its own. Flows are
+scheduled on the simulation clock, deterministically: at each control tick the timers that
+are due wake first (earliest first), then key events, then sensor reports (activities in file
+order), then the ready flows run in turn, each for a slice of :data:`SLICE` activities. A flow
+that ran :data:`FLOW_TICK_STEPS` activities in one tick, or that loops in a While without
+anything having changed since its last pass, waits for the next tick, so a busy-waiting loop
+never freezes the others. A Timer puts only its own flow to sleep.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+from collections import deque
+from dataclasses import dataclass, field
+from heapq import heappop, heappush
+from typing import Any
+
+from workbench.control.commands import MotorPower, MoveAtPower, TurnByDegrees, WheelPowers
+
+from . import kinds as K
+from .code import first_sensor_value
+from .compiled import DEFAULTS, Compiled
+from .expr import ExprError, Scope, Value, show, type_name
+from .keys import KeyEvent
+from .model import ELSE
+
+SLICE = 50
+FLOW_TICK_STEPS = 5_000
+TICK_STEPS = 50_000
+MAX_FLOWS = 2_000
+MAX_CALL_DEPTH = 64
+MAX_PRINTED = 5_000
+MAX_ERRORS = 100
+#: activities that pass the message straight on when one arrives
+_PASS_ON = frozenset(
+    (
+        K.MERGE,
+        K.INPUT_PIN,
+        K.KEY_PRESS,
+        K.KEY_RELEASE,
+        K.TOUCH,
+        K.DISTANCE,
+        K.OTHER_SENSOR,
+        K.RAW_SENSOR,
+    )
+)
+
+
+@dataclass(frozen=True)
+class Printed:
+    time: float
+    text: str
+
+
+@dataclass(frozen=True)
+class Fired:
+    """An event the program answered: a key, a release, a custom event, a touch."""
+
+    time: float
+    activity: int
+    what: str
+
+
+@dataclass(frozen=True)
+class RunError:
+    time: float
+    panel: str
+    activity: int
+    label: str
+    message: str
+
+    def __str__(self) -> str:
+        return (
+            f"{self.time:.2f} s: panel {self.panel}: activity {self.activity} ({self.label}): "
+            f"{self.message}"
+        )
+
+
+@dataclass
+class Frame:
+    """One running custom activity (``block`` None: Main, or an event inside a panel)."""
+
+    panel: str
+    instance: dict[str, Value]
+    block: int | None = None
+    parent: Frame | None = None
+    depth: int = 0
+
+
+@dataclass
+class Flow:
+    number: int
+    activity: int
+    value: Value
+    frame: Frame
+    in_pin: int = 0
+    steps: int = 0
+    #: While id -> (changes, message) at its last pass, to notice a loop that changes nothing
+    loops: dict[int, tuple[int, Any]] = field(default_factory=dict)
+
+
+class _Sleep(Exception):
+    def __init__(self, seconds: float) -> None:
+        self.seconds = seconds
+
+
+class _Park(Exception):
+    pass
+
+
+class ProgramController:
+    """A :class:`workbench.sim.session.Controller` that runs a VIPLE program."""
+
+    def __init__(self, compiled: Compiled, keys: tuple[KeyEvent, ...] = ()) -> None:
+        self.compiled = compiled
+        self.program = compiled.program
+        self.key_script = keys
+        self.reset()
+
+    # -- the Controller protocol ----------------------------------------------------------
+    def reset(self) -> None:
+        self.globals: dict[str, Value] = {
+            key: DEFAULTS.get(vtype) for key, (_, vtype) in self.compiled.globals.items()
+        }
+        self.printed: list[Printed] = []
+        self.printed_dropped = 0
+        self.fired: list[Fired] = []
+        self.errors: list[RunError] = []
+        self.commands: list[Any] = []
+        self.changes = 0
+        self.now = 0.0
+        self._numbers = itertools.count()
+        self._ready: deque[Flow] = deque()
+        self._parked: list[Flow] = []
+        self._sleeping: list[tuple[float, int, Flow]] = []
+        self._joins: dict[tuple[int, int], list[deque[Value]]] = {}
+        self._held: set[str] = set()
+        self._next_key = 0
+        self._touch: dict[int, int] = {}
+        self.flows_dropped = 0
+        self.steps = 0
+        self.state: str | None = None
+
+    @property
+    def variables(self) -> dict[str, Any]:
+        names = self.compiled.globals
+        return {names[k][0]: v for k, v in self.globals.items() if v is None or _plain(v)}
+
+    def start(self, t: float) -> list[Any]:
+        self.now = t
+        program = self.program
+        main = Frame("Main", {})
+        for aid in program.panels["Main"].activities:
+            act = program.activities[aid]
+            if act.kind in (K.DATA, K.CALCULATE, K.BLOCK) and aid not in program.inputs:
+                self._spawn(aid, None, main)
+        return self._run()
+
+    def tick(self, t: float, readings: dict[str, float], events: frozenset[str]) -> list[Any]:
+        self.now = t
+        while self._sleeping and self._sleeping[0][0] <= t + 1e-9:
+            self._ready.append(heappop(self._sleeping)[2])
+        self._ready.extend(self._parked)
+        self._parked = []
+        self._keys(t)
+        self._sensors({int(name.split()[-1]): v for name, v in readings.items()})
+        return self._run()
+
+    # -- events --------------------------------------------------------------------------
+    def _keys(self, t: float) -> None:
+        script = self.key_script
+        while self._next_key < len(script) and script[self._next_key].time <= t + 1e-9:
+            event = script[self._next_key]
+            self._next_key += 1
+            if event.release:
+                self._held.clear()
+                for act in self._sources(K.KEY_RELEASE):
+                    self._fire(act.id, "", "key release")
+                continue
+            self._held |= event.keys
+            for act in self._sources(K.KEY_PRESS):
+                wanted = self.compiled.key_sets.get(act.id, frozenset())
+                if wanted and wanted <= self._held and wanted & event.keys:
+                    self._fire(act.id, "+".join(sorted(wanted)), f"key {'+'.join(sorted(wanted))}")
+
+    def _sensors(self, readings: dict[int, float]) -> None:
+        raw = None
+        for aid, (kind, port) in self.compiled.sensors.items():
+            if kind == K.RAW_SENSOR:
+                if raw is None:
+                    raw = json.dumps(
+                        {
+                            "sensors": [
+                                {"name": f"sensor{p}", "id": p, "value": readings[p]}
+                                for p in sorted(readings)
+                            ]
+                        }
+                    )
+                self._fire(aid, raw)
+                continue
+            if port not in readings:
+                continue
+            value = readings[port]
+            if kind == K.TOUCH:
+                pressed = 1 if value else 0
+                before = self._touch.get(aid, 0)
+                self._touch[aid] = pressed
+                if pressed and not before:
+                    self._fire(aid, 1, f"touch {port}")
+                continue
+            self._fire(aid, value)
+
+    def _sources(self, kind: int):
+        return [a for a in self.program.activities.values() if a.kind == kind]
+
+    def _fire(self, aid: int, value: Value, what: str | None = None) -> None:
+        act = self.program.activities[aid]
+        if what is not None:
+            self.fired.append(Fired(self.now, aid, what))
+        frame = Frame(act.panel, self._instance_defaults(act.panel))
+        for link in self.program.targets(aid):
+            self._spawn(link.target, value, frame, link.in_pin)
+
+    def _instance_defaults(self, panel: str) -> dict[str, Value]:
+        if panel == "Main":
+            return {}
+        return {v.name.lower(): DEFAULTS.get(v.type) for v in self.program.panels[panel].inputs}
+
+    # -- scheduling ----------------------------------------------------------------------
+    def _spawn(self, aid: int, value: Value, frame: Frame, in_pin: int = 0) -> None:
+        live = len(self._ready) + len(self._parked) + len(self._sleeping)
+        if live >= MAX_FLOWS:
+            self.flows_dropped += 1
+            if self.flows_dropped == 1:
+                self._error(aid, f"more than {MAX_FLOWS:,} flows at once: new messages dropped")
+            return
+        self.changes += 1
+        self._ready.append(Flow(next(self._numbers), aid, value, frame, in_pin))
+
+    def _run(self) -> list[Any]:
+        total = 0
+        ready = self._ready
+        while ready and total < TICK_STEPS:
+            flow = ready.popleft()
+            if flow.steps >= FLOW_TICK_STEPS:
+                self._parked.append(flow)
+                continue
+            done = 0
+            try:
+                while done < SLICE:
+                    done += 1
+                    if not self._step(flow):
+                        flow = None
+                        break
+                else:
+                    ready.append(flow)
+            except _Sleep as sleep:
+                heappush(self._sleeping, (self.now + sleep.seconds, flow.number, flow))
+            except _Park:
+                self._parked.append(flow)
+            if flow is not None:
+                flow.steps += done
+            total += done
+        self.steps += total
+        for flow in itertools.chain(ready, self._parked):
+            flow.steps = 0
+        for _, _, flow in self._sleeping:
+            flow.steps = 0
+        busy = len(ready) + len(self._parked) + len(self._sleeping)
+        self.state = f"{busy} flow{'s' if busy != 1 else ''}"
+        commands, self.commands = self.commands, []
+        return commands
+
+    # -- one activity ----------------------------------------------------------------------
+    def _step(self, flow: Flow) -> bool:
+        """Run the activity the flow is at; False when the flow has ended."""
+        act = self.program.activities[flow.activity]
+        try:
+            return self._execute(flow, act)
+        except (ExprError, ValueError, TypeError, OverflowError) as exc:
+            self._error(act.id, str(exc))
+            return False
+
+    def _go(self, flow: Flow, pin: int, value: Value, source: int | None = None) -> bool:
+        """Send ``value`` out of ``pin``: the first target continues this flow."""
+        links = self.program.targets(flow.activity if source is None else source, pin)
+        if not links:
+            return False
+        for link in links[1:]:
+            self._spawn(link.target, value, flow.frame, link.in_pin)
+        first = links[0]
+        flow.activity, flow.value, flow.in_pin = first.target, value, first.in_pin
+        return True
+
+    def _scope(self, flow: Flow) -> Scope:
+        value = flow.value
+        return Scope(
+            value, self.globals, flow.frame.instance, value if isinstance(value, dict) else None
+        )
+
+    def _execute(self, flow: Flow, act) -> bool:
+        kind, value, compiled = act.kind, flow.value, self.compiled
+        if kind in _PASS_ON:
+            return self._go(flow, 0, value)
+        if kind == K.DATA:
+            return self._go(flow, 0, compiled.constants[act.id])
+        if kind == K.CALCULATE:
+            return self._go(flow, 0, compiled.expr(act.id, 0)(self._scope(flow)))
+        if kind == K.VARIABLE:
+            key = act.value(0).strip().lower()
+            stored = convert(value, compiled.globals[key][1])
+            self.globals[key] = stored
+            self.changes += 1
+            return self._go(flow, 0, stored)
+        if kind == K.IF:
+            scope = self._scope(flow)
+            for index in range(len(act.values)):
+                if _truth(compiled.expr(act.id, index)(scope), index):
+                    return self._go(flow, index, value)
+            return self._go(flow, ELSE, value)
+        if kind == K.SWITCH:
+            scope = self._scope(flow)
+            for index in range(len(act.values)):
+                case = compiled.expr(act.id, index)(scope)
+                if case is True or (not isinstance(case, bool) and case == value):
+                    return self._go(flow, index, value)
+            return self._go(flow, ELSE, value)
+        if kind == K.WHILE:
+            if _truth(compiled.expr(act.id, 0)(self._scope(flow)), 0):
+                mark = (self.changes, _key(value))
+                if flow.loops.get(act.id) == mark:
+                    raise _Park()
+                flow.loops[act.id] = mark
+                return self._go(flow, 0, value)
+            flow.loops.pop(act.id, None)
+            return self._go(flow, 0, value, self.program.loop_end[act.id])
+        if kind == K.END_WHILE:
+            flow.activity = self.program.loop_start[act.id]
+            return True
+        if kind == K.BREAK:
+            loop = self.program.break_loop[act.id]
+            flow.loops.pop(loop, None)
+            return self._go(flow, 0, value, self.program.loop_end[loop])
+        if kind == K.JOIN:
+            return self._join(flow, act)
+        if kind == K.TIMER:
+            if not isinstance(value, int | float) or isinstance(value, bool):
+                raise ValueError(
+                    f"the Timer needs a number of milliseconds, not {type_name(value)}"
+                )
+            if not self._go(flow, 0, value):
+                return False  # nothing waits for the Timer
+            raise _Sleep(max(0.0, float(value)) / 1000.0)
+        if kind == K.PRINT_LINE:
+            self._print(show(value))
+            return self._go(flow, 0, value)
+        if kind == K.DRIVE:
+            scope = self._scope(flow)
+            left = _power(compiled.expr(act.id, 0)(scope), "left")
+            right = _power(compiled.expr(act.id, 1)(scope), "right")
+            self._command(WheelPowers(left, right))
+            return self._go(flow, 0, value)
+        if kind == K.BLOCK:
+            return self._call(flow, act)
+        if kind == K.OUTPUT_PIN:
+            frame = flow.frame
+            if frame.block is None or frame.parent is None:
+                return False
+            flow.frame = frame.parent
+            return self._go(flow, 0, value, frame.block)
+        if kind == K.EVENT_PIN:
+            for aid, block in compiled.event_blocks.items():
+                if block == flow.frame.panel:
+                    self.fired.append(Fired(self.now, aid, f"custom event {block}"))
+                    for link in self.program.targets(aid):
+                        self._spawn(link.target, value, Frame("Main", {}), link.in_pin)
+            return False
+        if kind == K.CODE:
+            return self._go(flow, 0, first_sensor_value(value))
+        mapped = self.program.kinds.get(kind)
+        if mapped is not None:
+            return self._mapped(flow, act, mapped)
+        return False  # Comment, Robot: never run
+
+    def _mapped(self, flow: Flow, act, mapped) -> bool:
+        if mapped.activity == "custom-event":
+            return self._go(flow, 0, flow.value)
+        if mapped.activity == "ignore":
+            return False
+        if mapped.value is not None:
+            arg = self.compiled.expr(act.id, mapped.value)(self._scope(flow))
+        else:
+            arg = flow.value
+        if mapped.activity == "move-at-power":
+            self._command(MoveAtPower(_power(arg, "power")))
+        elif mapped.activity == "turn-by-degrees":
+            self._command(TurnByDegrees(_number(arg, "degrees")))
+        else:
+            wheel = "left" if mapped.activity == "motor-left" else "right"
+            self._command(MotorPower(wheel, _power(arg, wheel)))
+        return self._go(flow, 0, flow.value)
+
+    def _call(self, flow: Flow, act) -> bool:
+        frame = flow.frame
+        if frame.depth >= MAX_CALL_DEPTH:
+            raise ValueError(f"activity blocks call each other more than {MAX_CALL_DEPTH} deep")
+        instance = self._instance_defaults(act.name)
+        scope = self._scope(flow)
+        types = {v.name.lower(): v.type for v in self.program.panels[act.name].inputs}
+        for index in range(1, len(act.values), 2):
+            name = act.values[index - 1].strip().lower()
+            if name:
+                instance[name] = convert(self.compiled.expr(act.id, index)(scope), types[name])
+        flow.frame = Frame(act.name, instance, act.id, frame, frame.depth + 1)
+        entry = self.program.pin_of(act.name, K.INPUT_PIN)
+        if entry is None:
+            return False
+        flow.activity = entry
+        return True
+
+    def _join(self, flow: Flow, act) -> bool:
+        inputs = self.program.inputs.get(act.id, ())
+        count = max(len(act.values), max((lk.in_pin for lk in inputs), default=0) + 1)
+        # one Join per running block call; events at panel level share the panel's Join
+        owner = id(flow.frame) if flow.frame.block is not None else None
+        queues = self._joins.setdefault((act.id, owner), [deque() for _ in range(count)])
+        if len(queues[flow.in_pin]) >= 1_000:
+            raise ValueError("more than 1,000 messages wait at one Join input")
+        queues[flow.in_pin].append(flow.value)
+        if not all(queues):
+            return False
+        names = [(act.value(i).strip() or f"input{i}").lower() for i in range(count)]
+        message = {name: q.popleft() for name, q in zip(names, queues, strict=True)}
+        return self._go(flow, 0, message)
+
+    # -- effects ---------------------------------------------------------------------------
+    def _command(self, cmd: Any) -> None:
+        self.commands.append(cmd)
+        self.changes += 1
+
+    def _print(self, text: str) -> None:
+        self.changes += 1
+        if len(self.printed) < MAX_PRINTED:
+            self.printed.append(Printed(self.now, text[:1000]))
+        else:
+            self.printed_dropped += 1
+
+    def _error(self, aid: int, message: str) -> None:
+        if len(self.errors) < MAX_ERRORS:
+            act = self.program.activities[aid]
+            self.errors.append(RunError(self.now, act.panel, aid, self.program.label(act), message))
+
+
+def convert(value: Value, vtype: str) -> Value:
+    """A value stored in a variable or parameter of a declared type (as C#'s Convert)."""
+    if vtype == "System.String":
+        return show(value)
+    if isinstance(value, dict):
+        raise ValueError("a Join message cannot be stored in a variable")
+    if vtype in ("System.Int32", "System.Double"):
+        if isinstance(value, str):
+            try:
+                value = float(value.strip()) if "." in value else int(value.strip())
+            except ValueError:
+                raise ValueError(f"{value[:30]!r} is not a number for a {vtype[7:]}") from None
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise ValueError(f"{type_name(value)} cannot be stored in a {vtype[7:]}")
+        return round(value) if vtype == "System.Int32" else float(value)
+    if vtype == "System.Boolean":
+        if isinstance(value, str) and value.strip().lower() in ("true", "false"):
+            return value.strip().lower() == "true"
+        if not isinstance(value, bool):
+            raise ValueError(f"{type_name(value)} cannot be stored in a Boolean")
+    return value
+
+
+def _truth(value: Value, index: int) -> bool:
+    if not isinstance(value, bool):
+        raise ValueError(f"condition {index} gave {type_name(value)}, not true or false")
+    return value
+
+
+def _number(value: Value, what: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, int | float):
+        raise ValueError(f"the {what} must be a number, not {type_name(value)}")
+    return float(value)
+
+
+def _power(value: Value, what: str) -> float:
+    return _number(value, f"{what} power")
+
+
+def _plain(value: Value) -> bool:
+    return isinstance(value, int | float | str | bool)
+
+
+def _key(value: Value) -> Any:
+    if isinstance(value, dict):
+        return tuple(sorted(value.items()))
+    return (type(value), value)
