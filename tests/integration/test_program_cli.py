@@ -1,4 +1,4 @@
-"""`workbench program check` and `run` as a user runs them, and the real VIPLE programs."""
+"""`workbench viple check`, `show` and `run` as a user runs them, and the real VIPLE programs."""
 
 from __future__ import annotations
 
@@ -30,19 +30,19 @@ def test_check_exit_codes_and_problem_lines(tmp_path, capsys):
     good = forward_program(tmp_path)
     bad = tmp_path / "bad.viple"
     bad.write_bytes(b"<Program><Version>4.0</Version>")
-    assert main(["program", "check", good]) == 0
+    assert main(["viple", "check", good]) == 0
     assert "ok (VIPLE 4.0.0.1, 5 activities" in capsys.readouterr().out
-    assert main(["program", "check", good, str(bad)]) == 1
+    assert main(["viple", "check", good, str(bad)]) == 1
     out = capsys.readouterr().out
     assert f"{bad}: line 1, column 32: the XML is not well formed" in out
     with pytest.raises(SystemExit) as info:
-        main(["program", "check"])
+        main(["viple", "check"])
     assert info.value.code == 2
 
 
 def test_run_prints_measures_prints_and_events(tmp_path, capsys):
     path = forward_program(tmp_path)
-    code = main(["program", "run", path, "--maze", WEB_MAZE, "--keys", "w@0.5", "--seconds", "3"])
+    code = main(["viple", "run", path, "--maze", WEB_MAZE, "--keys", "w@0.5", "--max-time", "3"])
     out = capsys.readouterr().out
     assert code == 1  # the maze has an exit the robot did not reach
     assert "forward.viple on" in out and "distance travelled" in out and "turning degrees" in out
@@ -51,7 +51,7 @@ def test_run_prints_measures_prints_and_events(tmp_path, capsys):
 
 def test_run_json_is_deterministic(tmp_path, capsys):
     path = forward_program(tmp_path)
-    args = ["program", "run", path, "--maze", WEB_MAZE, "--keys", "w@0.2", "--seconds", "4"]
+    args = ["viple", "run", path, "--maze", WEB_MAZE, "--keys", "w@0.2", "--max-time", "4"]
     outs = []
     for _ in range(2):
         main([*args, "--json", "--seed", "3", "--noise", "realistic"])
@@ -68,7 +68,7 @@ def test_missing_sensor_is_an_error_before_the_run(tmp_path, capsys):
     b.robot(m)
     sensor = m.add(23, "Robot/IoT Controller 0", "7")
     path = b.write(tmp_path / "s.viple")
-    assert main(["program", "run", path, "--maze", WEB_MAZE, "--seconds", "1"]) == 2
+    assert main(["viple", "run", path, "--maze", WEB_MAZE, "--max-time", "1"]) == 2
     err = capsys.readouterr().err
     assert f"activity {sensor} (kind 23, Robot Distance Sensor): it reads port 7" in err
     assert "add --sensor distance:7:MOUNT" in err
@@ -78,7 +78,7 @@ def test_missing_sensor_is_an_error_before_the_run(tmp_path, capsys):
 class TestRealPrograms:
     def test_each_real_program_loads(self, capsys):
         files = sorted(str(p) for p in REAL.iterdir() if p.suffix in (".viple", ".xml"))
-        assert files and main(["program", "check", *files]) == 0
+        assert files and main(["viple", "check", *files]) == 0
 
     @pytest.mark.parametrize(
         ("key", "powers"),
@@ -117,7 +117,7 @@ class TestRealPrograms:
 
     def test_wall_follower_follows_a_wall(self, capsys):
         args = [
-            "program",
+            "viple",
             "run",
             str(REAL / "WallFollower.viple"),
             "--maze",
@@ -128,7 +128,7 @@ class TestRealPrograms:
             "distance:3:right",
             "--keys",
             "a@0.2",
-            "--seconds",
+            "--max-time",
             "30",
             "--json",
         ]
@@ -141,6 +141,20 @@ class TestRealPrograms:
 
 def test_the_shipped_example_leaves_the_web_maze(capsys):
     example = str(Path(WEB_MAZE).parents[1] / "programs" / "right-wall.viple")
-    assert main(["program", "run", example, "--maze", WEB_MAZE, "--json"]) == 0
+    assert main(["viple", "run", example, "--maze", WEB_MAZE, "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["reached_exit"] and not data["errors"]
+
+
+def test_show_prints_panels_activities_and_links_in_80_columns(tmp_path, capsys):
+    path = forward_program(tmp_path)
+    assert main(["viple", "show", path]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith(path[:60])  # a long path is cut at 80 columns
+    assert any(line.startswith("panel Main") for line in out)
+    assert any(" -> " in line for line in out)  # the links, from each activity's outputs
+    assert max(len(line) for line in out) <= 80
+    bad = tmp_path / "bad.viple"
+    bad.write_text("<not a program")
+    assert main(["viple", "show", str(bad)]) == 1
+    assert "bad.viple" in capsys.readouterr().err

@@ -127,7 +127,7 @@ def test_unknown_kinds_by_number_and_id_then_named_by_a_mapping_file(tmp_path):
     assert found == [
         f"{path}: panel Main: activity {move} (kind 47, unknown): kind 47 is not known to the "
         "workbench (if you know which VIPLE service it is, name it in a kinds mapping file "
-        "(--kinds FILE, see docs/programs.md))"
+        "(--kinds FILE, see docs/viple-programs.md))"
     ]
     mapping = tmp_path / "kinds.yaml"
     mapping.write_text("kinds:\n  47: {activity: move-at-power, value: 0}\n")

@@ -13,12 +13,12 @@ from . import algorithms as algorithms_cmd
 from . import instructor as instructor_cmd
 from . import labs as labs_cmd
 from . import maze as maze_cmd
-from . import program as program_cmd
 from . import run as run_cmd
 from . import serve as serve_cmd
 from . import signoff as signoff_cmd
 from . import ssh as ssh_cmd
 from . import viple_client as viple_client_cmd
+from . import viple_program as viple_program_cmd
 from .common import default_maze_path, error, new_runs_dir, runs_home
 
 
@@ -90,7 +90,7 @@ def build_parser() -> argparse.ArgumentParser:
     maze_cmd.register(sub)
     algorithms_cmd.register(sub)
     run_cmd.register(sub)
-    program_cmd.register(sub)
+    viple_program_cmd.register(sub)
     labs_cmd.register(sub)
     serve_cmd.register(sub)
     viple_client_cmd.register(sub)

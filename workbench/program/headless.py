@@ -1,4 +1,4 @@
-"""Running a VIPLE program on a maze without a screen: the engine of ``workbench program run``."""
+"""Running a VIPLE program on a maze without a screen: the engine of ``workbench viple run``."""
 
 from __future__ import annotations
 

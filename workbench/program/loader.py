@@ -486,7 +486,7 @@ class _Builder:
                 self.problem(
                     f"kind {act.kind} is not known to the workbench",
                     "if you know which VIPLE service it is, name it in a kinds mapping file "
-                    "(--kinds FILE, see docs/programs.md)",
+                    "(--kinds FILE, see docs/viple-programs.md)",
                     act=act,
                 )
             if act.kind in (K.INPUT_PIN, K.OUTPUT_PIN, K.EVENT_PIN) and act.panel == "Main":

@@ -1,4 +1,4 @@
-"""``workbench program``: check VIPLE program files, and run one on a maze headless."""
+"""``workbench viple``: check and show VIPLE program files, and run one on a maze headless."""
 
 from __future__ import annotations
 
@@ -9,18 +9,26 @@ import sys
 from workbench.control.headless import RunSetupError
 from workbench.program.headless import ProgramRunSpec, load_compiled, run_program
 from workbench.program.problems import ProgramError
+from workbench.program.show import describe_program
 
 from .run import _simulation_options, describe_measures
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("program", help="check or run VIPLE programs (.viple, VIPLE 3.x .xml)")
-    psub = p.add_subparsers(dest="program_command", metavar="ACTION", required=True)
+    p = sub.add_parser(
+        "viple", help="check, show or run VIPLE programs (.viple, VIPLE 3.x .xml) without VIPLE"
+    )
+    psub = p.add_subparsers(dest="viple_command", metavar="ACTION", required=True)
 
     c = psub.add_parser("check", help="load and check programs; list every problem")
     c.add_argument("files", nargs="+", metavar="FILE")
     c.add_argument("--kinds", metavar="MAP.yaml", help="names for unknown activity kinds")
     c.set_defaults(func=cmd_check)
+
+    s = psub.add_parser("show", help="a program's panels, activities, values, links, globals")
+    s.add_argument("file", metavar="FILE")
+    s.add_argument("--kinds", metavar="MAP.yaml", help="names for unknown activity kinds")
+    s.set_defaults(func=cmd_show)
 
     r = psub.add_parser("run", help="run a program on a maze and print its measures")
     r.add_argument("file", metavar="FILE")
@@ -36,7 +44,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     r.add_argument("--keys", default="", metavar="SCRIPT", help='e.g. "w@0.5 release@3 a@4.2"')
     r.add_argument("--kinds", metavar="MAP.yaml", help="names for unknown activity kinds")
     r.add_argument("--seed", type=int, default=0)
-    r.add_argument("--seconds", type=float, help="simulated seconds (default: from maze size)")
+    r.add_argument("--max-time", type=float, help="simulated seconds (default: from maze size)")
     r.add_argument("--record", metavar="FILE.jsonl", help="write the run record")
     r.add_argument("--json", action="store_true", help="one JSON object")
     r.set_defaults(func=cmd_run)
@@ -60,9 +68,20 @@ def cmd_check(args: argparse.Namespace) -> int:
     return 1 if bad else 0
 
 
+def cmd_show(args: argparse.Namespace) -> int:
+    try:
+        compiled = load_compiled(args.file, args.kinds)
+    except ProgramError as exc:
+        for problem in exc.problems:
+            print(problem, file=sys.stderr)
+        return 1
+    print("\n".join(describe_program(compiled.program)))
+    return 0
+
+
 def cmd_run(args: argparse.Namespace) -> int:
-    if args.seconds is not None and not 0 < args.seconds <= 24 * 3600:
-        print("workbench program run: --seconds must be above 0 and at most a day", file=sys.stderr)
+    if args.max_time is not None and not 0 < args.max_time <= 24 * 3600:
+        print("workbench viple run: --max-time must be above 0 and at most a day", file=sys.stderr)
         return 2
     spec = ProgramRunSpec(
         program=args.file,
@@ -74,7 +93,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         seed=args.seed,
         noise=args.noise,
         noise_params=tuple(args.noise_set),
-        max_time=args.seconds,
+        max_time=args.max_time,
         record=args.record,
     )
     try:
@@ -84,7 +103,7 @@ def cmd_run(args: argparse.Namespace) -> int:
             print(problem, file=sys.stderr)
         return 2
     except RunSetupError as exc:
-        print(f"workbench program run: {exc}", file=sys.stderr)
+        print(f"workbench viple run: {exc}", file=sys.stderr)
         return 2
     data = result.as_dict()
     if args.json:
