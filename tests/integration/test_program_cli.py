@@ -158,3 +158,19 @@ def test_show_prints_panels_activities_and_links_in_80_columns(tmp_path, capsys)
     bad.write_text("<not a program")
     assert main(["viple", "show", str(bad)]) == 1
     assert "bad.viple" in capsys.readouterr().err
+
+
+def test_eval_ranks_programs_beside_algorithms(tmp_path, capsys):
+    example = str(Path(WEB_MAZE).parents[1] / "programs" / "right-wall.viple")
+    maze = str(Path(WEB_MAZE).parent / "rank-wall-wins.txt")
+    args = ["eval", "--maze", maze, "--algorithm", "right-wall", "--program", example]
+    assert main([*args, "--profile", "web", "--seeds", "2", "--jobs", "1", "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    cells = {c["algorithm"]: c for c in data["cells"]}
+    assert set(cells) == {"right-wall", "right-wall.viple"}
+    assert cells["right-wall.viple"]["runs"] == 2 and cells["right-wall.viple"]["reached"] == 2
+    assert sorted(data["ranking"][maze]) == ["right-wall", "right-wall.viple"]
+    assert main(["eval", "--maze", maze, "--program", example, example]) == 2
+    assert "right-wall.viple: give each once" in capsys.readouterr().err
+    assert main(["eval", "--maze", maze]) == 2
+    assert "give --algorithm" in capsys.readouterr().err

@@ -9,6 +9,7 @@ import sys
 
 from workbench.control.evaluate import EvalError, evaluate, format_table, write_csv
 from workbench.control.headless import RunSetupError, RunSpec, run
+from workbench.program.headless import program_entrant
 from workbench.sim.noise import NOISE_LEVELS
 from workbench.sim.profiles import PROFILES
 
@@ -47,9 +48,22 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--json", action="store_true", help="one JSON object")
     p.set_defaults(func=cmd_run)
 
-    e = sub.add_parser("eval", help="every algorithm on every maze, over several seeds")
+    e = sub.add_parser(
+        "eval", help="every algorithm and VIPLE program on every maze, over several seeds"
+    )
     e.add_argument("--maze", nargs="+", required=True, metavar="M")
-    e.add_argument("--algorithm", nargs="+", required=True, metavar="A")
+    e.add_argument("--algorithm", nargs="+", default=[], metavar="A")
+    e.add_argument(
+        "--program", nargs="+", default=[], metavar="FILE", help="VIPLE programs (.viple, .xml)"
+    )
+    e.add_argument(
+        "--sensor",
+        action="append",
+        default=[],
+        metavar="KIND:PORT:MOUNT",
+        help="the robot's sensors for the programs (default: the profile's)",
+    )
+    e.add_argument("--kinds", metavar="MAP.yaml", help="names for unknown activity kinds")
     _simulation_options(e)
     e.add_argument("--seeds", type=int, default=3, help="seeds 0..N-1 (default 3)")
     e.add_argument("--max-time", type=float, help="simulated seconds per run")
@@ -122,10 +136,31 @@ def cmd_eval(args: argparse.Namespace) -> int:
     if args.seeds < 1 or args.jobs < 1:
         print("workbench eval: --seeds and --jobs must be at least 1", file=sys.stderr)
         return 2
+    if not args.algorithm and not args.program:
+        print(
+            "workbench eval: give --algorithm A ... or --program FILE ... (or both)",
+            file=sys.stderr,
+        )
+        return 2
+    bases = [os.path.basename(p) for p in args.program]
+    programs = [
+        program_entrant(
+            path,
+            name=base if bases.count(base) == 1 else path,
+            kinds=args.kinds,
+            profile=args.profile,
+            sensors=tuple(args.sensor),
+            noise=args.noise,
+            noise_params=tuple(args.noise_set),
+            max_time=args.max_time,
+        )
+        for path, base in zip(args.program, bases, strict=True)
+    ]
     try:
         result = evaluate(
             args.maze,
             args.algorithm,
+            others=programs,
             seeds=args.seeds,
             profile=args.profile,
             noise=args.noise,

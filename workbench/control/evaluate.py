@@ -1,4 +1,10 @@
-"""The algorithm x maze matrix: every algorithm on every maze over several seeds, in parallel."""
+"""The entrant x maze matrix: every algorithm (or VIPLE program) on every maze over several
+seeds, in parallel.
+
+An entrant is a name and a way to make the spec of one run (maze, seed); a spec checks itself
+before anything runs and runs itself in a worker process. Algorithms are made here; VIPLE
+programs come from :mod:`workbench.program` the same way.
+"""
 
 from __future__ import annotations
 
@@ -7,15 +13,52 @@ import statistics
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Protocol
 
-from .headless import RunSetupError, RunSpec, prepare, run
+from .headless import RunSetupError, RunSpec
 
 MEASURES = ("distance_cells", "turn_degrees", "sim_time", "collisions", "turns")
 
 
 class EvalError(ValueError):
     """The evaluation cannot start (named inputs that do not load)."""
+
+
+class Runnable(Protocol):
+    """One run's spec: sent to a worker process, so a picklable value."""
+
+    def check(self) -> None: ...
+
+    def execute(self) -> dict[str, Any]: ...
+
+
+@dataclass(frozen=True)
+class Entrant:
+    """What takes part: its name in the table, and the spec of its run on a maze with a seed."""
+
+    name: str
+    spec: Callable[[str, int], Runnable]
+
+
+def algorithm_entrant(
+    algorithm: str,
+    profile: str | None = None,
+    noise: str | None = None,
+    noise_params: tuple[str, ...] = (),
+    max_time: float | None = None,
+) -> Entrant:
+    def spec(maze: str, seed: int) -> RunSpec:
+        return RunSpec(
+            maze=maze,
+            algorithm=algorithm,
+            profile=profile,
+            seed=seed,
+            noise=noise,
+            noise_params=noise_params,
+            max_time=max_time,
+        )
+
+    return Entrant(algorithm, spec)
 
 
 @dataclass(frozen=True)
@@ -66,8 +109,8 @@ class EvalResult:
         }
 
 
-def _one(spec: RunSpec) -> dict[str, Any]:
-    return run(spec).as_dict()
+def _one(spec: Runnable) -> dict[str, Any]:
+    return spec.execute()
 
 
 def _summarise(maze: str, algorithm: str, results: list[dict[str, Any]]) -> Cell:
@@ -80,7 +123,7 @@ def _summarise(maze: str, algorithm: str, results: list[dict[str, Any]]) -> Cell
 
 def evaluate(
     mazes: Sequence[str],
-    algorithms: Sequence[str],
+    algorithms: Sequence[str] = (),
     seeds: int = 3,
     profile: str | None = None,
     noise: str | None = None,
@@ -88,34 +131,32 @@ def evaluate(
     max_time: float | None = None,
     jobs: int = 1,
     progress: bool | Callable[[int, int], None] = False,
+    others: Sequence[Entrant] = (),
 ) -> EvalResult:
-    specs = [
-        RunSpec(
-            maze=m,
-            algorithm=a,
-            profile=profile,
-            seed=s,
-            noise=noise,
-            noise_params=noise_params,
-            max_time=max_time,
-        )
-        for m in mazes
-        for a in algorithms
-        for s in range(seeds)
+    """Every algorithm (by name) and every other entrant (VIPLE programs) on every maze."""
+    entrants = [
+        *(algorithm_entrant(a, profile, noise, noise_params, max_time) for a in algorithms),
+        *others,
     ]
+    names = [e.name for e in entrants]
+    if not entrants:
+        raise EvalError("nothing to evaluate: give algorithms or programs")
+    if len(set(names)) != len(names):
+        twice = sorted({n for n in names if names.count(n) > 1})
+        raise EvalError(f"two entrants are named {', '.join(twice)}: give each once")
+    specs = [e.spec(m, s) for m in mazes for e in entrants for s in range(seeds)]
     # fail fast, in this process, on inputs that cannot run at all
     for m in mazes:
-        for a in algorithms:
+        for e in entrants:
             try:
-                prepare(RunSpec(maze=m, algorithm=a, profile=profile, noise=noise,
-                                noise_params=noise_params))  # fmt: skip
-            except RunSetupError as exc:
-                raise EvalError(f"{a} on {m}: {exc}") from None
+                e.spec(m, 0).check()
+            except (RunSetupError, ValueError) as exc:
+                raise EvalError(f"{e.name} on {m}: {exc}") from None
     results = _run_all(specs, jobs, progress)
     cells = []
-    for i, (m, a) in enumerate((m, a) for m in mazes for a in algorithms):
-        cells.append(_summarise(m, a, results[i * seeds : (i + 1) * seeds]))
-    return EvalResult(tuple(mazes), tuple(algorithms), seeds, tuple(cells))
+    for i, (m, name) in enumerate((m, n) for m in mazes for n in names):
+        cells.append(_summarise(m, name, results[i * seeds : (i + 1) * seeds]))
+    return EvalResult(tuple(mazes), tuple(names), seeds, tuple(cells))
 
 
 def _run_all(

@@ -53,6 +53,14 @@ class RunSpec:
     record: str | None = None
     dt: float = 1 / 60
 
+    def check(self) -> None:
+        """Raise :class:`RunSetupError` when this run cannot start (nothing runs)."""
+        prepare(self)
+
+    def execute(self) -> dict[str, Any]:
+        """Run it; the result as ``workbench run --json`` gives it."""
+        return run(self).as_dict()
+
 
 @dataclass
 class RunResult:

@@ -6,6 +6,7 @@ import os
 from dataclasses import dataclass, field
 from typing import Any
 
+from workbench.control.evaluate import Entrant
 from workbench.control.headless import RunSetupError, default_max_time, parse_noise_params
 from workbench.files.bounded import BoundedFileError
 from workbench.sim.maze import Maze, MazeError
@@ -43,6 +44,42 @@ class ProgramRunSpec:
     max_time: float | None = None
     record: str | None = None
     dt: float = 1 / 60
+
+    def check(self) -> None:
+        """Raise :class:`ProgramError` or :class:`RunSetupError` when this run cannot start."""
+        prepare(self)
+
+    def execute(self) -> dict[str, Any]:
+        """Run it; the result as ``workbench viple run --json`` gives it."""
+        return run_program(self).as_dict()
+
+
+def program_entrant(
+    path: str,
+    name: str | None = None,
+    kinds: str | None = None,
+    profile: str | None = None,
+    sensors: tuple[str, ...] = (),
+    noise: str | None = None,
+    noise_params: tuple[str, ...] = (),
+    max_time: float | None = None,
+) -> Entrant:
+    """A program in ``workbench eval`` (named ``name``, default its path), on each maze and seed."""
+
+    def spec(maze: str, seed: int) -> ProgramRunSpec:
+        return ProgramRunSpec(
+            program=path,
+            maze=maze,
+            profile=profile,
+            sensors=sensors,
+            kinds=kinds,
+            seed=seed,
+            noise=noise,
+            noise_params=noise_params,
+            max_time=max_time,
+        )
+
+    return Entrant(name or path, spec)
 
 
 @dataclass
