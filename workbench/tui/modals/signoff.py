@@ -30,6 +30,7 @@ from workbench.labs.signoff import (
 from workbench.labs.store import Store
 
 from ..widgets.field import Field
+from ..widgets.tick import Tick
 
 
 class SignoffModal(ModalScreen[str | None]):
@@ -153,7 +154,7 @@ class SignoffModal(ModalScreen[str | None]):
                         id="signoff-note",
                         compact=True,
                     )
-                yield Checkbox(
+                yield Tick(
                     "Override: sign off although objectives have not passed",
                     value=False,
                     id="signoff-override",
