@@ -53,21 +53,3 @@ def test_editing_keys_typed_ahead_act_in_the_order_typed(tmp_path):
         assert field.value == "a5"  # ctrl+u cleared what was left of the cursor
 
     run(app, body)
-
-
-def test_a_tick_box_reads_ticked_or_not_in_plain_characters():
-    from textual.app import App
-
-    from workbench.tui.widgets.tick import Tick
-
-    class Host(App[None]):
-        def compose(self):
-            yield Tick("Override", id="tick")
-
-    async def body(pilot: Pilot) -> None:
-        tick = pilot.app.query_one(Tick)
-        assert str(tick.render()).startswith("[ ]")
-        await pilot.click(Tick)
-        assert tick.value and str(tick.render()).startswith("[X]")
-
-    run(Host(), body)
