@@ -254,3 +254,71 @@ def test_an_unreachable_server_is_named_without_its_password(tmp_path):
     with pytest.raises(StoreError, match="cannot be reached") as caught:
         Store.open(tmp_path, db=url)
     assert "s3cret" not in str(caught.value) and "teacher:***@127.0.0.1" in str(caught.value)
+
+
+def test_the_database_stopped_and_restarted_under_a_writer_loses_nothing(
+    pg_server, pg_url, tmp_path
+):
+    """A student keeps working while the course database restarts: every save reports
+    whether it reached the database, what did not is kept and written once it is back, and
+    afterwards the database holds every save, the newest of each exercise."""
+    store = Store.open(tmp_path, db=pg_url)
+    outcome: dict[int, bool] = {}
+    stop = threading.Event()
+
+    def writer() -> None:
+        i = 0
+        while not stop.is_set():
+            outcome[i] = store.save_progress("alice", "lab", f"ex{i % 25}", {"i": i})
+            i += 1
+            time.sleep(0.01)
+
+    thread = threading.Thread(target=writer)
+    thread.start()
+    try:
+        while sum(outcome.values()) < 20:
+            time.sleep(0.01)
+        pg_server.stop()
+        down_from = len(outcome)
+        time.sleep(1.0)
+        assert not any(outcome[i] for i in range(down_from + 5, len(outcome)))  # pending
+        assert store.pending > 0 and not store.available
+        with pytest.raises(StoreError, match=r"cannot be reached|went away"):
+            store.signoffs()  # reads say so; they never wait on a dead server
+    finally:
+        pg_server.start()
+    deadline = time.monotonic() + 20
+    while store.pending and time.monotonic() < deadline:
+        time.sleep(0.05)
+    stop.set()
+    thread.join()
+    store.flush()
+    assert store.pending == 0
+    last = len(outcome) - 1
+    with Store.open(tmp_path, db=pg_url) as fresh:
+        saved = fresh.progress("alice")
+    newest = {f"ex{i % 25}": i for i in range(last + 1)}
+    assert {ex: p["i"] for (_, ex), p in saved.items()} == newest
+    store.close()
+
+
+def test_a_store_opened_while_the_server_is_down_catches_up_when_it_is_back(
+    pg_server, pg_url, tmp_path
+):
+    Store.open(tmp_path, db=pg_url).close()
+    pg_server.stop()
+    try:
+        store = Store.open(tmp_path, db=pg_url, offline_ok=True)
+        assert store.save_progress("alice", "lab", "ex1", {"i": 1}) is False
+        assert store.set_place("alice", "lab", "ex1") is False
+        assert store.pending == 2 and not store.available
+        with pytest.raises(StoreError, match="cannot be reached"):
+            Store.open(tmp_path, db=pg_url)  # without offline_ok it says so at once
+    finally:
+        pg_server.start()
+    time.sleep(1.1)  # past the pause between tries
+    assert store.flush() is True
+    with Store.open(tmp_path, db=pg_url) as fresh:
+        assert fresh.progress("alice") == {("lab", "ex1"): {"i": 1}}
+        assert fresh.place("alice") == ("lab", "ex1")
+    store.close()

@@ -399,8 +399,7 @@ def unlock_instructor(
     except FileNotFoundError:
         where = store.where if store is not None and store.keeps_roster else Path(path).parent
         raise UnknownInstructor(
-            f"no key for instructor {name} in {where} (create it with "
-            f"'workbench instructor add')"
+            f"no key for instructor {name} in {where} (create it with 'workbench instructor add')"
         ) from None
     except StoreError as exc:
         raise SignoffError(str(exc)) from None
@@ -853,3 +852,8 @@ GRADEBOOK_COLUMNS = (
     "seq",
     "log_head",
 )
+
+
+def log_head(rows: list[StoredSignoff]) -> Head:
+    """The head of a log as stored (``rows`` in the order of the log), checked or not."""
+    return signlog.check_chain([_entry(r) for r in rows]).head
