@@ -8,6 +8,7 @@ import sys
 from collections.abc import Sequence
 
 from workbench import __version__
+from workbench.labs.store import StoreError, resolve_db
 
 from . import algorithms as algorithms_cmd
 from . import instructor as instructor_cmd
@@ -17,9 +18,10 @@ from . import run as run_cmd
 from . import serve as serve_cmd
 from . import signoff as signoff_cmd
 from . import ssh as ssh_cmd
+from . import store as store_cmd
 from . import viple_client as viple_client_cmd
 from . import viple_program as viple_program_cmd
-from .common import default_maze_path, error, new_runs_dir, runs_home
+from .common import db_option, default_maze_path, error, new_runs_dir, runs_home
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -80,6 +82,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="where lab progress and sign-offs are kept (default: $WORKBENCH_DATA "
         "or the user data folder)",
     )
+    db_option(parser)
     parser.add_argument(
         "--workspace",
         metavar="DIR",
@@ -97,6 +100,7 @@ def build_parser() -> argparse.ArgumentParser:
     instructor_cmd.register(sub)
     signoff_cmd.register(sub)
     ssh_cmd.register(sub)
+    store_cmd.register(sub)
     return parser
 
 
@@ -125,6 +129,11 @@ def open_app(args: argparse.Namespace) -> int:
     from workbench.tui.app import AppSetupError, make_app
 
     try:
+        db = resolve_db(args.db)
+    except StoreError as exc:
+        error(str(exc))
+        return 2
+    try:
         app = make_app(
             args.maze,
             args.profile,
@@ -144,6 +153,7 @@ def open_app(args: argparse.Namespace) -> int:
             student_fixed=bool(args.student) or "SSH_CONNECTION" in os.environ,
             connect_hint=args.connect_hint,
             workspace=args.workspace,
+            db=db,
         )
     except AppSetupError as exc:
         error(str(exc))

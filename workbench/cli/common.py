@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import argparse
 import os
 import sys
 import time
@@ -27,6 +28,16 @@ def runs_home() -> Path:
 def new_runs_dir() -> str:
     """A folder for this app session's run records (created when the first run starts)."""
     return str(runs_home() / time.strftime("%Y%m%d-%H%M%S"))
+
+
+def db_option(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--db",
+        metavar="URL",
+        help="keep progress, sign-offs and the roster in this PostgreSQL database "
+        "(postgresql://USER@HOST/DBNAME), shared by every lab server of a course (default: "
+        "$WORKBENCH_DB, else the SQLite file in the data folder)",
+    )
 
 
 def error(message: str) -> None:

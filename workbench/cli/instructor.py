@@ -17,9 +17,12 @@ from workbench.labs.signoff import (
     create_instructor,
     key_path,
     load_roster,
+    offered_roster,
     roster_path,
 )
-from workbench.labs.store import resolve_data_dir
+from workbench.labs.store import Store, StoreError, resolve_data_dir, resolve_db
+
+from .common import db_option
 
 
 def data_dir_option(parser: argparse.ArgumentParser) -> None:
@@ -44,11 +47,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     _trusted_option(add, "add the public key to this roster file too")
     data_dir_option(add)
+    db_option(add)
     add.set_defaults(func=cmd_add)
 
     ls = inner.add_parser("list", help="list the instructors in the roster")
     _trusted_option(ls, "compare the data folder's roster with this one")
     data_dir_option(ls)
+    db_option(ls)
     ls.set_defaults(func=cmd_list)
 
 
@@ -84,13 +89,26 @@ def read_new_passphrase(from_stdin: bool) -> str:
     return first
 
 
+def _course_store(args: argparse.Namespace, data_dir: Path) -> Store | None:
+    """The course's PostgreSQL store when ``--db``/``$WORKBENCH_DB`` names one, else None
+    (the roster and keys stay in the data folder's files)."""
+    db = resolve_db(args.db)
+    return Store.open(data_dir, db=db) if db else None
+
+
 def cmd_add(args: argparse.Namespace) -> int:
     data_dir = resolve_data_dir(args.data_dir)
     trusted = _trusted_path(args)
     try:
+        store = _course_store(args, data_dir)
+    except StoreError as exc:
+        return fail(str(exc))
+    try:
         name = check_name(args.name)
-        if name in load_roster(roster_path(data_dir)):
-            raise SignoffError(f"{name} is already in the roster {roster_path(data_dir)}")
+        where = store.where if store is not None else str(roster_path(data_dir))
+        offered = offered_roster(store) if store is not None else None
+        if name in (offered if offered is not None else load_roster(roster_path(data_dir))):
+            raise SignoffError(f"{name} is already in the roster {where}")
         if trusted.resolve().is_relative_to(data_dir.resolve()):
             raise SignoffError(
                 f"{trusted} is inside the data folder {data_dir}: keep your own roster "
@@ -99,14 +117,20 @@ def cmd_add(args: argparse.Namespace) -> int:
         if name in load_roster(trusted):
             raise SignoffError(f"{name} is already in your trusted roster {trusted}")
         passphrase = read_new_passphrase(args.passphrase_stdin)
-        entry = create_instructor(data_dir, name, passphrase, trusted=trusted)
+        entry = create_instructor(data_dir, name, passphrase, trusted=trusted, store=store)
     except (SignoffError, EOFError) as exc:
         return fail(str(exc) or "no passphrase given")
     except OSError as exc:
         return fail(f"cannot write the key or a roster: {exc}")
-    print(f"added {entry.name} (key {entry.fingerprint()}) to {roster_path(data_dir)}")
+    finally:
+        if store is not None:
+            store.close()
+    print(f"added {entry.name} (key {entry.fingerprint()}) to {where}")
     print(f"and to your trusted roster {trusted}, which 'workbench signoff verify' checks with")
-    print(f"the private key is encrypted in {key_path(data_dir, name)}")
+    if store is not None:
+        print(f"the private key is encrypted in the course database {where}")
+    else:
+        print(f"the private key is encrypted in {key_path(data_dir, name)}")
     return 0
 
 
@@ -114,16 +138,30 @@ def cmd_list(args: argparse.Namespace) -> int:
     data_dir = resolve_data_dir(args.data_dir)
     trusted_path = _trusted_path(args)
     try:
-        roster = load_roster(roster_path(data_dir))
-        trusted = load_roster(trusted_path)
-    except SignoffError as exc:
+        store = _course_store(args, data_dir)
+    except StoreError as exc:
         return fail(str(exc))
+    try:
+        if store is not None:
+            where = store.where
+            roster = offered_roster(store)
+            keys = {name for name in roster if store.instructor_key(name) is not None}
+        else:
+            where = str(roster_path(data_dir))
+            roster = load_roster(roster_path(data_dir))
+            keys = {name for name in roster if key_path(data_dir, name).exists()}
+        trusted = load_roster(trusted_path)
+    except (SignoffError, StoreError) as exc:
+        return fail(str(exc))
+    finally:
+        if store is not None:
+            store.close()
     if not roster:
-        print(f"no instructors in {roster_path(data_dir)} (add one: workbench instructor add NAME)")
+        print(f"no instructors in {where} (add one: workbench instructor add NAME)")
         return 0
     width = max(len(n) for n in roster)
     for entry in roster.values():
-        unlockable = "key here" if key_path(data_dir, entry.name).exists() else "public key only"
+        unlockable = "key here" if entry.name in keys else "public key only"
         kept = trusted.get(entry.name)
         if kept is None:
             trust = "NOT in your trusted roster"

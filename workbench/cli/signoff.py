@@ -1,6 +1,7 @@
 """``workbench signoff``: list, verify and export the signed sign-off log.
 
-All three only read the database (SQLite's read-only mode). ``verify`` and ``export`` trust
+All three only read the database (SQLite's read-only mode, or a read-only PostgreSQL session
+with ``--db``/``$WORKBENCH_DB``: the whole course's log). ``verify`` and ``export`` trust
 only the instructor's own roster (``--roster FILE`` or the configuration folder's), print the
 log's head for the instructor to keep, and take a kept head back (``--head``,
 ``--head-from``) to find a log that was cut short or rolled back.
@@ -32,9 +33,11 @@ from workbench.labs.store import (
     StoreError,
     read_signoffs,
     resolve_data_dir,
+    resolve_db,
 )
 from workbench.sim.mazefile import write_text_atomic
 
+from .common import db_option
 from .instructor import data_dir_option
 
 CHECKS = (
@@ -52,6 +55,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     ls.add_argument("--student", help="only this student (either member of a pair)")
     ls.add_argument("--lab", help="only this lab")
     data_dir_option(ls)
+    db_option(ls)
     ls.set_defaults(func=cmd_list)
 
     ver = inner.add_parser(
@@ -60,12 +64,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     _trust_options(ver)
     data_dir_option(ver)
+    db_option(ver)
     ver.set_defaults(func=cmd_verify)
 
     exp = inner.add_parser("export", help="write a gradebook CSV: one row per student and exercise")
     exp.add_argument("--csv", required=True, metavar="FILE", help="the CSV file to write")
     _trust_options(exp)
     data_dir_option(exp)
+    db_option(exp)
     exp.set_defaults(func=cmd_export)
 
 
@@ -117,6 +123,10 @@ def _checked_log(args: argparse.Namespace) -> tuple[Path, LogVerdict]:
     data_dir = resolve_data_dir(args.data_dir)
     kept = _kept_head(args)
     try:
+        db = resolve_db(args.db)
+    except StoreError as exc:
+        raise _Refused(str(exc), 2) from None
+    try:
         path = trusted_roster_path(args.roster, data_dir)
         roster = load_roster(path)
     except UntrustedRoster as exc:
@@ -124,11 +134,11 @@ def _checked_log(args: argparse.Namespace) -> tuple[Path, LogVerdict]:
     except SignoffError as exc:
         raise _Refused(str(exc), 2) from None
     try:
-        local = load_roster(roster_path(data_dir))
+        local = {} if db else load_roster(roster_path(data_dir))
     except SignoffError:
         local = {}  # only used to explain a signature by another key
     try:
-        rows = read_signoffs(data_dir)
+        rows = read_signoffs(data_dir, db)
     except StoreError as exc:  # LogMissing too: no log where one should be
         raise _Refused(f"{exc}\nthe log does NOT verify", 1) from None
     return path, verify_log(rows, roster, kept, local)
@@ -136,7 +146,7 @@ def _checked_log(args: argparse.Namespace) -> tuple[Path, LogVerdict]:
 
 def cmd_list(args: argparse.Namespace) -> int:
     try:
-        rows = read_signoffs(resolve_data_dir(args.data_dir))
+        rows = read_signoffs(resolve_data_dir(args.data_dir), resolve_db(args.db))
     except StoreError as exc:
         return fail(str(exc))
     if args.student:

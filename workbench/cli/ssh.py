@@ -6,11 +6,15 @@ import argparse
 import asyncio
 import getpass
 import math
+import os
 import signal
 import sys
 from pathlib import Path
 
-from workbench.labs.store import resolve_data_dir
+from workbench.labs.database import ENV_DB
+from workbench.labs.store import Store, StoreError, StoreUnavailable, resolve_data_dir, resolve_db
+
+from .common import db_option
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -29,6 +33,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )  # fmt: skip
     serve.add_argument("--users", help="users file (default <data-dir>/ssh-users.yaml)")
     _data_dir(serve)
+    db_option(serve)
     serve.add_argument(
         "--port-range", default="41000-41999",
         help="VIPLE ports for sessions, two each (default 41000-41999)",
@@ -236,6 +241,15 @@ def cmd_serve(args: argparse.Namespace) -> int:
         lock_for=args.password_lock_for,
     )
     data_dir = resolve_data_dir(args.data_dir)
+    try:
+        db = resolve_db(args.db)
+    except StoreError as exc:
+        return fail("serve-ssh", str(exc))
+    if db:
+        problem = _prepare_course_store(data_dir, db)
+        if problem:
+            return fail("serve-ssh", f"{problem}\nthe server did not start")
+        os.environ[ENV_DB] = db  # every session's app inherits it (never on a command line)
     config = ServerConfig(
         data_dir=data_dir,
         port=args.port,
@@ -266,6 +280,22 @@ def cmd_serve(args: argparse.Namespace) -> int:
         return asyncio.run(_serve(server))
     except OSError as exc:
         return fail("serve-ssh", f"cannot listen on port {args.port}: {exc.strerror or exc}")
+
+
+def _prepare_course_store(data_dir: Path, db: str) -> str:
+    """Bring the course database's schema up to date once, before any session opens it.
+    A server that is down only warns: the apps keep students' work until it is back."""
+    try:
+        Store.open(data_dir, db=db).close()
+    except StoreUnavailable as exc:
+        print(
+            f"workbench serve-ssh: {exc}: serving anyway; the apps keep students' progress "
+            "until the database is back",
+            file=sys.stderr,
+        )
+    except StoreError as exc:
+        return str(exc)
+    return ""
 
 
 async def _serve(server) -> int:

@@ -43,7 +43,7 @@ from workbench.sim.record import file_sha256
 from . import signlog
 from .names import NameProblem, check_student, clean_name
 from .signlog import Head, LogError
-from .store import APP_NAME, Store, StoredSignoff, utc_iso
+from .store import APP_NAME, Store, StoredSignoff, StoreError, utc_iso
 
 log = logging.getLogger(__name__)
 
@@ -307,16 +307,21 @@ def create_instructor(
     kdf: KdfParams | None = None,
     now: datetime | None = None,
     trusted: Path | None = None,
+    store: Store | None = None,
 ) -> RosterEntry:
-    """Make a key pair: the private key is saved encrypted, the public key joins the data
-    folder's roster and, given ``trusted`` (the instructor's own roster file), that one too."""
+    """Make a key pair: the private key is saved encrypted, the public key joins the store's
+    roster (the data folder's files, or the database of a PostgreSQL ``store``, which holds
+    the encrypted key as well) and, given ``trusted`` (the instructor's own roster file),
+    that one too."""
     name = check_name(name)
     check_passphrase(passphrase)
     params = kdf or KdfParams()
+    in_database = store is not None and store.keeps_roster
     roster_file = roster_path(data_dir)
-    roster = load_roster(roster_file)
+    roster = offered_roster(store) if in_database else load_roster(roster_file)
     if name in roster:
-        raise SignoffError(f"{name} is already in the roster {roster_file}")
+        where = store.where if in_database and store is not None else roster_file
+        raise SignoffError(f"{name} is already in the roster {where}")
     kept = load_roster(trusted) if trusted is not None else {}
     if name in kept:
         raise SignoffError(
@@ -324,7 +329,7 @@ def create_instructor(
             "another name, or remove the old entry from that file first"
         )
     target = key_path(data_dir, name)
-    if target.exists():
+    if not in_database and target.exists():
         raise SignoffError(f"{target}: a key for {name} already exists")
     private = Ed25519PrivateKey.generate()
     instructor = Instructor(name, private)
@@ -343,31 +348,61 @@ def create_instructor(
         "cipher": {"name": "AES-256-GCM", "nonce": _b64(nonce)},
         "encrypted_private_key": _b64(sealed),
     }
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd = os.open(target, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
-    with os.fdopen(fd, "w", encoding="utf-8") as fh:
-        fh.write(json.dumps(data, indent=2) + "\n")
-        fh.flush()
-        os.fsync(fh.fileno())
     entry = RosterEntry(name, public, utc_iso(now or _now()))
-    roster[name] = entry
-    save_roster(roster_file, roster)
+    if in_database and store is not None:
+        try:
+            store.add_instructor(name, public, entry.added, json.dumps(data, indent=2) + "\n")
+        except StoreError as exc:
+            raise SignoffError(str(exc)) from None
+    else:
+        target.parent.mkdir(parents=True, exist_ok=True)
+        fd = os.open(target, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(json.dumps(data, indent=2) + "\n")
+            fh.flush()
+            os.fsync(fh.fileno())
+        roster[name] = entry
+        save_roster(roster_file, roster)
     if trusted is not None:
         kept[name] = entry
         save_roster(trusted, kept)
     return entry
 
 
-def unlock_instructor(data_dir: Path, name: str, passphrase: str) -> Instructor:
-    """Decrypt an instructor's private key; :class:`WrongPassphrase` if it does not open."""
-    path = key_path(data_dir, name)
+def offered_roster(store: Store) -> dict[str, RosterEntry]:
+    """The instructors the app offers to sign with: the database's roster (PostgreSQL) or
+    the data folder's ``roster.json`` (SQLite). Neither is trusted for checking."""
+    if not store.keeps_roster:
+        return load_roster(roster_path(store.data_dir))
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
+        rows = store.roster_rows()
+    except StoreError as exc:
+        raise SignoffError(str(exc)) from None
+    return {name: RosterEntry(name, key, added) for name, key, added in rows}
+
+
+def unlock_instructor(
+    data_dir: Path, name: str, passphrase: str, store: Store | None = None
+) -> Instructor:
+    """Decrypt an instructor's private key (from the data folder, or from the database of a
+    PostgreSQL ``store``); :class:`WrongPassphrase` if it does not open."""
+    path: Path | str = key_path(data_dir, name)
+    try:
+        if store is not None and store.keeps_roster:
+            path = f"{store.where} (instructors: {name})"
+            text = store.instructor_key(name)
+            if text is None:
+                raise FileNotFoundError(path)
+        else:
+            text = Path(path).read_text(encoding="utf-8")
+        data = json.loads(text)
     except FileNotFoundError:
+        where = store.where if store is not None and store.keeps_roster else Path(path).parent
         raise UnknownInstructor(
-            f"no key for instructor {name} in {path.parent} (create it with "
-            f"'workbench instructor add')"
+            f"no key for instructor {name} in {where} (create it with 'workbench instructor add')"
         ) from None
+    except StoreError as exc:
+        raise SignoffError(str(exc)) from None
     except OSError as exc:
         raise SignoffError(f"{path}: cannot read the key: {exc.strerror}") from None
     except json.JSONDecodeError:
@@ -570,7 +605,7 @@ def sign_off(
     if state.locked_until > now.timestamp():
         raise LockedOut(instructor, state.locked_until - now.timestamp())
     try:
-        signer = unlock_instructor(store.data_dir, instructor, passphrase)
+        signer = unlock_instructor(store.data_dir, instructor, passphrase, store)
     except WrongPassphrase:
         after = store.record_failure(instructor, now, FAILURE_LIMIT, LOCK_SECONDS)
         where = f"{record_fields.student} {record_fields.lab}/{record_fields.exercise}"
@@ -817,3 +852,8 @@ GRADEBOOK_COLUMNS = (
     "seq",
     "log_head",
 )
+
+
+def log_head(rows: list[StoredSignoff]) -> Head:
+    """The head of a log as stored (``rows`` in the order of the log), checked or not."""
+    return signlog.check_chain([_entry(r) for r in rows]).head

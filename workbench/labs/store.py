@@ -1,8 +1,12 @@
-"""The workbench's own database: sign-off records, exercise progress, drivers, lockouts.
+"""The workbench's own database: sign-off records, exercise progress, drivers, lockouts, and
+(in PostgreSQL) the instructors' roster.
 
-One SQLite file in the data folder, in WAL mode so that the app and a command-line tool can
-use it at the same time. Every write is one transaction, committed before the call returns,
-so a process killed afterwards loses nothing that was already saved.
+By default one SQLite file in the data folder, in WAL mode so that the app and a command-line
+tool can use it at the same time; given a ``postgresql://`` URL (``--db`` or
+``$WORKBENCH_DB``), one PostgreSQL database that every lab server of a course shares. Every
+write is one transaction, committed before the call returns, so a process killed afterwards
+loses nothing that was already saved. The schema is built by the numbered steps of
+:mod:`workbench.labs.migrations`.
 
 The sign-off table holds the log of :mod:`workbench.labs.signlog`: each record's fields, its
 signature, its sequence number (unique), the hash of the record before it and its own hash.
@@ -15,7 +19,6 @@ checking and exporting.
 from __future__ import annotations
 
 import json
-import math
 import os
 import sqlite3
 import urllib.request
@@ -28,96 +31,36 @@ from typing import Any
 
 import platformdirs
 
-from .signlog import GENESIS, entry_hash, signed_payload
+from .database import (
+    BUSY_TIMEOUT_MS,
+    Backend,
+    LogMissing,
+    PostgresBackend,
+    SqliteBackend,
+    StoreError,
+    StoreUnavailable,
+    Tx,
+    resolve_db,
+)
+from .migrations import RECORD_COLUMNS, SIGNOFF_LOCK, check_version, latest, migrate
+from .signlog import GENESIS, entry_hash, parse_metrics, signed_payload
+
+__all__ = [
+    "LogMissing",
+    "Store",
+    "StoreError",
+    "StoreUnavailable",
+    "StoredSignoff",
+    "read_signoffs",
+    "resolve_data_dir",
+    "resolve_db",
+]
 
 APP_NAME = "viple-workbench"
 DB_NAME = "workbench.sqlite3"
 ENV_DATA_DIR = "WORKBENCH_DATA"
-SCHEMA_VERSION = 2
-BUSY_TIMEOUT_MS = 10_000
-
-SCHEMA = """
-CREATE TABLE IF NOT EXISTS meta (
-    key TEXT PRIMARY KEY,
-    value TEXT NOT NULL
-);
-CREATE TABLE IF NOT EXISTS signoffs (
-    id INTEGER PRIMARY KEY AUTOINCREMENT,
-    student TEXT NOT NULL,
-    partner TEXT NOT NULL,
-    driver TEXT NOT NULL,
-    lab TEXT NOT NULL,
-    exercise TEXT NOT NULL,
-    instructor TEXT NOT NULL,
-    signed_at TEXT NOT NULL,
-    note TEXT NOT NULL,
-    override INTEGER NOT NULL,
-    run_record TEXT NOT NULL,
-    evidence_digest TEXT NOT NULL,
-    metrics TEXT NOT NULL,
-    signature TEXT NOT NULL,
-    seq INTEGER,
-    prev_hash TEXT,
-    entry_hash TEXT,
-    legacy INTEGER NOT NULL DEFAULT 0
-);
-CREATE INDEX IF NOT EXISTS signoffs_by_student ON signoffs (student, lab, exercise);
-CREATE TABLE IF NOT EXISTS progress (
-    student TEXT NOT NULL,
-    lab TEXT NOT NULL,
-    exercise TEXT NOT NULL,
-    progress TEXT NOT NULL,
-    updated_at TEXT NOT NULL,
-    PRIMARY KEY (student, lab, exercise)
-);
-CREATE TABLE IF NOT EXISTS places (
-    student TEXT PRIMARY KEY,
-    lab TEXT NOT NULL,
-    exercise TEXT NOT NULL,
-    updated_at TEXT NOT NULL
-);
-CREATE TABLE IF NOT EXISTS drivers (
-    student TEXT NOT NULL,
-    partner TEXT NOT NULL,
-    lab TEXT NOT NULL,
-    exercise TEXT NOT NULL,
-    driver TEXT NOT NULL,
-    updated_at TEXT NOT NULL,
-    PRIMARY KEY (student, partner, lab, exercise)
-);
-CREATE TABLE IF NOT EXISTS lockouts (
-    instructor TEXT PRIMARY KEY,
-    failures INTEGER NOT NULL,
-    locked_until REAL NOT NULL,
-    updated_at TEXT NOT NULL
-);
-CREATE TABLE IF NOT EXISTS events (
-    id INTEGER PRIMARY KEY AUTOINCREMENT,
-    at TEXT NOT NULL,
-    instructor TEXT NOT NULL,
-    event TEXT NOT NULL,
-    detail TEXT NOT NULL
-);
-"""
-
-
-# columns added to the sign-off table by schema 2 (the chain)
-CHAIN_COLUMNS = (
-    ("seq", "INTEGER"),
-    ("prev_hash", "TEXT"),
-    ("entry_hash", "TEXT"),
-    ("legacy", "INTEGER NOT NULL DEFAULT 0"),
-)
+SCHEMA_VERSION = latest("sqlite")
 MAX_SEQ = 2**53  # sequence numbers stay exact wherever the log is kept (JSON, any database)
-SEQ_INDEX = "CREATE UNIQUE INDEX IF NOT EXISTS signoffs_by_seq ON signoffs (seq)"
-
-
-class StoreError(Exception):
-    """The database cannot be opened, read or written; the message names the file."""
-
-
-class LogMissing(StoreError):
-    """There is no sign-off log to read: no database, or no sign-off table in it."""
 
 
 def default_data_dir() -> Path:
@@ -172,10 +115,7 @@ class StoredSignoff:
     def metrics_value(self) -> Any:
         """The metrics as signed (stored as canonical JSON text); text that is not JSON the
         workbench writes (not JSON, NaN, nested too deep) as ``{"unreadable": text}``."""
-        try:
-            return json.loads(self.metrics, parse_constant=_no_constant, parse_float=_finite)
-        except (ValueError, RecursionError):
-            return {"unreadable": self.metrics}
+        return parse_metrics(self.metrics)
 
     def signed_bytes(self) -> bytes:
         """The bytes the instructor's signature must cover, rebuilt from the columns."""
@@ -195,7 +135,7 @@ class StoredSignoff:
 
 
 SIGNOFF_COLUMNS = tuple(StoredSignoff.__dataclass_fields__)
-RECORD_COLUMNS = SIGNOFF_COLUMNS[1:14]  # the fields, evidence and signature of a record
+assert SIGNOFF_COLUMNS[1:14] == RECORD_COLUMNS  # the fields, evidence and signature of a record
 
 
 @dataclass(frozen=True)
@@ -213,17 +153,49 @@ class Event:
 
 
 class Store:
-    """The database in one data folder. Use :meth:`open`; close it (or use ``with``)."""
+    """The store of one data folder (SQLite) or of a whole course (PostgreSQL, ``db``). Use
+    :meth:`open`; close it (or use ``with``).
 
-    def __init__(self, data_dir: Path, conn: sqlite3.Connection):
+    Saving progress, places and drivers never fails because a PostgreSQL server is down: the
+    write is kept pending (the newest per exercise) and written with the next write or
+    :meth:`flush`; their return value says whether it reached the database. Sign-offs and the
+    lockout need the database and raise :class:`StoreUnavailable` while it is away."""
+
+    def __init__(self, data_dir: Path, backend: Backend):
         self.data_dir = data_dir
-        self.path = data_dir / DB_NAME
-        self._conn = conn
+        self.backend = backend
+        #: the SQLite file (``None`` for PostgreSQL)
+        self.path: Path | None = backend.path if isinstance(backend, SqliteBackend) else None
+        self.where = backend.where
+        self._pending: dict[tuple[str, ...], tuple[str, tuple[Any, ...]]] = {}
+        self._migrated = False
 
     @classmethod
-    def open(cls, data_dir: str | os.PathLike | None = None, *, create: bool = True) -> Store:
-        """Open (and with ``create``, make if needed) the database in the data folder."""
+    def open(
+        cls,
+        data_dir: str | os.PathLike | None = None,
+        *,
+        create: bool = True,
+        db: str | None = None,
+        offline_ok: bool = False,
+    ) -> Store:
+        """Open the store: the PostgreSQL database ``db`` (a URL; see :func:`resolve_db`) or
+        else the SQLite file in the data folder (with ``create``, made if needed). Missing
+        schema steps are applied. With ``offline_ok`` a PostgreSQL server that cannot be
+        reached gives a store that keeps writes pending until it can (:attr:`available`)."""
         folder = resolve_data_dir(data_dir)
+        if db:
+            store = cls(folder, PostgresBackend(db))
+            try:
+                store._ensure_schema()
+            except StoreUnavailable:
+                if not offline_ok:
+                    store.close()
+                    raise
+            except StoreError:
+                store.close()
+                raise
+            return store
         path = folder / DB_NAME
         if not create and not path.is_file():
             raise StoreError(
@@ -234,66 +206,47 @@ class Store:
             folder.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
             raise StoreError(f"{folder}: cannot create the data folder: {exc.strerror}") from None
+        store = cls(folder, SqliteBackend.open(path))
         try:
-            conn = sqlite3.connect(path, timeout=BUSY_TIMEOUT_MS / 1000, isolation_level=None)
-        except sqlite3.Error as exc:
-            raise StoreError(f"{path}: cannot open the database: {exc}") from None
-        store = cls(folder, conn)
-        try:
-            store._prepare()
-        except sqlite3.DatabaseError as exc:
-            conn.close()
-            raise StoreError(
-                f"{path}: not a readable workbench database ({exc}); move it aside to start a "
-                "new one, or restore it from a backup"
-            ) from None
-        except StoreError:
-            conn.close()
+            store._ensure_schema()
+        except StoreError as exc:
+            store.close()
+            text = str(exc)
+            if "file is not a database" in text or "malformed" in text:
+                raise StoreError(
+                    f"{path}: not a readable workbench database ({text.split(': ')[-1]}); "
+                    "move it aside to start a new one, or restore it from a backup"
+                ) from None
             raise
         return store
 
-    def _prepare(self) -> None:
-        conn = self._conn
-        conn.execute(f"PRAGMA busy_timeout = {BUSY_TIMEOUT_MS}")
-        mode = conn.execute("PRAGMA journal_mode = WAL").fetchone()[0]
-        if str(mode).lower() != "wal":
-            raise StoreError(f"{self.path}: the database cannot use WAL mode (got {mode})")
-        conn.execute("PRAGMA synchronous = FULL")
-        with self._write() as cur:
-            for statement in SCHEMA.split(";"):
-                if statement.strip():
-                    cur.execute(statement)
-            row = cur.execute("SELECT value FROM meta WHERE key = 'schema_version'").fetchone()
-            if row is not None:
-                _check_version(self.path, row[0])
-            if _chain_missing(cur):
-                self._chain_legacy_records(cur)
-            cur.execute(SEQ_INDEX)
-            cur.execute(
-                "INSERT INTO meta (key, value) VALUES ('schema_version', ?) "
-                "ON CONFLICT (key) DO UPDATE SET value = excluded.value",
-                (str(SCHEMA_VERSION),),
-            )
+    def _ensure_schema(self) -> None:
+        if not self._migrated:
+            migrate(self.backend)
+            self._migrated = True
 
-    def _chain_legacy_records(self, cur: sqlite3.Cursor) -> None:
-        """Upgrade a schema 1 sign-off table: add the chain's columns and give every record,
-        in the order stored, its place in the log as a legacy entry."""
-        for name, kind in CHAIN_COLUMNS:
-            cur.execute(f"ALTER TABLE signoffs ADD COLUMN {name} {kind}")
-        columns = ", ".join(("id", *RECORD_COLUMNS))
-        rows = [
-            _signoff_from_row(r, ("id", *RECORD_COLUMNS))
-            for r in cur.execute(f"SELECT {columns} FROM signoffs ORDER BY id").fetchall()
-        ]
-        for row in legacy_chain(rows):
-            cur.execute(
-                "UPDATE signoffs SET seq = ?, prev_hash = ?, entry_hash = ?, legacy = 1 "
-                "WHERE id = ?",
-                (row.seq, row.prev_hash, row.entry_hash, row.id),
-            )
+    @property
+    def postgres(self) -> bool:
+        return self.backend.postgres
+
+    @property
+    def keeps_roster(self) -> bool:
+        """Whether the instructors' roster and keys are in the database (PostgreSQL), not in
+        the data folder's files."""
+        return self.backend.postgres
+
+    @property
+    def available(self) -> bool:
+        """Whether the database answered the last time it was asked (and nothing is pending)."""
+        return self._migrated and not self._pending
+
+    @property
+    def pending(self) -> int:
+        """Writes kept until the database can be reached again."""
+        return len(self._pending)
 
     def close(self) -> None:
-        self._conn.close()
+        self.backend.close()
 
     def __enter__(self) -> Store:
         return self
@@ -302,54 +255,78 @@ class Store:
         self.close()
 
     @contextmanager
-    def _write(self) -> Iterator[sqlite3.Cursor]:
-        """One write transaction; taken at once (IMMEDIATE) so concurrent writers queue."""
-        cur = self._conn.cursor()
-        try:
-            cur.execute("BEGIN IMMEDIATE")
-        except sqlite3.OperationalError as exc:
-            raise StoreError(f"{self.path}: cannot write: {exc}") from None
-        try:
-            yield cur
-        except BaseException:
-            self._conn.rollback()
-            raise
-        else:
-            try:
-                cur.execute("COMMIT")
-            except sqlite3.Error as exc:
-                self._conn.rollback()
-                raise StoreError(f"{self.path}: cannot write: {exc}") from None
+    def _write(self) -> Iterator[Tx]:
+        """One write transaction; on SQLite taken at once (IMMEDIATE) so writers queue."""
+        self._ensure_schema()
+        with self.backend.write() as tx:
+            yield tx
 
     def _read(self, sql: str, params: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
+        self._ensure_schema()
+        return self.backend.read(sql, params)
+
+    def _keep(self, key: tuple[str, ...], sql: str, params: tuple[Any, ...]) -> bool:
+        """Write one upsert, or keep it pending while the database is away; the newest write
+        of a key replaces an older pending one. True when it (and all pending) was written."""
+        self._pending.pop(key, None)
+        self._pending[key] = (sql, params)
+        return self.flush()
+
+    def flush(self) -> bool:
+        """Write everything pending in one transaction. True when nothing is left pending;
+        False while the database cannot be reached. Other errors drop what was pending (it
+        would fail again) and are raised."""
+        if not self._pending:
+            return True
+        batch = dict(self._pending)
         try:
-            return self._conn.execute(sql, params).fetchall()
-        except sqlite3.DatabaseError as exc:
-            raise StoreError(f"{self.path}: cannot read: {exc}") from None
+            with self._write() as tx:
+                for sql, params in batch.values():
+                    tx.execute(sql, params)
+        except StoreUnavailable:
+            return False
+        except StoreError:
+            for key in batch:
+                self._pending.pop(key, None)
+            raise
+        for key, value in batch.items():
+            if self._pending.get(key) == value:
+                del self._pending[key]
+        return not self._pending
 
     def schema_version(self) -> int:
         rows = self._read("SELECT value FROM meta WHERE key = 'schema_version'")
         return int(rows[0][0])
+
+    def migrations(self) -> list[tuple[int, str]]:
+        """The schema steps applied to this store: (version, name)."""
+        rows = self._read("SELECT version, name FROM schema_migrations ORDER BY version")
+        return [(int(v), str(n)) for v, n in rows]
 
     # sign-off records
 
     def append_signoff(self, sign: Callable[[int, str], dict[str, Any]]) -> StoredSignoff:
         """Add a record at the end of the log. ``sign(seq, prev_hash)`` returns the record's
         columns (those of :data:`RECORD_COLUMNS`) signed for that place; it is called inside
-        the write transaction, so two processes signing at once queue and never take the same
+        the write transaction, which holds the log (SQLite: the write lock; PostgreSQL: an
+        advisory lock), so two processes signing at once queue and never take the same
         place. Returns the row as stored."""
-        with self._write() as cur:
+        postgres = self.backend.postgres
+        with self._write() as tx:
+            if postgres:
+                tx.execute("SELECT pg_advisory_xact_lock(?)", (SIGNOFF_LOCK,))
             # rows whose seq is not a number were tampered with: verify names them, and the
             # log goes on after the last numbered record
-            last = cur.execute(
-                "SELECT seq, entry_hash FROM signoffs WHERE typeof(seq) = 'integer' "
+            numbered = "seq IS NOT NULL" if postgres else "typeof(seq) = 'integer'"
+            last = tx.execute(
+                f"SELECT seq, entry_hash FROM signoffs WHERE {numbered} "
                 "ORDER BY seq DESC LIMIT 1"
             ).fetchone()
             seq, prev = (int(last[0]) + 1, str(last[1] or "")) if last else (1, GENESIS)
             if seq >= MAX_SEQ:
                 raise StoreError(
-                    f"{self.path}: the sign-off log claims {seq - 1} records, more than it can "
-                    "hold; check it with 'workbench signoff verify'"
+                    f"{self.where}: the sign-off log claims {seq - 1} records, more than it "
+                    "can hold; check it with 'workbench signoff verify'"
                 )
             values = sign(seq, prev)
             draft = StoredSignoff(
@@ -367,12 +344,12 @@ class Store:
                 digest,
                 0,
             )
-            cur.execute(
+            new = tx.execute(
                 f"INSERT INTO signoffs ({', '.join(columns)}) "
-                f"VALUES ({', '.join('?' for _ in columns)})",
+                f"VALUES ({', '.join('?' for _ in columns)}) RETURNING id",
                 row,
-            )
-            row_id = int(cur.lastrowid or 0)
+            ).fetchone()
+            row_id = int(new[0])
         return replace(draft, id=row_id, entry_hash=digest)
 
     def signoffs(self, student: str | None = None, lab: str | None = None) -> list[StoredSignoff]:
@@ -401,19 +378,20 @@ class Store:
         exercise: str,
         progress: dict[str, Any],
         now: datetime | None = None,
-    ) -> None:
-        """Replace the saved progress of one student in one exercise (any JSON object)."""
+    ) -> bool:
+        """Replace the saved progress of one student in one exercise (any JSON object).
+        True when written; False when kept pending (the database is away)."""
         text = json.dumps(progress, sort_keys=True, allow_nan=False)
-        with self._write() as cur:
-            cur.execute(
-                "INSERT INTO progress (student, lab, exercise, progress, updated_at) "
-                "VALUES (?, ?, ?, ?, ?) ON CONFLICT (student, lab, exercise) DO UPDATE SET "
-                "progress = excluded.progress, updated_at = excluded.updated_at",
-                (student, lab, exercise, text, utc_iso(now or _now())),
-            )
+        return self._keep(
+            ("progress", student, lab, exercise),
+            "INSERT INTO progress (student, lab, exercise, progress, updated_at) "
+            "VALUES (?, ?, ?, ?, ?) ON CONFLICT (student, lab, exercise) DO UPDATE SET "
+            "progress = excluded.progress, updated_at = excluded.updated_at",
+            (student, lab, exercise, text, utc_iso(now or _now())),
+        )
 
     def progress(self, student: str, lab: str | None = None) -> dict[tuple[str, str], dict]:
-        """Saved progress by (lab, exercise)."""
+        """Saved progress by (lab, exercise), including what is still pending."""
         sql = "SELECT lab, exercise, progress FROM progress WHERE student = ?"
         params: tuple[Any, ...] = (student,)
         if lab:
@@ -425,25 +403,31 @@ class Store:
                 out[(lab_id, exercise)] = json.loads(text)
             except json.JSONDecodeError:
                 raise StoreError(
-                    f"{self.path}: the saved progress of {student} in {lab_id}/{exercise} is "
-                    "not JSON"
+                    f"{self.where}: the saved progress of {student} in {lab_id}/{exercise} "
+                    "is not JSON"
                 ) from None
+        for key, (_, params_) in self._pending.items():
+            if key[0] == "progress" and key[1] == student and (not lab or key[2] == lab):
+                out[(key[2], key[3])] = json.loads(params_[3])
         return out
 
     # where each student was
 
-    def set_place(self, student: str, lab: str, exercise: str, now: datetime | None = None) -> None:
+    def set_place(self, student: str, lab: str, exercise: str, now: datetime | None = None) -> bool:
         """Remember the exercise ``student`` has open (the labs reopen there)."""
-        with self._write() as cur:
-            cur.execute(
-                "INSERT INTO places (student, lab, exercise, updated_at) VALUES (?, ?, ?, ?) "
-                "ON CONFLICT (student) DO UPDATE SET lab = excluded.lab, "
-                "exercise = excluded.exercise, updated_at = excluded.updated_at",
-                (student, lab, exercise, utc_iso(now or _now())),
-            )
+        return self._keep(
+            ("place", student),
+            "INSERT INTO places (student, lab, exercise, updated_at) VALUES (?, ?, ?, ?) "
+            "ON CONFLICT (student) DO UPDATE SET lab = excluded.lab, "
+            "exercise = excluded.exercise, updated_at = excluded.updated_at",
+            (student, lab, exercise, utc_iso(now or _now())),
+        )
 
     def place(self, student: str) -> tuple[str, str] | None:
         """The (lab, exercise) ``student`` had open last, if any."""
+        pending = self._pending.get(("place", student))
+        if pending is not None:
+            return (pending[1][1], pending[1][2])
         rows = self._read("SELECT lab, exercise FROM places WHERE student = ?", (student,))
         return (rows[0][0], rows[0][1]) if rows else None
 
@@ -457,15 +441,15 @@ class Store:
         exercise: str,
         driver: str,
         now: datetime | None = None,
-    ) -> None:
+    ) -> bool:
         """Record who drove (did the typing in) an exercise for a student or a pair."""
-        with self._write() as cur:
-            cur.execute(
-                "INSERT INTO drivers (student, partner, lab, exercise, driver, updated_at) "
-                "VALUES (?, ?, ?, ?, ?, ?) ON CONFLICT (student, partner, lab, exercise) "
-                "DO UPDATE SET driver = excluded.driver, updated_at = excluded.updated_at",
-                (student, partner, lab, exercise, driver, utc_iso(now or _now())),
-            )
+        return self._keep(
+            ("driver", student, partner, lab, exercise),
+            "INSERT INTO drivers (student, partner, lab, exercise, driver, updated_at) "
+            "VALUES (?, ?, ?, ?, ?, ?) ON CONFLICT (student, partner, lab, exercise) "
+            "DO UPDATE SET driver = excluded.driver, updated_at = excluded.updated_at",
+            (student, partner, lab, exercise, driver, utc_iso(now or _now())),
+        )
 
     def drivers(self, student: str, partner: str = "") -> dict[tuple[str, str], str]:
         rows = self._read(
@@ -488,8 +472,10 @@ class Store:
         self, instructor: str, now: datetime, limit: int, lock_seconds: float
     ) -> LockoutState:
         """Count a wrong passphrase; the ``limit``-th in a row locks until now + lock_seconds."""
-        with self._write() as cur:
-            row = cur.execute(
+        with self._write() as tx:
+            if self.backend.postgres:  # two servers counting one instructor's failures queue
+                tx.execute("SELECT pg_advisory_xact_lock(?)", (SIGNOFF_LOCK + 1,))
+            row = tx.execute(
                 "SELECT failures FROM lockouts WHERE instructor = ?", (instructor,)
             ).fetchone()
             failures = (int(row[0]) if row else 0) + 1
@@ -497,7 +483,7 @@ class Store:
             if failures >= limit:
                 locked_until = now.timestamp() + lock_seconds
                 failures = 0
-            cur.execute(
+            tx.execute(
                 "INSERT INTO lockouts (instructor, failures, locked_until, updated_at) "
                 "VALUES (?, ?, ?, ?) ON CONFLICT (instructor) DO UPDATE SET "
                 "failures = excluded.failures, locked_until = excluded.locked_until, "
@@ -507,16 +493,16 @@ class Store:
         return LockoutState(failures, locked_until)
 
     def clear_failures(self, instructor: str, now: datetime) -> None:
-        with self._write() as cur:
-            cur.execute(
+        with self._write() as tx:
+            tx.execute(
                 "UPDATE lockouts SET failures = 0, locked_until = 0, updated_at = ? "
                 "WHERE instructor = ?",
                 (utc_iso(now), instructor),
             )
 
     def log_event(self, instructor: str, event: str, detail: str, now: datetime) -> None:
-        with self._write() as cur:
-            cur.execute(
+        with self._write() as tx:
+            tx.execute(
                 "INSERT INTO events (at, instructor, event, detail) VALUES (?, ?, ?, ?)",
                 (utc_iso(now), instructor, event, detail),
             )
@@ -529,16 +515,37 @@ class Store:
             params = (instructor,)
         return [Event(*r) for r in self._read(sql + " ORDER BY id", params)]
 
+    # the instructors' roster (PostgreSQL; a SQLite store keeps it in the data folder)
 
-def _no_constant(name: str) -> Any:
-    raise ValueError(f"{name} is not a JSON number")
+    def roster_rows(self) -> list[tuple[str, str, str]]:
+        """(name, public key, added) of each instructor in the database's roster."""
+        self._need_roster()
+        rows = self._read("SELECT name, public_key, added FROM instructors ORDER BY added, name")
+        return [(str(n), str(k), str(a)) for n, k, a in rows]
 
+    def instructor_key(self, name: str) -> str | None:
+        """The encrypted key file (JSON text) of an instructor, if the database holds it."""
+        self._need_roster()
+        rows = self._read("SELECT key_file FROM instructors WHERE name = ?", (name,))
+        return str(rows[0][0]) if rows and rows[0][0] is not None else None
 
-def _finite(text: str) -> float:
-    value = float(text)
-    if not math.isfinite(value):
-        raise ValueError(f"{text} is too large")
-    return value
+    def add_instructor(self, name: str, public_key: str, added: str, key_file: str | None) -> None:
+        """Add an instructor (refused if the name is taken: a roster entry is never replaced)."""
+        self._need_roster()
+        with self._write() as tx:
+            taken = tx.execute("SELECT 1 FROM instructors WHERE name = ?", (name,)).fetchone()
+            if taken:
+                raise StoreError(f"{name} is already in the roster in {self.where}")
+            tx.execute(
+                "INSERT INTO instructors (name, public_key, added, key_file) VALUES (?, ?, ?, ?)",
+                (name, public_key, added, key_file),
+            )
+
+    def _need_roster(self) -> None:
+        if not self.keeps_roster:
+            raise StoreError(
+                f"{self.where}: a SQLite store keeps the roster in the data folder's files"
+            )
 
 
 def _signoff_from_row(row: tuple[Any, ...], names: tuple[str, ...]) -> StoredSignoff:
@@ -565,30 +572,19 @@ def legacy_chain(rows: list[StoredSignoff]) -> list[StoredSignoff]:
     return out
 
 
-def _check_version(path: Path, value: object) -> int:
-    if not str(value).isdigit():
-        raise StoreError(f"{path}: the schema version {value!r} is not a number")
-    if int(str(value)) > SCHEMA_VERSION:
-        raise StoreError(
-            f"{path}: written by a newer workbench (schema {value}, this one knows "
-            f"{SCHEMA_VERSION}); update the workbench"
-        )
-    return int(str(value))
-
-
-def _columns(conn: sqlite3.Connection | sqlite3.Cursor, table: str) -> set[str]:
-    return {r[1] for r in conn.execute(f"PRAGMA table_info({table})").fetchall()}
-
-
-def _chain_missing(cur: sqlite3.Cursor) -> bool:
-    return "seq" not in _columns(cur, "signoffs")
-
-
-def read_signoffs(data_dir: str | os.PathLike) -> list[StoredSignoff]:
-    """The sign-off log of the database in ``data_dir``, in the order of the log, read in
-    SQLite's read-only mode: nothing is created, upgraded or written. A schema 1 table is
-    read as the legacy entries an upgrade would make. Raises :class:`LogMissing` when there
-    is no database or no sign-off table, :class:`StoreError` when the file cannot be read."""
+def read_signoffs(data_dir: str | os.PathLike, db: str | None = None) -> list[StoredSignoff]:
+    """The sign-off log, in the order of the log, read without writing anything: from the
+    PostgreSQL database ``db`` (in a read-only session) or else from the SQLite file in
+    ``data_dir`` (in SQLite's read-only mode). Nothing is created or upgraded; a schema 1
+    table is read as the legacy entries an upgrade would make. Raises :class:`LogMissing`
+    when there is no database or no sign-off table, :class:`StoreError` when it cannot be
+    read."""
+    if db:
+        backend = PostgresBackend(db, read_only=True)
+        try:
+            return _read_log(backend.read, "postgresql", backend.where)
+        finally:
+            backend.close()
     path = Path(data_dir) / DB_NAME
     if not path.is_file():
         raise LogMissing(
@@ -600,28 +596,59 @@ def read_signoffs(data_dir: str | os.PathLike) -> list[StoredSignoff]:
         conn = sqlite3.connect(uri, uri=True, timeout=BUSY_TIMEOUT_MS / 1000)
     except sqlite3.Error as exc:
         raise StoreError(f"{path}: cannot open the database: {exc}") from None
+
+    def read(sql: str, params: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
+        return conn.execute(sql, params).fetchall()
+
     try:
-        tables = {r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
-        if "meta" not in tables:
-            raise StoreError(f"{path}: not a workbench database (it has no meta table)")
-        version = conn.execute("SELECT value FROM meta WHERE key = 'schema_version'").fetchone()
-        if version is None:
-            raise StoreError(f"{path}: not a workbench database (no schema version)")
-        _check_version(path, version[0])
-        if "signoffs" not in tables:
-            raise LogMissing(
-                f"{path}: the sign-off table is missing: the log was deleted from the database"
-            )
-        if "seq" in _columns(conn, "signoffs"):
-            sql = f"SELECT {', '.join(SIGNOFF_COLUMNS)} FROM signoffs"
-            rows = conn.execute(sql + " ORDER BY seq IS NULL, seq, id").fetchall()
-            return [_signoff_from_row(r, SIGNOFF_COLUMNS) for r in rows]
-        names = ("id", *RECORD_COLUMNS)
-        rows = conn.execute(f"SELECT {', '.join(names)} FROM signoffs ORDER BY id").fetchall()
-        return legacy_chain([_signoff_from_row(r, names) for r in rows])
+        return _read_log(read, "sqlite", str(path))
     except sqlite3.DatabaseError as exc:
         raise StoreError(
             f"{path}: not a readable workbench database ({exc}); restore it from a backup"
         ) from None
     finally:
         conn.close()
+
+
+def _read_log(
+    read: Callable[..., list[tuple[Any, ...]]], kind: str, where: str
+) -> list[StoredSignoff]:
+    if kind == "sqlite":
+        tables = {r[0] for r in read("SELECT name FROM sqlite_master WHERE type = 'table'")}
+    else:
+        tables = {
+            r[0]
+            for r in read(
+                "SELECT table_name FROM information_schema.tables "
+                "WHERE table_schema = current_schema()"
+            )
+        }
+    if "meta" not in tables:
+        raise (LogMissing if not tables else StoreError)(
+            f"{where}: not a workbench database (it has no meta table)"
+        )
+    version = read("SELECT value FROM meta WHERE key = 'schema_version'")
+    if not version:
+        raise StoreError(f"{where}: not a workbench database (no schema version)")
+    check_version(where, version[0][0], kind)
+    if "signoffs" not in tables:
+        raise LogMissing(
+            f"{where}: the sign-off table is missing: the log was deleted from the database"
+        )
+    if kind == "sqlite":
+        columns = {r[1] for r in read("PRAGMA table_info(signoffs)")}
+    else:
+        columns = {
+            r[0]
+            for r in read(
+                "SELECT column_name FROM information_schema.columns "
+                "WHERE table_schema = current_schema() AND table_name = 'signoffs'"
+            )
+        }
+    if "seq" in columns:
+        sql = f"SELECT {', '.join(SIGNOFF_COLUMNS)} FROM signoffs"
+        rows = read(sql + " ORDER BY seq IS NULL, seq, id")
+        return [_signoff_from_row(r, SIGNOFF_COLUMNS) for r in rows]
+    names = ("id", *RECORD_COLUMNS)
+    rows = read(f"SELECT {', '.join(names)} FROM signoffs ORDER BY id")
+    return legacy_chain([_signoff_from_row(r, names) for r in rows])

@@ -8,6 +8,7 @@ snapshot on every screen that shows it.
 
 from __future__ import annotations
 
+import contextlib
 import getpass
 import os
 from pathlib import Path
@@ -99,6 +100,7 @@ class WorkbenchApp(App[None]):
         ask_names: bool = False,
         student_fixed: bool = False,
         connect_hint: str = "",
+        db: str | None = None,
     ) -> None:
         super().__init__()
         self.student = student or user or _login_name()
@@ -108,6 +110,8 @@ class WorkbenchApp(App[None]):
         #: how to reach this app's VIPLE endpoints from elsewhere (the SSH server sets it)
         self.connect_hint = connect_hint
         self.data_dir = data_dir
+        #: the course's PostgreSQL database (None: the SQLite file in the data folder)
+        self.db = db
         self.store: Store | None = None
         self.store_problem = ""
         self._labs: LabsScreen | None = None
@@ -273,10 +277,12 @@ class WorkbenchApp(App[None]):
 
     def _open_store(self) -> None:
         try:
-            self.store = Store.open(self.data_dir)
+            # a course database that is down now still gets the work once it is back
+            self.store = Store.open(self.data_dir, db=self.db, offline_ok=True)
         except Exception as exc:  # the labs work without saving rather than not at all
             self.store = None
-            self.store_problem = f"cannot open the data folder, so nothing is saved: {exc}"
+            where = "the course database" if self.db else "the data folder"
+            self.store_problem = f"cannot open {where}, so nothing is saved: {exc}"
 
     def set_up_done(self, setup: Setup | None = None) -> None:
         """A lab's set-up changed the bench: follow its maze and profile, and start the VIPLE
@@ -324,6 +330,9 @@ class WorkbenchApp(App[None]):
     async def _shut_down(self) -> None:
         self.bench.close()
         if self.store is not None:
+            # a last try for what the database did not get yet (never shown as saved)
+            with contextlib.suppress(Exception):
+                self.store.flush()
             self.store.close()
         if self.endpoints is not None:
             await self.endpoints.close()
@@ -352,6 +361,7 @@ def make_app(
     student_fixed: bool = False,
     connect_hint: str = "",
     workspace: str | os.PathLike | None = None,
+    db: str | None = None,
 ) -> WorkbenchApp:
     """The workbench app on a maze file (default: the bundled Unity maze).
 
@@ -360,7 +370,8 @@ def make_app(
     False once a WebSocket exercise is set up or the user presses ``v``); neither runs unless
     asked for (a lab exercise's set-up starts the one it needs).
     ``student`` (default: the login name) and ``partner`` do the labs; their progress and
-    sign-offs are kept in ``data_dir`` (default: ``$WORKBENCH_DATA`` or the user data folder).
+    sign-offs are kept in ``data_dir`` (default: ``$WORKBENCH_DATA`` or the user data folder),
+    or in the course's PostgreSQL database ``db`` (a ``postgresql://`` URL).
     ``ask_names`` asks for them when the app starts (the student's name cannot be changed there
     when ``student_fixed``, as for an SSH login); ``connect_hint`` tells the user how to reach the
     VIPLE endpoints (shown at start and in the help). With a ``workspace`` folder (a served
@@ -427,6 +438,7 @@ def make_app(
         ask_names=ask_names,
         student_fixed=student_fixed,
         connect_hint=connect_hint,
+        db=db,
     )
 
 

@@ -23,11 +23,10 @@ from workbench.labs.signoff import (
     LockedOut,
     RecordFields,
     SignoffError,
-    load_roster,
-    roster_path,
+    offered_roster,
     sign_off,
 )
-from workbench.labs.store import Store
+from workbench.labs.store import Store, StoreError
 
 from ..widgets.field import Field
 from ..widgets.tick import Tick
@@ -112,9 +111,9 @@ class SignoffModal(ModalScreen[str | None]):
         self.driver = driver or student
         self.signed = False
         try:
-            self.roster = sorted(load_roster(roster_path(store.data_dir)))
+            self.roster = sorted(offered_roster(store))
             self.roster_problem = "" if self.roster else "the roster has no instructors yet"
-        except SignoffError as exc:
+        except (SignoffError, StoreError) as exc:
             self.roster = []
             self.roster_problem = str(exc)
         if self.roster_problem:

@@ -18,18 +18,24 @@ from textual.app import ComposeResult
 from textual.binding import Binding, BindingType
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.screen import Screen
+from textual.timer import Timer
 from textual.widgets import Footer, Input, Label, Markdown, OptionList, Static
 from textual.widgets.option_list import Option
 
 from workbench.control.bench import Bench
 from workbench.labs.checks import ExerciseProgress, apply_setup, evaluate, keep_passed
 from workbench.labs.model import Exercise, Lab, LabFileError, load_labs
-from workbench.labs.store import Store
+from workbench.labs.store import Store, StoreUnavailable
 from workbench.sim.session import Snapshot
 
 from ..widgets.field import Field
 
 PASS, FAIL, OPEN = "✓", "✗", "·"
+
+
+UNREACHABLE = "the course database cannot be reached"
+#: seconds between tries to write what the course database did not get
+RETRY_SECONDS = 2.0
 
 
 class LabsScreen(Screen[None]):
@@ -123,6 +129,8 @@ class LabsScreen(Screen[None]):
         self._done: set[tuple[str, str]] = set()
         self._signed: set[tuple[str, str]] = set()
         self._drivers: dict[tuple[str, str], str] = {}
+        self._retry_timer: Timer | None = None
+        self._reload_when_back = False
         self._load_saved()
 
     # -- store ---------------------------------------------------------------------------
@@ -133,6 +141,13 @@ class LabsScreen(Screen[None]):
             saved = self.store.progress(self.student)
             signed = self.store.signoffs(student=self.student)
             self._drivers = self.store.drivers(self.student, self.partner)
+        except StoreUnavailable:
+            self._store_problem = (
+                f"{UNREACHABLE}: saved progress is not shown yet; what you do now is kept "
+                "and saved when it is back"
+            )
+            self._reload_when_back = True
+            return
         except Exception as exc:  # a damaged database must not stop the lab
             self._store_problem = f"cannot read saved progress: {exc}"
             return
@@ -159,9 +174,59 @@ class LabsScreen(Screen[None]):
         if self.store is None:
             return
         try:
-            self.store.save_progress(self.student, progress.lab, progress.exercise, _json(progress))
+            saved = self.store.save_progress(
+                self.student, progress.lab, progress.exercise, _json(progress)
+            )
         except Exception as exc:
             self.say(f"progress not saved: {exc}")
+            return
+        if not saved:
+            self._wait_for_store()
+
+    # -- a course database that went away ------------------------------------------------
+    def _wait_for_store(self) -> None:
+        """Say the database is away and try it again every few seconds until what is kept
+        here is written; the student works on meanwhile."""
+        store = self.store
+        if store is None:
+            return
+        if store.pending:
+            self.say(
+                f"{UNREACHABLE}: your progress is kept here ({store.pending} change(s)) and "
+                "saved as soon as it is back"
+            )
+        if self._retry_timer is None and self._ready:
+            self._retry_timer = self.set_interval(RETRY_SECONDS, self._retry_store)
+
+    def _retry_store(self) -> None:
+        store = self.store
+        if store is None:
+            return
+        try:
+            done = store.flush()
+            if done and self._reload_when_back:
+                self._load_saved_again()
+        except StoreUnavailable:
+            return
+        except Exception as exc:
+            self.say(f"progress not saved: {exc}")
+            done = True
+        if not done:
+            return
+        if self._retry_timer is not None:
+            self._retry_timer.stop()
+            self._retry_timer = None
+        self.say("the course database is back: your progress is saved")
+
+    def _load_saved_again(self) -> None:
+        """Read the saved progress the database could not give at the start (what this
+        session changed meanwhile was written first, so it reads back as it is here)."""
+        assert self.store is not None
+        self.store.progress(self.student)  # raises while the database is still away
+        self._reload_when_back = False
+        self._store_problem = ""
+        self._load_saved()
+        self._refresh_list()
 
     # -- layout --------------------------------------------------------------------------
     def compose(self) -> ComposeResult:
@@ -188,6 +253,8 @@ class LabsScreen(Screen[None]):
 
     def on_mount(self) -> None:
         self._ready = True
+        if self._reload_when_back or (self.store is not None and self.store.pending):
+            self._retry_timer = self.set_interval(RETRY_SECONDS, self._retry_store)
         problem = self._problem or self._store_problem
         if problem:
             self.say(problem)
@@ -237,7 +304,8 @@ class LabsScreen(Screen[None]):
         self.selected = (lab, exercise)
         if self.store is not None:
             try:
-                self.store.set_place(self.student, lab.id, exercise.id)
+                if not self.store.set_place(self.student, lab.id, exercise.id):
+                    self._wait_for_store()
             except Exception as exc:
                 self.say(f"cannot save where you are: {exc}")
         self.driver = self._drivers.get((lab.id, exercise.id), self.driver)

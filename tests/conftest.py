@@ -1,0 +1,32 @@
+"""Fixtures shared by every test folder: a PostgreSQL server for the store's tests.
+
+One server per test process (each pytest-xdist worker is one), started the first time a test
+asks for it and stopped when the process ends; each test gets a database of its own on it.
+Where no server can start, the tests that need one are skipped with the reason.
+"""
+
+from __future__ import annotations
+
+import itertools
+
+import pytest
+
+from .pgserver import NoServer, PgServer
+
+_names = itertools.count(1)
+
+
+@pytest.fixture(scope="session")
+def pg_server():
+    try:
+        server = PgServer.create()
+    except NoServer as exc:
+        pytest.skip(f"no PostgreSQL server can start here: {exc}")
+    yield server
+    server.destroy()
+
+
+@pytest.fixture
+def pg_url(pg_server: PgServer) -> str:
+    """A new, empty database on the session's server."""
+    return pg_server.create_database(f"t{next(_names)}")

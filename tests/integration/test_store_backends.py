@@ -1,0 +1,324 @@
+"""The store's behaviour, the same on both databases: the SQLite file in the data folder and a
+PostgreSQL database (a real server the test session starts, see tests/conftest.py)."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import threading
+import time
+from datetime import UTC, datetime
+from pathlib import Path
+
+import pytest
+
+from workbench.labs import signoff as so
+from workbench.labs.store import LogMissing, Store, StoreError, read_signoffs
+
+FAST = so.KdfParams(n=2**10, r=8, p=1)
+PASS = "correct horse battery"
+T0 = datetime(2026, 3, 2, 14, 5, 9, tzinfo=UTC)
+ROOT = Path(__file__).resolve().parents[2]
+
+
+class Where:
+    """One store's place: its data folder and, for PostgreSQL, its database URL."""
+
+    def __init__(self, data_dir: Path, db: str | None):
+        self.data_dir = data_dir
+        self.db = db
+
+    def open(self) -> Store:
+        return Store.open(self.data_dir, db=self.db)
+
+    def raw(self, sql: str, params: tuple = ()) -> None:
+        """Change the database behind the workbench's back (as someone with access could)."""
+        with self.open() as store, store.backend.write() as tx:
+            tx.execute(sql, params)
+
+    def add_instructor(self, name: str = "Dr Chen") -> None:
+        with self.open() as store:
+            so.create_instructor(self.data_dir, name, PASS, kdf=FAST, store=store)
+
+    def roster(self) -> dict[str, so.RosterEntry]:
+        with self.open() as store:
+            return so.offered_roster(store)
+
+
+@pytest.fixture(params=["sqlite", "postgresql"])
+def where(request, tmp_path: Path) -> Where:
+    db = request.getfixturevalue("pg_url") if request.param == "postgresql" else None
+    return Where(tmp_path / "data", db)
+
+
+def fields(student: str = "alice", **kw) -> so.RecordFields:
+    base = dict(
+        student=student,
+        partner="bob",
+        driver=student,
+        lab="unity-simulator",
+        exercise="wall-following",
+        evidence=so.Evidence("", "", {"exit_time": 41.5}),
+        objectives_passed=True,
+    )
+    base.update(kw)
+    return so.RecordFields(**base)
+
+
+def test_progress_places_and_drivers_are_saved_replaced_and_read_back(where):
+    with where.open() as s:
+        assert s.save_progress("alice", "web", "ex1", {"objectives": {"keys": True}}, now=T0)
+        s.save_progress("alice", "web", "ex1", {"objectives": {"keys": True, "maze": False}})
+        s.save_progress("alice", "unity", "ex2", {"answers": [1]})
+        s.set_place("alice", "web", "ex1")
+        s.set_place("alice", "unity", "ex2")
+        s.set_driver("alice", "bob", "web", "ex1", "alice")
+        s.set_driver("alice", "bob", "web", "ex1", "bob")
+        with pytest.raises(ValueError):
+            s.save_progress("alice", "web", "ex1", {"t": float("inf")})
+    with where.open() as s:  # another process (or server) opening the same store
+        assert s.progress("alice", "web") == {
+            ("web", "ex1"): {"objectives": {"keys": True, "maze": False}}
+        }
+        assert len(s.progress("alice")) == 2 and s.progress("nobody") == {}
+        assert s.place("alice") == ("unity", "ex2") and s.place("bob") is None
+        assert s.drivers("alice", "bob") == {("web", "ex1"): "bob"}
+        assert s.pending == 0 and s.available
+
+
+def test_schema_steps_are_numbered_and_recorded_once(where):
+    with where.open() as s:
+        steps = s.migrations()
+        version = s.schema_version()
+    with where.open() as s:
+        assert s.migrations() == steps  # opening again applies nothing
+    expected = [(1, "tables"), (2, "sign-off chain")]
+    if where.db:
+        expected.append((3, "instructors' roster"))
+    assert steps == expected and version == expected[-1][0]
+
+
+def test_a_store_written_by_a_newer_workbench_is_refused(where):
+    where.open().close()
+    where.raw("UPDATE meta SET value = '99' WHERE key = 'schema_version'")
+    with pytest.raises(StoreError, match=r"newer workbench \(schema 99"):
+        where.open()
+
+
+def test_signoffs_form_one_log_that_verifies_and_reads_back_the_same(where):
+    where.add_instructor()
+    roster = where.roster()
+    assert list(roster) == ["Dr Chen"]
+    with where.open() as s:
+        for student in ("alice", "carol", "dave"):
+            so.sign_off(s, "Dr Chen", PASS, fields(student))
+        stored = s.signoffs()
+        assert [r.student for r in s.signoffs(student="bob")] == ["alice", "carol", "dave"]
+    assert [r.seq for r in stored] == [1, 2, 3]
+    read = read_signoffs(where.data_dir, where.db)
+    assert read == stored
+    log = so.verify_log(read, roster)
+    assert log.ok and log.head.seq == 3
+
+
+def test_a_record_edited_in_the_database_fails_verify(where):
+    where.add_instructor()
+    with where.open() as s:
+        so.sign_off(s, "Dr Chen", PASS, fields())
+    where.raw("UPDATE signoffs SET note = 'great work'")
+    [verdict] = so.verify_log(read_signoffs(where.data_dir, where.db), where.roster()).verdicts
+    assert any("signature does not match" in p for p in verdict.problems)
+
+
+def test_a_sequence_number_is_taken_once(where):
+    where.add_instructor()
+    with where.open() as s:
+        so.sign_off(s, "Dr Chen", PASS, fields())
+    columns = (
+        "student, partner, driver, lab, exercise, instructor, signed_at, note, override, "
+        "run_record, evidence_digest, metrics, signature, seq"
+    )
+    with pytest.raises(StoreError, match=r"(?i)unique"):
+        where.raw(f"INSERT INTO signoffs ({columns}) SELECT {columns} FROM signoffs")
+
+
+def test_the_lockout_counts_across_a_reopen(where):
+    where.add_instructor()
+    for _ in range(4):
+        with where.open() as s, pytest.raises(so.WrongPassphrase):
+            so.sign_off(s, "Dr Chen", "wrong wrong wrong", fields(), clock=lambda: T0)
+    with where.open() as s:
+        with pytest.raises(so.LockedOut, match="60 s more"):
+            so.sign_off(s, "Dr Chen", "wrong wrong wrong", fields(), clock=lambda: T0)
+        assert [e.event for e in s.events("Dr Chen")] == ["wrong-passphrase"] * 5 + ["locked"]
+
+
+def test_two_threads_write_at_the_same_time(where):
+    where.open().close()
+    errors: list[BaseException] = []
+
+    def writer(who: str) -> None:
+        try:
+            with where.open() as s:
+                for i in range(30):
+                    s.save_progress(who, "lab", f"ex{i}", {"i": i})
+                    s.log_event(who, "tick", str(i), T0)
+        except BaseException as exc:
+            errors.append(exc)
+
+    threads = [threading.Thread(target=writer, args=(w,)) for w in ("alice", "bob")]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert errors == []
+    with where.open() as s:
+        assert len(s.progress("alice")) == 30 and len(s.progress("bob")) == 30
+        assert len(s.events()) == 60
+
+
+SIGNER = """
+import sys, time
+from workbench.labs import signoff as so
+from workbench.labs.store import Store
+data_dir, db, who, start = sys.argv[1], sys.argv[2] or None, sys.argv[3], float(sys.argv[4])
+fields = so.RecordFields(student=who, lab="lab", exercise="ex", objectives_passed=True)
+with Store.open(data_dir, db=db) as store:
+    time.sleep(max(0.0, start - time.time()))
+    for i in range(10):
+        so.sign_off(store, "Dr Chen", "correct horse battery", fields)
+"""
+
+
+def test_two_processes_signing_at_once_make_one_log(where):
+    """Two servers' apps sign off at the same moment: one log, no number taken twice."""
+    where.add_instructor()
+    start = str(time.time() + 1.5)  # both begin together, once started
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    args = [str(where.data_dir), where.db or ""]
+    procs = [
+        subprocess.Popen([sys.executable, "-c", SIGNER, *args, who, start], env=env)
+        for who in ("alice", "bob")
+    ]
+    assert [p.wait(timeout=120) for p in procs] == [0, 0]
+    rows = read_signoffs(where.data_dir, where.db)
+    assert [r.seq for r in rows] == list(range(1, 21))
+    assert sorted(r.student for r in rows) == ["alice"] * 10 + ["bob"] * 10
+    log = so.verify_log(rows, where.roster())
+    assert log.ok, (log.breaks, [v.problems for v in log.verdicts if not v.ok])
+
+
+# PostgreSQL only
+
+
+def test_a_course_database_holds_the_roster_and_the_keys(pg_url, tmp_path):
+    """An instructor added on one server signs on another: the key travels in the database,
+    encrypted, and no file is written in either data folder."""
+    one, two = Where(tmp_path / "one", pg_url), Where(tmp_path / "two", pg_url)
+    one.add_instructor("Dr Chen")
+    assert not (tmp_path / "one" / "instructors").exists()
+    assert not (tmp_path / "one" / "roster.json").exists()
+    with two.open() as s:
+        assert list(so.offered_roster(s)) == ["Dr Chen"]
+        assert '"encrypted_private_key"' in (s.instructor_key("Dr Chen") or "")
+        so.sign_off(s, "Dr Chen", PASS, fields())
+        with pytest.raises(so.WrongPassphrase):
+            so.sign_off(s, "Dr Chen", "not the passphrase", fields())
+        with pytest.raises(so.UnknownInstructor, match="no key for instructor Dr Lee"):
+            so.sign_off(s, "Dr Lee", PASS, fields())
+    with pytest.raises(so.SignoffError, match="already in the roster"):
+        two.add_instructor("Dr Chen")
+
+
+def test_reading_an_empty_database_finds_no_log_and_creates_nothing(pg_url, tmp_path):
+    with pytest.raises(LogMissing, match="no meta table"):
+        read_signoffs(tmp_path, pg_url)
+    with pytest.raises(LogMissing):
+        read_signoffs(tmp_path, pg_url)  # still nothing: reading made no table
+
+
+def test_a_database_that_is_not_the_workbenchs_is_refused(pg_url, tmp_path):
+    import psycopg
+
+    with psycopg.connect(pg_url, autocommit=True) as conn:
+        conn.execute("CREATE TABLE customers (id int)")
+    with pytest.raises(StoreError, match="not a workbench database"):
+        Store.open(tmp_path, db=pg_url)
+
+
+def test_an_unreachable_server_is_named_without_its_password(tmp_path):
+    from tests.pgserver import free_port
+
+    url = f"postgresql://teacher:s3cret@127.0.0.1:{free_port()}/course"
+    with pytest.raises(StoreError, match="cannot be reached") as caught:
+        Store.open(tmp_path, db=url)
+    assert "s3cret" not in str(caught.value) and "teacher:***@127.0.0.1" in str(caught.value)
+
+
+def test_the_database_stopped_and_restarted_under_a_writer_loses_nothing(
+    pg_server, pg_url, tmp_path
+):
+    """A student keeps working while the course database restarts: every save reports
+    whether it reached the database, what did not is kept and written once it is back, and
+    afterwards the database holds every save, the newest of each exercise."""
+    store = Store.open(tmp_path, db=pg_url)
+    outcome: dict[int, bool] = {}
+    stop = threading.Event()
+
+    def writer() -> None:
+        i = 0
+        while not stop.is_set():
+            outcome[i] = store.save_progress("alice", "lab", f"ex{i % 25}", {"i": i})
+            i += 1
+            time.sleep(0.01)
+
+    thread = threading.Thread(target=writer)
+    thread.start()
+    try:
+        while sum(outcome.values()) < 20:
+            time.sleep(0.01)
+        pg_server.stop()
+        down_from = len(outcome)
+        time.sleep(1.0)
+        assert not any(outcome[i] for i in range(down_from + 5, len(outcome)))  # pending
+        assert store.pending > 0 and not store.available
+        with pytest.raises(StoreError, match=r"cannot be reached|went away"):
+            store.signoffs()  # reads say so; they never wait on a dead server
+    finally:
+        pg_server.start()
+    deadline = time.monotonic() + 20
+    while store.pending and time.monotonic() < deadline:
+        time.sleep(0.05)
+    stop.set()
+    thread.join()
+    store.flush()
+    assert store.pending == 0
+    last = len(outcome) - 1
+    with Store.open(tmp_path, db=pg_url) as fresh:
+        saved = fresh.progress("alice")
+    newest = {f"ex{i % 25}": i for i in range(last + 1)}
+    assert {ex: p["i"] for (_, ex), p in saved.items()} == newest
+    store.close()
+
+
+def test_a_store_opened_while_the_server_is_down_catches_up_when_it_is_back(
+    pg_server, pg_url, tmp_path
+):
+    Store.open(tmp_path, db=pg_url).close()
+    pg_server.stop()
+    try:
+        store = Store.open(tmp_path, db=pg_url, offline_ok=True)
+        assert store.save_progress("alice", "lab", "ex1", {"i": 1}) is False
+        assert store.set_place("alice", "lab", "ex1") is False
+        assert store.pending == 2 and not store.available
+        with pytest.raises(StoreError, match="cannot be reached"):
+            Store.open(tmp_path, db=pg_url)  # without offline_ok it says so at once
+    finally:
+        pg_server.start()
+    time.sleep(1.1)  # past the pause between tries
+    assert store.flush() is True
+    with Store.open(tmp_path, db=pg_url) as fresh:
+        assert fresh.progress("alice") == {("lab", "ex1"): {"i": 1}}
+        assert fresh.place("alice") == ("lab", "ex1")
+    store.close()
