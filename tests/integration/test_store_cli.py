@@ -134,3 +134,8 @@ def test_a_bad_database_url_is_refused_with_what_to_write(capsys, monkeypatch):
     monkeypatch.setenv("WORKBENCH_DB", "redis://cache")
     assert main(["signoff", "list"]) == 2
     assert "$WORKBENCH_DB: 'redis://cache' is not a PostgreSQL URL" in capsys.readouterr().err
+
+
+def test_db_may_be_given_before_the_command_too(capsys):
+    assert main(["--db", "sqlite:///tmp/x.db", "signoff", "verify"]) == 2
+    assert "not a PostgreSQL URL" in capsys.readouterr().err

@@ -82,7 +82,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="where lab progress and sign-offs are kept (default: $WORKBENCH_DATA "
         "or the user data folder)",
     )
-    db_option(parser)
+    db_option(parser, top=True)
     parser.add_argument(
         "--workspace",
         metavar="DIR",

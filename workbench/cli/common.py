@@ -30,10 +30,12 @@ def new_runs_dir() -> str:
     return str(runs_home() / time.strftime("%Y%m%d-%H%M%S"))
 
 
-def db_option(parser: argparse.ArgumentParser) -> None:
+def db_option(parser: argparse.ArgumentParser, top: bool = False) -> None:
+    """``--db URL``: given before or after the command (a command's own --db wins)."""
     parser.add_argument(
         "--db",
         metavar="URL",
+        default=None if top else argparse.SUPPRESS,
         help="keep progress, sign-offs and the roster in this PostgreSQL database "
         "(postgresql://USER@HOST/DBNAME), shared by every lab server of a course (default: "
         "$WORKBENCH_DB, else the SQLite file in the data folder)",
