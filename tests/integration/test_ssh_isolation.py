@@ -101,7 +101,11 @@ def dialog_says(phrase: str):
     """A check that a dialog's text holds ``phrase``, however its lines are wrapped."""
 
     def check(screen: str) -> bool:
-        inside = [line.split("│")[1] for line in screen.splitlines() if line.count("│") >= 2]
+        inside = []
+        for line in screen.splitlines():
+            edges = [i for i, c in enumerate(line) if c in "│|"]  # Unicode or ASCII frames
+            if len(edges) >= 2:
+                inside.append(line[edges[0] + 1 : edges[-1]])
         return phrase in " ".join(" ".join(inside).split())
 
     return check
