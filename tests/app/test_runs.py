@@ -14,7 +14,7 @@ from workbench.sim.mazefile import parse_maze
 from workbench.sim.record import FORMAT
 from workbench.tui.screens.path_dialog import PathDialog
 from workbench.tui.screens.replay import ReplayScreen
-from workbench.tui.screens.runs import RunsScreen, driver_name
+from workbench.tui.screens.runs import RunsScreen
 from workbench.tui.widgets import MazeView
 
 BEND = parse_maze(
@@ -263,8 +263,3 @@ async def test_runs_that_end_while_the_screen_is_open_appear(tmp_path):
         screen.show_snapshot(bench.snapshot())
         await pilot.pause()
         assert screen.query_one(DataTable).row_count == 3
-
-
-def test_driver_names_drop_the_algorithm_prefix():
-    assert driver_name("algorithm right-wall") == "right-wall"
-    assert driver_name("keys") == "keys"

@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from workbench.sim.clock import Pacer
+from workbench.sim.driver import Driver
 from workbench.sim.maze import MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.noise import noise_settings
@@ -273,6 +274,7 @@ async def serve(the_plan: ServePlan, stop: asyncio.Event | None = None) -> int:
     endpoints = [e for e in (tcp, ws) if e is not None]
     session.record_header(
         driver="VIPLE",
+        driven_by=Driver.viple().as_json(),
         endpoints=[_endpoint_json(e.status) for e in endpoints],
         report_ms=(the_plan.tcp or the_plan.ws).report_ms,
         **the_plan.fields,

@@ -23,7 +23,6 @@ from workbench.sim.replay import load_replay
 from .path_dialog import PathDialog
 from .replay import ReplayScreen
 
-ALGORITHM_PREFIX = "algorithm "
 #: column key, heading (ASCII), heading (Unicode)
 COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("number", "#", "#"),
@@ -45,11 +44,6 @@ OPEN_HELP = (
 )
 
 
-def driver_name(driver: str) -> str:
-    """``algorithm right-wall`` -> ``right-wall``; ``keys`` stays."""
-    return driver[len(ALGORITHM_PREFIX) :] if driver.startswith(ALGORITHM_PREFIX) else driver
-
-
 def run_cells(run: RunEntry, unicode: bool) -> tuple[str, ...]:
     """The table cells of a run, in :data:`COLUMNS` order."""
     m = run.metrics
@@ -57,7 +51,7 @@ def run_cells(run: RunEntry, unicode: bool) -> tuple[str, ...]:
     yes, no = ("✓", "✗") if unicode else ("yes", "no")
     return (
         str(run.number),
-        driver_name(run.driver),
+        run.driver.short,
         yes if m.reached_exit else no,
         f"{time:.1f}",
         f"{m.distance_cells:.2f}",
