@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 
-from textual.app import App
 from textual.screen import Screen
 from textual.widgets import DataTable, Input, Static
 
@@ -12,6 +11,7 @@ from tests.app.support import sync
 from workbench.control.bench import Bench
 from workbench.sim.mazefile import parse_maze
 from workbench.sim.record import FORMAT
+from workbench.tui.host import ScreenHost
 from workbench.tui.screens.path_dialog import PathDialog
 from workbench.tui.screens.replay import ReplayScreen
 from workbench.tui.screens.runs import RunsScreen
@@ -23,7 +23,7 @@ BEND = parse_maze(
 SIZE = (80, 24)
 
 
-class Host(App):
+class Host(ScreenHost):
     def __init__(self, screen: Screen) -> None:
         super().__init__()
         self.under_test = screen
