@@ -5,7 +5,7 @@ import json
 
 import pytest
 
-from workbench.control.commands import MoveAtPower, TurnByDegrees, WheelPowers
+from workbench.sim.commands import MoveAtPower, TurnByDegrees, WheelPowers
 from workbench.sim.driver import Driver
 from workbench.sim.mazefile import parse_maze
 from workbench.sim.metrics import TurnCounter

@@ -8,6 +8,7 @@ import sys
 from collections.abc import Sequence
 
 from workbench import __version__
+from workbench.files.bundled import default_maze_path
 
 from . import algorithms as algorithms_cmd
 from . import instructor as instructor_cmd
@@ -18,7 +19,7 @@ from . import serve as serve_cmd
 from . import signoff as signoff_cmd
 from . import ssh as ssh_cmd
 from . import viple_client as viple_client_cmd
-from .common import default_maze_path, error, new_runs_dir, runs_home
+from .common import error, new_runs_dir, runs_home
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -17,6 +17,7 @@ import sys
 from dataclasses import dataclass, field
 from typing import Any
 
+from workbench.files.bundled import default_maze_path
 from workbench.sim.clock import Pacer
 from workbench.sim.driver import Driver
 from workbench.sim.maze import MazeError
@@ -39,8 +40,6 @@ from workbench.viple.link import (
 )
 from workbench.viple.tcp_server import DEFAULT_PORT, EndpointError, TcpConfig, TcpServer
 from workbench.viple.ws_client import WsClient, WsConfig
-
-from .common import default_maze_path
 
 #: how often the simulation is advanced on the event loop, and the status line's period
 TICK_HZ = 60.0

@@ -14,6 +14,7 @@ from typing import Any
 
 from workbench.files.workspace import LOCAL, FileAccess
 from workbench.sim.clock import Pacer
+from workbench.sim.commands import Command, Stop, motion_of
 from workbench.sim.driver import KEYS, Driver
 from workbench.sim.maze import Maze
 from workbench.sim.metrics import Metrics
@@ -31,7 +32,6 @@ from workbench.sim.sensors import (
 from workbench.sim.session import Session, Snapshot
 
 from .algorithms import load_algorithm
-from .commands import Command, Stop, motion_of
 from .fsm import FsmController, FsmDefinition, FsmRuntimeError, bind_sensors, preset_sensors
 from .fsmfile import parse_param_overrides
 from .manual import exact_move, key_command

@@ -18,8 +18,8 @@ from typing import IO, Any
 import pymunk
 
 import workbench
-from workbench.control.commands import MotorPower, MoveAtPower, Stop, TurnByDegrees, WheelPowers
 
+from .commands import MotorPower, MoveAtPower, Stop, TurnByDegrees, WheelPowers
 from .driver import KEYS, NOBODY, Driver
 
 FORMAT = "workbench-run/1"

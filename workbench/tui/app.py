@@ -20,6 +20,7 @@ from textual.reactive import var
 from textual.screen import Screen
 
 from workbench.control.bench import Bench
+from workbench.files.bundled import default_maze_path
 from workbench.files.workspace import LOCAL, FileAccess
 from workbench.labs.model import Setup
 from workbench.labs.names import NameProblem, check_pair
@@ -395,8 +396,6 @@ def make_app(
     an argument is not one the workbench knows.
     """
     if maze_path is None:
-        from workbench.cli.common import default_maze_path
-
         maze_path = default_maze_path()
     path = Path(maze_path)
     if profile is not None and profile not in PROFILES:

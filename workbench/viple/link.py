@@ -31,7 +31,7 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from typing import Protocol
 
-from workbench.control.commands import Stop
+from workbench.sim.commands import Stop
 from workbench.sim.driver import NOBODY, Driver
 from workbench.sim.session import Session
 
