@@ -265,7 +265,7 @@ def test_x_starts_and_stops_the_chosen_algorithm_from_the_main_screen():
         assert app.bench.controller is not None
         await pilot.press("x")
         assert app.bench.controller is None
-        assert app.bench.snapshot().driver == "keys"
+        assert str(app.bench.snapshot().driver) == "keys"
 
     run(app, body)
 

@@ -44,7 +44,7 @@ def test_a_viple_program_drives_the_robot_the_app_shows(tmp_path):
             await pilot.pause(0.5)
             snap = app.bench.snapshot()
             assert snap.pose.x > x0 + 20  # heading right at 120 px/s
-            assert snap.driver.startswith("VIPLE tcp 127.0.0.1:")
+            assert str(snap.driver).startswith("VIPLE tcp 127.0.0.1:")
             assert "in 1 out" in status(app)
             writer.write(b"not json\r\n")
             await writer.drain()

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from textual.app import App
 from textual.screen import Screen
 from textual.widgets import Input, OptionList, Select
 
@@ -10,6 +9,7 @@ from tests.app.support import sync
 from workbench.control.bench import Bench
 from workbench.sim.mazefile import write_maze
 from workbench.sim.mazeio import load_maze
+from workbench.tui.host import ScreenHost
 from workbench.tui.screens.editor import EditorScreen
 from workbench.tui.screens.generate_dialog import GenerateDialog
 from workbench.tui.screens.path_dialog import PathDialog
@@ -21,7 +21,7 @@ ROOM_TEXT = "#######\n#S....#\n#.....#\n#....E#\n#######\n"
 SIZE = (80, 24)
 
 
-class Host(App):
+class Host(ScreenHost):
     """Pushes one screen and keeps what it was dismissed with."""
 
     def __init__(self, screen: Screen) -> None:

@@ -180,7 +180,7 @@ def test_a_store_with_unreadable_progress_says_so_and_starts_that_exercise_afres
 
 
 def test_a_bundled_maze_is_never_saved_over_the_editor_asks_where(tmp_path):
-    from workbench.cli.common import default_maze_path
+    from workbench.files.bundled import default_maze_path
     from workbench.tui.screens.editor import EditorScreen
     from workbench.tui.screens.path_dialog import PathDialog
 

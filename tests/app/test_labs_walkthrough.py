@@ -335,7 +335,7 @@ async def viple_over_websocket(w: Walkthrough, screen: LabsScreen, lab: Lab, ex:
         assert w.bench.viple and w.bench.viple[-1].drove
         server.close()  # the students stop their program
     for _ in range(300):
-        if not w.bench.session.driver.startswith("VIPLE"):
+        if not str(w.bench.session.driver).startswith("VIPLE"):
             break
         await asyncio.sleep(0.01)
     w.bench.step(1)

@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 
-from textual.app import App
 from textual.screen import Screen
 from textual.widgets import DataTable, Input, Static
 
@@ -12,9 +11,10 @@ from tests.app.support import sync
 from workbench.control.bench import Bench
 from workbench.sim.mazefile import parse_maze
 from workbench.sim.record import FORMAT
+from workbench.tui.host import ScreenHost
 from workbench.tui.screens.path_dialog import PathDialog
 from workbench.tui.screens.replay import ReplayScreen
-from workbench.tui.screens.runs import RunsScreen, driver_name
+from workbench.tui.screens.runs import RunsScreen
 from workbench.tui.widgets import MazeView
 
 BEND = parse_maze(
@@ -23,7 +23,7 @@ BEND = parse_maze(
 SIZE = (80, 24)
 
 
-class Host(App):
+class Host(ScreenHost):
     def __init__(self, screen: Screen) -> None:
         super().__init__()
         self.under_test = screen
@@ -263,8 +263,3 @@ async def test_runs_that_end_while_the_screen_is_open_appear(tmp_path):
         screen.show_snapshot(bench.snapshot())
         await pilot.pause()
         assert screen.query_one(DataTable).row_count == 3
-
-
-def test_driver_names_drop_the_algorithm_prefix():
-    assert driver_name("algorithm right-wall") == "right-wall"
-    assert driver_name("keys") == "keys"

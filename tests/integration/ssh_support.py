@@ -14,6 +14,7 @@ from pathlib import Path
 import asyncssh
 import pyte
 
+from workbench.cli.ssh import WORKBENCH_APP
 from workbench.ssh.limits import SessionLimits
 from workbench.ssh.logins import LoginPolicy
 from workbench.ssh.passwords import hash_password
@@ -99,6 +100,7 @@ async def lab_host(
             bind="127.0.0.1",
             port_range=port_range(),
             public_host="lab.example",
+            app=WORKBENCH_APP,
             limits=limits or SessionLimits(),
             **({"logins": LoginPolicy(first_delay=0.05, max_delay=0.2)} | config),
         )

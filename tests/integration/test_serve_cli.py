@@ -17,6 +17,8 @@ from websockets.asyncio.server import serve as ws_serve
 
 from workbench.cli import build_parser, main
 from workbench.cli.serve import plan, serve
+from workbench.sim.driver import Driver
+from workbench.sim.record import recorded_driver
 from workbench.viple.codec import parse_report
 
 MOVE = b'{"servos":[{"isTurn":false,"servoId":-1,"servoSpeed":1}]}\r\n'
@@ -80,6 +82,7 @@ def test_serve_is_driven_over_tcp_and_stops_cleanly_on_a_signal(tmp_path, sig):
     assert "disconnected" in err and "stopping" in err
     rows = [json.loads(line) for line in record.read_text().splitlines()]
     assert rows[0]["type"] == "header" and rows[0]["driver"] == "VIPLE"
+    assert recorded_driver(rows[0]) == Driver.viple()
     summary = rows[-1]
     assert summary["type"] == "summary"
     assert summary["distance"] > 0.2
@@ -118,7 +121,7 @@ def test_serve_in_process_with_the_websocket_role_runs_in_real_time(tmp_path):
     assert asyncio.run(scenario()) == 0
     # about a second of real time at 1 unit/s (the start waits for the connection)
     assert 0.5 < session.world.pose.y - y0 < 1.2
-    assert session.driver == "nobody"
+    assert str(session.driver) == "nobody"
     assert reports and all(sorted(parse_report(r)) == [4, 6] for r in reports)
     summary = json.loads(record.read_text().splitlines()[-1])
     assert summary["type"] == "summary" and summary["endpoints"][0]["role"] == "ws"

@@ -15,6 +15,7 @@ from pathlib import Path
 import pytest
 
 from tests.app.support import sync
+from workbench.cli.ssh import WORKBENCH_APP
 from workbench.ssh import forkserver as forkserver_module
 from workbench.ssh.appproc import app_env
 from workbench.ssh.forkserver import ForkServer, ForkServerError
@@ -43,7 +44,7 @@ async def eventually(check, what: str, timeout: float = 10.0) -> None:
 
 @sync
 async def test_the_fork_server_runs_apps_with_their_options_errors_and_exit_status(tmp_path):
-    server = ForkServer(app_env())
+    server = ForkServer(app_env(), WORKBENCH_APP.main, WORKBENCH_APP.preload)
     await server.start()
     try:
         assert server.running and server.modules > 100

@@ -17,8 +17,8 @@ import pytest
 from websockets.asyncio.client import connect as ws_connect
 
 from workbench.cli import main
-from workbench.control.commands import MoveAtPower, Stop, TurnByDegrees
 from workbench.control.headless import RunSpec, run
+from workbench.sim.commands import MoveAtPower, Stop, TurnByDegrees
 from workbench.sim.noise import noise_settings
 from workbench.sim.profiles import get_profile
 from workbench.viple import client as client_mod

@@ -5,7 +5,6 @@ from __future__ import annotations
 import pytest
 
 from tests.program.builder import ProgramBuilder
-from workbench.control.commands import MoveAtPower, WheelPowers
 from workbench.program.compiled import compile_program
 from workbench.program.interp import ProgramController
 from workbench.program.keys import KeyScriptError, parse_key_script
@@ -13,6 +12,7 @@ from workbench.program.kinds import parse_kind_map
 from workbench.program.loader import load_program
 from workbench.program.model import ELSE
 from workbench.program.problems import ProgramError
+from workbench.sim.commands import MoveAtPower, WheelPowers
 
 TICK = 0.05
 

@@ -9,7 +9,6 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from textual.app import App
 from textual.pilot import Pilot
 from textual.screen import Screen
 from textual.widgets import Input
@@ -17,6 +16,7 @@ from textual.widgets import Input
 from workbench.control.bench import Bench
 from workbench.sim.generate import generate
 from workbench.sim.mazeio import load_maze
+from workbench.tui.host import ScreenHost
 from workbench.tui.screens.editor import EditorScreen
 from workbench.tui.screens.replay import ReplayScreen
 from workbench.tui.screens.runs import RunsScreen
@@ -27,7 +27,7 @@ SMALL = (80, 24)
 LARGE = (120, 40)
 
 
-class Host(App):
+class Host(ScreenHost):
     """Pushes the screen under test over an empty default screen."""
 
     def __init__(self, screen: Screen) -> None:

@@ -4,6 +4,7 @@ import pytest
 
 from workbench.control.bench import Bench, SensorRow, check_sensor_rows
 from workbench.control.fsm import SensorBindingError
+from workbench.sim.driver import Driver
 from workbench.sim.mazefile import parse_maze
 from workbench.sim.mazeio import load_maze
 from workbench.sim.sensors import SensorSpec
@@ -28,7 +29,7 @@ def test_unity_keys_move_and_turn_like_the_course_key_program():
     y = b.snapshot().pose.y
     b.step(30)
     assert b.snapshot().pose.y == pytest.approx(y, abs=0.02)
-    assert b.keys_used == {"d", "w", "space"} and b.snapshot().driver == "keys"
+    assert b.keys_used == {"d", "w", "space"} and str(b.snapshot().driver) == "keys"
 
 
 def test_web_keys_spin_until_the_next_key():
@@ -102,7 +103,7 @@ def test_missing_sensor_is_explained_and_fixed_with_the_preset():
     b.apply_algorithm_preset()
     assert b.missing_sensors() is None
     b.start_algorithm()
-    assert b.snapshot().driver == "algorithm right-wall"
+    assert str(b.snapshot().driver) == "algorithm right-wall"
 
 
 def test_algorithm_run_to_the_exit_is_recorded_in_runs(tmp_path):
@@ -115,7 +116,7 @@ def test_algorithm_run_to_the_exit_is_recorded_in_runs(tmp_path):
             break
     run = b.runs[0]
     assert run.ended == "exit" and run.metrics.reached_exit
-    assert run.driver == "algorithm right-wall"
+    assert str(run.driver) == "algorithm right-wall"
     assert b.pacer.paused
     assert (tmp_path / "run-001.jsonl").read_text().splitlines()[-1].startswith('{"type":"summary"')
 
@@ -138,7 +139,7 @@ def test_keys_take_over_from_an_algorithm_and_close_its_run():
     b.step(60)
     b.key("space")
     assert b.controller is None and b.runs[-1].ended == "stopped"
-    assert b.snapshot().driver == "keys"
+    assert str(b.snapshot().driver) == "keys"
 
 
 def test_reset_robot_returns_to_start_and_loading_a_maze_restarts():
@@ -197,7 +198,7 @@ def test_a_failing_algorithm_is_stopped_with_the_reason_instead_of_raising(tmp_p
     assert b.controller is None and b.pacer.paused
     assert b.message.startswith("algorithm stopped: failing, state Go: guard")
     assert b.runs[-1].ended == "error"
-    assert b.snapshot().driver == "keys"
+    assert str(b.snapshot().driver) == "keys"
 
 
 def test_a_new_maze_keeps_pause_speed_and_frame_budget():
@@ -225,14 +226,18 @@ def test_a_viple_program_that_drives_is_recorded_with_its_role_and_a_run():
     assert link.connect("127.0.0.1:50312")
     b.step(1)
     assert [(c.role, c.peer, c.drove) for c in b.viple] == [("tcp", "127.0.0.1:50312", False)]
-    assert b.runs[-1].driver == "keys" and b.runs[-1].ended == "stopped"
+    assert str(b.runs[-1].driver) == "keys" and b.runs[-1].ended == "stopped"
     assert link.apply(MOVE)
     b.step(60)
     assert b.viple[0].drove and b.viple[0].distance > 0.5
     link.disconnect()
     b.step(1)
     run = b.runs[-1]
-    assert (run.driver, run.ended, run.source) == ("VIPLE tcp 127.0.0.1:50312", "stopped", None)
+    assert (run.driver, run.ended, run.source) == (
+        Driver.viple("tcp", "127.0.0.1:50312"),
+        "stopped",
+        None,
+    )
     assert run.maze_digest == CORRIDOR.digest()
     assert len(b.viple) == 1
 
@@ -259,7 +264,7 @@ def test_a_viple_program_that_takes_the_robot_from_an_algorithm_ends_its_run():
     Link(b.session, "tcp").connect("127.0.0.1:1")
     b.step(1)
     assert b.controller is None
-    assert b.runs[-1].driver == "algorithm right-wall"
+    assert str(b.runs[-1].driver) == "algorithm right-wall"
     assert b.runs[-1].source.endswith("right-wall.yaml")
 
 

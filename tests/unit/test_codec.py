@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from workbench.control.commands import (
+from workbench.sim.commands import (
     MotorPower,
     MoveAtPower,
     Stop,

@@ -5,7 +5,6 @@ import time
 import pytest
 
 from workbench.control.algorithms import load_algorithm
-from workbench.control.commands import MotorPower, MoveAtPower, Stop, TurnByDegrees, WheelPowers
 from workbench.control.fsm import (
     FsmController,
     FsmDefinition,
@@ -30,6 +29,7 @@ from workbench.control.fsm import (
     preset_sensors,
     resolve_params,
 )
+from workbench.sim.commands import MotorPower, MoveAtPower, Stop, TurnByDegrees, WheelPowers
 from workbench.sim.sensors import SensorSpec
 
 DT = 1 / 60

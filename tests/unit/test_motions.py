@@ -2,7 +2,8 @@
 
 import pytest
 
-from workbench.control.commands import (
+from workbench.control.manual import KEY_NAMES, KEY_PROGRAMS
+from workbench.sim.commands import (
     MotorPower,
     MoveAtPower,
     Stop,
@@ -10,7 +11,6 @@ from workbench.control.commands import (
     WheelPowers,
     motion_of,
 )
-from workbench.control.manual import KEY_NAMES, KEY_PROGRAMS
 
 
 @pytest.mark.parametrize(

@@ -190,7 +190,7 @@ def test_snapshot_carries_the_tick_for_the_maze_view(tmp_path):
     replay = load_replay(write_record(tmp_path / "s.jsonl", ticks(3), header=header))
     snap = replay.snapshot(1)
     assert snap.pose.x == 16.0 and snap.block == (1, 1) and snap.readings == {1: 39.0}
-    assert [str(s) for s in snap.sensors] == ["distance:1:front"] and snap.driver == "keys"
+    assert [str(s) for s in snap.sensors] == ["distance:1:front"] and str(snap.driver) == "keys"
 
 
 def test_a_bad_sensor_in_the_header_is_reported(tmp_path):

@@ -5,7 +5,8 @@ import json
 
 import pytest
 
-from workbench.control.commands import MoveAtPower, TurnByDegrees, WheelPowers
+from workbench.sim.commands import MoveAtPower, TurnByDegrees, WheelPowers
+from workbench.sim.driver import Driver
 from workbench.sim.mazefile import parse_maze
 from workbench.sim.metrics import TurnCounter
 from workbench.sim.record import FORMAT, Recorder, RecordError, read_record
@@ -17,7 +18,7 @@ ROOM = parse_maze("#######\n#.....#\n#..S..#\n#.....#\n#######\n", source="room.
 
 def test_driving_to_the_exit_gives_the_course_metrics():
     session = Session(CORRIDOR, "erobotic", noise="off")
-    session.command(MoveAtPower(1.0), driver="keyboard")
+    session.command(MoveAtPower(1.0), driver=Driver.program("a script"))
     metrics = session.run(max_time=30)
     assert metrics.reached_exit
     # the exit block's edge is 6.5 blocks from the start block's centre
@@ -26,7 +27,7 @@ def test_driving_to_the_exit_gives_the_course_metrics():
     assert metrics.turns == 0 and metrics.collisions == 0
     assert metrics.efficiency == pytest.approx(1.0, abs=0.01)
     assert metrics.exit_time == metrics.sim_time
-    assert session.snapshot().driver == "keyboard"
+    assert session.snapshot().driver == Driver.program("a script")
 
 
 def test_run_without_exits_goes_to_the_time_limit():
@@ -62,7 +63,7 @@ def test_snapshot_has_readings_by_port():
     snap = session.snapshot()
     assert set(snap.readings) == {1, 2, 3}
     assert snap.block == (3, 2)
-    assert snap.state is None and snap.driver == "nobody"
+    assert snap.state is None and str(snap.driver) == "nobody"
 
 
 def test_reset_returns_to_the_start_and_clears_metrics():

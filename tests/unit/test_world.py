@@ -6,7 +6,7 @@ import math
 
 import pytest
 
-from workbench.control.commands import MotorPower, MoveAtPower, Stop, TurnByDegrees, WheelPowers
+from workbench.sim.commands import MotorPower, MoveAtPower, Stop, TurnByDegrees, WheelPowers
 from workbench.sim.maze import Maze
 from workbench.sim.noise import NoiseSettings, noise_settings
 from workbench.sim.profiles import PROFILES, get_profile

@@ -8,6 +8,7 @@ import sys
 from collections.abc import Sequence
 
 from workbench import __version__
+from workbench.files.bundled import default_maze_path
 from workbench.labs.store import StoreError, resolve_db
 
 from . import algorithms as algorithms_cmd
@@ -21,7 +22,7 @@ from . import ssh as ssh_cmd
 from . import store as store_cmd
 from . import viple_client as viple_client_cmd
 from . import viple_program as viple_program_cmd
-from .common import db_option, default_maze_path, error, new_runs_dir, runs_home
+from .common import db_option, error, new_runs_dir, runs_home
 
 
 def build_parser() -> argparse.ArgumentParser:

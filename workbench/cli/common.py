@@ -8,14 +8,6 @@ import sys
 import time
 from pathlib import Path
 
-import workbench
-
-MAZE_DIR = Path(workbench.__file__).resolve().parent.parent / "mazes"
-
-
-def default_maze_path() -> Path:
-    return MAZE_DIR / "unity-default.txt"
-
 
 def runs_home() -> Path:
     """Where the app keeps run records: $XDG_DATA_HOME/viple-workbench/runs."""

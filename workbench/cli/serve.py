@@ -17,7 +17,9 @@ import sys
 from dataclasses import dataclass, field
 from typing import Any
 
+from workbench.files.bundled import default_maze_path
 from workbench.sim.clock import Pacer
+from workbench.sim.driver import Driver
 from workbench.sim.maze import MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.noise import noise_settings
@@ -38,8 +40,6 @@ from workbench.viple.link import (
 )
 from workbench.viple.tcp_server import DEFAULT_PORT, EndpointError, TcpConfig, TcpServer
 from workbench.viple.ws_client import WsClient, WsConfig
-
-from .common import default_maze_path
 
 #: how often the simulation is advanced on the event loop, and the status line's period
 TICK_HZ = 60.0
@@ -273,6 +273,7 @@ async def serve(the_plan: ServePlan, stop: asyncio.Event | None = None) -> int:
     endpoints = [e for e in (tcp, ws) if e is not None]
     session.record_header(
         driver="VIPLE",
+        driven_by=Driver.viple().as_json(),
         endpoints=[_endpoint_json(e.status) for e in endpoints],
         report_ms=(the_plan.tcp or the_plan.ws).report_ms,
         **the_plan.fields,

@@ -13,8 +13,17 @@ from pathlib import Path
 
 from workbench.labs.database import ENV_DB
 from workbench.labs.store import Store, StoreError, StoreUnavailable, resolve_data_dir, resolve_db
+from workbench.ssh.appproc import AppEntry
 
 from .common import db_option
+
+#: the app every SSH session runs: this Python's ``-m workbench``, or forked from the fork
+#: server as :func:`workbench.cli.main` with the app's modules imported beforehand
+WORKBENCH_APP = AppEntry(
+    command=(sys.executable, "-m", "workbench"),
+    main="workbench.cli:main",
+    preload=("workbench.cli", "workbench.tui.app"),
+)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -261,6 +270,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
         limits=SessionLimits(args.max_per_user, args.max_sessions, args.idle_timeout),
         logins=logins,
         fork_server=not args.no_fork_server,
+        app=WORKBENCH_APP,
     )
     try:
         log_path = setup_logging(data_dir)

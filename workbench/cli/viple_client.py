@@ -7,7 +7,7 @@ import asyncio
 import json
 import sys
 
-from workbench.control.commands import Command
+from workbench.sim.commands import Command
 from workbench.sim.profiles import PROFILES
 from workbench.sim.record import command_json
 from workbench.viple.client import (

@@ -14,6 +14,8 @@ from typing import Any
 
 from workbench.files.workspace import LOCAL, FileAccess
 from workbench.sim.clock import Pacer
+from workbench.sim.commands import Command, Stop, motion_of
+from workbench.sim.driver import KEYS, Driver
 from workbench.sim.maze import Maze
 from workbench.sim.metrics import Metrics
 from workbench.sim.noise import NoiseSettings
@@ -30,7 +32,6 @@ from workbench.sim.sensors import (
 from workbench.sim.session import Session, Snapshot
 
 from .algorithms import load_algorithm
-from .commands import Command, Stop, motion_of
 from .fsm import FsmController, FsmDefinition, FsmRuntimeError, bind_sensors, preset_sensors
 from .fsmfile import parse_param_overrides
 from .manual import exact_move, key_command
@@ -41,9 +42,6 @@ PRESETS: dict[str, tuple[SensorSpec, ...]] = {
     "web-wall-following": (SensorSpec("distance", 1, "right"), SensorSpec("touch", 2, "front")),
     "web-two-distance": (SensorSpec("distance", 3, "front"),),
 }
-KEYS_DRIVER = "keys"
-#: how a session names a connected VIPLE program as its driver: "VIPLE ROLE PEER"
-VIPLE_PREFIX = "VIPLE "
 #: the rows the Web Simulator's sensor panel always offers: two distance sensors and one touch
 PANEL_KINDS = ("distance", "distance", "touch")
 
@@ -62,7 +60,7 @@ class RunEntry:
     """A finished (or abandoned) run, for comparing algorithms side by side."""
 
     number: int
-    driver: str
+    driver: Driver
     maze: str
     profile: str
     seed: int
@@ -146,7 +144,7 @@ class Bench:
     #: every VIPLE program seen driving this bench, oldest first
     viple: list[VipleConnection] = field(default_factory=list)
     _run_open: bool = False
-    _run_driver: str = KEYS_DRIVER
+    _run_driver: Driver = KEYS
     _run_source: str | None = None
     _viple_now: VipleConnection | None = None
     _odometry_seen: tuple[float, float] = (0.0, 0.0)
@@ -178,7 +176,7 @@ class Bench:
             self.pacer.paused = old.paused
             self.pacer.speed = old.speed
             self.pacer.budget = old.budget
-        self.session.driver = KEYS_DRIVER
+        self.session.driver = KEYS
         self.session.on_command = self._commanded
 
     # -- time ----------------------------------------------------------------------------
@@ -227,12 +225,12 @@ class Bench:
             last = (0.0, 0.0)
         self._odometry_seen = seen
         driver = self.session.driver
-        if not driver.startswith(VIPLE_PREFIX):
+        if not driver.is_viple:
             self._viple_now = None
-            if self._run_open and self._run_driver.startswith(VIPLE_PREFIX):
+            if self._run_open and self._run_driver.is_viple:
                 self._close_run("stopped")
             return
-        role, _, peer = driver[len(VIPLE_PREFIX) :].partition(" ")
+        role, peer = driver.role, driver.peer
         now = self._viple_now
         if now is None or (now.role, now.peer) != (role, peer):  # another program took over
             self._viple_now = VipleConnection(role, peer)
@@ -257,9 +255,9 @@ class Bench:
             self._viple_now = VipleConnection(self._viple_now.role, self._viple_now.peer)
             self.viple.append(self._viple_now)
 
-    def _commanded(self, cmd: Command, driver: str) -> None:
+    def _commanded(self, cmd: Command, driver: Driver) -> None:
         """A VIPLE program's command: remember the motion it asked for (its drive keys)."""
-        if not driver.startswith(VIPLE_PREFIX):
+        if not driver.is_viple:
             return
         self._watch_viple()  # the connection that sent it is the current one
         motion = motion_of(cmd)
@@ -290,12 +288,12 @@ class Bench:
         self._go_on_after_exit()
         if self.controller is not None:
             self.stop_algorithm("stopped")
-        if self._run_open and self._run_driver != KEYS_DRIVER:
+        if self._run_open and self._run_driver != KEYS:
             self._close_run("stopped")  # the keys take the robot from a VIPLE program
         if not self._run_open and not self.session.reached_exit:
-            self._open_run(KEYS_DRIVER)  # a run starts at the robot's last reset
+            self._open_run(KEYS)  # a run starts at the robot's last reset
         self.keys_used.add(key)
-        self.session.command(cmd, driver=KEYS_DRIVER)
+        self.session.command(cmd, driver=KEYS)
         if exact_move(self.profile, key):
             profile = get_profile(self.profile)
             self.session.command_after(self.session.world.cell / profile.move_speed, Stop())
@@ -402,7 +400,7 @@ class Bench:
         self._go_on_after_exit()
         self.session.reset()
         self.controller = controller
-        self.session.attach(controller, binding, f"algorithm {self.algorithm.name}")
+        self.session.attach(controller, binding, Driver.algorithm(self.algorithm.name))
         self._open_run(self.session.driver)
         self.pacer.paused = False
         self.message = ""
@@ -411,7 +409,7 @@ class Bench:
         if self.controller is None:
             return
         self.session.command(Stop())
-        self.session.detach(KEYS_DRIVER)
+        self.session.detach(KEYS)
         self.controller = None
         if self._run_open:
             self._close_run(ended)
@@ -425,7 +423,7 @@ class Bench:
         if self.controller is not None:
             self.stop_algorithm("reset")
         self.session.reset()
-        self.session.driver = KEYS_DRIVER
+        self.session.driver = KEYS
         self.message = ""
 
     def load_maze(self, maze: Maze) -> None:
@@ -438,7 +436,7 @@ class Bench:
         self._build_session()
 
     # -- runs ----------------------------------------------------------------------------
-    def _open_run(self, driver: str) -> None:
+    def _open_run(self, driver: Driver) -> None:
         self._run_open = True
         self._run_driver = driver
         self._run_source = self.algorithm.source if self.controller and self.algorithm else None
@@ -449,7 +447,8 @@ class Bench:
             self._record_path = path
             self.session.recorder = self._recorder
             self.session.record_header(
-                algorithm=self.algorithm.name if self.controller else driver,
+                algorithm=self.algorithm.name if self.controller else str(driver),
+                driven_by=driver.as_json(),
                 params=self.params() if self.controller else {},
             )
 

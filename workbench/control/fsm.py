@@ -13,14 +13,6 @@ from collections import deque
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 
-from workbench.control.commands import (
-    Command,
-    MotorPower,
-    MoveAtPower,
-    Stop,
-    TurnByDegrees,
-    WheelPowers,
-)
 from workbench.control.expr import Expr, Fn, Value, compile_expr
 from workbench.control.fsmdef import (
     EVENTS,
@@ -51,6 +43,14 @@ from workbench.control.fsmdef import (
     check_definition,
     preset_sensors,
     resolve_params,
+)
+from workbench.sim.commands import (
+    Command,
+    MotorPower,
+    MoveAtPower,
+    Stop,
+    TurnByDegrees,
+    WheelPowers,
 )
 
 __all__ = [

@@ -6,6 +6,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from workbench.sim.driver import Driver
 from workbench.sim.maze import Maze, MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.noise import noise_settings
@@ -133,14 +134,19 @@ def prepare(spec: RunSpec) -> tuple[Session, FsmController, dict[str, float], fl
         raise RunSetupError(str(exc)) from None
     except OSError as exc:
         raise RunSetupError(f"{exc.filename}: cannot write the record: {exc.strerror}") from None
-    session.attach(controller, binding, f"algorithm {definition.name}")
+    session.attach(controller, binding, Driver.algorithm(definition.name))
     max_time = spec.max_time or default_max_time(maze, profile, session.world.cell)
     return session, controller, controller.params, max_time
 
 
 def run(spec: RunSpec) -> RunResult:
     session, controller, params, max_time = prepare(spec)
-    session.record_header(algorithm=controller.definition.name, params=params, max_time=max_time)
+    session.record_header(
+        algorithm=controller.definition.name,
+        driven_by=session.driver.as_json(),
+        params=params,
+        max_time=max_time,
+    )
     try:
         metrics = session.run(max_time)
         cut = bool(session.maze.exits) and not metrics.reached_exit

@@ -11,7 +11,7 @@
 
 from __future__ import annotations
 
-from .commands import Command, MoveAtPower, Stop, TurnByDegrees, WheelPowers
+from workbench.sim.commands import Command, MoveAtPower, Stop, TurnByDegrees, WheelPowers
 
 KEYS = ("w", "a", "s", "d", "space")
 KEY_NAMES = {

@@ -16,10 +16,12 @@ from pathlib import Path
 
 import workbench
 
+from .bundled import MAZE_DIR
+
 _PACKAGE = Path(workbench.__file__).resolve().parent
 #: the bundled mazes, labs and starter algorithms: readable by everyone, written by nobody
 BUNDLED = (
-    _PACKAGE.parent / "mazes",
+    MAZE_DIR,
     _PACKAGE.parent / "labs",
     _PACKAGE / "control" / "algorithms",
 )

@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from workbench.control.algorithms import ALGORITHM_DIR
-from workbench.control.bench import VIPLE_PREFIX, Bench, RunEntry
+from workbench.control.bench import Bench, RunEntry
 from workbench.control.manual import KEY_NAMES
 from workbench.sim.profiles import get_profile
 from workbench.sim.record import file_sha256
@@ -131,7 +131,7 @@ def record_digest(path: str | None) -> str | None:
 def run_evidence(run: RunEntry) -> dict[str, Any]:
     return {
         "run": run.number,
-        "driver": run.driver,
+        "driver": str(run.driver),
         "maze": run.maze,
         "maze_digest": run.maze_digest,
         "profile": run.profile,
@@ -145,11 +145,11 @@ def run_evidence(run: RunEntry) -> dict[str, Any]:
 def driver_kinds(run: RunEntry) -> set[str]:
     """What kinds of driver an ``exit`` objective would see in ``run``."""
     kinds = {"any"}
-    if run.driver.startswith(VIPLE_PREFIX):
+    if run.driver.kind == "viple":
         kinds.add("viple")
-    elif run.driver.startswith("algorithm ") and run.source:
+    elif run.driver.kind == "algorithm" and run.source:
         if Path(run.source).resolve().parent == ALGORITHM_DIR:
-            kinds.add(f"algorithm {run.driver.removeprefix('algorithm ')}")
+            kinds.add(f"algorithm {run.driver.name}")
         else:
             kinds.add("fsm")
     return kinds

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 from heapq import heappop, heappush
 from typing import Any
 
-from workbench.control.commands import MotorPower, MoveAtPower, TurnByDegrees, WheelPowers
+from workbench.sim.commands import MotorPower, MoveAtPower, TurnByDegrees, WheelPowers
 
 from . import kinds as K
 from .code import first_sensor_value

@@ -18,7 +18,9 @@ from typing import IO, Any
 import pymunk
 
 import workbench
-from workbench.control.commands import MotorPower, MoveAtPower, Stop, TurnByDegrees, WheelPowers
+
+from .commands import MotorPower, MoveAtPower, Stop, TurnByDegrees, WheelPowers
+from .driver import KEYS, NOBODY, Driver
 
 FORMAT = "workbench-run/1"
 FLUSH_EVERY = 20
@@ -169,3 +171,27 @@ def read_record(path: str | os.PathLike) -> RunRecord:
     if record is None:
         raise RecordError(f"{path}: empty file, not a run record")
     return record
+
+
+def recorded_driver(header: dict[str, Any]) -> Driver:
+    """Who drove the recorded run.
+
+    A record holds its driver as ``"driven_by": {"kind": ...}``, beside the text older readers
+    take: ``"algorithm"`` is an algorithm's name, ``keys`` or ``VIPLE ROLE PEER``, and a record
+    served headless says ``"driver": "VIPLE"``. Records written before ``driven_by`` hold only
+    that text; this is the one place it is read.
+    """
+    driver = Driver.from_json(header.get("driven_by"))
+    if driver is not None:
+        return driver
+    if header.get("driver") == "VIPLE":
+        return Driver.viple()
+    text = header.get("algorithm")
+    if not isinstance(text, str) or not text or text == "keys":
+        return KEYS
+    if text == "nobody":
+        return NOBODY
+    if text == "VIPLE" or text.startswith("VIPLE "):
+        role, _, peer = text.removeprefix("VIPLE").strip().partition(" ")
+        return Driver.viple(role, peer)
+    return Driver.algorithm(text)

@@ -22,7 +22,7 @@ from workbench.files.workspace import LOCAL, FileAccess, OutsideWorkspace
 from .maze import Maze, MazeError
 from .mazeio import load_maze
 from .metrics import Metrics, TurnCounter, efficiency
-from .record import RecordError, RunRecord, iter_lines, read_record
+from .record import RecordError, RunRecord, iter_lines, read_record, recorded_driver
 from .sensors import SensorConfigError, SensorSpec
 from .session import Snapshot
 from .world import Pose
@@ -203,6 +203,8 @@ class Replay:
             previous = tick["t"]
         self.record = record
         self.sensors = _header_sensors(record.header)
+        #: who drove the run
+        self.driver = recorded_driver(record.header)
         self.times = [float(t["t"]) for t in record.ticks]
         self.poses = [Pose(*(float(v) for v in t["pose"])) for t in record.ticks]
         self._log = _changes(record.ticks)
@@ -247,8 +249,7 @@ class Replay:
     def title(self) -> str:
         maze = self.header.get("maze")
         name = maze.get("name") if isinstance(maze, dict) else None
-        algorithm = self.header.get("algorithm") or "keys"
-        return f"{algorithm} on {name or 'an unnamed maze'}"
+        return f"{self.driver.short} on {name or 'an unnamed maze'}"
 
     def frame(self, index: int | None = None) -> Frame:
         i = self.index if index is None else index
@@ -282,7 +283,7 @@ class Replay:
             block=f.block(self.cell),
             readings=dict(f.sensors),
             sensors=self.sensors,
-            driver=str(self.header.get("algorithm") or "keys"),
+            driver=self.driver,
             state=f.state,
             variables=f.variables,
             metrics=self.metrics(f.index),

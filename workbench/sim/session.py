@@ -13,6 +13,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
+from .driver import NOBODY, Driver
 from .maze import Maze
 from .metrics import Metrics, TurnCounter, efficiency
 from .noise import NoiseSettings
@@ -43,7 +44,7 @@ class Snapshot:
     block: tuple[int, int]
     readings: dict[int, float | int]
     sensors: tuple[SensorSpec, ...]
-    driver: str
+    driver: Driver
     state: str | None
     variables: dict[str, Any]
     metrics: Metrics
@@ -71,9 +72,9 @@ class Session:
         self.shortest_blocks = maze.shortest_path_length()
         self.controller: Controller | None = None
         self.binding: dict[str, int] = {}
-        self.driver = "nobody"
+        self.driver = NOBODY
         #: told of every command from outside the controller, with the driver that sent it
-        self.on_command: Callable[[Any, str], None] | None = None
+        self.on_command: Callable[[Any, Driver], None] | None = None
         self._reset_run_state()
 
     def _reset_run_state(self) -> None:
@@ -89,19 +90,19 @@ class Session:
         self.last_events: tuple[str, ...] = ()
 
     # -- who drives ---------------------------------------------------------------------
-    def attach(self, controller: Controller, binding: dict[str, int], driver: str) -> None:
+    def attach(self, controller: Controller, binding: dict[str, int], driver: Driver) -> None:
         """Let ``controller`` drive; ``binding`` maps its sensor names to ports."""
         self.controller = controller
         self.binding = dict(binding)
         self.driver = driver
         self._started = False
 
-    def detach(self, driver: str = "nobody") -> None:
+    def detach(self, driver: Driver = NOBODY) -> None:
         self.controller = None
         self.binding = {}
         self.driver = driver
 
-    def command(self, cmd: Any, driver: str | None = None) -> None:
+    def command(self, cmd: Any, driver: Driver | None = None) -> None:
         """A command from outside the controller (a key, a VIPLE message).
 
         It cancels a command still waiting from :meth:`command_after`.

@@ -27,7 +27,7 @@ from typing import NamedTuple
 import pymunk
 from pymunk._chipmunk import lib as _cp
 
-from ..control.commands import (
+from .commands import (
     Command,
     MotorPower,
     MoveAtPower,

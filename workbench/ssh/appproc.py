@@ -15,7 +15,6 @@ import json
 import logging
 import os
 import signal
-import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -40,6 +39,19 @@ READ_SIZE = 65536
 
 
 @dataclass(frozen=True)
+class AppEntry:
+    """How the lab server starts a session's app, handed down by the command that starts the
+    server (the server itself knows no app)."""
+
+    #: the command that starts the app as a new process; the app's options follow it
+    command: tuple[str, ...]
+    #: the same app as a function for the fork server: ``module:function`` taking the options
+    main: str
+    #: modules the fork server imports before it forks (the app's own)
+    preload: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
 class AppSpec:
     """What one session's app is started with."""
 
@@ -56,8 +68,8 @@ class AppSpec:
     height: int = 24
     term: str = "xterm-256color"
 
-    def argv(self, command: tuple[str, ...] | None = None) -> list[str]:
-        return [*(command or (sys.executable, "-m", "workbench")), *self.options()]
+    def argv(self, command: tuple[str, ...]) -> list[str]:
+        return [*command, *self.options()]
 
     def options(self) -> list[str]:
         """The app's options (its command line without the command)."""

@@ -4,16 +4,18 @@ a fresh ``python -m workbench`` takes.
 
 Two halves live here:
 
-- the fork server process (``python -m workbench.ssh.forkserver FD``): started by the lab
-  server with the apps' environment, it imports the app's modules (the :data:`PRELOAD` list and
-  every module of the workbench packages the app uses), freezes them out of the garbage
-  collector's reach (so the pages stay shared with the children) and waits on a Unix socket.
+- the fork server process (``python -m workbench.ssh.forkserver FD MAIN [MODULE...]``): started
+  by the lab server with the apps' environment and the app's entry point (``MAIN``, as
+  ``module:function``, handed down by whoever starts the lab server), it imports the modules it
+  is given, the :data:`PRELOAD` list and every module of the workbench packages the app uses,
+  freezes them out of the garbage collector's reach (so the pages stay shared with the
+  children) and waits on a Unix socket.
   Each request carries the app's options and environment and two file descriptors (SCM_RIGHTS):
   the socket that becomes the app's standard input and output, and its error log. It forks; the
   child starts a new session (its own process group), puts the descriptors on 0, 1 and 2, sets
-  the environment and runs :func:`workbench.cli.main`, ending with the interpreter's ordinary
-  exit. The fork server answers with the child's pid, reaps children as they end and reports
-  each one's exit status.
+  the environment and runs the entry point with the app's options, ending with the
+  interpreter's ordinary exit. The fork server answers with the child's pid, reaps children
+  as they end and reports each one's exit status.
 - :class:`ForkServer`, the lab server's side: starts that process, sends requests and turns the
   answers into :class:`ForkedApp` objects that look like an ``asyncio.subprocess.Process``
   (``pid``, ``returncode``, ``stdin``, ``stdout``, ``wait()``).
@@ -45,7 +47,7 @@ from pathlib import Path
 log = logging.getLogger("workbench.ssh")
 
 #: modules the app imports, loaded once in the fork server
-PRELOAD = ("workbench.cli", "workbench.tui.app", "textual.drivers.web_driver")
+PRELOAD = ("textual.drivers.web_driver",)
 #: packages whose every module is loaded too (the app imports many of them only when used)
 PRELOAD_PACKAGES = (
     "workbench.sim",
@@ -73,9 +75,20 @@ def _send(control: socket.socket, message: dict) -> None:
         control.send(json.dumps(message).encode())
 
 
-def preload() -> int:
+def entry_point(main: str) -> Callable[[list[str]], int]:
+    """The function named ``module:function``; ValueError when it is not one."""
+    module, _, function = main.partition(":")
+    if not module or not function:
+        raise ValueError(f"the app's entry point must read module:function, not {main!r}")
+    entry = vars(importlib.import_module(module)).get(function)
+    if not callable(entry):
+        raise ValueError(f"{main}: {module} has no function {function!r}")
+    return entry
+
+
+def preload(modules: tuple[str, ...] = ()) -> int:
     """Import what the app will import; the number of modules loaded in all."""
-    for name in PRELOAD:
+    for name in (*modules, *PRELOAD):
         importlib.import_module(name)
     for package in PRELOAD_PACKAGES:
         path = importlib.import_module(package).__path__
@@ -92,8 +105,9 @@ def preload() -> int:
 class _Zygote:
     """The fork server's loop: fork on request, reap and report the children's ends."""
 
-    def __init__(self, control: socket.socket) -> None:
+    def __init__(self, control: socket.socket, main: Callable[[list[str]], int]) -> None:
         self.control = control
+        self.main = main
 
     def serve(self) -> Callable[[], int] | None:
         """Serve until the lab server goes (``None``); in a forked child, return its app."""
@@ -151,7 +165,7 @@ class _Zygote:
             os.setsid()  # its own session and process group, before the server learns its pid
             os.close(ready_r)
             os.close(ready_w)
-            return lambda: _run_app(options, env, fds, request.get("cwd"))
+            return lambda: _run_app(self.main, options, env, fds, request.get("cwd"))
         for fd in (*fds, ready_w):
             os.close(fd)
         with contextlib.suppress(OSError):
@@ -171,7 +185,13 @@ class _Zygote:
             _send(self.control, {"exit": pid, "code": os.waitstatus_to_exitcode(status)})
 
 
-def _run_app(options: list[str], env: dict[str, str], fds: list[int], cwd: str | None) -> int:
+def _run_app(
+    main: Callable[[list[str]], int],
+    options: list[str],
+    env: dict[str, str],
+    fds: list[int],
+    cwd: str | None,
+) -> int:
     """In the forked child: become the session's app."""
     io, errors = fds
     os.dup2(io, 0)
@@ -187,8 +207,6 @@ def _run_app(options: list[str], env: dict[str, str], fds: list[int], cwd: str |
         with contextlib.suppress(OSError):
             os.chdir(cwd)
     sys.argv = ["workbench", *options]
-    from workbench.cli import main
-
     return main(options)
 
 
@@ -200,7 +218,8 @@ def serve_main(argv: list[str] | None = None) -> int:
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the lab server decides when this ends
     started = time.perf_counter()
     try:
-        modules = preload()
+        main = entry_point(args[1])
+        modules = preload(tuple(args[2:]))
     except Exception as exc:
         _send(control, {"failed": f"{type(exc).__name__}: {exc}"})
         return 1
@@ -210,7 +229,7 @@ def serve_main(argv: list[str] | None = None) -> int:
     gc.collect()
     gc.freeze()  # the children leave the preloaded objects alone, so their pages stay shared
     _send(control, {"ready": modules, "seconds": round(time.perf_counter() - started, 3)})
-    app = _Zygote(control).serve()
+    app = _Zygote(control, main).serve()
     if app is None:
         return 0
     return app()
@@ -253,8 +272,19 @@ class ForkedApp:
 class ForkServer:
     """Starts the fork server process and asks it for apps."""
 
-    def __init__(self, env: dict[str, str], *, start_timeout: float = 60.0) -> None:
+    def __init__(
+        self,
+        env: dict[str, str],
+        main: str,
+        preload: tuple[str, ...] = (),
+        *,
+        start_timeout: float = 60.0,
+    ) -> None:
         self.env = env
+        #: the app's entry point, ``module:function`` taking the app's options
+        self.main = main
+        #: modules the fork server imports before it forks (the app's own)
+        self.preload = preload
         self.start_timeout = start_timeout
         self.process: asyncio.subprocess.Process | None = None
         self.modules = 0
@@ -281,6 +311,7 @@ class ForkServer:
         try:
             self.process = await asyncio.create_subprocess_exec(
                 sys.executable, "-m", "workbench.ssh.forkserver", str(theirs.fileno()),
+                self.main, *self.preload,
                 pass_fds=[theirs.fileno()], stdin=asyncio.subprocess.DEVNULL,
                 stdout=asyncio.subprocess.DEVNULL, env=self.env, start_new_session=True,
             )  # fmt: skip

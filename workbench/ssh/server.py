@@ -19,7 +19,7 @@ import asyncssh
 
 from workbench.files.workspace import workspace_folder
 
-from .appproc import RESTORE_TERMINAL, AppProcess, AppSpec, app_env, forward_hint
+from .appproc import RESTORE_TERMINAL, AppEntry, AppProcess, AppSpec, app_env, forward_hint
 from .forkserver import ForkServer, ForkServerError
 from .forwarding import local_forward_refusal, remote_forward_refusal
 from .hostkey import host_key_path, load_or_create_host_key
@@ -51,7 +51,7 @@ class ServerConfig:
     port_range: tuple[int, int] = (41000, 41999)
     public_host: str = ""
     limits: SessionLimits = field(default_factory=SessionLimits)
-    #: the app's command before its options (default: this Python's ``-m workbench``)
+    #: the app's command before its options, instead of the entry's (no fork server then)
     app_command: tuple[str, ...] | None = None
     #: fork each app from a fork server that has the app imported (not with ``app_command``)
     fork_server: bool = True
@@ -59,6 +59,8 @@ class ServerConfig:
     stop_grace: float = 2.0
     logins: LoginPolicy = field(default_factory=LoginPolicy)
     keepalive_interval: float = 30.0
+    #: the app each session runs
+    app: AppEntry = field(kw_only=True)
 
     def __post_init__(self) -> None:
         self.data_dir = Path(self.data_dir)
@@ -166,7 +168,7 @@ class LabServer:
             why = "--no-fork-server" if not config.fork_server else "an app command is set"
             log.info("apps start as new processes (%s)", why)
             return
-        forkserver = ForkServer(app_env())
+        forkserver = ForkServer(app_env(), config.app.main, config.app.preload)
         try:
             await forkserver.start()
         except ForkServerError as exc:
@@ -619,7 +621,7 @@ class LabSession(asyncssh.SSHServerSession):
         )
         log_path = config.data_dir / "logs" / user / f"{stamp}-{self.id}.log"
         self.app = AppProcess(
-            self.spec.argv(config.app_command),
+            self.spec.argv(config.app_command or config.app.command),
             self.spec.env(),
             log_path,
             self._output,

@@ -16,12 +16,12 @@ from time import perf_counter
 from typing import ClassVar
 
 from textual import events
-from textual.app import App
 from textual.binding import Binding, BindingType
 from textual.reactive import var
 from textual.screen import Screen
 
 from workbench.control.bench import Bench
+from workbench.files.bundled import default_maze_path
 from workbench.files.workspace import LOCAL, FileAccess
 from workbench.labs.model import Setup
 from workbench.labs.names import NameProblem, check_pair
@@ -36,6 +36,15 @@ from workbench.viple.tcp_server import TcpConfig
 from workbench.viple.ws_client import WsConfig
 
 from .commands import WorkbenchCommands
+from .host import (
+    BenchChanged,
+    MazeChanged,
+    OpenScreen,
+    ScreenHost,
+    SetUpDone,
+    ShowsSnapshot,
+    StartEndpoint,
+)
 from .modals.help import HelpScreen
 from .modals.too_small import TooSmallScreen
 from .screens.editor import EditorScreen
@@ -61,12 +70,12 @@ class AppSetupError(ValueError):
     """The app cannot start with these arguments; the message says what to change."""
 
 
-class WorkbenchApp(App[None]):
+class WorkbenchApp(ScreenHost[None]):
     """VIPLE Maze Lab Workbench."""
 
     CSS_PATH = "app.tcss"
     TITLE = "VIPLE Maze Lab Workbench"
-    COMMANDS = App.COMMANDS | {WorkbenchCommands}
+    COMMANDS = ScreenHost.COMMANDS | {WorkbenchCommands}
     HORIZONTAL_BREAKPOINTS: ClassVar[list[tuple[int, str]]] = [(0, "-narrow"), (110, "-wide")]
     BINDINGS: ClassVar[list[BindingType]] = [
         Binding("ctrl+q", "quit", "Quit", priority=True, id="app.quit"),
@@ -77,8 +86,6 @@ class WorkbenchApp(App[None]):
         *FOCUS_BINDINGS,
     ]
 
-    #: draw the maze with Unicode lines and arrows (False: plain ASCII)
-    unicode: var[bool] = var(False, init=False)
     #: frames drawn so far (per-tick state: no repaint)
     frames: var[int] = var(0)
 
@@ -128,6 +135,7 @@ class WorkbenchApp(App[None]):
         self._last_tick = perf_counter()
         self._drawn: tuple[object, ...] = ()
         self._too_small: TooSmallScreen | None = None
+        self._main: MainScreen | None = None
 
     def who(self) -> str:
         """Who is at the robot, for the message line ("" when nobody was named)."""
@@ -137,7 +145,10 @@ class WorkbenchApp(App[None]):
         return f"{names} ({self.role})"
 
     def get_default_screen(self) -> Screen:
-        return MainScreen(self.bench, unicode=self.unicode)
+        self._main = MainScreen(
+            self.bench, unicode=self.unicode, who=self.who(), maze_path=self.maze_path
+        )
+        return self._main
 
     async def on_mount(self) -> None:
         tcp, ws = self._viple_configs
@@ -145,7 +156,7 @@ class WorkbenchApp(App[None]):
             ws = None  # later: a WebSocket exercise's set-up or the v key starts it
         if tcp is not None or ws is not None:
             self.endpoints = await Endpoints.open(self.bench.session, tcp, ws)
-        self.set_class(not self.unicode, "-ascii")
+        self.mark_ascii()
         self._show_maze_title()
         self._last_tick = perf_counter()
         self.set_interval(1.0 / self.tick_hz, self._tick, name="simulation")
@@ -195,9 +206,8 @@ class WorkbenchApp(App[None]):
         self._drawn = (bench.pacer.paused, bench.message, bench.controller, len(bench.runs))
         snapshot = bench.snapshot()
         for screen in self.screen_stack:
-            show = getattr(screen, "show_snapshot", None)
-            if show is not None:
-                show(snapshot)
+            if isinstance(screen, ShowsSnapshot):
+                screen.show_snapshot(snapshot)
         labs = self._labs
         if labs is not None and labs not in self.screen_stack:
             labs.track()  # the exercise's progress is saved while the student drives
@@ -223,18 +233,31 @@ class WorkbenchApp(App[None]):
         """While the terminal is too small only quitting works."""
         return self._too_small is None or action == "quit"
 
-    # -- view settings -------------------------------------------------------------------------
-    def watch_unicode(self, unicode: bool) -> None:
-        self.set_class(not unicode, "-ascii")
-        for screen in self.screen_stack:
-            setter = getattr(screen, "set_unicode", None)
-            if setter is not None:
-                setter(unicode)
+    # -- what screens ask for -------------------------------------------------------------------
+    def on_bench_changed(self, message: BenchChanged) -> None:
+        self.refresh_views()
+
+    def on_maze_changed(self, message: MazeChanged) -> None:
+        self.maze_changed(message.path)
+
+    def on_set_up_done(self, message: SetUpDone) -> None:
+        self.set_up_done(message.setup)
+
+    def on_open_screen(self, message: OpenScreen) -> None:
+        if message.screen == "editor":
+            self.open_editor()
+        elif message.screen == "runs":
+            self.open_runs()
+        else:
+            self.open_labs()
+
+    def on_start_endpoint(self, message: StartEndpoint) -> None:
+        self.run_worker(self.open_endpoint(message.role), group="endpoints")
 
     # -- screens -------------------------------------------------------------------------------
     def action_help(self) -> None:
         if not isinstance(self.screen, HelpScreen):
-            self.push_screen(HelpScreen(self.bench.profile))
+            self.push_screen(HelpScreen(self.bench.profile, self.connect_hint))
 
     def open_editor(self) -> None:
         # the bundled mazes (and the labs' set-up mazes) are never overwritten, nor is a file
@@ -253,6 +276,8 @@ class WorkbenchApp(App[None]):
         (the editor saves there unless it is a bundled maze)."""
         if path is not None:
             self.maze_path = Path(path)
+            if self._main is not None:
+                self._main.maze_path = self.maze_path
         self._show_maze_title()
         self.refresh_views()
 
@@ -382,8 +407,6 @@ def make_app(
     an argument is not one the workbench knows.
     """
     if maze_path is None:
-        from workbench.cli.common import default_maze_path
-
         maze_path = default_maze_path()
     path = Path(maze_path)
     if profile is not None and profile not in PROFILES:

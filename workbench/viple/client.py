@@ -41,7 +41,6 @@ from websockets.asyncio.server import ServerConnection, serve
 from websockets.exceptions import ConnectionClosed
 
 from workbench.control.algorithms import load_algorithm
-from workbench.control.commands import Command, Stop, TurnByDegrees
 from workbench.control.fsm import (
     FsmController,
     FsmDefinition,
@@ -52,6 +51,7 @@ from workbench.control.fsm import (
     preset_sensors,
 )
 from workbench.control.fsmfile import FsmFileError, parse_param_overrides
+from workbench.sim.commands import Command, Stop, TurnByDegrees
 from workbench.sim.profiles import Profile, get_profile
 from workbench.sim.sensors import SensorConfigError, SensorSpec, check_ports
 

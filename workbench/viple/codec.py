@@ -32,7 +32,7 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
 
-from workbench.control.commands import (
+from workbench.sim.commands import (
     Command,
     MotorPower,
     MoveAtPower,

@@ -31,7 +31,8 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from typing import Protocol
 
-from workbench.control.commands import Stop
+from workbench.sim.commands import Stop
+from workbench.sim.driver import NOBODY, Driver
 from workbench.sim.session import Session
 
 from .codec import REPORT_KINDS, CodecError, WheelPorts, encode_report, parse_command
@@ -46,8 +47,6 @@ BATCH = 64
 SEND_BUFFER_BYTES = 16384
 #: how long a driver may send nothing and read nothing before it loses the seat, seconds
 IDLE_S_DEFAULT = 30.0
-
-NOBODY = "nobody"
 
 
 class Outbox(Protocol):
@@ -200,7 +199,7 @@ class Link:
         self.idled = 0
         self._line_no = 0
         self._active_at = time.monotonic()
-        self._driver: str | None = None
+        self._driver: Driver | None = None
         self._work = 0
         self._bad_log = RateLimitedLog(self.log)
 
@@ -223,8 +222,8 @@ class Link:
         )
 
     @property
-    def driver(self) -> str | None:
-        """The session's driver name while a program is connected (``VIPLE tcp HOST:PORT``)."""
+    def driver(self) -> Driver | None:
+        """The session's driver while a program is connected (a VIPLE driver with role and peer)."""
         return self._driver
 
     @property
@@ -248,7 +247,7 @@ class Link:
         self.peer = peer
         self.connections += 1
         self._line_no = 0
-        self._driver = f"VIPLE {self.role} {peer}"
+        self._driver = Driver.viple(self.role, peer)
         self._bad_log = RateLimitedLog(self.log)
         self._active_at = time.monotonic()
         self.session.detach(self._driver)
@@ -342,7 +341,7 @@ class Link:
         except CodecError as err:
             self.reject(str(err), line_no)
             return False
-        driver = self._driver or f"VIPLE {self.role}"
+        driver = self._driver or Driver.viple(self.role)
         for cmd in commands:
             self.session.command(cmd, driver=driver)
         if self.log.isEnabledFor(logging.DEBUG):

@@ -25,6 +25,7 @@ from workbench.control.fsmfile import FsmFileError
 from workbench.files.workspace import OutsideWorkspace
 from workbench.sim.session import Snapshot
 
+from ..host import BenchChanged, ShowsSnapshot
 from ..widgets.field import Field
 from ..widgets.param_editor import ParamEditor
 
@@ -39,7 +40,7 @@ def _source(source: str) -> str:
     return source
 
 
-class AlgorithmModal(ModalScreen[None]):
+class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
     """Choose and set up the algorithm that drives the robot."""
 
     DEFAULT_CSS = """
@@ -252,11 +253,8 @@ class AlgorithmModal(ModalScreen[None]):
         self.query_one("#alg-error", Static).update(text)
 
     def _refresh_all(self) -> None:
-        refresh = getattr(self.app, "refresh_views", None)
-        if refresh is not None:
-            refresh()
-        else:
-            self.show_snapshot(self.bench.snapshot())
+        self.show_snapshot(self.bench.snapshot())
+        self.post_message(BenchChanged())
 
     # -- choosing ---------------------------------------------------------------------------------
     async def choose(self, name_or_path: str | Path) -> bool:
@@ -359,7 +357,7 @@ class AlgorithmModal(ModalScreen[None]):
         if action == "close":
             self.dismiss()
         elif action in ("start", "pause", "step", "reset", "fix"):
-            getattr(self, f"action_{action}")()
+            await self.run_action(action)
 
     @on(Button.Pressed, "#alg-defaults")
     async def _defaults(self) -> None:

@@ -95,9 +95,11 @@ class HelpScreen(ModalScreen[None]):
         Binding("escape,question_mark,q", "close", "Close", id="dialog.close"),
     ]
 
-    def __init__(self, profile: str) -> None:
+    def __init__(self, profile: str, connect_hint: str = "") -> None:
         super().__init__()
         self.profile = profile
+        #: how to reach the app's VIPLE endpoints from elsewhere (shown first when set)
+        self.connect_hint = connect_hint
 
     def compose(self) -> ComposeResult:
         from ..screens.editor import EditorScreen
@@ -117,7 +119,7 @@ class HelpScreen(ModalScreen[None]):
                 ("Replay (enter on a run)", ReplayScreen.BINDINGS),
             ]
             keys = [(name, [b for b in found if isinstance(b, Binding)]) for name, found in screens]
-            hint = getattr(app, "connect_hint", "")
+            hint = self.connect_hint
             if hint:
                 yield Static(
                     Text.assemble(("Connect VIPLE", "bold underline"), "\n", hint, "\n"),

@@ -21,6 +21,7 @@ from workbench.sim.profiles import get_profile
 from workbench.sim.sensors import PORT_RANGE
 from workbench.sim.session import Snapshot
 
+from ..host import BenchChanged, ShowsSnapshot
 from ..widgets.sensor_row_editor import SensorRowEditor
 from ..widgets.text import reading
 
@@ -32,7 +33,7 @@ PRESET_LABELS = {
 MAX_ROWS = 8
 
 
-class SensorPortsModal(ModalScreen[None]):
+class SensorPortsModal(ShowsSnapshot, ModalScreen[None]):
     """Edit the robot's sensors; the live robot changes only on Apply or a preset."""
 
     DEFAULT_CSS = """
@@ -189,11 +190,8 @@ class SensorPortsModal(ModalScreen[None]):
         )
 
     def _refresh_all(self) -> None:
-        refresh = getattr(self.app, "refresh_views", None)
-        if refresh is not None:
-            refresh()
-        else:
-            self.show_snapshot(self.bench.snapshot())
+        self.show_snapshot(self.bench.snapshot())
+        self.post_message(BenchChanged())
 
     def action_close(self) -> None:
         self.dismiss()

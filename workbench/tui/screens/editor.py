@@ -24,6 +24,7 @@ from workbench.control.bench import Bench
 from workbench.sim.editing import EditorError, Finding, GenerateOptions, MazeEditor
 from workbench.sim.maze import Maze
 
+from ..host import FollowsUnicode, ToggleUnicode
 from ..widgets.maze_view import MazeView
 from .generate_dialog import GenerateDialog
 from .path_dialog import PathDialog
@@ -51,7 +52,7 @@ def _problem_line(finding: Finding) -> str:
     return f"({finding.cell[0]}, {finding.cell[1]}) {finding.message}"
 
 
-class EditorScreen(Screen[Maze | None]):
+class EditorScreen(FollowsUnicode, Screen[Maze | None]):
     """Edit the bench's maze; dismissed with the maze the robot now runs on, or None."""
 
     AUTO_FOCUS = ""
@@ -210,7 +211,7 @@ class EditorScreen(Screen[Maze | None]):
         self,
         bench: Bench,
         path: str | None = None,
-        unicode: bool | None = None,
+        unicode: bool = False,
         *,
         name: str | None = None,
         id: str | None = None,
@@ -228,8 +229,6 @@ class EditorScreen(Screen[Maze | None]):
 
     # -- layout ----------------------------------------------------------------------------
     def compose(self) -> ComposeResult:
-        if self._unicode is None:
-            self._unicode = bool(getattr(self.app, "unicode", False))
         yield Static(id="editor-title", markup=False)
         with Horizontal(id="editor-body"):
             yield MazeView(
@@ -253,7 +252,7 @@ class EditorScreen(Screen[Maze | None]):
     # -- public ------------------------------------------------------------------------------
     @property
     def unicode(self) -> bool:
-        return bool(self._unicode)
+        return self._unicode
 
     @property
     def dirty(self) -> bool:
@@ -519,8 +518,4 @@ class EditorScreen(Screen[Maze | None]):
             self.app.exit(maze)
 
     def action_unicode(self) -> None:
-        unicode = not self.unicode
-        if hasattr(self.app, "unicode"):
-            self.app.unicode = unicode
-        if self.unicode != unicode:
-            self.set_unicode(unicode)
+        self.post_message(ToggleUnicode())

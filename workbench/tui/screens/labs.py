@@ -28,6 +28,7 @@ from workbench.labs.model import Exercise, Lab, LabFileError, load_labs
 from workbench.labs.store import Store, StoreUnavailable
 from workbench.sim.session import Snapshot
 
+from ..host import SetUpDone, ShowsSnapshot
 from ..widgets.field import Field
 
 PASS, FAIL, OPEN = "✓", "✗", "·"
@@ -38,7 +39,7 @@ UNREACHABLE = "the course database cannot be reached"
 RETRY_SECONDS = 2.0
 
 
-class LabsScreen(Screen[None]):
+class LabsScreen(ShowsSnapshot, Screen[None]):
     """Choose an exercise, set it up, watch its objectives, answer its questions."""
 
     DEFAULT_CSS = """
@@ -407,9 +408,7 @@ class LabsScreen(Screen[None]):
             return
         setup = exercise.setup
         self.say(f"set up: {setup.profile}, {setup.maze.path.name}, {setup.controller}")
-        refresh = getattr(self.app, "set_up_done", None)
-        if refresh is not None:
-            refresh(setup)
+        self.post_message(SetUpDone(setup))
         self.show_snapshot(self.bench.snapshot())
 
     def action_sign_off(self) -> None:

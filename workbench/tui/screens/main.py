@@ -27,6 +27,15 @@ from workbench.sim.sensors import SensorConfigError
 from workbench.sim.session import Snapshot
 
 from ..compositor import LiveCompositor
+from ..host import (
+    BenchChanged,
+    FollowsUnicode,
+    MazeChanged,
+    OpenScreen,
+    ShowsSnapshot,
+    StartEndpoint,
+    ToggleUnicode,
+)
 from ..widgets.algorithm_state import AlgorithmState
 from ..widgets.key_legend import KeyLegend
 from ..widgets.maze_view import MazeView
@@ -38,7 +47,7 @@ from ..widgets.sensor_readings import SensorReadings
 PANEL_HZ = 4.0
 
 
-class MainScreen(Screen[None]):
+class MainScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
     """Drive, watch and set up the robot."""
 
     # the keys pressed again and again while driving are priority bindings: the screen takes
@@ -70,8 +79,19 @@ class MainScreen(Screen[None]):
     #: the last snapshot drawn (per-tick state: never repaints by itself)
     snapshot: var[Snapshot | None] = var(None)
 
-    def __init__(self, bench: Bench, unicode: bool = False, trail: bool = True) -> None:
+    def __init__(
+        self,
+        bench: Bench,
+        unicode: bool = False,
+        trail: bool = True,
+        who: str = "",
+        maze_path: Path | None = None,
+    ) -> None:
         super().__init__()
+        #: who is at the robot, for the message line
+        self.who = who
+        #: the file of the maze on the bench (where the maze dialog starts)
+        self.maze_path = maze_path
         # the maze and the panels change a few cells at a time, many times a second
         self._compositor = LiveCompositor()
         self.bench = bench
@@ -89,7 +109,7 @@ class MainScreen(Screen[None]):
         self._legend = KeyLegend(bench.profile, id="legend")
         self._readings = SensorReadings(id="readings")
         self._algorithm = AlgorithmState(id="algorithm")
-        self._message = MessageBar(self.app_who(), id="message")
+        self._message = MessageBar(self.who, id="message")
         with Horizontal(id="body"):
             with Vertical(id="stage"):
                 yield self._maze_view
@@ -100,10 +120,6 @@ class MainScreen(Screen[None]):
                 yield self._algorithm
         yield self._message
         yield Footer(compact=True, show_command_palette=False)
-
-    def app_who(self) -> str:
-        who = getattr(self.app, "who", "")
-        return who() if callable(who) else ""
 
     def on_mount(self) -> None:
         self._ready = True
@@ -154,11 +170,8 @@ class MainScreen(Screen[None]):
 
     def refresh_views(self) -> None:
         """Redraw after an action: through the app, so open dialogs follow too."""
-        refresh = getattr(self.app, "refresh_views", None)
-        if refresh is not None:
-            refresh()
-        else:
-            self.show_snapshot(self.bench.snapshot())
+        self.show_snapshot(self.bench.snapshot())
+        self.post_message(BenchChanged())
 
     def say(self, message: str) -> None:
         self.bench.message = message
@@ -237,11 +250,7 @@ class MainScreen(Screen[None]):
         self.say(f"sensors set for {bench.algorithm.name}: {ports}; x starts it")
 
     def action_unicode(self) -> None:
-        app = self.app
-        if hasattr(app, "unicode"):
-            app.unicode = not self.unicode  # the app tells every screen
-        else:
-            self.set_unicode(not self.unicode)
+        self.post_message(ToggleUnicode())
 
     def set_unicode(self, unicode: bool) -> None:
         self._maze_view.set_unicode(unicode)
@@ -257,7 +266,7 @@ class MainScreen(Screen[None]):
 
         files = self.bench.files
         if value is None:
-            current = getattr(self.app, "maze_path", None)
+            current = self.maze_path
             value = f"{files.shown(Path(current).parent)}/" if current else files.home()
             value = value.replace("~//", "~/")
 
@@ -285,16 +294,16 @@ class MainScreen(Screen[None]):
         self._maze_view.set_maze(maze)
         self._maze_view.clear_trail()
         self.bench.message = f"the robot is on {maze.name}"
-        self.app.maze_changed(real)  # type: ignore[attr-defined]
+        self.post_message(MazeChanged(real))
 
     def action_editor(self) -> None:
-        self.app.open_editor()  # type: ignore[attr-defined]
+        self.post_message(OpenScreen("editor"))
 
     def action_runs(self) -> None:
-        self.app.open_runs()  # type: ignore[attr-defined]
+        self.post_message(OpenScreen("runs"))
 
     def action_labs(self) -> None:
-        self.app.open_labs()  # type: ignore[attr-defined]
+        self.post_message(OpenScreen("labs"))
 
     def action_viple_ws(self) -> None:
-        self.app.run_worker(self.app.open_endpoint("ws"), group="endpoints")  # type: ignore[attr-defined]
+        self.post_message(StartEndpoint("ws"))

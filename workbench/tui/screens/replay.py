@@ -26,6 +26,7 @@ from workbench.files.workspace import LOCAL, FileAccess
 from workbench.sim.maze import Maze
 from workbench.sim.replay import Replay, load_replay, replay_maze
 
+from ..host import FollowsUnicode, ToggleUnicode
 from ..widgets.maze_view import MazeView
 
 #: how often the view is redrawn while playing (frames per second of wall time)
@@ -60,7 +61,7 @@ def _command(cmd: object) -> str:
     return f"{name} {_number(value)}"
 
 
-class ReplayScreen(Screen[None]):
+class ReplayScreen(FollowsUnicode, Screen[None]):
     """Step through or play a recorded run; escape goes back."""
 
     AUTO_FOCUS = ""
@@ -185,7 +186,7 @@ class ReplayScreen(Screen[None]):
         record_path: str | os.PathLike,
         replay: Replay | None = None,
         mazes: Sequence[Maze] = (),
-        unicode: bool | None = None,
+        unicode: bool = False,
         *,
         files: FileAccess = LOCAL,
         name: str | None = None,
@@ -206,8 +207,6 @@ class ReplayScreen(Screen[None]):
         self._drawn = -1
 
     def compose(self) -> ComposeResult:
-        if self._unicode is None:
-            self._unicode = bool(getattr(self.app, "unicode", False))
         yield Static(id="replay-title", markup=False)
         yield Static(
             self.note, id="replay-note", markup=False, classes="" if self.note else "-empty"
@@ -236,7 +235,7 @@ class ReplayScreen(Screen[None]):
     # -- public ------------------------------------------------------------------------------
     @property
     def unicode(self) -> bool:
-        return bool(self._unicode)
+        return self._unicode
 
     def set_unicode(self, unicode: bool) -> None:
         self._unicode = unicode
@@ -364,11 +363,7 @@ class ReplayScreen(Screen[None]):
             self._timer.pause()
 
     def action_unicode(self) -> None:
-        unicode = not self.unicode
-        if hasattr(self.app, "unicode"):
-            self.app.unicode = unicode
-        if self.unicode != unicode:
-            self.set_unicode(unicode)
+        self.post_message(ToggleUnicode())
 
     def action_leave(self) -> None:
         self._stop_timer()

@@ -19,11 +19,12 @@ from workbench.control.bench import Bench, RunEntry
 from workbench.files.workspace import OutsideWorkspace
 from workbench.sim.record import RecordError
 from workbench.sim.replay import load_replay
+from workbench.sim.session import Snapshot
 
+from ..host import FollowsUnicode, ShowsSnapshot, ToggleUnicode
 from .path_dialog import PathDialog
 from .replay import ReplayScreen
 
-ALGORITHM_PREFIX = "algorithm "
 #: column key, heading (ASCII), heading (Unicode)
 COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("number", "#", "#"),
@@ -45,11 +46,6 @@ OPEN_HELP = (
 )
 
 
-def driver_name(driver: str) -> str:
-    """``algorithm right-wall`` -> ``right-wall``; ``keys`` stays."""
-    return driver[len(ALGORITHM_PREFIX) :] if driver.startswith(ALGORITHM_PREFIX) else driver
-
-
 def run_cells(run: RunEntry, unicode: bool) -> tuple[str, ...]:
     """The table cells of a run, in :data:`COLUMNS` order."""
     m = run.metrics
@@ -57,7 +53,7 @@ def run_cells(run: RunEntry, unicode: bool) -> tuple[str, ...]:
     yes, no = ("✓", "✗") if unicode else ("yes", "no")
     return (
         str(run.number),
-        driver_name(run.driver),
+        run.driver.short,
         yes if m.reached_exit else no,
         f"{time:.1f}",
         f"{m.distance_cells:.2f}",
@@ -71,7 +67,7 @@ def run_cells(run: RunEntry, unicode: bool) -> tuple[str, ...]:
     )
 
 
-class RunsScreen(Screen[None]):
+class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
     """The bench's runs side by side; enter replays one, ``o`` opens a record file."""
 
     DEFAULT_CSS = """
@@ -128,7 +124,7 @@ class RunsScreen(Screen[None]):
     def __init__(
         self,
         bench: Bench,
-        unicode: bool | None = None,
+        unicode: bool = False,
         *,
         name: str | None = None,
         id: str | None = None,
@@ -143,8 +139,6 @@ class RunsScreen(Screen[None]):
         self.status = ""
 
     def compose(self) -> ComposeResult:
-        if self._unicode is None:
-            self._unicode = bool(getattr(self.app, "unicode", False))
         yield Static(id="runs-title", markup=False)
         yield Static(id="runs-help", markup=False)
         yield DataTable(id="runs-table", cursor_type="row", zebra_stripes=True)
@@ -160,7 +154,7 @@ class RunsScreen(Screen[None]):
     # -- public ------------------------------------------------------------------------------
     @property
     def unicode(self) -> bool:
-        return bool(self._unicode)
+        return self._unicode
 
     def set_unicode(self, unicode: bool) -> None:
         self._unicode = unicode
@@ -168,7 +162,7 @@ class RunsScreen(Screen[None]):
             self._shown = None
             self.refresh_runs()
 
-    def show_snapshot(self, snapshot: object) -> None:
+    def show_snapshot(self, snapshot: Snapshot) -> None:
         """Called by the app on every frame: pick up runs that ended meanwhile."""
         if len(self.bench.runs) != self._shown_count:
             self.refresh_runs()
@@ -274,11 +268,7 @@ class RunsScreen(Screen[None]):
         )
 
     def action_unicode(self) -> None:
-        unicode = not self.unicode
-        if hasattr(self.app, "unicode"):
-            self.app.unicode = unicode
-        if self.unicode != unicode:
-            self.set_unicode(unicode)
+        self.post_message(ToggleUnicode())
 
     def action_leave(self) -> None:
         if len(self.app.screen_stack) > 1 and self.app.screen is self:

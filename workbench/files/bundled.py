@@ -1,0 +1,16 @@
+"""Where the mazes that come with the workbench are, and the one a session starts on."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import workbench
+
+#: the bundled maze files (beside the package, as in a source checkout or an editable install)
+MAZE_DIR = Path(workbench.__file__).resolve().parent.parent / "mazes"
+#: the maze the app and ``workbench serve`` open when no maze is named (the Unity simulator's)
+DEFAULT_MAZE = "unity-default.txt"
+
+
+def default_maze_path() -> Path:
+    return MAZE_DIR / DEFAULT_MAZE

@@ -1,0 +1,99 @@
+"""How screens and the app that hosts them speak to each other.
+
+A screen never reaches into the app: it posts one of the messages below, which bubbles up to
+the app. The app speaks to its screens only through the two small roles a screen may take on:
+:class:`ShowsSnapshot` (draws the bench at each tick) and :class:`FollowsUnicode` (redraws when
+the drawing switches between Unicode and ASCII). :class:`ScreenHost` is the part of an app that
+every host shares, the workbench app and the tests' bare hosts alike: it holds the Unicode
+setting, toggles it when a screen asks and applies it to every screen.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Literal, TypeVar
+
+from textual.app import App
+from textual.message import Message
+from textual.reactive import var
+
+from workbench.labs.model import Setup
+from workbench.sim.session import Snapshot
+
+ReturnType = TypeVar("ReturnType")
+#: the screens a screen may ask the app to open
+ScreenName = Literal["editor", "runs", "labs"]
+
+
+class ShowsSnapshot:
+    """A screen that draws the bench: the app hands it every snapshot it draws."""
+
+    def show_snapshot(self, snapshot: Snapshot) -> None:
+        raise NotImplementedError
+
+
+class FollowsUnicode:
+    """A screen that draws in Unicode or ASCII as the app's setting says."""
+
+    def set_unicode(self, unicode: bool) -> None:
+        raise NotImplementedError
+
+
+class ToggleUnicode(Message):
+    """Switch the drawing between Unicode and ASCII, on every screen."""
+
+
+class BenchChanged(Message):
+    """An action changed the bench: every screen that shows it redraws."""
+
+
+class MazeChanged(Message):
+    """The bench has a new maze (or profile); ``path`` is its file when it came from one."""
+
+    def __init__(self, path: str | os.PathLike | None = None) -> None:
+        super().__init__()
+        self.path = path
+
+
+class SetUpDone(Message):
+    """A lab exercise's set-up changed the bench (maze, profile, sensors, driver)."""
+
+    def __init__(self, setup: Setup) -> None:
+        super().__init__()
+        self.setup = setup
+
+
+class OpenScreen(Message):
+    """Open one of the app's screens over the current one."""
+
+    def __init__(self, screen: ScreenName) -> None:
+        super().__init__()
+        self.screen = screen
+
+
+class StartEndpoint(Message):
+    """Start the app's VIPLE endpoint of ``role`` (``tcp`` or ``ws``)."""
+
+    def __init__(self, role: str) -> None:
+        super().__init__()
+        self.role = role
+
+
+class ScreenHost(App[ReturnType]):
+    """The Unicode setting of an app that hosts the workbench's screens, in one place."""
+
+    #: draw with Unicode lines, arrows and marks (False: plain ASCII)
+    unicode: var[bool] = var(False, init=False)
+
+    def on_toggle_unicode(self, message: ToggleUnicode) -> None:
+        self.unicode = not self.unicode
+
+    def watch_unicode(self, unicode: bool) -> None:
+        self.mark_ascii()
+        for screen in self.screen_stack:
+            if isinstance(screen, FollowsUnicode):
+                screen.set_unicode(unicode)
+
+    def mark_ascii(self) -> None:
+        """The app's CSS class for plain-ASCII drawing (narrower panel borders)."""
+        self.set_class(not self.unicode, "-ascii")
