@@ -9,6 +9,7 @@ from typing import Any
 from workbench.control.evaluate import Entrant
 from workbench.control.headless import RunSetupError, default_max_time, parse_noise_params
 from workbench.files.bounded import BoundedFileError
+from workbench.sim.driver import Driver
 from workbench.sim.maze import Maze, MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.noise import noise_settings
@@ -195,7 +196,7 @@ def prepare(spec: ProgramRunSpec) -> tuple[Session, ProgramController, float]:
     session = Session(maze, profile.name, sensors, noise, spec.seed, spec.dt, recorder=recorder)
     controller = ProgramController(compiled, keys)
     binding = {f"port {s.port}": s.port for s in sensors}
-    session.attach(controller, binding, f"program {os.path.basename(spec.program)}")
+    session.attach(controller, binding, Driver.program(os.path.basename(spec.program)))
     max_time = spec.max_time or default_max_time(maze, profile, session.world.cell)
     return session, controller, max_time
 
