@@ -136,7 +136,7 @@ def test_sign_off_happy_path_then_the_driver_changes(tmp_path):
         assert drivers[("unity-simulator", "reading-wall-following")] == "ben"
         listing = screen.query_one("#labs-list", OptionList)
         option = listing.get_option(DRIVE)
-        assert "✓" in str(option.prompt)
+        assert str(option.prompt).startswith("★")  # signed off, apart from only passed
 
     run(app, body)
 
@@ -145,7 +145,15 @@ def test_sign_off_happy_path_then_the_driver_changes(tmp_path):
     async def later(pilot: Pilot) -> None:
         screen = await open_exercise(pilot, DRIVE)
         assert screen.driver == "ana"  # who drove it, from the store
-        assert "✓" in str(screen.query_one("#labs-list", OptionList).get_option(DRIVE).prompt)
+        assert str(screen.query_one("#labs-list", OptionList).get_option(DRIVE).prompt)[0] == "★"
+        title = str(screen.query_one("#labs-title").render())
+        assert "★ signed off by " in title  # by whom and when
+        await pilot.press("i")
+        await pilot.pause()
+        assert "Already signed off by " in str(
+            pilot.app.screen.query_one("#signoff-already").render()
+        )
+        await pilot.press("escape")
         await open_exercise(pilot, "unity-simulator/reading-wall-following")
         assert screen.driver == "ben"
 

@@ -379,7 +379,7 @@ def test_a_pair_completes_and_signs_off_every_exercise_in_the_app(tmp_path):
             await w.sign_off(screen, PAIR[(n + 1) % 2])
         listing = screen.query_one("#labs-list", OptionList)
         for lab, ex in EXERCISES:
-            assert str(listing.get_option(f"{lab.id}/{ex.id}").prompt).startswith("✓")
+            assert str(listing.get_option(f"{lab.id}/{ex.id}").prompt).startswith("★")
         await pilot.press("ctrl+q")
 
     run(app, body)

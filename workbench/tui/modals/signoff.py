@@ -102,8 +102,12 @@ class SignoffModal(ModalScreen[str | None]):
         student: str,
         partner: str = "",
         driver: str = "",
+        already: str = "",
     ) -> None:
+        """``already`` says who signed the exercise off before, and when (empty when nobody
+        has): the dialog is then a re-sign-off, which adds a second record."""
         super().__init__()
+        self.already = already
         self.store = store
         self.progress = progress
         self.student = student
@@ -122,7 +126,8 @@ class SignoffModal(ModalScreen[str | None]):
     def compose(self) -> ComposeResult:
         progress = self.progress
         dialog = Vertical(id="signoff-dialog")
-        dialog.border_title = f"Sign off {progress.lab}/{progress.exercise}"
+        again = " again" if self.already else ""
+        dialog.border_title = f"Sign off{again} {progress.lab}/{progress.exercise}"
         dialog.border_subtitle = "escape closes"
         who = self.student + (f" and {self.partner}" if self.partner else "")
         passed = sum(o.passed for o in progress.objectives)
@@ -132,6 +137,13 @@ class SignoffModal(ModalScreen[str | None]):
             else f"{passed} of {len(progress.objectives)} objectives pass: an override is needed"
         )
         with dialog:
+            if self.already:
+                yield Static(
+                    f"Already signed off {self.already}. Signing again adds a second record; "
+                    "the first stays in the log.",
+                    id="signoff-already",
+                    markup=False,
+                )
             yield Static(f"{who}, driver {self.driver}; {state}", id="signoff-state", markup=False)
             with Vertical(id="signoff-form"):
                 with Horizontal(classes="field-row"):

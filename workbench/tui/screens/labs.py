@@ -32,6 +32,8 @@ from ..host import SetUpDone, ShowsSnapshot
 from ..widgets.field import Field
 
 PASS, FAIL, OPEN = "✓", "✗", "·"
+#: the lab list's mark of an exercise an instructor has signed off (apart from passed)
+SIGNED = "★"
 
 
 UNREACHABLE = "the course database cannot be reached"
@@ -128,7 +130,8 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
         #: the progress last saved (or read back) for each exercise
         self._saved: dict[tuple[str, str], ExerciseProgress] = {}
         self._done: set[tuple[str, str]] = set()
-        self._signed: set[tuple[str, str]] = set()
+        #: (lab, exercise) -> "by INSTRUCTOR on DATE" of its last sign-off
+        self._signed: dict[tuple[str, str], str] = {}
         self._drivers: dict[tuple[str, str], str] = {}
         self._retry_timer: Timer | None = None
         self._reload_when_back = False
@@ -165,7 +168,9 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
             self.answers[key] = dict(progress.answers)
         if damaged:
             self._store_problem = f"saved progress unreadable (starts afresh): {', '.join(damaged)}"
-        self._signed = {(row.lab, row.exercise) for row in signed}
+        self._signed = {
+            (row.lab, row.exercise): _by(row.instructor, row.signed_at) for row in signed
+        }
 
     def _save(self, progress: ExerciseProgress) -> None:
         key = (progress.lab, progress.exercise)
@@ -248,7 +253,7 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
             options.append(Option(lab.title, id=f"lab:{lab.id}", disabled=True))
             for ex in lab.exercises:
                 key = (lab.id, ex.id)
-                mark = PASS if key in self._done or key in self._signed else OPEN
+                mark = SIGNED if key in self._signed else PASS if key in self._done else OPEN
                 options.append(Option(f"{mark} {ex.title}", id=f"{lab.id}/{ex.id}"))
         return options
 
@@ -311,7 +316,11 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
                 self.say(f"cannot save where you are: {exc}")
         self.driver = self._drivers.get((lab.id, exercise.id), self.driver)
         self.progress = None
-        self.query_one("#labs-title", Label).update(f"{lab.title}: {exercise.title}")
+        signed = self._signed.get((lab.id, exercise.id))
+        title = f"{lab.title}: {exercise.title}"
+        if signed:
+            title += f" ({SIGNED} signed off {signed})"
+        self.query_one("#labs-title", Label).update(title)
         self.query_one("#labs-instructions", Markdown).update(exercise.instructions)
         box = self.query_one("#labs-questions", Vertical)
         box.remove_children()
@@ -423,7 +432,14 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
         progress = self.track()
         assert progress is not None
         self.app.push_screen(
-            SignoffModal(self.store, progress, self.student, self.partner, self.driver),
+            SignoffModal(
+                self.store,
+                progress,
+                self.student,
+                self.partner,
+                self.driver,
+                already=self._signed.get((progress.lab, progress.exercise), ""),
+            ),
             self._signed_off,
         )
 
@@ -431,7 +447,7 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
         if driver is None or self.selected is None:
             return
         lab, exercise = self.selected
-        self._signed.add((lab.id, exercise.id))
+        self._signed[(lab.id, exercise.id)] = "just now"
         self._drivers[(lab.id, exercise.id)] = self.driver
         self.driver = driver
         following = list(lab.exercises)[list(lab.exercises).index(exercise) + 1 :]
@@ -445,6 +461,12 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
                 return
         self._refresh_list()
         self.say(f"signed off; {driver} drives next")
+
+
+def _by(instructor: str, signed_at: str) -> str:
+    """``by Dr Chen on 2026-03-02 10:00``: who signed an exercise off, and when (UTC)."""
+    when = signed_at.replace("T", " ").rstrip("Z")[:16]
+    return f"by {instructor} on {when} UTC" if when else f"by {instructor}"
 
 
 def _changed(before: ExerciseProgress, now: ExerciseProgress) -> bool:
