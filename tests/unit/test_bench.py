@@ -312,3 +312,26 @@ def test_a_pause_the_user_chose_stays_until_they_resume():
     b.key("w")
     b.advance(0.5)
     assert b.pacer.paused and b.snapshot().metrics.distance == 0
+
+
+def test_a_viple_program_drives_on_after_the_maze_is_changed_under_it():
+    from workbench.viple.link import Link
+
+    b = Bench.open(ROOM, "erobotic", noise="off")
+    session = b.session
+    link = Link(session, "tcp")
+    assert link.connect("127.0.0.1:50312")
+    b.load_maze(CORRIDOR)
+    assert b.session is session and link.session is session  # one session, one reference
+    assert link.apply(MOVE)
+    b.step(60)
+    assert str(b.snapshot().driver) == "VIPLE tcp 127.0.0.1:50312"
+    assert b.snapshot().metrics.distance > 0.5 and b.session.world.maze is CORRIDOR
+
+
+def test_pausing_is_one_switch_on_the_bench():
+    b = Bench.open(ROOM, "erobotic", noise="off")
+    b.pause()
+    assert b.paused and b.advance(1.0) == 0
+    assert b.toggle_pause() is False and not b.paused
+    assert b.advance(0.5) > 0

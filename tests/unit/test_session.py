@@ -129,3 +129,17 @@ def test_record_lines_are_compact_json(tmp_path):
     session.run(max_time=0.1)
     line = json.loads(buf.getvalue().splitlines()[0])
     assert set(line) == {"t", "pose", "sensors"}
+
+
+def test_a_new_maze_goes_into_the_same_session_with_its_setup():
+    session = Session(ROOM, "erobotic", noise="low", seed=7)
+    session.set_sensors(session.world.sensors[:1])
+    sensors, noise = session.world.sensors, session.world.noise
+    session.command(MoveAtPower(1.0), driver=Driver.program("a script"))
+    session.run(max_time=1)
+    session.load_maze(CORRIDOR)
+    assert session.maze is CORRIDOR and session.world.maze is CORRIDOR
+    assert (session.world.sensors, session.world.noise, session.world.seed) == (sensors, noise, 7)
+    assert session.world.block == CORRIDOR.start and session.metrics().distance == 0
+    session.command(MoveAtPower(1.0))
+    assert session.run(max_time=30).reached_exit  # the corridor's exit, on the new maze

@@ -166,16 +166,10 @@ class Bench:
         return cls(maze=maze, profile=name, sensors=check_ports(chosen), **kwargs)
 
     def __post_init__(self) -> None:
-        self._build_session()
-
-    def _build_session(self) -> None:
-        old = getattr(self, "pacer", None)
+        # one session for the bench's whole life: a new maze goes into it (see load_maze), so
+        # the VIPLE endpoints serving it and the pacer keep the one reference
         self.session = Session(self.maze, self.profile, self.sensors, self.noise, self.seed)
         self.pacer = Pacer(self.session)
-        if old is not None:  # a new maze keeps the pace the user (and the front end) set
-            self.pacer.paused = old.paused
-            self.pacer.speed = old.speed
-            self.pacer.budget = old.budget
         self.session.driver = KEYS
         self.session.on_command = self._commanded
 
@@ -205,14 +199,14 @@ class Bench:
 
     def _algorithm_failed(self, exc: FsmRuntimeError) -> None:
         self.stop_algorithm("error")
-        self.pacer.paused = True
+        self.pause()
         self.message = f"algorithm stopped: {exc}"
 
     def _after_steps(self) -> None:
         self._watch_viple()
         if self._run_open and self.maze.exits and self.session.reached_exit:
             self._close_run("exit")
-            self.pacer.paused = True
+            self.pause()
             self._held_at_exit = True
             self.message = "the robot is out: run finished (r resets the robot)"
 
@@ -264,17 +258,24 @@ class Bench:
         if motion is not None and self._viple_now is not None:
             self._viple_now.motions.add(motion)
 
-    def toggle_pause(self) -> bool:
-        self.pacer.paused = not self.pacer.paused
+    @property
+    def paused(self) -> bool:
+        return self.pacer.paused
+
+    def pause(self, paused: bool = True) -> None:
+        """Stop simulated time (or, with False, let it run again): the user's choice."""
         self._held_at_exit = False
+        self.pacer.paused = paused
+
+    def toggle_pause(self) -> bool:
+        self.pause(not self.pacer.paused)
         return self.pacer.paused
 
     def _go_on_after_exit(self) -> None:
         """The run that ended at the exit paused the robot; a new action lets time run again
         (keys would otherwise seem dead after a run)."""
         if self._held_at_exit:
-            self._held_at_exit = False
-            self.pacer.paused = False
+            self.pause(False)
 
     def snapshot(self) -> Snapshot:
         return self.session.snapshot()
@@ -402,7 +403,7 @@ class Bench:
         self.controller = controller
         self.session.attach(controller, binding, Driver.algorithm(self.algorithm.name))
         self._open_run(self.session.driver)
-        self.pacer.paused = False
+        self.pause(False)
         self.message = ""
 
     def stop_algorithm(self, ended: str = "stopped") -> None:
@@ -433,7 +434,8 @@ class Bench:
             self._close_run("maze changed")
         self.stop_algorithm("maze changed")
         self.maze = maze
-        self._build_session()
+        self.session.load_maze(maze, self.profile, self.sensors, self.noise, self.seed)
+        self.session.driver = KEYS
 
     # -- runs ----------------------------------------------------------------------------
     def _open_run(self, driver: Driver) -> None:

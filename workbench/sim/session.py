@@ -119,6 +119,42 @@ class Session:
         """Apply ``cmd`` after exactly ``seconds`` of simulated time (to the step)."""
         self._scheduled = (self._steps + max(1, round(seconds / self.world.dt)), cmd)
 
+    def load_maze(
+        self,
+        maze: Maze,
+        profile: str | None = None,
+        sensors: Sequence[SensorSpec] | None = None,
+        noise: NoiseSettings | str | None = None,
+        seed: int | None = None,
+    ) -> None:
+        """Put the robot on ``maze``: a new world, the robot at the start, the run counted
+        afresh and no controller attached.
+
+        What is not given stays as it was: the profile, the sensors, the seed, and the noise
+        (with a new profile and no noise given, that profile's own). The session stays the
+        same object, so whatever serves it (VIPLE endpoints, a pacer) carries on with the new
+        maze.
+        """
+        old = self.world
+        same_profile = profile is None or profile == old.profile.name
+        if noise is None and same_profile:
+            noise = old.noise
+        self.world = World(
+            maze,
+            old.profile if profile is None else profile,
+            list(old.sensors if sensors is None else sensors),
+            noise,
+            old.seed if seed is None else seed,
+            old.dt,
+        )
+        self._world_step = self.world.step
+        self.profile = self.world.profile
+        self.maze = maze
+        self.shortest_blocks = maze.shortest_path_length()
+        self.controller = None
+        self.binding = {}
+        self._reset_run_state()
+
     def set_sensors(self, specs: Sequence[SensorSpec]) -> None:
         self.world.set_sensors(list(specs))
         self.readings = self.world.read_sensors()

@@ -193,17 +193,16 @@ class WorkbenchApp(ScreenHost[None]):
         self._last_tick = now
         bench = self.bench
         if self.endpoints is not None:
-            self.endpoints.follow(bench.session)
             bench.connection = self.endpoints.summary()
         steps = bench.advance(elapsed)
-        state = (bench.pacer.paused, bench.message, bench.controller, len(bench.runs))
+        state = (bench.paused, bench.message, bench.controller, len(bench.runs))
         if steps or state != self._drawn:
             self.refresh_views()
 
     def refresh_views(self) -> None:
         """Draw the bench's current snapshot on every screen of the stack that shows one."""
         bench = self.bench
-        self._drawn = (bench.pacer.paused, bench.message, bench.controller, len(bench.runs))
+        self._drawn = (bench.paused, bench.message, bench.controller, len(bench.runs))
         snapshot = bench.snapshot()
         for screen in self.screen_stack:
             if isinstance(screen, ShowsSnapshot):
@@ -441,7 +440,7 @@ def make_app(
         )
     except ValueError as exc:
         raise AppSetupError(f"cannot set up the robot: {exc}") from None
-    bench.pacer.paused = paused
+    bench.pause(paused)
     # max speed may use at most 60 % of each frame, so keys and drawing stay responsive
     bench.pacer.budget = 0.6 / tick_hz
     return WorkbenchApp(

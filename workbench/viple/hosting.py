@@ -60,12 +60,6 @@ class Endpoints:
     def active(self) -> list[TcpServer | WsClient]:
         return [e for e in (self.tcp, self.ws) if e is not None]
 
-    def follow(self, session: Session) -> None:
-        """Serve ``session`` from now on (the front end replaced its session: a new maze)."""
-        for endpoint in self.active:
-            if endpoint.link.session is not session:
-                endpoint.link.session = session
-
     def statuses(self) -> list[LinkStatus]:
         return [e.status for e in self.active]
 

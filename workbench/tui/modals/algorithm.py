@@ -241,13 +241,13 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
         if not self._ready:
             return  # the app ticks while the dialog is still being built
         bench = self.bench
-        paused = " (paused)" if bench.pacer.paused else ""
+        paused = " (paused)" if bench.paused else ""
         if bench.controller is not None:
             text = f"running, in {bench.controller.state}{paused}"
         else:
             text = f"driver: {snapshot.driver}{paused}"
         self.query_one("#alg-live", Label).update(text)
-        self.query_one("#alg-pause", Button).label = "Resume" if bench.pacer.paused else "Pause"
+        self.query_one("#alg-pause", Button).label = "Resume" if bench.paused else "Pause"
 
     def _error(self, text: str) -> None:
         self.query_one("#alg-error", Static).update(text)
@@ -323,7 +323,7 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
 
     def action_step(self) -> None:
         bench = self.bench
-        bench.pacer.paused = True
+        bench.pause()
         bench.step(bench.session.every)
         self._refresh_all()
 

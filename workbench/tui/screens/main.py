@@ -154,13 +154,13 @@ class MainScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         # at once when paused (steps, snapshots) and when who drives or the state changes
         now = monotonic()
         moment = (
-            bench.pacer.paused,
+            bench.paused,
             bench.message,
             snapshot.driver,
             snapshot.state,
             bench.connection,
         )
-        if bench.pacer.paused or moment != self._moment or now - self._panels_at >= 1 / PANEL_HZ:
+        if bench.paused or moment != self._moment or now - self._panels_at >= 1 / PANEL_HZ:
             self._moment = moment
             self._panels_at = now
             self._readings.show(snapshot, bench.profile)
@@ -190,7 +190,7 @@ class MainScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
 
     def action_step(self) -> None:
         bench = self.bench
-        bench.pacer.paused = True
+        bench.pause()
         bench.step(bench.session.every)
         self.refresh_views()
 

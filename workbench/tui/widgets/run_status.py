@@ -30,7 +30,7 @@ class RunStatus(TextLines):
         sep = separator(unicode)
         unit = get_profile(bench.profile).unit
         m = snapshot.metrics
-        state = "PAUSED" if bench.pacer.paused else "running"
+        state = "PAUSED" if bench.paused else "running"
         set_border_title(self, f"Run: {bench.maze.name} ({bench.profile})")
         driver = f"driver: {snapshot.driver}"
         clock = f"{state} at {speed(bench.pacer.speed)}{sep}t {snapshot.time:.1f} s"
