@@ -290,3 +290,22 @@ def test_a_data_folder_that_cannot_open_is_reported_and_the_labs_still_work(tmp_
         assert "cannot open the data folder" in text(screen, "#labs-message")
 
     run(app, body)
+
+
+def test_every_objective_is_reachable_at_80x24(tmp_path):
+    app = lab_app(tmp_path / "data")
+
+    async def body(pilot: Pilot) -> None:
+        screen = await open_exercise(pilot, "unity-simulator/wall-following")
+        objectives = screen.query_one("#labs-objectives", Static)
+        lines = [line for line in text(screen, "#labs-objectives").splitlines() if line]
+        assert len(lines) == len(screen.selected[1].objectives) == 4
+        # the objectives are not cut: the box is as tall as its wrapped text, and it scrolls
+        # with the instructions, so the last one can be brought on screen
+        assert objectives.size.height >= len(lines)
+        assert objectives.parent is screen.query_one("#labs-scroll")
+        screen.query_one("#labs-scroll").scroll_to_widget(objectives, top=True, animate=False)
+        await pilot.pause()
+        assert objectives.region.bottom <= pilot.app.size.height
+
+    run(app, body, size=(80, 24))

@@ -71,7 +71,6 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
     }
     LabsScreen #labs-objectives {
         height: auto;
-        max-height: 8;
         margin-bottom: 1;
     }
     LabsScreen #labs-questions {
@@ -240,8 +239,9 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
             yield OptionList(*self._options(), id="labs-list")
             with Vertical(id="labs-exercise"):
                 yield Label("", id="labs-title", markup=False)
-                yield Static("", id="labs-objectives", markup=False)
+                # objectives scroll with the text: every one stays reachable, however many
                 with VerticalScroll(id="labs-scroll"):
+                    yield Static("", id="labs-objectives", markup=False)
                     yield Markdown("", id="labs-instructions")
                     yield Vertical(id="labs-questions")
         yield Static("", id="labs-message", markup=False)
