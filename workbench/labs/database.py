@@ -13,6 +13,7 @@ from __future__ import annotations
 import os
 import sqlite3
 import time
+from abc import ABC, abstractmethod
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -87,21 +88,24 @@ class Tx:
         return self.cursor
 
 
-class Backend:
+class Backend(ABC):
     """One connection to the store's database."""
 
     kind = ""
     #: how messages name the database: the file's path or the URL without its password
     where = ""
 
-    def write(self) -> Any:  # a context manager yielding a Tx
-        raise NotImplementedError
+    @abstractmethod
+    def write(self) -> Any:
+        """A context manager yielding a :class:`Tx`: one transaction."""
 
+    @abstractmethod
     def read(self, sql: str, params: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
-        raise NotImplementedError
+        """The rows of one query."""
 
+    @abstractmethod
     def close(self) -> None:
-        raise NotImplementedError
+        """Close the connection."""
 
     @property
     def postgres(self) -> bool:

@@ -11,7 +11,7 @@ setting, toggles it when a screen asks and applies it to every screen.
 from __future__ import annotations
 
 import os
-from typing import Literal, TypeVar
+from typing import TYPE_CHECKING, Literal, TypeVar
 
 from textual.app import App
 from textual.message import Message
@@ -26,17 +26,24 @@ ScreenName = Literal["editor", "runs", "labs"]
 
 
 class ShowsSnapshot:
-    """A screen that draws the bench: the app hands it every snapshot it draws."""
+    """A screen that draws the bench: the app hands it every snapshot it draws.
 
-    def show_snapshot(self, snapshot: Snapshot) -> None:
-        raise NotImplementedError
+    A role, not a base: the screen defines ``show_snapshot`` itself (a mixin with an abstract
+    method would clash with Textual's metaclass).
+    """
+
+    if TYPE_CHECKING:
+
+        def show_snapshot(self, snapshot: Snapshot) -> None: ...
 
 
 class FollowsUnicode:
-    """A screen that draws in Unicode or ASCII as the app's setting says."""
+    """A screen that draws in Unicode or ASCII as the app's setting says (it defines
+    ``set_unicode``)."""
 
-    def set_unicode(self, unicode: bool) -> None:
-        raise NotImplementedError
+    if TYPE_CHECKING:
+
+        def set_unicode(self, unicode: bool) -> None: ...
 
 
 class ToggleUnicode(Message):
