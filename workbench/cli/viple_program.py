@@ -61,10 +61,15 @@ def cmd_check(args: argparse.Namespace) -> int:
                 print(problem)
             continue
         program = compiled.program
-        print(
-            f"{path}: ok (VIPLE {program.version}, {len(program.activities)} activities, "
-            f"{len(program.panels)} panels, {len(program.links)} links)"
+        counts = ", ".join(
+            _many(len(things), word)
+            for things, word in (
+                (program.activities, "activity"),
+                (program.panels, "panel"),
+                (program.links, "link"),
+            )
         )
+        print(f"{path}: ok (VIPLE {program.version}, {counts})")
     return 1 if bad else 0
 
 
@@ -134,3 +139,10 @@ def describe_program_run(result) -> str:
         lines.append(f"  errors: {len(result.errors)}")
         lines += [f"    {e}" for e in result.errors[:10]]
     return "\n".join(lines)
+
+
+def _many(count: int, word: str) -> str:
+    """``1 panel``, ``5 panels``, ``32 activities``."""
+    if count == 1:
+        return f"1 {word}"
+    return f"{count} {word[:-1]}ies" if word.endswith("y") else f"{count} {word}s"
