@@ -132,7 +132,9 @@ def compile_expr(
     _prescan(text, lead)
     try:
         with warnings.catch_warnings():
-            warnings.simplefilter("ignore", SyntaxWarning)  # e.g. "1and x": never printed
+            # e.g. "1and x" or "\\.": Python's own warnings about the text are never printed
+            warnings.simplefilter("ignore", SyntaxWarning)
+            warnings.simplefilter("ignore", DeprecationWarning)
             tree = ast.parse(body, mode="eval")
     except SyntaxError as exc:
         col = (exc.offset or 1) + lead if (exc.lineno or 1) == 1 else exc.offset
