@@ -225,7 +225,7 @@ def start_server(data: Path, port: int, sessions: int, fork: bool) -> subprocess
     first = 42000 + (port % 100) * 100
     server = subprocess.Popen(
         [sys.executable, "-m", "workbench", "serve-ssh", "--bind", "127.0.0.1",
-         "--port", str(port), "--data-dir", str(data), "--public-host", "bench",
+         "--port", str(port), "--data-dir", str(data), "--public-host", "station",
          "--port-range", f"{first}-{first + 2 * sessions + 40}",
          "--max-sessions", str(max(60, sessions)), *([] if fork else ["--no-fork-server"])],
         cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,

@@ -6,7 +6,7 @@ at start), passes the names dialog, and drives the robot on the bundled Unity ma
 --seconds:
 
   * ``--keys ssh`` (default): the key pattern of ``bench/ssh_load.py`` at --hz keys a second
-    (forward, a turn now and then, stop now and then), as the load bench sends it;
+    (forward, a turn now and then, stop now and then), as the load station sends it;
   * ``--keys drive``: ``w`` once, then a turn (``a`` or ``d``) every 1.5 s, no other keys.
 
 The app ticks its simulation at its own 20 Hz either way. Printed: the app process's CPU
@@ -82,11 +82,11 @@ async def one_run(seconds: float, hz: float, keys: str, profile: str | None) -> 
     with tempfile.TemporaryDirectory(prefix="tui-cpu-") as tmp:
         data = Path(tmp)
         spec = AppSpec(
-            user="bench",
+            user="station",
             role="student",
             tcp_port=free_port(),
             ws_port=free_port(),
-            hint="VIPLE: bench",
+            hint="VIPLE: station",
             data_dir=data / "data",
             record_dir=data / "runs",
             workspace=data,

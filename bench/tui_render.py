@@ -204,16 +204,16 @@ async def measure(
 async def measure_app(maze: Maze, seconds: float, hz: float, speed: float) -> dict[str, float]:
     """The whole workbench app (maze view, side panels, run status) with right-wall running."""
     with tempfile.TemporaryDirectory() as tmp:
-        path = os.path.join(tmp, "bench-maze.txt")
+        path = os.path.join(tmp, "station-maze.txt")
         write_maze(path, maze)
         app = make_app(path, PROFILE, noise="off", tick_hz=hz)
         async with app.run_test(size=SIZE) as pilot:
             await pilot.pause()
-            bench = app.bench
-            bench.pacer.speed = speed
-            bench.select_algorithm(ALGORITHM)
-            bench.apply_algorithm_preset()
-            bench.start_algorithm()
+            station = app.station
+            station.pacer.speed = speed
+            station.select_algorithm(ALGORITHM)
+            station.apply_algorithm_preset()
+            station.start_algorithm()
             stats = Stats()
             _Timing.stats = stats
             driver = app._driver
@@ -236,7 +236,7 @@ async def measure_app(maze: Maze, seconds: float, hz: float, speed: float) -> di
                 "frames": len(stats.frames),
                 "frame_mean_ms": 1000 * statistics.fmean(stats.frames) if stats.frames else 0.0,
                 "frame_p95_ms": 1000 * p95(stats.frames),
-                "sim_time": bench.session.world.time,
+                "sim_time": station.session.world.time,
             }
 
 

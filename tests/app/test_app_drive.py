@@ -17,12 +17,12 @@ from workbench.cli import main
 from workbench.control.manual import key_legend
 from workbench.tui.app import FOCUS_BINDINGS, AppSetupError, WorkbenchApp, make_app
 from workbench.tui.commands import COMMANDS, WorkbenchCommands
-from workbench.tui.modals.help import HelpScreen
-from workbench.tui.modals.too_small import TooSmallScreen
+from workbench.tui.dialogs.help import HelpScreen
+from workbench.tui.dialogs.too_small import TooSmallScreen
+from workbench.tui.dialogs.unsaved import UnsavedDialog
 from workbench.tui.screens.editor import EditorScreen
 from workbench.tui.screens.main import MainScreen
 from workbench.tui.screens.runs import RunsScreen
-from workbench.tui.screens.unsaved_dialog import UnsavedDialog
 from workbench.tui.widgets.key_legend import KeyLegend
 from workbench.tui.widgets.maze_view import MazeView
 from workbench.tui.widgets.run_status import RunStatus
@@ -46,23 +46,23 @@ def status(app: WorkbenchApp) -> str:
 
 def test_unity_keys_turn_by_degree_and_move_at_power(tmp_path):
     app = make_app(maze_file(tmp_path, ROOM, "unity"), paused=True, noise="off")
-    start = app.bench.snapshot().pose
+    start = app.station.snapshot().pose
 
     async def body(pilot: Pilot) -> None:
         await pilot.press("d")
-        app.bench.step(60 * 4)
-        assert app.bench.snapshot().pose.heading == pytest.approx(90, abs=0.5)
+        app.station.step(60 * 4)
+        assert app.station.snapshot().pose.heading == pytest.approx(90, abs=0.5)
         await pilot.press("w")
-        app.bench.step(60)
+        app.station.step(60)
         await pilot.press("space")
-        app.bench.step(30)
+        app.station.step(30)
         app.refresh_views()
         await pilot.pause()
-        pose = app.bench.snapshot().pose
+        pose = app.station.snapshot().pose
         assert pose.y > start.y + 0.5 and pose.x == pytest.approx(start.x, abs=0.05)
-        assert app.screen.query_one(MazeView).robot_cell == app.bench.snapshot().block
+        assert app.screen.query_one(MazeView).robot_cell == app.station.snapshot().block
         assert "driver: keys" in status(app)
-        assert app.bench.keys_used == {"d", "w", "space"}
+        assert app.station.keys_used == {"d", "w", "space"}
 
     run(app, body)
 
@@ -72,26 +72,26 @@ def test_web_keys_spin_until_the_next_key(tmp_path):
 
     async def body(pilot: Pilot) -> None:
         await pilot.press("a")
-        app.bench.step(90)  # (-0.2, 0.2) for 1.5 s: a quarter turn left
-        assert app.bench.snapshot().pose.heading == pytest.approx(270, abs=10)
+        app.station.step(90)  # (-0.2, 0.2) for 1.5 s: a quarter turn left
+        assert app.station.snapshot().pose.heading == pytest.approx(270, abs=10)
         await pilot.press("space")
-        heading = app.bench.snapshot().pose.heading
-        app.bench.step(60)
-        assert app.bench.snapshot().pose.heading == pytest.approx(heading, abs=0.01)
+        heading = app.station.snapshot().pose.heading
+        app.station.step(60)
+        assert app.station.snapshot().pose.heading == pytest.approx(heading, abs=0.01)
 
     run(app, body)
 
 
 def test_erobotic_w_drives_exactly_one_block(tmp_path):
     app = make_app(maze_file(tmp_path, CORRIDOR, "erobotic"), paused=True)
-    start = app.bench.maze.start
+    start = app.station.maze.start
 
     async def body(pilot: Pilot) -> None:
         await pilot.press("w")
-        app.bench.step(120)
+        app.station.step(120)
         app.refresh_views()
         await pilot.pause()
-        snap = app.bench.snapshot()
+        snap = app.station.snapshot()
         assert snap.block == (start[0] + 1, start[1])
         assert snap.metrics.distance_cells == pytest.approx(1.0, abs=1e-6)
         assert app.screen.query_one(MazeView).robot_cell == snap.block
@@ -118,31 +118,31 @@ def test_the_key_legend_follows_the_profile(tmp_path, profile):
 
 def test_pause_step_speed_and_reset(tmp_path):
     app = make_app(maze_file(tmp_path, ROOM, "unity"), noise="off")
-    bench = app.bench
+    station = app.station
 
     async def body(pilot: Pilot) -> None:
         await pilot.press("w")
         await pilot.pause(0.3)
-        assert bench.snapshot().time > 0  # the interval runs the simulation in real time
+        assert station.snapshot().time > 0  # the interval runs the simulation in real time
         await pilot.press("p")
-        assert bench.pacer.paused and "PAUSED" in status(app)
-        t = bench.snapshot().time
+        assert station.pacer.paused and "PAUSED" in status(app)
+        t = station.snapshot().time
         await pilot.pause(0.2)
-        assert bench.snapshot().time == t
+        assert station.snapshot().time == t
         await pilot.press("n")
-        assert bench.snapshot().time == pytest.approx(t + bench.session.every / 60)
-        assert bench.pacer.paused
+        assert station.snapshot().time == pytest.approx(t + station.session.every / 60)
+        assert station.pacer.paused
         seen = []
         for _ in range(5):
             await pilot.press("plus")
             seen.append(status(app).splitlines()[1].split(" at ")[1].split()[0])
         assert seen == ["2x", "4x", "10x", "max", "1x"]
         await pilot.press("r")
-        snap = bench.snapshot()
-        assert snap.time == 0 and snap.block == bench.maze.start
-        assert bench.runs[-1].ended == "reset"
+        snap = station.snapshot()
+        assert snap.time == 0 and snap.block == station.maze.start
+        assert station.runs[-1].ended == "reset"
         await pilot.press("p")
-        assert not bench.pacer.paused and "running" in status(app)
+        assert not station.pacer.paused and "running" in status(app)
 
     run(app, body)
 
@@ -151,10 +151,10 @@ def test_a_slow_frame_loses_no_simulated_time(tmp_path):
     app = make_app(maze_file(tmp_path, ROOM, "unity"), paused=True, tick_hz=20)
 
     async def body(pilot: Pilot) -> None:
-        app.bench.pacer.paused = False
+        app.station.pacer.paused = False
         app._last_tick = perf_counter() - 0.2  # the next tick comes 200 ms late
         app._tick()
-        assert app.bench.snapshot().time == pytest.approx(0.2, abs=2 / 60)
+        assert app.station.snapshot().time == pytest.approx(0.2, abs=2 / 60)
 
     run(app, body)
 
@@ -209,9 +209,9 @@ def test_the_command_palette_offers_the_bindings_and_runs_them(tmp_path):
         await pilot.press("enter")
         for _ in range(20):
             await pilot.pause(0.05)
-            if app.bench.pacer.speed == 2.0:
+            if app.station.pacer.speed == 2.0:
                 break
-        assert app.bench.pacer.speed == 2.0
+        assert app.station.pacer.speed == 2.0
 
     run(app, body)
 
@@ -240,7 +240,7 @@ def test_a_terminal_below_80x24_gets_a_message_instead_of_the_layout(tmp_path):
         assert "70x20" in text and "80x24" in text
         await pilot.press("w", "question_mark")
         assert isinstance(app.screen, TooSmallScreen)
-        assert app.bench.keys_used == set()
+        assert app.station.keys_used == set()
         await pilot.resize_terminal(80, 24)
         await pilot.pause(0.1)
         assert isinstance(app.screen, MainScreen)
@@ -283,7 +283,7 @@ def test_ctrl_q_quits_and_keeps_the_open_run(tmp_path):
 
     run(app, body)
     assert app.return_code == 0
-    assert [r.ended for r in app.bench.runs] == ["stopped"]
+    assert [r.ended for r in app.station.runs] == ["stopped"]
 
 
 def test_e_opens_the_maze_editor_and_capital_r_the_runs(tmp_path):
@@ -295,8 +295,8 @@ def test_e_opens_the_maze_editor_and_capital_r_the_runs(tmp_path):
         assert isinstance(app.screen, EditorScreen)
         titles = [t for t, _h, _r in WorkbenchCommands(app.screen)._commands()]
         assert "App: quit" in titles and any(t.startswith("Editor: ") for t in titles)
-        edited = app.bench.maze.with_block(5, 2, True)
-        app.bench.load_maze(edited)  # what the editor does with a valid edit on leaving
+        edited = app.station.maze.with_block(5, 2, True)
+        app.station.load_maze(edited)  # what the editor does with a valid edit on leaving
         app.screen.dismiss(edited)
         await pilot.pause()
         assert isinstance(app.screen, MainScreen)
@@ -330,8 +330,8 @@ def test_make_app_reports_bad_arguments_in_words(tmp_path):
 
 def test_make_app_defaults_to_the_bundled_maze():
     app = make_app(paused=True)
-    assert app.bench.maze.name == "Unity default" and app.bench.profile == "unity"
-    assert app.bench.pacer.paused
+    assert app.station.maze.name == "Unity default" and app.station.profile == "unity"
+    assert app.station.pacer.paused
 
 
 @pytest.mark.parametrize(

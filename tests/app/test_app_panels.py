@@ -9,8 +9,8 @@ from textual.widgets import Input, OptionList, Select, Static
 from tests.app.support import run
 from workbench.sim.sensors import SensorSpec
 from workbench.tui.app import WorkbenchApp, make_app
-from workbench.tui.modals.algorithm import AlgorithmModal
-from workbench.tui.modals.sensor_ports import SensorPortsModal
+from workbench.tui.dialogs.algorithm import AlgorithmModal
+from workbench.tui.dialogs.sensor_ports import SensorPortsModal
 from workbench.tui.screens.main import MainScreen
 from workbench.tui.widgets.algorithm_state import AlgorithmState
 from workbench.tui.widgets.param_editor import ParamEditor
@@ -72,7 +72,7 @@ def test_the_panel_opens_with_two_distance_sensors_and_a_touch_sensor():
             ("touch", "3", None),
         ]
         readings = [str(e.query_one(".row-reading").render()) for e in row_editors(screen)]
-        snap = app.bench.snapshot()
+        snap = app.station.snapshot()
         assert readings == [f"{snap.readings[1]:.2f}", f"{snap.readings[2]:.2f}", "not mounted"]
 
     run(app, body)
@@ -80,7 +80,7 @@ def test_the_panel_opens_with_two_distance_sensors_and_a_touch_sensor():
 
 def test_duplicate_and_out_of_range_ports_are_shown_inline_and_nothing_is_applied():
     app = unity_app()
-    before = list(app.bench.sensors)
+    before = list(app.station.sensors)
 
     async def body(pilot: Pilot) -> None:
         screen = await open_ports(pilot)
@@ -96,7 +96,7 @@ def test_duplicate_and_out_of_range_ports_are_shown_inline_and_nothing_is_applie
         assert all(e.has_class("-invalid") for e in (first, second, third))
         status = text_of(screen.query_one("#ports-status", Static))
         assert status.startswith("nothing applied: 3 rows to fix")
-        assert app.bench.sensors == before
+        assert app.station.sensors == before
         set_row(second, port="2")
         set_row(third, port="5")
         await pilot.pause()
@@ -116,12 +116,12 @@ def test_a_valid_apply_changes_the_live_robot_and_the_readings_by_port():
         await pilot.pause()
         first.query_one(".row-port", Input).focus()
         await pilot.press("enter")  # enter in a port field applies
-        assert app.bench.sensors == [
+        assert app.station.sensors == [
             SensorSpec("distance", 7, "right"),
             SensorSpec("distance", 2, "front"),
             SensorSpec("touch", 3, "back"),
         ]
-        assert set(app.bench.snapshot().readings) == {7, 2, 3}
+        assert set(app.station.snapshot().readings) == {7, 2, 3}
         await pilot.pause()
         assert str(third.query_one(".row-reading").render()) == "free"
         await pilot.press("escape")
@@ -140,7 +140,7 @@ def test_presets_add_and_remove_rows():
         screen = await open_ports(pilot)
         await click(pilot, "#preset-web-two-distance")
         await pilot.pause()
-        assert app.bench.sensors == [SensorSpec("distance", 3, "front")]
+        assert app.station.sensors == [SensorSpec("distance", 3, "front")]
         assert [(r.kind, r.port, r.mount) for r in screen.rows()] == [
             ("distance", "3", "front"),
             ("distance", "1", None),
@@ -148,7 +148,7 @@ def test_presets_add_and_remove_rows():
         ]
         await click(pilot, "#preset-web-wall-following")
         await pilot.pause()
-        assert app.bench.sensors == [
+        assert app.station.sensors == [
             SensorSpec("distance", 1, "right"),
             SensorSpec("touch", 2, "front"),
         ]
@@ -160,7 +160,7 @@ def test_presets_add_and_remove_rows():
         assert [r.port for r in screen.rows()] == ["2", "3", "4"]
         assert [e.number for e in row_editors(screen)] == [1, 2, 3]
         await click(pilot, "#ports-apply")
-        assert app.bench.sensors == [SensorSpec("touch", 2, "front")]
+        assert app.station.sensors == [SensorSpec("touch", 2, "front")]
 
     run(app, body)
 
@@ -190,7 +190,7 @@ def test_choosing_shows_description_sensors_and_parameters():
     async def body(pilot: Pilot) -> None:
         screen = await open_algorithms(pilot)
         await choose_builtin(pilot, screen, "right-wall")
-        assert app.bench.algorithm.name == "right-wall"
+        assert app.station.algorithm.name == "right-wall"
         assert text_of(screen.query_one("#alg-title", Static)) == "right-wall  (built-in)"
         assert "Right-wall following" in text_of(screen.query_one("#alg-description", Static))
         sensors = text_of(screen.query_one("#alg-sensors", Static))
@@ -204,7 +204,7 @@ def test_choosing_shows_description_sensors_and_parameters():
 
 def test_start_and_the_state_display_follows_the_engine():
     app = unity_app()
-    bench = app.bench
+    station = app.station
 
     async def body(pilot: Pilot) -> None:
         screen = await open_algorithms(pilot)
@@ -212,22 +212,22 @@ def test_start_and_the_state_display_follows_the_engine():
         await click(pilot, "#alg-start")
         await pilot.pause()
         assert isinstance(app.screen, MainScreen)
-        assert bench.controller is not None and not bench.pacer.paused
-        bench.pacer.paused = True
+        assert station.controller is not None and not station.pacer.paused
+        station.pacer.paused = True
         state = app.screen.query_one(AlgorithmState)
         seen = set()
         for _ in range(40):
-            bench.step(60)
+            station.step(60)
             app.refresh_views()
             await pilot.pause()
-            assert state.highlighted == bench.controller.state
+            assert state.highlighted == station.controller.state
             seen.add(state.highlighted)
         assert len(seen) >= 3
-        assert state.summary.startswith(f"in {bench.controller.state}")
-        last = bench.controller.history[-1]
+        assert state.summary.startswith(f"in {station.controller.state}")
+        last = station.controller.history[-1]
         assert state.last.startswith(f"{last.time:.1f} s {last.source} -> {last.target}")
         log = app.screen.query_one(TransitionLog)
-        assert log.line_count == len(bench.controller.history)
+        assert log.line_count == len(station.controller.history)
         assert "driver: algorithm right-wall" in "\n".join(app.screen.query_one("#run").lines)
 
     run(app, body)
@@ -235,7 +235,7 @@ def test_start_and_the_state_display_follows_the_engine():
 
 def test_pause_step_and_reset_from_the_dialog():
     app = unity_app()
-    bench = app.bench
+    station = app.station
 
     async def body(pilot: Pilot) -> None:
         screen = await open_algorithms(pilot)
@@ -244,59 +244,59 @@ def test_pause_step_and_reset_from_the_dialog():
         await pilot.pause()
         screen = await open_algorithms(pilot)
         await click(pilot, "#alg-pause")
-        assert bench.pacer.paused
-        t = bench.snapshot().time
+        assert station.pacer.paused
+        t = station.snapshot().time
         await click(pilot, "#alg-step")
-        assert bench.snapshot().time == pytest.approx(t + bench.session.every / 60)
+        assert station.snapshot().time == pytest.approx(t + station.session.every / 60)
         assert "running, in" in str(screen.query_one("#alg-live").render())
         await click(pilot, "#alg-reset")
-        assert bench.controller is None and bench.snapshot().time == 0
-        assert bench.runs[-1].ended == "reset"
+        assert station.controller is None and station.snapshot().time == 0
+        assert station.runs[-1].ended == "reset"
 
     run(app, body, size=(120, 40))
 
 
 def test_x_starts_and_stops_the_chosen_algorithm_from_the_main_screen():
     app = unity_app()
-    app.bench.select_algorithm("right-wall")
+    app.station.select_algorithm("right-wall")
 
     async def body(pilot: Pilot) -> None:
         await pilot.press("x")
-        assert app.bench.controller is not None
+        assert app.station.controller is not None
         await pilot.press("x")
-        assert app.bench.controller is None
-        assert str(app.bench.snapshot().driver) == "keys"
+        assert app.station.controller is None
+        assert str(app.station.snapshot().driver) == "keys"
 
     run(app, body)
 
 
 def test_a_missing_sensor_is_explained_with_a_one_key_fix():
     app = unity_app()
-    bench = app.bench
-    bench.apply_preset("web-two-distance")
-    bench.select_algorithm("right-wall")
+    station = app.station
+    station.apply_preset("web-two-distance")
+    station.select_algorithm("right-wall")
 
     async def body(pilot: Pilot) -> None:
         state = app.screen.query_one(AlgorithmState)
         assert "cannot start" in state.summary and "f fits" in state.summary
         await pilot.press("x")
-        assert bench.controller is None
-        assert "f fits the sensors it needs" in bench.message
+        assert station.controller is None
+        assert "f fits the sensors it needs" in station.message
         await pilot.press("f")
-        assert bench.missing_sensors() is None
-        assert bench.sensors == [
+        assert station.missing_sensors() is None
+        assert station.sensors == [
             SensorSpec("distance", 1, "right"),
             SensorSpec("distance", 2, "front"),
         ]
         await pilot.press("x")
-        assert bench.controller is not None
+        assert station.controller is not None
 
     run(app, body)
 
 
 def test_the_dialog_explains_a_missing_sensor_and_f_fixes_it():
     app = unity_app()
-    app.bench.apply_preset("web-two-distance")
+    app.station.apply_preset("web-two-distance")
 
     async def body(pilot: Pilot) -> None:
         screen = await open_algorithms(pilot)
@@ -304,12 +304,12 @@ def test_the_dialog_explains_a_missing_sensor_and_f_fixes_it():
         missing = screen.query_one("#alg-missing", Static)
         assert missing.display and "needs a distance sensor mounted right" in text_of(missing)
         await click(pilot, "#alg-start")
-        assert app.bench.controller is None
+        assert app.station.controller is None
         assert "press f" in text_of(screen.query_one("#alg-error", Static))
         await pilot.press("f")
-        assert app.bench.missing_sensors() is None and not missing.display
+        assert app.station.missing_sensors() is None and not missing.display
         await click(pilot, "#alg-start")
-        assert app.bench.controller is not None
+        assert app.station.controller is not None
 
     run(app, body, size=(120, 40))
 
@@ -328,7 +328,7 @@ def test_a_bad_fsm_file_is_reported_with_file_line_and_column(tmp_path):
         await pilot.pause()
         error = text_of(screen.query_one("#alg-error", Static))
         assert error.startswith(f"{bad}:6:")
-        assert app.bench.algorithm is None
+        assert app.station.algorithm is None
 
     run(app, body, size=(120, 40))
 
@@ -348,7 +348,7 @@ def test_a_good_fsm_file_loads(tmp_path):
         screen.query_one("#alg-path", Input).value = str(good)
         await click(pilot, "#alg-load")
         await pilot.pause()
-        assert app.bench.algorithm is not None and app.bench.algorithm.name == "mine"
+        assert app.station.algorithm is not None and app.station.algorithm.name == "mine"
         assert text_of(screen.query_one("#alg-title", Static)) == f"mine  ({good})"
         assert text_of(screen.query_one("#alg-error", Static)) == ""
 
@@ -367,14 +367,14 @@ def test_parameters_are_checked_as_typed_and_reset_to_defaults():
         assert editor.invalid
         assert "above its maximum 1" in text_of(editor.query_one(".param-error", Static))
         await click(pilot, "#alg-start")
-        assert app.bench.controller is None
+        assert app.station.controller is None
         assert "forward_power" in text_of(screen.query_one("#alg-error", Static))
         editor.query_one(Input).value = "0.5"
         await pilot.pause()
-        assert not editor.invalid and app.bench.params()["forward_power"] == 0.5
+        assert not editor.invalid and app.station.params()["forward_power"] == 0.5
         await click(pilot, "#alg-defaults")
         await pilot.pause()
-        assert app.bench.params()["forward_power"] == 1.0
+        assert app.station.params()["forward_power"] == 1.0
         fresh = next(e for e in screen.query(ParamEditor) if e.parameter.name == "forward_power")
         assert fresh.text == "1"
 
@@ -389,12 +389,12 @@ def test_a_failing_algorithm_stops_with_its_reason_on_the_message_line(tmp_path)
         "      - when: 1 / (front - front) > 0\n        to: Go\n"
     )
     app = unity_app()
-    app.bench.select_algorithm(failing)
+    app.station.select_algorithm(failing)
 
     async def body(pilot: Pilot) -> None:
         await pilot.press("x")
         await pilot.pause(0.3)
-        assert app.bench.controller is None
+        assert app.station.controller is None
         message = app.screen.query_one("#message").message
         assert message.startswith("algorithm stopped: failing, state Go")
 

@@ -38,11 +38,11 @@ def test_a_viple_program_drives_the_robot_the_app_shows(tmp_path):
             reader, writer = await asyncio.open_connection("127.0.0.1", port)
             report = await asyncio.wait_for(reader.readline(), 2)
             assert report.startswith(b'{"sensors":[')
-            x0 = app.bench.snapshot().pose.x
+            x0 = app.station.snapshot().pose.x
             writer.write(b'{"servos":[{"isTurn":false,"servoId":-1,"servoSpeed":"1"}]}\r\n')
             await writer.drain()
             await pilot.pause(0.5)
-            snap = app.bench.snapshot()
+            snap = app.station.snapshot()
             assert snap.pose.x > x0 + 20  # heading right at 120 px/s
             assert str(snap.driver).startswith("VIPLE tcp 127.0.0.1:")
             assert "in 1 out" in status(app)
@@ -52,9 +52,9 @@ def test_a_viple_program_drives_the_robot_the_app_shows(tmp_path):
             assert "1 rejected (last: line 2: not JSON" in status(app)
             writer.close()
             await pilot.pause(0.3)
-            x1 = app.bench.snapshot().pose.x
+            x1 = app.station.snapshot().pose.x
             await pilot.pause(0.2)
-            assert app.bench.snapshot().pose.x == x1  # the robot stopped when VIPLE went
+            assert app.station.snapshot().pose.x == x1  # the robot stopped when VIPLE went
             await pilot.press("ctrl+q")
 
     asyncio.run(go())
@@ -73,6 +73,6 @@ def test_a_port_in_use_is_shown_and_the_app_keeps_working(tmp_path):
                 assert f"VIPLE tcp not listening: port {port} is in use" in status(app)
                 await pilot.press("d")
                 await pilot.press("n")
-                assert app.bench.keys_used == {"d"}
+                assert app.station.keys_used == {"d"}
 
         asyncio.run(go())

@@ -9,11 +9,11 @@ from textual.widgets import Input, Static
 from tests.bad_files import SECRET, write_corpus
 from workbench.labs import model
 from workbench.tui.app import make_app
-from workbench.tui.modals.algorithm import AlgorithmModal
+from workbench.tui.dialogs.algorithm import AlgorithmModal
+from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.screens import labs as labs_screen
 from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
-from workbench.tui.screens.path_dialog import PathDialog
 
 from .labs_support import lab_app, text
 from .support import run
@@ -39,7 +39,7 @@ def test_m_with_a_bad_maze_shows_the_error_and_keeps_the_maze(corpus, name):
     path = corpus[name]
 
     async def body(pilot: Pilot) -> None:
-        before = app.bench.maze
+        before = app.station.maze
         await pilot.press("m")
         app.screen.query_one("#path", Input).value = str(path)
         await pilot.press("enter")
@@ -50,7 +50,7 @@ def test_m_with_a_bad_maze_shows_the_error_and_keeps_the_maze(corpus, name):
         assert path.name in error and SECRET not in error
         await pilot.press("escape")
         assert isinstance(app.screen, MainScreen)
-        assert app.bench.maze is before and app.is_running
+        assert app.station.maze is before and app.is_running
 
     run(app, body)
 
@@ -72,7 +72,7 @@ def test_g_with_a_bad_fsm_file_shows_the_error_and_keeps_running(corpus, name):
         await pilot.pause()
         error = shown(screen.query_one("#alg-error", Static))
         assert error.startswith(str(path)) and SECRET not in error
-        assert app.bench.algorithm is None and app.is_running
+        assert app.station.algorithm is None and app.is_running
 
     run(app, body, size=(120, 40))
 

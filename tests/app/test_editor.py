@@ -6,15 +6,15 @@ from textual.screen import Screen
 from textual.widgets import Input, OptionList, Select
 
 from tests.app.support import sync
-from workbench.control.bench import Bench
+from workbench.control.station import LabStation
 from workbench.sim.mazefile import write_maze
 from workbench.sim.mazeio import load_maze
+from workbench.tui.dialogs.generate import GenerateDialog
+from workbench.tui.dialogs.path import PathDialog
+from workbench.tui.dialogs.size import SizeDialog
+from workbench.tui.dialogs.unsaved import UnsavedDialog
 from workbench.tui.host import ScreenHost
 from workbench.tui.screens.editor import EditorScreen
-from workbench.tui.screens.generate_dialog import GenerateDialog
-from workbench.tui.screens.path_dialog import PathDialog
-from workbench.tui.screens.size_dialog import SizeDialog
-from workbench.tui.screens.unsaved_dialog import UnsavedDialog
 from workbench.tui.widgets import MazeView
 
 ROOM_TEXT = "#######\n#S....#\n#.....#\n#....E#\n#######\n"
@@ -37,13 +37,13 @@ def room(tmp_path, name="room.txt"):
     path = tmp_path / name
     path.write_text(ROOM_TEXT)
     maze = load_maze(path)
-    return path, Bench.open(maze, "erobotic", noise="off")
+    return path, LabStation.open(maze, "erobotic", noise="off")
 
 
 def editor_app(tmp_path, with_path=True):
-    path, bench = room(tmp_path)
-    screen = EditorScreen(bench, str(path) if with_path else None, unicode=False)
-    return Host(screen), screen, bench, path
+    path, station = room(tmp_path)
+    screen = EditorScreen(station, str(path) if with_path else None, unicode=False)
+    return Host(screen), screen, station, path
 
 
 @sync
@@ -155,17 +155,17 @@ async def test_save_as_asks_for_a_path_and_reports_failures(tmp_path):
 
 @sync
 async def test_escape_without_changes_leaves_and_keeps_the_run(tmp_path):
-    app, _screen, bench, _ = editor_app(tmp_path)
-    maze = bench.maze
+    app, _screen, station, _ = editor_app(tmp_path)
+    maze = station.maze
     async with app.run_test(size=SIZE) as pilot:
         await pilot.press("escape")
         await pilot.pause()
-        assert app.results == [None] and bench.maze is maze
+        assert app.results == [None] and station.maze is maze
 
 
 @sync
 async def test_unsaved_prompt_cancel_stays_in_the_editor(tmp_path):
-    app, screen, _bench, _ = editor_app(tmp_path)
+    app, screen, _station, _ = editor_app(tmp_path)
     async with app.run_test(size=SIZE) as pilot:
         await pilot.press("right", "space", "escape")
         assert isinstance(app.screen, UnsavedDialog)
@@ -178,31 +178,31 @@ async def test_unsaved_prompt_cancel_stays_in_the_editor(tmp_path):
 
 
 @sync
-async def test_unsaved_prompt_discard_leaves_the_bench_and_file_alone(tmp_path):
-    app, _screen, bench, path = editor_app(tmp_path)
-    maze = bench.maze
+async def test_unsaved_prompt_discard_leaves_the_station_and_file_alone(tmp_path):
+    app, _screen, station, path = editor_app(tmp_path)
+    maze = station.maze
     async with app.run_test(size=SIZE) as pilot:
         await pilot.press("right", "space", "escape", "d")
         await pilot.pause()
-        assert app.results == [None] and bench.maze is maze
+        assert app.results == [None] and station.maze is maze
         assert path.read_text() == ROOM_TEXT
 
 
 @sync
-async def test_unsaved_prompt_save_writes_and_gives_the_bench_the_maze(tmp_path):
-    app, _screen, bench, path = editor_app(tmp_path)
+async def test_unsaved_prompt_save_writes_and_gives_the_station_the_maze(tmp_path):
+    app, _screen, station, path = editor_app(tmp_path)
     async with app.run_test(size=SIZE) as pilot:
         await pilot.press("right", "space", "escape", "s")
         await pilot.pause()
         (given,) = app.results
-        assert given is bench.maze and bench.maze.is_wall(2, 1)
+        assert given is station.maze and station.maze.is_wall(2, 1)
         assert load_maze(path).is_wall(2, 1)
-        assert "edited maze" in bench.message
+        assert "edited maze" in station.message
 
 
 @sync
 async def test_unsaved_prompt_save_without_a_path_asks_for_one_then_leaves(tmp_path):
-    app, _screen, bench, _ = editor_app(tmp_path, with_path=False)
+    app, _screen, station, _ = editor_app(tmp_path, with_path=False)
     async with app.run_test(size=SIZE) as pilot:
         await pilot.press("right", "space", "escape", "s")
         await pilot.pause()
@@ -210,24 +210,24 @@ async def test_unsaved_prompt_save_without_a_path_asks_for_one_then_leaves(tmp_p
         app.screen.query_one(Input).value = str(tmp_path / "saved.txt")
         await pilot.press("enter")
         await pilot.pause()
-        assert len(app.results) == 1 and bench.maze.is_wall(2, 1)
+        assert len(app.results) == 1 and station.maze.is_wall(2, 1)
         assert load_maze(tmp_path / "saved.txt").is_wall(2, 1)
 
 
 @sync
-async def test_leaving_with_an_invalid_maze_keeps_the_old_one_on_the_bench(tmp_path):
-    app, screen, bench, _ = editor_app(tmp_path)
-    maze = bench.maze
+async def test_leaving_with_an_invalid_maze_keeps_the_old_one_on_the_station(tmp_path):
+    app, screen, station, _ = editor_app(tmp_path)
+    maze = station.maze
     async with app.run_test(size=SIZE) as pilot:
         await pilot.press(*["right"] * 5, "space", "escape", "d")  # discard: nothing saved
         await pilot.pause()
-        assert bench.maze is maze
-    app, screen, bench, _path = editor_app(tmp_path)
+        assert station.maze is maze
+    app, screen, station, _path = editor_app(tmp_path)
     async with app.run_test(size=SIZE) as pilot:
         await pilot.press(*["right"] * 5, "space", "ctrl+s", "escape")
         await pilot.pause()
-        assert app.results == [None] and bench.maze is not screen.editor.maze
-        assert bench.message == "the maze has 1 problem, so the robot stays on the previous maze"
+        assert app.results == [None] and station.maze is not screen.editor.maze
+        assert station.message == "the maze has 1 problem, so the robot stays on the previous maze"
 
 
 @sync
@@ -299,11 +299,11 @@ async def test_unicode_follows_the_screen_setting(tmp_path):
         assert not screen.query_one(MazeView).unicode
 
 
-def test_the_editor_saves_into_the_bench_maze_file_it_was_given(tmp_path):
-    maze_path, bench = room(tmp_path)
-    write_maze(maze_path, bench.maze.with_block(3, 2, True))
-    screen = EditorScreen(bench, str(maze_path))
-    assert screen.editor.path == str(maze_path) and screen.editor.maze is bench.maze
+def test_the_editor_saves_into_the_station_maze_file_it_was_given(tmp_path):
+    maze_path, station = room(tmp_path)
+    write_maze(maze_path, station.maze.with_block(3, 2, True))
+    screen = EditorScreen(station, str(maze_path))
+    assert screen.editor.path == str(maze_path) and screen.editor.maze is station.maze
 
 
 @sync

@@ -8,7 +8,7 @@ from textual.widgets import Input, OptionList, Static
 
 from workbench.labs.store import Store
 from workbench.tui.app import make_app
-from workbench.tui.modals.identity import IdentityDialog
+from workbench.tui.dialogs.identity import IdentityDialog
 from workbench.tui.screens.main import MainScreen
 from workbench.viple.tcp_server import TcpConfig
 
@@ -143,8 +143,8 @@ def test_the_set_up_of_a_websocket_exercise_starts_the_websocket_client(tmp_path
         await pilot.pause()
         assert app.endpoints is not None and app.endpoints.ws is not None
         assert app.endpoints.ws.config.url == "ws://localhost:8124/"
-        assert "robot connects to ws://localhost:8124/" in app.bench.message
-        assert "VIPLE ws waiting for ws://localhost:8124/" in app.bench.connection
+        assert "robot connects to ws://localhost:8124/" in app.station.message
+        assert "VIPLE ws waiting for ws://localhost:8124/" in app.station.connection
         assert screen is app.screen
 
     run(app, body)
@@ -158,7 +158,7 @@ def test_the_set_up_of_a_tcp_exercise_starts_listening(tmp_path):
         text_shown = await app.open_endpoint("tcp")
         port = app.endpoints.tcp.port
         assert port > 0 and text_shown == f"VIPLE: connect your program (TCP) to localhost:{port}"
-        assert f"VIPLE tcp listening on 127.0.0.1:{port}" in app.bench.connection
+        assert f"VIPLE tcp listening on 127.0.0.1:{port}" in app.station.connection
         assert await app.open_endpoint("tcp") == text_shown  # already listening: the same
 
     run(app, body)
@@ -181,8 +181,8 @@ def test_a_store_with_unreadable_progress_says_so_and_starts_that_exercise_afres
 
 def test_a_bundled_maze_is_never_saved_over_the_editor_asks_where(tmp_path):
     from workbench.files.bundled import default_maze_path
+    from workbench.tui.dialogs.path import PathDialog
     from workbench.tui.screens.editor import EditorScreen
-    from workbench.tui.screens.path_dialog import PathDialog
 
     bundled = default_maze_path()
     before = bundled.read_bytes()
@@ -244,7 +244,7 @@ def test_a_websocket_url_can_wait_until_asked_and_v_connects(tmp_path):
         await app.workers.wait_for_complete()
         await pilot.pause()
         assert app.endpoints.ws is not None and app.endpoints.ws.config.url == url
-        assert app.bench.message == (
+        assert app.station.message == (
             f"VIPLE: start your program's WebSocket server; the robot connects to {url}"
         )
 

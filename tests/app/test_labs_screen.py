@@ -9,7 +9,7 @@ from textual.widgets import Button, Checkbox, Input, OptionList, Select, Static
 from workbench.cli import build_parser
 from workbench.labs import signoff as so
 from workbench.labs.store import Store
-from workbench.tui.modals.signoff import SignoffModal
+from workbench.tui.dialogs.signoff import SignoffModal
 from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
 
@@ -25,11 +25,11 @@ async def complete_drive_by_wire(pilot: Pilot, screen: LabsScreen) -> None:
     await pilot.press("a")  # the set-up
     await pilot.press("escape")
     await pilot.press("w", "a", "s", "d", "space")
-    bench = pilot.app.bench
-    maze = bench.maze
+    station = pilot.app.station
+    maze = station.maze
     inner = next((x, y) for y in range(1, maze.height - 1) for x in range(1, maze.width - 1)
                  if maze.is_wall(x, y))  # fmt: skip
-    bench.load_maze(maze.with_block(*inner, wall=False))  # what the editor puts on the bench
+    station.load_maze(maze.with_block(*inner, wall=False))  # what the editor puts on the station
     await pilot.press("l")
     await pilot.pause()
     screen.query_one("#q-tcp-port", Input).value = "1350"
@@ -59,7 +59,7 @@ def test_set_up_then_driving_flips_the_keys_objective_and_saves_progress(tmp_pat
         screen = await open_exercise(pilot)
         assert text(screen, "#labs-objectives").startswith("✗ drove with w, a, s, d and space")
         await pilot.press("a")
-        assert app.bench.profile == "unity"
+        assert app.station.profile == "unity"
         assert "set up: unity" in text(screen, "#labs-message")
         await pilot.press("escape")
         await pilot.press("w", "a", "s", "d", "space")
@@ -284,7 +284,7 @@ def test_a_data_folder_that_cannot_open_is_reported_and_the_labs_still_work(tmp_
         assert app.store is None
         assert text(screen, "#labs-message").startswith("cannot open the data folder")
         await pilot.press("a")
-        assert app.bench.profile == "unity"
+        assert app.station.profile == "unity"
         await pilot.press("i")
         assert app.screen is screen
         assert "cannot open the data folder" in text(screen, "#labs-message")

@@ -26,13 +26,13 @@ from workbench.labs import signoff as so
 from workbench.labs.model import Exercise, Lab, LabMaze, Objective, load_labs
 from workbench.labs.store import Store
 from workbench.tui.app import WorkbenchApp, make_app
-from workbench.tui.modals.algorithm import AlgorithmModal
-from workbench.tui.modals.sensor_ports import SensorPortsModal
-from workbench.tui.modals.signoff import SignoffModal
+from workbench.tui.dialogs.algorithm import AlgorithmModal
+from workbench.tui.dialogs.path import PathDialog
+from workbench.tui.dialogs.sensor_ports import SensorPortsModal
+from workbench.tui.dialogs.signoff import SignoffModal
 from workbench.tui.screens.editor import EditorScreen
 from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
-from workbench.tui.screens.path_dialog import PathDialog
 from workbench.tui.widgets.param_editor import ParamEditor
 from workbench.tui.widgets.sensor_row_editor import SensorRowEditor
 from workbench.viple.tcp_server import TcpConfig
@@ -59,8 +59,8 @@ class Walkthrough:
         self.met: set[str] = set()
 
     @property
-    def bench(self):
-        return self.app.bench
+    def station(self):
+        return self.app.station
 
     async def press(self, *keys: str) -> None:
         await self.pilot.press(*keys)
@@ -92,7 +92,7 @@ class Walkthrough:
     # -- the work --------------------------------------------------------------------------
     async def load_maze(self, lab_maze: LabMaze) -> None:
         """The maze key: type the file's path in the dialog."""
-        if self.bench.maze.same_layout(lab_maze.maze):
+        if self.station.maze.same_layout(lab_maze.maze):
             return
         await self.main_screen()
         await self.press("m")
@@ -101,7 +101,7 @@ class Walkthrough:
         dialog.query_one("#path", Input).value = str(lab_maze.path)
         await self.press("enter")
         assert isinstance(self.app.screen, MainScreen)
-        assert self.bench.maze.same_layout(lab_maze.maze), self.bench.message
+        assert self.station.maze.same_layout(lab_maze.maze), self.station.message
 
     async def algorithm_dialog(self) -> AlgorithmModal:
         await self.main_screen()
@@ -112,12 +112,12 @@ class Walkthrough:
 
     async def run_builtin(self, name: str) -> None:
         """A built-in algorithm: picked in the algorithm dialog the first time the pair meets
-        it, its sensors fitted (f), started; later through the bench, as the dialog does."""
-        bench = self.bench
+        it, its sensors fitted (f), started; later through the station, as the dialog does."""
+        station = self.station
         if name in self.met:
-            bench.select_algorithm(name)
-            bench.apply_algorithm_preset()
-            bench.start_algorithm()
+            station.select_algorithm(name)
+            station.apply_algorithm_preset()
+            station.start_algorithm()
             await self.run_to_exit()
             return
         self.met.add(name)
@@ -126,20 +126,20 @@ class Walkthrough:
         options.highlighted = list_algorithms().index(name)
         options.focus()
         await self.press("enter")
-        assert bench.algorithm is not None and bench.algorithm.name == name
-        if bench.missing_sensors():
+        assert station.algorithm is not None and station.algorithm.name == name
+        if station.missing_sensors():
             await self.press("f")  # fit the sensors the algorithm reads
         await self.start(modal)
 
     async def run_starter(self, path: str) -> None:
         """The exercise's starter FSM, completed in the parameter editor and started; once it
         is complete, x runs it again (on another maze, say)."""
-        bench = self.bench
-        definition = bench.algorithm
+        station = self.station
+        definition = station.algorithm
         if definition is not None and definition.source == path and self.completed(definition):
             await self.main_screen()
             await self.press("x")
-            assert bench.controller is not None, bench.message
+            assert station.controller is not None, station.message
             await self.run_to_exit()
             return
         modal = await self.algorithm_dialog()
@@ -148,18 +148,18 @@ class Walkthrough:
             field.value = path
             await field.action_submit()
             await self.pilot.pause()
-        definition = bench.algorithm
+        definition = station.algorithm
         assert definition is not None and definition.source == path
         editors = {e.parameter.name: e for e in modal.query(ParamEditor)}
         for item in SOLUTIONS[definition.name]:
             name, value = item.split("=")
             editors[name].query_one(Input).value = value
         await self.pilot.pause()
-        assert self.completed(definition), bench.params()
+        assert self.completed(definition), station.params()
         await self.start(modal)
 
     def completed(self, definition) -> bool:
-        params = self.bench.params()
+        params = self.station.params()
         return all(
             params[name] == float(value)
             for name, value in (item.split("=") for item in SOLUTIONS[definition.name])
@@ -169,19 +169,19 @@ class Walkthrough:
         await self.pilot.click("#alg-start")
         await self.pilot.pause()
         assert self.app.screen is not modal, str(modal.query_one("#alg-error").render())
-        assert self.bench.controller is not None
+        assert self.station.controller is not None
         await self.run_to_exit()
 
     async def run_to_exit(self) -> None:
         """Step the running algorithm in large batches until its run ends."""
-        bench = self.bench
-        done = len(bench.runs)
+        station = self.station
+        done = len(station.runs)
         for _ in range(600):
-            bench.step(60)
-            if len(bench.runs) > done:
+            station.step(60)
+            if len(station.runs) > done:
                 break
-        last = bench.runs[-1]
-        assert len(bench.runs) > done and last.ended == "exit", (last, bench.message)
+        last = station.runs[-1]
+        assert len(station.runs) > done and last.ended == "exit", (last, station.message)
         await self.pilot.pause()
 
     async def reach_exit(self, ex: Exercise, obj: Objective) -> None:
@@ -204,7 +204,7 @@ class Walkthrough:
         await self.main_screen()
         for key in obj.keys:
             await self.press(key)
-            self.bench.step(10)
+            self.station.step(10)
 
     async def set_sensors(self, obj: Objective) -> None:
         """The sensor panel (o): kinds, ports and mounts typed in its rows, then Apply."""
@@ -228,7 +228,7 @@ class Walkthrough:
         await self.pilot.pause()
         assert str(modal.query_one("#ports-status").render()).startswith("applied:")
         await self.press("escape")
-        assert {str(s) for s in self.bench.sensors} == {str(s) for s in obj.sensors}
+        assert {str(s) for s in self.station.sensors} == {str(s) for s in obj.sensors}
 
     async def edit_maze(self) -> None:
         """The maze editor: open an inner wall, save the maze as a new file, go back."""
@@ -236,7 +236,7 @@ class Walkthrough:
         await self.press("e")
         editor = self.app.screen
         assert isinstance(editor, EditorScreen)
-        maze = self.bench.maze
+        maze = self.station.maze
         target = next((x, y) for y in range(1, maze.height - 1) for x in range(1, maze.width - 1)
                       if maze.is_wall(x, y))  # fmt: skip
         x, y = editor.editor.cursor
@@ -252,7 +252,7 @@ class Walkthrough:
         assert not editor.dirty, editor.status
         await self.press("escape")
         assert isinstance(self.app.screen, MainScreen)
-        assert not self.bench.maze.same_layout(maze)
+        assert not self.station.maze.same_layout(maze)
 
     async def answer_questions(self, ex: Exercise) -> None:
         screen = await self.labs()
@@ -274,7 +274,7 @@ class Walkthrough:
             await self.load_maze(ex.setup.maze)
         for obj in ex.objectives:
             if obj.kind == "sensors":
-                if {str(s) for s in self.bench.sensors} != {str(s) for s in obj.sensors}:
+                if {str(s) for s in self.station.sensors} != {str(s) for s in obj.sensors}:
                     await self.set_sensors(obj)
             elif obj.kind == "keys":
                 await self.drive_keys(obj)
@@ -288,7 +288,7 @@ class Walkthrough:
         modal = self.app.screen
         assert isinstance(modal, SignoffModal)
         assert "all objectives pass" in str(modal.query_one("#signoff-state").render())
-        modal.query_one("#signoff-note", Input).value = "seen at the bench"
+        modal.query_one("#signoff-note", Input).value = "seen at the station"
         field = modal.query_one("#signoff-passphrase", Input)
         field.value = PASS
         field.focus()
@@ -330,15 +330,15 @@ async def viple_over_websocket(w: Walkthrough, screen: LabsScreen, lab: Lab, ex:
                 break
             await asyncio.sleep(0.01)
         assert client.status.invalid == 0, client.status.last_rejection
-        w.bench.step(30)  # the program's move, simulated
+        w.station.step(30)  # the program's move, simulated
         await w.pilot.pause()
-        assert w.bench.viple and w.bench.viple[-1].drove
+        assert w.station.viple and w.station.viple[-1].drove
         server.close()  # the students stop their program
     for _ in range(300):
-        if not str(w.bench.session.driver).startswith("VIPLE"):
+        if not str(w.station.session.driver).startswith("VIPLE"):
             break
         await asyncio.sleep(0.01)
-    w.bench.step(1)
+    w.station.step(1)
     await w.open(lab, ex)
 
 
@@ -369,7 +369,7 @@ def test_a_pair_completes_and_signs_off_every_exercise_in_the_app(tmp_path):
                 await w.press("a")
             message = str(screen.query_one("#labs-message").render())
             assert message.startswith(f"set up: {ex.setup.profile}"), message
-            assert w.bench.profile == ex.setup.profile
+            assert w.station.profile == ex.setup.profile
             await w.do(lab, ex)
             screen = await w.labs()
             lines = objectives(screen)

@@ -127,7 +127,7 @@ def test_partial_updates_match_a_full_render_while_the_robot_drives(size):
             await asyncio.sleep(0.25)
         await pilot.pause()
         assert checker.mismatches == []
-        if not app.bench.pacer.paused:
+        if not app.station.pacer.paused:
             await pilot.press("p")  # still: every change reaches the screen
         await asyncio.sleep(0.3)
         await pilot.pause()
@@ -145,7 +145,7 @@ def test_redrawing_an_unchanged_snapshot_refreshes_nothing():
         screen = app.screen
         assert isinstance(screen, MainScreen)
         await pilot.press("w")
-        app.bench.step(30)
+        app.station.step(30)
         app.refresh_views()
         await pilot.pause()
         view = screen.query_one(MazeView)

@@ -1,4 +1,4 @@
-"""The maze key (m): a maze file typed in a dialog goes on the bench."""
+"""The maze key (m): a maze file typed in a dialog goes on the station."""
 
 from __future__ import annotations
 
@@ -8,15 +8,15 @@ from textual.widgets import Input, Static
 from workbench.labs.model import LABS_DIR
 from workbench.sim.mazeio import load_maze
 from workbench.tui.app import make_app
+from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.screens.main import MainScreen
-from workbench.tui.screens.path_dialog import PathDialog
 
 from .support import run
 
 RANKING = LABS_DIR.parent / "mazes" / "rank-local-best-wins.txt"
 
 
-def test_m_loads_a_maze_file_onto_the_bench_and_keeps_the_profile(tmp_path):
+def test_m_loads_a_maze_file_onto_the_station_and_keeps_the_profile(tmp_path):
     app = make_app(paused=True, profile="unity")
 
     async def body(pilot: Pilot) -> None:
@@ -24,15 +24,15 @@ def test_m_loads_a_maze_file_onto_the_bench_and_keeps_the_profile(tmp_path):
         dialog = app.screen
         assert isinstance(dialog, PathDialog)
         field = dialog.query_one("#path", Input)
-        assert field.value.endswith("mazes/")  # the folder of the maze on the bench
+        assert field.value.endswith("mazes/")  # the folder of the maze on the station
         field.value = str(RANKING)
         await pilot.press("enter")
         await pilot.pause()
         assert isinstance(app.screen, MainScreen)
-        assert app.bench.maze.same_layout(load_maze(RANKING))
-        assert app.bench.profile == "unity"
+        assert app.station.maze.same_layout(load_maze(RANKING))
+        assert app.station.profile == "unity"
         assert app.maze_path == RANKING  # the editor saves there
-        assert app.sub_title == f"{app.bench.maze.name} (unity)"
+        assert app.sub_title == f"{app.station.maze.name} (unity)"
 
     run(app, body)
 
@@ -41,7 +41,7 @@ def test_a_maze_that_cannot_be_read_is_shown_in_the_dialog(tmp_path):
     app = make_app(paused=True)
 
     async def body(pilot: Pilot) -> None:
-        before = app.bench.maze
+        before = app.station.maze
         await pilot.press("m")
         app.screen.query_one("#path", Input).value = str(tmp_path / "missing.txt")
         await pilot.press("enter")
@@ -52,6 +52,6 @@ def test_a_maze_that_cannot_be_read_is_shown_in_the_dialog(tmp_path):
         assert "cannot read" in str(dialog.query_one("#error", Static).render())
         await pilot.press("escape")
         assert isinstance(app.screen, MainScreen)
-        assert app.bench.maze is before
+        assert app.station.maze is before
 
     run(app, body)

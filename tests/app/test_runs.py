@@ -8,11 +8,11 @@ from textual.screen import Screen
 from textual.widgets import DataTable, Input, Static
 
 from tests.app.support import sync
-from workbench.control.bench import Bench
+from workbench.control.station import LabStation
 from workbench.sim.mazefile import parse_maze
 from workbench.sim.record import FORMAT
+from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.host import ScreenHost
-from workbench.tui.screens.path_dialog import PathDialog
 from workbench.tui.screens.replay import ReplayScreen
 from workbench.tui.screens.runs import RunsScreen
 from workbench.tui.widgets import MazeView
@@ -32,22 +32,22 @@ class Host(ScreenHost):
         self.push_screen(self.under_test)
 
 
-def run_algorithms(bench: Bench, *names: str) -> Bench:
+def run_algorithms(station: LabStation, *names: str) -> LabStation:
     for name in names:
-        bench.select_algorithm(name)
-        bench.apply_algorithm_preset()
-        bench.start_algorithm()
-        before = len(bench.runs)
+        station.select_algorithm(name)
+        station.apply_algorithm_preset()
+        station.start_algorithm()
+        before = len(station.runs)
         for _ in range(200):
-            bench.step(60)
-            if len(bench.runs) > before:
+            station.step(60)
+            if len(station.runs) > before:
                 break
-    return bench
+    return station
 
 
-def two_runs(tmp_path) -> Bench:
-    bench = Bench.open(BEND, "erobotic", noise="off", record_dir=str(tmp_path / "runs"))
-    return run_algorithms(bench, "right-wall", "two-distance-local-best")
+def two_runs(tmp_path) -> LabStation:
+    station = LabStation.open(BEND, "erobotic", noise="off", record_dir=str(tmp_path / "runs"))
+    return run_algorithms(station, "right-wall", "two-distance-local-best")
 
 
 def text(widget: Static) -> str:
@@ -60,8 +60,8 @@ def table_rows(table: DataTable) -> list[list[str]]:
 
 @sync
 async def test_the_table_shows_each_run_with_its_measures(tmp_path):
-    bench = two_runs(tmp_path)
-    app = Host(RunsScreen(bench, unicode=False))
+    station = two_runs(tmp_path)
+    app = Host(RunsScreen(station, unicode=False))
     async with app.run_test(size=SIZE) as pilot:
         await pilot.pause()
         table = app.screen.query_one(DataTable)
@@ -109,19 +109,19 @@ async def test_the_table_shows_each_run_with_its_measures(tmp_path):
                 "yes",
             ],
         ]
-        assert text(app.screen.query_one("#runs-title")).startswith("Runs on this bench: 2")
+        assert text(app.screen.query_one("#runs-title")).startswith("Runs on this station: 2")
 
 
 @sync
 async def test_new_runs_appear_when_the_screen_comes_back(tmp_path):
-    bench = two_runs(tmp_path)
-    screen = RunsScreen(bench)
+    station = two_runs(tmp_path)
+    screen = RunsScreen(station)
     app = Host(screen)
     async with app.run_test(size=SIZE) as pilot:
         await pilot.press("enter")
         await pilot.pause()
         assert isinstance(app.screen, ReplayScreen)
-        run_algorithms(bench, "right-wall")
+        run_algorithms(station, "right-wall")
         await pilot.press("escape")
         await pilot.pause()
         assert app.screen is screen and screen.query_one(DataTable).row_count == 3
@@ -129,13 +129,13 @@ async def test_new_runs_appear_when_the_screen_comes_back(tmp_path):
 
 @sync
 async def test_no_runs_yet_and_a_run_without_a_record(tmp_path):
-    bench = Bench.open(BEND, "erobotic", noise="off")
-    screen = RunsScreen(bench)
+    station = LabStation.open(BEND, "erobotic", noise="off")
+    screen = RunsScreen(station)
     app = Host(screen)
     async with app.run_test(size=SIZE) as pilot:
         await pilot.pause()
         assert text(screen.query_one("#runs-help")).startswith("No runs yet")
-        run_algorithms(bench, "right-wall")
+        run_algorithms(station, "right-wall")
         screen.refresh_runs()
         await pilot.pause()
         await pilot.press("enter")
@@ -146,8 +146,8 @@ async def test_no_runs_yet_and_a_run_without_a_record(tmp_path):
 
 @sync
 async def test_replay_steps_through_the_recorded_run(tmp_path):
-    bench = two_runs(tmp_path)
-    app = Host(RunsScreen(bench, unicode=False))
+    station = two_runs(tmp_path)
+    app = Host(RunsScreen(station, unicode=False))
     async with app.run_test(size=SIZE) as pilot:
         await pilot.press("down", "enter")
         await pilot.pause()
@@ -155,7 +155,7 @@ async def test_replay_steps_through_the_recorded_run(tmp_path):
         assert isinstance(replay_screen, ReplayScreen)
         replay = replay_screen.replay
         assert replay.title == "two-distance-local-best on Bend"
-        assert replay_screen.maze is bench.maze and replay_screen.note == ""
+        assert replay_screen.maze is station.maze and replay_screen.note == ""
         view = replay_screen.query_one(MazeView)
         assert view.robot_cell == BEND.start
         await pilot.press("right", "right", "right")
@@ -181,8 +181,8 @@ async def test_replay_steps_through_the_recorded_run(tmp_path):
 
 @sync
 async def test_replay_plays_at_a_speed_and_pauses(tmp_path):
-    bench = two_runs(tmp_path)
-    app = Host(RunsScreen(bench))
+    station = two_runs(tmp_path)
+    app = Host(RunsScreen(station))
     async with app.run_test(size=SIZE) as pilot:
         await pilot.press("enter")
         await pilot.pause()
@@ -209,8 +209,8 @@ async def test_replay_plays_at_a_speed_and_pauses(tmp_path):
 
 @sync
 async def test_open_a_record_by_path_and_a_malformed_one(tmp_path):
-    bench = two_runs(tmp_path)
-    screen = RunsScreen(bench)
+    station = two_runs(tmp_path)
+    screen = RunsScreen(station)
     app = Host(screen)
     bad = tmp_path / "bad.jsonl"
     bad.write_text(
@@ -232,7 +232,7 @@ async def test_open_a_record_by_path_and_a_malformed_one(tmp_path):
         await pilot.pause()
         assert app.screen is screen
         await pilot.press("o")
-        app.screen.query_one(Input).value = bench.runs[0].record
+        app.screen.query_one(Input).value = station.runs[0].record
         await pilot.press("enter")
         await pilot.pause()
         assert isinstance(app.screen, ReplayScreen)
@@ -241,8 +241,8 @@ async def test_open_a_record_by_path_and_a_malformed_one(tmp_path):
 
 @sync
 async def test_replay_of_a_run_whose_maze_cannot_be_found(tmp_path):
-    bench = two_runs(tmp_path)
-    record = bench.runs[0].record
+    station = two_runs(tmp_path)
+    record = station.runs[0].record
     app = Host(ReplayScreen(record))  # no known mazes; bend.txt is nowhere
     async with app.run_test(size=SIZE) as pilot:
         await pilot.pause()
@@ -255,11 +255,11 @@ async def test_replay_of_a_run_whose_maze_cannot_be_found(tmp_path):
 
 @sync
 async def test_runs_that_end_while_the_screen_is_open_appear(tmp_path):
-    bench = two_runs(tmp_path)
-    screen = RunsScreen(bench)
+    station = two_runs(tmp_path)
+    screen = RunsScreen(station)
     app = Host(screen)
     async with app.run_test(size=SIZE) as pilot:
-        run_algorithms(bench, "right-wall")
-        screen.show_snapshot(bench.snapshot())
+        run_algorithms(station, "right-wall")
+        screen.show_snapshot(station.snapshot())
         await pilot.pause()
         assert screen.query_one(DataTable).row_count == 3

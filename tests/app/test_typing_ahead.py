@@ -7,8 +7,8 @@ from textual.pilot import Pilot
 from textual.widgets import Input
 
 from workbench.tui.app import make_app
-from workbench.tui.screens.path_dialog import PathDialog
-from workbench.tui.screens.size_dialog import SizeDialog
+from workbench.tui.dialogs.path import PathDialog
+from workbench.tui.dialogs.size import SizeDialog
 
 from .support import run
 

@@ -11,9 +11,9 @@ from textual.widgets import Input, Static
 from workbench.files.workspace import BUNDLED, workspace_folder
 from workbench.sim.mazeio import load_maze
 from workbench.tui.app import make_app
+from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.screens.editor import EditorScreen
 from workbench.tui.screens.main import MainScreen
-from workbench.tui.screens.path_dialog import PathDialog
 from workbench.tui.screens.runs import RunsScreen
 
 from .support import run
@@ -29,7 +29,7 @@ def served_app(tmp_path: Path):
     (data / "ssh-users.yaml").write_text(SECRET)
     workspace = workspace_folder(data, "ann")
     app = make_app(paused=True, workspace=workspace, data_dir=data, student="ann")
-    return app, data, app.bench.files.workspace
+    return app, data, app.station.files.workspace
 
 
 def screen_text(app) -> str:
@@ -48,7 +48,7 @@ def test_m_loads_from_the_workspace_and_refuses_the_server_s_files(tmp_path):
     (workspace / "mine.txt").write_text(SMALL)
 
     async def body(pilot: Pilot) -> None:
-        before = app.bench.maze
+        before = app.station.maze
         await pilot.press("m")
         assert "your workspace, ~/" in screen_text(app)  # the dialog says where files are
         for outside in ("../../ssh-users.yaml", str(data / "ssh-users.yaml"), "~root/x"):
@@ -57,15 +57,15 @@ def test_m_loads_from_the_workspace_and_refuses_the_server_s_files(tmp_path):
             error = str(app.screen.query_one("#error", Static).render())
             assert "outside your workspace" in error or "another user" in error
             assert "scrypt" not in screen_text(app) and "rivera" not in screen_text(app)
-        assert app.bench.maze is before
+        assert app.station.maze is before
         await type_path(pilot, "mine.txt")  # a name alone is in the workspace
         assert isinstance(app.screen, MainScreen)
-        assert app.bench.maze.same_layout(load_maze(workspace / "mine.txt"))
+        assert app.station.maze.same_layout(load_maze(workspace / "mine.txt"))
         await pilot.press("m")
         assert app.screen.query_one("#path", Input).value == "~/"
         await type_path(pilot, str(UNITY))  # a bundled maze is readable
         assert isinstance(app.screen, MainScreen)
-        assert app.bench.maze.same_layout(load_maze(UNITY))
+        assert app.station.maze.same_layout(load_maze(UNITY))
 
     run(app, body)
     assert (data / "ssh-users.yaml").read_text() == SECRET
@@ -115,7 +115,7 @@ def test_g_loads_fsm_files_only_from_the_workspace(tmp_path):
         error = str(app.screen.query_one("#alg-error", Static).render())
         assert "outside your workspace" in error
         assert "scrypt" not in screen_text(app)
-        assert app.bench.algorithm is None
+        assert app.station.algorithm is None
 
     run(app, body)
 

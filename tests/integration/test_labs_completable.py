@@ -1,4 +1,4 @@
-"""Every exercise of every bundled lab can be completed through the bench, as a student would:
+"""Every exercise of every bundled lab can be completed through the station, as a student would:
 keys, the sensor panel, the maze editor, a completed starter FSM or a built-in algorithm, and a
 scripted VIPLE program over the real endpoints. Wrong set-ups show the expected reason."""
 
@@ -11,7 +11,7 @@ from decimal import Decimal
 import pytest
 from websockets.asyncio.server import serve
 
-from workbench.control.bench import Bench
+from workbench.control.station import LabStation
 from workbench.labs.checks import ExerciseProgress, apply_setup, evaluate
 from workbench.labs.model import Exercise, LabMaze, Objective, Question, load_labs
 from workbench.viple.tcp_server import TcpConfig, TcpServer
@@ -36,43 +36,45 @@ SOLUTIONS = {
 }  # fmt: skip
 
 
-def fresh_bench(ex: Exercise) -> Bench:
-    bench = Bench.open(ex.setup.maze.maze, ex.setup.profile, noise="off")
-    apply_setup(bench, ex.setup)
-    return bench
+def fresh_station(ex: Exercise) -> LabStation:
+    station = LabStation.open(ex.setup.maze.maze, ex.setup.profile, noise="off")
+    apply_setup(station, ex.setup)
+    return station
 
 
-def run_to_exit(bench: Bench, limit_s: int = 600) -> None:
-    bench.start_algorithm()
-    done = len(bench.runs)
+def run_to_exit(station: LabStation, limit_s: int = 600) -> None:
+    station.start_algorithm()
+    done = len(station.runs)
     for _ in range(limit_s):
-        bench.step(60)
-        if len(bench.runs) > done:
-            assert bench.runs[-1].ended == "exit", bench.runs[-1]
+        station.step(60)
+        if len(station.runs) > done:
+            assert station.runs[-1].ended == "exit", station.runs[-1]
             return
-    raise AssertionError(f"{bench.algorithm.name} did not get out of {bench.maze.name}")
+    raise AssertionError(f"{station.algorithm.name} did not get out of {station.maze.name}")
 
 
-def run_on(bench: Bench, maze: LabMaze, algorithm: str, params: list[str] | None = None) -> None:
-    bench.load_maze(maze.maze)
-    bench.select_algorithm(algorithm)
+def run_on(
+    station: LabStation, maze: LabMaze, algorithm: str, params: list[str] | None = None
+) -> None:
+    station.load_maze(maze.maze)
+    station.select_algorithm(algorithm)
     if params:
-        bench.set_params(params)
+        station.set_params(params)
     else:
-        bench.apply_algorithm_preset()
-    run_to_exit(bench)
+        station.apply_algorithm_preset()
+    run_to_exit(station)
 
 
-def reach_exit(bench: Bench, ex: Exercise, obj: Objective) -> None:
+def reach_exit(station: LabStation, ex: Exercise, obj: Objective) -> None:
     assert obj.maze is not None
     if "fsm" in obj.drivers:
         starter = ex.setup.controller
         assert starter.kind == "starter", "an fsm exit objective needs a starter to complete"
-        bench.select_algorithm(starter.value)
-        run_on(bench, obj.maze, starter.value, SOLUTIONS[bench.algorithm.name])
+        station.select_algorithm(starter.value)
+        run_on(station, obj.maze, starter.value, SOLUTIONS[station.algorithm.name])
     else:
         name = next(d.split(" ", 1)[1] for d in obj.drivers if d.startswith("algorithm "))
-        run_on(bench, obj.maze, name)
+        run_on(station, obj.maze, name)
 
 
 def free_port() -> int:
@@ -89,20 +91,20 @@ async def until(predicate, timeout: float = 3.0) -> None:
         await asyncio.sleep(0.01)
 
 
-async def drive_over_tcp(bench: Bench) -> None:
+async def drive_over_tcp(station: LabStation) -> None:
     """A scripted VIPLE program in the Unity-simulator role: connect, move, leave."""
-    async with TcpServer(bench.session, TcpConfig(port=0)) as server:
+    async with TcpServer(station.session, TcpConfig(port=0)) as server:
         reader, writer = await asyncio.open_connection("127.0.0.1", server.port)
         writer.write(MOVE.encode() + b"\r\n")
         await writer.drain()
         await asyncio.wait_for(reader.readline(), 3)
-        bench.step(30)
+        station.step(30)
         writer.close()
         await until(lambda: server.status.peer is None)
-        bench.step(1)
+        station.step(1)
 
 
-async def drive_over_ws(bench: Bench) -> None:
+async def drive_over_ws(station: LabStation) -> None:
     """A scripted VIPLE WebSocket server: the workbench connects to it; it sends a move."""
     arrived: asyncio.Queue = asyncio.Queue()
 
@@ -113,20 +115,20 @@ async def drive_over_ws(bench: Bench) -> None:
 
     port = free_port()
     async with serve(robot, "127.0.0.1", port):
-        client = WsClient(bench.session, WsConfig(url=f"ws://127.0.0.1:{port}/"))
+        client = WsClient(station.session, WsConfig(url=f"ws://127.0.0.1:{port}/"))
         await client.start()
         try:
             await asyncio.wait_for(arrived.get(), 3)
             await until(lambda: client.status.messages_in >= 1)
             assert client.status.invalid == 0, client.status.last_rejection
-            bench.step(30)
+            station.step(30)
         finally:
             await client.close()
-        bench.step(1)
+        station.step(1)
 
 
-def viple_drive(bench: Bench, role: str) -> None:
-    asyncio.run(drive_over_tcp(bench) if role == "tcp" else drive_over_ws(bench))
+def viple_drive(station: LabStation, role: str) -> None:
+    asyncio.run(drive_over_tcp(station) if role == "tcp" else drive_over_ws(station))
 
 
 def answer(q: Question) -> str:
@@ -143,49 +145,49 @@ def answer(q: Question) -> str:
     raise AssertionError(f"no answer to {q.id} in the searched range")
 
 
-def complete(bench: Bench, ex: Exercise) -> dict[str, str]:
+def complete(station: LabStation, ex: Exercise) -> dict[str, str]:
     kinds = {o.kind for o in ex.objectives}
     for obj in ex.objectives:
         if obj.kind == "exit":
-            reach_exit(bench, ex, obj)
+            reach_exit(station, ex, obj)
         elif obj.kind == "compare":
             for maze in obj.mazes:
                 for name in obj.algorithms:
-                    run_on(bench, maze, name)
-    apply_setup(bench, ex.setup)  # back to the exercise's maze and sensors
+                    run_on(station, maze, name)
+    apply_setup(station, ex.setup)  # back to the exercise's maze and sensors
     for obj in ex.objectives:
         if obj.kind == "sensors":
-            bench.apply_sensors(obj.sensors)
+            station.apply_sensors(obj.sensors)
         elif obj.kind == "keys":
             for key in obj.keys:
-                bench.key(key)
-                bench.step(10)
+                station.key(key)
+                station.step(10)
         elif obj.kind == "viple":
-            viple_drive(bench, obj.role)
+            viple_drive(station, obj.role)
     if "maze-edited" in kinds:
-        maze = bench.maze
+        maze = station.maze
         inner = next((x, y) for y in range(1, maze.height - 1) for x in range(1, maze.width - 1)
                      if maze.is_wall(x, y))  # fmt: skip
-        bench.load_maze(maze.with_block(*inner, wall=False))
+        station.load_maze(maze.with_block(*inner, wall=False))
     return {q.id: answer(q) for q in ex.questions}
 
 
 @pytest.mark.parametrize(("lab_id", "ex"), EXERCISES, ids=[f"{lab}/{e.id}" for lab, e in EXERCISES])
 def test_every_exercise_can_be_completed(lab_id, ex):
-    bench = fresh_bench(ex)
-    before = evaluate(lab_id, ex, bench)
+    station = fresh_station(ex)
+    before = evaluate(lab_id, ex, station)
     assert not before.passed
-    answers = complete(bench, ex)
-    progress = evaluate(lab_id, ex, bench, answers)
+    answers = complete(station, ex)
+    progress = evaluate(lab_id, ex, station, answers)
     failed = [(o.text, o.reason) for o in progress.objectives if not o.passed]
     assert failed == [], failed
     assert progress.passed
     assert ExerciseProgress.from_json(progress.to_json()) == progress
 
 
-def reasons(lab_id: str, ex_id: str, bench: Bench | None = None, answers=None) -> list[str]:
+def reasons(lab_id: str, ex_id: str, station: LabStation | None = None, answers=None) -> list[str]:
     ex = LABS[lab_id].exercise(ex_id)
-    progress = evaluate(lab_id, ex, bench or fresh_bench(ex), answers)
+    progress = evaluate(lab_id, ex, station or fresh_station(ex), answers)
     return [("✓ " if o.passed else "✗ ") + o.reason for o in progress.objectives]
 
 
@@ -195,10 +197,10 @@ def test_web_sensors_left_at_the_default_show_what_is_missing():
 
 def test_a_starter_run_as_given_does_not_count_as_getting_out():
     ex = LABS["unity-simulator"].exercise("wall-following")
-    bench = fresh_bench(ex)
-    bench.start_algorithm()
-    bench.step(60 * 120)
-    assert reasons("unity-simulator", "wall-following", bench)[:2] == [
+    station = fresh_station(ex)
+    station.start_algorithm()
+    station.step(60 * 120)
+    assert reasons("unity-simulator", "wall-following", station)[:2] == [
         "✓ sensors are distance:1:right, distance:2:front",
         "✗ no run by viple or fsm has reached the exit of 'eRobotic lab maze' (unity) yet",
     ]
@@ -206,27 +208,27 @@ def test_a_starter_run_as_given_does_not_count_as_getting_out():
 
 def test_the_wrong_sensor_for_local_best_on_the_web():
     ex = LABS["web-simulator"].exercise("local-best-activities")
-    bench = fresh_bench(ex)
-    bench.apply_sensors(LABS["web-simulator"].exercise("wall-main").setup.sensors)
-    assert reasons("web-simulator", "local-best-activities", bench)[0] == (
+    station = fresh_station(ex)
+    station.apply_sensors(LABS["web-simulator"].exercise("wall-main").setup.sensors)
+    assert reasons("web-simulator", "local-best-activities", station)[0] == (
         "✗ missing distance:3:front; not wanted distance:1:right, touch:2:front"
     )
 
 
 def test_viple_in_the_unity_role_does_not_count_for_the_web_connection():
     ex = LABS["web-simulator"].exercise("connect")
-    bench = fresh_bench(ex)
-    viple_drive(bench, "tcp")
-    assert reasons("web-simulator", "connect", bench)[0] == (
+    station = fresh_station(ex)
+    viple_drive(station, "tcp")
+    assert reasons("web-simulator", "connect", station)[0] == (
         "✗ VIPLE connected over tcp; this exercise needs WebSocket (the Web Simulator's)"
     )
 
 
 def test_a_built_in_algorithm_does_not_stand_in_for_the_students_program():
     ex = LABS["web-simulator"].exercise("wall-main")
-    bench = fresh_bench(ex)
-    run_on(bench, ex.setup.maze, "web-wall-following")
-    assert reasons("web-simulator", "wall-main", bench)[1] == (
+    station = fresh_station(ex)
+    run_on(station, ex.setup.maze, "web-wall-following")
+    assert reasons("web-simulator", "wall-main", station)[1] == (
         "✗ no run by viple or fsm has reached the exit of 'Web Simulator lab maze' (web) yet"
     )
 

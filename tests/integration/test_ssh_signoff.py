@@ -32,8 +32,8 @@ async def test_an_instructor_signs_off_an_exercise_from_the_students_session(tmp
         await term.wait_for("•" * len(PASSPHRASE))
         term.send("\t")
         await asyncio.sleep(0.2)  # a person's pace between keys: focus moves first
-        term.send("checked at the bench")
-        await term.wait_for("at the bench")
+        term.send("checked at the station")
+        await term.wait_for("at the station")
         for key in ("\t", " ", "\x1b[Z", "\r"):  # to the override, tick it, back to the note
             term.send(key)
             await asyncio.sleep(0.2)  # a person's pace between keys
@@ -53,4 +53,4 @@ async def test_an_instructor_signs_off_an_exercise_from_the_students_session(tmp
         (record,) = store.signoffs()
     assert (record.instructor, record.student) == ("ito", "ann")
     assert (record.lab, record.exercise) == ("unity-simulator", "drive-by-wire")
-    assert record.override and record.note == "checked at the bench"
+    assert record.override and record.note == "checked at the station"

@@ -33,23 +33,23 @@ def still(pilot: Pilot) -> None:
 
 
 async def drive_a_little(pilot: Pilot) -> None:
-    bench = pilot.app.bench
+    station = pilot.app.station
     await pilot.press("d")
-    bench.step(180)
+    station.step(180)
     await pilot.press("w")
-    bench.step(120)
+    station.step(120)
     await pilot.press("space")
-    bench.step(30)
+    station.step(30)
     pilot.app.refresh_views()
     await pilot.pause()
 
 
 async def run_right_wall(pilot: Pilot) -> None:
-    bench = pilot.app.bench
-    bench.select_algorithm("right-wall")
-    bench.start_algorithm()  # what x does; paused again before the clock can run it
-    bench.pacer.paused = True
-    bench.step(60 * 25)
+    station = pilot.app.station
+    station.select_algorithm("right-wall")
+    station.start_algorithm()  # what x does; paused again before the clock can run it
+    station.pacer.paused = True
+    station.step(60 * 25)
     pilot.app.refresh_views()
     await pilot.pause()
 
@@ -84,8 +84,8 @@ def test_sensor_ports_with_problems_marked(snap_compare, size, unicode):
 @grid
 def test_algorithm_selector_with_a_missing_sensor(snap_compare, size, unicode):
     async def before(pilot: Pilot) -> None:
-        pilot.app.bench.apply_preset("web-two-distance")
-        pilot.app.bench.select_algorithm("right-wall")
+        pilot.app.station.apply_preset("web-two-distance")
+        pilot.app.station.select_algorithm("right-wall")
         await pilot.press("g")
         await pilot.pause()
         still(pilot)

@@ -13,7 +13,7 @@ from textual.pilot import Pilot
 from textual.screen import Screen
 from textual.widgets import Input
 
-from workbench.control.bench import Bench
+from workbench.control.station import LabStation
 from workbench.sim.generate import generate
 from workbench.sim.mazeio import load_maze
 from workbench.tui.host import ScreenHost
@@ -38,8 +38,8 @@ class Host(ScreenHost):
         self.push_screen(self.under_test)
 
 
-def web_bench(**kwargs) -> Bench:
-    return Bench.open(load_maze(ROOT / WEB), "web", noise="off", **kwargs)
+def web_station(**kwargs) -> LabStation:
+    return LabStation.open(load_maze(ROOT / WEB), "web", noise="off", **kwargs)
 
 
 def still_inputs(pilot: Pilot) -> None:
@@ -59,20 +59,20 @@ def press_then_still(*keys: str):
 
 
 @pytest.fixture(scope="module")
-def web_runs(tmp_path_factory) -> Bench:
-    """A bench on the Web Simulator maze after two recorded algorithm runs."""
-    bench = web_bench(record_dir=str(tmp_path_factory.mktemp("runs")))
+def web_runs(tmp_path_factory) -> LabStation:
+    """A station on the Web Simulator maze after two recorded algorithm runs."""
+    station = web_station(record_dir=str(tmp_path_factory.mktemp("runs")))
     for name in ("web-wall-following", "two-distance-local-best"):
-        bench.select_algorithm(name)
-        bench.apply_algorithm_preset()
-        bench.start_algorithm()
-        before = len(bench.runs)
+        station.select_algorithm(name)
+        station.apply_algorithm_preset()
+        station.start_algorithm()
+        before = len(station.runs)
         for _ in range(400):
-            bench.step(60)
-            if len(bench.runs) > before:
+            station.step(60)
+            if len(station.runs) > before:
                 break
-    assert [r.ended for r in bench.runs] == ["exit", "exit"]
-    return bench
+    assert [r.ended for r in station.runs] == ["exit", "exit"]
+    return station
 
 
 # -- editor -----------------------------------------------------------------------------------
@@ -82,30 +82,30 @@ EDIT_KEYS = ("left", "space", "up", "up", "right", "right", "x")
 
 @pytest.mark.parametrize("unicode", [False, True], ids=["ascii", "unicode"])
 def test_editor_80x24(snap_compare, unicode):
-    app = Host(EditorScreen(web_bench(), WEB, unicode=unicode))
+    app = Host(EditorScreen(web_station(), WEB, unicode=unicode))
     assert snap_compare(app, press=EDIT_KEYS, terminal_size=SMALL)
 
 
 @pytest.mark.parametrize("unicode", [False, True], ids=["ascii", "unicode"])
 def test_editor_generated_120x40(snap_compare, unicode):
-    bench = Bench.open(generate(16, 16, 7), "unity", noise="off")
-    app = Host(EditorScreen(bench, None, unicode=unicode))
+    station = LabStation.open(generate(16, 16, 7), "unity", noise="off")
+    app = Host(EditorScreen(station, None, unicode=unicode))
     assert snap_compare(app, press=("up", "up", "right", "space", "s"), terminal_size=LARGE)
 
 
 def test_generate_dialog_80x24(snap_compare):
-    app = Host(EditorScreen(web_bench(), WEB))
+    app = Host(EditorScreen(web_station(), WEB))
     assert snap_compare(app, run_before=press_then_still("g"), terminal_size=SMALL)
 
 
 def test_new_maze_dialog_with_an_error_80x24(snap_compare):
-    app = Host(EditorScreen(web_bench(), WEB))
+    app = Host(EditorScreen(web_station(), WEB))
     keys = ("n", "backspace", "backspace", "2", "enter")
     assert snap_compare(app, run_before=press_then_still(*keys), terminal_size=SMALL)
 
 
 def test_unsaved_changes_prompt_80x24(snap_compare):
-    app = Host(EditorScreen(web_bench(), WEB, unicode=True))
+    app = Host(EditorScreen(web_station(), WEB, unicode=True))
     assert snap_compare(app, press=("right", "space", "escape"), terminal_size=SMALL)
 
 

@@ -2,8 +2,8 @@
 
 import pytest
 
-from workbench.control.bench import Bench, SensorRow, check_sensor_rows
 from workbench.control.fsm import SensorBindingError
+from workbench.control.station import LabStation, SensorRow, check_sensor_rows
 from workbench.sim.driver import Driver
 from workbench.sim.mazefile import parse_maze
 from workbench.sim.mazeio import load_maze
@@ -13,12 +13,12 @@ CORRIDOR = parse_maze("##########\n#S......E#\n##########\n", source="corridor.t
 ROOM = parse_maze("#######\n#.....#\n#..S..#\n#.....#\n#######\n", source="room.txt")
 
 
-def bench(maze=ROOM, profile="erobotic", **kw):
-    return Bench.open(maze, profile, noise="off", **kw)
+def station(maze=ROOM, profile="erobotic", **kw):
+    return LabStation.open(maze, profile, noise="off", **kw)
 
 
 def test_unity_keys_move_and_turn_like_the_course_key_program():
-    b = bench(profile="unity")
+    b = station(profile="unity")
     b.key("d")
     b.step(60 * 4)
     assert b.snapshot().pose.heading == pytest.approx(90, abs=0.5)  # facing down the page
@@ -33,7 +33,7 @@ def test_unity_keys_move_and_turn_like_the_course_key_program():
 
 
 def test_web_keys_spin_until_the_next_key():
-    b = bench(profile="web")
+    b = station(profile="web")
     b.key("a")
     b.step(90)  # (-0.2, 0.2) for 1.5 s: about 90 degrees left
     assert b.snapshot().pose.heading == pytest.approx(270, abs=10)
@@ -44,7 +44,7 @@ def test_web_keys_spin_until_the_next_key():
 
 
 def test_erobotic_w_moves_exactly_one_block_and_stops():
-    b = bench(CORRIDOR)
+    b = station(CORRIDOR)
     b.key("w")
     b.step(120)
     snap = b.snapshot()
@@ -53,11 +53,11 @@ def test_erobotic_w_moves_exactly_one_block_and_stops():
 
 
 def test_non_drive_keys_are_ignored():
-    assert bench().key("x") is False
+    assert station().key("x") is False
 
 
 def test_sensor_rows_are_checked_and_nothing_applied_on_error():
-    b = bench()
+    b = station()
     before = list(b.sensors)
     errors = b.apply_sensor_rows(
         [SensorRow("distance", "1", "right"), SensorRow("touch", "1", "front"),
@@ -73,7 +73,7 @@ def test_sensor_rows_are_checked_and_nothing_applied_on_error():
 
 
 def test_unmounted_rows_are_left_out_and_readings_follow_the_new_ports():
-    b = bench()
+    b = station()
     assert (
         b.apply_sensor_rows([SensorRow("distance", "7", "front"), SensorRow("touch", "2", None)])
         == {}
@@ -88,13 +88,13 @@ def test_check_sensor_rows_returns_specs_in_row_order():
 
 
 def test_presets_of_the_course_simulators():
-    b = bench()
+    b = station()
     b.apply_preset("web-two-distance")
     assert b.sensors == [SensorSpec("distance", 3, "front")]
 
 
 def test_missing_sensor_is_explained_and_fixed_with_the_preset():
-    b = bench()
+    b = station()
     b.apply_preset("web-two-distance")
     b.select_algorithm("right-wall")
     assert "needs a distance sensor mounted right" in b.missing_sensors()
@@ -107,7 +107,7 @@ def test_missing_sensor_is_explained_and_fixed_with_the_preset():
 
 
 def test_algorithm_run_to_the_exit_is_recorded_in_runs(tmp_path):
-    b = bench(load_maze("mazes/rank-wall-wins.txt"), record_dir=str(tmp_path))
+    b = station(load_maze("mazes/rank-wall-wins.txt"), record_dir=str(tmp_path))
     b.select_algorithm("right-wall")
     b.start_algorithm()
     for _ in range(200):
@@ -122,7 +122,7 @@ def test_algorithm_run_to_the_exit_is_recorded_in_runs(tmp_path):
 
 
 def test_parameters_are_validated_before_any_is_kept():
-    b = bench()
+    b = station()
     b.select_algorithm("right-wall")
     with pytest.raises(ValueError, match="not a number"):
         b.set_params(["open_right=120", "front_blocked=near"])
@@ -133,7 +133,7 @@ def test_parameters_are_validated_before_any_is_kept():
 
 
 def test_keys_take_over_from_an_algorithm_and_close_its_run():
-    b = bench(load_maze("mazes/erobotic.txt"))
+    b = station(load_maze("mazes/erobotic.txt"))
     b.select_algorithm("farthest-distance")
     b.start_algorithm()
     b.step(60)
@@ -143,7 +143,7 @@ def test_keys_take_over_from_an_algorithm_and_close_its_run():
 
 
 def test_reset_robot_returns_to_start_and_loading_a_maze_restarts():
-    b = bench(CORRIDOR)
+    b = station(CORRIDOR)
     b.key("w")
     b.step(60)
     b.reset_robot()
@@ -153,7 +153,7 @@ def test_reset_robot_returns_to_start_and_loading_a_maze_restarts():
 
 
 def test_sensor_rows_pad_the_live_sensors_like_the_web_simulator_panel():
-    b = bench(profile="unity")
+    b = station(profile="unity")
     assert b.sensor_rows() == [
         SensorRow("distance", "1", "right"),
         SensorRow("distance", "2", "front"),
@@ -188,7 +188,7 @@ states:
 def test_a_failing_algorithm_is_stopped_with_the_reason_instead_of_raising(tmp_path, how):
     path = tmp_path / "failing.yaml"
     path.write_text(FAILING_FSM)
-    b = bench()
+    b = station()
     b.select_algorithm(path)
     b.start_algorithm()
     if how == "step":
@@ -202,7 +202,7 @@ def test_a_failing_algorithm_is_stopped_with_the_reason_instead_of_raising(tmp_p
 
 
 def test_a_new_maze_keeps_pause_speed_and_frame_budget():
-    b = bench()
+    b = station()
     b.toggle_pause()
     b.pacer.next_speed()
     b.pacer.budget = 0.03
@@ -217,7 +217,7 @@ MOVE = '{"servos":[{"isTurn":false,"servoId":-1,"servoSpeed":1}]}'
 def test_a_viple_program_that_drives_is_recorded_with_its_role_and_a_run():
     from workbench.viple.link import Link
 
-    b = bench(CORRIDOR, profile="unity")
+    b = station(CORRIDOR, profile="unity")
     b.key("w")
     b.step(10)
     b.key("space")
@@ -245,7 +245,7 @@ def test_a_viple_program_that_drives_is_recorded_with_its_role_and_a_run():
 def test_a_viple_program_that_only_connects_has_not_driven():
     from workbench.viple.link import Link
 
-    b = bench(CORRIDOR, profile="unity")
+    b = station(CORRIDOR, profile="unity")
     link = Link(b.session, "ws", "ws://localhost:8124/")
     link.connect("ws://localhost:8124/")
     b.step(30)
@@ -257,7 +257,7 @@ def test_a_viple_program_that_only_connects_has_not_driven():
 def test_a_viple_program_that_takes_the_robot_from_an_algorithm_ends_its_run():
     from workbench.viple.link import Link
 
-    b = bench(CORRIDOR, profile="unity")
+    b = station(CORRIDOR, profile="unity")
     b.select_algorithm("right-wall")
     b.start_algorithm()
     b.step(20)
@@ -271,7 +271,7 @@ def test_a_viple_program_that_takes_the_robot_from_an_algorithm_ends_its_run():
 def test_starting_an_exercise_forgets_keys_and_viple_seen_before_but_not_the_one_driving():
     from workbench.viple.link import Link
 
-    b = bench(CORRIDOR, profile="unity")
+    b = station(CORRIDOR, profile="unity")
     for key in ("w", "a"):
         b.key(key)
     old = Link(b.session, "ws", "ws://localhost:8124/")
@@ -291,7 +291,7 @@ def test_starting_an_exercise_forgets_keys_and_viple_seen_before_but_not_the_one
 
 
 def test_after_a_run_ends_at_the_exit_the_next_drive_key_drives():
-    b = bench(load_maze("mazes/rank-wall-wins.txt"), "unity")
+    b = station(load_maze("mazes/rank-wall-wins.txt"), "unity")
     b.select_algorithm("right-wall")
     b.apply_algorithm_preset()
     b.start_algorithm()
@@ -307,7 +307,7 @@ def test_after_a_run_ends_at_the_exit_the_next_drive_key_drives():
 
 
 def test_a_pause_the_user_chose_stays_until_they_resume():
-    b = bench(profile="unity")
+    b = station(profile="unity")
     assert b.toggle_pause()
     b.key("w")
     b.advance(0.5)
@@ -317,7 +317,7 @@ def test_a_pause_the_user_chose_stays_until_they_resume():
 def test_a_viple_program_drives_on_after_the_maze_is_changed_under_it():
     from workbench.viple.link import Link
 
-    b = Bench.open(ROOM, "erobotic", noise="off")
+    b = LabStation.open(ROOM, "erobotic", noise="off")
     session = b.session
     link = Link(session, "tcp")
     assert link.connect("127.0.0.1:50312")
@@ -329,8 +329,8 @@ def test_a_viple_program_drives_on_after_the_maze_is_changed_under_it():
     assert b.snapshot().metrics.distance > 0.5 and b.session.world.maze is CORRIDOR
 
 
-def test_pausing_is_one_switch_on_the_bench():
-    b = Bench.open(ROOM, "erobotic", noise="off")
+def test_pausing_is_one_switch_on_the_station():
+    b = LabStation.open(ROOM, "erobotic", noise="off")
     b.pause()
     assert b.paused and b.advance(1.0) == 0
     assert b.toggle_pause() is False and not b.paused

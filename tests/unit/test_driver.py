@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from workbench.control.bench import Bench
+from workbench.control.station import LabStation
 from workbench.sim.driver import KEYS, NOBODY, Driver
 from workbench.sim.mazefile import parse_maze
 from workbench.sim.record import FORMAT, read_record, recorded_driver
@@ -55,8 +55,8 @@ def test_older_headless_and_driverless_records_read_as_viple_and_keys():
     assert recorded_driver({"algorithm": 7}) == KEYS
 
 
-def test_a_bench_record_holds_the_driver_both_ways(tmp_path):
-    b = Bench.open(BEND, "erobotic", noise="off", record_dir=str(tmp_path))
+def test_a_station_record_holds_the_driver_both_ways(tmp_path):
+    b = LabStation.open(BEND, "erobotic", noise="off", record_dir=str(tmp_path))
     link = Link(b.session, "tcp")
     assert link.connect("127.0.0.1:50312")
     assert link.apply(MOVE)

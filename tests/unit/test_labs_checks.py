@@ -5,8 +5,8 @@ from pathlib import Path
 
 import pytest
 
-from workbench.control.bench import Bench
 from workbench.control.fsmfile import load_fsm
+from workbench.control.station import LabStation
 from workbench.labs.checks import (
     ExerciseProgress,
     apply_setup,
@@ -41,8 +41,8 @@ def exercise(*objectives, questions=(), maze=EROBOTIC, profile="unity", controll
     return Exercise("ex", "Ex", "do it", setup, tuple(objectives), tuple(questions))
 
 
-def bench_for(ex):
-    b = Bench.open(ex.setup.maze.maze, ex.setup.profile, noise="off")
+def station_for(ex):
+    b = LabStation.open(ex.setup.maze.maze, ex.setup.profile, noise="off")
     apply_setup(b, ex.setup)
     return b
 
@@ -65,7 +65,7 @@ def run_to_exit(b, limit_s=400):
 def test_keys_objective_names_the_keys_still_to_use():
     obj = Objective("keys", "drove", keys=("w", "a", "s", "d", "space"))
     ex = exercise(obj)
-    b = bench_for(ex)
+    b = station_for(ex)
     for key in ("w", "d"):
         b.key(key)
     assert check(obj, ex, b) == (False, "not used yet: a, s, space")
@@ -78,7 +78,7 @@ def test_sensors_objective_lists_what_is_missing_and_what_is_extra():
     want = (SensorSpec("distance", 1, "right"), SensorSpec("touch", 2, "front"))
     obj = Objective("sensors", "sensors", sensors=want)
     ex = exercise(obj)
-    b = bench_for(ex)
+    b = station_for(ex)
     assert check(obj, ex, b) == (False, "missing touch:2:front; not wanted distance:2:front")
     b.apply_sensors(want)
     assert check(obj, ex, b) == (True, "sensors are distance:1:right, touch:2:front")
@@ -89,7 +89,7 @@ def test_sensors_objective_lists_what_is_missing_and_what_is_extra():
 def test_viple_objective_needs_the_role_and_real_driving():
     obj = Objective("viple", "connected", role="tcp")
     ex = exercise(obj)
-    b = bench_for(ex)
+    b = station_for(ex)
     assert check(obj, ex, b) == (
         False,
         "no VIPLE program has connected over TCP (the Unity simulator's role) yet",
@@ -118,7 +118,7 @@ def test_viple_objective_needs_the_role_and_real_driving():
 def test_exit_objective_wants_the_right_kind_of_driver_on_the_right_maze():
     obj = Objective("exit", "out", maze=EROBOTIC, drivers=("fsm",))
     ex = exercise(obj)
-    b = bench_for(ex)
+    b = station_for(ex)
     assert check(obj, ex, b) == (
         False,
         "no run by fsm has reached the exit of 'eRobotic lab maze' (unity) yet",
@@ -141,7 +141,7 @@ def test_exit_objective_wants_the_right_kind_of_driver_on_the_right_maze():
 def test_exit_objective_accepts_a_named_algorithm_and_reports_a_broken_limit():
     obj = Objective("exit", "out", maze=RANK, drivers=("algorithm right-wall",), max_time=5)
     ex = exercise(obj, maze=RANK)
-    b = bench_for(ex)
+    b = station_for(ex)
     b.select_algorithm("right-wall")
     run = run_to_exit(b)
     passed, reason = check(obj, ex, b)
@@ -164,7 +164,7 @@ def test_exit_objective_accepts_a_named_algorithm_and_reports_a_broken_limit():
 def test_exit_objective_with_a_record_keeps_its_digest(tmp_path):
     obj = Objective("exit", "out", maze=RANK, drivers=("any",))
     ex = exercise(obj, maze=RANK)
-    b = Bench.open(RANK.maze, "unity", noise="off", record_dir=str(tmp_path))
+    b = LabStation.open(RANK.maze, "unity", noise="off", record_dir=str(tmp_path))
     apply_setup(b, ex.setup)
     b.select_algorithm("right-wall")
     run_to_exit(b)
@@ -175,7 +175,7 @@ def test_exit_objective_with_a_record_keeps_its_digest(tmp_path):
 def test_maze_edited_objective_wants_a_change_and_a_valid_maze():
     obj = Objective("maze-edited", "edited")
     ex = exercise(obj)
-    b = bench_for(ex)
+    b = station_for(ex)
     assert check(obj, ex, b) == (
         False,
         "the maze is still 'eRobotic lab maze' as set up: add or remove a block",
@@ -194,7 +194,7 @@ def test_compare_objective_names_the_missing_runs():
     obj = Objective("compare", "compared", algorithms=("right-wall", "two-distance-local-best"),
                     mazes=(RANK,))  # fmt: skip
     ex = exercise(obj, maze=RANK)
-    b = bench_for(ex)
+    b = station_for(ex)
     assert check(obj, ex, b) == (
         False,
         "no run to the exit yet: right-wall on 'Ranking - right wall wins' (unity) (+1 more)",
@@ -222,7 +222,7 @@ def test_questions_objective_counts_unanswered_and_wrong_answers():
     obj = Objective("questions", "answered")
     qs = (question("one", "a"), question("two", 90, tolerance=0, step="1"))
     ex = exercise(obj, questions=qs)
-    b = bench_for(ex)
+    b = station_for(ex)
     assert check(obj, ex, b, {}) == (False, "not answered yet: one, two")
     assert check(obj, ex, b, {"one": "b", "two": "90"}) == (False, "1 of 2 not right yet: one")
     assert check(obj, ex, b, {"one": "A", "two": "90"}) == (True, "all 2 answered correctly")
@@ -231,7 +231,7 @@ def test_questions_objective_counts_unanswered_and_wrong_answers():
 def test_progress_round_trips_through_json_and_has_a_stable_digest():
     keys = Objective("keys", "drove", keys=("w",))
     ex = exercise(keys)
-    b = bench_for(ex)
+    b = station_for(ex)
     before = evaluate("lab", ex, b)
     assert not before.passed and before.objectives[0].reason == "not used yet: w"
     b.key("w")
@@ -244,11 +244,11 @@ def test_progress_round_trips_through_json_and_has_a_stable_digest():
     assert before.evidence_digest() != after.evidence_digest()
 
 
-def test_apply_setup_puts_profile_maze_sensors_and_controller_on_the_bench():
+def test_apply_setup_puts_profile_maze_sensors_and_controller_on_the_station():
     ex = exercise(
         maze=RANK, profile="web", controller="starter labs/starters/web-two-distance.yaml"
     )
-    b = Bench.open(EROBOTIC.maze, "unity", noise="off")
+    b = LabStation.open(EROBOTIC.maze, "unity", noise="off")
     apply_setup(b, ex.setup)
     assert (b.profile, b.maze.name) == ("web", "Ranking - right wall wins")
     assert [str(s) for s in b.sensors] == RIGHT_WALL
@@ -257,7 +257,7 @@ def test_apply_setup_puts_profile_maze_sensors_and_controller_on_the_bench():
 
 @pytest.mark.parametrize("starter", sorted(Path("labs/starters").glob("*.yaml")))
 def test_every_starter_loads_and_runs_but_does_not_get_out_as_given(starter):
-    b = Bench.open(EROBOTIC.maze, "unity" if "unity" in starter.name else "web", noise="off")
+    b = LabStation.open(EROBOTIC.maze, "unity" if "unity" in starter.name else "web", noise="off")
     b.select_algorithm(starter)
     b.apply_algorithm_preset()
     b.start_algorithm()
@@ -269,7 +269,7 @@ def test_every_starter_loads_and_runs_but_does_not_get_out_as_given(starter):
 def test_runs_on_another_profile_do_not_count():
     obj = Objective("exit", "out", maze=RANK, drivers=("algorithm right-wall",))
     ex = exercise(obj, maze=RANK, profile="web")
-    b = Bench.open(RANK.maze, "unity", noise="off")
+    b = LabStation.open(RANK.maze, "unity", noise="off")
     b.select_algorithm("right-wall")
     run_to_exit(b)
     assert check(obj, ex, b) == (
@@ -288,14 +288,14 @@ def test_objectives_that_passed_before_stay_passed_with_their_evidence():
     sensors = Objective("sensors", "sensors", sensors=(SensorSpec("touch", 2, "front"),))
     asked = Objective("questions", "answers")
     ex = exercise(keys, sensors, asked, questions=[question("q", "a")])
-    first = bench_for(ex)
+    first = station_for(ex)
     first.key("w")
     first.key("a")
     earlier = evaluate("lab", ex, first, {"q": "a"})
     assert [o.passed for o in earlier.objectives] == [True, False, True]
     saved = ExerciseProgress.from_dict(json.loads(earlier.to_json()))  # as the store keeps it
 
-    again = bench_for(ex)  # a new app: no keys used yet, the answer changed to a wrong one
+    again = station_for(ex)  # a new app: no keys used yet, the answer changed to a wrong one
     progress = keep_passed(saved, evaluate("lab", ex, again, {"q": "b"}))
     drove, sensed, answered = progress.objectives
     assert (drove.passed, drove.reason) == (True, "passed earlier: used w, a")
@@ -318,7 +318,7 @@ def test_saved_progress_in_the_wrong_shape_is_refused_with_a_reason():
 def test_the_set_up_starts_the_exercise_afresh():
     obj = Objective("keys", "drove", keys=("w",))
     ex = exercise(obj)
-    b = bench_for(ex)
+    b = station_for(ex)
     b.key("w")
     assert check(obj, ex, b)[0]
     apply_setup(b, ex.setup)
@@ -328,7 +328,7 @@ def test_the_set_up_starts_the_exercise_afresh():
 def test_keys_objective_with_a_role_accepts_a_viple_program_making_the_five_motions():
     obj = Objective("keys", "drove", keys=("w", "a", "s", "d", "space"), role="tcp")
     ex = exercise(obj)
-    b = bench_for(ex)
+    b = station_for(ex)
     assert check(obj, ex, b) == (False, "not used yet: w, a, s, d, space")
     link = Link(b.session, "tcp")
     link.connect("127.0.0.1:50500")

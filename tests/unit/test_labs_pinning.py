@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from workbench.control.bench import Bench
+from workbench.control.station import LabStation
 from workbench.labs.checks import apply_setup, check_objective
 from workbench.labs.model import LabFileError, load_lab
 from workbench.sim.mazeio import load_maze
@@ -57,7 +57,7 @@ def test_a_run_on_an_easier_copy_does_not_meet_the_exit_objective(tmp_path):
     obj = ex.objectives[0]
     copy = tmp_path / "copy.txt"
     copy.write_text(EASIER)
-    b = Bench.open(load_maze(copy), "unity", noise="off")
+    b = LabStation.open(load_maze(copy), "unity", noise="off")
     b.select_algorithm("right-wall")
     quick = run_to_exit(b)
     assert quick.maze == ex.setup.maze.name and quick.maze_digest != ex.setup.maze.digest
@@ -78,7 +78,7 @@ def test_the_lab_maze_changed_on_disk_after_loading_is_another_maze(tmp_path):
     ex = lab_in(tmp_path)
     pinned = ex.setup.maze.digest
     (tmp_path / "lab-maze.txt").write_text(EASIER)  # someone edits the lab's own file
-    b = Bench.open(load_maze(tmp_path / "lab-maze.txt"), "unity", noise="off")
+    b = LabStation.open(load_maze(tmp_path / "lab-maze.txt"), "unity", noise="off")
     b.select_algorithm("right-wall")
     run_to_exit(b)
     assert not check_objective(ex.objectives[0], ex, b).passed
@@ -93,7 +93,7 @@ def test_the_lab_maze_changed_on_disk_after_loading_is_another_maze(tmp_path):
 def test_the_set_up_uses_the_starter_as_it_was_when_the_lab_was_loaded(tmp_path):
     ex = lab_in(tmp_path, controller="starter starter.yaml", driver="fsm")
     (tmp_path / "starter.yaml").write_text("not: [an, fsm")
-    b = Bench.open(load_maze(Path("mazes/erobotic.txt")), "unity", noise="off")
+    b = LabStation.open(load_maze(Path("mazes/erobotic.txt")), "unity", noise="off")
     apply_setup(b, ex.setup)
     assert b.algorithm.name == "starter-unity-wall-following"
     assert Path(b.algorithm.source) == tmp_path / "starter.yaml"

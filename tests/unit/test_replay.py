@@ -4,7 +4,7 @@ import json
 
 import pytest
 
-from workbench.control.bench import Bench
+from workbench.control.station import LabStation
 from workbench.sim.mazefile import parse_maze, write_maze
 from workbench.sim.record import FORMAT, RecordError, RunRecord
 from workbench.sim.replay import SPEEDS, Replay, load_replay, replay_maze
@@ -141,8 +141,8 @@ def test_a_cut_off_record_replays_without_summary(tmp_path):
     assert replay.summary is None and len(replay) == 3
 
 
-def bench_record(tmp_path):
-    b = Bench.open(BEND, "erobotic", noise="off", record_dir=str(tmp_path))
+def station_record(tmp_path):
+    b = LabStation.open(BEND, "erobotic", noise="off", record_dir=str(tmp_path))
     b.select_algorithm("right-wall")
     b.apply_algorithm_preset()
     b.start_algorithm()
@@ -154,7 +154,7 @@ def bench_record(tmp_path):
 
 
 def test_a_real_run_replays_to_the_exit(tmp_path):
-    replay = load_replay(bench_record(tmp_path))
+    replay = load_replay(station_record(tmp_path))
     assert replay.title == "right-wall on an unnamed maze"
     replay.to_end()
     assert replay.frame().block(replay.cell) == BEND.exits[0]
@@ -163,7 +163,7 @@ def test_a_real_run_replays_to_the_exit(tmp_path):
 
 
 def test_replay_maze_prefers_a_known_maze_then_the_file(tmp_path):
-    path = bench_record(tmp_path)
+    path = station_record(tmp_path)
     replay = load_replay(path)
     assert replay_maze(replay, path, [BEND]) == (BEND, "")
     maze, note = replay_maze(replay, path)
@@ -200,7 +200,7 @@ def test_a_bad_sensor_in_the_header_is_reported(tmp_path):
 
 
 def test_metrics_at_the_end_agree_with_the_summary(tmp_path):
-    replay = load_replay(bench_record(tmp_path))
+    replay = load_replay(station_record(tmp_path))
     replay.to_end()
     m, summary = replay.metrics(), replay.summary
     assert m.reached_exit and m.exit_time == pytest.approx(summary["exit_time"], abs=0.06)

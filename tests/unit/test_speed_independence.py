@@ -1,5 +1,5 @@
 """A run's numbers do not depend on how fast it is shown: at every speed, and in single steps,
-the app's bench runs the same simulation steps as ``workbench run`` and stops at the exit."""
+the app's station runs the same simulation steps as ``workbench run`` and stops at the exit."""
 
 from __future__ import annotations
 
@@ -7,8 +7,8 @@ from pathlib import Path
 
 import pytest
 
-from workbench.control.bench import Bench
 from workbench.control.headless import RunSpec, run
+from workbench.control.station import LabStation
 from workbench.sim.clock import SPEEDS
 from workbench.sim.mazeio import load_maze
 
@@ -24,27 +24,27 @@ def ticks(path) -> list[str]:
     return [line for line in Path(path).read_text().splitlines() if not line.startswith('{"type"')]
 
 
-def bench_run(speed: float | None, single: int | None = None, record_dir=None) -> dict:
-    bench = Bench.open(load_maze(MAZE), seed=3, record_dir=record_dir)
-    bench.select_algorithm("right-wall")
-    bench.apply_algorithm_preset()
-    bench.start_algorithm()
-    bench.pacer.speed = speed
+def station_run(speed: float | None, single: int | None = None, record_dir=None) -> dict:
+    station = LabStation.open(load_maze(MAZE), seed=3, record_dir=record_dir)
+    station.select_algorithm("right-wall")
+    station.apply_algorithm_preset()
+    station.start_algorithm()
+    station.pacer.speed = speed
     for _ in range(100_000):
-        if bench.runs:
+        if station.runs:
             break
         if single is not None:
-            bench.step(single)
+            station.step(single)
         else:
-            bench.advance(0.05)  # a frame at 20 Hz: at max speed the budget decides the steps
-    (entry,) = bench.runs
+            station.advance(0.05)  # a frame at 20 Hz: at max speed the budget decides the steps
+    (entry,) = station.runs
     assert entry.ended == "exit"
     return entry.metrics.as_dict() | {"record": entry.record}
 
 
 @pytest.mark.parametrize("speed", SPEEDS, ids=lambda s: f"{s}x" if s else "max")
 def test_every_speed_gives_the_numbers_of_a_headless_run(speed):
-    got, want = bench_run(speed), headless()
+    got, want = station_run(speed), headless()
     assert got["reached_exit"] and got["exit_time"] == want["exit_time"]
     for key in ("sim_time", "distance", "turn_degrees", "turns", "collisions"):
         assert got[key] == pytest.approx(want[key], abs=1e-9), key
@@ -52,12 +52,12 @@ def test_every_speed_gives_the_numbers_of_a_headless_run(speed):
 
 @pytest.mark.parametrize("single", [1, 7, 60])
 def test_single_steps_stop_at_the_exit_too(single):
-    got, want = bench_run(1.0, single), headless()
+    got, want = station_run(1.0, single), headless()
     assert got["sim_time"] == pytest.approx(want["sim_time"])
     assert got["distance"] == pytest.approx(want["distance"])
 
 
 def test_the_app_s_run_record_holds_the_ticks_of_the_headless_record(tmp_path):
-    got = bench_run(None, record_dir=str(tmp_path / "app"))
+    got = station_run(None, record_dir=str(tmp_path / "app"))
     headless(record=str(tmp_path / "headless.jsonl"))
     assert ticks(got["record"]) == ticks(tmp_path / "headless.jsonl")

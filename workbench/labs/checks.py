@@ -1,4 +1,4 @@
-"""The automatic checks of a lab exercise, read from the live bench and its runs.
+"""The automatic checks of a lab exercise, read from the live station and its runs.
 
 Each objective gives a :class:`Check`: passed or not, a one-line reason the app shows next to
 ✓ or ✗, and the evidence a sign-off keeps (the run, its metrics and its record's digest).
@@ -14,8 +14,8 @@ from pathlib import Path
 from typing import Any
 
 from workbench.control.algorithms import ALGORITHM_DIR
-from workbench.control.bench import Bench, RunEntry
 from workbench.control.manual import KEY_NAMES
+from workbench.control.station import LabStation, RunEntry
 from workbench.sim.profiles import get_profile
 from workbench.sim.record import file_sha256
 
@@ -83,7 +83,7 @@ KEPT = "passed earlier: "
 def keep_passed(saved: ExerciseProgress | None, live: ExerciseProgress) -> ExerciseProgress:
     """``live`` with every objective that passed in ``saved`` still passed, with its evidence.
 
-    What was checked once is not lost: after a restart (or a new robot, a new maze) the bench
+    What was checked once is not lost: after a restart (or a new robot, a new maze) the station
     no longer shows the run that passed, but the saved progress does. Objectives are matched
     by kind and text, so a changed lab file does not carry over a different objective. The
     questions follow the answers as they stand (those are saved and shown again).
@@ -103,18 +103,18 @@ def keep_passed(saved: ExerciseProgress | None, live: ExerciseProgress) -> Exerc
 
 
 # -- set-up --------------------------------------------------------------------------------
-def apply_setup(bench: Bench, setup: Setup) -> None:
+def apply_setup(station: LabStation, setup: Setup) -> None:
     """The exercise's one-key set-up: profile, maze, sensors and the controller to use, with
     the maze and starter as they were when the lab was loaded."""
-    bench.profile = setup.profile
-    bench.load_maze(setup.maze.maze)
-    bench.apply_sensors(setup.sensors or get_profile(setup.profile).sensors)
+    station.profile = setup.profile
+    station.load_maze(setup.maze.maze)
+    station.apply_sensors(setup.sensors or get_profile(setup.profile).sensors)
     controller = setup.controller
     if controller.starter is not None:
-        bench.use_algorithm(controller.starter)
+        station.use_algorithm(controller.starter)
     elif controller.kind == "algorithm":
-        bench.select_algorithm(controller.value)
-    bench.start_exercise()
+        station.select_algorithm(controller.value)
+    station.start_exercise()
 
 
 # -- evidence ------------------------------------------------------------------------------
@@ -156,29 +156,29 @@ def driver_kinds(run: RunEntry) -> set[str]:
 
 
 # -- the objective kinds -------------------------------------------------------------------
-def check_keys(obj: Objective, bench: Bench) -> Check:
-    """The drive keys pressed on the bench, or (with ``role``) the same motions asked for by a
+def check_keys(obj: Objective, station: LabStation) -> Check:
+    """The drive keys pressed on the station, or (with ``role``) the same motions asked for by a
     VIPLE program over that role: its own key bindings turned into commands."""
-    missing = [k for k in obj.keys if k not in bench.keys_used]
-    evidence: dict[str, Any] = {"keys_used": sorted(bench.keys_used)}
+    missing = [k for k in obj.keys if k not in station.keys_used]
+    evidence: dict[str, Any] = {"keys_used": sorted(station.keys_used)}
     if not missing:
         return Check(True, f"used {', '.join(obj.keys)}", evidence)
     if obj.role:
         wanted = [KEY_NAMES[k] for k in obj.keys]
-        for c in reversed([c for c in bench.viple if c.role == obj.role]):
+        for c in reversed([c for c in station.viple if c.role == obj.role]):
             if all(m in c.motions for m in wanted):
                 evidence = {"role": c.role, "peer": c.peer, "motions": sorted(c.motions)}
                 reason = f"VIPLE {c.role} program asked for {', '.join(wanted)}"
                 return Check(True, reason, evidence)
-        motions = set().union(*(c.motions for c in bench.viple if c.role == obj.role))
+        motions = set().union(*(c.motions for c in station.viple if c.role == obj.role))
         if motions:
             lacking = [m for m in wanted if m not in motions]
             return Check(False, f"VIPLE has not asked for {', '.join(lacking)} yet", evidence)
     return Check(False, f"not used yet: {', '.join(missing)}", evidence)
 
 
-def check_sensors(obj: Objective, bench: Bench) -> Check:
-    have = {str(s) for s in bench.sensors}
+def check_sensors(obj: Objective, station: LabStation) -> Check:
+    have = {str(s) for s in station.sensors}
     want = {str(s) for s in obj.sensors}
     evidence = {"sensors": sorted(have)}
     if have == want:
@@ -191,8 +191,8 @@ def check_sensors(obj: Objective, bench: Bench) -> Check:
     return Check(False, "; ".join(parts), evidence)
 
 
-def check_viple(obj: Objective, bench: Bench) -> Check:
-    mine = [c for c in bench.viple if c.role == obj.role]
+def check_viple(obj: Objective, station: LabStation) -> Check:
+    mine = [c for c in station.viple if c.role == obj.role]
     drove = [c for c in mine if c.drove]
     if drove:
         c = drove[-1]
@@ -201,7 +201,7 @@ def check_viple(obj: Objective, bench: Bench) -> Check:
         return Check(True, f"VIPLE {c.role} program at {c.peer} drove the robot", evidence)
     if mine:
         return Check(False, f"VIPLE {obj.role} program connected but has not moved the robot")
-    others = sorted({c.role for c in bench.viple})
+    others = sorted({c.role for c in station.viple})
     if others:
         return Check(
             False,
@@ -224,35 +224,35 @@ def _limits(obj: Objective, run: RunEntry) -> str | None:
     return None
 
 
-def _exits(bench: Bench, maze: LabMaze, profile: str) -> list[RunEntry]:
+def _exits(station: LabStation, maze: LabMaze, profile: str) -> list[RunEntry]:
     """Runs that reached the exit of exactly the lab's ``maze`` (same layout) on ``profile``."""
     return [
         r
-        for r in bench.runs
+        for r in station.runs
         if r.ended == "exit" and r.maze_digest == maze.digest and r.profile == profile
     ]
 
 
-def _not_the_lab_maze(bench: Bench, maze: LabMaze, profile: str) -> RunEntry | None:
+def _not_the_lab_maze(station: LabStation, maze: LabMaze, profile: str) -> RunEntry | None:
     """The last run that got out of a maze of the same name as the lab's but not its layout."""
     others = [
         r
-        for r in bench.runs
+        for r in station.runs
         if r.ended == "exit" and r.maze == maze.name and r.profile == profile
         and r.maze_digest != maze.digest
     ]  # fmt: skip
     return others[-1] if others else None
 
 
-def check_exit(obj: Objective, exercise: Exercise, bench: Bench) -> Check:
+def check_exit(obj: Objective, exercise: Exercise, station: LabStation) -> Check:
     assert obj.maze is not None
     maze = obj.maze
     profile = exercise.setup.profile
     wanted = set(obj.drivers)
-    runs = [r for r in _exits(bench, maze, profile) if driver_kinds(r) & wanted]
+    runs = [r for r in _exits(station, maze, profile) if driver_kinds(r) & wanted]
     drivers = " or ".join(obj.drivers)
     if not runs:
-        other = _not_the_lab_maze(bench, maze, profile)
+        other = _not_the_lab_maze(station, maze, profile)
         if other is not None:
             return Check(
                 False,
@@ -274,12 +274,12 @@ def check_exit(obj: Objective, exercise: Exercise, bench: Bench) -> Check:
     return Check(False, f"run {last.number} ({last.driver}) {_limits(obj, last)}", {})
 
 
-def check_maze_edited(exercise: Exercise, bench: Bench) -> Check:
+def check_maze_edited(exercise: Exercise, station: LabStation) -> Check:
     original = exercise.setup.maze.maze
-    evidence = {"maze_digest": bench.maze.digest(), "original_digest": original.digest()}
-    if bench.maze.same_layout(original):
+    evidence = {"maze_digest": station.maze.digest(), "original_digest": original.digest()}
+    if station.maze.same_layout(original):
         return Check(False, f"the maze is still {original.name!r} as set up: add or remove a block")
-    problems = bench.maze.validate()
+    problems = station.maze.validate()
     if problems:
         first = problems[0]
         return Check(
@@ -288,14 +288,14 @@ def check_maze_edited(exercise: Exercise, bench: Bench) -> Check:
     return Check(True, "the maze was edited and is valid", evidence)
 
 
-def check_compare(obj: Objective, exercise: Exercise, bench: Bench) -> Check:
+def check_compare(obj: Objective, exercise: Exercise, station: LabStation) -> Check:
     table: list[dict[str, Any]] = []
     missing = []
     for maze in obj.mazes:
         for name in obj.algorithms:
             runs = [
                 r
-                for r in _exits(bench, maze, exercise.setup.profile)
+                for r in _exits(station, maze, exercise.setup.profile)
                 if f"algorithm {name}" in driver_kinds(r)
             ]
             if runs:
@@ -322,27 +322,30 @@ def check_questions(exercise: Exercise, answers: Mapping[str, str]) -> Check:
 
 
 def check_objective(
-    obj: Objective, exercise: Exercise, bench: Bench, answers: Mapping[str, str] | None = None
+    obj: Objective,
+    exercise: Exercise,
+    station: LabStation,
+    answers: Mapping[str, str] | None = None,
 ) -> Check:
     by_kind: dict[str, Callable[[], Check]] = {
-        "keys": lambda: check_keys(obj, bench),
-        "sensors": lambda: check_sensors(obj, bench),
-        "viple": lambda: check_viple(obj, bench),
-        "exit": lambda: check_exit(obj, exercise, bench),
-        "maze-edited": lambda: check_maze_edited(exercise, bench),
-        "compare": lambda: check_compare(obj, exercise, bench),
+        "keys": lambda: check_keys(obj, station),
+        "sensors": lambda: check_sensors(obj, station),
+        "viple": lambda: check_viple(obj, station),
+        "exit": lambda: check_exit(obj, exercise, station),
+        "maze-edited": lambda: check_maze_edited(exercise, station),
+        "compare": lambda: check_compare(obj, exercise, station),
         "questions": lambda: check_questions(exercise, answers or {}),
     }
     return by_kind[obj.kind]()
 
 
 def evaluate(
-    lab_id: str, exercise: Exercise, bench: Bench, answers: Mapping[str, str] | None = None
+    lab_id: str, exercise: Exercise, station: LabStation, answers: Mapping[str, str] | None = None
 ) -> ExerciseProgress:
-    """Every objective of ``exercise`` checked against the bench now."""
+    """Every objective of ``exercise`` checked against the station now."""
     states = []
     for obj in exercise.objectives:
-        check = check_objective(obj, exercise, bench, answers)
+        check = check_objective(obj, exercise, station, answers)
         states.append(
             ObjectiveState(obj.kind, obj.text, check.passed, check.reason, check.evidence)
         )

@@ -376,7 +376,7 @@ def replay_maze(
 ) -> tuple[Maze | None, str]:
     """The maze the run was on, and a note for the student (empty when all is well).
 
-    A maze in ``known`` (e.g. the bench's) with the recorded layout digest wins; otherwise the
+    A maze in ``known`` (e.g. the station's) with the recorded layout digest wins; otherwise the
     maze file named in the header is read (as given, then beside the record). A file whose
     layout changed since the run is still used, with a warning. Only files that ``files``
     allows are read.

@@ -1,8 +1,8 @@
-"""The workbench app: one bench (maze, robot, driver, runs) behind a Textual front end.
+"""The workbench app: one station (maze, robot, driver, runs) behind a Textual front end.
 
 :func:`make_app` builds the app for the command line, the SSH server and the tests. The app
 ticks the simulation from a Textual interval: each tick hands the real time that has passed to
-the bench (a fixed-step accumulator, so a late tick loses no simulated time), then draws one
+the station (a fixed-step accumulator, so a late tick loses no simulated time), then draws one
 snapshot on every screen that shows it.
 """
 
@@ -20,7 +20,7 @@ from textual.binding import Binding, BindingType
 from textual.reactive import var
 from textual.screen import Screen
 
-from workbench.control.bench import Bench
+from workbench.control.station import LabStation
 from workbench.files.bundled import default_maze_path
 from workbench.files.workspace import LOCAL, FileAccess
 from workbench.labs.model import Setup
@@ -36,17 +36,17 @@ from workbench.viple.tcp_server import TcpConfig
 from workbench.viple.ws_client import WsConfig
 
 from .commands import WorkbenchCommands
+from .dialogs.help import HelpScreen
+from .dialogs.too_small import TooSmallScreen
 from .host import (
-    BenchChanged,
     MazeChanged,
     OpenScreen,
     ScreenHost,
     SetUpDone,
     ShowsSnapshot,
     StartEndpoint,
+    StationChanged,
 )
-from .modals.help import HelpScreen
-from .modals.too_small import TooSmallScreen
 from .screens.editor import EditorScreen
 from .screens.labs import LabsScreen
 from .screens.main import MainScreen
@@ -91,7 +91,7 @@ class WorkbenchApp(ScreenHost[None]):
 
     def __init__(
         self,
-        bench: Bench,
+        station: LabStation,
         maze_path: Path | None = None,
         user: str | None = None,
         role: str = "student",
@@ -126,7 +126,7 @@ class WorkbenchApp(ScreenHost[None]):
         self._ws_at_start = ws_at_start
         self._report_ms = report_ms
         self.endpoints: Endpoints | None = None
-        self.bench = bench
+        self.station = station
         self.maze_path = maze_path
         self.user = user
         self.role = role
@@ -146,7 +146,7 @@ class WorkbenchApp(ScreenHost[None]):
 
     def get_default_screen(self) -> Screen:
         self._main = MainScreen(
-            self.bench, unicode=self.unicode, who=self.who(), maze_path=self.maze_path
+            self.station, unicode=self.unicode, who=self.who(), maze_path=self.maze_path
         )
         return self._main
 
@@ -155,16 +155,16 @@ class WorkbenchApp(ScreenHost[None]):
         if not self._ws_at_start:
             ws = None  # later: a WebSocket exercise's set-up or the v key starts it
         if tcp is not None or ws is not None:
-            self.endpoints = await Endpoints.open(self.bench.session, tcp, ws)
+            self.endpoints = await Endpoints.open(self.station.session, tcp, ws)
         self.mark_ascii()
         self._show_maze_title()
         self._last_tick = perf_counter()
         self.set_interval(1.0 / self.tick_hz, self._tick, name="simulation")
         if self.connect_hint:
-            self.bench.message = self.hint_line()
+            self.station.message = self.hint_line()
         self._check_size(self.size.width, self.size.height)
         if self._ask_names:
-            from .modals.identity import IdentityDialog
+            from .dialogs.identity import IdentityDialog
 
             dialog = IdentityDialog(self.student, self.partner, student_fixed=self.student_fixed)
             self.push_screen(dialog, self._named)
@@ -191,19 +191,19 @@ class WorkbenchApp(ScreenHost[None]):
         now = perf_counter()
         elapsed = now - self._last_tick
         self._last_tick = now
-        bench = self.bench
+        station = self.station
         if self.endpoints is not None:
-            bench.connection = self.endpoints.summary()
-        steps = bench.advance(elapsed)
-        state = (bench.paused, bench.message, bench.controller, len(bench.runs))
+            station.connection = self.endpoints.summary()
+        steps = station.advance(elapsed)
+        state = (station.paused, station.message, station.controller, len(station.runs))
         if steps or state != self._drawn:
             self.refresh_views()
 
     def refresh_views(self) -> None:
-        """Draw the bench's current snapshot on every screen of the stack that shows one."""
-        bench = self.bench
-        self._drawn = (bench.paused, bench.message, bench.controller, len(bench.runs))
-        snapshot = bench.snapshot()
+        """Draw the station's current snapshot on every screen of the stack that shows one."""
+        station = self.station
+        self._drawn = (station.paused, station.message, station.controller, len(station.runs))
+        snapshot = station.snapshot()
         for screen in self.screen_stack:
             if isinstance(screen, ShowsSnapshot):
                 screen.show_snapshot(snapshot)
@@ -233,7 +233,7 @@ class WorkbenchApp(ScreenHost[None]):
         return self._too_small is None or action == "quit"
 
     # -- what screens ask for -------------------------------------------------------------------
-    def on_bench_changed(self, message: BenchChanged) -> None:
+    def on_station_changed(self, message: StationChanged) -> None:
         self.refresh_views()
 
     def on_maze_changed(self, message: MazeChanged) -> None:
@@ -256,22 +256,22 @@ class WorkbenchApp(ScreenHost[None]):
     # -- screens -------------------------------------------------------------------------------
     def action_help(self) -> None:
         if not isinstance(self.screen, HelpScreen):
-            self.push_screen(HelpScreen(self.bench.profile, self.connect_hint))
+            self.push_screen(HelpScreen(self.station.profile, self.connect_hint))
 
     def open_editor(self) -> None:
         # the bundled mazes (and the labs' set-up mazes) are never overwritten, nor is a file
         # outside a served student's workspace: saving one asks where to keep the copy
         path = self.maze_path
-        if path is not None and not self.bench.files.allows_writing(path):
+        if path is not None and not self.station.files.allows_writing(path):
             path = None
         path = str(path) if path is not None else None
-        self.push_screen(EditorScreen(self.bench, path, unicode=self.unicode), self._edited)
+        self.push_screen(EditorScreen(self.station, path, unicode=self.unicode), self._edited)
 
     def _edited(self, maze: Maze | None) -> None:
         self.maze_changed()
 
     def maze_changed(self, path: str | os.PathLike | None = None) -> None:
-        """The bench has a new maze (or profile): follow it, and its file when one is given
+        """The station has a new maze (or profile): follow it, and its file when one is given
         (the editor saves there unless it is a bundled maze)."""
         if path is not None:
             self.maze_path = Path(path)
@@ -281,16 +281,16 @@ class WorkbenchApp(ScreenHost[None]):
         self.refresh_views()
 
     def _show_maze_title(self) -> None:
-        self.sub_title = f"{self.bench.maze.name} ({self.bench.profile})"
+        self.sub_title = f"{self.station.maze.name} ({self.station.profile})"
 
     def open_runs(self) -> None:
-        self.push_screen(RunsScreen(self.bench, unicode=self.unicode))
+        self.push_screen(RunsScreen(self.station, unicode=self.unicode))
 
     def open_labs(self) -> None:
         if self._labs is None:
             self._open_store()
             self._labs = LabsScreen(
-                self.bench,
+                self.station,
                 self.store,
                 self.student,
                 self.partner,
@@ -309,7 +309,7 @@ class WorkbenchApp(ScreenHost[None]):
             self.store_problem = f"cannot open {where}, so nothing is saved: {exc}"
 
     def set_up_done(self, setup: Setup | None = None) -> None:
-        """A lab's set-up changed the bench: follow its maze and profile, and start the VIPLE
+        """A lab's set-up changed the station: follow its maze and profile, and start the VIPLE
         endpoint an exercise done from VIPLE needs."""
         self.maze_changed(setup.maze.path if setup is not None else None)
         if setup is not None and setup.controller.kind == "viple":
@@ -321,7 +321,7 @@ class WorkbenchApp(ScreenHost[None]):
         tcp, ws = self._viple_configs
         if self.endpoints is None:
             self.endpoints = Endpoints()
-        session = self.bench.session
+        session = self.station.session
         if role == "tcp":
             config = tcp or TcpConfig(report_ms=self._report_ms)
             if await self.endpoints.start_tcp(session, config):
@@ -335,12 +335,12 @@ class WorkbenchApp(ScreenHost[None]):
             text = f"VIPLE: start your program's WebSocket server; the robot connects to {url}"
         if self.connect_hint:
             text = self.hint_line()
-        self.bench.connection = self.endpoints.summary()
+        self.station.connection = self.endpoints.summary()
         self._say(text)
         return text
 
     def _say(self, message: str) -> None:
-        self.bench.message = message
+        self.station.message = message
         self.refresh_views()
 
     async def action_quit(self) -> None:
@@ -352,7 +352,7 @@ class WorkbenchApp(ScreenHost[None]):
             await self._shut_down()
 
     async def _shut_down(self) -> None:
-        self.bench.close()
+        self.station.close()
         if self.store is not None:
             # a last try for what the database did not get yet (never shown as saved)
             with contextlib.suppress(Exception):
@@ -435,16 +435,16 @@ def make_app(
     except OSError as exc:
         raise AppSetupError(f"cannot use the workspace folder {workspace}: {exc}") from None
     try:
-        bench = Bench.open(
+        station = LabStation.open(
             maze, profile, seed=seed, noise=noise, record_dir=record_dir, files=files
         )
     except ValueError as exc:
         raise AppSetupError(f"cannot set up the robot: {exc}") from None
-    bench.pause(paused)
+    station.pause(paused)
     # max speed may use at most 60 % of each frame, so keys and drawing stay responsive
-    bench.pacer.budget = 0.6 / tick_hz
+    station.pacer.budget = 0.6 / tick_hz
     return WorkbenchApp(
-        bench,
+        station,
         maze_path=path,
         user=user,
         role=role,

@@ -2,7 +2,7 @@
 
 A screen never reaches into the app: it posts one of the messages below, which bubbles up to
 the app. The app speaks to its screens only through the two small roles a screen may take on:
-:class:`ShowsSnapshot` (draws the bench at each tick) and :class:`FollowsUnicode` (redraws when
+:class:`ShowsSnapshot` (draws the station at each tick) and :class:`FollowsUnicode` (redraws when
 the drawing switches between Unicode and ASCII). :class:`ScreenHost` is the part of an app that
 every host shares, the workbench app and the tests' bare hosts alike: it holds the Unicode
 setting, toggles it when a screen asks and applies it to every screen.
@@ -26,7 +26,7 @@ ScreenName = Literal["editor", "runs", "labs"]
 
 
 class ShowsSnapshot:
-    """A screen that draws the bench: the app hands it every snapshot it draws.
+    """A screen that draws the station: the app hands it every snapshot it draws.
 
     A role, not a base: the screen defines ``show_snapshot`` itself (a mixin with an abstract
     method would clash with Textual's metaclass).
@@ -50,12 +50,12 @@ class ToggleUnicode(Message):
     """Switch the drawing between Unicode and ASCII, on every screen."""
 
 
-class BenchChanged(Message):
-    """An action changed the bench: every screen that shows it redraws."""
+class StationChanged(Message):
+    """An action changed the station: every screen that shows it redraws."""
 
 
 class MazeChanged(Message):
-    """The bench has a new maze (or profile); ``path`` is its file when it came from one."""
+    """The station has a new maze (or profile); ``path`` is its file when it came from one."""
 
     def __init__(self, path: str | os.PathLike | None = None) -> None:
         super().__init__()
@@ -63,7 +63,7 @@ class MazeChanged(Message):
 
 
 class SetUpDone(Message):
-    """A lab exercise's set-up changed the bench (maze, profile, sensors, driver)."""
+    """A lab exercise's set-up changed the station (maze, profile, sensors, driver)."""
 
     def __init__(self, setup: Setup) -> None:
         super().__init__()

@@ -1,8 +1,8 @@
 """The maze editor screen: draw walls, place the start and exits, check and save the maze.
 
 All editing happens in :class:`~workbench.sim.editing.MazeEditor`; this screen draws it and
-routes keys and clicks to it. On leaving, a changed maze that is valid goes to the bench, so
-the robot runs on it; the screen is dismissed with that maze (or None when the bench kept its
+routes keys and clicks to it. On leaving, a changed maze that is valid goes to the station, so
+the robot runs on it; the screen is dismissed with that maze (or None when the station kept its
 maze).
 """
 
@@ -20,16 +20,16 @@ from textual.screen import Screen
 from textual.widgets import Footer, OptionList, Static
 from textual.widgets.option_list import Option
 
-from workbench.control.bench import Bench
+from workbench.control.station import LabStation
 from workbench.sim.editing import EditorError, Finding, GenerateOptions, MazeEditor
 from workbench.sim.maze import Maze
 
+from ..dialogs.generate import GenerateDialog
+from ..dialogs.path import PathDialog
+from ..dialogs.size import SizeDialog
+from ..dialogs.unsaved import Choice, UnsavedDialog
 from ..host import FollowsUnicode, ToggleUnicode
 from ..widgets.maze_view import MazeView
-from .generate_dialog import GenerateDialog
-from .path_dialog import PathDialog
-from .size_dialog import SizeDialog
-from .unsaved_dialog import Choice, UnsavedDialog
 
 SAVE_HELP = (
     "The file is written atomically: a crash leaves the old file or the new one, never half. "
@@ -53,7 +53,7 @@ def _problem_line(finding: Finding) -> str:
 
 
 class EditorScreen(FollowsUnicode, Screen[Maze | None]):
-    """Edit the bench's maze; dismissed with the maze the robot now runs on, or None."""
+    """Edit the station's maze; dismissed with the maze the robot now runs on, or None."""
 
     AUTO_FOCUS = ""
 
@@ -209,7 +209,7 @@ class EditorScreen(FollowsUnicode, Screen[Maze | None]):
 
     def __init__(
         self,
-        bench: Bench,
+        station: LabStation,
         path: str | None = None,
         unicode: bool = False,
         *,
@@ -218,8 +218,8 @@ class EditorScreen(FollowsUnicode, Screen[Maze | None]):
         classes: str | None = None,
     ) -> None:
         super().__init__(name=name, id=id, classes=classes)
-        self.bench = bench
-        self.editor = MazeEditor(bench.maze, path, bench.files)
+        self.station = station
+        self.editor = MazeEditor(station.maze, path, station.files)
         self._unicode = unicode
         self._generate_options = GenerateOptions()
         self._shown_problems: tuple[bool, tuple[str, ...]] | None = None
@@ -463,7 +463,7 @@ class EditorScreen(FollowsUnicode, Screen[Maze | None]):
             "Save maze as",
             SAVE_HELP,
             value=self.editor.suggested_path() if value is None else value,
-            note=self.bench.files.note(),
+            note=self.station.files.note(),
             action="Save",
             error=error,
         )
@@ -508,10 +508,10 @@ class EditorScreen(FollowsUnicode, Screen[Maze | None]):
     def _leave(self, discard: bool) -> None:
         maze, note = self.editor.handover(discard)
         if maze is not None:
-            self.bench.load_maze(maze)
-            self.bench.message = f"the robot is on the edited maze {maze.name}"
+            self.station.load_maze(maze)
+            self.station.message = f"the robot is on the edited maze {maze.name}"
         elif note:
-            self.bench.message = note
+            self.station.message = note
         if len(self.app.screen_stack) > 1 and self.app.screen is self:
             self.dismiss(maze)
         else:

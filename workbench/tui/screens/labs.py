@@ -2,8 +2,8 @@
 
 On the left, every lab and its exercises (✓ once an exercise's objectives pass or it has been
 signed off); on the right, the chosen exercise: its instructions, its objectives with ✓/✗ and
-a one-line reason that follow the bench as the student works, and its questions. ``a`` puts
-the exercise's set-up on the bench, ``i`` opens the instructor's sign-off. Progress is saved
+a one-line reason that follow the station as the student works, and its questions. ``a`` puts
+the exercise's set-up on the station, ``i`` opens the instructor's sign-off. Progress is saved
 in the store as soon as an exercise is opened and each time an objective or an answer
 changes; an objective that passed once stays passed, with its evidence, after a restart.
 """
@@ -22,7 +22,7 @@ from textual.timer import Timer
 from textual.widgets import Footer, Input, Label, Markdown, OptionList, Static
 from textual.widgets.option_list import Option
 
-from workbench.control.bench import Bench
+from workbench.control.station import LabStation
 from workbench.labs.checks import ExerciseProgress, apply_setup, evaluate, keep_passed
 from workbench.labs.model import Exercise, Lab, LabFileError, load_labs
 from workbench.labs.store import Store, StoreUnavailable
@@ -100,7 +100,7 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
 
     def __init__(
         self,
-        bench: Bench,
+        station: LabStation,
         store: Store | None,
         student: str,
         partner: str = "",
@@ -108,7 +108,7 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
         store_problem: str = "",
     ) -> None:
         super().__init__()
-        self.bench = bench
+        self.station = station
         self.store = store
         self.student = student
         self.partner = partner
@@ -287,7 +287,7 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
         return option if option in known else None
 
     def on_screen_resume(self) -> None:
-        self.show_snapshot(self.bench.snapshot())
+        self.show_snapshot(self.station.snapshot())
 
     def _refresh_list(self) -> None:
         listing = self.query_one("#labs-list", OptionList)
@@ -339,7 +339,7 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
                     classes="question",
                 )
             )
-        self.show_snapshot(self.bench.snapshot())
+        self.show_snapshot(self.station.snapshot())
 
     def _answer_reason(self, exercise: Exercise, question_id: str) -> str:
         lab = self.selected[0] if self.selected else None
@@ -365,18 +365,18 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
             box.query_one(".question-reason", Static).update(
                 self._answer_reason(exercise, question_id)
             )
-        self.show_snapshot(self.bench.snapshot())
+        self.show_snapshot(self.station.snapshot())
 
     # -- live checks ---------------------------------------------------------------------
     def track(self) -> ExerciseProgress | None:
-        """Check the chosen exercise against the bench (objectives that passed before stay
+        """Check the chosen exercise against the station (objectives that passed before stay
         passed); save it when it is new or an objective or an answer changed."""
         if self.selected is None:
             return None
         lab, exercise = self.selected
         key = (lab.id, exercise.id)
         saved = self._saved.get(key)
-        live = evaluate(lab.id, exercise, self.bench, self.answers.get(key, {}))
+        live = evaluate(lab.id, exercise, self.station, self.answers.get(key, {}))
         progress = keep_passed(saved, live)
         if saved is None or _changed(saved, progress):
             was_done = key in self._done
@@ -411,14 +411,14 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
             return
         exercise = self.selected[1]
         try:
-            apply_setup(self.bench, exercise.setup)
+            apply_setup(self.station, exercise.setup)
         except Exception as exc:
             self.say(f"cannot set up {exercise.title}: {exc}")
             return
         setup = exercise.setup
         self.say(f"set up: {setup.profile}, {setup.maze.path.name}, {setup.controller}")
         self.post_message(SetUpDone(setup))
-        self.show_snapshot(self.bench.snapshot())
+        self.show_snapshot(self.station.snapshot())
 
     def action_sign_off(self) -> None:
         if self.selected is None:
@@ -427,7 +427,7 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
         if self.store is None:
             self.say(self._store_problem or "no data folder: sign-off is not available")
             return
-        from ..modals.signoff import SignoffModal
+        from ..dialogs.signoff import SignoffModal
 
         progress = self.track()
         assert progress is not None

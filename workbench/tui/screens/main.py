@@ -2,7 +2,7 @@
 
 Layout: the maze view (most of the space) over the run status, a side panel with the key
 legend, the sensor readings by port and the algorithm's live state, the message line and the
-footer. Every action here calls the bench; the screen only draws what the bench reports.
+footer. Every action here calls the station; the screen only draws what the station reports.
 """
 
 from __future__ import annotations
@@ -18,8 +18,8 @@ from textual.reactive import var
 from textual.screen import Screen
 from textual.widgets import Footer
 
-from workbench.control.bench import Bench
 from workbench.control.fsm import FsmError
+from workbench.control.station import LabStation
 from workbench.files.workspace import OutsideWorkspace
 from workbench.sim.maze import MazeError
 from workbench.sim.mazeio import load_maze
@@ -28,12 +28,12 @@ from workbench.sim.session import Snapshot
 
 from ..compositor import LiveCompositor
 from ..host import (
-    BenchChanged,
     FollowsUnicode,
     MazeChanged,
     OpenScreen,
     ShowsSnapshot,
     StartEndpoint,
+    StationChanged,
     ToggleUnicode,
 )
 from ..widgets.algorithm_state import AlgorithmState
@@ -81,7 +81,7 @@ class MainScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
 
     def __init__(
         self,
-        bench: Bench,
+        station: LabStation,
         unicode: bool = False,
         trail: bool = True,
         who: str = "",
@@ -90,11 +90,11 @@ class MainScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         super().__init__()
         #: who is at the robot, for the message line
         self.who = who
-        #: the file of the maze on the bench (where the maze dialog starts)
+        #: the file of the maze on the station (where the maze dialog starts)
         self.maze_path = maze_path
         # the maze and the panels change a few cells at a time, many times a second
         self._compositor = LiveCompositor()
-        self.bench = bench
+        self.station = station
         self._ready = False
         self._unicode = unicode
         self._trail = trail
@@ -103,10 +103,12 @@ class MainScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self._panels_at = 0.0
 
     def compose(self) -> ComposeResult:
-        bench = self.bench
-        self._maze_view = MazeView(bench.maze, unicode=self._unicode, trail=self._trail, id="maze")
+        station = self.station
+        self._maze_view = MazeView(
+            station.maze, unicode=self._unicode, trail=self._trail, id="maze"
+        )
         self._run_status = RunStatus(id="run")
-        self._legend = KeyLegend(bench.profile, id="legend")
+        self._legend = KeyLegend(station.profile, id="legend")
         self._readings = SensorReadings(id="readings")
         self._algorithm = AlgorithmState(id="algorithm")
         self._message = MessageBar(self.who, id="message")
@@ -123,15 +125,15 @@ class MainScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
 
     def on_mount(self) -> None:
         self._ready = True
-        self.show_snapshot(self.bench.snapshot())
+        self.show_snapshot(self.station.snapshot())
 
     def on_screen_resume(self) -> None:
         view = self._maze_view
-        if view.maze is not self.bench.maze:
-            view.set_maze(self.bench.maze)
+        if view.maze is not self.station.maze:
+            view.set_maze(self.station.maze)
             view.clear_trail()
-        self._legend.profile = self.bench.profile
-        self.show_snapshot(self.bench.snapshot())
+        self._legend.profile = self.station.profile
+        self.show_snapshot(self.station.snapshot())
 
     # -- drawing ---------------------------------------------------------------------------
     @property
@@ -142,112 +144,112 @@ class MainScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         """Draw one snapshot: each widget repaints only what changed."""
         if not self._ready:
             return  # the app ticks while the screen is still being built
-        bench = self.bench
+        station = self.station
         self.snapshot = snapshot
         unicode = self.unicode
-        if bench.controller is not self._controller:
-            self._controller = bench.controller
-            if bench.controller is not None:
+        if station.controller is not self._controller:
+            self._controller = station.controller
+            if station.controller is not None:
                 self._maze_view.clear_trail()  # a new run starts from the start block
-        self._maze_view.show(snapshot, bench.session.world.cell)
+        self._maze_view.show(snapshot, station.session.world.cell)
         # the text panels follow at PANEL_HZ while the robot runs (every byte counts over SSH);
         # at once when paused (steps, snapshots) and when who drives or the state changes
         now = monotonic()
         moment = (
-            bench.paused,
-            bench.message,
+            station.paused,
+            station.message,
             snapshot.driver,
             snapshot.state,
-            bench.connection,
+            station.connection,
         )
-        if bench.paused or moment != self._moment or now - self._panels_at >= 1 / PANEL_HZ:
+        if station.paused or moment != self._moment or now - self._panels_at >= 1 / PANEL_HZ:
             self._moment = moment
             self._panels_at = now
-            self._readings.show(snapshot, bench.profile)
-            self._run_status.show(snapshot, bench, unicode)
-            self._algorithm.show(bench, unicode)
-            self._message.message = bench.message
+            self._readings.show(snapshot, station.profile)
+            self._run_status.show(snapshot, station, unicode)
+            self._algorithm.show(station, unicode)
+            self._message.message = station.message
 
     def refresh_views(self) -> None:
         """Redraw after an action: through the app, so open dialogs follow too."""
-        self.show_snapshot(self.bench.snapshot())
-        self.post_message(BenchChanged())
+        self.show_snapshot(self.station.snapshot())
+        self.post_message(StationChanged())
 
     def say(self, message: str) -> None:
-        self.bench.message = message
+        self.station.message = message
         self.refresh_views()
 
     # -- actions -------------------------------------------------------------------------------
     def action_drive(self, key: str) -> None:
-        bench = self.bench
-        bench.message = ""
-        bench.key(key)
+        station = self.station
+        station.message = ""
+        station.key(key)
         self.refresh_views()
 
     def action_pause(self) -> None:
-        paused = self.bench.toggle_pause()
+        paused = self.station.toggle_pause()
         self.say("paused: n steps, p resumes" if paused else "")
 
     def action_step(self) -> None:
-        bench = self.bench
-        bench.pause()
-        bench.step(bench.session.every)
+        station = self.station
+        station.pause()
+        station.step(station.session.every)
         self.refresh_views()
 
     def action_speed(self) -> None:
-        self.bench.pacer.next_speed()
+        self.station.pacer.next_speed()
         self.refresh_views()
 
     def action_reset(self) -> None:
-        self.bench.reset_robot()
+        self.station.reset_robot()
         self._maze_view.clear_trail()
         self.refresh_views()
 
     def action_sensors(self) -> None:
-        from ..modals.sensor_ports import SensorPortsModal
+        from ..dialogs.sensor_ports import SensorPortsModal
 
-        self.app.push_screen(SensorPortsModal(self.bench))
+        self.app.push_screen(SensorPortsModal(self.station))
 
     def action_algorithm(self) -> None:
-        from ..modals.algorithm import AlgorithmModal
+        from ..dialogs.algorithm import AlgorithmModal
 
-        self.app.push_screen(AlgorithmModal(self.bench))
+        self.app.push_screen(AlgorithmModal(self.station))
 
     def action_run_algorithm(self) -> None:
-        bench = self.bench
-        if bench.controller is not None:
-            bench.stop_algorithm("stopped")
+        station = self.station
+        if station.controller is not None:
+            station.stop_algorithm("stopped")
             self.say("algorithm stopped: the keys drive")
             return
-        if bench.algorithm is None:
+        if station.algorithm is None:
             self.action_algorithm()
             return
-        missing = bench.missing_sensors()
+        missing = station.missing_sensors()
         if missing:
             self.say("the algorithm lacks a sensor: f fits the sensors it needs")
             return
         try:
-            bench.start_algorithm()
+            station.start_algorithm()
         except (FsmError, ValueError) as exc:
             self.say(f"cannot start: {exc}")
             return
         self.refresh_views()
 
     def action_fix_sensors(self) -> None:
-        bench = self.bench
-        if bench.algorithm is None:
+        station = self.station
+        if station.algorithm is None:
             self.say("choose an algorithm first (g)")
             return
-        if bench.missing_sensors() is None:
-            self.say(f"the sensors already fit {bench.algorithm.name}")
+        if station.missing_sensors() is None:
+            self.say(f"the sensors already fit {station.algorithm.name}")
             return
         try:
-            bench.apply_algorithm_preset()
+            station.apply_algorithm_preset()
         except (SensorConfigError, FsmError, ValueError) as exc:
             self.say(f"cannot fit the sensors: {exc}")
             return
-        ports = ", ".join(str(s) for s in bench.sensors)
-        self.say(f"sensors set for {bench.algorithm.name}: {ports}; x starts it")
+        ports = ", ".join(str(s) for s in station.sensors)
+        self.say(f"sensors set for {station.algorithm.name}: {ports}; x starts it")
 
     def action_unicode(self) -> None:
         self.post_message(ToggleUnicode())
@@ -261,10 +263,10 @@ class MainScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         view.set_trail(not view.trail)
 
     def action_maze(self, value: str | None = None, error: str = "") -> None:
-        """Ask for a maze file and put it on the bench (the robot starts over on it)."""
-        from .path_dialog import PathDialog
+        """Ask for a maze file and put it on the station (the robot starts over on it)."""
+        from ..dialogs.path import PathDialog
 
-        files = self.bench.files
+        files = self.station.files
         if value is None:
             current = self.maze_path
             value = f"{files.shown(Path(current).parent)}/" if current else files.home()
@@ -282,7 +284,7 @@ class MainScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
 
     def _load_maze(self, path: str) -> None:
         try:
-            real = self.bench.files.for_reading(path)
+            real = self.station.files.for_reading(path)
             maze = load_maze(real)
         except OutsideWorkspace as exc:
             self.action_maze(path, str(exc))
@@ -290,10 +292,10 @@ class MainScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         except MazeError as exc:
             self.action_maze(path, "\n".join(str(p) for p in exc.problems))
             return
-        self.bench.load_maze(maze)
+        self.station.load_maze(maze)
         self._maze_view.set_maze(maze)
         self._maze_view.clear_trail()
-        self.bench.message = f"the robot is on {maze.name}"
+        self.station.message = f"the robot is on {maze.name}"
         self.post_message(MazeChanged(real))
 
     def action_editor(self) -> None:

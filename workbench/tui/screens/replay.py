@@ -195,7 +195,7 @@ class ReplayScreen(FollowsUnicode, Screen[None]):
     ) -> None:
         """``replay`` is the record already loaded (else it is loaded here and a malformed
         record raises :class:`~workbench.sim.record.RecordError`); ``mazes`` are mazes the run
-        may have been on (the bench's), found again by their layout digest; a maze file named
+        may have been on (the station's), found again by their layout digest; a maze file named
         by the record is read only where ``files`` allows."""
         super().__init__(name=name, id=id, classes=classes)
         self.record_path = os.fspath(record_path)

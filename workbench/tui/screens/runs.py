@@ -1,4 +1,4 @@
-"""The runs screen: the bench's last runs side by side, and the way into their replays.
+"""The runs screen: the station's last runs side by side, and the way into their replays.
 
 Each row is one run with the course's measures, so students can answer "which algorithm is
 better on this maze". Enter (or a click) on a run with a record opens its replay; ``o`` opens
@@ -15,14 +15,14 @@ from textual.binding import Binding, BindingType
 from textual.screen import Screen
 from textual.widgets import DataTable, Footer, Static
 
-from workbench.control.bench import Bench, RunEntry
+from workbench.control.station import LabStation, RunEntry
 from workbench.files.workspace import OutsideWorkspace
 from workbench.sim.record import RecordError
 from workbench.sim.replay import load_replay
 from workbench.sim.session import Snapshot
 
+from ..dialogs.path import PathDialog
 from ..host import FollowsUnicode, ShowsSnapshot, ToggleUnicode
-from .path_dialog import PathDialog
 from .replay import ReplayScreen
 
 #: column key, heading (ASCII), heading (Unicode)
@@ -68,7 +68,7 @@ def run_cells(run: RunEntry, unicode: bool) -> tuple[str, ...]:
 
 
 class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
-    """The bench's runs side by side; enter replays one, ``o`` opens a record file."""
+    """The station's runs side by side; enter replays one, ``o`` opens a record file."""
 
     DEFAULT_CSS = """
     RunsScreen #runs-title {
@@ -123,7 +123,7 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
 
     def __init__(
         self,
-        bench: Bench,
+        station: LabStation,
         unicode: bool = False,
         *,
         name: str | None = None,
@@ -131,7 +131,7 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         classes: str | None = None,
     ) -> None:
         super().__init__(name=name, id=id, classes=classes)
-        self.bench = bench
+        self.station = station
         self._unicode = unicode
         self._shown: tuple[tuple[str, ...], ...] | None = None
         self._shown_count = -1
@@ -164,17 +164,17 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
 
     def show_snapshot(self, snapshot: Snapshot) -> None:
         """Called by the app on every frame: pick up runs that ended meanwhile."""
-        if len(self.bench.runs) != self._shown_count:
+        if len(self.station.runs) != self._shown_count:
             self.refresh_runs()
 
     def refresh_runs(self) -> None:
-        """Show the bench's runs (newest last); repaints only when they changed."""
-        runs = self.bench.runs
+        """Show the station's runs (newest last); repaints only when they changed."""
+        runs = self.station.runs
         self._shown_count = len(runs)
         rows = tuple(run_cells(run, self.unicode) for run in runs)
         table = self.query_one(DataTable)
         self.query_one("#runs-title", Static).update(
-            f"Runs on this bench: {len(runs)}  [maze now: {self.bench.maze.name or '-'}]"
+            f"Runs on this bench: {len(runs)}  [maze now: {self.station.maze.name or '-'}]"
         )
         if runs:
             help_text = (
@@ -209,10 +209,10 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
     # -- replay ------------------------------------------------------------------------------
     def _selected(self) -> RunEntry | None:
         table = self.query_one(DataTable)
-        if not self.bench.runs or table.row_count == 0:
+        if not self.station.runs or table.row_count == 0:
             return None
         key = table.coordinate_to_cell_key(table.cursor_coordinate).row_key.value
-        return next((r for r in self.bench.runs if str(r.number) == key), None)
+        return next((r for r in self.station.runs if str(r.number) == key), None)
 
     def action_replay(self) -> None:
         run = self._selected()
@@ -236,10 +236,14 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
     def open_record(self, path: str) -> bool:
         """Open the replay of the record at ``path``; a bad record is reported here."""
         try:
-            real = self.bench.files.for_reading(path)
+            real = self.station.files.for_reading(path)
             replay = load_replay(real)
             screen = ReplayScreen(
-                real, replay, mazes=(self.bench.maze,), unicode=self.unicode, files=self.bench.files
+                real,
+                replay,
+                mazes=(self.station.maze,),
+                unicode=self.unicode,
+                files=self.station.files,
             )
         except (OutsideWorkspace, RecordError) as exc:
             self._status(str(exc), error=True)
@@ -259,10 +263,10 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             PathDialog(
                 "Open a run record",
                 OPEN_HELP,
-                value=value or self.bench.files.home(),
+                value=value or self.station.files.home(),
                 action="Open",
                 error=error,
-                note=self.bench.files.note(),
+                note=self.station.files.note(),
             ),
             chosen,
         )

@@ -10,7 +10,7 @@ from textual.content import Content
 from textual.reactive import var
 from textual.widgets import Static
 
-from workbench.control.bench import Bench
+from workbench.control.station import LabStation
 from workbench.sim.profiles import get_profile
 
 from .text import arrow, number, set_border_title
@@ -18,7 +18,7 @@ from .transition_log import TransitionLog, values_text
 
 
 class AlgorithmState(Vertical):
-    """What the algorithm is doing, refreshed from the bench after each tick."""
+    """What the algorithm is doing, refreshed from the station after each tick."""
 
     DEFAULT_CSS = """
     AlgorithmState {
@@ -70,10 +70,10 @@ class AlgorithmState(Vertical):
         """The state shown as the current one (None when no algorithm runs)."""
         return self.states[1]
 
-    def show(self, bench: Bench, unicode: bool) -> None:
-        definition = bench.algorithm
-        controller = bench.controller
-        unit = get_profile(bench.profile).unit
+    def show(self, station: LabStation, unicode: bool) -> None:
+        definition = station.algorithm
+        controller = station.controller
+        unit = get_profile(station.profile).unit
         log = self._log
         if definition is None:
             set_border_title(self, "Algorithm")
@@ -87,7 +87,7 @@ class AlgorithmState(Vertical):
         set_border_title(self, f"Algorithm {definition.name}")
         names = tuple(s.name for s in definition.states)
         if controller is None:
-            missing = bench.missing_sensors()
+            missing = station.missing_sensors()
             if missing:
                 first = missing.splitlines()[0].split(": add one")[0]
                 self.summary = f"cannot start: {first}. f fits the sensors it needs."
@@ -98,7 +98,7 @@ class AlgorithmState(Vertical):
             self.last = ""
             log.display = False
             return
-        t = bench.session.world.time
+        t = station.session.world.time
         timer = controller.timer_remaining(t)
         self.summary = f"in {controller.state}" + (
             f", timer {timer:.1f} s" if timer is not None else ""

@@ -168,7 +168,7 @@ class MazeView(ScrollView, can_focus=False):
         self._strips: list[Strip | None] = [None] * maze.height
         self._styles: dict[str, Style] = {}
         self._tooltip_text = ""
-        #: how many row strips have been rendered since the widget was made (for tests/benches)
+        #: how many row strips have been rendered since the widget was made (for tests/stations)
         self.strips_built = 0
 
     # -- public API ----------------------------------------------------------------------

@@ -7,7 +7,7 @@ from textual.widgets import Static
 
 
 class MessageBar(Static):
-    """The bench message on the left; the user and role on the right."""
+    """The station message on the left; the user and role on the right."""
 
     DEFAULT_CSS = """
     MessageBar {

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from workbench.control.bench import Bench
+from workbench.control.station import LabStation
 from workbench.sim.profiles import get_profile
 from workbench.sim.session import Snapshot
 
@@ -26,14 +26,14 @@ class RunStatus(TextLines):
         super().__init__(id=id, classes=classes)
         set_border_title(self, "Run")
 
-    def show(self, snapshot: Snapshot, bench: Bench, unicode: bool) -> None:
+    def show(self, snapshot: Snapshot, station: LabStation, unicode: bool) -> None:
         sep = separator(unicode)
-        unit = get_profile(bench.profile).unit
+        unit = get_profile(station.profile).unit
         m = snapshot.metrics
-        state = "PAUSED" if bench.paused else "running"
-        set_border_title(self, f"Run: {bench.maze.name} ({bench.profile})")
+        state = "PAUSED" if station.paused else "running"
+        set_border_title(self, f"Run: {station.maze.name} ({station.profile})")
         driver = f"driver: {snapshot.driver}"
-        clock = f"{state} at {speed(bench.pacer.speed)}{sep}t {snapshot.time:.1f} s"
+        clock = f"{state} at {speed(station.pacer.speed)}{sep}t {snapshot.time:.1f} s"
         if m.reached_exit and m.exit_time is not None:
             clock += f"{sep}out at {m.exit_time:.1f} s"
             if m.efficiency is not None:
@@ -44,5 +44,5 @@ class RunStatus(TextLines):
             f"turn{'' if m.turns == 1 else 's'}"
             f"{sep}collisions {m.collisions}"
         )
-        connection = (bench.connection,) if bench.connection else ()
+        connection = (station.connection,) if station.connection else ()
         self.set_lines([driver, clock, travel, turning, *connection])

@@ -8,7 +8,7 @@ from textual.containers import Horizontal, Vertical
 from textual.message import Message
 from textual.widgets import Button, Label, Select, Static
 
-from workbench.control.bench import SensorRow
+from workbench.control.station import SensorRow
 from workbench.sim.sensors import KINDS
 
 from .field import Field

@@ -1,7 +1,7 @@
 """The live workbench: one maze, one robot, who drives it, and the runs done so far.
 
-Everything the app shows and every action it offers goes through :class:`Bench`, so the app
-only renders and routes input. A bench owns a :class:`Session` and its :class:`Pacer`.
+Everything the app shows and every action it offers goes through :class:`LabStation`, so the app
+only renders and routes input. A station owns a :class:`Session` and its :class:`Pacer`.
 """
 
 from __future__ import annotations
@@ -122,7 +122,7 @@ def check_sensor_rows(rows: Sequence[SensorRow]) -> tuple[list[SensorSpec], dict
 
 
 @dataclass
-class Bench:
+class LabStation:
     maze: Maze
     profile: str
     sensors: list[SensorSpec]
@@ -141,7 +141,7 @@ class Bench:
     message: str = ""
     #: the VIPLE endpoints' status line, kept up to date by the front end that hosts them
     connection: str = ""
-    #: every VIPLE program seen driving this bench, oldest first
+    #: every VIPLE program seen driving this station, oldest first
     viple: list[VipleConnection] = field(default_factory=list)
     _run_open: bool = False
     _run_driver: Driver = KEYS
@@ -160,13 +160,13 @@ class Bench:
         profile: str | None = None,
         sensors: Sequence[SensorSpec] | None = None,
         **kwargs: Any,
-    ) -> Bench:
+    ) -> LabStation:
         name = profile or maze.profile or "unity"
         chosen = list(sensors) if sensors is not None else list(get_profile(name).sensors)
         return cls(maze=maze, profile=name, sensors=check_ports(chosen), **kwargs)
 
     def __post_init__(self) -> None:
-        # one session for the bench's whole life: a new maze goes into it (see load_maze), so
+        # one session for the station's whole life: a new maze goes into it (see load_maze), so
         # the VIPLE endpoints serving it and the pacer keep the one reference
         self.session = Session(self.maze, self.profile, self.sensors, self.noise, self.seed)
         self.pacer = Pacer(self.session)
@@ -428,7 +428,7 @@ class Bench:
         self.message = ""
 
     def load_maze(self, maze: Maze) -> None:
-        """Put a (new or edited) maze on the bench; the robot starts over on it."""
+        """Put a (new or edited) maze on the station; the robot starts over on it."""
         self._go_on_after_exit()
         if self._run_open:
             self._close_run("maze changed")

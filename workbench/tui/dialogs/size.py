@@ -11,7 +11,7 @@ from workbench.sim.editing import MIN_BLOCKS, EditorError, parse_size
 from workbench.sim.maze import MAX_SIZE
 
 from ..widgets.field import Field
-from .dialog import Dialog
+from .frame import Dialog
 
 
 class SizeDialog(Dialog[tuple[int, int] | None]):

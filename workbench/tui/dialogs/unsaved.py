@@ -10,7 +10,7 @@ from textual.binding import Binding, BindingType
 from textual.containers import Horizontal, Vertical
 from textual.widgets import Button, Static
 
-from .dialog import Dialog
+from .frame import Dialog
 
 Choice = Literal["save", "discard", "cancel"]
 

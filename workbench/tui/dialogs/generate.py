@@ -11,7 +11,7 @@ from workbench.sim.editing import EditorError, GenerateOptions
 from workbench.sim.generate import EXITS, MAX_CELLS, MIN_CELLS, STYLES
 
 from ..widgets.field import Field
-from .dialog import Dialog
+from .frame import Dialog
 
 STYLE_HELP = {"perfect": "perfect (one path)", "braid": "braid (loops, no dead ends)"}
 EXIT_HELP = {

@@ -16,12 +16,12 @@ from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.screen import ModalScreen
 from textual.widgets import Button, Input, Label, Select, Static
 
-from workbench.control.bench import PRESETS, Bench, SensorRow, check_sensor_rows
+from workbench.control.station import PRESETS, LabStation, SensorRow, check_sensor_rows
 from workbench.sim.profiles import get_profile
 from workbench.sim.sensors import PORT_RANGE
 from workbench.sim.session import Snapshot
 
-from ..host import BenchChanged, ShowsSnapshot
+from ..host import ShowsSnapshot, StationChanged
 from ..widgets.sensor_row_editor import SensorRowEditor
 from ..widgets.text import reading
 
@@ -86,19 +86,19 @@ class SensorPortsModal(ShowsSnapshot, ModalScreen[None]):
         Binding("ctrl+n", "add_row", "Add row", id="sensors.add"),
     ]
 
-    def __init__(self, bench: Bench) -> None:
+    def __init__(self, station: LabStation) -> None:
         super().__init__()
-        self.bench = bench
+        self.station = station
         self._ready = False
 
     def compose(self) -> ComposeResult:
         dialog = Vertical(id="ports-dialog")
-        dialog.border_title = f"Sensor ports ({self.bench.profile})"
+        dialog.border_title = f"Sensor ports ({self.station.profile})"
         dialog.border_subtitle = "enter or Apply puts them on the robot, escape closes"
         with dialog:
             yield Label("#   kind          port   mount         live reading", id="ports-head")
             with VerticalScroll(id="ports-rows"):
-                for i, row in enumerate(self.bench.sensor_rows()):
+                for i, row in enumerate(self.station.sensor_rows()):
                     yield SensorRowEditor(i + 1, row)
             with Horizontal(classes="button-row", id="ports-presets"):
                 yield Label("Presets:")
@@ -113,7 +113,7 @@ class SensorPortsModal(ShowsSnapshot, ModalScreen[None]):
 
     def on_mount(self) -> None:
         self._ready = True
-        self.show_snapshot(self.bench.snapshot())
+        self.show_snapshot(self.station.snapshot())
         self.query(SensorRowEditor).first().query_one(".row-port", Input).focus()
 
     # -- reading ---------------------------------------------------------------------------
@@ -128,7 +128,7 @@ class SensorPortsModal(ShowsSnapshot, ModalScreen[None]):
         """The live reading of each row's port (when the robot has that sensor there)."""
         if not self._ready:
             return  # the app ticks while the dialog is still being built
-        profile = get_profile(self.bench.profile)
+        profile = get_profile(self.station.profile)
         live = {spec.port: spec for spec in snapshot.sensors}
         for editor in self.editors:
             row = editor.row()
@@ -148,7 +148,7 @@ class SensorPortsModal(ShowsSnapshot, ModalScreen[None]):
     # -- actions -----------------------------------------------------------------------------
     def action_apply(self) -> None:
         editors = self.editors
-        errors = self.bench.apply_sensor_rows([e.row() for e in editors])
+        errors = self.station.apply_sensor_rows([e.row() for e in editors])
         for i, editor in enumerate(editors):
             editor.set_error(errors.get(i))
         if errors:
@@ -157,9 +157,9 @@ class SensorPortsModal(ShowsSnapshot, ModalScreen[None]):
                 f"nothing applied: {count} row{'s' if count > 1 else ''} to fix (marked above)"
             )
         else:
-            specs = ", ".join(str(s) for s in self.bench.sensors) or "no sensors"
+            specs = ", ".join(str(s) for s in self.station.sensors) or "no sensors"
             self._status(f"applied: {specs}")
-            self.bench.message = ""
+            self.station.message = ""
         self._refresh_all()
 
     async def action_add_row(self) -> None:
@@ -173,12 +173,12 @@ class SensorPortsModal(ShowsSnapshot, ModalScreen[None]):
         await self.query_one("#ports-rows").mount(editor)
         editor.scroll_visible()
         editor.query_one(".row-port", Input).focus()
-        self.show_snapshot(self.bench.snapshot())
+        self.show_snapshot(self.station.snapshot())
 
     async def apply_preset(self, name: str) -> None:
-        self.bench.apply_preset(name)
+        self.station.apply_preset(name)
         await self._rebuild_rows()
-        specs = ", ".join(str(s) for s in self.bench.sensors)
+        specs = ", ".join(str(s) for s in self.station.sensors)
         self._status(f"preset {PRESET_LABELS.get(name, name)} applied: {specs}")
         self._refresh_all()
 
@@ -186,12 +186,12 @@ class SensorPortsModal(ShowsSnapshot, ModalScreen[None]):
         container = self.query_one("#ports-rows")
         await container.remove_children()
         await container.mount_all(
-            SensorRowEditor(i + 1, row) for i, row in enumerate(self.bench.sensor_rows())
+            SensorRowEditor(i + 1, row) for i, row in enumerate(self.station.sensor_rows())
         )
 
     def _refresh_all(self) -> None:
-        self.show_snapshot(self.bench.snapshot())
-        self.post_message(BenchChanged())
+        self.show_snapshot(self.station.snapshot())
+        self.post_message(StationChanged())
 
     def action_close(self) -> None:
         self.dismiss()
@@ -226,7 +226,7 @@ class SensorPortsModal(ShowsSnapshot, ModalScreen[None]):
         _, errors = check_sensor_rows([e.row() for e in editors])
         for i, editor in enumerate(editors):
             editor.set_error(errors.get(i))
-        self.show_snapshot(self.bench.snapshot())
+        self.show_snapshot(self.station.snapshot())
 
     async def on_sensor_row_editor_removed(self, event: SensorRowEditor.Removed) -> None:
         await event.editor.remove()

@@ -14,8 +14,8 @@ from textual.widgets import Button, Input, Label, Static
 
 from workbench.labs.names import NameProblem, check_pair
 
-from ..screens.dialog import Dialog
 from ..widgets.field import Field
+from .frame import Dialog
 
 
 class IdentityDialog(Dialog[tuple[str, str] | None]):

@@ -8,7 +8,7 @@ from textual.containers import Horizontal, Vertical
 from textual.widgets import Button, Input, Label, Static
 
 from ..widgets.field import Field
-from .dialog import Dialog
+from .frame import Dialog
 
 
 class PathDialog(Dialog[str | None]):

@@ -19,13 +19,13 @@ from textual.widgets import Button, Input, Label, OptionList, Static
 from textual.widgets.option_list import Option
 
 from workbench.control.algorithms import ALGORITHM_DIR, list_algorithms
-from workbench.control.bench import Bench
 from workbench.control.fsm import FsmError, resolve_params
 from workbench.control.fsmfile import FsmFileError
+from workbench.control.station import LabStation
 from workbench.files.workspace import OutsideWorkspace
 from workbench.sim.session import Snapshot
 
-from ..host import BenchChanged, ShowsSnapshot
+from ..host import ShowsSnapshot, StationChanged
 from ..widgets.field import Field
 from ..widgets.param_editor import ParamEditor
 
@@ -132,9 +132,9 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
         Binding("ctrl+d", "defaults", "Defaults", id="algorithm.defaults"),
     ]
 
-    def __init__(self, bench: Bench) -> None:
+    def __init__(self, station: LabStation) -> None:
         super().__init__()
-        self.bench = bench
+        self.station = station
         self._ready = False
 
     # -- layout ----------------------------------------------------------------------------
@@ -149,7 +149,7 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
                     yield Label("Built-in", classes="heading")
                     yield OptionList(*[Option(n, id=n) for n in names], id="alg-builtins")
                     yield Label("FSM file (YAML)", classes="heading")
-                    files = self.bench.files
+                    files = self.station.files
                     example = "~/my-fsm.yaml" if files.confined else "path/to/fsm.yaml"
                     yield Field(placeholder=example, compact=True, id="alg-path")
                     yield Button("Load file", compact=True, id="alg-load")
@@ -175,23 +175,23 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
     async def on_mount(self) -> None:
         self._ready = True
         options = self.query_one("#alg-builtins", OptionList)
-        current = self.bench.algorithm
+        current = self.station.algorithm
         names = list_algorithms()
         if current is not None and _source(current.source) == "built-in":
             options.highlighted = names.index(current.name)
         elif current is not None and current.source:
-            self.query_one("#alg-path", Input).value = self.bench.files.shown(current.source)
+            self.query_one("#alg-path", Input).value = self.station.files.shown(current.source)
             options.highlighted = 0
         else:
             options.highlighted = 0
         options.focus()
         await self._show_definition()
-        self.show_snapshot(self.bench.snapshot())
+        self.show_snapshot(self.station.snapshot())
 
     # -- drawing -------------------------------------------------------------------------------
     async def _show_definition(self) -> None:
-        bench = self.bench
-        definition = bench.algorithm
+        station = self.station
+        definition = station.algorithm
         params = self.query_one("#alg-params", Vertical)
         await params.remove_children()
         title = self.query_one("#alg-title", Static)
@@ -205,10 +205,10 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
         description = self.query_one("#alg-description", Static)
         description.update(" ".join(definition.description.split()) or "(no description)")
         description.display = True
-        lines = [f"Sensors it reads ({bench.profile} ports):"]
+        lines = [f"Sensors it reads ({station.profile} ports):"]
         lines += [
             f"  {need.name}: {need.kind} sensor mounted {need.mount}, "
-            f"port {need.ports.get(bench.profile, '?')}"
+            f"port {need.ports.get(station.profile, '?')}"
             for need in definition.sensors
         ]
         if not definition.sensors:
@@ -217,8 +217,8 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
         sensors.update("\n".join(lines))
         sensors.display = True
         self._show_missing()
-        values = bench.params()
-        defaults = resolve_params(definition, bench.profile)
+        values = station.params()
+        defaults = resolve_params(definition, station.profile)
         await params.mount_all(
             ParamEditor(p, values[p.name], defaults[p.name]) for p in definition.parameters
         )
@@ -226,7 +226,7 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
             await params.mount(Label("none", markup=False))
 
     def _show_missing(self) -> None:
-        missing = self.bench.missing_sensors()
+        missing = self.station.missing_sensors()
         widget = self.query_one("#alg-missing", Static)
         if missing:
             why = "\n".join(line.split(": add one")[0] for line in missing.splitlines())
@@ -240,27 +240,27 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
     def show_snapshot(self, snapshot: Snapshot) -> None:
         if not self._ready:
             return  # the app ticks while the dialog is still being built
-        bench = self.bench
-        paused = " (paused)" if bench.paused else ""
-        if bench.controller is not None:
-            text = f"running, in {bench.controller.state}{paused}"
+        station = self.station
+        paused = " (paused)" if station.paused else ""
+        if station.controller is not None:
+            text = f"running, in {station.controller.state}{paused}"
         else:
             text = f"driver: {snapshot.driver}{paused}"
         self.query_one("#alg-live", Label).update(text)
-        self.query_one("#alg-pause", Button).label = "Resume" if bench.paused else "Pause"
+        self.query_one("#alg-pause", Button).label = "Resume" if station.paused else "Pause"
 
     def _error(self, text: str) -> None:
         self.query_one("#alg-error", Static).update(text)
 
     def _refresh_all(self) -> None:
-        self.show_snapshot(self.bench.snapshot())
-        self.post_message(BenchChanged())
+        self.show_snapshot(self.station.snapshot())
+        self.post_message(StationChanged())
 
     # -- choosing ---------------------------------------------------------------------------------
     async def choose(self, name_or_path: str | Path) -> bool:
-        """Select an algorithm on the bench; a bad file's problems are shown, not raised."""
+        """Select an algorithm on the station; a bad file's problems are shown, not raised."""
         try:
-            definition = self.bench.select_algorithm(name_or_path)
+            definition = self.station.select_algorithm(name_or_path)
         except FsmFileError as exc:
             self._error("\n".join(str(p) for p in exc.problems))
             return False
@@ -270,7 +270,7 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
         self._error("")
         await self._show_definition()
         self._refresh_all()
-        self.bench.message = f"chose {definition.name}: Start (or x) runs it"
+        self.station.message = f"chose {definition.name}: Start (or x) runs it"
         return True
 
     @on(OptionList.OptionSelected, "#alg-builtins")
@@ -290,7 +290,7 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
     @on(ParamEditor.Edited)
     def _param_edited(self, event: ParamEditor.Edited) -> None:
         try:
-            self.bench.set_params([event.item])
+            self.station.set_params([event.item])
         except (FsmError, ValueError) as exc:
             event.editor.set_error(str(exc))
             return
@@ -298,19 +298,19 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
 
     # -- actions ----------------------------------------------------------------------------------
     def action_start(self) -> None:
-        bench = self.bench
-        if bench.algorithm is None:
+        station = self.station
+        if station.algorithm is None:
             self._error("pick an algorithm first")
             return
         bad = [e.parameter.name for e in self.query(ParamEditor) if e.invalid]
         if bad:
             self._error(f"fix the parameters marked in red first: {', '.join(bad)}")
             return
-        if bench.missing_sensors():
+        if station.missing_sensors():
             self._error("the robot lacks a sensor this algorithm reads: press f to fit them")
             return
         try:
-            bench.start_algorithm()
+            station.start_algorithm()
         except (FsmError, ValueError) as exc:
             self._error(f"cannot start: {exc}")
             return
@@ -318,34 +318,34 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
         self.dismiss()
 
     def action_pause(self) -> None:
-        self.bench.toggle_pause()
+        self.station.toggle_pause()
         self._refresh_all()
 
     def action_step(self) -> None:
-        bench = self.bench
-        bench.pause()
-        bench.step(bench.session.every)
+        station = self.station
+        station.pause()
+        station.step(station.session.every)
         self._refresh_all()
 
     def action_reset(self) -> None:
-        self.bench.reset_robot()
+        self.station.reset_robot()
         self._refresh_all()
 
     def action_fix(self) -> None:
-        bench = self.bench
-        if bench.algorithm is None or bench.missing_sensors() is None:
+        station = self.station
+        if station.algorithm is None or station.missing_sensors() is None:
             return
-        bench.apply_algorithm_preset()
-        ports = ", ".join(str(s) for s in bench.sensors)
+        station.apply_algorithm_preset()
+        ports = ", ".join(str(s) for s in station.sensors)
         self._error("")
-        bench.message = f"sensors set for {bench.algorithm.name}: {ports}"
+        station.message = f"sensors set for {station.algorithm.name}: {ports}"
         self._show_missing()
         self._refresh_all()
 
     async def action_defaults(self) -> None:
-        if self.bench.algorithm is None:
+        if self.station.algorithm is None:
             return
-        self.bench.reset_params()
+        self.station.reset_params()
         await self._show_definition()
 
     def action_close(self) -> None:
