@@ -28,18 +28,18 @@ from workbench.sim.record import Recorder
 from workbench.sim.sensors import SensorConfigError, SensorSpec, check_ports
 from workbench.sim.session import Session
 from workbench.sim.world import WorldError
+from workbench.viple.hosting import Endpoints
 from workbench.viple.link import (
     IDLE_S_DEFAULT,
     REPORT_MS_DEFAULT,
     REPORT_MS_MAX,
     REPORT_MS_MIN,
     LinkStatus,
-    Seat,
     check_idle_s,
     check_report_ms,
 )
-from workbench.viple.tcp_server import DEFAULT_PORT, EndpointError, TcpConfig, TcpServer
-from workbench.viple.ws_client import WsClient, WsConfig
+from workbench.viple.tcp_server import DEFAULT_PORT, TcpConfig
+from workbench.viple.ws_client import WsConfig
 
 #: how often the simulation is advanced on the event loop, and the status line's period
 TICK_HZ = 60.0
@@ -248,14 +248,11 @@ async def serve(the_plan: ServePlan, stop: asyncio.Event | None = None) -> int:
     stop = stop or asyncio.Event()
     loop = asyncio.get_running_loop()
     installed = _on_signals(loop, stop.set)
-    seat = Seat()
-    tcp = TcpServer(session, the_plan.tcp, seat) if the_plan.tcp else None
-    ws = WsClient(session, the_plan.ws, seat) if the_plan.ws else None
-    try:
-        if tcp is not None:
-            await tcp.start()
-    except EndpointError as exc:
-        print(f"workbench serve: {exc}", file=sys.stderr)
+    endpoints = await Endpoints.open(session, the_plan.tcp, the_plan.ws)
+    if endpoints.problems:
+        for problem in endpoints.problems:
+            print(f"workbench serve: {problem}", file=sys.stderr)
+        await endpoints.close()
         _off_signals(loop, installed)
         return 1
     try:
@@ -265,22 +262,18 @@ async def serve(the_plan: ServePlan, stop: asyncio.Event | None = None) -> int:
             f"workbench serve: {the_plan.record}: cannot write the record: {exc.strerror}",
             file=sys.stderr,
         )
-        if tcp is not None:
-            await tcp.close()
+        await endpoints.close()
         _off_signals(loop, installed)
         return 2
     session.recorder = recorder
-    endpoints = [e for e in (tcp, ws) if e is not None]
     session.record_header(
         driver="VIPLE",
         driven_by=Driver.viple().as_json(),
-        endpoints=[_endpoint_json(e.status) for e in endpoints],
+        endpoints=[_endpoint_json(status) for status in endpoints.statuses()],
         report_ms=(the_plan.tcp or the_plan.ws).report_ms,
         **the_plan.fields,
     )
     _log_setup(session)
-    if ws is not None:
-        await ws.start()
     tasks = [
         asyncio.create_task(run_realtime(Pacer(session)), name="pacer"),
         asyncio.create_task(_status_lines(session, endpoints), name="status"),
@@ -292,11 +285,11 @@ async def serve(the_plan: ServePlan, stop: asyncio.Event | None = None) -> int:
         for task in tasks:
             task.cancel()
         await asyncio.gather(*tasks, return_exceptions=True)
-        for endpoint in endpoints:
-            await endpoint.close()
-        _finish_record(session, endpoints)
+        statuses = endpoints.statuses()
+        await endpoints.close()
+        _finish_record(session, statuses)
         _off_signals(loop, installed)
-    log.info("stopped: %s", status_line(session, endpoints))
+    log.info("stopped: %s", status_line(session, statuses))
     return 0
 
 
@@ -312,13 +305,15 @@ async def run_realtime(pacer: Pacer, hz: float = TICK_HZ) -> None:
         last = now
 
 
-async def _status_lines(session: Session, endpoints: list, every: float = STATUS_SECONDS) -> None:
+async def _status_lines(
+    session: Session, endpoints: Endpoints, every: float = STATUS_SECONDS
+) -> None:
     while True:
         await asyncio.sleep(every)
-        log.info("%s", status_line(session, endpoints))
+        log.info("%s", status_line(session, endpoints.statuses()))
 
 
-def status_line(session: Session, endpoints: list) -> str:
+def status_line(session: Session, statuses: list[LinkStatus]) -> str:
     snap = session.snapshot()
     kinds = {s.port: s.kind for s in snap.sensors}
     sensors = " ".join(
@@ -326,7 +321,7 @@ def status_line(session: Session, endpoints: list) -> str:
         for port, value in sorted(snap.readings.items())
     )
     pose = snap.pose
-    links = "; ".join(_link_summary(e.status) for e in endpoints)
+    links = "; ".join(_link_summary(status) for status in statuses)
     return (
         f"t {snap.time:.1f} s | pose x {pose.x:.2f} y {pose.y:.2f} heading {pose.heading:.0f}° "
         f"| sensors {sensors or 'none'} | driver {snap.driver} | {links}"
@@ -365,7 +360,7 @@ def _log_setup(session: Session) -> None:
     )
 
 
-def _finish_record(session: Session, endpoints: list) -> None:
+def _finish_record(session: Session, statuses: list[LinkStatus]) -> None:
     recorder = session.recorder
     if recorder is None:
         return
@@ -373,15 +368,15 @@ def _finish_record(session: Session, endpoints: list) -> None:
         session.record_summary(
             endpoints=[
                 {
-                    "role": e.status.role,
-                    "address": e.status.address,
-                    "connections": e.status.connections,
-                    "refused": e.status.refused,
-                    "messages_in": e.status.messages_in,
-                    "messages_out": e.status.messages_out,
-                    "invalid": e.status.invalid,
+                    "role": s.role,
+                    "address": s.address,
+                    "connections": s.connections,
+                    "refused": s.refused,
+                    "messages_in": s.messages_in,
+                    "messages_out": s.messages_out,
+                    "invalid": s.invalid,
                 }
-                for e in endpoints
+                for s in statuses
             ]
         )
     finally:

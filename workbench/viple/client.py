@@ -266,10 +266,10 @@ class RemoteFsm:
         return Step(t, commands, fired, due, started)
 
 
-# ----------------------------------------------------------------------------- links
+# ----------------------------------------------------------------------------- channels
 
 
-class Link(Protocol):
+class Channel(Protocol):
     """One connection to the simulator, TCP or WebSocket."""
 
     async def send(self, message: str) -> None: ...
@@ -281,7 +281,7 @@ class Link(Protocol):
     async def close(self) -> None: ...
 
 
-class TcpLink:
+class TcpChannel:
     def __init__(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
         self.reader = reader
         self.writer = writer
@@ -309,7 +309,7 @@ class TcpLink:
             await self.writer.wait_closed()
 
 
-class WsLink:
+class WsChannel:
     def __init__(self, connection: ServerConnection) -> None:
         self.connection = connection
 
@@ -384,7 +384,7 @@ class _Received:
 
 @dataclass(frozen=True)
 class _Connected:
-    link: Link
+    channel: Channel
     peer: str
 
 
@@ -429,11 +429,11 @@ class VipleClient:
     # -- meeting the simulator ----------------------------------------------------------
 
     async def _run_connected(self) -> None:
-        link = await self._connect()
-        if link is not None:
-            await self._drive(link)
+        channel = await self._connect()
+        if channel is not None:
+            await self._drive(channel)
 
-    async def _connect(self) -> TcpLink | None:
+    async def _connect(self) -> TcpChannel | None:
         ep = self.setup.endpoint
         deadline = time.monotonic() + CONNECT_PATIENCE_S
         told = False
@@ -463,7 +463,7 @@ class VipleClient:
                     return None
                 continue
             self.log(f"connected to {ep}")
-            return TcpLink(reader, writer)
+            return TcpChannel(reader, writer)
 
     async def _run_listening(self) -> None:
         ep = self.setup.endpoint
@@ -480,7 +480,7 @@ class VipleClient:
                 if isinstance(item, _Connected):
                     self.log(f"the simulator connected from {item.peer}")
                     try:
-                        await self._drive(item.link)
+                        await self._drive(item.channel)
                     finally:
                         self._released.set()
                     return
@@ -491,7 +491,7 @@ class VipleClient:
             return
         self._busy = True
         peer = _peer(connection.remote_address)
-        self.inbox.put_nowait(_Connected(WsLink(connection), peer))
+        self.inbox.put_nowait(_Connected(WsChannel(connection), peer))
         await self._released.wait()
 
     async def _interrupted_within(self, seconds: float) -> bool:
@@ -507,30 +507,30 @@ class VipleClient:
 
     # -- driving -------------------------------------------------------------------------
 
-    async def _drive(self, link: Link) -> None:
+    async def _drive(self, channel: Channel) -> None:
         self._t0 = time.monotonic()
         fsm = RemoteFsm(self.setup)
-        pump = asyncio.create_task(self._pump(link))
+        pump = asyncio.create_task(self._pump(channel))
         try:
-            await self._send(link, self._shown(fsm.start(0.0), fsm))
-            await self._loop(link, fsm)
+            await self._send(channel, self._shown(fsm.start(0.0), fsm))
+            await self._loop(channel, fsm)
         finally:
             pump.cancel()
             with contextlib.suppress(asyncio.CancelledError):
                 await pump
             with contextlib.suppress(OSError, ConnectionClosed):
-                await link.close()
+                await channel.close()
             self.result.time = self._now()
             self.result.final_state = fsm.state
             self.result.transitions = fsm.transitions
             self.result.readings = dict(fsm.readings or {})
 
-    async def _loop(self, link: Link, fsm: RemoteFsm) -> None:
+    async def _loop(self, channel: Channel, fsm: RemoteFsm) -> None:
         end = self.setup.duration
         while True:
             now = self._now()
             if end is not None and now >= end:
-                await self._stop_robot(link)
+                await self._stop_robot(channel)
                 self._end("duration", EXIT_OK, f"--duration {end:g} s has passed")
                 return
             wake = fsm.next_tick() if end is None else min(fsm.next_tick(), end)
@@ -538,19 +538,19 @@ class VipleClient:
                 async with asyncio.timeout(max(0.0, wake - now)):
                     item = await self.inbox.get()
             except TimeoutError:
-                await self._send(link, self._shown(fsm.tick(self._now()), fsm))
+                await self._send(channel, self._shown(fsm.tick(self._now()), fsm))
                 continue
             if isinstance(item, _Received):
-                await self._reports(link, fsm, item)
+                await self._reports(channel, fsm, item)
             elif isinstance(item, _Interrupted):
-                await self._stop_robot(link)
+                await self._stop_robot(channel)
                 self._interrupted(item)
                 return
             elif isinstance(item, _Closed):
                 self._closed()
                 return
 
-    async def _reports(self, link: Link, fsm: RemoteFsm, item: _Received) -> None:
+    async def _reports(self, channel: Channel, fsm: RemoteFsm, item: _Received) -> None:
         for reason in item.problems:
             self._reject(reason)
         for line in item.lines:
@@ -563,28 +563,28 @@ class VipleClient:
             try:
                 step = fsm.report(self._now(), readings)
             except (ClientRunError, FsmRuntimeError) as exc:
-                await self._stop_robot(link)
+                await self._stop_robot(channel)
                 raise _Abort(str(exc)) from None
-            await self._send(link, self._shown(step, fsm))
+            await self._send(channel, self._shown(step, fsm))
 
-    async def _pump(self, link: Link) -> None:
+    async def _pump(self, channel: Channel) -> None:
         try:
-            while (got := await link.receive()) is not None:
+            while (got := await channel.receive()) is not None:
                 self.inbox.put_nowait(_Received(*got))
         finally:
             self.inbox.put_nowait(_Closed())
 
-    async def _send(self, link: Link, commands: list[Command]) -> None:
+    async def _send(self, channel: Channel, commands: list[Command]) -> None:
         wheels = self.setup.wheels
         for cmd in commands:
             try:
-                await link.send(encode_command(cmd, wheels))
+                await channel.send(encode_command(cmd, wheels))
             except (OSError, ConnectionClosed):
                 return
             self.result.commands += 1
 
-    async def _stop_robot(self, link: Link) -> None:
-        await self._send(link, [Stop()])
+    async def _stop_robot(self, channel: Channel) -> None:
+        await self._send(channel, [Stop()])
 
     def _shown(self, step: Step, fsm: RemoteFsm) -> list[Command]:
         """Report a start or a state change to ``on_step``; the step's commands."""
