@@ -10,6 +10,9 @@ from typing import Any
 from textual.app import App
 from textual.pilot import Pilot
 
+from workbench.tui.screens.main import MainScreen
+from workbench.tui.widgets.run_status import RunStatus
+
 
 def sync(test: Callable[..., Coroutine[Any, Any, None]]) -> Callable[..., None]:
     """Run an ``async def`` test body with asyncio (the suite has no async test plugin)."""
@@ -34,3 +37,14 @@ def run(
             await body(pilot)
 
     asyncio.run(go())
+
+
+def said(app: App) -> str:
+    """What the workbench's message line says now."""
+    return next(s for s in app.screen_stack if isinstance(s, MainScreen)).message
+
+
+def run_panel(app: App) -> str:
+    """The main screen's run panel (who drives, time, measures, the VIPLE connection line)."""
+    main = next(s for s in app.screen_stack if isinstance(s, MainScreen))
+    return "\n".join(main.query_one(RunStatus).lines)

@@ -6,7 +6,7 @@ import pytest
 from textual.pilot import Pilot
 from textual.widgets import Input, OptionList, Select, Static
 
-from tests.app.support import run
+from tests.app.support import run, said
 from workbench.sim.sensors import SensorSpec
 from workbench.tui.app import WorkbenchApp, make_app
 from workbench.tui.dialogs.algorithm import AlgorithmModal
@@ -281,7 +281,7 @@ def test_a_missing_sensor_is_explained_with_a_one_key_fix():
         assert "cannot start" in state.summary and "f fits" in state.summary
         await pilot.press("x")
         assert station.controller is None
-        assert "f fits the sensors it needs" in station.message
+        assert "f fits the sensors it needs" in said(app)
         await pilot.press("f")
         assert station.missing_sensors() is None
         assert station.sensors == [

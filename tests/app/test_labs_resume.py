@@ -13,7 +13,7 @@ from workbench.tui.screens.main import MainScreen
 from workbench.viple.tcp_server import TcpConfig
 
 from .labs_support import DRIVE, lab_app, open_exercise, text
-from .support import run
+from .support import run, run_panel, said
 
 CONNECT = "web-simulator/connect"
 
@@ -143,8 +143,8 @@ def test_the_set_up_of_a_websocket_exercise_starts_the_websocket_client(tmp_path
         await pilot.pause()
         assert app.endpoints is not None and app.endpoints.ws is not None
         assert app.endpoints.ws.config.url == "ws://localhost:8124/"
-        assert "robot connects to ws://localhost:8124/" in app.station.message
-        assert "VIPLE ws waiting for ws://localhost:8124/" in app.station.connection
+        assert "robot connects to ws://localhost:8124/" in said(app)
+        assert "VIPLE ws waiting for ws://localhost:8124/" in run_panel(app)
         assert screen is app.screen
 
     run(app, body)
@@ -158,7 +158,7 @@ def test_the_set_up_of_a_tcp_exercise_starts_listening(tmp_path):
         text_shown = await app.open_endpoint("tcp")
         port = app.endpoints.tcp.port
         assert port > 0 and text_shown == f"VIPLE: connect your program (TCP) to localhost:{port}"
-        assert f"VIPLE tcp listening on 127.0.0.1:{port}" in app.station.connection
+        assert f"VIPLE tcp listening on 127.0.0.1:{port}" in run_panel(app)
         assert await app.open_endpoint("tcp") == text_shown  # already listening: the same
 
     run(app, body)
@@ -244,7 +244,7 @@ def test_a_websocket_url_can_wait_until_asked_and_v_connects(tmp_path):
         await app.workers.wait_for_complete()
         await pilot.pause()
         assert app.endpoints.ws is not None and app.endpoints.ws.config.url == url
-        assert app.station.message == (
+        assert said(app) == (
             f"VIPLE: start your program's WebSocket server; the robot connects to {url}"
         )
 

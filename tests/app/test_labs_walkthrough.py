@@ -38,7 +38,7 @@ from workbench.tui.widgets.sensor_row_editor import SensorRowEditor
 from workbench.viple.tcp_server import TcpConfig
 from workbench.viple.ws_client import WsConfig
 
-from .support import run
+from .support import run, said
 
 FAST = so.KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
 INSTRUCTOR = "Dr Chen"
@@ -101,7 +101,7 @@ class Walkthrough:
         dialog.query_one("#path", Input).value = str(lab_maze.path)
         await self.press("enter")
         assert isinstance(self.app.screen, MainScreen)
-        assert self.station.maze.same_layout(lab_maze.maze), self.station.message
+        assert self.station.maze.same_layout(lab_maze.maze), said(self.app)
 
     async def algorithm_dialog(self) -> AlgorithmModal:
         await self.main_screen()
@@ -139,7 +139,7 @@ class Walkthrough:
         if definition is not None and definition.source == path and self.completed(definition):
             await self.main_screen()
             await self.press("x")
-            assert station.controller is not None, station.message
+            assert station.controller is not None, said(self.app)
             await self.run_to_exit()
             return
         modal = await self.algorithm_dialog()
@@ -181,7 +181,7 @@ class Walkthrough:
             if len(station.runs) > done:
                 break
         last = station.runs[-1]
-        assert len(station.runs) > done and last.ended == "exit", (last, station.message)
+        assert len(station.runs) > done and last.ended == "exit", (last, said(self.app))
         await self.pilot.pause()
 
     async def reach_exit(self, ex: Exercise, obj: Objective) -> None:

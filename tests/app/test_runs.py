@@ -109,7 +109,7 @@ async def test_the_table_shows_each_run_with_its_measures(tmp_path):
                 "yes",
             ],
         ]
-        assert text(app.screen.query_one("#runs-title")).startswith("Runs on this station: 2")
+        assert text(app.screen.query_one("#runs-title")).startswith("Runs on this bench: 2")
 
 
 @sync

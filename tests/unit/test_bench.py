@@ -3,7 +3,14 @@
 import pytest
 
 from workbench.control.fsm import SensorBindingError
-from workbench.control.station import LabStation, SensorRow, check_sensor_rows
+from workbench.control.station import (
+    ALGORITHM_FAILED,
+    OUT,
+    LabStation,
+    Notice,
+    SensorRow,
+    check_sensor_rows,
+)
 from workbench.sim.driver import Driver
 from workbench.sim.mazefile import parse_maze
 from workbench.sim.mazeio import load_maze
@@ -196,7 +203,8 @@ def test_a_failing_algorithm_is_stopped_with_the_reason_instead_of_raising(tmp_p
     else:
         b.advance(0.5)
     assert b.controller is None and b.pacer.paused
-    assert b.message.startswith("algorithm stopped: failing, state Go: guard")
+    assert b.notice.kind == ALGORITHM_FAILED
+    assert b.notice.detail.startswith("failing, state Go: guard")
     assert b.runs[-1].ended == "error"
     assert str(b.snapshot().driver) == "keys"
 
@@ -297,7 +305,7 @@ def test_after_a_run_ends_at_the_exit_the_next_drive_key_drives():
     b.start_algorithm()
     while not b.runs:
         b.step(60)
-    assert b.pacer.paused and "run finished" in b.message
+    assert b.pacer.paused and b.notice == Notice(OUT)
     b.reset_robot()
     b.load_maze(load_maze("mazes/rank-local-best-wins.txt"))
     assert not b.pacer.paused  # reset and a new maze: time runs again

@@ -262,7 +262,7 @@ def test_every_starter_loads_and_runs_but_does_not_get_out_as_given(starter):
     b.apply_algorithm_preset()
     b.start_algorithm()
     b.step(60 * 120)
-    assert b.message == "" and b.controller is not None
+    assert b.notice is None and b.controller is not None
     assert not b.session.reached_exit
 
 

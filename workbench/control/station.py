@@ -73,6 +73,21 @@ class RunEntry:
     maze_digest: str = ""
 
 
+#: the kinds of :class:`Notice`
+ALGORITHM_FAILED = "algorithm failed"
+OUT = "out"
+
+
+@dataclass(frozen=True)
+class Notice:
+    """Something the station did on its own (not asked by a key or a button): a front end
+    words it for the person at the station. A new value each time, so it can be told apart
+    from the last one seen."""
+
+    kind: str  # ALGORITHM_FAILED (detail: why) or OUT (the run finished at the exit)
+    detail: str = ""
+
+
 @dataclass
 class VipleConnection:
     """A VIPLE program that held the robot: its role (tcp / ws), where it was, what it did."""
@@ -138,9 +153,8 @@ class LabStation:
     controller: FsmController | None = None
     runs: list[RunEntry] = field(default_factory=list)
     keys_used: set[str] = field(default_factory=set)
-    message: str = ""
-    #: the VIPLE endpoints' status line, kept up to date by the front end that hosts them
-    connection: str = ""
+    #: the last thing the station did on its own that the person at it should hear of
+    notice: Notice | None = None
     #: every VIPLE program seen driving this station, oldest first
     viple: list[VipleConnection] = field(default_factory=list)
     _run_open: bool = False
@@ -177,7 +191,7 @@ class LabStation:
     def advance(self, wall_seconds: float) -> int:
         """Run real time forward; closes the run when the robot gets out.
 
-        An algorithm whose guard or action fails is stopped with the reason in :attr:`message`
+        An algorithm whose guard or action fails is stopped with the reason in :attr:`notice`
         and the simulation paused, so a front end never sees the exception.
         """
         try:
@@ -200,7 +214,7 @@ class LabStation:
     def _algorithm_failed(self, exc: FsmRuntimeError) -> None:
         self.stop_algorithm("error")
         self.pause()
-        self.message = f"algorithm stopped: {exc}"
+        self.notice = Notice(ALGORITHM_FAILED, str(exc))
 
     def _after_steps(self) -> None:
         self._watch_viple()
@@ -208,7 +222,7 @@ class LabStation:
             self._close_run("exit")
             self.pause()
             self._held_at_exit = True
-            self.message = "the robot is out: run finished (r resets the robot)"
+            self.notice = Notice(OUT)
 
     def _watch_viple(self) -> None:
         """Notice a VIPLE program taking or leaving the robot; its driving is a run."""
@@ -404,7 +418,6 @@ class LabStation:
         self.session.attach(controller, binding, Driver.algorithm(self.algorithm.name))
         self._open_run(self.session.driver)
         self.pause(False)
-        self.message = ""
 
     def stop_algorithm(self, ended: str = "stopped") -> None:
         if self.controller is None:
@@ -425,7 +438,6 @@ class LabStation:
             self.stop_algorithm("reset")
         self.session.reset()
         self.session.driver = KEYS
-        self.message = ""
 
     def load_maze(self, maze: Maze) -> None:
         """Put a (new or edited) maze on the station; the robot starts over on it."""

@@ -44,6 +44,7 @@ from .host import (
     ScreenHost,
     SetUpDone,
     ShowsSnapshot,
+    ShowsStatus,
     StartEndpoint,
     StationChanged,
 )
@@ -126,6 +127,8 @@ class WorkbenchApp(ScreenHost[None]):
         self._ws_at_start = ws_at_start
         self._report_ms = report_ms
         self.endpoints: Endpoints | None = None
+        #: the endpoints' status line as last handed to the screens
+        self._connection = ""
         self.station = station
         self.maze_path = maze_path
         self.user = user
@@ -161,7 +164,7 @@ class WorkbenchApp(ScreenHost[None]):
         self._last_tick = perf_counter()
         self.set_interval(1.0 / self.tick_hz, self._tick, name="simulation")
         if self.connect_hint:
-            self.station.message = self.hint_line()
+            self.say(self.hint_line())
         self._check_size(self.size.width, self.size.height)
         if self._ask_names:
             from .dialogs.identity import IdentityDialog
@@ -193,16 +196,16 @@ class WorkbenchApp(ScreenHost[None]):
         self._last_tick = now
         station = self.station
         if self.endpoints is not None:
-            station.connection = self.endpoints.summary()
+            self._show_connection(self.endpoints.summary())
         steps = station.advance(elapsed)
-        state = (station.paused, station.message, station.controller, len(station.runs))
+        state = (station.paused, station.notice, station.controller, len(station.runs))
         if steps or state != self._drawn:
             self.refresh_views()
 
     def refresh_views(self) -> None:
         """Draw the station's current snapshot on every screen of the stack that shows one."""
         station = self.station
-        self._drawn = (station.paused, station.message, station.controller, len(station.runs))
+        self._drawn = (station.paused, station.notice, station.controller, len(station.runs))
         snapshot = station.snapshot()
         for screen in self.screen_stack:
             if isinstance(screen, ShowsSnapshot):
@@ -335,13 +338,22 @@ class WorkbenchApp(ScreenHost[None]):
             text = f"VIPLE: start your program's WebSocket server; the robot connects to {url}"
         if self.connect_hint:
             text = self.hint_line()
-        self.station.connection = self.endpoints.summary()
+        self._show_connection(self.endpoints.summary())
         self._say(text)
         return text
 
     def _say(self, message: str) -> None:
-        self.station.message = message
+        self.say(message)
         self.refresh_views()
+
+    def _show_connection(self, text: str) -> None:
+        """Hand the VIPLE endpoints' status line to the screens that show it, when it changed."""
+        if text == self._connection:
+            return
+        self._connection = text
+        for screen in self.screen_stack:
+            if isinstance(screen, ShowsStatus):
+                screen.show_connection(text)
 
     async def action_quit(self) -> None:
         """Quit; an editor with unsaved changes asks first (save / discard / cancel)."""

@@ -1,11 +1,14 @@
 """How screens and the app that hosts them speak to each other.
 
 A screen never reaches into the app: it posts one of the messages below, which bubbles up to
-the app. The app speaks to its screens only through the two small roles a screen may take on:
-:class:`ShowsSnapshot` (draws the station at each tick) and :class:`FollowsUnicode` (redraws when
-the drawing switches between Unicode and ASCII). :class:`ScreenHost` is the part of an app that
-every host shares, the workbench app and the tests' bare hosts alike: it holds the Unicode
-setting, toggles it when a screen asks and applies it to every screen.
+the app. The app speaks to its screens only through the small roles a screen may take on:
+:class:`ShowsSnapshot` (draws the station at each tick), :class:`ShowsStatus` (shows the
+workbench's one-line message and the VIPLE connection line) and :class:`FollowsUnicode` (redraws
+when the drawing switches between Unicode and ASCII). :class:`ScreenHost` is the part of an app
+that every host shares, the workbench app and the tests' bare hosts alike: it holds the Unicode
+setting, toggles it when a screen asks and applies it to every screen, and hands what is said
+(:class:`Say`) to every screen that shows it. The words are the TUI's: the station below only
+holds values.
 """
 
 from __future__ import annotations
@@ -37,6 +40,17 @@ class ShowsSnapshot:
         def show_snapshot(self, snapshot: Snapshot) -> None: ...
 
 
+class ShowsStatus:
+    """A screen with the workbench's message line: the app hands it what is said and the
+    VIPLE endpoints' status (it defines ``show_message`` and ``show_connection``)."""
+
+    if TYPE_CHECKING:
+
+        def show_message(self, text: str) -> None: ...
+
+        def show_connection(self, text: str) -> None: ...
+
+
 class FollowsUnicode:
     """A screen that draws in Unicode or ASCII as the app's setting says (it defines
     ``set_unicode``)."""
@@ -48,6 +62,14 @@ class FollowsUnicode:
 
 class ToggleUnicode(Message):
     """Switch the drawing between Unicode and ASCII, on every screen."""
+
+
+class Say(Message):
+    """Put ``text`` on the workbench's message line ("" clears it)."""
+
+    def __init__(self, text: str) -> None:
+        super().__init__()
+        self.text = text
 
 
 class StationChanged(Message):
@@ -94,6 +116,15 @@ class ScreenHost(App[ReturnType]):
 
     def on_toggle_unicode(self, message: ToggleUnicode) -> None:
         self.unicode = not self.unicode
+
+    def on_say(self, message: Say) -> None:
+        self.say(message.text)
+
+    def say(self, text: str) -> None:
+        """Show ``text`` on the message line of every screen that has one."""
+        for screen in self.screen_stack:
+            if isinstance(screen, ShowsStatus):
+                screen.show_message(text)
 
     def watch_unicode(self, unicode: bool) -> None:
         self.mark_ascii()

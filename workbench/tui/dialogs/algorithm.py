@@ -25,7 +25,7 @@ from workbench.control.station import LabStation
 from workbench.files.workspace import OutsideWorkspace
 from workbench.sim.session import Snapshot
 
-from ..host import ShowsSnapshot, StationChanged
+from ..host import Say, ShowsSnapshot, StationChanged
 from ..widgets.field import Field
 from ..widgets.param_editor import ParamEditor
 
@@ -270,7 +270,7 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
         self._error("")
         await self._show_definition()
         self._refresh_all()
-        self.station.message = f"chose {definition.name}: Start (or x) runs it"
+        self.post_message(Say(f"chose {definition.name}: Start (or x) runs it"))
         return True
 
     @on(OptionList.OptionSelected, "#alg-builtins")
@@ -338,7 +338,7 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
         station.apply_algorithm_preset()
         ports = ", ".join(str(s) for s in station.sensors)
         self._error("")
-        station.message = f"sensors set for {station.algorithm.name}: {ports}"
+        self.post_message(Say(f"sensors set for {station.algorithm.name}: {ports}"))
         self._show_missing()
         self._refresh_all()
 

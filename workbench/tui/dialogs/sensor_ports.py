@@ -21,7 +21,7 @@ from workbench.sim.profiles import get_profile
 from workbench.sim.sensors import PORT_RANGE
 from workbench.sim.session import Snapshot
 
-from ..host import ShowsSnapshot, StationChanged
+from ..host import Say, ShowsSnapshot, StationChanged
 from ..widgets.sensor_row_editor import SensorRowEditor
 from ..widgets.text import reading
 
@@ -159,7 +159,7 @@ class SensorPortsModal(ShowsSnapshot, ModalScreen[None]):
         else:
             specs = ", ".join(str(s) for s in self.station.sensors) or "no sensors"
             self._status(f"applied: {specs}")
-            self.station.message = ""
+            self.post_message(Say(""))
         self._refresh_all()
 
     async def action_add_row(self) -> None:

@@ -28,7 +28,7 @@ from ..dialogs.generate import GenerateDialog
 from ..dialogs.path import PathDialog
 from ..dialogs.size import SizeDialog
 from ..dialogs.unsaved import Choice, UnsavedDialog
-from ..host import FollowsUnicode, ToggleUnicode
+from ..host import FollowsUnicode, Say, ToggleUnicode
 from ..widgets.maze_view import MazeView
 
 SAVE_HELP = (
@@ -509,9 +509,9 @@ class EditorScreen(FollowsUnicode, Screen[Maze | None]):
         maze, note = self.editor.handover(discard)
         if maze is not None:
             self.station.load_maze(maze)
-            self.station.message = f"the robot is on the edited maze {maze.name}"
+            self.post_message(Say(f"the robot is on the edited maze {maze.name}"))
         elif note:
-            self.station.message = note
+            self.post_message(Say(note))
         if len(self.app.screen_stack) > 1 and self.app.screen is self:
             self.dismiss(maze)
         else:

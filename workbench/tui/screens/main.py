@@ -19,7 +19,7 @@ from textual.screen import Screen
 from textual.widgets import Footer
 
 from workbench.control.fsm import FsmError
-from workbench.control.station import LabStation
+from workbench.control.station import ALGORITHM_FAILED, LabStation, Notice
 from workbench.files.workspace import OutsideWorkspace
 from workbench.sim.maze import MazeError
 from workbench.sim.mazeio import load_maze
@@ -32,6 +32,7 @@ from ..host import (
     MazeChanged,
     OpenScreen,
     ShowsSnapshot,
+    ShowsStatus,
     StartEndpoint,
     StationChanged,
     ToggleUnicode,
@@ -47,7 +48,7 @@ from ..widgets.sensor_readings import SensorReadings
 PANEL_HZ = 4.0
 
 
-class MainScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
+class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, Screen[None]):
     """Drive, watch and set up the robot."""
 
     # the keys pressed again and again while driving are priority bindings: the screen takes
@@ -101,6 +102,10 @@ class MainScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self._controller: object = None
         self._moment: tuple[object, ...] = ()
         self._panels_at = 0.0
+        #: the message line's text, and the VIPLE endpoints' status line
+        self._said = ""
+        self._connection = ""
+        self._notice: Notice | None = station.notice
 
     def compose(self) -> ComposeResult:
         station = self.station
@@ -155,34 +160,45 @@ class MainScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         # the text panels follow at PANEL_HZ while the robot runs (every byte counts over SSH);
         # at once when paused (steps, snapshots) and when who drives or the state changes
         now = monotonic()
-        moment = (
-            station.paused,
-            station.message,
-            snapshot.driver,
-            snapshot.state,
-            station.connection,
-        )
+        if station.notice is not self._notice:
+            self._notice = station.notice
+            if station.notice is not None:
+                self._said = worded(station.notice)
+        moment = (station.paused, self._said, snapshot.driver, snapshot.state, self._connection)
         if station.paused or moment != self._moment or now - self._panels_at >= 1 / PANEL_HZ:
             self._moment = moment
             self._panels_at = now
             self._readings.show(snapshot, station.profile)
-            self._run_status.show(snapshot, station, unicode)
+            self._run_status.show(snapshot, station, unicode, self._connection)
             self._algorithm.show(station, unicode)
-            self._message.message = station.message
+            self._message.message = self._said
 
     def refresh_views(self) -> None:
         """Redraw after an action: through the app, so open dialogs follow too."""
         self.show_snapshot(self.station.snapshot())
         self.post_message(StationChanged())
 
+    @property
+    def message(self) -> str:
+        """What the message line says now."""
+        return self._said
+
+    def show_message(self, text: str) -> None:
+        self._said = text
+        if self._ready:
+            self._message.message = text
+
+    def show_connection(self, text: str) -> None:
+        self._connection = text
+
     def say(self, message: str) -> None:
-        self.station.message = message
+        self.show_message(message)
         self.refresh_views()
 
     # -- actions -------------------------------------------------------------------------------
     def action_drive(self, key: str) -> None:
         station = self.station
-        station.message = ""
+        self._said = ""
         station.key(key)
         self.refresh_views()
 
@@ -295,7 +311,7 @@ class MainScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self.station.load_maze(maze)
         self._maze_view.set_maze(maze)
         self._maze_view.clear_trail()
-        self.station.message = f"the robot is on {maze.name}"
+        self.show_message(f"the robot is on {maze.name}")
         self.post_message(MazeChanged(real))
 
     def action_editor(self) -> None:
@@ -309,3 +325,10 @@ class MainScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
 
     def action_viple_ws(self) -> None:
         self.post_message(StartEndpoint("ws"))
+
+
+def worded(notice: Notice) -> str:
+    """What the message line says of something the station did on its own."""
+    if notice.kind == ALGORITHM_FAILED:
+        return f"algorithm stopped: {notice.detail}"
+    return "the robot is out: run finished (r resets the robot)"

@@ -26,7 +26,9 @@ class RunStatus(TextLines):
         super().__init__(id=id, classes=classes)
         set_border_title(self, "Run")
 
-    def show(self, snapshot: Snapshot, station: LabStation, unicode: bool) -> None:
+    def show(
+        self, snapshot: Snapshot, station: LabStation, unicode: bool, connection: str = ""
+    ) -> None:
         sep = separator(unicode)
         unit = get_profile(station.profile).unit
         m = snapshot.metrics
@@ -44,5 +46,4 @@ class RunStatus(TextLines):
             f"turn{'' if m.turns == 1 else 's'}"
             f"{sep}collisions {m.collisions}"
         )
-        connection = (station.connection,) if station.connection else ()
-        self.set_lines([driver, clock, travel, turning, *connection])
+        self.set_lines([driver, clock, travel, turning, *([connection] if connection else [])])
