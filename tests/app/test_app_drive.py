@@ -16,10 +16,11 @@ from tests.app.support import run
 from workbench.cli import main
 from workbench.control.manual import key_legend
 from workbench.tui.app import FOCUS_BINDINGS, AppSetupError, WorkbenchApp, make_app
-from workbench.tui.commands import COMMANDS, WorkbenchCommands
+from workbench.tui.commands import WorkbenchCommands
 from workbench.tui.dialogs.help import HelpScreen
 from workbench.tui.dialogs.too_small import TooSmallScreen
 from workbench.tui.dialogs.unsaved import UnsavedDialog
+from workbench.tui.keys import KEYS
 from workbench.tui.screens.editor import EditorScreen
 from workbench.tui.screens.main import MainScreen
 from workbench.tui.screens.runs import RunsScreen
@@ -175,7 +176,7 @@ def test_help_explains_every_key(tmp_path):
         console.print(app.screen.query_one("#help-text", Static).content)
         text = " ".join(console.export_text().split())
         for binding in [*MainScreen.BINDINGS, *KEYED_APP_BINDINGS]:
-            info = COMMANDS[binding.id]
+            info = KEYS[binding.id]
             if info.group != "Drive":
                 assert " ".join(info.explanation.split()) in text
         for _key, what in key_legend("web"):
@@ -188,7 +189,7 @@ def test_help_explains_every_key(tmp_path):
 
 def test_every_binding_has_an_id_and_a_help_entry():
     for binding in [*MainScreen.BINDINGS, *KEYED_APP_BINDINGS]:
-        assert binding.id in COMMANDS, binding
+        assert binding.id in KEYS, binding
 
 
 def test_the_command_palette_offers_the_bindings_and_runs_them(tmp_path):
@@ -294,7 +295,7 @@ def test_e_opens_the_maze_editor_and_capital_r_the_runs(tmp_path):
         await pilot.press("e")
         assert isinstance(app.screen, EditorScreen)
         titles = [t for t, _h, _r in WorkbenchCommands(app.screen)._commands()]
-        assert "App: quit" in titles and any(t.startswith("Editor: ") for t in titles)
+        assert "App: quit" in titles and any(t.startswith("Maze editor: ") for t in titles)
         edited = app.station.maze.with_block(5, 2, True)
         app.station.load_maze(edited)  # what the editor does with a valid edit on leaving
         app.screen.dismiss(edited)

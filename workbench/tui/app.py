@@ -48,6 +48,7 @@ from .host import (
     StartEndpoint,
     StationChanged,
 )
+from .keys import bindings
 from .screens.editor import EditorScreen
 from .screens.labs import LabsScreen
 from .screens.main import MainScreen
@@ -79,11 +80,7 @@ class WorkbenchApp(ScreenHost[None]):
     COMMANDS = ScreenHost.COMMANDS | {WorkbenchCommands}
     HORIZONTAL_BREAKPOINTS: ClassVar[list[tuple[int, str]]] = [(0, "-narrow"), (110, "-wide")]
     BINDINGS: ClassVar[list[BindingType]] = [
-        Binding("ctrl+q", "quit", "Quit", priority=True, id="app.quit"),
-        Binding("question_mark", "help", "Help", key_display="?", id="app.help"),
-        Binding(
-            "ctrl+p", "command_palette", "Commands", show=False, priority=True, id="app.commands"
-        ),
+        *bindings("app.quit", "app.help", "app.commands"),
         *FOCUS_BINDINGS,
     ]
 

@@ -12,7 +12,7 @@ from typing import ClassVar
 
 from textual import on
 from textual.app import ComposeResult
-from textual.binding import Binding, BindingType
+from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.screen import ModalScreen
 from textual.widgets import Button, Input, Label, OptionList, Static
@@ -26,6 +26,7 @@ from workbench.files.workspace import OutsideWorkspace
 from workbench.sim.session import Snapshot
 
 from ..host import Say, ShowsSnapshot, StationChanged
+from ..keys import bindings
 from ..widgets.field import Field
 from ..widgets.param_editor import ParamEditor
 
@@ -127,9 +128,7 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
     """
 
     BINDINGS: ClassVar[list[BindingType]] = [
-        Binding("escape", "close", "Close", id="dialog.close"),
-        Binding("f", "fix", "Fit sensors", id="algorithm.fix"),
-        Binding("ctrl+d", "defaults", "Defaults", id="algorithm.defaults"),
+        *bindings("dialog.close", "algorithm.fix", "algorithm.defaults")
     ]
 
     def __init__(self, station: LabStation) -> None:
@@ -331,7 +330,7 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
         self.station.reset_robot()
         self._refresh_all()
 
-    def action_fix(self) -> None:
+    def action_fix_sensors(self) -> None:
         station = self.station
         if station.algorithm is None or station.missing_sensors() is None:
             return

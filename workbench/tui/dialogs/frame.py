@@ -5,9 +5,11 @@ from __future__ import annotations
 from typing import ClassVar, TypeVar
 
 from textual import on
-from textual.binding import Binding, BindingType
+from textual.binding import BindingType
 from textual.screen import ModalScreen
 from textual.widgets import Button, Static
+
+from ..keys import bindings
 
 ResultType = TypeVar("ResultType")
 
@@ -63,9 +65,7 @@ class Dialog(ModalScreen[ResultType]):
     }
     """
 
-    BINDINGS: ClassVar[list[BindingType]] = [
-        Binding("escape", "cancel", "Cancel", id="dialog.cancel"),
-    ]
+    BINDINGS: ClassVar[list[BindingType]] = bindings("dialog.cancel")
 
     def show_error(self, text: str) -> None:
         """Show why the input cannot be used (empty text hides the line)."""

@@ -16,7 +16,7 @@ from textual.widgets import Static
 
 from workbench.control.manual import key_legend
 
-from ..commands import COMMANDS, CommandInfo
+from ..keys import KEYS, bindings
 
 
 def _table() -> Table:
@@ -29,25 +29,19 @@ def _table() -> Table:
 def help_text(
     screens: list[tuple[str, list[Binding]]], profile: str, key_name: Callable[[Binding], str]
 ) -> Group:
-    """Every key: the profile's drive keys, then each screen's keys grouped as in
-    :data:`COMMANDS` (bindings without an entry there explain themselves)."""
+    """Every key: the profile's drive keys, then each screen's keys grouped as
+    :data:`~workbench.tui.keys.KEYS` says."""
     sections: list[tuple[str, Table]] = []
     drive = _table()
     for key, text in key_legend(profile):
         drive.add_row(key, text)
     sections.append((f"Drive ({profile} key program)", drive))
     tables: dict[str, Table] = {}
-    for screen_group, bindings in screens:
-        for binding in bindings:
+    for _screen, screen_bindings in screens:
+        for binding in screen_bindings:
             if not binding.id:
                 continue
-            info = COMMANDS.get(binding.id)
-            if info is None:
-                info = CommandInfo(
-                    screen_group,
-                    binding.description.lower(),
-                    binding.tooltip or f"{binding.description}.",
-                )
+            info = KEYS[binding.id]
             if info.group == "Drive":
                 continue
             if info.group not in tables:
@@ -91,9 +85,7 @@ class HelpScreen(ModalScreen[None]):
     }
     """
 
-    BINDINGS: ClassVar[list[BindingType]] = [
-        Binding("escape,question_mark,q", "close", "Close", id="dialog.close"),
-    ]
+    BINDINGS: ClassVar[list[BindingType]] = bindings("help.close")
 
     def __init__(self, profile: str, connect_hint: str = "") -> None:
         super().__init__()

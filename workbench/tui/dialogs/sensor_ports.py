@@ -11,7 +11,7 @@ from typing import ClassVar
 
 from textual import on
 from textual.app import ComposeResult
-from textual.binding import Binding, BindingType
+from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.screen import ModalScreen
 from textual.widgets import Button, Input, Label, Select, Static
@@ -22,6 +22,7 @@ from workbench.sim.sensors import PORT_RANGE
 from workbench.sim.session import Snapshot
 
 from ..host import Say, ShowsSnapshot, StationChanged
+from ..keys import bindings
 from ..widgets.sensor_row_editor import SensorRowEditor
 from ..widgets.text import reading
 
@@ -81,10 +82,7 @@ class SensorPortsModal(ShowsSnapshot, ModalScreen[None]):
     }
     """
 
-    BINDINGS: ClassVar[list[BindingType]] = [
-        Binding("escape", "close", "Close", id="dialog.close"),
-        Binding("ctrl+n", "add_row", "Add row", id="sensors.add"),
-    ]
+    BINDINGS: ClassVar[list[BindingType]] = bindings("dialog.close", "sensors.add")
 
     def __init__(self, station: LabStation) -> None:
         super().__init__()

@@ -12,7 +12,7 @@ from typing import ClassVar
 
 from textual import on
 from textual.app import ComposeResult
-from textual.binding import Binding, BindingType
+from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical
 from textual.screen import ModalScreen
 from textual.widgets import Button, Checkbox, Input, Label, Select, Static
@@ -28,6 +28,7 @@ from workbench.labs.signoff import (
 )
 from workbench.labs.store import Store, StoreError
 
+from ..keys import bindings
 from ..widgets.field import Field
 from ..widgets.tick import Tick
 
@@ -91,9 +92,7 @@ class SignoffModal(ModalScreen[str | None]):
     }
     """
 
-    BINDINGS: ClassVar[list[BindingType]] = [
-        Binding("escape", "close", "Close", id="dialog.close"),
-    ]
+    BINDINGS: ClassVar[list[BindingType]] = bindings("dialog.close")
 
     def __init__(
         self,

@@ -6,10 +6,11 @@ from typing import ClassVar, Literal
 
 from textual import on
 from textual.app import ComposeResult
-from textual.binding import Binding, BindingType
+from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical
 from textual.widgets import Button, Static
 
+from ..keys import bindings
 from .frame import Dialog
 
 Choice = Literal["save", "discard", "cancel"]
@@ -18,11 +19,9 @@ Choice = Literal["save", "discard", "cancel"]
 class UnsavedDialog(Dialog[Choice | None]):
     """Dismisses with "save", "discard" or "cancel" (escape cancels too)."""
 
-    BINDINGS: ClassVar[list[BindingType]] = [
-        Binding("s", "choose('save')", "Save", id="unsaved.save"),
-        Binding("d", "choose('discard')", "Discard", id="unsaved.discard"),
-        Binding("c,escape", "choose('cancel')", "Cancel", id="unsaved.cancel"),
-    ]
+    BINDINGS: ClassVar[list[BindingType]] = bindings(
+        "unsaved.save", "unsaved.discard", "unsaved.cancel"
+    )
 
     def __init__(self, title: str, detail: str = "") -> None:
         super().__init__()

@@ -14,7 +14,7 @@ from typing import ClassVar
 from rich.text import Text
 from textual import on
 from textual.app import ComposeResult
-from textual.binding import Binding, BindingType
+from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical
 from textual.screen import Screen
 from textual.widgets import Footer, OptionList, Static
@@ -29,6 +29,7 @@ from ..dialogs.path import PathDialog
 from ..dialogs.size import SizeDialog
 from ..dialogs.unsaved import Choice, UnsavedDialog
 from ..host import FollowsUnicode, Say, ToggleUnicode
+from ..keys import bindings
 from ..widgets.maze_view import MazeView
 
 SAVE_HELP = (
@@ -117,94 +118,24 @@ class EditorScreen(FollowsUnicode, Screen[Maze | None]):
     """
 
     BINDINGS: ClassVar[list[BindingType]] = [
-        Binding("up", "move(0, -1)", "Cursor up", show=False, id="editor.up"),
-        Binding("down", "move(0, 1)", "Cursor down", show=False, id="editor.down"),
-        Binding("left", "move(-1, 0)", "Cursor left", show=False, id="editor.left"),
-        Binding("right", "move(1, 0)", "Cursor right", show=False, id="editor.right"),
-        Binding(
-            "space",
-            "toggle_wall",
-            "Wall",
-            id="editor.wall",
-            tooltip="Turn the block under the cursor into wall or floor (or click a block).",
-        ),
-        Binding(
-            "s",
-            "start",
-            "Start",
-            id="editor.start",
-            tooltip="Put the start on the cursor; press again to turn its heading.",
-        ),
-        Binding(
-            "x", "exit", "Exit", id="editor.exit", tooltip="Add or remove an exit at the cursor."
-        ),
-        Binding(
-            "ctrl+z", "undo", "Undo", key_display="^z", id="editor.undo", tooltip="Undo an edit."
-        ),
-        Binding(
-            "ctrl+y",
-            "redo",
-            "Redo",
-            key_display="^y",
-            show=False,
-            id="editor.redo",
-            tooltip="Redo an undone edit.",
-        ),
-        Binding(
-            "n",
-            "new",
-            "New",
-            show=False,
-            id="editor.new",
-            tooltip="Start an empty maze of a size you type.",
-        ),
-        Binding(
-            "g",
-            "generate",
-            "Generate",
-            show=False,
-            id="editor.generate",
-            tooltip="Generate a maze from a seed (perfect or braid, with exits or none).",
-        ),
-        Binding(
-            "ctrl+s",
-            "save",
-            "Save",
-            key_display="^s",
-            id="editor.save",
-            tooltip="Save to the maze's file (asks for a path the first time).",
-        ),
-        Binding(
-            "a",
-            "save_as",
-            "Save as",
-            show=False,
-            id="editor.save_as",
-            tooltip="Save to a new path.",
-        ),
-        Binding(
-            "p",
-            "next_problem",
-            "Next problem",
-            show=False,
-            id="editor.next_problem",
-            tooltip="Move the cursor to the next problem in the list.",
-        ),
-        Binding(
-            "u",
-            "unicode",
-            "Unicode",
-            show=False,
-            id="editor.unicode",
-            tooltip="Draw the maze in plain ASCII or with Unicode lines.",
-        ),
-        Binding(
-            "escape",
-            "leave",
-            "Back",
-            id="editor.leave",
-            tooltip="Leave the editor; a changed valid maze goes to the robot.",
-        ),
+        *bindings(
+            "editor.up",
+            "editor.down",
+            "editor.left",
+            "editor.right",
+            "editor.wall",
+            "editor.start",
+            "editor.exit",
+            "editor.undo",
+            "editor.redo",
+            "editor.new",
+            "editor.generate",
+            "editor.save",
+            "editor.save_as",
+            "editor.next_problem",
+            "editor.unicode",
+            "editor.leave",
+        )
     ]
 
     def __init__(

@@ -15,7 +15,7 @@ from typing import ClassVar
 
 from textual import on
 from textual.app import ComposeResult
-from textual.binding import Binding, BindingType
+from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.screen import Screen
 from textual.timer import Timer
@@ -29,6 +29,7 @@ from workbench.labs.store import Store, StoreUnavailable
 from workbench.sim.session import Snapshot
 
 from ..host import SetUpDone, ShowsSnapshot
+from ..keys import bindings
 from ..widgets.field import Field
 
 PASS, FAIL, OPEN = "✓", "✗", "·"
@@ -92,11 +93,7 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
     }
     """
 
-    BINDINGS: ClassVar[list[BindingType]] = [
-        Binding("escape", "close", "Back", id="labs.close"),
-        Binding("a", "apply_setup", "Set up", id="labs.setup"),
-        Binding("i", "sign_off", "Sign off", id="labs.signoff"),
-    ]
+    BINDINGS: ClassVar[list[BindingType]] = bindings("labs.close", "labs.setup", "labs.signoff")
 
     def __init__(
         self,

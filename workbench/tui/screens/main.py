@@ -12,7 +12,7 @@ from time import monotonic
 from typing import ClassVar
 
 from textual.app import ComposeResult
-from textual.binding import Binding, BindingType
+from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical
 from textual.reactive import var
 from textual.screen import Screen
@@ -37,6 +37,7 @@ from ..host import (
     StationChanged,
     ToggleUnicode,
 )
+from ..keys import bindings
 from ..widgets.algorithm_state import AlgorithmState
 from ..widgets.key_legend import KeyLegend
 from ..widgets.maze_view import MazeView
@@ -55,26 +56,28 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, Screen[None]):
     # them before the focused widget (the transition log, which has no use for them) would, so
     # a key press runs its action at once instead of bubbling up through the side panel
     BINDINGS: ClassVar[list[BindingType]] = [
-        Binding("w", "drive('w')", "Forward", show=False, priority=True, id="drive.forward"),
-        Binding("a", "drive('a')", "Left", show=False, priority=True, id="drive.left"),
-        Binding("s", "drive('s')", "Backward", show=False, priority=True, id="drive.backward"),
-        Binding("d", "drive('d')", "Right", show=False, priority=True, id="drive.right"),
-        Binding("space", "drive('space')", "Stop", show=False, priority=True, id="drive.stop"),
-        Binding("p", "pause", "Pause", priority=True, id="sim.pause"),
-        Binding("n", "step", "Step", priority=True, id="sim.step"),
-        Binding("plus,equals_sign", "speed", "Speed", key_display="+", id="sim.speed"),
-        Binding("r", "reset", "Reset", id="sim.reset"),
-        Binding("o", "sensors", "Ports", id="panel.sensors"),
-        Binding("g", "algorithm", "Algorithm", id="panel.algorithm"),
-        Binding("x", "run_algorithm", "Run", id="algorithm.run"),
-        Binding("f", "fix_sensors", "Fix sensors", show=False, id="algorithm.fix"),
-        Binding("u", "unicode", "Unicode", show=False, id="view.unicode"),
-        Binding("t", "trail", "Trail", show=False, id="view.trail"),
-        Binding("m", "maze", "Maze", show=False, id="maze.load"),
-        Binding("e", "editor", "Editor", show=False, id="screen.editor"),
-        Binding("R", "runs", "Runs", show=False, id="screen.runs"),
-        Binding("l", "labs", "Labs", show=False, id="screen.labs"),
-        Binding("v", "viple_ws", "WebSocket", show=False, id="viple.ws"),
+        *bindings(
+            "drive.forward",
+            "drive.left",
+            "drive.backward",
+            "drive.right",
+            "drive.stop",
+            "sim.pause",
+            "sim.step",
+            "sim.speed",
+            "sim.reset",
+            "panel.sensors",
+            "panel.algorithm",
+            "algorithm.run",
+            "algorithm.fix",
+            "view.unicode",
+            "view.trail",
+            "maze.load",
+            "screen.editor",
+            "screen.runs",
+            "screen.labs",
+            "viple.ws",
+        )
     ]
 
     #: the last snapshot drawn (per-tick state: never repaints by itself)

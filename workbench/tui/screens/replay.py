@@ -16,7 +16,7 @@ from typing import ClassVar
 
 from rich.text import Text
 from textual.app import ComposeResult
-from textual.binding import Binding, BindingType
+from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical
 from textual.screen import Screen
 from textual.timer import Timer
@@ -27,6 +27,7 @@ from workbench.sim.maze import Maze
 from workbench.sim.replay import Replay, load_replay, replay_maze
 
 from ..host import FollowsUnicode, ToggleUnicode
+from ..keys import bindings
 from ..widgets.maze_view import MazeView
 
 #: how often the view is redrawn while playing (frames per second of wall time)
@@ -115,70 +116,19 @@ class ReplayScreen(FollowsUnicode, Screen[None]):
     """
 
     BINDINGS: ClassVar[list[BindingType]] = [
-        Binding(
-            "right",
-            "step(1)",
-            "Step",
-            id="replay.step",
-            tooltip="Forward one control tick.",
-        ),
-        Binding(
-            "left",
-            "step(-1)",
-            "Back",
-            id="replay.back",
-            tooltip="Back one control tick.",
-        ),
-        Binding(
-            "pagedown",
-            "step(10)",
-            "+10",
-            show=False,
-            id="replay.step10",
-            tooltip="Forward ten ticks.",
-        ),
-        Binding(
-            "pageup",
-            "step(-10)",
-            "-10",
-            show=False,
-            id="replay.back10",
-            tooltip="Back ten ticks.",
-        ),
-        Binding(
-            "space",
-            "play",
-            "Play/pause",
-            id="replay.play",
-            tooltip="Play the run at the speed shown, or pause it.",
-        ),
-        Binding(
-            "plus,equals_sign",
-            "faster",
-            "Faster",
-            key_display="+",
-            id="replay.faster",
-            tooltip="Play faster.",
-        ),
-        Binding(
-            "minus",
-            "slower",
-            "Slower",
-            key_display="-",
-            id="replay.slower",
-            tooltip="Play slower.",
-        ),
-        Binding("home", "first", "First", show=False, id="replay.first", tooltip="The first tick."),
-        Binding("end", "last", "Last", show=False, id="replay.last", tooltip="The last tick."),
-        Binding(
-            "u",
-            "unicode",
-            "Unicode",
-            show=False,
-            id="replay.unicode",
-            tooltip="Draw the maze in plain ASCII or with Unicode lines.",
-        ),
-        Binding("escape", "leave", "Back", id="replay.leave", tooltip="Back to the runs."),
+        *bindings(
+            "replay.step",
+            "replay.back",
+            "replay.step10",
+            "replay.back10",
+            "replay.play",
+            "replay.faster",
+            "replay.slower",
+            "replay.first",
+            "replay.last",
+            "replay.unicode",
+            "replay.leave",
+        )
     ]
 
     def __init__(

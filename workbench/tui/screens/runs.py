@@ -11,7 +11,7 @@ from typing import ClassVar
 
 from textual import on
 from textual.app import ComposeResult
-from textual.binding import Binding, BindingType
+from textual.binding import BindingType
 from textual.screen import Screen
 from textual.widgets import DataTable, Footer, Static
 
@@ -23,6 +23,7 @@ from workbench.sim.session import Snapshot
 
 from ..dialogs.path import PathDialog
 from ..host import FollowsUnicode, ShowsSnapshot, ToggleUnicode
+from ..keys import bindings
 from .replay import ReplayScreen
 
 #: column key, heading (ASCII), heading (Unicode)
@@ -96,29 +97,7 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
     """
 
     BINDINGS: ClassVar[list[BindingType]] = [
-        Binding(
-            "enter",
-            "replay",
-            "Replay",
-            id="runs.replay",
-            tooltip="Replay the selected run from its record.",
-        ),
-        Binding(
-            "o",
-            "open",
-            "Open record",
-            id="runs.open",
-            tooltip="Replay any run record (.jsonl) by its path.",
-        ),
-        Binding(
-            "u",
-            "unicode",
-            "Unicode",
-            show=False,
-            id="runs.unicode",
-            tooltip="Plain ASCII or Unicode marks.",
-        ),
-        Binding("escape", "leave", "Back", id="runs.leave", tooltip="Back to the workbench."),
+        *bindings("runs.replay", "runs.open", "runs.unicode", "runs.leave")
     ]
 
     def __init__(

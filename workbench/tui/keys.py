@@ -1,0 +1,486 @@
+"""What every key does, in one table: the screens' bindings, the help screen, the command
+palette and the footer are all made from :data:`KEYS`.
+
+Each entry has an id (``group.what``); a screen lists the ids it answers with
+:func:`bindings`. The drive keys' effect in each profile's key program (the legend beside the
+maze) comes from ``control/manual.py``, which the drive entries point to.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from textual.binding import Binding
+
+from workbench.control.manual import KEY_NAMES
+
+
+@dataclass(frozen=True)
+class Key:
+    """One key of the workbench: which keys, which action, and how it is explained."""
+
+    #: the key names, comma-separated, as Textual writes them
+    keys: str
+    action: str
+    #: the footer's word for it
+    label: str
+    #: the help's section and the palette's prefix
+    group: str
+    #: the palette's name for it
+    title: str
+    #: the help's sentence
+    explanation: str
+    show: bool = True
+    #: taken before the focused widget sees the key
+    priority: bool = False
+    #: how the key is written on screen, when not Textual's own way
+    display: str | None = None
+
+
+KEYS: dict[str, Key] = {
+    "app.quit": Key(
+        "ctrl+q",
+        "quit",
+        "Quit",
+        "App",
+        "quit",
+        "Quit the workbench (ctrl+c does not quit).",
+        priority=True,
+    ),
+    "app.help": Key(
+        "question_mark",
+        "help",
+        "Help",
+        "App",
+        "help",
+        "This help: every key and what it does.",
+        display="?",
+    ),
+    "app.commands": Key(
+        "ctrl+p",
+        "command_palette",
+        "Commands",
+        "App",
+        "command palette",
+        "Search every command by name.",
+        show=False,
+        priority=True,
+    ),
+    "drive.forward": Key(
+        "w",
+        "drive('w')",
+        "Forward",
+        "Drive",
+        KEY_NAMES["w"],
+        "Drive forward, as the course's key program does for this profile.",
+        show=False,
+        priority=True,
+    ),
+    "drive.left": Key(
+        "a",
+        "drive('a')",
+        "Left",
+        "Drive",
+        KEY_NAMES["a"],
+        "Turn left (unity: Turn by Degree -90; web: spin).",
+        show=False,
+        priority=True,
+    ),
+    "drive.backward": Key(
+        "s",
+        "drive('s')",
+        "Backward",
+        "Drive",
+        KEY_NAMES["s"],
+        "Drive backward.",
+        show=False,
+        priority=True,
+    ),
+    "drive.right": Key(
+        "d",
+        "drive('d')",
+        "Right",
+        "Drive",
+        KEY_NAMES["d"],
+        "Turn right (unity: Turn by Degree 90; web: spin).",
+        show=False,
+        priority=True,
+    ),
+    "drive.stop": Key(
+        "space",
+        "drive('space')",
+        "Stop",
+        "Drive",
+        KEY_NAMES["space"],
+        "Stop the motors.",
+        show=False,
+        priority=True,
+    ),
+    "sim.pause": Key(
+        "p",
+        "pause",
+        "Pause",
+        "Simulation",
+        "pause / resume",
+        "Pause or resume the simulation (keys still queue commands while paused).",
+        priority=True,
+    ),
+    "sim.step": Key(
+        "n",
+        "step",
+        "Step",
+        "Simulation",
+        "single step",
+        "Pause, then advance one control tick (1/20 s of simulated time).",
+        priority=True,
+    ),
+    "sim.speed": Key(
+        "plus,equals_sign",
+        "speed",
+        "Speed",
+        "Simulation",
+        "speed",
+        "Cycle the speed: 1x, 2x, 4x, 10x, max (as fast as the machine allows).",
+        display="+",
+    ),
+    "sim.reset": Key(
+        "r",
+        "reset",
+        "Reset",
+        "Simulation",
+        "reset robot",
+        "Robot back to the start, stopped, like the Unity simulator's reset button; a running "
+        "algorithm stops and the run is kept in the runs list.",
+    ),
+    "panel.sensors": Key(
+        "o",
+        "sensors",
+        "Ports",
+        "Set-up",
+        "sensor ports",
+        "Open the sensor port panel: kinds, port numbers, mounts, presets, live readings.",
+    ),
+    "panel.algorithm": Key(
+        "g",
+        "algorithm",
+        "Algorithm",
+        "Set-up",
+        "algorithm",
+        "Choose a built-in algorithm or load a YAML FSM file; edit its parameters.",
+    ),
+    "algorithm.run": Key(
+        "x",
+        "run_algorithm",
+        "Run",
+        "Algorithm",
+        "start / stop algorithm",
+        "Start the chosen algorithm from the start block (a new run), or stop it.",
+    ),
+    "algorithm.fix": Key(
+        "f",
+        "fix_sensors",
+        "Fix sensors",
+        "Algorithm",
+        "fit the sensors it needs",
+        "When the algorithm lacks a sensor: give the robot the sensors it reads (the "
+        "algorithm's preset).",
+        show=False,
+    ),
+    "view.unicode": Key(
+        "u",
+        "unicode",
+        "Unicode",
+        "View",
+        "ASCII / Unicode",
+        "Draw the maze with plain ASCII (any terminal) or Unicode lines and arrows.",
+        show=False,
+    ),
+    "view.trail": Key(
+        "t",
+        "trail",
+        "Trail",
+        "View",
+        "trail",
+        "Show or hide the blocks the robot has driven through.",
+        show=False,
+    ),
+    "maze.load": Key(
+        "m",
+        "maze",
+        "Maze",
+        "Set-up",
+        "load a maze",
+        "Put a maze file on the bench (the robot starts over on it, same profile).",
+        show=False,
+    ),
+    "screen.editor": Key(
+        "e",
+        "editor",
+        "Editor",
+        "Screens",
+        "maze editor",
+        "Edit the maze: walls, start, exits, new, generate, validate, save.",
+        show=False,
+    ),
+    "screen.runs": Key(
+        "R",
+        "runs",
+        "Runs",
+        "Screens",
+        "runs",
+        "Compare the last runs side by side; replay a recorded run.",
+        show=False,
+    ),
+    "screen.labs": Key(
+        "l",
+        "labs",
+        "Labs",
+        "Screens",
+        "labs",
+        "The lab exercises: instructions, set-up, live objectives, questions, sign-off.",
+        show=False,
+    ),
+    "viple.ws": Key(
+        "v",
+        "viple_ws",
+        "WebSocket",
+        "VIPLE",
+        "connect over WebSocket",
+        "Connect to VIPLE's WebSocket server (the Web Simulator's role) at --ws-url or "
+        "ws://localhost:8124/; it tries every second until the VIPLE program runs.",
+        show=False,
+    ),
+    "editor.up": Key(
+        "up", "move(0, -1)", "Cursor up", "Maze editor", "cursor up", "Cursor up.", show=False
+    ),
+    "editor.down": Key(
+        "down",
+        "move(0, 1)",
+        "Cursor down",
+        "Maze editor",
+        "cursor down",
+        "Cursor down.",
+        show=False,
+    ),
+    "editor.left": Key(
+        "left",
+        "move(-1, 0)",
+        "Cursor left",
+        "Maze editor",
+        "cursor left",
+        "Cursor left.",
+        show=False,
+    ),
+    "editor.right": Key(
+        "right",
+        "move(1, 0)",
+        "Cursor right",
+        "Maze editor",
+        "cursor right",
+        "Cursor right.",
+        show=False,
+    ),
+    "editor.wall": Key(
+        "space",
+        "toggle_wall",
+        "Wall",
+        "Maze editor",
+        "wall",
+        "Turn the block under the cursor into wall or floor (or click a block).",
+    ),
+    "editor.start": Key(
+        "s",
+        "start",
+        "Start",
+        "Maze editor",
+        "start",
+        "Put the start on the cursor; press again to turn its heading.",
+    ),
+    "editor.exit": Key(
+        "x", "exit", "Exit", "Maze editor", "exit", "Add or remove an exit at the cursor."
+    ),
+    "editor.undo": Key(
+        "ctrl+z", "undo", "Undo", "Maze editor", "undo", "Undo an edit.", display="^z"
+    ),
+    "editor.redo": Key(
+        "ctrl+y",
+        "redo",
+        "Redo",
+        "Maze editor",
+        "redo",
+        "Redo an undone edit.",
+        show=False,
+        display="^y",
+    ),
+    "editor.new": Key(
+        "n",
+        "new",
+        "New",
+        "Maze editor",
+        "new",
+        "Start an empty maze of a size you type.",
+        show=False,
+    ),
+    "editor.generate": Key(
+        "g",
+        "generate",
+        "Generate",
+        "Maze editor",
+        "generate",
+        "Generate a maze from a seed (perfect or braid, with exits or none).",
+        show=False,
+    ),
+    "editor.save": Key(
+        "ctrl+s",
+        "save",
+        "Save",
+        "Maze editor",
+        "save",
+        "Save to the maze's file (asks for a path the first time).",
+        display="^s",
+    ),
+    "editor.save_as": Key(
+        "a", "save_as", "Save as", "Maze editor", "save as", "Save to a new path.", show=False
+    ),
+    "editor.next_problem": Key(
+        "p",
+        "next_problem",
+        "Next problem",
+        "Maze editor",
+        "next problem",
+        "Move the cursor to the next problem in the list.",
+        show=False,
+    ),
+    "editor.unicode": Key(
+        "u",
+        "unicode",
+        "Unicode",
+        "Maze editor",
+        "unicode",
+        "Draw the maze in plain ASCII or with Unicode lines.",
+        show=False,
+    ),
+    "editor.leave": Key(
+        "escape",
+        "leave",
+        "Back",
+        "Maze editor",
+        "back",
+        "Leave the editor; a changed valid maze goes to the robot.",
+    ),
+    "runs.replay": Key(
+        "enter", "replay", "Replay", "Runs", "replay", "Replay the selected run from its record."
+    ),
+    "runs.open": Key(
+        "o",
+        "open",
+        "Open record",
+        "Runs",
+        "open record",
+        "Replay any run record (.jsonl) by its path.",
+    ),
+    "runs.unicode": Key(
+        "u", "unicode", "Unicode", "Runs", "unicode", "Plain ASCII or Unicode marks.", show=False
+    ),
+    "runs.leave": Key("escape", "leave", "Back", "Runs", "back", "Back to the workbench."),
+    "replay.step": Key("right", "step(1)", "Step", "Replay", "step", "Forward one control tick."),
+    "replay.back": Key("left", "step(-1)", "Back", "Replay", "back", "Back one control tick."),
+    "replay.step10": Key(
+        "pagedown", "step(10)", "+10", "Replay", "+10", "Forward ten ticks.", show=False
+    ),
+    "replay.back10": Key(
+        "pageup", "step(-10)", "-10", "Replay", "-10", "Back ten ticks.", show=False
+    ),
+    "replay.play": Key(
+        "space",
+        "play",
+        "Play/pause",
+        "Replay",
+        "play/pause",
+        "Play the run at the speed shown, or pause it.",
+    ),
+    "replay.faster": Key(
+        "plus,equals_sign", "faster", "Faster", "Replay", "faster", "Play faster.", display="+"
+    ),
+    "replay.slower": Key(
+        "minus", "slower", "Slower", "Replay", "slower", "Play slower.", display="-"
+    ),
+    "replay.first": Key("home", "first", "First", "Replay", "first", "The first tick.", show=False),
+    "replay.last": Key("end", "last", "Last", "Replay", "last", "The last tick.", show=False),
+    "replay.unicode": Key(
+        "u",
+        "unicode",
+        "Unicode",
+        "Replay",
+        "unicode",
+        "Draw the maze in plain ASCII or with Unicode lines.",
+        show=False,
+    ),
+    "replay.leave": Key("escape", "leave", "Back", "Replay", "back", "Back to the runs."),
+    "labs.close": Key(
+        "escape",
+        "close",
+        "Back",
+        "Labs",
+        "back",
+        "Back to the maze (the exercise keeps being checked).",
+    ),
+    "labs.setup": Key(
+        "a",
+        "apply_setup",
+        "Set up",
+        "Labs",
+        "set up the exercise",
+        "Put the exercise's profile, maze, sensors and controller on the bench.",
+    ),
+    "labs.signoff": Key(
+        "i",
+        "sign_off",
+        "Sign off",
+        "Labs",
+        "instructor sign-off",
+        "The instructor signs the exercise off with their passphrase; then change driver.",
+    ),
+    "dialog.close": Key("escape", "close", "Close", "Dialog", "close", "Close this dialog."),
+    "sensors.add": Key(
+        "ctrl+n", "add_row", "Add row", "Sensor ports", "add a row", "Add a sensor row."
+    ),
+    "algorithm.defaults": Key(
+        "ctrl+d",
+        "defaults",
+        "Defaults",
+        "Algorithm dialog",
+        "default parameters",
+        "Put every parameter back to its default for this profile.",
+    ),
+    "dialog.cancel": Key("escape", "cancel", "Cancel", "Dialog", "cancel", "Cancel."),
+    "unsaved.save": Key("s", "choose('save')", "Save", "Unsaved changes", "save", "Save."),
+    "unsaved.discard": Key(
+        "d", "choose('discard')", "Discard", "Unsaved changes", "discard", "Discard."
+    ),
+    "unsaved.cancel": Key(
+        "c,escape", "choose('cancel')", "Cancel", "Unsaved changes", "cancel", "Cancel."
+    ),
+    "help.close": Key(
+        "escape,question_mark,q", "close", "Close", "Dialog", "close", "Close this dialog."
+    ),
+}
+
+
+def bindings(*ids: str) -> list[Binding]:
+    """The bindings of the keys ``ids``, in that order (a screen's ``BINDINGS``)."""
+    made = []
+    for key_id in ids:
+        key = KEYS[key_id]
+        made.append(
+            Binding(
+                key.keys,
+                key.action,
+                key.label,
+                show=key.show,
+                key_display=key.display,
+                priority=key.priority,
+                id=key_id,
+            )
+        )
+    return made
