@@ -1,5 +1,6 @@
 """Lab files: the bundled labs load, and every schema error names the file, line and key."""
 
+import re
 import shutil
 from pathlib import Path
 
@@ -129,7 +130,25 @@ def test_schema_errors_name_the_file_line_key_and_fix(folder, old, new, message)
     assert old in text
     with pytest.raises(LabFileError) as err:
         load_lab(write(folder, text.replace(old, new, 1)))
-    assert f"small.yaml:{message.split(':', 1)[1]}" in str(err.value)
+    line, rest = message.removeprefix("small.yaml:").split(": ", 1)
+    rest = rest.replace(" (use ", " (hint: use ")
+    assert re.search(rf"small\.yaml:{line}:\d+: {re.escape(rest)}", str(err.value)), err.value
+
+
+def test_every_problem_of_a_lab_file_is_reported_at_once(folder):
+    text = (
+        good_text()
+        .replace("kind: keys", "kind: drive-keys")
+        .replace("profile: unity", "profile: unitty")
+        .replace("lab: small", "lab: other")
+    )
+    with pytest.raises(LabFileError) as err:
+        load_lab(write(folder, text))
+    found = [str(p) for p in err.value.problems]
+    assert len(found) == 3, found
+    assert re.search(r"small\.yaml:1:\d+: lab: id 'other' differs", found[0])
+    assert re.search(r"small\.yaml:9:\d+: exercise 'drive': setup: unknown profile", found[1])
+    assert re.search(r"small\.yaml:14:\d+: exercise 'drive': unknown objective kind", found[2])
 
 
 def test_unknown_objective_kind_lists_the_kinds_and_the_exact_line(folder):
@@ -137,8 +156,8 @@ def test_unknown_objective_kind_lists_the_kinds_and_the_exact_line(folder):
     with pytest.raises(LabFileError) as err:
         load_lab(path)
     assert str(err.value).endswith(
-        ":14: exercise 'drive': unknown objective kind 'drive-keys' (use one of keys, sensors, "
-        "viple, exit, maze-edited, compare, questions)"
+        ":14:15: exercise 'drive': unknown objective kind 'drive-keys' (hint: use one of keys, "
+        "sensors, viple, exit, maze-edited, compare, questions)"
     )
 
 
@@ -155,16 +174,16 @@ def test_exit_objective_checks_its_driver_and_limits(folder):
     lab = load_lab(lab_with("[viple, fsm]", "60"))
     obj = lab.exercises[0].objectives[1]
     assert (obj.drivers, obj.max_time) == (("viple", "fsm"), 60.0)
-    with pytest.raises(LabFileError, match=r":19: .*unknown driver 'robot'"):
+    with pytest.raises(LabFileError, match=r":19:\d+: .*unknown driver 'robot'"):
         load_lab(lab_with("robot", "60"))
-    with pytest.raises(LabFileError, match=r":20: .*max_time: 'soon' is not a number"):
+    with pytest.raises(LabFileError, match=r":20:\d+: .*max_time: 'soon' is not a number"):
         load_lab(lab_with("fsm", "soon"))
 
 
 def test_yaml_syntax_errors_and_empty_files_name_the_line(folder):
-    with pytest.raises(LabFileError, match=r"small\.yaml:2: not valid YAML: mapping values"):
+    with pytest.raises(LabFileError, match=r"small\.yaml:2:\d+: YAML syntax: mapping values"):
         load_lab(write(folder, "lab: small\ntitle: x: y\n"))
-    with pytest.raises(LabFileError, match=r"small\.yaml:1: empty file"):
+    with pytest.raises(LabFileError, match=r"small\.yaml:1:1: empty file"):
         load_lab(write(folder, ""))
 
 

@@ -105,14 +105,14 @@ def test_a_lab_whose_maze_or_starter_cannot_be_read_is_refused_at_loading(tmp_pa
     with pytest.raises(LabFileError) as bad_maze:
         load_lab(tmp_path / "pinned.yaml")
     assert str(bad_maze.value).endswith(
-        "pinned.yaml:15: exercise 'out': objective 'exit': maze 'lab-maze.txt' cannot be read: "
-        "line 2: unknown character 'Z' (see every problem with 'workbench maze check FILE')"
+        "pinned.yaml:15:15: exercise 'out': objective 'exit': maze 'lab-maze.txt' cannot be read: "
+        "line 2: unknown character 'Z' (hint: see every problem with 'workbench maze check FILE')"
     )
     (tmp_path / "lab-maze.txt").write_text(ORIGINAL)
     (tmp_path / "starter.yaml").write_text("not: [an, fsm")
     with pytest.raises(LabFileError) as bad_starter:
         load_lab(tmp_path / "pinned.yaml")
     assert (
-        "pinned.yaml:11: exercise 'out': controller: starter 'starter.yaml' cannot be read: "
+        "pinned.yaml:11:19: exercise 'out': controller: starter 'starter.yaml' cannot be read: "
         "YAML syntax" in str(bad_starter.value)
     )

@@ -71,15 +71,32 @@ def test_an_empty_or_missing_file_has_no_users(tmp_path):
         ("users:\n  -bad:\n    role: student\n", 2, "users.-bad", "letters, digits"),
         ("people:\n  ann: {}\n", 1, "people", "'users:'"),
         ("users:\n  ann:\n    role: student\n  ann:\n    role: student\n", 4, "users", "twice"),
-        ("users:\n  ann: [oops\n", 3, "not valid YAML", "docs/ssh.md"),
+        ("users:\n  ann: [oops\n", 3, "YAML syntax", "docs/ssh.md"),
     ],
 )
 def test_a_malformed_file_names_the_line_the_key_and_the_fix(text, line, where, fix):
     with pytest.raises(UsersFileError) as caught:
         parse_users(text, "/srv/lab/ssh-users.yaml")
-    message = str(caught.value)
-    assert message.startswith(f"/srv/lab/ssh-users.yaml:{line}: "), message
-    assert where in message and fix in message and "(fix: " in message
+    problems = caught.value.problems
+    assert any(
+        (p.file, p.line) == ("/srv/lab/ssh-users.yaml", line)
+        and where in p.message
+        and fix in f"{p.message} {p.hint}"
+        for p in problems
+    ), problems
+    assert str(caught.value) == "\n".join(str(p) for p in problems)
+
+
+def test_every_user_with_a_problem_is_named_at_once_and_the_rest_are_not():
+    text = (
+        "users:\n  ann:\n    role: teacher\n    password: X\n"
+        "  bo:\n    role: student\n    keys: []\n"
+        f"  cy:\n    role: student\n    keys: [{PUB}]\n"
+    )
+    with pytest.raises(UsersFileError) as caught:
+        parse_users(text, "users.yaml")
+    found = [(p.line, p.message.split(":")[0]) for p in caught.value.problems]
+    assert found == [(3, "users.ann.role"), (5, "users.bo")], found
 
 
 def test_add_user_writes_a_file_only_its_owner_reads_and_updates_users(tmp_path):

@@ -10,7 +10,6 @@ from __future__ import annotations
 import difflib
 import math
 from collections.abc import Iterable
-from dataclasses import dataclass
 from pathlib import Path
 
 import yaml
@@ -40,12 +39,11 @@ from workbench.control.fsm import (
 from workbench.files.bounded import (
     FSM_LIMITS,
     BoundedFileError,
-    capped,
     check_text,
     compose_yaml,
-    more_problems,
     read_text,
 )
+from workbench.files.yamlread import FileProblem, problem_list
 
 TOP_KEYS = ("name", "description", "sensors", "parameters", "variables", "initial", "states")
 SENSOR_KEYS = ("kind", "mount", "port")
@@ -74,36 +72,18 @@ _NULL = "tag:yaml.org,2002:null"
 _STR = "tag:yaml.org,2002:str"
 
 
-@dataclass(frozen=True)
-class FileProblem:
-    file: str
-    line: int
-    column: int
-    message: str
-    hint: str = ""
-
-    def __str__(self) -> str:
-        where = f"{self.file}:{self.line}:{self.column}" if self.line else self.file
-        return f"{where}: {self.message}" + (f" (hint: {self.hint})" if self.hint else "")
-
-
 class FsmFileError(ValueError):
     """An FSM file that cannot be used; ``problems`` lists every problem found (a long list
     is cut after :data:`~workbench.files.bounded.MAX_PROBLEMS`, saying how many more)."""
 
     def __init__(self, problems: list[FileProblem]) -> None:
-        file = problems[0].file if problems else "<text>"
-        self.problems = capped(
-            list(problems),
-            lambda n: FileProblem(file, 0, 0, more_problems(n), "fix the problems above first"),
-        )
+        self.problems = problem_list(problems)
         super().__init__("\n".join(str(p) for p in self.problems))
 
     @classmethod
     def refused(cls, exc: BoundedFileError) -> FsmFileError:
         """The error of a file refused by the bounded reader."""
-        line, column = exc.line or 0, exc.column or (1 if exc.line else 0)
-        return cls([FileProblem(exc.path, line, column, exc.message, exc.hint)])
+        return cls([FileProblem.refused(exc)])
 
 
 def load_fsm(path: str | Path) -> FsmDefinition:
@@ -122,10 +102,8 @@ def loads_fsm(text: str, filename: str = "<text>") -> FsmDefinition:
         root = compose_yaml(check_text(text, filename, FSM_LIMITS), filename, FSM_LIMITS)
     except BoundedFileError as exc:
         raise FsmFileError.refused(exc) from None
-    except yaml.MarkedYAMLError as exc:
-        raise FsmFileError([_yaml_problem(filename, exc)]) from None
     except yaml.YAMLError as exc:
-        raise FsmFileError([FileProblem(filename, 1, 1, f"YAML syntax: {exc}")]) from None
+        raise FsmFileError([FileProblem.syntax(filename, exc)]) from None
     if root is None:
         raise FsmFileError(
             [FileProblem(filename, 1, 1, "the file is empty", "start with name: and states:")]
@@ -186,24 +164,6 @@ def parse_param_overrides(definition: FsmDefinition, items: Iterable[str]) -> di
 def _known(known: Iterable[str]) -> str:
     names = ", ".join(known)
     return f"parameters: {names}" if names else "it has no parameters"
-
-
-def _yaml_problem(filename: str, exc: yaml.MarkedYAMLError) -> FileProblem:
-    mark = exc.problem_mark or exc.context_mark
-    message = exc.problem or str(exc)
-    if exc.context:
-        message = f"{exc.context}: {message}"
-    hint = ""
-    if "\t" in message or "'\\t'" in message:
-        hint = "indent with spaces, not tabs"
-    elif "mapping values are not allowed" in message:
-        hint = "put quotes around a value that contains ': '"
-    elif "expected a single document" in message or "but found another document" in message:
-        hint = "one FSM per file: remove the extra '---'"
-    elif "could not find expected ':'" in message:
-        hint = "each entry must be 'key: value'; check the indentation of this line"
-    line, col = (mark.line + 1, mark.column + 1) if mark else (1, 1)
-    return FileProblem(filename, line, col, f"YAML syntax: {message}", hint)
 
 
 class _Reader:

@@ -20,6 +20,7 @@ from workbench.control.algorithms import list_algorithms
 from workbench.control.fsmdef import FsmDefinition
 from workbench.control.fsmfile import FsmFileError, load_fsm
 from workbench.files.bounded import LAB_LIMITS, BoundedFileError, compose_yaml, read_text
+from workbench.files.yamlread import FileProblem, NodeReader, Skip, problem_list
 from workbench.sim.maze import Maze, MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.profiles import PROFILES
@@ -36,7 +37,12 @@ VIPLE_ROLES = ("tcp", "ws")
 
 
 class LabFileError(ValueError):
-    """A lab file that cannot be used: ``file:line: where: what (fix)``."""
+    """A lab file that cannot be used; ``problems`` lists every problem found, each as
+    ``file:line:column: where: what (hint: fix)``."""
+
+    def __init__(self, problems: list[FileProblem]) -> None:
+        self.problems = problem_list(problems)
+        super().__init__("\n".join(str(p) for p in self.problems))
 
 
 # -- answers --------------------------------------------------------------------------------
@@ -209,60 +215,12 @@ class Lab:
 
 
 # -- reading -------------------------------------------------------------------------------
-class _Reader:
+class _Reader(NodeReader):
     def __init__(self, path: Path, label: str):
+        super().__init__(label)
         self.path = path
-        self.label = label
         self.base = path.parent
         self.mazes: dict[Path, LabMaze] = {}
-
-    def fail(self, node: yaml.Node | None, where: str, message: str, hint: str = "") -> None:
-        line = node.start_mark.line + 1 if node is not None else 1
-        fix = f" ({hint})" if hint else ""
-        prefix = f"{where}: " if where else ""
-        raise LabFileError(f"{self.label}:{line}: {prefix}{message}{fix}")
-
-    def mapping(
-        self, node: yaml.Node, where: str, required: tuple[str, ...], optional: tuple[str, ...]
-    ) -> dict[str, yaml.Node]:
-        if not isinstance(node, yaml.MappingNode):
-            self.fail(node, where, "must be a mapping of keys to values", "write 'key: value'")
-        out: dict[str, yaml.Node] = {}
-        allowed = required + optional
-        for key_node, value in node.value:
-            key = key_node.value if isinstance(key_node, yaml.ScalarNode) else None
-            if key not in allowed:
-                self.fail(
-                    key_node, where, f"unknown key {key!r}", f"use one of {', '.join(allowed)}"
-                )
-            if key in out:
-                self.fail(key_node, where, f"key {key!r} is given twice", "keep one")
-            out[key] = value
-        for key in required:
-            if key not in out:
-                self.fail(node, where, f"missing key {key!r}", f"add '{key}: ...'")
-        return out
-
-    def text(self, node: yaml.Node, where: str) -> str:
-        if not isinstance(node, yaml.ScalarNode) or not str(node.value).strip():
-            self.fail(node, where, "must be a non-empty text", "write it on the same line")
-        return str(node.value)
-
-    def number(self, node: yaml.Node, where: str, minimum: float = 0.0) -> float:
-        value = yaml.safe_load(yaml.serialize(node)) if isinstance(node, yaml.ScalarNode) else None
-        if isinstance(value, bool) or not isinstance(value, int | float) or value < minimum:
-            self.fail(node, where, f"{node.value!r} is not a number of at least {minimum:g}")
-        return float(value)
-
-    def items(self, node: yaml.Node, where: str) -> list[yaml.Node]:
-        if isinstance(node, yaml.ScalarNode):
-            return [node]
-        if not isinstance(node, yaml.SequenceNode) or not node.value:
-            self.fail(node, where, "must be a list with at least one item", "write [a, b]")
-        return list(node.value)
-
-    def texts(self, node: yaml.Node, where: str) -> tuple[str, ...]:
-        return tuple(self.text(n, where) for n in self.items(node, where))
 
     def file(self, node: yaml.Node, where: str) -> Path:
         path = (self.base / self.text(node, where)).resolve()
@@ -300,39 +258,42 @@ class _Reader:
             self.fail(node, where, str(exc))
         return tuple(specs)
 
-    def choice(self, node: yaml.Node, where: str, allowed: tuple[str, ...], what: str) -> str:
-        value = self.text(node, where)
-        if value not in allowed:
-            self.fail(node, where, f"unknown {what} {value!r}", f"use one of {', '.join(allowed)}")
-        return value
-
 
 def load_lab(path: str | Path) -> Lab:
-    """Read and check one lab file; raises :class:`LabFileError` naming the line and the fix."""
+    """Read and check one lab file; raises :class:`LabFileError` with every problem found,
+    each naming its line and the fix."""
     path = Path(path)
     label = _label(path)
     try:
         root = compose_yaml(read_text(path, LAB_LIMITS, label), label, LAB_LIMITS)
     except BoundedFileError as exc:
-        line = f":{exc.line}" if exc.line is not None else ""
-        raise LabFileError(f"{label}{line}: {exc.message} ({exc.hint})") from None
+        raise LabFileError([FileProblem.refused(exc)]) from None
     except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        line = mark.line + 1 if mark is not None else 1
-        problem = getattr(exc, "problem", None) or "cannot be parsed"
-        raise LabFileError(f"{label}:{line}: not valid YAML: {problem}") from None
-    r = _Reader(path, label)
+        raise LabFileError([FileProblem.syntax(label, exc)]) from None
     if root is None:
-        raise LabFileError(f"{label}:1: empty file (a lab needs 'lab', 'title' and 'exercises')")
+        raise LabFileError(
+            [FileProblem(label, 1, 1, "empty file", "a lab needs 'lab', 'title' and 'exercises'")]
+        )
+    r = _Reader(path, label)
+    try:
+        lab = _lab(r, root, path)
+    except Skip:
+        lab = None
+    r.check(LabFileError)
+    assert lab is not None
+    return lab
+
+
+def _lab(r: _Reader, root: yaml.Node, path: Path) -> Lab:
     top = r.mapping(root, "", ("lab", "title", "exercises"), ("summary",))
     lab_id = r.text(top["lab"], "lab")
     if lab_id != path.stem:
-        r.fail(top["lab"], "lab", f"id {lab_id!r} differs from the file name", f"use {path.stem!r}")
+        r.note(top["lab"], "lab", f"id {lab_id!r} differs from the file name", f"use {path.stem!r}")
     exercises: list[Exercise] = []
-    for node in r.items(top["exercises"], "exercises"):
-        ex = _exercise(r, node)
+    read = r.each(r.items(top["exercises"], "exercises"), lambda node: (node, _exercise(r, node)))
+    for node, ex in read:
         if any(e.id == ex.id for e in exercises):
-            r.fail(node, f"exercise {ex.id!r}", "id is used twice", "give each exercise its own id")
+            r.note(node, f"exercise {ex.id!r}", "id is used twice", "give each exercise its own id")
         exercises.append(ex)
     summary = r.text(top["summary"], "summary") if "summary" in top else ""
     return Lab(lab_id, r.text(top["title"], "title"), summary, tuple(exercises), path)
@@ -360,20 +321,27 @@ def _exercise(r: _Reader, node: yaml.Node) -> Exercise:
     ex_id = r.text(keys["id"], "exercise")
     where = f"exercise {ex_id!r}"
     questions = (
-        tuple(_question(r, q, where) for q in r.items(keys["questions"], f"{where}: questions"))
+        tuple(
+            r.each(
+                r.items(keys["questions"], f"{where}: questions"),
+                lambda q: _question(r, q, where),
+            )
+        )
         if "questions" in keys
         else ()
     )
     ids = [q.id for q in questions]
     if len(set(ids)) != len(ids):
-        r.fail(keys["questions"], where, "two questions share an id", "give each its own id")
+        r.note(keys["questions"], where, "two questions share an id", "give each its own id")
     objectives = tuple(
-        _objective(r, o, where) for o in r.items(keys["objectives"], f"{where}: objectives")
+        r.each(
+            r.items(keys["objectives"], f"{where}: objectives"), lambda o: _objective(r, o, where)
+        )
     )
     if any(o.kind == "questions" for o in objectives) and not questions:
-        r.fail(keys["objectives"], where, "a 'questions' objective but no questions", "add them")
+        r.note(keys["objectives"], where, "a 'questions' objective but no questions", "add them")
     if "signoff" in keys and keys["signoff"].value != "required":
-        r.fail(keys["signoff"], where, "sign-off can only be 'required'", "write it so")
+        r.note(keys["signoff"], where, "sign-off can only be 'required'", "write it so")
     return Exercise(
         ex_id,
         r.text(keys["title"], where),

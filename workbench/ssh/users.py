@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import os
 import re
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -31,6 +31,7 @@ from workbench.files.bounded import (
     compose_yaml,
     read_text,
 )
+from workbench.files.yamlread import FileProblem, NodeReader, Skip, is_null, problem_list
 
 from .passwords import PasswordError, parse_hash, verify_password
 
@@ -46,7 +47,17 @@ HEADER = (
 
 
 class UsersFileError(ValueError):
-    """A users file that cannot be used: ``file:line: where: what (fix: ...)``."""
+    """A users file (or a user to add) that cannot be used; for a file, ``problems`` lists
+    every problem found, each as ``file:line:column: where: what (hint: fix)``."""
+
+    def __init__(self, message: str, problems: Sequence[FileProblem] = ()) -> None:
+        super().__init__(message)
+        self.problems = list(problems)
+
+    @classmethod
+    def found(cls, problems: Sequence[FileProblem]) -> UsersFileError:
+        problems = problem_list(problems)
+        return cls("\n".join(str(p) for p in problems), problems)
 
 
 def users_path(data_dir: str | os.PathLike) -> Path:
@@ -98,126 +109,96 @@ class User:
         return [parse_public_key(k).get_fingerprint() for k in self.keys]
 
 
-class _Reader:
-    def __init__(self, path: Path) -> None:
-        self.path = path
-
-    def fail(self, node: yaml.Node | None, where: str, message: str, fix: str) -> None:
-        line = node.start_mark.line + 1 if node is not None else 1
-        prefix = f"{where}: " if where else ""
-        raise UsersFileError(f"{self.path}:{line}: {prefix}{message} (fix: {fix})")
-
-    def mapping(
-        self, node: yaml.Node, where: str, what: str
-    ) -> list[tuple[str, yaml.Node, yaml.Node]]:
-        if not isinstance(node, yaml.MappingNode):
-            self.fail(node, where, f"must be {what}", "indent it as 'key: value' lines")
-        items: list[tuple[str, yaml.Node, yaml.Node]] = []
-        seen: set[str] = set()
-        for key, value in node.value:
-            if not isinstance(key, yaml.ScalarNode):
-                self.fail(key, where, "a key must be a plain name", "write 'name:'")
-            if key.value in seen:
-                self.fail(key, where, f"{key.value!r} is given twice", "keep one of them")
-            seen.add(key.value)
-            items.append((key.value, key, value))
-        return items
-
-    def text(self, node: yaml.Node, where: str, fix: str) -> str:
-        if not isinstance(node, yaml.ScalarNode) or not str(node.value).strip():
-            self.fail(node, where, "must be a text on the same line", fix)
-        return str(node.value).strip()
-
-
 def parse_users(text: str, path: str | os.PathLike = USERS_FILE) -> dict[str, User]:
-    """The users of a users file's text; :class:`UsersFileError` names line, key and fix."""
-    reader = _Reader(Path(path))
+    """The users of a users file's text; :class:`UsersFileError` lists every problem with its
+    line, key and fix."""
     try:
         root = compose_yaml(check_text(text, str(path), USERS_LIMITS), str(path), USERS_LIMITS)
     except BoundedFileError as exc:
         raise _refused(exc) from None
     except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        line = mark.line + 1 if mark is not None else 1
-        problem = getattr(exc, "problem", None) or str(exc)
-        raise UsersFileError(
-            f"{path}:{line}: not valid YAML: {problem} (fix: compare with docs/ssh.md)"
+        raise UsersFileError.found(
+            [FileProblem.syntax(str(path), exc, "compare with docs/ssh.md")]
         ) from None
     if root is None:
         return {}
-    top = {name: value for name, _, value in reader.mapping(root, "", "a 'users:' mapping")}
-    for name, key, _ in reader.mapping(root, "", "a 'users:' mapping"):
-        if name != "users":
-            reader.fail(key, name, "is not a known key", "the file has one key, 'users:'")
-    node = top.get("users")
-    if node is None or (isinstance(node, yaml.ScalarNode) and node.value in ("", "~", "null")):
-        return {}
+    reader = NodeReader(str(path))
     users: dict[str, User] = {}
-    for name, name_node, entry in reader.mapping(node, "users", "a mapping of login names"):
-        where = f"users.{name}"
-        if not NAME_PATTERN.fullmatch(name):
-            reader.fail(
-                name_node,
-                where,
-                "is not a usable login name",
-                "use 1-32 letters, digits, '_', '.' or '-'",
-            )
-        fields = {
-            key: value
-            for key, _, value in reader.mapping(entry, where, "role, keys and/or password")
-        }
-        for key, value in fields.items():
-            if key not in FIELDS:
-                reader.fail(
-                    value,
-                    f"{where}.{key}",
-                    "is not a known key",
-                    "use role, keys and password only",
-                )
-        if "role" not in fields:
-            reader.fail(
-                name_node, where, "has no role", "add 'role: student' or 'role: instructor'"
-            )
-        role = reader.text(fields["role"], f"{where}.role", "write 'role: student'")
-        if role not in ROLES:
-            reader.fail(
-                fields["role"],
-                f"{where}.role",
-                f"{role!r} is not a role",
-                "write student or instructor",
-            )
-        keys = _keys(reader, fields.get("keys"), f"{where}.keys")
-        password = None
-        if "password" in fields:
-            password = reader.text(
-                fields["password"],
-                f"{where}.password",
-                f"make one with: workbench ssh add-user {name} --password",
-            )
+    try:
+        node = _users_node(reader, root)
+        for name, name_node, entry in reader.pairs(node, "users", "a mapping of login names"):
             try:
-                parse_hash(password)
-            except PasswordError as exc:
-                reader.fail(
-                    fields["password"],
-                    f"{where}.password",
-                    str(exc),
-                    f"set it again with: workbench ssh add-user {name} --password",
-                )
-        if not keys and password is None:
-            reader.fail(
-                name_node,
-                where,
-                "has neither keys nor a password, so cannot log in",
-                f"workbench ssh add-user {name} --key FILE.pub (or --password)",
-            )
-        users[name] = User(name, role, keys, password)
+                users[name] = _user(reader, name, name_node, entry)
+            except Skip:
+                continue
+    except Skip:
+        pass
+    reader.check(UsersFileError.found)
     return users
 
 
-def _keys(reader: _Reader, node: yaml.Node | None, where: str) -> tuple[str, ...]:
-    if node is None:
-        return ()
-    if isinstance(node, yaml.ScalarNode) and node.value in ("", "~", "null"):
+def _users_node(reader: NodeReader, root: yaml.Node) -> yaml.Node:
+    top = reader.pairs(root, "", "a 'users:' mapping")
+    for name, key, _ in top:
+        if name != "users":
+            reader.note(key, name, "is not a known key", "the file has one key, 'users:'")
+    node = next((value for name, _, value in top if name == "users"), None)
+    if is_null(node):
+        raise Skip  # no users yet
+    assert node is not None
+    return node
+
+
+def _user(reader: NodeReader, name: str, name_node: yaml.Node, entry: yaml.Node) -> User:
+    where = f"users.{name}"
+    if not NAME_PATTERN.fullmatch(name):
+        reader.note(
+            name_node,
+            where,
+            "is not a usable login name",
+            "use 1-32 letters, digits, '_', '.' or '-'",
+        )
+    fields: dict[str, yaml.Node] = {}
+    for key, _, value in reader.pairs(entry, where, "role, keys and/or password"):
+        if key not in FIELDS:
+            reader.note(
+                value, f"{where}.{key}", "is not a known key", "use role, keys and password only"
+            )
+        else:
+            fields[key] = value
+    if "role" not in fields:
+        reader.fail(name_node, where, "has no role", "add 'role: student' or 'role: instructor'")
+    role = reader.choice(fields["role"], f"{where}.role", ROLES, "role")
+    before = len(reader.problems)
+    keys = _keys(reader, fields.get("keys"), f"{where}.keys")
+    password = None
+    if "password" in fields:
+        password = reader.text(
+            fields["password"],
+            f"{where}.password",
+            f"make one with: workbench ssh add-user {name} --password",
+        )
+        try:
+            parse_hash(password)
+        except PasswordError as exc:
+            reader.note(
+                fields["password"],
+                f"{where}.password",
+                str(exc),
+                f"set it again with: workbench ssh add-user {name} --password",
+            )
+    if not keys and password is None and len(reader.problems) == before:
+        reader.note(
+            name_node,
+            where,
+            "has neither keys nor a password, so cannot log in",
+            f"workbench ssh add-user {name} --key FILE.pub (or --password)",
+        )
+    return User(name, role, keys, password)
+
+
+def _keys(reader: NodeReader, node: yaml.Node | None, where: str) -> tuple[str, ...]:
+    if is_null(node) or (isinstance(node, yaml.SequenceNode) and not node.value):
         return ()
     if not isinstance(node, yaml.SequenceNode):
         reader.fail(node, where, "must be a list", "write each key on its own '- ' line")
@@ -227,12 +208,13 @@ def _keys(reader: _Reader, node: yaml.Node | None, where: str) -> tuple[str, ...
         try:
             parse_public_key(text)
         except ValueError as exc:
-            reader.fail(
+            reader.note(
                 item,
                 f"{where}[{index}]",
                 str(exc),
                 "paste the whole line of the user's .pub file (e.g. ~/.ssh/id_ed25519.pub)",
             )
+            continue
         keys.append(text)
     return tuple(keys)
 
@@ -250,9 +232,8 @@ def load_users(path: str | os.PathLike) -> dict[str, User]:
 
 
 def _refused(exc: BoundedFileError) -> UsersFileError:
-    """The error of a users file refused by the bounded reader, in this file's style."""
-    line = f":{exc.line}" if exc.line is not None else ""
-    return UsersFileError(f"{exc.path}{line}: {exc.message} (fix: {exc.hint})")
+    """The error of a users file refused by the bounded reader."""
+    return UsersFileError.found([FileProblem.refused(exc)])
 
 
 def dump_users(users: Iterable[User]) -> str:
