@@ -42,6 +42,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="the robot's sensors, e.g. distance:3:right (default: the profile's)",
     )
     r.add_argument("--keys", default="", metavar="SCRIPT", help='e.g. "w@0.5 release@3 a@4.2"')
+    r.add_argument(
+        "--typed",
+        default="",
+        metavar="SCRIPT",
+        help='keys as a terminal sends them, e.g. "w@0.5 w@0.55 d@2": released after a quiet '
+        "gap, as in the app",
+    )
     r.add_argument("--kinds", metavar="MAP.yaml", help="names for unknown activity kinds")
     r.add_argument("--seed", type=int, default=0)
     r.add_argument("--max-time", type=float, help="simulated seconds (default: from maze size)")
@@ -94,6 +101,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         profile=args.profile,
         sensors=tuple(args.sensor),
         keys=args.keys,
+        typed=args.typed,
         kinds=args.kinds,
         seed=args.seed,
         noise=args.noise,

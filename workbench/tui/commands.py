@@ -64,12 +64,21 @@ COMMANDS: dict[str, CommandInfo] = {
         "panel.algorithm": (
             "Set-up",
             "algorithm",
-            "Choose a built-in algorithm or load a YAML FSM file; edit its parameters.",
+            "Choose a built-in algorithm or load a YAML FSM file or a VIPLE program "
+            "(.viple, .xml); edit its parameters.",
         ),
         "algorithm.run": (
             "Algorithm",
             "start / stop algorithm",
-            "Start the chosen algorithm from the start block (a new run), or stop it.",
+            "Start the chosen algorithm or VIPLE program from the start block (a new run), "
+            "or stop it.",
+        ),
+        "program.keys": (
+            "Algorithm",
+            "keys to a program",
+            "While a VIPLE program drives, w a s d, the arrows, the digits and letters the "
+            "screen does not use go to its Key Press events; a key counts as released 0.75 s "
+            "after it stops repeating, or when another key comes. Space stops the program.",
         ),
         "algorithm.fix": (
             "Algorithm",
