@@ -95,9 +95,9 @@ class ProgramState(Vertical):
             self._printed = 0
             self._log.clear()
         held = "+".join(sorted(run.held))
-        self.summary = f"running, {run.state or '0 flows'}" + (f", holds {held}" if held else "")
+        self.summary = "running" + (f", holds {held}" if held else "")
         self.flows = _flows(run)
-        self.variables = " ".join(f"{name}={show(v)}" for name, v in run.variables.items())
+        self.variables = " ".join(f"{name}={_value(v)}" for name, v in run.variables.items())
         self.events = "\n".join(f"{f.time:5.1f} s {f.what}" for f in run.fired[-SHOWN_EVENTS:])
         self._follow_console(run)
 
@@ -132,4 +132,11 @@ def _flows(run: ProgramController) -> str:
              for panel, label, what in running[:SHOWN_FLOWS]]  # fmt: skip
     if len(running) > SHOWN_FLOWS:
         lines.append("...")
-    return "\n".join(lines) if lines else "no flow runs: waiting for an event"
+    return "\n".join(lines) if lines else "idle: waiting for events"
+
+
+def _value(value: object) -> str:
+    """A global as the panel shows it: reals to four figures, the rest as VIPLE prints them."""
+    if isinstance(value, float):
+        return f"{value:.4g}"
+    return show(value)
