@@ -37,10 +37,12 @@ def help_text(
         drive.add_row(key, text)
     sections.append((f"Drive ({profile} key program)", drive))
     tables: dict[str, Table] = {}
+    shown: set[tuple[str, str]] = set()
     for screen_group, bindings in screens:
         for binding in bindings:
-            if not binding.id:
-                continue
+            if not binding.id or (screen_group, binding.id) in shown:
+                continue  # the keys of one command (the arrows) are explained once
+            shown.add((screen_group, binding.id))
             info = COMMANDS.get(binding.id)
             if info is None:
                 info = CommandInfo(

@@ -87,7 +87,7 @@ class MainScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             id="program.keys",
         ),
         *(
-            Binding(arrow, f"program_key('{arrow}')", show=False, priority=True)
+            Binding(arrow, f"program_key('{arrow}')", show=False, priority=True, id="program.keys")
             for arrow in ("down", "left", "right")
         ),
     ]
