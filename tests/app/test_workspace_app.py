@@ -107,7 +107,7 @@ def test_g_loads_fsm_files_only_from_the_workspace(tmp_path):
     async def body(pilot: Pilot) -> None:
         await pilot.press("g")
         field = app.screen.query_one("#alg-path", Input)
-        assert field.placeholder == "~/my-fsm.yaml"
+        assert field.placeholder == "~/my.yaml or ~/my.viple"
         field.value = str(data / "ssh-users.yaml")
         field.focus()
         await pilot.press("enter")

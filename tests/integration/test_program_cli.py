@@ -174,3 +174,18 @@ def test_eval_ranks_programs_beside_algorithms(tmp_path, capsys):
     assert "right-wall.viple: give each once" in capsys.readouterr().err
     assert main(["eval", "--maze", maze]) == 2
     assert "give --algorithm" in capsys.readouterr().err
+
+
+def test_run_typed_keys_are_released_as_in_the_app(tmp_path, capsys):
+    b = ProgramBuilder()
+    panel = b.panel("Main")
+    b.robot(panel)
+    panel.chain(panel.add(13, "22"), panel.add(20, "0.5", "0.5", "R", "3", "5"))
+    panel.chain(panel.add(29, ""), panel.add(20, "0", "0", "R", "3", "5"))
+    path = b.write(tmp_path / "wire.viple")
+    args = ["viple", "run", path, "--maze", WEB_MAZE, "--max-time", "3", "--json"]
+    main([*args, "--typed", "w@0.5 w@0.9 w@1.3"])
+    data = json.loads(capsys.readouterr().out)
+    events = [(e["time"], e["event"]) for e in data["events"]]
+    # the repeats keep w held; 0.75 s after the last one it is released (at the next tick)
+    assert events == [(0.5, "key w"), (2.05, "key release")]

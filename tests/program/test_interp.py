@@ -265,3 +265,55 @@ def test_key_scripts():
         parse_key_script("x1@2")
     with pytest.raises(KeyScriptError, match="must be KEY@SECONDS"):
         parse_key_script("w")
+
+
+def test_a_join_inside_a_block_call_goes_with_the_call(tmp_path):
+    """A call whose Join got only one of its inputs leaves nothing behind once it ends."""
+    import gc
+
+    from workbench.program.interp import Frame
+
+    b = ProgramBuilder()
+    main = b.panel("Main")
+    half = b.panel("Half")
+    join = half.add(4, "a", "b")
+    sometimes = half.add(6, "value > 100")  # never true: the second input never comes
+    b.link(half.pin_in, join, in_pin=0)
+    b.link(half.pin_in, sometimes)
+    b.link(sometimes, join, in_pin=1)
+    b.link(join, half.pin_out)
+    b.link(half.pin_in, half.pin_out)
+    key = main.add(13, "22")
+    data = main.add(3, "1")
+    block = main.add(0, name="Half")
+    p = main.add(28, "")
+    main.chain(key, data, block, p)
+    script = " ".join(f"w@{0.1 * i:.1f} release@{0.1 * i + 0.05:.2f}" for i in range(1, 101))
+    c = controller(b, tmp_path, keys=script)
+    run(c, 10.5)
+    assert len(texts(c)) == 100  # every call ran and came out of its output pin
+    gc.collect()
+    assert [o for o in gc.get_objects() if isinstance(o, Frame) and o.block is not None] == []
+    assert c._joins == {}
+
+
+def test_typed_keys_hold_while_repeating_and_release_after_a_quiet_gap():
+    from workbench.program.keys import RELEASE_GAP, TypedKeys, typed_events
+
+    typed = TypedKeys()
+    assert [e.keys for e in typed.press("w", 1.0)] == [frozenset({"w"})]
+    assert typed.press("w", 1.5) == []  # the key repeating: still held
+    assert typed.due(1.5 + RELEASE_GAP - 0.01) is None
+    release = typed.due(1.5 + RELEASE_GAP)
+    assert release is not None and release.release and release.time == 1.5 + RELEASE_GAP
+    events = typed.press("a", 5.0) + typed.press("d", 5.1)  # another key: release, then press
+    assert [(e.time, sorted(e.keys)) for e in events] == [(5.0, ["a"]), (5.1, []), (5.1, ["d"])]
+    script = parse_key_script("w@0.5 w@0.6 w@0.7 d@3")
+    assert [(e.time, sorted(e.keys)) for e in typed_events(script, until=10)] == [
+        (0.5, ["w"]),
+        (0.7 + RELEASE_GAP, []),
+        (3.0, ["d"]),
+        (3.0 + RELEASE_GAP, []),
+    ]
+    with pytest.raises(KeyScriptError, match="type one key an item"):
+        typed_events(parse_key_script("w+d@1"), until=10)

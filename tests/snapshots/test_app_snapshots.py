@@ -102,3 +102,45 @@ def test_help_screen(snap_compare, size, unicode):
 @pytest.mark.parametrize("unicode", [False, True], ids=["ascii", "unicode"])
 def test_too_small_terminal(snap_compare, unicode):
     assert snap_compare(app(unicode), terminal_size=(60, 20))
+
+
+@grid
+def test_main_screen_with_a_program_driving(snap_compare, size, unicode, tmp_path, monkeypatch):
+    from tests.app.test_app_program import drive_by_wire
+    from workbench.program.choice import choose_program
+
+    monkeypatch.chdir(tmp_path)
+    drive_by_wire(tmp_path)
+
+    async def before(pilot: Pilot) -> None:
+        station = pilot.app.station
+        choose_program(station, "wire.viple")
+        station.start_program()
+        station.pacer.paused = True
+        station.step(6)
+        await pilot.press("w")
+        station.step(30)
+        await pilot.press("w")  # the key repeating: still held
+        station.step(30)
+        pilot.app.refresh_views()
+        await pilot.pause()
+
+    assert snap_compare(app(unicode), terminal_size=size, run_before=before)
+
+
+@grid
+def test_algorithm_dialog_with_a_bad_program(snap_compare, size, unicode, tmp_path, monkeypatch):
+    from tests.app.test_app_program import bad_program
+
+    monkeypatch.chdir(tmp_path)
+    bad_program(tmp_path)
+
+    async def before(pilot: Pilot) -> None:
+        await pilot.press("g")
+        await pilot.pause()
+        pilot.app.screen.query_one("#alg-path", Input).value = "bad.viple"
+        await pilot.app.screen.choose("bad.viple")
+        still(pilot)
+        await pilot.pause()
+
+    assert snap_compare(app(unicode), terminal_size=size, run_before=before)

@@ -349,3 +349,31 @@ def test_keys_objective_with_a_role_accepts_a_viple_program_making_the_five_moti
                         "motions": ["backward", "forward", "left", "right", "stop"]}  # fmt: skip
     other = Objective("keys", "drove", keys=("w",), role="ws")
     assert check(other, exercise(other), b) == (False, "not used yet: w")  # tcp is not ws
+
+
+def test_a_viple_exercise_passes_with_the_students_program_run_here():
+    import hashlib
+
+    from workbench.program.choice import choose_program
+
+    web = LabMaze.read(MAZES / "web.txt")
+    for_viple = Objective("exit", "out", maze=web, drivers=("viple",))
+    for_fsm = Objective("exit", "out", maze=web, drivers=("fsm",))
+    sensors = tuple(SensorSpec.parse(s) for s in ("distance:1:right", "touch:2:front"))
+    ex = Exercise("ex", "Ex", "do it", Setup("web", web, sensors, Controller("keys", "")),
+                  (for_viple, for_fsm), ())  # fmt: skip
+    b = station_for(ex)
+    choose_program(b, "programs/right-wall.viple")
+    b.start_program()
+    for _ in range(200):
+        b.step(60)
+        if b.runs and b.runs[-1].ended == "exit":
+            break
+    run = b.runs[-1]
+    assert run.ended == "exit" and str(run.driver) == "VIPLE program right-wall.viple"
+    passed, reason = check(for_viple, ex, b)
+    assert passed and reason.startswith(f"run {run.number} (VIPLE program right-wall.viple)")
+    evidence = check_objective(for_viple, ex, b).evidence
+    digest = hashlib.sha256(Path("programs/right-wall.viple").read_bytes()).hexdigest()
+    assert evidence["program_sha256"] == digest
+    assert check(for_fsm, ex, b)[0] is False  # a VIPLE program is not an FSM file

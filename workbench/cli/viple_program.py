@@ -3,13 +3,26 @@
 from __future__ import annotations
 
 import argparse
+import asyncio
 import json
+import os
 import sys
 
 from workbench.control.headless import RunSetupError
 from workbench.program.headless import ProgramRunSpec, load_compiled, run_program
+from workbench.program.keys import KeyScriptError, parse_key_script, typed_events
 from workbench.program.problems import ProgramError
+from workbench.program.remote import RemoteProgram, robot_settings, wheel_ports
 from workbench.program.show import describe_program
+from workbench.sim.profiles import get_profile
+from workbench.viple.client import (
+    ClientSetup,
+    ClientSetupError,
+    Step,
+    parse_endpoint,
+    run_client,
+)
+from workbench.viple.codec import WheelPorts
 
 from .run import _simulation_options, describe_measures
 
@@ -32,7 +45,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     r = psub.add_parser("run", help="run a program on a maze and print its measures")
     r.add_argument("file", metavar="FILE")
-    r.add_argument("--maze", required=True, help="maze file (any supported format)")
+    r.add_argument("--maze", help="maze file (any supported format); not with --connect")
     _simulation_options(r)
     r.add_argument(
         "--sensor",
@@ -42,11 +55,30 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="the robot's sensors, e.g. distance:3:right (default: the profile's)",
     )
     r.add_argument("--keys", default="", metavar="SCRIPT", help='e.g. "w@0.5 release@3 a@4.2"')
+    r.add_argument(
+        "--typed",
+        default="",
+        metavar="SCRIPT",
+        help='keys as a terminal sends them, e.g. "w@0.5 w@0.55 d@2": released after a quiet '
+        "gap, as in the app",
+    )
     r.add_argument("--kinds", metavar="MAP.yaml", help="names for unknown activity kinds")
     r.add_argument("--seed", type=int, default=0)
     r.add_argument("--max-time", type=float, help="simulated seconds (default: from maze size)")
     r.add_argument("--record", metavar="FILE.jsonl", help="write the run record")
     r.add_argument("--json", action="store_true", help="one JSON object")
+    r.add_argument(
+        "--connect",
+        nargs="?",
+        const="robot",
+        metavar="URL",
+        help="drive a real robot or an external simulator over VIPLE's protocol, where the "
+        "program's Robot activity says (Wi-Fi: TCP client of host:port; WebSocket: server on "
+        "its port), or at URL (tcp://HOST:PORT to connect, ws://HOST:PORT to listen)",
+    )
+    r.add_argument(
+        "--duration", type=float, metavar="S", help="with --connect: stop after S seconds"
+    )
     r.set_defaults(func=cmd_run)
 
 
@@ -85,6 +117,11 @@ def cmd_show(args: argparse.Namespace) -> int:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
+    if args.connect is not None:
+        return cmd_connect(args)
+    if not args.maze:
+        print("workbench viple run: give --maze M (or --connect for a robot)", file=sys.stderr)
+        return 2
     if args.max_time is not None and not 0 < args.max_time <= 24 * 3600:
         print("workbench viple run: --max-time must be above 0 and at most a day", file=sys.stderr)
         return 2
@@ -94,6 +131,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         profile=args.profile,
         sensors=tuple(args.sensor),
         keys=args.keys,
+        typed=args.typed,
         kinds=args.kinds,
         seed=args.seed,
         noise=args.noise,
@@ -146,3 +184,136 @@ def _many(count: int, word: str) -> str:
     if count == 1:
         return f"1 {word}"
     return f"{count} {word[:-1]}ies" if word.endswith("y") else f"{count} {word}s"
+
+
+# -- driving a robot over the protocol ---------------------------------------------------------
+class _ProgramBrain:
+    """A :class:`RemoteProgram` as the VIPLE client's brain; prints what the program printed."""
+
+    def __init__(self, remote: RemoteProgram, log) -> None:
+        self.remote = remote
+        self.log = log
+        self.transitions = 0
+        self._told_missing = False
+        self._errors = 0
+
+    @property
+    def readings(self):
+        return self.remote.readings
+
+    @property
+    def state(self) -> str | None:
+        return self.remote.state
+
+    def next_tick(self) -> float:
+        return self.remote.next_tick()
+
+    def start(self, t: float) -> Step:
+        return self._step(t, self.remote.start(t), started=True)
+
+    def report(self, t: float, readings) -> Step:
+        missing = self.remote.missing_ports(readings)
+        if missing and not self._told_missing:
+            self._told_missing = True
+            have = ", ".join(str(p) for p in sorted(readings)) or "none"
+            self.log(
+                f"{t:8.2f} s  the reports carry no sensor on port(s) "
+                f"{', '.join(map(str, missing))}, which the program reads (they carry {have})"
+            )
+        return self._step(t, self.remote.report(t, readings))
+
+    def tick(self, t: float) -> Step:
+        return self._step(t, self.remote.tick(t))
+
+    def _step(self, t: float, commands, started: bool = False) -> Step:
+        printed, fired = self.remote.news()
+        self.transitions += len(fired)
+        for f in fired:
+            self.log(f"{f.time:8.2f} s  {f.what}")
+        for p in printed:
+            self.log(f"{p.time:8.2f} s  print: {p.text[:200]}")
+        errors = self.remote.controller.errors
+        for e in errors[self._errors :]:
+            self.log(f"error at {e}")
+        self._errors = len(errors)
+        return Step(t, list(commands), started=started)
+
+
+def cmd_connect(args: argparse.Namespace) -> int:
+    name = "workbench viple run --connect"
+    if args.maze:
+        print(f"{name}: --maze is for simulated runs; the robot is the maze here", file=sys.stderr)
+        return 2
+    try:
+        compiled = load_compiled(args.file, args.kinds)
+        keys = parse_key_script(args.keys)
+        if args.typed:
+            typed = typed_events(parse_key_script(args.typed), until=float("inf"))
+            keys = tuple(sorted(keys + typed, key=lambda e: e.time))
+        if args.connect == "robot":
+            robot = robot_settings(compiled)
+            url = robot.url
+        else:
+            url = args.connect
+        scheme = url.split(":", 1)[0].lower()
+        if scheme not in ("tcp", "ws"):
+            raise ClientSetupError(
+                f"--connect {url!r} must be tcp://HOST:PORT (connect) or ws://HOST:PORT (listen)"
+            )
+        endpoint = parse_endpoint(
+            connect=url if scheme == "tcp" else None, listen=url if scheme == "ws" else None
+        )
+        if args.duration is not None and not (0 < args.duration <= 24 * 3600):
+            raise ClientSetupError("--duration must be above 0 and at most a day")
+        profile = get_profile(args.profile or "unity")
+    except ProgramError as exc:
+        for problem in exc.problems:
+            print(problem, file=sys.stderr)
+        return 2
+    except (KeyScriptError, ClientSetupError, ValueError) as exc:
+        print(f"{name}: {exc}", file=sys.stderr)
+        return 2
+    progress = sys.stderr if args.json else sys.stdout
+
+    def log(text: str) -> None:
+        print(text, file=progress, flush=True)
+
+    ports = wheel_ports(compiled)
+    setup = ClientSetup(
+        definition=None,
+        profile=profile,
+        params={},
+        sensors=(),
+        binding={},
+        endpoint=endpoint,
+        duration=args.duration,
+        brain=lambda: _ProgramBrain(RemoteProgram(compiled, keys), log),
+        title=os.path.basename(args.file),
+        ports=WheelPorts(*ports) if ports else None,
+    )
+    wheels = setup.wheels
+    log(
+        f"{setup.name} over {endpoint} (wheels on ports {wheels.left}/{wheels.right}; "
+        f"sha256 {compiled.program.digest[:16]}...)"
+    )
+    result = asyncio.run(run_client(setup, log))
+    data = {**result.as_dict(), "program_sha256": compiled.program.digest}
+    data["events"] = data.pop("transitions")
+    if args.json:
+        print(json.dumps(data))
+    elif result.ended != "no connection":
+        print(
+            "\n".join(
+                [
+                    f"summary: {setup.name} over {result.endpoint}",
+                    f"  ended           {result.message or result.ended}",
+                    f"  driven for      {result.time:.1f} s",
+                    f"  reports         {result.reports} received, {result.rejected} rejected",
+                    f"  commands sent   {result.commands}",
+                    f"  events          {result.transitions}",
+                ]
+            )
+        )
+    if result.ended in ("no connection", "error"):
+        print(f"{name}: {result.message}", file=sys.stderr)
+    return result.exit_code

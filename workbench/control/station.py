@@ -7,10 +7,10 @@ only renders and routes input. A station owns a :class:`Session` and its :class:
 from __future__ import annotations
 
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 from workbench.files.workspace import LOCAL, FileAccess
 from workbench.sim.clock import Pacer
@@ -29,7 +29,7 @@ from workbench.sim.sensors import (
     SensorSpec,
     check_ports,
 )
-from workbench.sim.session import Session, Snapshot
+from workbench.sim.session import Controller, Session, Snapshot
 
 from .algorithms import load_algorithm
 from .fsm import FsmController, FsmDefinition, FsmRuntimeError, bind_sensors, preset_sensors
@@ -67,7 +67,7 @@ class RunEntry:
     metrics: Metrics
     ended: str  # "exit", "stopped", "reset", "maze changed"
     record: str | None = None
-    #: the FSM file of the algorithm that drove (None for keys and VIPLE)
+    #: the FSM file of the algorithm, or the program file, that drove (None for keys and VIPLE)
     source: str | None = None
     #: the layout digest of the maze the run was on (see ``Maze.digest``)
     maze_digest: str = ""
@@ -86,6 +86,31 @@ class Notice:
 
     kind: str  # ALGORITHM_FAILED (detail: why) or OUT (the run finished at the exit)
     detail: str = ""
+
+
+class ProgramDriver(Controller, Protocol):
+    """A controller that also answers typed keys (a VIPLE program: ``workbench.program``)."""
+
+    def reset(self) -> None: ...
+
+    def type_key(self, key: str, t: float) -> None: ...
+
+
+@dataclass(frozen=True)
+class ProgramChoice:
+    """A program file chosen to drive, read and checked by the layer that knows programs."""
+
+    #: the file's name, as the driver and the runs show it
+    name: str
+    #: the path it was read from, and sha256 of its bytes
+    source: str
+    digest: str
+    #: a fresh controller running the program
+    make: Callable[[], ProgramDriver]
+    #: why the program cannot run with these sensors (None when it can)
+    needs: Callable[[Sequence[SensorSpec]], str | None]
+    #: a few lines on what the program is and what it answers (keys, sensors)
+    summary: tuple[str, ...] = ()
 
 
 @dataclass
@@ -157,6 +182,10 @@ class LabStation:
     notice: Notice | None = None
     #: every VIPLE program seen driving this station, oldest first
     viple: list[VipleConnection] = field(default_factory=list)
+    #: the program file chosen to drive (most recent choice wins over :attr:`algorithm`)
+    program: ProgramChoice | None = None
+    #: the program driving now
+    program_run: ProgramDriver | None = None
     _run_open: bool = False
     _run_driver: Driver = KEYS
     _run_source: str | None = None
@@ -249,6 +278,10 @@ class LabStation:
             self.controller = None  # the program took the robot from the algorithm
             if self._run_open:
                 self._close_run("stopped")
+        if self.program_run is not None and self.session.controller is None:
+            self.program_run = None  # the VIPLE link took the robot from the program file
+            if self._run_open:
+                self._close_run("stopped")
         if self._run_open and self._run_driver != driver:
             self._close_run("stopped")
         if not self._run_open and not self.session.reached_exit:
@@ -296,7 +329,17 @@ class LabStation:
 
     # -- driving by keys -----------------------------------------------------------------
     def key(self, key: str) -> bool:
-        """A drive key (w a s d space); takes the robot from an algorithm. False if no drive key."""
+        """A drive key (w a s d space); takes the robot from an algorithm. False if no drive key.
+
+        While a program file drives, every key but space goes to the program (its Key Press
+        events); space stops the program, as it stops the robot.
+        """
+        if self.program_run is not None:
+            if key == "space":
+                self.stop_program("stopped")
+            else:
+                self.program_run.type_key(key, self.session.world.time)
+            return True
         cmd = key_command(self.profile, key)
         if cmd is None:
             return False
@@ -347,6 +390,8 @@ class LabStation:
         self.sensors = list(specs)
         if self.controller is not None:
             self.session.binding = bind_sensors(self.algorithm, specs, self.profile)
+        if self.program_run is not None:
+            self.session.binding = _port_binding(specs)
 
     def apply_preset(self, name: str) -> None:
         try:
@@ -368,7 +413,9 @@ class LabStation:
         """Choose an algorithm already read (a lab's starter as the lab was loaded)."""
         if self.controller is not None:
             self.stop_algorithm("stopped")
+        self.stop_program("stopped")
         self.algorithm = definition
+        self.program = None
         self.overrides = {}
         return definition
 
@@ -410,6 +457,7 @@ class LabStation:
             raise ValueError("choose an algorithm first")
         binding = bind_sensors(self.algorithm, self.sensors, self.profile)
         controller = FsmController(self.algorithm, self.overrides, self.profile)
+        self.stop_program("stopped")
         if self._run_open:
             self._close_run("stopped")
         self._go_on_after_exit()
@@ -418,6 +466,43 @@ class LabStation:
         self.session.attach(controller, binding, Driver.algorithm(self.algorithm.name))
         self._open_run(self.session.driver)
         self.pause(False)
+
+    # -- program files -------------------------------------------------------------------
+    def use_program(self, choice: ProgramChoice) -> None:
+        """Choose a program file to drive (the choice of algorithm is kept for later)."""
+        self.stop_algorithm("stopped")
+        self.stop_program("stopped")
+        self.program = choice
+
+    def start_program(self) -> None:
+        """Robot back to the start and the chosen program driving (a new run)."""
+        choice = self.program
+        if choice is None:
+            raise ValueError("choose a program first")
+        missing = choice.needs(self.sensors)
+        if missing:
+            raise ValueError(missing)
+        controller = choice.make()
+        self.stop_algorithm("stopped")
+        self.stop_program("stopped")
+        if self._run_open:
+            self._close_run("stopped")
+        self._go_on_after_exit()
+        self.session.reset()
+        self.program_run = controller
+        driver = Driver.program(choice.name, choice.digest)
+        self.session.attach(controller, _port_binding(self.sensors), driver)
+        self._open_run(driver)
+        self.pause(False)
+
+    def stop_program(self, ended: str = "stopped") -> None:
+        if self.program_run is None:
+            return
+        self.session.command(Stop())
+        self.session.detach(KEYS)
+        self.program_run = None
+        if self._run_open:
+            self._close_run(ended)
 
     def stop_algorithm(self, ended: str = "stopped") -> None:
         if self.controller is None:
@@ -436,6 +521,7 @@ class LabStation:
             self._close_run("reset")
         if self.controller is not None:
             self.stop_algorithm("reset")
+        self.stop_program("reset")
         self.session.reset()
         self.session.driver = KEYS
 
@@ -445,6 +531,7 @@ class LabStation:
         if self._run_open:
             self._close_run("maze changed")
         self.stop_algorithm("maze changed")
+        self.stop_program("maze changed")
         self.maze = maze
         self.session.load_maze(maze, self.profile, self.sensors, self.noise, self.seed)
         self.session.driver = KEYS
@@ -454,6 +541,8 @@ class LabStation:
         self._run_open = True
         self._run_driver = driver
         self._run_source = self.algorithm.source if self.controller and self.algorithm else None
+        if self.program_run is not None and self.program is not None:
+            self._run_source = self.program.source
         if self.record_dir:
             Path(self.record_dir).mkdir(parents=True, exist_ok=True)
             path = os.path.join(self.record_dir, f"run-{len(self.runs) + 1:03d}.jsonl")
@@ -461,9 +550,16 @@ class LabStation:
             self._record_path = path
             self.session.recorder = self._recorder
             self.session.record_header(
-                algorithm=self.algorithm.name if self.controller else str(driver),
+                algorithm=self.algorithm.name
+                if self.controller and self.algorithm
+                else str(driver),
                 driven_by=driver.as_json(),
                 params=self.params() if self.controller else {},
+                **(
+                    {"program": self.program.name, "program_sha256": self.program.digest}
+                    if self.program_run is not None and self.program is not None
+                    else {}
+                ),
             )
 
     def _close_run(self, ended: str) -> None:
@@ -484,8 +580,9 @@ class LabStation:
         )
         self.runs.append(entry)
         if self._recorder is not None:
+            running = self.controller or self.program_run
             self.session.record_summary(
-                ended=ended, final_state=self.controller.state if self.controller else None
+                ended=ended, final_state=running.state if running is not None else None
             )
             self._recorder.close()
             self.session.recorder = None
@@ -496,3 +593,8 @@ class LabStation:
         """End the session: an open run is kept (with its record) as stopped."""
         if self._run_open:
             self._close_run("stopped")
+
+
+def _port_binding(sensors: Sequence[SensorSpec]) -> dict[str, int]:
+    """A program reads sensors by port: each one under the name ``port N``."""
+    return {f"port {s.port}": s.port for s in sensors}

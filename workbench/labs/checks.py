@@ -129,9 +129,11 @@ def record_digest(path: str | None) -> str | None:
 
 
 def run_evidence(run: RunEntry) -> dict[str, Any]:
+    program = {"program_sha256": run.driver.digest} if run.driver.digest else {}
     return {
         "run": run.number,
         "driver": str(run.driver),
+        **program,
         "maze": run.maze,
         "maze_digest": run.maze_digest,
         "profile": run.profile,
@@ -147,6 +149,8 @@ def driver_kinds(run: RunEntry) -> set[str]:
     kinds = {"any"}
     if run.driver.kind == "viple":
         kinds.add("viple")
+    elif run.driver.kind == "program" and run.driver.digest:
+        kinds.update(("viple", "program"))  # the student's VIPLE program file, run here
     elif run.driver.kind == "algorithm" and run.source:
         if Path(run.source).resolve().parent == ALGORITHM_DIR:
             kinds.add(f"algorithm {run.driver.name}")

@@ -31,7 +31,7 @@ LABS_DIR = Path(__file__).resolve().parents[2] / "labs"
 OBJECTIVE_KINDS = ("keys", "sensors", "viple", "exit", "maze-edited", "compare", "questions")
 CONTROLLER_KINDS = ("keys", "algorithm", "starter", "viple")
 #: what an ``exit`` objective may require of the driver
-DRIVER_KINDS = ("viple", "fsm", "algorithm", "any")
+DRIVER_KINDS = ("viple", "program", "fsm", "algorithm", "any")
 DRIVE_KEYS = ("w", "a", "s", "d", "space")
 VIPLE_ROLES = ("tcp", "ws")
 
@@ -178,7 +178,7 @@ class Objective:
     sensors: tuple[SensorSpec, ...] = ()
     role: str = ""
     maze: LabMaze | None = None
-    #: accepted drivers for ``exit``: "viple", "fsm", "algorithm NAME", "any"
+    #: accepted drivers for ``exit``: "viple", "program", "fsm", "algorithm NAME", "any"
     drivers: tuple[str, ...] = ()
     max_time: float | None = None
     max_turn_degrees: float | None = None
@@ -430,7 +430,7 @@ def _objective(r: _Reader, node: yaml.Node, where: str) -> Objective:
             head, _, name = d.partition(" ")
             if head not in DRIVER_KINDS or (head == "algorithm") != bool(name):
                 r.fail(keys["driver"], here, f"unknown driver {d!r}",
-                       "use viple, fsm, algorithm NAME or any")  # fmt: skip
+                       "use viple, program, fsm, algorithm NAME or any")  # fmt: skip
         limits = {k: r.number(keys[k], f"{here}: {k}") for k in optional if k in keys}
         if "max_collisions" in limits:
             limits["max_collisions"] = int(limits["max_collisions"])

@@ -22,7 +22,7 @@ from workbench.sim.world import WorldError
 from . import kinds as K
 from .compiled import Compiled, compile_program
 from .interp import Fired, Printed, ProgramController, RunError
-from .keys import KeyScriptError, parse_key_script
+from .keys import KeyScriptError, parse_key_script, typed_events
 from .kinds import load_kind_map
 from .loader import load_program
 from .problems import Problem, ProgramError
@@ -38,6 +38,8 @@ class ProgramRunSpec:
     profile: str | None = None
     sensors: tuple[str, ...] = ()
     keys: str = ""
+    #: keys as a terminal types them (one key an item, repeats while held; see TypedKeys)
+    typed: str = ""
     kinds: str | None = None
     seed: int = 0
     noise: str | None = None
@@ -181,6 +183,9 @@ def prepare(spec: ProgramRunSpec) -> tuple[Session, ProgramController, float]:
         else:
             sensors = list(profile.sensors)
         keys = parse_key_script(spec.keys)
+        if spec.typed:
+            typed = typed_events(parse_key_script(spec.typed), until=float("inf"))
+            keys = tuple(sorted(keys + typed, key=lambda e: e.time))
         noise = noise_settings(
             spec.noise or profile.noise, profile, **parse_noise_params(spec.noise_params)
         )
@@ -196,7 +201,8 @@ def prepare(spec: ProgramRunSpec) -> tuple[Session, ProgramController, float]:
     session = Session(maze, profile.name, sensors, noise, spec.seed, spec.dt, recorder=recorder)
     controller = ProgramController(compiled, keys)
     binding = {f"port {s.port}": s.port for s in sensors}
-    session.attach(controller, binding, Driver.program(os.path.basename(spec.program)))
+    driver = Driver.program(os.path.basename(spec.program), compiled.program.digest)
+    session.attach(controller, binding, driver)
     max_time = spec.max_time or default_max_time(maze, profile, session.world.cell)
     return session, controller, max_time
 

@@ -26,7 +26,7 @@ from . import kinds as K
 from .code import first_sensor_value
 from .compiled import DEFAULTS, Compiled
 from .expr import ExprError, Scope, Value, show, type_name
-from .keys import KeyEvent
+from .keys import KeyEvent, TypedKeys
 from .model import ELSE
 
 SLICE = 50
@@ -36,6 +36,9 @@ MAX_FLOWS = 2_000
 MAX_CALL_DEPTH = 64
 MAX_PRINTED = 5_000
 MAX_ERRORS = 100
+MAX_FIRED = 5_000
+#: the newest printed lines a live console keeps (the list of all stops at MAX_PRINTED)
+RECENT_PRINTED = 200
 #: activities that pass the message straight on when one arrives
 _PASS_ON = frozenset(
     (
@@ -90,6 +93,8 @@ class Frame:
     block: int | None = None
     parent: Frame | None = None
     depth: int = 0
+    #: this call's Joins: Join id -> one queue per input (gone with the call)
+    joins: dict[int, list[deque[Value]]] = field(default_factory=dict)
 
 
 @dataclass
@@ -129,7 +134,11 @@ class ProgramController:
         }
         self.printed: list[Printed] = []
         self.printed_dropped = 0
+        #: every line printed so far, counted, and the newest of them
+        self.printed_total = 0
+        self.recent: deque[Printed] = deque(maxlen=RECENT_PRINTED)
         self.fired: list[Fired] = []
+        self.fired_dropped = 0
         self.errors: list[RunError] = []
         self.commands: list[Any] = []
         self.changes = 0
@@ -138,9 +147,12 @@ class ProgramController:
         self._ready: deque[Flow] = deque()
         self._parked: list[Flow] = []
         self._sleeping: list[tuple[float, int, Flow]] = []
-        self._joins: dict[tuple[int, int], list[deque[Value]]] = {}
+        #: the Joins of Main and of events inside panels (a block call keeps its own)
+        self._joins: dict[int, list[deque[Value]]] = {}
         self._held: set[str] = set()
         self._next_key = 0
+        self._typed = TypedKeys()
+        self._pushed: list[KeyEvent] = []
         self._touch: dict[int, int] = {}
         self.flows_dropped = 0
         self.steps = 0
@@ -168,25 +180,45 @@ class ProgramController:
         self._ready.extend(self._parked)
         self._parked = []
         self._keys(t)
-        self._sensors({int(name.split()[-1]): v for name, v in readings.items()})
+        if readings:  # a tick between two reports of a remote robot fires no sensor
+            self._sensors({int(name.split()[-1]): v for name, v in readings.items()})
         return self._run()
 
     # -- events --------------------------------------------------------------------------
+    def type_key(self, key: str, t: float) -> None:
+        """A key typed on a terminal at ``t`` (it fires at the next tick); the release comes by
+        :class:`TypedKeys`'s rule."""
+        self._pushed += self._typed.press(key.lower(), t)
+
+    @property
+    def held(self) -> frozenset[str]:
+        """The keys the program sees held now."""
+        return frozenset(self._held)
+
     def _keys(self, t: float) -> None:
         script = self.key_script
         while self._next_key < len(script) and script[self._next_key].time <= t + 1e-9:
-            event = script[self._next_key]
             self._next_key += 1
-            if event.release:
-                self._held.clear()
-                for act in self._sources(K.KEY_RELEASE):
-                    self._fire(act.id, "", "key release")
-                continue
-            self._held |= event.keys
-            for act in self._sources(K.KEY_PRESS):
-                wanted = self.compiled.key_sets.get(act.id, frozenset())
-                if wanted and wanted <= self._held and wanted & event.keys:
-                    self._fire(act.id, "+".join(sorted(wanted)), f"key {'+'.join(sorted(wanted))}")
+            self._key_event(script[self._next_key - 1])
+        release = self._typed.due(t)
+        if release is not None:
+            self._pushed.append(release)
+        pushed, self._pushed = self._pushed, []
+        for event in pushed:
+            self._key_event(event)
+
+    def _key_event(self, event: KeyEvent) -> None:
+        """One press or release, from a key script or typed: the one way keys reach events."""
+        if event.release:
+            self._held.clear()
+            for act in self._sources(K.KEY_RELEASE):
+                self._fire(act.id, "", "key release")
+            return
+        self._held |= event.keys
+        for act in self._sources(K.KEY_PRESS):
+            wanted = self.compiled.key_sets.get(act.id, frozenset())
+            if wanted and wanted <= self._held and wanted & event.keys:
+                self._fire(act.id, "+".join(sorted(wanted)), f"key {'+'.join(sorted(wanted))}")
 
     def _sensors(self, readings: dict[int, float]) -> None:
         raw = None
@@ -218,10 +250,16 @@ class ProgramController:
     def _sources(self, kind: int):
         return [a for a in self.program.activities.values() if a.kind == kind]
 
+    def _fired(self, aid: int, what: str) -> None:
+        if len(self.fired) < MAX_FIRED:
+            self.fired.append(Fired(self.now, aid, what))
+        else:
+            self.fired_dropped += 1
+
     def _fire(self, aid: int, value: Value, what: str | None = None) -> None:
         act = self.program.activities[aid]
         if what is not None:
-            self.fired.append(Fired(self.now, aid, what))
+            self._fired(aid, what)
         frame = Frame(act.panel, self._instance_defaults(act.panel))
         for link in self.program.targets(aid):
             self._spawn(link.target, value, frame, link.in_pin)
@@ -230,6 +268,19 @@ class ProgramController:
         if panel == "Main":
             return {}
         return {v.name.lower(): DEFAULTS.get(v.type) for v in self.program.panels[panel].inputs}
+
+    # -- what runs now (for a live panel) -----------------------------------------------------
+    def running(self, limit: int = 20) -> list[tuple[str, str, str]]:
+        """The live flows' current activities, oldest flow first: (panel, activity, what it
+        does: ``ready``, ``waiting`` for the next tick, or ``sleeping``)."""
+        flows = [(f, "ready") for f in self._ready] + [(f, "waiting") for f in self._parked]
+        flows += [(f, "sleeping") for _, _, f in self._sleeping]
+        flows.sort(key=lambda item: item[0].number)
+        out = []
+        for flow, what in flows[:limit]:
+            act = self.program.activities[flow.activity]
+            out.append((act.panel, self.program.label(act), what))
+        return out
 
     # -- scheduling ----------------------------------------------------------------------
     def _spawn(self, aid: int, value: Value, frame: Frame, in_pin: int = 0) -> None:
@@ -376,7 +427,7 @@ class ProgramController:
         if kind == K.EVENT_PIN:
             for aid, block in compiled.event_blocks.items():
                 if block == flow.frame.panel:
-                    self.fired.append(Fired(self.now, aid, f"custom event {block}"))
+                    self._fired(aid, f"custom event {block}")
                     for link in self.program.targets(aid):
                         self._spawn(link.target, value, Frame("Main", {}), link.in_pin)
             return False
@@ -426,9 +477,10 @@ class ProgramController:
     def _join(self, flow: Flow, act) -> bool:
         inputs = self.program.inputs.get(act.id, ())
         count = max(len(act.values), max((lk.in_pin for lk in inputs), default=0) + 1)
-        # one Join per running block call; events at panel level share the panel's Join
-        owner = id(flow.frame) if flow.frame.block is not None else None
-        queues = self._joins.setdefault((act.id, owner), [deque() for _ in range(count)])
+        # one Join per running block call, kept by the call so it goes with it; events at
+        # panel level share the panel's Join
+        joins = flow.frame.joins if flow.frame.block is not None else self._joins
+        queues = joins.setdefault(act.id, [deque() for _ in range(count)])
         if len(queues[flow.in_pin]) >= 1_000:
             raise ValueError("more than 1,000 messages wait at one Join input")
         queues[flow.in_pin].append(flow.value)
@@ -445,8 +497,11 @@ class ProgramController:
 
     def _print(self, text: str) -> None:
         self.changes += 1
+        line = Printed(self.now, text[:1000])
+        self.printed_total += 1
+        self.recent.append(line)
         if len(self.printed) < MAX_PRINTED:
-            self.printed.append(Printed(self.now, text[:1000]))
+            self.printed.append(line)
         else:
             self.printed_dropped += 1
 

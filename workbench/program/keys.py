@@ -6,8 +6,13 @@ A Key Press Event stores an index into VIPLE's key list: ``a``..``z`` are 0..25,
 
 A key script says what a student would press and when, in simulated seconds:
 ``"w@0.5 release@3.0 a+d@4.2"``. Pressing a key holds it down with any key already held;
-``release`` lets go of every key, which is when VIPLE's Key Release Event fires (a terminal
-sends no key-up, so in a script and in the app a release is always explicit).
+``release`` lets go of every key, which is when VIPLE's Key Release Event fires.
+
+A terminal sends no key-up: a key held down arrives as the same key again and again (the
+keyboard's auto-repeat). :class:`TypedKeys` turns such presses into presses and releases by
+one rule, the same in the app and in a headless run's ``--typed`` script: a key counts as held
+while it keeps arriving; the keyboard is released when no key has come for :data:`RELEASE_GAP`
+seconds of simulated time, or when a different key arrives (released first, then pressed).
 """
 
 from __future__ import annotations
@@ -22,6 +27,9 @@ KEY_NAMES.update({36: "up", 37: "left", 38: "right", 39: "down", 59: "space"})
 KEY_NUMBERS = {name: number for number, name in KEY_NAMES.items()}
 MAX_KEY_EVENTS = 10_000
 RELEASE = "release"
+#: simulated seconds without a key after which a typed key counts as released: longer than a
+#: keyboard's delay before auto-repeat starts (0.25 to 0.66 s), so a held key stays held
+RELEASE_GAP = 0.75
 
 
 class KeyScriptError(ValueError):
@@ -67,3 +75,50 @@ def parse_key_script(text: str) -> tuple[KeyEvent, ...]:
                 )
         events.append(KeyEvent(time, frozenset(names)))
     return tuple(sorted(events, key=lambda e: e.time))
+
+
+class TypedKeys:
+    """Key presses from a terminal (no key-up) as the presses and releases a program sees."""
+
+    def __init__(self, gap: float = RELEASE_GAP) -> None:
+        self.gap = gap
+        self.held: frozenset[str] = frozenset()
+        self._last = 0.0
+
+    def press(self, key: str, t: float) -> list[KeyEvent]:
+        """``key`` arrived at ``t``: the events it makes (none for a repeat of the held key)."""
+        events = [e for e in (self.due(t),) if e is not None]
+        if key in self.held:
+            self._last = t
+            return events
+        if self.held:
+            events.append(KeyEvent(t, frozenset()))
+        self.held = frozenset((key,))
+        self._last = t
+        events.append(KeyEvent(t, self.held))
+        return events
+
+    def due(self, t: float) -> KeyEvent | None:
+        """The release the quiet gap makes by ``t`` (None while a key is still held)."""
+        if not self.held or t < self._last + self.gap - 1e-9:
+            return None
+        self.held = frozenset()
+        return KeyEvent(self._last + self.gap, frozenset())
+
+
+def typed_events(script: tuple[KeyEvent, ...], until: float) -> tuple[KeyEvent, ...]:
+    """A script of typed keys (``w@0.5 w@0.55 d@2``, one key an item, no releases) as the
+    presses and releases :class:`TypedKeys` makes of it by ``until``."""
+    typed = TypedKeys()
+    out: list[KeyEvent] = []
+    for event in script:
+        if event.release or len(event.keys) != 1:
+            raise KeyScriptError(
+                f"typed keys at {event.time:g} s: type one key an item (releases come by "
+                f"themselves after {RELEASE_GAP:g} s without a key)"
+            )
+        out += typed.press(next(iter(event.keys)), event.time)
+    last = typed.due(until)
+    if last is not None:
+        out.append(last)
+    return tuple(out)

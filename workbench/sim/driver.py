@@ -19,12 +19,15 @@ class Driver:
     ``name`` is the algorithm's name (``algorithm``) or what a program calls itself
     (``program``: a script or front end driving the session through its own API); ``role``
     (``tcp`` / ``ws``) and ``peer`` (where it connected from) belong to a VIPLE program.
+    ``digest`` (sha256 of the file's bytes) marks a ``program`` that is a VIPLE program file
+    the workbench runs itself.
     """
 
     kind: DriverKind
     name: str = ""
     role: str = ""
     peer: str = ""
+    digest: str = ""
 
     def __post_init__(self) -> None:
         if self.kind not in KINDS:
@@ -39,8 +42,8 @@ class Driver:
         return cls("viple", role=role, peer=peer)
 
     @classmethod
-    def program(cls, name: str) -> Driver:
-        return cls("program", name=name)
+    def program(cls, name: str, digest: str = "") -> Driver:
+        return cls("program", name=name, digest=digest)
 
     @property
     def is_viple(self) -> bool:
@@ -57,13 +60,15 @@ class Driver:
         if self.kind == "viple":
             return " ".join(part for part in ("VIPLE", self.role, self.peer) if part)
         if self.kind == "program":
+            if self.digest:
+                return f"VIPLE program {self.name}"
             return self.name or "program"
         return self.kind
 
     def as_json(self) -> dict[str, str]:
         """The driver as a run record's header holds it (only the fields that are set)."""
         out = {"kind": self.kind}
-        for key in ("name", "role", "peer"):
+        for key in ("name", "role", "peer", "digest"):
             value = getattr(self, key)
             if value:
                 out[key] = value
@@ -74,7 +79,7 @@ class Driver:
         """A driver read back from :meth:`as_json`; None when ``obj`` is not one."""
         if not isinstance(obj, dict) or obj.get("kind") not in KINDS:
             return None
-        fields = {key: obj.get(key, "") for key in ("name", "role", "peer")}
+        fields = {key: obj.get(key, "") for key in ("name", "role", "peer", "digest")}
         if not all(isinstance(value, str) for value in fields.values()):
             return None
         return cls(obj["kind"], **fields)

@@ -21,6 +21,7 @@ class Key:
 
     #: the key names, comma-separated, as Textual writes them
     keys: str
+    #: the action; ``{key}`` in it makes one binding per key, each naming its key
     action: str
     #: the footer's word for it
     label: str
@@ -166,7 +167,8 @@ KEYS: dict[str, Key] = {
         "Algorithm",
         "Set-up",
         "algorithm",
-        "Choose a built-in algorithm or load a YAML FSM file; edit its parameters.",
+        "Choose a built-in algorithm or load a YAML FSM file or a VIPLE program "
+        "(.viple, .xml); edit its parameters.",
     ),
     "algorithm.run": Key(
         "x",
@@ -174,7 +176,20 @@ KEYS: dict[str, Key] = {
         "Run",
         "Algorithm",
         "start / stop algorithm",
-        "Start the chosen algorithm from the start block (a new run), or stop it.",
+        "Start the chosen algorithm or VIPLE program from the start block (a new run), or stop it.",
+    ),
+    "program.keys": Key(
+        "up,down,left,right",
+        "program_key('{key}')",
+        "Keys to the program",
+        "Algorithm",
+        "keys to a program",
+        "While a VIPLE program drives, w a s d, the arrows, the digits and letters the screen "
+        "does not use go to its Key Press events; a key counts as released 0.75 s after it "
+        "stops repeating, or when another key comes. Space stops the program.",
+        show=False,
+        priority=True,
+        display="arrows",
     ),
     "algorithm.fix": Key(
         "f",
@@ -472,15 +487,17 @@ def bindings(*ids: str) -> list[Binding]:
     made = []
     for key_id in ids:
         key = KEYS[key_id]
-        made.append(
-            Binding(
-                key.keys,
-                key.action,
-                key.label,
-                show=key.show,
-                key_display=key.display,
-                priority=key.priority,
-                id=key_id,
+        each = key.keys.split(",") if "{key}" in key.action else [key.keys]
+        for name in each:
+            made.append(
+                Binding(
+                    name,
+                    key.action.replace("{key}", name),
+                    key.label,
+                    show=key.show,
+                    key_display=key.display,
+                    priority=key.priority,
+                    id=key_id,
+                )
             )
-        )
     return made

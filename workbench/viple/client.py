@@ -134,18 +134,46 @@ def _endpoint(role: str, option: str, text: str, scheme: str) -> Endpoint:
     return Endpoint(role, parts.hostname, port or DEFAULT_PORTS[scheme])
 
 
+class Brain(Protocol):
+    """What drives from the VIPLE side: an FSM (:class:`RemoteFsm`) or a VIPLE program."""
+
+    readings: Mapping[Any, float] | None
+    transitions: int
+
+    @property
+    def state(self) -> str | None: ...
+
+    def start(self, t: float) -> Step: ...
+
+    def report(self, t: float, readings: Mapping[int, float]) -> Step: ...
+
+    def next_tick(self) -> float: ...
+
+    def tick(self, t: float) -> Step: ...
+
+
 @dataclass(frozen=True)
 class ClientSetup:
-    definition: FsmDefinition
+    definition: FsmDefinition | None
     profile: Profile
     params: dict[str, float]
     sensors: tuple[SensorSpec, ...]
     binding: dict[str, int]
     endpoint: Endpoint
     duration: float | None = None
+    #: another brain than the FSM (a VIPLE program), its name, and its own wheel ports
+    brain: Callable[[], Brain] | None = None
+    title: str = ""
+    ports: WheelPorts | None = None
+
+    @property
+    def name(self) -> str:
+        return self.title or (self.definition.name if self.definition else "")
 
     @property
     def wheels(self) -> WheelPorts:
+        if self.ports is not None:
+            return self.ports
         return WheelPorts(self.profile.left_port, self.profile.right_port)
 
 
@@ -214,6 +242,7 @@ class RemoteFsm:
     """The FSM as a VIPLE program runs it: readings by port in, commands out, turn by timer."""
 
     def __init__(self, setup: ClientSetup) -> None:
+        assert setup.definition is not None
         self.setup = setup
         self.controller = FsmController(setup.definition, setup.params, setup.profile.name)
         self.readings: dict[str, float] | None = None
@@ -401,9 +430,7 @@ class VipleClient:
         self.log = log
         self.on_step = on_step or (lambda step, state: None)
         self.inbox: asyncio.Queue[object] = asyncio.Queue()
-        self.result = ClientResult(
-            str(setup.endpoint), setup.definition.name, setup.profile.name, "", EXIT_OK
-        )
+        self.result = ClientResult(str(setup.endpoint), setup.name, setup.profile.name, "", EXIT_OK)
         self._busy = False
         self._released = asyncio.Event()
         self._t0 = 0.0
@@ -509,7 +536,7 @@ class VipleClient:
 
     async def _drive(self, channel: Channel) -> None:
         self._t0 = time.monotonic()
-        fsm = RemoteFsm(self.setup)
+        fsm: Brain = self.setup.brain() if self.setup.brain else RemoteFsm(self.setup)
         pump = asyncio.create_task(self._pump(channel))
         try:
             await self._send(channel, self._shown(fsm.start(0.0), fsm))
@@ -523,9 +550,9 @@ class VipleClient:
             self.result.time = self._now()
             self.result.final_state = fsm.state
             self.result.transitions = fsm.transitions
-            self.result.readings = dict(fsm.readings or {})
+            self.result.readings = {str(k): v for k, v in (fsm.readings or {}).items()}
 
-    async def _loop(self, channel: Channel, fsm: RemoteFsm) -> None:
+    async def _loop(self, channel: Channel, fsm: Brain) -> None:
         end = self.setup.duration
         while True:
             now = self._now()
@@ -550,7 +577,7 @@ class VipleClient:
                 self._closed()
                 return
 
-    async def _reports(self, channel: Channel, fsm: RemoteFsm, item: _Received) -> None:
+    async def _reports(self, channel: Channel, fsm: Brain, item: _Received) -> None:
         for reason in item.problems:
             self._reject(reason)
         for line in item.lines:
@@ -586,7 +613,7 @@ class VipleClient:
     async def _stop_robot(self, channel: Channel) -> None:
         await self._send(channel, [Stop()])
 
-    def _shown(self, step: Step, fsm: RemoteFsm) -> list[Command]:
+    def _shown(self, step: Step, fsm: Brain) -> list[Command]:
         """Report a start or a state change to ``on_step``; the step's commands."""
         if step.transition is not None or step.started:
             self.on_step(step, fsm.state)

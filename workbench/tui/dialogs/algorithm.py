@@ -1,8 +1,10 @@
-"""The algorithm selector: pick a built-in or load a YAML FSM file, read what it does and what
-it needs, tune its parameters, and start, pause, step or reset it.
+"""The algorithm selector: pick a built-in or load a YAML FSM file or a VIPLE program, read what
+it does and what it needs, tune its parameters, and start, pause, step or reset it.
 
-A file with problems is reported as ``file:line:column: message``. A missing sensor is
-explained, with a one-key fix: ``f`` gives the robot the sensors the algorithm reads.
+An FSM file with problems is reported as ``file:line:column: message``; a VIPLE program's
+problems are listed all at once, as the loader words them, in the scrolling details. A missing
+sensor is explained, with a one-key fix for algorithms: ``f`` gives the robot the sensors the
+algorithm reads.
 """
 
 from __future__ import annotations
@@ -23,6 +25,8 @@ from workbench.control.fsm import FsmError, resolve_params
 from workbench.control.fsmfile import FsmFileError
 from workbench.control.station import LabStation
 from workbench.files.workspace import OutsideWorkspace
+from workbench.program.choice import choose_program, is_program_path
+from workbench.program.problems import ProgramError
 from workbench.sim.session import Snapshot
 
 from ..host import Say, ShowsSnapshot, StationChanged
@@ -96,6 +100,9 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
     AlgorithmModal #alg-missing {
         color: $text-warning;
     }
+    AlgorithmModal #alg-problems {
+        color: $text-error;
+    }
     AlgorithmModal #alg-params {
         height: auto;
         margin-bottom: 1;
@@ -147,13 +154,14 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
                 with Vertical(id="alg-choose"):
                     yield Label("Built-in", classes="heading")
                     yield OptionList(*[Option(n, id=n) for n in names], id="alg-builtins")
-                    yield Label("FSM file (YAML)", classes="heading")
+                    yield Label("File: FSM or VIPLE", classes="heading")
                     files = self.station.files
-                    example = "~/my-fsm.yaml" if files.confined else "path/to/fsm.yaml"
+                    example = "~/my.yaml or ~/my.viple" if files.confined else "fsm.yaml, x.viple"
                     yield Field(placeholder=example, compact=True, id="alg-path")
                     yield Button("Load file", compact=True, id="alg-load")
                 with VerticalScroll(id="alg-details"):
                     yield Static(id="alg-title", markup=False)
+                    yield Static(id="alg-problems", markup=False)
                     yield Static(id="alg-missing", markup=False)
                     yield Static(id="alg-sensors", markup=False)
                     with Horizontal(id="alg-params-head"):
@@ -176,7 +184,10 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
         options = self.query_one("#alg-builtins", OptionList)
         current = self.station.algorithm
         names = list_algorithms()
-        if current is not None and _source(current.source) == "built-in":
+        if self.station.program is not None:
+            self.query_one("#alg-path", Input).value = self.station.program.source
+            options.highlighted = 0
+        elif current is not None and _source(current.source) == "built-in":
             options.highlighted = names.index(current.name)
         elif current is not None and current.source:
             self.query_one("#alg-path", Input).value = self.station.files.shown(current.source)
@@ -194,7 +205,11 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
         params = self.query_one("#alg-params", Vertical)
         await params.remove_children()
         title = self.query_one("#alg-title", Static)
+        self.query_one("#alg-problems", Static).display = False
         self.query_one("#alg-params-head").display = definition is not None
+        if station.program is not None:
+            self._show_program()
+            return
         if definition is None:
             title.update("No algorithm chosen: pick a built-in on the left, or load a YAML file.")
             for name in ("#alg-description", "#alg-sensors", "#alg-missing"):
@@ -224,6 +239,45 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
         if not definition.parameters:
             await params.mount(Label("none", markup=False))
 
+    def _show_program(self) -> None:
+        station = self.station
+        choice = station.program
+        assert choice is not None
+        self.query_one("#alg-params-head").display = False
+        self.query_one("#alg-title", Static).update(f"{choice.name}  (VIPLE program)")
+        sensors = self.query_one("#alg-sensors", Static)
+        sensors.update("\n".join(choice.summary))
+        sensors.display = True
+        description = self.query_one("#alg-description", Static)
+        description.update(
+            "Start (or x) runs it from the start block. While it drives, w a s d, the arrows "
+            "and the digits go to its Key Press events, and a key counts as released 0.75 s "
+            "after it stops repeating. Space stops it."
+        )
+        description.display = True
+        missing = choice.needs(station.sensors)
+        widget = self.query_one("#alg-missing", Static)
+        if missing:
+            widget.update(f"{missing}\n\nSet the sensor ports (o) to the ones it reads.")
+        widget.display = bool(missing)
+        self.query_one("#alg-fix", Button).disabled = True
+
+    async def _show_problems(self, path: str, problems: list[str]) -> None:
+        """A program that did not load: every problem, in the scrolling details."""
+        await self._show_definition()
+        count = len(problems)
+        self.query_one("#alg-title", Static).update(
+            f"{path}: {count} problem{'s' if count != 1 else ''}; the program was not loaded"
+        )
+        widget = self.query_one("#alg-problems", Static)
+        widget.update("\n".join(problems))
+        widget.display = True
+        for name in ("#alg-description", "#alg-sensors", "#alg-missing"):
+            self.query_one(name, Static).display = False
+        self.query_one("#alg-params-head").display = False
+        await self.query_one("#alg-params", Vertical).remove_children()
+        self.query_one("#alg-details", VerticalScroll).scroll_home(animate=False)
+
     def _show_missing(self) -> None:
         missing = self.station.missing_sensors()
         widget = self.query_one("#alg-missing", Static)
@@ -243,6 +297,8 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
         paused = " (paused)" if station.paused else ""
         if station.controller is not None:
             text = f"running, in {station.controller.state}{paused}"
+        elif station.program_run is not None:
+            text = f"program running, {station.program_run.state}{paused}"
         else:
             text = f"driver: {snapshot.driver}{paused}"
         self.query_one("#alg-live", Label).update(text)
@@ -258,6 +314,8 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
     # -- choosing ---------------------------------------------------------------------------------
     async def choose(self, name_or_path: str | Path) -> bool:
         """Select an algorithm on the station; a bad file's problems are shown, not raised."""
+        if is_program_path(str(name_or_path)):
+            return await self.choose_program(str(name_or_path))
         try:
             definition = self.station.select_algorithm(name_or_path)
         except FsmFileError as exc:
@@ -272,6 +330,23 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
         self.post_message(Say(f"chose {definition.name}: Start (or x) runs it"))
         return True
 
+    async def choose_program(self, path: str) -> bool:
+        """Load a VIPLE program to drive; a bad one's problems are all shown, not raised."""
+        try:
+            choice = choose_program(self.station, path)
+        except ProgramError as exc:
+            await self._show_problems(path, [str(p) for p in exc.problems])
+            self._error("fix these in VIPLE (or the file) and load it again")
+            return False
+        except (OSError, OutsideWorkspace) as exc:
+            self._error(str(exc))
+            return False
+        self._error("")
+        await self._show_definition()
+        self._refresh_all()
+        self.post_message(Say(f"chose the program {choice.name}: Start (or x) runs it"))
+        return True
+
     @on(OptionList.OptionSelected, "#alg-builtins")
     async def _builtin_selected(self, event: OptionList.OptionSelected) -> None:
         assert event.option.id is not None
@@ -282,7 +357,7 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
     async def _load_file(self) -> None:
         text = self.query_one("#alg-path", Input).value.strip()
         if not text:
-            self._error("type the path of a YAML FSM file first")
+            self._error("type the path of a YAML FSM file or a VIPLE program first")
             return
         await self.choose(text)
 
@@ -298,6 +373,15 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
     # -- actions ----------------------------------------------------------------------------------
     def action_start(self) -> None:
         station = self.station
+        if station.program is not None:
+            try:
+                station.start_program()
+            except ValueError as exc:
+                self._error(f"cannot start: {exc.args[0].splitlines()[0]}")
+                return
+            self._refresh_all()
+            self.dismiss()
+            return
         if station.algorithm is None:
             self._error("pick an algorithm first")
             return

@@ -37,10 +37,12 @@ def help_text(
         drive.add_row(key, text)
     sections.append((f"Drive ({profile} key program)", drive))
     tables: dict[str, Table] = {}
-    for _screen, screen_bindings in screens:
+    shown: set[tuple[str, str]] = set()
+    for screen, screen_bindings in screens:
         for binding in screen_bindings:
-            if not binding.id:
-                continue
+            if not binding.id or (screen, binding.id) in shown:
+                continue  # the keys of one command (the arrows) are explained once
+            shown.add((screen, binding.id))
             info = KEYS[binding.id]
             if info.group == "Drive":
                 continue

@@ -11,6 +11,7 @@ from pathlib import Path
 from time import monotonic
 from typing import ClassVar
 
+from textual import events
 from textual.app import ComposeResult
 from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical
@@ -42,6 +43,7 @@ from ..widgets.algorithm_state import AlgorithmState
 from ..widgets.key_legend import KeyLegend
 from ..widgets.maze_view import MazeView
 from ..widgets.message_bar import MessageBar
+from ..widgets.program_state import ProgramState
 from ..widgets.run_status import RunStatus
 from ..widgets.sensor_readings import SensorReadings
 
@@ -77,8 +79,11 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, Screen[None]):
             "screen.runs",
             "screen.labs",
             "viple.ws",
+            "program.keys",
         )
     ]
+    #: keys a running VIPLE program may have besides the drive keys and the arrows
+    PROGRAM_KEYS = frozenset("bchijkqyz0123456789")
 
     #: the last snapshot drawn (per-tick state: never repaints by itself)
     snapshot: var[Snapshot | None] = var(None)
@@ -119,6 +124,7 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, Screen[None]):
         self._legend = KeyLegend(station.profile, id="legend")
         self._readings = SensorReadings(id="readings")
         self._algorithm = AlgorithmState(id="algorithm")
+        self._program = ProgramState(id="program")
         self._message = MessageBar(self.who, id="message")
         with Horizontal(id="body"):
             with Vertical(id="stage"):
@@ -128,6 +134,7 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, Screen[None]):
                 yield self._legend
                 yield self._readings
                 yield self._algorithm
+                yield self._program
         yield self._message
         yield Footer(compact=True, show_command_palette=False)
 
@@ -167,13 +174,26 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, Screen[None]):
             self._notice = station.notice
             if station.notice is not None:
                 self._said = worded(station.notice)
-        moment = (station.paused, self._said, snapshot.driver, snapshot.state, self._connection)
+        moment = (
+            station.paused,
+            self._said,
+            snapshot.driver,
+            snapshot.state,
+            self._connection,
+            station.program,
+        )
         if station.paused or moment != self._moment or now - self._panels_at >= 1 / PANEL_HZ:
             self._moment = moment
             self._panels_at = now
             self._readings.show(snapshot, station.profile)
             self._run_status.show(snapshot, station, unicode, self._connection)
-            self._algorithm.show(station, unicode)
+            program = station.program is not None
+            self._algorithm.display = not program
+            self._program.display = program
+            if program:
+                self._program.show(station)
+            else:
+                self._algorithm.show(station, unicode)
             self._message.message = self._said
 
     def refresh_views(self) -> None:
@@ -201,9 +221,33 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, Screen[None]):
     # -- actions -------------------------------------------------------------------------------
     def action_drive(self, key: str) -> None:
         station = self.station
+        program = station.program_run is not None
         self._said = ""
         station.key(key)
+        if program and station.program_run is None:
+            self._said = "program stopped: the keys drive"
         self.refresh_views()
+
+    def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None:
+        if action == "program_key":
+            return self.station.program_run is not None
+        return True
+
+    def action_program_key(self, key: str) -> None:
+        """An arrow while a program drives."""
+        self.station.key(key)
+        self.refresh_views()
+
+    def on_key(self, event: events.Key) -> None:
+        """Arrows, digits and the free letters reach a running program."""
+        key = event.key
+        if self.station.program_run is None:
+            return
+        if key in self.PROGRAM_KEYS:
+            event.stop()
+            event.prevent_default()
+            self.station.key(key)
+            self.refresh_views()
 
     def action_pause(self) -> None:
         paused = self.station.toggle_pause()
@@ -239,6 +283,18 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, Screen[None]):
         if station.controller is not None:
             station.stop_algorithm("stopped")
             self.say("algorithm stopped: the keys drive")
+            return
+        if station.program_run is not None:
+            station.stop_program("stopped")
+            self.say("program stopped: the keys drive")
+            return
+        if station.program is not None:
+            try:
+                station.start_program()
+            except ValueError as exc:
+                self.say(f"cannot start: {exc.args[0].splitlines()[0]} (o sets the ports)")
+                return
+            self.refresh_views()
             return
         if station.algorithm is None:
             self.action_algorithm()

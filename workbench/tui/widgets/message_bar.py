@@ -7,7 +7,7 @@ from textual.widgets import Static
 
 
 class MessageBar(Static):
-    """The station message on the left; the user and role on the right."""
+    """The workbench's message on the left; the user and role on the right."""
 
     DEFAULT_CSS = """
     MessageBar {

@@ -1,0 +1,99 @@
+"""A program file chosen to drive the lab station's robot, as the app loads it.
+
+:func:`choose_program` reads the file through the station's file rules (a served student
+reaches only their workspace), loads, checks and compiles it, and hands the station a
+:class:`~workbench.control.station.ProgramChoice`: a maker of fresh controllers, the check of
+the robot's sensors, and the lines that describe the program.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Sequence
+from dataclasses import replace
+
+from workbench.control.station import LabStation, ProgramChoice
+from workbench.sim.sensors import SensorSpec
+
+from . import kinds as K
+from .compiled import Compiled
+from .headless import check_sensors, load_compiled
+from .interp import ProgramController
+from .problems import ProgramError
+
+#: the file endings the app takes for a VIPLE program (VIPLE 4.x, and 3.x XML)
+PROGRAM_SUFFIXES = (".viple", ".xml")
+
+_SENSOR_WORDS = {
+    K.TOUCH: "touch",
+    K.DISTANCE: "distance",
+    K.OTHER_SENSOR: "sensor",
+    K.RAW_SENSOR: "every sensor (raw report)",
+}
+
+
+def is_program_path(text: str) -> bool:
+    return text.strip().lower().endswith(PROGRAM_SUFFIXES)
+
+
+def choose_program(station: LabStation, path: str) -> ProgramChoice:
+    """Load the program at ``path`` (as the student typed it) and choose it on the station.
+
+    A program with problems raises :class:`ProgramError` naming the file as the student
+    typed it; a file outside the workspace raises ``OutsideWorkspace``.
+    """
+    files = station.files
+    real = files.for_reading(path)
+    shown = files.shown(real)
+    try:
+        compiled = load_compiled(str(real))
+    except ProgramError as exc:
+        raise ProgramError([replace(p, source=shown) for p in exc.problems]) from None
+    choice = program_choice(compiled, shown)
+    station.use_program(choice)
+    return choice
+
+
+def program_choice(compiled: Compiled, shown: str) -> ProgramChoice:
+    program = compiled.program
+
+    def needs(sensors: Sequence[SensorSpec]) -> str | None:
+        problems = check_sensors(compiled, list(sensors))
+        if not problems:
+            return None
+        return "\n".join(str(replace(p, source=shown)) for p in problems)
+
+    return ProgramChoice(
+        name=os.path.basename(shown),
+        source=shown,
+        digest=program.digest,
+        make=lambda: ProgramController(compiled),
+        needs=needs,
+        summary=tuple(describe_choice(compiled)),
+    )
+
+
+def describe_choice(compiled: Compiled) -> list[str]:
+    """What the program is and what it answers, in a few short lines."""
+    program = compiled.program
+    acts = len(program.activities)
+    panels = len(program.panels)
+    lines = [
+        f"VIPLE {program.version}: {acts} activit{'y' if acts == 1 else 'ies'}, "
+        f"{panels} panel{'' if panels == 1 else 's'}",
+        f"sha256 {program.digest[:16]}...",
+    ]
+    keys = sorted({"+".join(sorted(k)) for k in compiled.key_sets.values() if k})
+    releases = any(a.kind == K.KEY_RELEASE for a in program.activities.values())
+    if keys or releases:
+        lines.append("keys it answers: " + ", ".join(keys + (["release"] if releases else [])))
+    sensors = sorted(set(compiled.sensors.values()), key=lambda kp: (kp[1], kp[0]))
+    if sensors:
+        lines.append("sensors it reads:")
+        lines += [
+            f"  {_SENSOR_WORDS[kind]}" + (f" on port {port}" if port >= 0 else "")
+            for kind, port in sensors
+        ]
+    else:
+        lines.append("sensors it reads: none")
+    return lines
