@@ -399,3 +399,24 @@ def test_a_failing_algorithm_stops_with_its_reason_on_the_message_line(tmp_path)
         assert message.startswith("algorithm stopped: failing, state Go")
 
     run(app, body)
+
+
+def test_the_message_line_follows_what_the_student_does(tmp_path):
+    app = unity_app()
+    station = app.station
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.press("g")
+        assert isinstance(app.screen, AlgorithmModal)
+        await pilot.press("enter")  # the first built-in: right-wall
+        await pilot.pause()
+        assert said(app) == "chose right-wall: Start (or x) runs it"
+        await pilot.press("escape", "x")
+        await pilot.pause()
+        assert station.controller is not None and said(app) == ""
+        await pilot.press("x")
+        assert said(app) == "algorithm stopped: the keys drive"
+        await pilot.press("r")
+        assert said(app) == ""
+
+    run(app, body)

@@ -379,6 +379,7 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
             except ValueError as exc:
                 self._error(f"cannot start: {exc.args[0].splitlines()[0]}")
                 return
+            self.post_message(Say(""))
             self._refresh_all()
             self.dismiss()
             return
@@ -397,6 +398,7 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
         except (FsmError, ValueError) as exc:
             self._error(f"cannot start: {exc}")
             return
+        self.post_message(Say(""))
         self._refresh_all()
         self.dismiss()
 
@@ -412,6 +414,7 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
 
     def action_reset(self) -> None:
         self.station.reset_robot()
+        self.post_message(Say(""))
         self._refresh_all()
 
     def action_fix_sensors(self) -> None:

@@ -266,7 +266,7 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, Screen[None]):
     def action_reset(self) -> None:
         self.station.reset_robot()
         self._maze_view.clear_trail()
-        self.refresh_views()
+        self.say("")
 
     def action_sensors(self) -> None:
         from ..dialogs.sensor_ports import SensorPortsModal
@@ -294,7 +294,7 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, Screen[None]):
             except ValueError as exc:
                 self.say(f"cannot start: {exc.args[0].splitlines()[0]} (o sets the ports)")
                 return
-            self.refresh_views()
+            self.say("")
             return
         if station.algorithm is None:
             self.action_algorithm()
@@ -308,7 +308,7 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, Screen[None]):
         except (FsmError, ValueError) as exc:
             self.say(f"cannot start: {exc}")
             return
-        self.refresh_views()
+        self.say("")
 
     def action_fix_sensors(self) -> None:
         station = self.station
