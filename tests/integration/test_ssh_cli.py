@@ -80,7 +80,7 @@ def test_serve_ssh_refuses_a_broken_users_file_naming_line_and_fix(tmp_path):
         "serve-ssh", "--users", str(users), "--data-dir", str(tmp_path / "d"), "--port", "0"
     )
     assert done.returncode == 2
-    assert f"{users}:3: users.ann.role: 'pupil' is not a role" in done.stderr
+    assert f"{users}:3:11: users.ann.role: unknown role 'pupil'" in done.stderr
     assert "(fix: write student or instructor)" in done.stderr
     assert "the server did not start" in done.stderr
 
