@@ -1,0 +1,31 @@
+"""The simulator teaches the course's lessons, not artefacts of its geometry (measured over
+seeds; `bench/fidelity.py` gives the full figures)."""
+
+import pytest
+
+from workbench.control.algorithms import load_algorithm
+from workbench.control.fsm import FsmController, bind_sensors, preset_sensors
+from workbench.sim.driver import Driver
+from workbench.sim.generate import generate
+from workbench.sim.session import Session
+
+
+def follow_right_wall(maze, profile, seed, max_time=1500.0):
+    definition = load_algorithm("right-wall")
+    sensors = preset_sensors(definition, profile)
+    session = Session(maze, profile, sensors, seed=seed)
+    session.attach(
+        FsmController(definition, None, profile),
+        bind_sensors(definition, sensors, profile),
+        Driver.algorithm("right-wall"),
+    )
+    return session.run(max_time)
+
+
+@pytest.mark.parametrize("hand", ["right", "left"])
+def test_wall_followers_get_out_of_every_generated_braid_maze(hand):
+    for seed in range(5):
+        maze = generate(8, 8, seed, "braid")
+        # a left-hand rule on a maze is the right-hand rule on its mirror image
+        metrics = follow_right_wall(maze if hand == "right" else maze.mirrored(), "unity", seed)
+        assert metrics.reached_exit, f"seed {seed}: {hand} wall following did not get out"
