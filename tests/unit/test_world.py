@@ -196,7 +196,7 @@ def test_distance_beyond_range_reports_no_echo():
     world = World(corridor(60), "unity", noise="off")  # 120 units of corridor, range 100
     readings = world.read_sensors()
     assert readings[2] == 1000  # front: Unity's "nothing hit"
-    assert readings[1] == pytest.approx(1.0 - 0.18)  # right: the corridor wall
+    assert readings[1] == pytest.approx(1.0 - 0.45)  # right: the corridor wall
 
 
 def test_touch_reads_one_against_a_wall_and_zero_away_from_it():
