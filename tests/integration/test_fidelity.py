@@ -1,9 +1,13 @@
 """The simulator teaches the course's lessons, not artefacts of its geometry (measured over
 seeds; `bench/fidelity.py` gives the full figures)."""
 
+import json
+
 import pytest
 
+from workbench.cli import main
 from workbench.control.algorithms import load_algorithm
+from workbench.control.evaluate import evaluate, format_table
 from workbench.control.fsm import FsmController, bind_sensors, preset_sensors
 from workbench.control.headless import RunSpec, run
 from workbench.sim.driver import Driver
@@ -55,3 +59,20 @@ def test_ranking_mazes_show_their_winner_under_their_own_profiles_default_noise(
             if theirs["reached_exit"]:
                 assert mine["distance_cells"] < theirs["distance_cells"], (seed, other)
                 assert mine["turn_degrees"] < theirs["turn_degrees"], (seed, other)
+
+
+def test_web_wall_following_touches_walls_on_purpose_without_colliding(capsys):
+    argv = ["run", "--maze", "mazes/web.txt", "--algorithm", "web-wall-following"]
+    assert main([*argv, "--profile", "web", "--noise", "off", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["reached_exit"] and out["collisions"] == 0 and out["touches"] >= 5
+    assert main([*argv, "--profile", "web", "--noise", "off"]) == 0
+    assert f"touches             {out['touches']} " in capsys.readouterr().out
+
+
+def test_eval_tables_carry_touches_beside_collisions():
+    result = evaluate(["mazes/web.txt"], ["web-wall-following"], seeds=1, profile="web", jobs=1)
+    cell = result.cell("mazes/web.txt", "web-wall-following")
+    assert cell.mean["collisions"] == 0 and cell.mean["touches"] >= 5
+    header = format_table(result).splitlines()[1]
+    assert header.split()[-2:] == ["collisions", "touches"]

@@ -11,7 +11,7 @@ from .text_lines import TextLines
 
 
 class RunStatus(TextLines):
-    """Who drives; pause, speed and time; distance; turning and collisions."""
+    """Who drives; pause, speed and time; distance; turning, collisions and touches."""
 
     DEFAULT_CSS = """
     RunStatus {
@@ -43,6 +43,11 @@ class RunStatus(TextLines):
             f"turned {degrees(m.turn_degrees, unicode)} in {m.turns} "
             f"turn{'' if m.turns == 1 else 's'}"
             f"{sep}collisions {m.collisions}"
+            f"{f' (+{m.touches} touch{_es(m.touches)})' if m.touches else ''}"
         )
         connection = (station.connection,) if station.connection else ()
         self.set_lines([driver, clock, travel, turning, *connection])
+
+
+def _es(count: int) -> str:
+    return "" if count == 1 else "es"
