@@ -194,19 +194,24 @@ def ranking_holds(winner: dict, others: list[dict]) -> bool:
 
 
 def touches(seeds: int) -> None:
-    print(f"4. web wall following on web.txt: collisions and touches ({seeds} seeds)")
-    maze = load_maze(MAZES / "web.txt")
+    print(f"4. web wall following: collisions and intended touches ({seeds} seeds)")
     web = get_profile("web")
-    for noise in ("off", web.noise):
-        hits, taps = [], []
-        for seed in range(seeds):
-            metrics, _, _ = run(maze, "web-wall-following", web, seed, 600.0, noise=noise)
-            hits.append(metrics["collisions"])
-            taps.append(metrics.get("touches", 0))
-        print(
-            f"   noise {noise:<4} collisions {min(hits)}-{max(hits)} "
-            f"(mean {statistics.fmean(hits):.1f}), touches {min(taps)}-{max(taps)}"
-        )
+    cases = [("web.txt", lambda seed: load_maze(MAZES / "web.txt"))]
+    cases.append(("8x8 perfect", lambda seed: generate(8, 8, seed)))
+    for name, make in cases:
+        for noise in ("off", web.noise):
+            hits, taps = [], []
+            for seed in range(seeds):
+                maze = make(seed)
+                limit = default_max_time(maze, web, web.cell)
+                metrics, _, _ = run(maze, "web-wall-following", web, seed, limit, noise=noise)
+                hits.append(metrics["collisions"])
+                taps.append(metrics["touches"])
+            print(
+                f"   {name:<12} noise {noise:<4} collisions {min(hits)}-{max(hits)} "
+                f"(mean {statistics.fmean(hits):.1f}), touches {min(taps)}-{max(taps)} "
+                f"(mean {statistics.fmean(taps):.1f})"
+            )
 
 
 def main() -> int:

@@ -357,7 +357,9 @@ def test_the_run_panel_counts_a_bumper_touch_apart_from_collisions(tmp_path):
         app.station.step(60 * 3)  # drives up to the wall above and presses the bumper
         app.refresh_views()
         await pilot.pause()
-        assert "collisions 0 (+1 touch)" in status(app)
+        lines = app.screen.query_one(RunStatus).lines
+        assert lines[-1] == "collisions 0 | touches 1"
+        assert lines[-2].startswith("turned ") and "collisions" not in lines[-2]
         metrics = app.station.snapshot().metrics
         assert (metrics.collisions, metrics.touches) == (0, 1)
 

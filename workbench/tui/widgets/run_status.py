@@ -42,12 +42,12 @@ class RunStatus(TextLines):
         turning = (
             f"turned {degrees(m.turn_degrees, unicode)} in {m.turns} "
             f"turn{'' if m.turns == 1 else 's'}"
-            f"{sep}collisions {m.collisions}"
-            f"{f' (+{m.touches} touch{_es(m.touches)})' if m.touches else ''}"
         )
+        hits = f"collisions {m.collisions}"
+        if m.touches:
+            # bumps a touch sensor was meant to feel: a line of their own, beside the collisions
+            contact = (turning, f"{hits}{sep}touches {m.touches}")
+        else:
+            contact = (f"{turning}{sep}{hits}",)
         connection = (station.connection,) if station.connection else ()
-        self.set_lines([driver, clock, travel, turning, *connection])
-
-
-def _es(count: int) -> str:
-    return "" if count == 1 else "es"
+        self.set_lines([driver, clock, travel, *contact, *connection])
