@@ -347,3 +347,21 @@ def test_workbench_with_bad_arguments_exits_2_before_the_app(capsys, args, messa
     assert main(args) == 2
     err = capsys.readouterr().err
     assert err.startswith("workbench: ") and message in err and "Traceback" not in err
+
+
+def test_the_run_panel_counts_a_bumper_touch_apart_from_collisions(tmp_path):
+    # web: a touch sensor at the front; w drives at the course's Forward speed
+    app = make_app(maze_file(tmp_path, ROOM, "web"), paused=True, noise="off")
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.press("w")
+        app.station.step(60 * 3)  # drives up to the wall above and presses the bumper
+        app.refresh_views()
+        await pilot.pause()
+        lines = app.screen.query_one(RunStatus).lines
+        assert lines[-1] == "collisions 0 | touches 1"
+        assert lines[-2].startswith("turned ") and "collisions" not in lines[-2]
+        metrics = app.station.snapshot().metrics
+        assert (metrics.collisions, metrics.touches) == (0, 1)
+
+    run(app, body)

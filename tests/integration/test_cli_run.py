@@ -20,7 +20,7 @@ def test_run_json_has_the_documented_keys(capsys):
     code = main(["run", "--maze", "mazes/erobotic.txt", "--algorithm", "right-wall", "--json"])
     data = json.loads(capsys.readouterr().out)
     assert code == 0
-    assert list(data)[:10] == [
+    assert list(data)[:11] == [
         "reached_exit",
         "sim_time",
         "distance",
@@ -28,6 +28,7 @@ def test_run_json_has_the_documented_keys(capsys):
         "turn_degrees",
         "turns",
         "collisions",
+        "touches",
         "efficiency",
         "final_state",
         "seed",

@@ -57,3 +57,11 @@ def test_default_heading_faces_the_only_opening():
 def test_start_on_an_exit_is_reported():
     maze = ROOM.with_exit(1, 1)
     assert "start is on an exit" in [p.message for p in maze.validate()]
+
+
+def test_mirrored_maze_swaps_left_and_right():
+    maze = Maze(rows=("#####", "#...#", "#.###"), start=(1, 1), heading="right", exits=((1, 2),))
+    mirror = maze.mirrored()
+    assert mirror.rows == ("#####", "#...#", "###.#")
+    assert (mirror.start, mirror.heading, mirror.exits) == ((3, 1), "left", ((3, 2),))
+    assert mirror.mirrored().same_layout(maze)

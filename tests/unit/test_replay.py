@@ -185,6 +185,19 @@ def test_metrics_so_far_follow_the_recorded_poses(simple):
     assert m.collisions == 1 and m.sim_time == pytest.approx(0.2)
 
 
+def test_touches_are_counted_apart_and_old_records_without_them_still_load(tmp_path):
+    touched = ticks(8)
+    touched[6]["events"] = ["touch"]
+    replay = load_replay(write_record(tmp_path / "t.jsonl", touched))
+    replay.to_end()
+    assert (replay.metrics().collisions, replay.metrics().touches) == (1, 1)
+    # a record from before touches were counted: no touch events, no "touches" in the summary
+    old = load_replay(write_record(tmp_path / "o.jsonl", ticks(8)))
+    old.to_end()
+    assert (old.metrics().collisions, old.metrics().touches) == (1, 0)
+    assert "touches" not in old.summary
+
+
 def test_snapshot_carries_the_tick_for_the_maze_view(tmp_path):
     header = {"type": "header", "format": FORMAT, "cell": 10.0, "sensors": ["distance:1:front"]}
     replay = load_replay(write_record(tmp_path / "s.jsonl", ticks(3), header=header))
@@ -206,6 +219,7 @@ def test_metrics_at_the_end_agree_with_the_summary(tmp_path):
     assert m.reached_exit and m.exit_time == pytest.approx(summary["exit_time"], abs=0.06)
     assert m.distance == pytest.approx(summary["distance"], rel=0.05)
     assert m.turns == summary["turns"] and m.collisions == summary["collisions"]
+    assert m.touches == summary["touches"]
 
 
 def test_a_binary_file_is_not_a_record(tmp_path):

@@ -11,7 +11,15 @@ from workbench.sim.maze import Maze
 from workbench.sim.noise import NoiseSettings, noise_settings
 from workbench.sim.profiles import PROFILES, get_profile
 from workbench.sim.sensors import SensorConfigError, SensorSpec
-from workbench.sim.world import COLLISION, EXIT, TURN_DONE, World, WorldError, wall_segments
+from workbench.sim.world import (
+    COLLISION,
+    EXIT,
+    TOUCH,
+    TURN_DONE,
+    World,
+    WorldError,
+    wall_segments,
+)
 
 ALL_MOUNTS = [
     SensorSpec("distance", 1, "front"),
@@ -196,7 +204,7 @@ def test_distance_beyond_range_reports_no_echo():
     world = World(corridor(60), "unity", noise="off")  # 120 units of corridor, range 100
     readings = world.read_sensors()
     assert readings[2] == 1000  # front: Unity's "nothing hit"
-    assert readings[1] == pytest.approx(1.0 - 0.18)  # right: the corridor wall
+    assert readings[1] == pytest.approx(1.0 - 0.45)  # right: the corridor wall
 
 
 def test_touch_reads_one_against_a_wall_and_zero_away_from_it():
@@ -333,6 +341,38 @@ def test_one_collision_per_bump_not_per_step_of_pushing():
     world.apply(WheelPowers(1, 1))
     world.run(2.0)
     assert world.odometry.collisions == 2
+
+
+def test_a_front_bumper_meeting_the_wall_at_driving_speed_is_a_touch_not_a_collision():
+    bumper = [SensorSpec("distance", 1, "right"), SensorSpec("touch", 2, "front")]
+    world = World(corridor(3), "web", bumper, noise="off")
+    world.apply(WheelPowers(0.5, 0.5))  # the course's Forward: one block a second
+    events = world.run(5.0)
+    assert [e for _, e in events] == [TOUCH]
+    assert world.read_sensors()[2] == 1
+    odo = world.odometry
+    assert (odo.touches, odo.collisions) == (1, 0)
+
+
+def test_ramming_a_wall_is_a_collision_even_with_a_bumper():
+    bumper = [SensorSpec("touch", 2, "front")]
+    world = World(corridor(3), "web", bumper, noise="off")
+    world.apply(WheelPowers(1, 1))  # two blocks a second, beyond the touch speed
+    events = world.run(5.0)
+    assert [e for _, e in events] == [COLLISION]
+    assert (world.odometry.touches, world.odometry.collisions) == (0, 1)
+
+
+def test_a_wall_met_where_no_bumper_is_is_a_collision():
+    behind = [SensorSpec("touch", 2, "front")]
+    world = World(corridor(3), "web", behind, noise="off")
+    world.apply(WheelPowers(-0.5, -0.5))  # backing into the wall behind the start
+    events = world.run(3.0)
+    assert [e for _, e in events] == [COLLISION]
+    world.set_sensors([SensorSpec("touch", 2, "back")])
+    world.reset()
+    world.apply(WheelPowers(-0.5, -0.5))
+    assert [e for _, e in world.run(3.0)] == [TOUCH]
 
 
 def test_wall_faces_are_merged_into_long_segments():

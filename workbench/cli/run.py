@@ -127,6 +127,7 @@ def describe_measures(result) -> list[str]:
         f"  distance travelled  {d['distance']:.1f} {unit} ({d['distance_cells']:.1f} blocks)",
         f"  turning degrees     {d['turn_degrees']:.0f} deg in {d['turns']} turns",
         f"  collisions          {d['collisions']}",
+        f"  touches             {d['touches']} (a touch sensor's bumper meeting a wall gently)",
         f"  efficiency          {eff} (shortest path / distance travelled)",
         f"  simulated time      {d['sim_time']:.1f} s",
     ]

@@ -17,7 +17,7 @@ from typing import Any, Protocol
 
 from .headless import RunSetupError, RunSpec
 
-MEASURES = ("distance_cells", "turn_degrees", "sim_time", "collisions", "turns")
+MEASURES = ("distance_cells", "turn_degrees", "sim_time", "collisions", "touches", "turns")
 
 
 class EvalError(ValueError):
@@ -215,13 +215,14 @@ def format_table(result: EvalResult) -> str:
         lines.append(f"{maze}  ({result.seeds} seed{'s' if result.seeds > 1 else ''})")
         lines.append(
             f"  {'rank':<5}{'algorithm':<26}{'out':>6}{'turning deg':>18}{'distance (blocks)':>22}"
-            f"{'time s':>10}{'collisions':>12}"
+            f"{'time s':>10}{'collisions':>12}{'touches':>9}"
         )
         for rank, c in enumerate(result.ranking(maze), start=1):
             lines.append(
                 f"  {rank:<5}{c.algorithm:<26}{f'{c.reached}/{c.runs}':>6}"
                 f"{_pm(c, 'turn_degrees', 0):>18}{_pm(c, 'distance_cells', 1):>22}"
                 f"{c.mean['sim_time']:>10.1f}{c.mean['collisions']:>12.1f}"
+                f"{c.mean['touches']:>9.1f}"
             )
         lines.append("")
     return "\n".join(lines).rstrip()

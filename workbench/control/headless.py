@@ -29,6 +29,7 @@ RESULT_KEYS = (
     "turn_degrees",
     "turns",
     "collisions",
+    "touches",
     "efficiency",
     "final_state",
     "seed",

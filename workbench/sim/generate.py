@@ -11,8 +11,10 @@ Styles:
   stack), so there is exactly one path between any two cells and every cell is reachable.
 * ``braid``: a perfect maze whose dead ends are then opened up, each by knocking out one of its
   walls (a wall into another dead end when there is one). Loops appear and no dead end is left
-  when both sides are at least 2 cells; a maze 1 cell wide keeps its two ends (or its single
-  cell), since those cells have nowhere else to open into.
+  but the start cell when both sides are at least 3 cells; a cell whose only closed wall faces
+  the start stays a dead end (in a maze 2 cells wide, the start's neighbour may), and a maze
+  1 cell wide keeps its two ends (or its single cell), since those cells have nowhere else to
+  open into.
 
 Exits:
 
@@ -21,7 +23,11 @@ Exits:
   micromouse goal; a side with an even number of cells contributes its two middle cells.
 * ``none``: no exit; runs on the maze are free exploration.
 
-The start is always the bottom-left cell, facing its only open side (or up when it has more).
+The start is always the bottom-left cell, and it always has one open side, which the robot
+faces: it starts in a corridor with a wall on either hand, as a micromouse does, so a wall
+follower (right hand or left hand) starts on the outer wall. When the spanning tree opens the
+corner both ways, its passage to the right is closed and the part of the maze cut off that way
+is joined on again elsewhere; braiding never opens the start cell again.
 """
 
 from __future__ import annotations
@@ -83,9 +89,11 @@ def generate(
     if exit not in EXITS:
         raise ValueError(f"unknown exit option {exit!r}; use one of {', '.join(EXITS)}")
     rng = random.Random(seed)
+    start_cell = (0, height - 1)
     passages = _backtracker(width, height, rng)
+    _start_in_corridor(width, height, start_cell, passages, rng)
     if style == "braid":
-        _braid(width, height, passages, rng)
+        _braid(width, height, start_cell, passages, rng)
     grid = [[WALL] * (2 * width + 1) for _ in range(2 * height + 1)]
     for cy in range(height):
         for cx in range(width):
@@ -93,7 +101,6 @@ def generate(
             grid[y][x] = FLOOR
     for a, b in passages:
         grid[a[1] + b[1] + 1][a[0] + b[0] + 1] = FLOOR
-    start_cell = (0, height - 1)
     exits = _exits(width, height, start_cell, passages, exit)
     for x, y in exits:
         grid[y][x] = FLOOR
@@ -157,14 +164,54 @@ def _degree(cell: Cell, passages: set[tuple[Cell, Cell]], width: int, height: in
     return sum(_edge(cell, n) in passages for n in _neighbours(cell, width, height))
 
 
-def _braid(width: int, height: int, passages: set[tuple[Cell, Cell]], rng: random.Random) -> None:
-    """Open one more wall of every dead end, preferring a wall into another dead end."""
-    cells = [(cx, cy) for cy in range(height) for cx in range(width)]
+def _start_in_corridor(
+    width: int,
+    height: int,
+    start: Cell,
+    passages: set[tuple[Cell, Cell]],
+    rng: random.Random,
+) -> None:
+    """Leave the start cell of a spanning tree one opening, keeping every cell reachable.
+
+    A corner cell open both up and to the right has one of those sides open beside a robot
+    facing the other, and a wall follower takes that side for a turning before it has started.
+    With one opening the robot starts in a corridor, a wall on either hand (the micromouse
+    start cell). The passage to the right is closed; the cells it cut off are joined to the
+    rest again through a wall chosen at random among those between the two parts.
+    """
+    right = (start[0] + 1, start[1])
+    if _degree(start, passages, width, height) < 2 or _edge(start, right) not in passages:
+        return
+    passages.discard(_edge(start, right))
+    cut_off = set(_cell_distances(right, passages, width, height))
+    bridges = sorted(
+        _edge(cell, n)
+        for cell in cut_off
+        for n in _neighbours(cell, width, height)
+        if n not in cut_off and n != start
+    )
+    passages.add(rng.choice(bridges))
+
+
+def _braid(
+    width: int,
+    height: int,
+    start: Cell,
+    passages: set[tuple[Cell, Cell]],
+    rng: random.Random,
+) -> None:
+    """Open one more wall of every dead end but the start, preferring a wall into another
+    dead end; no wall of the start cell is opened."""
+    cells = [(cx, cy) for cy in range(height) for cx in range(width) if (cx, cy) != start]
     rng.shuffle(cells)
     for cell in cells:
         if _degree(cell, passages, width, height) != 1:
             continue
-        closed = [n for n in _neighbours(cell, width, height) if _edge(cell, n) not in passages]
+        closed = [
+            n
+            for n in _neighbours(cell, width, height)
+            if _edge(cell, n) not in passages and n != start
+        ]
         if not closed:
             continue
         dead = [n for n in closed if _degree(n, passages, width, height) == 1]

@@ -142,6 +142,22 @@ class Maze:
     def with_start(self, x: int, y: int, heading: str | None = None) -> Maze:
         return replace(self, start=(x, y), heading=heading or self.heading)
 
+    def mirrored(self) -> Maze:
+        """The maze seen in a mirror, left and right swapped (start, heading and exits too).
+
+        A left-hand rule on a maze does what the right-hand rule does on its mirror image.
+        """
+        last = self.width - 1
+        flip = {"left": "right", "right": "left"}
+        return replace(
+            self,
+            rows=tuple(row[::-1] for row in self.rows),
+            start=None if self.start is None else (last - self.start[0], self.start[1]),
+            heading=flip.get(self.heading, self.heading),
+            exits=tuple((last - x, y) for x, y in self.exits),
+            name=f"{self.name} (mirrored)" if self.name else "",
+        )
+
     def with_exit(self, x: int, y: int, present: bool = True) -> Maze:
         exits = set(self.exits)
         if present:

@@ -21,6 +21,9 @@ class Metrics:
     turns: int
     collisions: int
     efficiency: float | None
+    #: intended contacts, counted apart from collisions: a touch sensor's bumper meeting a
+    #: wall gently (the rule is in workbench.sim.world); 0 in records written before touches
+    touches: int = 0
 
     def as_dict(self, digits: int = 4) -> dict[str, object]:
         out: dict[str, object] = {}

@@ -8,12 +8,18 @@ a side sensor of a centred robot reads ``c/2 - r``):
 
 ========  =====================================================================================
 unity     unit "unit" (metre-like). ``c = 2``, ``r = 0.18`` (robot 0.36 wide, as in the Unity
-          simulator). Centred side reading 1 - 0.18 = 0.82 < 1.0 ("right > 1.0" is open); an
-          opening on the side reads >= 3 - 0.18 = 2.82. Front < 0.9 stops the centre
-          0.9 + 0.18 = 1.08 from the wall, 0.08 short of the last block's centre (1.18 with the
-          two-distance program's 1.0). Move at Power: 1 unit/s, only the sign counts. Turn by
-          Degree: 35 deg/s (the simulator turned at 30-40 deg/s). Robot Drive: 1 unit/s per
-          wheel at power 1, spinning 90 deg/s at (1, -1). Ray range 100, 1000 = no echo.
+          simulator). The side sensors look out from the ends of a sensor bar 0.9 wide (0.45
+          from the centre); the front sensor sits 0.1 ahead of the centre, set back behind the
+          bumper. Centred side reading 1 - 0.45 = 0.55 < 1.0 ("right > 1.0" is open: a margin
+          of 0.45, almost a quarter of a block); an opening reads >= 3 - 0.45 = 2.55. Front
+          < 0.9 stops the centre 0.9 + 0.1 = 1.0 from the wall, on the last block's centre
+          (0.1 short with the two-distance program's 1.0), so after a quarter turn the side
+          reads 0.55 again. Sensors all on the robot's edge cannot do this: the course's two
+          numbers are 0.1 apart, so a robot that stops at "front < 0.9" and turns reads 0.9 to
+          the side, 0.1 from "open" (docs/profiles.md). Move at Power: 1 unit/s, only the sign
+          counts. Turn by Degree: 35 deg/s (the simulator turned at 30-40 deg/s). Robot Drive:
+          1 unit/s per wheel at power 1, spinning 90 deg/s at (1, -1). Ray range 100, 1000 =
+          no echo.
 web       unit "px". ``c = 70``, ``r = 10``. Centred side reading 35 - 10 = 25 (the programs'
           BaseDistance); an opening reads >= 105 - 10 = 95 > 75 (BaseDistance + 50), while the
           far wall of the corridor is at most 70 - 20 = 50 < 75. Front < 25 stops the centre
@@ -56,7 +62,8 @@ class Profile:
     #: radius of the robot's collision circle
     robot_radius: float
     #: distance from the robot's centre to a sensor on each mount, in MOUNTS order
-    #: (front, right, back, left)
+    #: (front, right, back, left); a sensor may sit inside the robot's circle (set back) or
+    #: outside it (on a bar wider than the robot)
     sensor_offsets: tuple[float, float, float, float]
     #: speed of one wheel at power 1 (Robot Drive / Robot Motor)
     max_wheel_speed: float
@@ -136,7 +143,7 @@ UNITY = Profile(
     unit="unit",
     cell=2.0,
     robot_radius=0.18,
-    sensor_offsets=_edge(0.18),
+    sensor_offsets=(0.1, 0.45, 0.18, 0.45),
     max_wheel_speed=1.0,
     track_width=_track_for_spin(1.0, 90.0),
     move_speed=1.0,

@@ -140,7 +140,7 @@ def _metrics_so_far(
     shortest = shortest if isinstance(shortest, int) and not isinstance(shortest, bool) else None
     out: list[Metrics] = []
     distance = turning = 0.0
-    collisions = 0
+    collisions = touches = 0
     exit_time: float | None = None
     counter = TurnCounter()
     for i, tick in enumerate(record.ticks):
@@ -152,6 +152,7 @@ def _metrics_so_far(
             counter.update(turn, times[i] - times[i - 1])
         events = tick.get("events", ())
         collisions += sum(e == "collision" for e in events)
+        touches += sum(e == "touch" for e in events)
         if exit_time is None and "exit" in events:
             exit_time = times[i]
         reached = exit_time is not None
@@ -165,6 +166,7 @@ def _metrics_so_far(
                 turn_degrees=turning,
                 turns=counter.current(),
                 collisions=collisions,
+                touches=touches,
                 efficiency=efficiency(shortest, cell, distance, reached),
             )
         )

@@ -256,6 +256,7 @@ class Session:
             turns=self._turns.current(),
             collisions=odo.collisions,
             efficiency=efficiency(self.shortest_blocks, cell, odo.distance, reached),
+            touches=odo.touches,
         )
 
     def snapshot(self) -> Snapshot:

@@ -15,6 +15,13 @@ body through a pivot joint (linear velocity) and a gear joint (angular velocity)
 ``max_bias = 0``; the robot's own velocity is never written, so the solver keeps it out of
 the walls. Distance sensors march the ray through the block grid (exact faces, no physics
 query); touch sensors look for wall within a small tolerance on their side's 90-degree arc.
+
+A contact with a wall is a *touch* when the robot meets the wall with a touch sensor's bumper
+(the wall lies within that sensor's 90-degree arc) at no more than ``TOUCH_SPEED`` blocks a
+second along the contact's normal: what a program that feels for walls with its touch sensor
+does on purpose. Every other contact (on a side without a touch sensor, or faster) is a
+*collision*. Contacts that start again within ``_COLLISION_GAP`` of the last one ending are the
+same contact, of the kind it started as.
 """
 
 from __future__ import annotations
@@ -42,7 +49,10 @@ from .sensors import MOUNTS, SensorSpec, check_ports
 
 TURN_DONE = "turn_done"
 COLLISION = "collision"
+TOUCH = "touch"
 EXIT = "exit"
+#: fastest approach (blocks per second, along the contact normal) that still counts as a touch
+TOUCH_SPEED = 1.5
 
 #: maze heading name -> world heading in degrees (0 = right, clockwise)
 HEADING_ANGLES: dict[str, float] = {"right": 0.0, "down": 90.0, "left": 180.0, "up": 270.0}
@@ -81,6 +91,8 @@ class Odometry:
     turn_degrees: float
     collisions: int
     exit_time: float | None
+    #: intended contacts: a touch sensor's bumper meeting a wall gently (not collisions)
+    touches: int = 0
 
 
 def wall_segments(maze: Maze) -> list[tuple[tuple[int, int], tuple[int, int]]]:
@@ -248,6 +260,7 @@ class World:
         self._touch_plan = tuple(
             (s.port, MOUNTS.index(s.mount)) for s in specs if s.kind == "touch"
         )
+        self._bumpers = tuple(sorted({mount for _, mount in self._touch_plan}))
         self._readings: dict[int, float | int] | None = None
 
     # -- the run -------------------------------------------------------------------------
@@ -267,9 +280,10 @@ class World:
         self._distance = 0.0
         self._turned = 0.0
         self._collisions = 0
+        self._touches = 0
         self._contacts = 0
         self._last_contact_end = -math.inf
-        self._new_collision = False
+        self._new_collision: str | None = None  # the event of a contact that just started
         self._exit_time: float | None = None
         self._wheels = (0.0, 0.0)
         self._v = 0.0
@@ -326,9 +340,25 @@ class World:
         if space is not self._space:
             return
         if self._contacts == 0 and self.time - self._last_contact_end > _COLLISION_GAP:
-            self._collisions += 1
-            self._new_collision = True
+            if self._bumpers and self._is_touch(arbiter.normal):
+                self._touches += 1
+                self._new_collision = TOUCH
+            else:
+                self._collisions += 1
+                self._new_collision = COLLISION
         self._contacts += 1
+
+    def _is_touch(self, normal: pymunk.Vec2d) -> bool:
+        """Whether a contact along ``normal`` (from the robot to the wall) meets a bumper
+        gently: within a touch sensor's arc, at no more than TOUCH_SPEED blocks a second."""
+        a = self._angle
+        c = math.cos(a)
+        s = math.sin(a)
+        dirs = ((c, s), (-s, c), (-c, -s), (s, -c))
+        nx, ny = normal.x, normal.y
+        if not any(dirs[m][0] * nx + dirs[m][1] * ny >= _COS45 for m in self._bumpers):
+            return False
+        return self._v * (c * nx + s * ny) <= TOUCH_SPEED * self.cell
 
     def _contact_end(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: object) -> None:
         if space is not self._space:
@@ -391,7 +421,8 @@ class World:
 
     # -- stepping ------------------------------------------------------------------------
     def step(self) -> tuple[str, ...]:
-        """Advance one ``dt``; the events of this step ("turn_done", "collision", "exit").
+        """Advance one ``dt``; the events of this step ("turn_done", "collision", "touch",
+        "exit").
 
         Where no wall is within reach of this step's motion the pose is integrated directly
         (free motion, exactly what the solver would do with nothing to collide with); anywhere
@@ -485,8 +516,8 @@ class World:
             self._free_w = 0.0
             events = (TURN_DONE,)
         if self._new_collision:
-            self._new_collision = False
-            events = (*events, COLLISION)
+            events = (*events, self._new_collision)
+            self._new_collision = None
         if self._exit_time is None and self._has_exits:
             inv = self._inv_cell
             if self._exits[(int(y * inv) + 1) * self._wp + int(x * inv) + 1]:
@@ -583,6 +614,7 @@ class World:
             turn_degrees=math.degrees(self._turned),
             collisions=self._collisions,
             exit_time=self._exit_time,
+            touches=self._touches,
         )
 
     # -- sensors -------------------------------------------------------------------------

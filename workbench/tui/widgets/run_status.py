@@ -11,7 +11,7 @@ from .text_lines import TextLines
 
 
 class RunStatus(TextLines):
-    """Who drives; pause, speed and time; distance; turning and collisions."""
+    """Who drives; pause, speed and time; distance; turning, collisions and touches."""
 
     DEFAULT_CSS = """
     RunStatus {
@@ -44,6 +44,11 @@ class RunStatus(TextLines):
         turning = (
             f"turned {degrees(m.turn_degrees, unicode)} in {m.turns} "
             f"turn{'' if m.turns == 1 else 's'}"
-            f"{sep}collisions {m.collisions}"
         )
-        self.set_lines([driver, clock, travel, turning, *([connection] if connection else [])])
+        hits = f"collisions {m.collisions}"
+        if m.touches:
+            # bumps a touch sensor was meant to feel: a line of their own, beside the collisions
+            contact = (turning, f"{hits}{sep}touches {m.touches}")
+        else:
+            contact = (f"{turning}{sep}{hits}",)
+        self.set_lines([driver, clock, travel, *contact, *([connection] if connection else [])])
