@@ -27,6 +27,8 @@ class Host(ScreenHost):
     def __init__(self, screen: Screen) -> None:
         super().__init__()
         self.under_test = screen
+        # the app draws as the screen does (its footer, scroll bars and dialogs too)
+        self.set_reactive(ScreenHost.unicode, bool(getattr(screen, "unicode", False)))
 
     def on_mount(self) -> None:
         self.push_screen(self.under_test)

@@ -26,6 +26,7 @@ from workbench.files.workspace import OutsideWorkspace
 from workbench.sim.session import Snapshot
 
 from ..host import ShowsSnapshot, StationChanged
+from ..plain import drawn_in_unicode, prose
 from ..widgets.field import Field
 from ..widgets.param_editor import ParamEditor
 
@@ -203,7 +204,8 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
             return
         title.update(f"{definition.name}  ({_source(definition.source)})")
         description = self.query_one("#alg-description", Static)
-        description.update(" ".join(definition.description.split()) or "(no description)")
+        text = " ".join(definition.description.split()) or "(no description)"
+        description.update(prose(text, drawn_in_unicode(self)))
         description.display = True
         lines = [f"Sensors it reads ({station.profile} ports):"]
         lines += [

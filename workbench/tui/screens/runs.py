@@ -174,7 +174,7 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         rows = tuple(run_cells(run, self.unicode) for run in runs)
         table = self.query_one(DataTable)
         self.query_one("#runs-title", Static).update(
-            f"Runs on this bench: {len(runs)}  [maze now: {self.station.maze.name or '-'}]"
+            f"Runs on this station: {len(runs)}  [maze now: {self.station.maze.name or '-'}]"
         )
         if runs:
             help_text = (
