@@ -16,9 +16,9 @@ from textual.widgets import Input
 
 from workbench.files.bundled import MAZE_DIR
 from workbench.labs import signoff as so
+from workbench.tui.app import make_app
 from workbench.tui.screens.replay import ReplayScreen
 from workbench.tui.screens.runs import RunsScreen
-from workbench.tui.app import make_app
 
 from .labs_support import open_exercise
 from .support import run, screen_lines

@@ -4,9 +4,10 @@ Ana and Ben open the labs (l), pick each exercise in turn, set it up (a) and do 
 way the app offers it: drive keys, the sensor panel, the maze editor, the maze key, the
 algorithm dialog (built-ins, and the starter FSMs completed in its parameter editor), a
 VIPLE program on the WebSocket server the app connects to, and the question fields. Every
-objective must show as passed ([X] in ASCII mode) on the labs screen without an override; then the instructor signs the
-exercise off (i) and the pair swaps the driver. At the end the store holds one signed record
-per exercise, the records verify and the gradebook has a row per student per exercise.
+objective must show as passed ([X] in ASCII mode) on the labs screen without an override;
+then the instructor signs the exercise off (i) and the pair swaps the driver. At the end the
+store holds one signed record per exercise, the records verify and the gradebook has a row per
+student per exercise.
 """
 
 from __future__ import annotations

@@ -1,8 +1,9 @@
 """The labs screen: the course's lab exercises, their instructions and their live checks.
 
 On the left, every lab and its exercises (✓ once an exercise's objectives pass, ★ once an
-instructor has signed it off; ``[X]`` and ``[*]`` in ASCII mode); on the right, the chosen exercise: its instructions, its objectives with ✓/✗ and
-a one-line reason that follow the station as the student works, and its questions. ``a`` puts
+instructor has signed it off; ``[X]`` and ``[*]`` in ASCII mode); on the right, the chosen
+exercise: its instructions, its objectives with ✓/✗ (``[X]``/``[ ]``) and a one-line reason
+that follow the station as the student works, and its questions. ``a`` puts
 the exercise's set-up on the station, ``i`` opens the instructor's sign-off. Progress is saved
 in the store as soon as an exercise is opened and each time an objective or an answer
 changes; an objective that passed once stays passed, with its evidence, after a restart.
