@@ -78,8 +78,8 @@ async def test_the_table_shows_each_run_with_its_measures(tmp_path):
             "Hits",
             "Eff",
             "Ended",
-            "Maze",
             "Rec",
+            "Maze",
         ]
         assert table_rows(table) == [
             [
@@ -93,8 +93,8 @@ async def test_the_table_shows_each_run_with_its_measures(tmp_path):
                 "0",
                 "1.00",
                 "exit",
-                "Bend",
                 "yes",
+                "Bend",
             ],
             [
                 "2",
@@ -107,8 +107,8 @@ async def test_the_table_shows_each_run_with_its_measures(tmp_path):
                 "0",
                 "0.98",
                 "exit",
-                "Bend",
                 "yes",
+                "Bend",
             ],
         ]
         assert text(app.screen.query_one("#runs-title")).startswith("Runs on this station: 2")

@@ -290,7 +290,9 @@ class MainScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             self.action_maze(path, str(exc))
             return
         except MazeError as exc:
-            self.action_maze(path, "\n".join(str(p) for p in exc.problems))
+            problems = [str(p) for p in exc.problems]
+            heading = [f"{len(problems)} problems in the file:"] if len(problems) > 1 else []
+            self.action_maze(path, "\n".join(heading + problems))
             return
         self.station.load_maze(maze)
         self._maze_view.set_maze(maze)
