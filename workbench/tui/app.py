@@ -136,6 +136,8 @@ class WorkbenchApp(ScreenHost[None]):
         self._drawn: tuple[object, ...] = ()
         self._too_small: TooSmallScreen | None = None
         self._main: MainScreen | None = None
+        #: the maze the message line last named
+        self._maze_named = station.maze
 
     def who(self) -> str:
         """Who is at the robot, for the message line ("" when nobody was named)."""
@@ -277,6 +279,11 @@ class WorkbenchApp(ScreenHost[None]):
             self.maze_path = Path(path)
             if self._main is not None:
                 self._main.maze_path = self.maze_path
+        maze = self.station.maze
+        if maze is not self._maze_named:
+            self._maze_named = maze
+            if maze.name not in self.station.message:  # else the screen has said it already
+                self.station.message = maze_message(self.station)
         self._show_maze_title()
         self.refresh_views()
 
@@ -462,6 +469,19 @@ def make_app(
         connect_hint=connect_hint,
         db=db,
     )
+
+
+def maze_message(station: LabStation) -> str:
+    """What the message line says when a maze goes on the station: its name, and the profile
+    the robot keeps when the file was made for another."""
+    maze = station.maze
+    text = f"the robot is on {maze.name}"
+    if maze.profile and maze.profile != station.profile:
+        text += (
+            f", still with the {station.profile} profile (the maze file names {maze.profile}; "
+            f"--profile {maze.profile} at start uses it)"
+        )
+    return text
 
 
 def _login_name() -> str:

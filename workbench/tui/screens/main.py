@@ -297,8 +297,7 @@ class MainScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self.station.load_maze(maze)
         self._maze_view.set_maze(maze)
         self._maze_view.clear_trail()
-        self.station.message = f"the robot is on {maze.name}"
-        self.post_message(MazeChanged(real))
+        self.post_message(MazeChanged(real))  # the app names the maze on the message line
 
     def action_editor(self) -> None:
         self.post_message(OpenScreen("editor"))
