@@ -92,6 +92,29 @@ class StartEndpoint(Message):
 class ScreenHost(App[ReturnType]):
     """The Unicode setting of an app that hosts the workbench's screens, in one place."""
 
+    # ASCII mode: Textual's own widgets without block-element borders (plain.py replaces
+    # their glyphs); here rather than in the app's stylesheet, so every host has them
+    DEFAULT_CSS = """
+    App.-ascii OptionList,
+    App.-ascii OptionList:focus {
+        border: ascii $border-blurred;
+    }
+    App.-ascii #alg-builtins,
+    App.-ascii #alg-builtins:focus {
+        border: none;
+    }
+    App.-ascii CommandPalette #--input,
+    App.-ascii CommandPalette LoadingIndicator {
+        border: none;
+        border-bottom: ascii $border;
+    }
+    App.-ascii CommandPalette CommandList,
+    App.-ascii CommandPalette CommandList:focus {
+        border: none;
+        border-bottom: ascii $border;
+    }
+    """
+
     #: draw with Unicode lines, arrows and marks (False: plain ASCII)
     unicode: var[bool] = var(False, init=False)
 
