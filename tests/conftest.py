@@ -30,3 +30,10 @@ def pg_server():
 def pg_url(pg_server: PgServer) -> str:
     """A new, empty database on the session's server."""
     return pg_server.create_database(f"t{next(_names)}")
+
+
+@pytest.fixture(autouse=True)
+def _own_data_folder(tmp_path_factory, monkeypatch):
+    """Every test's default data folder is a fresh one (never the user's): the app keeps the
+    last pair of names and the labs' progress there."""
+    monkeypatch.setenv("WORKBENCH_DATA", str(tmp_path_factory.mktemp("data")))

@@ -48,3 +48,25 @@ def run_panel(app: App) -> str:
     """The main screen's run panel (who drives, time, measures, the VIPLE connection line)."""
     main = next(s for s in app.screen_stack if isinstance(s, MainScreen))
     return "\n".join(main.query_one(RunStatus).lines)
+
+
+def screen_lines(app: App) -> list[str]:
+    """The text the terminal shows now, row by row (dialogs over the screens below them)."""
+    import io
+
+    from rich.console import Console
+
+    width, height = app.size
+    console = Console(
+        width=width,
+        height=height,
+        file=io.StringIO(),
+        force_terminal=True,
+        record=True,
+        legacy_windows=False,
+        safe_box=False,
+    )
+    console.print(
+        app.screen._compositor.render_update(full=True, screen_stack=app._background_screens)
+    )
+    return console.export_text().splitlines()

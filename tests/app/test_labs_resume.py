@@ -38,7 +38,7 @@ def test_what_passed_before_a_restart_is_still_passed_after_it(tmp_path):
         screen = await open_exercise(pilot, DRIVE)
         await pilot.press("a", "escape", "w", "a", "s", "d", "space", "l")
         await pilot.pause()
-        assert text(screen, "#labs-objectives").startswith("✓ drove with w, a, s, d and space")
+        assert text(screen, "#labs-objectives").startswith("[X] drove with w, a, s, d and space")
         screen.query_one("#q-tcp-port", Input).value = "13"  # half typed when the app dies
         await pilot.pause()
 
@@ -48,9 +48,9 @@ def test_what_passed_before_a_restart_is_still_passed_after_it(tmp_path):
     async def resume(pilot: Pilot) -> None:
         screen = await open_exercise(pilot, DRIVE)
         lines = text(screen, "#labs-objectives").splitlines()
-        kept = "✓ drove with w, a, s, d and space: passed earlier: used w, a, s, d, space"
+        kept = "[X] drove with w, a, s, d and space: passed earlier: used w, a, s, d, space"
         assert lines[0] == kept
-        assert lines[1].startswith("✗ edited the maze")
+        assert lines[1].startswith("[ ] edited the maze")
         assert screen.query_one("#q-tcp-port", Input).value == "13"
         saved = again.store.progress("ana")[("unity-simulator", "drive-by-wire")]
         assert saved["objectives"][0]["evidence"]["keys_used"] == ["a", "d", "s", "space", "w"]
@@ -174,7 +174,7 @@ def test_a_store_with_unreadable_progress_says_so_and_starts_that_exercise_afres
         screen = await open_exercise(pilot, DRIVE)
         message = text(screen, "#labs-message")
         assert message == "saved progress unreadable (starts afresh): unity-simulator/drive-by-wire"
-        assert text(screen, "#labs-objectives").startswith("✗ drove")
+        assert text(screen, "#labs-objectives").startswith("[ ] drove")
 
     run(app, body)
 

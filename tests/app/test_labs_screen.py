@@ -57,7 +57,7 @@ def test_set_up_then_driving_flips_the_keys_objective_and_saves_progress(tmp_pat
 
     async def body(pilot: Pilot) -> None:
         screen = await open_exercise(pilot)
-        assert text(screen, "#labs-objectives").startswith("✗ drove with w, a, s, d and space")
+        assert text(screen, "#labs-objectives").startswith("[ ] drove with w, a, s, d and space")
         await pilot.press("a")
         assert app.station.profile == "unity"
         assert "set up: unity" in text(screen, "#labs-message")
@@ -69,8 +69,8 @@ def test_set_up_then_driving_flips_the_keys_objective_and_saves_progress(tmp_pat
         await pilot.press("l")
         await pilot.pause()
         lines = text(screen, "#labs-objectives").splitlines()
-        assert lines[0].startswith("✓ drove with w, a, s, d and space")
-        assert lines[1].startswith("✗ edited the maze")
+        assert lines[0].startswith("[X] drove with w, a, s, d and space")
+        assert lines[1].startswith("[ ] edited the maze")
 
     run(app, body)
 
@@ -85,11 +85,11 @@ def test_a_question_is_checked_as_it_is_answered(tmp_path):
         screen.query_one("#q-tcp-port", Input).focus()
         await pilot.press("1", "3", "5", "1")
         await pilot.pause()
-        assert str(reason.render()).startswith("✗")
+        assert str(reason.render()).startswith("[ ]")
         await pilot.press("backspace", "0")
         await pilot.pause()
-        assert str(reason.render()) == "✓ correct"
-        assert "✓ question answered" in text(screen, "#labs-objectives")
+        assert str(reason.render()) == "[X] correct"
+        assert "[X] question answered" in text(screen, "#labs-objectives")
         saved = app.store.progress("ana")[("unity-simulator", "drive-by-wire")]
         assert saved["answers"] == {"tcp-port": "1350"}
 
@@ -136,7 +136,7 @@ def test_sign_off_happy_path_then_the_driver_changes(tmp_path):
         assert drivers[("unity-simulator", "reading-wall-following")] == "ben"
         listing = screen.query_one("#labs-list", OptionList)
         option = listing.get_option(DRIVE)
-        assert str(option.prompt).startswith("★")  # signed off, apart from only passed
+        assert str(option.prompt).startswith("[*]")  # signed off, apart from only passed
 
     run(app, body)
 
@@ -145,9 +145,11 @@ def test_sign_off_happy_path_then_the_driver_changes(tmp_path):
     async def later(pilot: Pilot) -> None:
         screen = await open_exercise(pilot, DRIVE)
         assert screen.driver == "ana"  # who drove it, from the store
-        assert str(screen.query_one("#labs-list", OptionList).get_option(DRIVE).prompt)[0] == "★"
+        assert str(screen.query_one("#labs-list", OptionList).get_option(DRIVE).prompt).startswith(
+            "[*]"
+        )
         title = str(screen.query_one("#labs-title").render())
-        assert "★ signed off by " in title  # by whom and when
+        assert "[*] signed off by " in title  # by whom and when
         await pilot.press("i")
         await pilot.pause()
         assert "Already signed off by " in str(

@@ -4,9 +4,10 @@ Ana and Ben open the labs (l), pick each exercise in turn, set it up (a) and do 
 way the app offers it: drive keys, the sensor panel, the maze editor, the maze key, the
 algorithm dialog (built-ins, and the starter FSMs completed in its parameter editor), a
 VIPLE program on the WebSocket server the app connects to, and the question fields. Every
-objective must show ✓ on the labs screen without an override; then the instructor signs the
-exercise off (i) and the pair swaps the driver. At the end the store holds one signed record
-per exercise, the records verify and the gradebook has a row per student per exercise.
+objective must show as passed ([X] in ASCII mode) on the labs screen without an override;
+then the instructor signs the exercise off (i) and the pair swaps the driver. At the end the
+store holds one signed record per exercise, the records verify and the gradebook has a row per
+student per exercise.
 """
 
 from __future__ import annotations
@@ -260,7 +261,7 @@ class Walkthrough:
             screen.query_one(f"#q-{q.id}", Input).value = answer(q)
         await self.pilot.pause()
         reasons = [str(s.render()) for s in screen.query(".question-reason").results(Static)]
-        assert reasons == ["✓ correct"] * len(ex.questions), reasons
+        assert reasons == ["[X] correct"] * len(ex.questions), reasons
 
     async def do(self, lab: Lab, ex: Exercise) -> None:
         """Everything the exercise asks, in the order a pair would do it."""
@@ -362,7 +363,7 @@ def test_a_pair_completes_and_signs_off_every_exercise_in_the_app(tmp_path):
             driver = PAIR[n % 2]
             screen = await w.open(lab, ex)
             assert screen.driver == driver, (lab.id, ex.id)
-            assert not all(line.startswith("✓") for line in objectives(screen))
+            assert not all(line.startswith("[X]") for line in objectives(screen))
             if ex.setup.controller.kind == "viple":
                 await viple_over_websocket(w, screen, lab, ex)
             else:
@@ -374,12 +375,12 @@ def test_a_pair_completes_and_signs_off_every_exercise_in_the_app(tmp_path):
             screen = await w.labs()
             lines = objectives(screen)
             assert len(lines) == len(ex.objectives)
-            assert all(line.startswith("✓") for line in lines), (lab.id, ex.id, lines)
+            assert all(line.startswith("[X]") for line in lines), (lab.id, ex.id, lines)
             assert screen.progress is not None and screen.progress.passed
             await w.sign_off(screen, PAIR[(n + 1) % 2])
         listing = screen.query_one("#labs-list", OptionList)
         for lab, ex in EXERCISES:
-            assert str(listing.get_option(f"{lab.id}/{ex.id}").prompt).startswith("★")
+            assert str(listing.get_option(f"{lab.id}/{ex.id}").prompt).startswith("[*]")
         await pilot.press("ctrl+q")
 
     run(app, body)

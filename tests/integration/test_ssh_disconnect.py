@@ -13,7 +13,7 @@ from workbench.ssh.ports import port_is_free
 from .ssh_support import Account, lab_host, open_exercise
 
 DRIVE = "Unity simulator: Drive by wire"
-KEYS_DONE = "✓ drove with w, a, s, d and space"
+KEYS_DONE = "[X] drove with w, a, s, d and space"
 
 
 def gone(pid: int) -> bool:

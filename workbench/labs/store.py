@@ -42,6 +42,7 @@ from .database import (
     Tx,
     resolve_db,
 )
+from .lastpair import name_key
 from .migrations import RECORD_COLUMNS, SIGNOFF_LOCK, check_version, latest, migrate
 from .signlog import GENESIS, entry_hash, parse_metrics, signed_payload
 
@@ -319,8 +320,7 @@ class Store:
             # log goes on after the last numbered record
             numbered = "seq IS NOT NULL" if postgres else "typeof(seq) = 'integer'"
             last = tx.execute(
-                f"SELECT seq, entry_hash FROM signoffs WHERE {numbered} "
-                "ORDER BY seq DESC LIMIT 1"
+                f"SELECT seq, entry_hash FROM signoffs WHERE {numbered} ORDER BY seq DESC LIMIT 1"
             ).fetchone()
             seq, prev = (int(last[0]) + 1, str(last[1] or "")) if last else (1, GENESIS)
             if seq >= MAX_SEQ:
@@ -410,6 +410,21 @@ class Store:
             if key[0] == "progress" and key[1] == student and (not lab or key[2] == lab):
                 out[(key[2], key[3])] = json.loads(params_[3])
         return out
+
+    def spelling(self, name: str) -> str:
+        """``name`` as the store already spells it when it holds progress, a place or a
+        sign-off of that student with other case or spacing (``alice  doe`` finds
+        ``Alice Doe``); else ``name`` itself."""
+        key = name_key(name)
+        sql = (
+            "SELECT student FROM progress UNION SELECT student FROM places "
+            "UNION SELECT student FROM signoffs"
+        )
+        known = sorted({str(row[0]) for row in self._read(sql, ())})
+        known += sorted({key_[1] for key_ in self._pending if key_[0] in ("progress", "place")})
+        if name in known:
+            return name
+        return next((k for k in known if name_key(k) == key), name)
 
     # where each student was
 

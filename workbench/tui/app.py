@@ -23,9 +23,10 @@ from textual.screen import Screen
 from workbench.control.station import LabStation
 from workbench.files.bundled import default_maze_path
 from workbench.files.workspace import LOCAL, FileAccess
+from workbench.labs.lastpair import read_last_pair, save_last_pair
 from workbench.labs.model import Setup
 from workbench.labs.names import NameProblem, check_pair
-from workbench.labs.store import Store
+from workbench.labs.store import Store, resolve_data_dir
 from workbench.sim.maze import Maze, MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.noise import NOISE_LEVELS
@@ -106,8 +107,11 @@ class WorkbenchApp(ScreenHost[None]):
         student_fixed: bool = False,
         connect_hint: str = "",
         db: str | None = None,
+        names_given: bool = False,
     ) -> None:
         super().__init__()
+        #: the pair was named on the command line (kept as the last pair at this workbench)
+        self._names_given = names_given
         self.student = student or user or _login_name()
         self.partner = partner
         self._ask_names = ask_names
@@ -136,6 +140,8 @@ class WorkbenchApp(ScreenHost[None]):
         self._drawn: tuple[object, ...] = ()
         self._too_small: TooSmallScreen | None = None
         self._main: MainScreen | None = None
+        #: the maze the message line last named
+        self._maze_named = station.maze
 
     def who(self) -> str:
         """Who is at the robot, for the message line ("" when nobody was named)."""
@@ -168,6 +174,16 @@ class WorkbenchApp(ScreenHost[None]):
 
             dialog = IdentityDialog(self.student, self.partner, student_fixed=self.student_fixed)
             self.push_screen(dialog, self._named)
+        elif self._names_given:
+            self._remember_pair()
+
+    def _remember_pair(self) -> None:
+        """Keep the pair for the next start at this workbench (never for a served student:
+        the data folder there is the server's)."""
+        if self.station.files.confined:
+            return
+        with contextlib.suppress(OSError):
+            save_last_pair(resolve_data_dir(self.data_dir), self.student, self.partner)
 
     def hint_line(self) -> str:
         """The connect hint for the message line: all of it when it fits beside the names,
@@ -181,6 +197,7 @@ class WorkbenchApp(ScreenHost[None]):
         if names is None:
             return
         self.student, self.partner = names  # before the labs open: the dialog is modal
+        self._remember_pair()
         for screen in self.screen_stack:
             bar = screen.query("#message")
             if bar:
@@ -277,6 +294,12 @@ class WorkbenchApp(ScreenHost[None]):
             self.maze_path = Path(path)
             if self._main is not None:
                 self._main.maze_path = self.maze_path
+        maze = self.station.maze
+        if maze is not self._maze_named:
+            self._maze_named = maze
+            said = self._main.message if self._main is not None else ""
+            if maze.name not in said:  # else the screen has said it already
+                self.say(maze_message(self.station))
         self._show_maze_title()
         self.refresh_views()
 
@@ -289,6 +312,7 @@ class WorkbenchApp(ScreenHost[None]):
     def open_labs(self) -> None:
         if self._labs is None:
             self._open_store()
+            self._match_stored_names()
             self._labs = LabsScreen(
                 self.station,
                 self.store,
@@ -298,6 +322,19 @@ class WorkbenchApp(ScreenHost[None]):
             )
             self.install_screen(self._labs, name="labs")
         self.push_screen("labs")
+
+    def _match_stored_names(self) -> None:
+        """Spell the pair as the store does, so "alice doe" resumes Alice Doe's progress (not
+        for a served student, whose login name is the only one that is theirs)."""
+        if self.store is None or self.station.files.confined:
+            return
+        try:
+            student = self.store.spelling(self.student)
+            partner = self.store.spelling(self.partner) if self.partner else ""
+        except Exception:  # the store may be away; the names stay as typed
+            return
+        if (student, partner) != (self.student, self.partner):
+            self._named((student, partner))
 
     def _open_store(self) -> None:
         try:
@@ -423,6 +460,12 @@ def make_app(
         raise AppSetupError(f"unknown noise level {noise!r}: use one of {', '.join(NOISE_LEVELS)}")
     if role not in ROLES:
         raise AppSetupError(f"unknown role {role!r}: use one of {', '.join(ROLES)}")
+    names_given = bool(student)
+    if not student and not user and workspace is None and not student_fixed:
+        # the pair at this workbench last time, offered instead of the login name
+        last = read_last_pair(resolve_data_dir(data_dir))
+        if last is not None:
+            student, partner = last[0], partner or last[1]
     try:
         student, partner = check_pair(student or user or _login_name(), partner)
     except NameProblem as exc:
@@ -470,7 +513,21 @@ def make_app(
         student_fixed=student_fixed,
         connect_hint=connect_hint,
         db=db,
+        names_given=names_given,
     )
+
+
+def maze_message(station: LabStation) -> str:
+    """What the message line says when a maze goes on the station: its name, and the profile
+    the robot keeps when the file was made for another."""
+    maze = station.maze
+    text = f"the robot is on {maze.name}"
+    if maze.profile and maze.profile != station.profile:
+        text += (
+            f", still with the {station.profile} profile (the maze file names {maze.profile}; "
+            f"--profile {maze.profile} at start uses it)"
+        )
+    return text
 
 
 def _login_name() -> str:

@@ -17,11 +17,14 @@ import os
 from typing import TYPE_CHECKING, Literal, TypeVar
 
 from textual.app import App
+from textual.binding import Binding
 from textual.message import Message
 from textual.reactive import var
 
 from workbench.labs.model import Setup
 from workbench.sim.session import Snapshot
+
+from .plain import PlainCommandPalette, follow
 
 ReturnType = TypeVar("ReturnType")
 #: the screens a screen may ask the app to open
@@ -111,8 +114,34 @@ class StartEndpoint(Message):
 class ScreenHost(App[ReturnType]):
     """The Unicode setting of an app that hosts the workbench's screens, in one place."""
 
+    # ASCII mode: Textual's own widgets without block-element borders (plain.py replaces
+    # their glyphs); here rather than in the app's stylesheet, so every host has them
+    DEFAULT_CSS = """
+    App.-ascii OptionList,
+    App.-ascii OptionList:focus {
+        border: ascii $border-blurred;
+    }
+    App.-ascii #alg-builtins,
+    App.-ascii #alg-builtins:focus {
+        border: none;
+    }
+    App.-ascii CommandPalette #--input,
+    App.-ascii CommandPalette LoadingIndicator {
+        border: none;
+        border-bottom: ascii $border;
+    }
+    App.-ascii CommandPalette CommandList,
+    App.-ascii CommandPalette CommandList:focus {
+        border: none;
+        border-bottom: ascii $border;
+    }
+    """
+
     #: draw with Unicode lines, arrows and marks (False: plain ASCII)
     unicode: var[bool] = var(False, init=False)
+
+    def on_mount(self) -> None:
+        self.mark_ascii()
 
     def on_toggle_unicode(self, message: ToggleUnicode) -> None:
         self.unicode = not self.unicode
@@ -129,9 +158,25 @@ class ScreenHost(App[ReturnType]):
     def watch_unicode(self, unicode: bool) -> None:
         self.mark_ascii()
         for screen in self.screen_stack:
+            follow(screen, unicode)
             if isinstance(screen, FollowsUnicode):
                 screen.set_unicode(unicode)
 
     def mark_ascii(self) -> None:
-        """The app's CSS class for plain-ASCII drawing (narrower panel borders)."""
+        """The app's CSS class for plain-ASCII drawing (panel borders and frames, scroll bars,
+        the glyphs of Textual's own widgets: see :mod:`workbench.tui.plain`)."""
         self.set_class(not self.unicode, "-ascii")
+
+    def get_key_display(self, binding: Binding) -> str:
+        """A key as the footer shows it; in ASCII mode arrows are named (``right``, not ``→``)."""
+        text = super().get_key_display(binding)
+        if self.unicode or text.isascii():
+            return text
+        return binding.key.split(",")[0].strip()
+
+    def action_command_palette(self) -> None:
+        """The command palette; in ASCII mode without its emoji search icon."""
+        if self.unicode:
+            super().action_command_palette()
+        elif self.use_command_palette and not PlainCommandPalette.is_open(self):
+            self.push_screen(PlainCommandPalette())

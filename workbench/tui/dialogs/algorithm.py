@@ -31,6 +31,7 @@ from workbench.sim.session import Snapshot
 
 from ..host import Say, ShowsSnapshot, StationChanged
 from ..keys import bindings
+from ..plain import drawn_in_unicode, prose
 from ..widgets.field import Field
 from ..widgets.param_editor import ParamEditor
 
@@ -217,7 +218,8 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
             return
         title.update(f"{definition.name}  ({_source(definition.source)})")
         description = self.query_one("#alg-description", Static)
-        description.update(" ".join(definition.description.split()) or "(no description)")
+        text = " ".join(definition.description.split()) or "(no description)"
+        description.update(prose(text, drawn_in_unicode(self)))
         description.display = True
         lines = [f"Sensors it reads ({station.profile} ports):"]
         lines += [

@@ -55,6 +55,12 @@ class Dialog(ModalScreen[ResultType]):
     Dialog #error.-empty {
         display: none;
     }
+    /* many problems (a maze file full of them) scroll, so the buttons stay on the screen */
+    Dialog #error-box {
+        height: auto;
+        max-height: 9;
+        scrollbar-size-vertical: 1;
+    }
     Dialog #buttons {
         height: 1;
         margin-top: 1;

@@ -10,6 +10,7 @@ from textual.widgets import Button, Input, Label, Select, Static
 from workbench.sim.editing import EditorError, GenerateOptions
 from workbench.sim.generate import EXITS, MAX_CELLS, MIN_CELLS, STYLES
 
+from ..plain import follow_app
 from ..widgets.field import Field
 from .frame import Dialog
 
@@ -70,6 +71,7 @@ class GenerateDialog(Dialog[GenerateOptions | None]):
                 yield Button("Cancel", id="cancel", compact=True)
 
     def on_mount(self) -> None:
+        follow_app(self)
         self.query_one("#width", Input).focus()
 
     @on(Input.Submitted)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from textual import on
 from textual.app import ComposeResult
-from textual.containers import Horizontal, Vertical
+from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.widgets import Button, Input, Label, Static
 
 from ..widgets.field import Field
@@ -44,7 +44,8 @@ class PathDialog(Dialog[str | None]):
             with Horizontal(classes="field"):
                 yield Label("Path")
                 yield Field(self._value, id="path", compact=True)
-            yield Static(self._error, id="error", classes="" if self._error else "-empty")
+            with VerticalScroll(id="error-box", can_focus=False):
+                yield Static(self._error, id="error", classes="" if self._error else "-empty")
             with Horizontal(id="buttons"):
                 yield Button(self._action, id="ok", variant="primary", compact=True)
                 yield Button("Cancel", id="cancel", compact=True)

@@ -29,6 +29,7 @@ from workbench.labs.signoff import (
 from workbench.labs.store import Store, StoreError
 
 from ..keys import bindings
+from ..plain import follow_app
 from ..widgets.field import Field
 from ..widgets.tick import Tick
 
@@ -186,6 +187,7 @@ class SignoffModal(ModalScreen[str | None]):
         return [self.student, self.partner] if self.partner else [self.student]
 
     def on_mount(self) -> None:
+        follow_app(self)
         self.query_one("#signoff-next").display = False
         if self.roster:
             field = "#signoff-passphrase" if len(self.roster) == 1 else "#signoff-instructor"

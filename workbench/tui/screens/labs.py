@@ -1,8 +1,9 @@
 """The labs screen: the course's lab exercises, their instructions and their live checks.
 
-On the left, every lab and its exercises (✓ once an exercise's objectives pass or it has been
-signed off); on the right, the chosen exercise: its instructions, its objectives with ✓/✗ and
-a one-line reason that follow the station as the student works, and its questions. ``a`` puts
+On the left, every lab and its exercises (✓ once an exercise's objectives pass, ★ once an
+instructor has signed it off; ``[X]`` and ``[*]`` in ASCII mode); on the right, the chosen
+exercise: its instructions, its objectives with ✓/✗ (``[X]``/``[ ]``) and a one-line reason
+that follow the station as the student works, and its questions. ``a`` puts
 the exercise's set-up on the station, ``i`` opens the instructor's sign-off. Progress is saved
 in the store as soon as an exercise is opened and each time an objective or an answer
 changes; an objective that passed once stays passed, with its evidence, after a restart.
@@ -11,7 +12,7 @@ changes; an objective that passed once stays passed, with its evidence, after a 
 from __future__ import annotations
 
 import json
-from typing import ClassVar
+from typing import ClassVar, NamedTuple
 
 from textual import on
 from textual.app import ComposeResult
@@ -19,7 +20,7 @@ from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.screen import Screen
 from textual.timer import Timer
-from textual.widgets import Footer, Input, Label, Markdown, OptionList, Static
+from textual.widgets import Footer, Input, Markdown, OptionList, Static
 from textual.widgets.option_list import Option
 
 from workbench.control.station import LabStation
@@ -28,13 +29,26 @@ from workbench.labs.model import Exercise, Lab, LabFileError, load_labs
 from workbench.labs.store import Store, StoreUnavailable
 from workbench.sim.session import Snapshot
 
-from ..host import SetUpDone, ShowsSnapshot
+from ..host import FollowsUnicode, SetUpDone, ShowsSnapshot
 from ..keys import bindings
+from ..plain import follow_app, prose
 from ..widgets.field import Field
 
-PASS, FAIL, OPEN = "✓", "✗", "·"
-#: the lab list's mark of an exercise an instructor has signed off (apart from passed)
-SIGNED = "★"
+
+class Marks(NamedTuple):
+    """How an objective, an answer or an exercise in the list is marked."""
+
+    passed: str
+    failed: str
+    open: str
+    #: the lab list's mark of an exercise an instructor has signed off (apart from passed)
+    signed: str
+
+
+UNICODE_MARKS = Marks("✓", "✗", "·", "★")
+#: ASCII mode: a ticked box for passed, an empty one for not yet, a star for signed off
+ASCII_MARKS = Marks("[X]", "[ ]", "[ ]", "[*]")
+PASS, FAIL, OPEN, SIGNED = UNICODE_MARKS
 
 
 UNREACHABLE = "the course database cannot be reached"
@@ -42,7 +56,7 @@ UNREACHABLE = "the course database cannot be reached"
 RETRY_SECONDS = 2.0
 
 
-class LabsScreen(ShowsSnapshot, Screen[None]):
+class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
     """Choose an exercise, set it up, watch its objectives, answer its questions."""
 
     DEFAULT_CSS = """
@@ -62,6 +76,7 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
         height: 1fr;
     }
     LabsScreen #labs-title {
+        height: auto;
         text-style: bold;
         color: $text-primary;
     }
@@ -78,6 +93,9 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
         height: auto;
     }
     LabsScreen .question {
+        height: auto;
+    }
+    LabsScreen .question-text {
         height: auto;
     }
     LabsScreen .question Input {
@@ -131,6 +149,7 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
         self._drivers: dict[tuple[str, str], str] = {}
         self._retry_timer: Timer | None = None
         self._reload_when_back = False
+        self.unicode = False
         self._load_saved()
 
     # -- store ---------------------------------------------------------------------------
@@ -233,9 +252,9 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
     # -- layout --------------------------------------------------------------------------
     def compose(self) -> ComposeResult:
         with Horizontal(id="labs-body"):
-            yield OptionList(*self._options(), id="labs-list")
+            yield OptionList(*self._options(), id="labs-list", markup=False)
             with Vertical(id="labs-exercise"):
-                yield Label("", id="labs-title", markup=False)
+                yield Static("", id="labs-title", markup=False)
                 # objectives scroll with the text: every one stays reachable, however many
                 with VerticalScroll(id="labs-scroll"):
                     yield Static("", id="labs-objectives", markup=False)
@@ -244,18 +263,45 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
         yield Static("", id="labs-message", markup=False)
         yield Footer(compact=True, show_command_palette=False)
 
+    @property
+    def marks(self) -> Marks:
+        return UNICODE_MARKS if self.unicode else ASCII_MARKS
+
     def _options(self) -> list[Option]:
         options: list[Option] = []
+        marks = self.marks
         for lab in self.labs:
-            options.append(Option(lab.title, id=f"lab:{lab.id}", disabled=True))
+            options.append(
+                Option(prose(lab.title, self.unicode), id=f"lab:{lab.id}", disabled=True)
+            )
             for ex in lab.exercises:
                 key = (lab.id, ex.id)
-                mark = SIGNED if key in self._signed else PASS if key in self._done else OPEN
-                options.append(Option(f"{mark} {ex.title}", id=f"{lab.id}/{ex.id}"))
+                mark = (
+                    marks.signed
+                    if key in self._signed
+                    else marks.passed
+                    if key in self._done
+                    else marks.open
+                )
+                title = prose(ex.title, self.unicode)
+                options.append(Option(f"{mark} {title}", id=f"{lab.id}/{ex.id}"))
         return options
 
+    def set_unicode(self, unicode: bool) -> None:
+        self.unicode = unicode
+        if not self._ready:
+            return
+        self._refresh_list()
+        if self.selected is not None:
+            lab, exercise = self.selected
+            self.selected = None
+            self._show_exercise(lab, exercise)
+
     def on_mount(self) -> None:
+        self.unicode = getattr(self.app, "unicode", True)
+        follow_app(self)
         self._ready = True
+        self._refresh_list()
         if self._reload_when_back or (self.store is not None and self.store.pending):
             self._retry_timer = self.set_interval(RETRY_SECONDS, self._retry_store)
         problem = self._problem or self._store_problem
@@ -301,7 +347,9 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
             return
         lab_id, ex_id = option_id.split("/", 1)
         lab = next(lab for lab in self.labs if lab.id == lab_id)
-        exercise = lab.exercise(ex_id)
+        self._show_exercise(lab, lab.exercise(ex_id))
+
+    def _show_exercise(self, lab: Lab, exercise: Exercise) -> None:
         if self.selected == (lab, exercise):
             return
         self.selected = (lab, exercise)
@@ -316,9 +364,10 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
         signed = self._signed.get((lab.id, exercise.id))
         title = f"{lab.title}: {exercise.title}"
         if signed:
-            title += f" ({SIGNED} signed off {signed})"
-        self.query_one("#labs-title", Label).update(title)
-        self.query_one("#labs-instructions", Markdown).update(exercise.instructions)
+            title += f" ({self.marks.signed} signed off {signed})"
+        unicode = self.unicode
+        self.query_one("#labs-title", Static).update(prose(title, unicode))
+        self.query_one("#labs-instructions", Markdown).update(prose(exercise.instructions, unicode))
         box = self.query_one("#labs-questions", Vertical)
         box.remove_children()
         answers = self.answers.get((lab.id, exercise.id), {})
@@ -330,9 +379,13 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
             )
             box.mount(
                 Vertical(
-                    Label(q.text, markup=False),
+                    Static(prose(q.text, unicode), markup=False, classes="question-text"),
                     field,
-                    Static(self._answer_reason(exercise, q.id), classes="question-reason"),
+                    Static(
+                        self._answer_reason(exercise, q.id),
+                        classes="question-reason",
+                        markup=False,
+                    ),
                     classes="question",
                 )
             )
@@ -346,7 +399,8 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
             return "not answered yet"
         q = next(q for q in exercise.questions if q.id == question_id)
         ok, reason = q.check(text)
-        return f"{PASS if ok else FAIL} {reason}"
+        marks = self.marks
+        return prose(f"{marks.passed if ok else marks.failed} {reason}", self.unicode)
 
     @on(Input.Submitted)
     @on(Input.Changed)
@@ -389,8 +443,12 @@ class LabsScreen(ShowsSnapshot, Screen[None]):
         progress = self.track()
         if progress is None:
             return
-        lines = [f"{PASS if o.passed else FAIL} {o.text}: {o.reason}" for o in progress.objectives]
-        self.query_one("#labs-objectives", Static).update("\n".join(lines))
+        marks = self.marks
+        lines = [
+            f"{marks.passed if o.passed else marks.failed} {o.text}: {o.reason}"
+            for o in progress.objectives
+        ]
+        self.query_one("#labs-objectives", Static).update(prose("\n".join(lines), self.unicode))
 
     def say(self, message: str) -> None:
         if self._ready:

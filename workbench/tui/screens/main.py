@@ -365,13 +365,14 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, Screen[None]):
             self.action_maze(path, str(exc))
             return
         except MazeError as exc:
-            self.action_maze(path, "\n".join(str(p) for p in exc.problems))
+            problems = [str(p) for p in exc.problems]
+            heading = [f"{len(problems)} problems in the file:"] if len(problems) > 1 else []
+            self.action_maze(path, "\n".join(heading + problems))
             return
         self.station.load_maze(maze)
         self._maze_view.set_maze(maze)
         self._maze_view.clear_trail()
-        self.show_message(f"the robot is on {maze.name}")
-        self.post_message(MazeChanged(real))
+        self.post_message(MazeChanged(real))  # the app names the maze on the message line
 
     def action_editor(self) -> None:
         self.post_message(OpenScreen("editor"))

@@ -7,6 +7,7 @@ any run record (JSONL) by path.
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import ClassVar
 
 from textual import on
@@ -38,8 +39,8 @@ COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("collisions", "Hits", "Hits"),
     ("efficiency", "Eff", "Eff"),
     ("ended", "Ended", "Ended"),
-    ("maze", "Maze", "Maze"),
     ("record", "Rec", "Rec"),
+    ("maze", "Maze", "Maze"),
 )
 OPEN_HELP = (
     "A run record is a .jsonl file written by 'workbench run --record FILE' or by the app "
@@ -63,8 +64,18 @@ def run_cells(run: RunEntry, unicode: bool) -> tuple[str, ...]:
         str(m.collisions),
         f"{m.efficiency:.2f}" if m.efficiency is not None else "-",
         run.ended,
-        run.maze or "-",
         yes if run.record else "-",
+        run.maze or "-",
+    )
+
+
+def run_detail(run: RunEntry) -> str:
+    """The chosen run in words, whole: who drove, on which maze and profile, its record (the
+    table's last columns do not fit 80 columns)."""
+    record = f"record {Path(run.record).name}" if run.record else "not recorded"
+    return (
+        f"run {run.number}: {run.driver} on {run.maze or '-'} ({run.profile}, seed {run.seed}), "
+        f"ended by {run.ended}; {record}"
     )
 
 
@@ -85,6 +96,10 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
     }
     RunsScreen #runs-table {
         height: 1fr;
+    }
+    RunsScreen #runs-detail {
+        height: auto;
+        padding: 0 1;
     }
     RunsScreen #runs-status {
         height: auto;
@@ -121,6 +136,7 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         yield Static(id="runs-title", markup=False)
         yield Static(id="runs-help", markup=False)
         yield DataTable(id="runs-table", cursor_type="row", zebra_stripes=True)
+        yield Static(id="runs-detail", markup=False)
         yield Static(id="runs-status", markup=False)
         yield Footer()
 
@@ -177,6 +193,16 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             table.add_row(*cells, key=str(run.number))
         if runs:
             table.move_cursor(row=min(max(row, 0), len(runs) - 1))
+        self._show_detail()
+
+    def _show_detail(self) -> None:
+        run = self._selected()
+        self.query_one("#runs-detail", Static).update(run_detail(run) if run else "")
+
+    @on(DataTable.RowHighlighted, "#runs-table")
+    def _row_highlighted(self, event: DataTable.RowHighlighted) -> None:
+        event.stop()
+        self._show_detail()
 
     # -- status ------------------------------------------------------------------------------
     def _status(self, text: str, error: bool = False) -> None:

@@ -11,7 +11,8 @@ class MessageBar(Static):
 
     DEFAULT_CSS = """
     MessageBar {
-        height: 1;
+        height: auto;
+        max-height: 3;
         padding: 0 1;
         background: $boost;
         color: $text-muted;

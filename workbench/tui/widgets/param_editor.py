@@ -1,5 +1,10 @@
 """One tunable parameter of an algorithm: its value (checked as it is typed), its range and
-default, and what it means."""
+default, and what it means.
+
+A starter FSM of the labs leaves some parameters for the students: their description starts
+with ``FILL IN:``. The editor marks those and shows the rest of the description (the lab's hint)
+under the value, so the student sees what to decide without opening the file.
+"""
 
 from __future__ import annotations
 
@@ -12,9 +17,20 @@ from workbench.control.fsm import Parameter
 
 from .field import Field
 
+#: how a starter FSM marks a parameter the students decide (the start of its description)
+FILL_IN = "FILL IN:"
+
 
 def _g(value: float) -> str:
     return f"{value:g}"
+
+
+def fill_in_hint(parameter: Parameter) -> str | None:
+    """The lab's hint for a parameter the students fill in (None: not one of those)."""
+    text = " ".join(parameter.description.split())
+    if not text.upper().startswith(FILL_IN):
+        return None
+    return text[len(FILL_IN) :].strip()
 
 
 class ParamEditor(Vertical):
@@ -25,19 +41,29 @@ class ParamEditor(Vertical):
         height: auto;
     }
     ParamEditor > Horizontal {
-        height: 1;
+        height: auto;
     }
     ParamEditor .param-name {
-        width: 16;
+        width: 15;
     }
     ParamEditor Input {
-        width: 10;
+        width: 8;
         margin-right: 1;
         background: $panel;
     }
     ParamEditor .param-range {
         width: 1fr;
+        height: auto;
         color: $text-muted;
+    }
+    ParamEditor .param-fill-in {
+        height: auto;
+        padding-left: 2;
+        color: $text-warning;
+    }
+    ParamEditor.-fill-in .param-name {
+        color: $text-warning;
+        text-style: bold;
     }
     ParamEditor .param-error {
         height: auto;
@@ -64,6 +90,9 @@ class ParamEditor(Vertical):
         self.default = default
         self._input = Field(_g(value), compact=True, classes="param-value")
         self._error = Static("", classes="param-error", markup=False)
+        #: the lab's hint when the students fill this parameter in
+        self.hint = fill_in_hint(parameter)
+        self.set_class(self.hint is not None, "-fill-in")
         if parameter.description:
             self.tooltip = " ".join(parameter.description.split())
 
@@ -80,7 +109,10 @@ class ParamEditor(Vertical):
         with Horizontal():
             yield Label(p.name, classes="param-name", markup=False)
             yield self._input
-            yield Label(", ".join(bounds), classes="param-range", markup=False)
+            # the whole range, wrapped under itself when the dialog is narrow
+            yield Static(", ".join(bounds), classes="param-range", markup=False)
+        if self.hint is not None:
+            yield Static(f"{FILL_IN} {self.hint}", classes="param-fill-in", markup=False)
         yield self._error
 
     @property

@@ -23,7 +23,8 @@ class RunStatus(TextLines):
     """
 
     def __init__(self, *, id: str | None = None, classes: str | None = None) -> None:
-        super().__init__(id=id, classes=classes)
+        # wrapped: the clock line with the exit time, or a long VIPLE line, is read whole
+        super().__init__(wrap=True, id=id, classes=classes)
         set_border_title(self, "Run")
 
     def show(

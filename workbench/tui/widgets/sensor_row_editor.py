@@ -11,6 +11,7 @@ from textual.widgets import Button, Label, Select, Static
 from workbench.control.station import SensorRow
 from workbench.sim.sensors import KINDS
 
+from ..plain import follow_app
 from .field import Field
 
 MOUNT_CHOICES = ("front", "left", "right", "back", "none")
@@ -98,6 +99,9 @@ class SensorRowEditor(Vertical):
             yield self._reading
             yield Button("x", compact=True, classes="row-remove", tooltip="remove this row")
         yield self._error
+
+    def on_mount(self) -> None:
+        follow_app(self)
 
     def row(self) -> SensorRow:
         mount = self._mount.value

@@ -6,6 +6,7 @@ a time; a ``Static`` would repaint its whole region on every change.
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Sequence
 
 from rich.segment import Segment
@@ -17,7 +18,11 @@ from textual.widget import Widget
 
 
 class TextLines(Widget):
-    """Lines of plain text (or Rich ``Text``), one per row, cached as strips."""
+    """Lines of plain text (or Rich ``Text``), one per row, cached as strips.
+
+    With ``wrap``, a plain line longer than the widget is wrapped at spaces onto the rows
+    below it (indented by two), so nothing is cut at a narrow terminal.
+    """
 
     DEFAULT_CSS = """
     TextLines {
@@ -29,21 +34,37 @@ class TextLines(Widget):
         self,
         lines: Sequence[str | Text] = (),
         *,
+        wrap: bool = False,
         id: str | None = None,
         classes: str | None = None,
     ) -> None:
         super().__init__(id=id, classes=classes)
+        self.wrap = wrap
+        self._source: list[str | Text] = list(lines)
         self._lines: list[str | Text] = list(lines)
         self._strips: list[Strip | None] = [None] * len(self._lines)
         self._width = 0
 
+    def _rows(self, lines: Sequence[str | Text], width: int) -> list[str | Text]:
+        """The rows ``lines`` take at ``width`` (themselves, unless wrapped)."""
+        if not self.wrap or width < 8:
+            return list(lines)
+        rows: list[str | Text] = []
+        for line in lines:
+            if isinstance(line, Text) or len(line) <= width:
+                rows.append(line)
+            else:
+                rows += textwrap.wrap(line, width, subsequent_indent="  ", break_on_hyphens=False)
+        return rows
+
     @property
     def lines(self) -> tuple[str | Text, ...]:
-        return tuple(self._lines)
+        return tuple(self._source)
 
     def set_lines(self, lines: Sequence[str | Text]) -> None:
         """Show ``lines``; repaint only the rows that changed (re-layout when the count does)."""
-        lines = list(lines)
+        self._source = list(lines)
+        lines = self._rows(lines, self.size.width)
         if len(lines) != len(self._lines):
             self._lines = lines
             self._strips = [None] * len(lines)
@@ -58,15 +79,16 @@ class TextLines(Widget):
                     self.refresh(Region(0, y, width, 1))
 
     def get_content_height(self, container: Size, viewport: Size, width: int) -> int:
-        return len(self._lines)
+        return len(self._rows(self._source, width))
 
     def get_content_width(self, container: Size, viewport: Size) -> int:
-        return max((len(str(line)) for line in self._lines), default=0)
+        return max((len(str(line)) for line in self._source), default=0)
 
     def render_line(self, y: int) -> Strip:
         width = self.size.width
         if width != self._width:
             self._width = width
+            self._lines = self._rows(self._source, width)
             self._strips = [None] * len(self._lines)
         if not 0 <= y < len(self._lines):
             return Strip.blank(width, self.rich_style)

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import textwrap
 from collections.abc import Iterable
 
+from textual.widget import Widget
 from textual.widgets import Log
 
 from workbench.control.fsm import Transition
@@ -19,7 +21,12 @@ def values_text(values: dict[str, object], unit: str) -> str:
 
 
 class TransitionLog(Log):
-    """Appends only the transitions it has not shown yet; cleared when a new run starts."""
+    """Appends only the transitions it has not shown yet; cleared when a new run starts.
+
+    An entry longer than the panel is wrapped onto indented lines below it (the log does not
+    scroll sideways, so a cut entry would lose the state it went to and the values that fired
+    it).
+    """
 
     DEFAULT_CSS = """
     TransitionLog {
@@ -54,8 +61,17 @@ class TransitionLog(Log):
                     break
         self._last = entries[-1]
         go = arrow(unicode)
-        self.write_lines(
-            f"{t.time:6.1f} {t.source} {go} {t.target}"
-            + (f"  {values_text(dict(t.values), unit)}" if t.values else "")
-            for t in entries[start:]
-        )
+        # the panel's width (the log itself has none yet while it is hidden), less the scroll
+        # bar's column
+        panel = self.parent
+        width = (panel.content_region.width if isinstance(panel, Widget) else 0) - 1
+        lines: list[str] = []
+        for t in entries[start:]:
+            text = f"{t.time:6.1f} {t.source} {go} {t.target}"
+            if t.values:
+                text += f"  {values_text(dict(t.values), unit)}"
+            if width < 16 or len(text) <= width:
+                lines.append(text)
+            else:
+                lines += textwrap.wrap(text, width, subsequent_indent=" " * 7)
+        self.write_lines(lines)

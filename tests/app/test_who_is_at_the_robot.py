@@ -1,0 +1,79 @@
+"""Who is at the robot: the app offers the last pair at this workbench, and a name typed with
+other case or spacing resumes the progress saved under it; a served student only ever gets
+the login's own name."""
+
+from __future__ import annotations
+
+from textual.pilot import Pilot
+from textual.widgets import Input
+
+from workbench.labs.lastpair import save_last_pair
+from workbench.tui.app import make_app
+from workbench.tui.dialogs.identity import IdentityDialog
+
+from .labs_support import DRIVE, open_exercise, text
+from .support import run
+
+
+def test_a_name_typed_in_lower_case_resumes_the_saved_progress(tmp_path):
+    data = tmp_path / "data"
+    first = make_app(paused=True, student="Alice Doe", data_dir=data)
+
+    async def drive(pilot: Pilot) -> None:
+        screen = await open_exercise(pilot, DRIVE)
+        await pilot.press("a", "escape", "w", "a", "s", "d", "space", "l")
+        await pilot.pause()
+        assert text(screen, "#labs-objectives").startswith("[X] drove with w, a, s, d")
+
+    run(first, drive)
+    again = make_app(paused=True, student=" alice doe ", data_dir=data)
+
+    async def resume(pilot: Pilot) -> None:
+        screen = await open_exercise(pilot, DRIVE)
+        assert screen.student == again.student == "Alice Doe"
+        assert text(screen, "#labs-objectives").startswith(
+            "[X] drove with w, a, s, d and space: passed earlier"
+        )
+
+    run(again, resume)
+
+
+def test_the_last_pair_is_offered_at_start_instead_of_the_login_name(tmp_path):
+    data = tmp_path / "data"
+    first = make_app(paused=True, data_dir=data, ask_names=True)
+
+    async def name_them(pilot: Pilot) -> None:
+        dialog = pilot.app.screen
+        assert isinstance(dialog, IdentityDialog)
+        dialog.query_one("#student", Input).value = "Ana Ruiz"
+        dialog.query_one("#partner", Input).value = "Ben Ortiz"
+        await pilot.press("enter")
+        await pilot.pause()
+        assert (first.student, first.partner) == ("Ana Ruiz", "Ben Ortiz")
+
+    run(first, name_them)
+    again = make_app(paused=True, data_dir=data, ask_names=True)
+
+    async def offered(pilot: Pilot) -> None:
+        dialog = pilot.app.screen
+        assert isinstance(dialog, IdentityDialog)
+        assert dialog.query_one("#student", Input).value == "Ana Ruiz"
+        assert dialog.query_one("#partner", Input).value == "Ben Ortiz"
+
+    run(again, offered)
+
+
+def test_a_served_student_is_never_offered_another_pair(tmp_path):
+    data = tmp_path / "data"
+    save_last_pair(data, "Alice Doe", "Bo Li")
+    workspace = tmp_path / "ws"
+    workspace.mkdir()
+    app = make_app(
+        paused=True,
+        data_dir=data,
+        workspace=workspace,
+        user="carol",
+        ask_names=True,
+        student_fixed=True,
+    )
+    assert (app.student, app.partner) == ("carol", "")
