@@ -23,7 +23,7 @@ import termios
 import tty
 from collections.abc import Callable, Iterator
 
-from workbench.program.keys import KEY_NUMBERS
+from workbench.program.keys import known_key
 from workbench.viple.client import VipleClient
 
 #: what :class:`KeyDecoder` gives for the two quit keys
@@ -101,10 +101,7 @@ class KeyDecoder:
 
 
 def _plain_key(byte: int) -> str | None:
-    if byte == ord(" "):
-        return "space"
-    char = chr(byte).lower()
-    return char if char in KEY_NUMBERS and len(char) == 1 else None
+    return known_key(chr(byte)) if byte < 0x80 else None
 
 
 @contextlib.contextmanager

@@ -35,6 +35,17 @@ RELEASE = "release"
 RELEASE_GAP = 0.75
 
 
+def known_key(name: str) -> str | None:
+    """A key as a terminal or the app names it (``W``, `` ``, ``space``, ``up``) as VIPLE's
+    key name (``w``, ``space``, ``up``); None for a key VIPLE has no number for. A capital
+    letter is its letter: Shift is not a key of its own."""
+    if name == " ":
+        name = "space"
+    if len(name) == 1:
+        name = name.lower()
+    return name if name in KEY_NUMBERS else None
+
+
 class KeyScriptError(ValueError):
     """A key script that cannot be read, naming the item and the fix."""
 
