@@ -192,3 +192,79 @@ def test_a_program_lacking_a_sensor_cannot_start_and_says_which(tmp_path):
         assert app.station.program_run is None
 
     run(app, body)
+
+
+def screen_keys(program: str, tmp_path) -> str:
+    """Answers p, r and space (keys the main screen uses) by printing them."""
+    b = ProgramBuilder()
+    main = b.panel("Main")
+    b.robot(main)
+    for number in (15, 17, 59):  # p, r, space
+        main.chain(main.add(13, str(number)), main.add(2, '"got " + value'), main.add(28, ""))
+    return b.write(tmp_path / program)
+
+
+def active_actions(app) -> set[str]:
+    """The actions of the keys the footer shows."""
+    return {b.binding.action for b in app.screen.active_bindings.values() if b.binding.show}
+
+
+def test_ctrl_k_sends_every_key_to_the_program_until_pressed_again(tmp_path):
+    app = make_app(maze_file(tmp_path), paused=True, noise="off")
+    path = screen_keys("keys.viple", tmp_path)
+
+    async def body(pilot: Pilot) -> None:
+        station = app.station
+        await load(pilot, path)
+        await pilot.press("escape")
+        await pilot.press("ctrl+k")  # no program runs yet: nothing happens
+        assert not app.screen.takes_all_keys
+        await pilot.press("x")
+        run_ = station.program_run
+        station.pause()
+        # p is the workbench's: it resumes the simulation, and the program never sees it
+        await pilot.press("p")
+        assert not station.paused
+        station.pause()
+        await pilot.press("ctrl+k")
+        await pilot.pause()
+        assert app.screen.takes_all_keys
+        assert active_actions(app) == {"keys_back", "quit"}  # the footer: ^k back, ^q quit
+        panel = app.screen.query_one(ProgramState)
+        assert "ALL KEYS go to it" in str(panel.query_one("#program-summary", Static).render())
+        for key in ("p", "r", "space", "R", "ctrl+p", "tab", "question_mark"):
+            await pilot.press(key)
+            station.step(2)
+        assert station.paused and station.program_run is run_  # nothing of the workbench ran
+        assert app.screen is app.screen_stack[-1] and len(app.screen_stack) == 1
+        app.refresh_views()
+        await pilot.pause()
+        got = [line.split(None, 1)[1] for line in panel.console_lines]
+        assert got == ["got p", "got r", "got space", "got r"]  # R is the r key
+        await pilot.press("ctrl+k")  # the keys come back
+        assert not app.screen.takes_all_keys and "pause" in active_actions(app)
+        await pilot.press("space")  # space stops the program again
+        assert station.program_run is None
+
+    run(app, body)
+
+
+def test_all_keys_end_when_the_program_stops(tmp_path):
+    app = make_app(maze_file(tmp_path), paused=True, noise="off")
+    path = screen_keys("keys.viple", tmp_path)
+
+    async def body(pilot: Pilot) -> None:
+        station = app.station
+        await load(pilot, path)
+        await pilot.press("escape", "x", "ctrl+k")
+        assert app.screen.takes_all_keys
+        station.stop_program("stopped")  # e.g. a lab's set-up changes the controller
+        app.refresh_views()
+        await pilot.pause()
+        assert not app.screen.takes_all_keys
+        paused = station.paused
+        await pilot.press("p")  # p is the workbench's again
+        assert station.paused is not paused
+        assert "keys_back" not in active_actions(app) and "pause" in active_actions(app)
+
+    run(app, body)

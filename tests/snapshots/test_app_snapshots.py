@@ -129,6 +129,30 @@ def test_main_screen_with_a_program_driving(snap_compare, size, unicode, tmp_pat
 
 
 @grid
+def test_main_screen_with_every_key_going_to_the_program(
+    snap_compare, size, unicode, tmp_path, monkeypatch
+):
+    from tests.app.test_app_program import drive_by_wire
+    from workbench.program.choice import choose_program
+
+    monkeypatch.chdir(tmp_path)
+    drive_by_wire(tmp_path)
+
+    async def before(pilot: Pilot) -> None:
+        station = pilot.app.station
+        choose_program(station, "wire.viple")
+        station.start_program()
+        station.pacer.paused = True
+        station.step(6)
+        await pilot.press("ctrl+k", "w")
+        station.step(30)
+        pilot.app.refresh_views()
+        await pilot.pause()
+
+    assert snap_compare(app(unicode), terminal_size=size, run_before=before)
+
+
+@grid
 def test_algorithm_dialog_with_a_bad_program(snap_compare, size, unicode, tmp_path, monkeypatch):
     from tests.app.test_app_program import bad_program
 

@@ -24,6 +24,7 @@ from workbench.viple.client import (
 )
 from workbench.viple.codec import WheelPorts
 
+from .keyboard import QUIT_KEYS, attach_keyboard, raw_terminal
 from .run import _simulation_options, describe_measures
 
 
@@ -78,6 +79,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     r.add_argument(
         "--duration", type=float, metavar="S", help="with --connect: stop after S seconds"
+    )
+    r.add_argument(
+        "--no-keyboard",
+        action="store_true",
+        help="with --connect: do not read the terminal's keys (they go to the program's Key "
+        f"Press events when the input is a terminal; {QUIT_KEYS} stops the robot and quits)",
     )
     r.set_defaults(func=cmd_run)
 
@@ -225,6 +232,9 @@ class _ProgramBrain:
     def tick(self, t: float) -> Step:
         return self._step(t, self.remote.tick(t))
 
+    def type_key(self, key: str, t: float) -> None:
+        self.remote.type_key(key, t)
+
     def _step(self, t: float, commands, started: bool = False) -> Step:
         printed, fired = self.remote.news()
         self.transitions += len(fired)
@@ -274,9 +284,13 @@ def cmd_connect(args: argparse.Namespace) -> int:
         print(f"{name}: {exc}", file=sys.stderr)
         return 2
     progress = sys.stderr if args.json else sys.stdout
+    keyboard = not args.no_keyboard and sys.stdin.isatty()
+    # in raw mode the terminal no longer turns \n into a new line at the left margin
+    newline = "\r\n" if keyboard and progress.isatty() else "\n"
 
     def log(text: str) -> None:
-        print(text, file=progress, flush=True)
+        progress.write(text.replace("\n", newline) + newline)
+        progress.flush()
 
     ports = wheel_ports(compiled)
     setup = ClientSetup(
@@ -296,7 +310,13 @@ def cmd_connect(args: argparse.Namespace) -> int:
         f"{setup.name} over {endpoint} (wheels on ports {wheels.left}/{wheels.right}; "
         f"sha256 {compiled.program.digest[:16]}...)"
     )
-    result = asyncio.run(run_client(setup, log))
+    if keyboard:
+        log(f"keys go to the program as you type them; {QUIT_KEYS} stops the robot and quits")
+        fd = sys.stdin.fileno()
+        with raw_terminal(fd):
+            result = asyncio.run(run_client(setup, log, attach=attach_keyboard(fd)))
+    else:
+        result = asyncio.run(run_client(setup, log))
     data = {**result.as_dict(), "program_sha256": compiled.program.digest}
     data["events"] = data.pop("transitions")
     if args.json:

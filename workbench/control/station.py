@@ -338,7 +338,7 @@ class LabStation:
             if key == "space":
                 self.stop_program("stopped")
             else:
-                self.program_run.type_key(key, self.session.world.time)
+                self.type_to_program(key)
             return True
         cmd = key_command(self.profile, key)
         if cmd is None:
@@ -355,6 +355,14 @@ class LabStation:
         if exact_move(self.profile, key):
             profile = get_profile(self.profile)
             self.session.command_after(self.session.world.cell / profile.move_speed, Stop())
+        return True
+
+    def type_to_program(self, key: str) -> bool:
+        """Any key (space too) for the running program's Key Press events, at the simulated
+        time; False when no program drives."""
+        if self.program_run is None:
+            return False
+        self.program_run.type_key(key, self.session.world.time)
         return True
 
     # -- sensors -------------------------------------------------------------------------

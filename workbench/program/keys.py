@@ -10,9 +10,12 @@ A key script says what a student would press and when, in simulated seconds:
 
 A terminal sends no key-up: a key held down arrives as the same key again and again (the
 keyboard's auto-repeat). :class:`TypedKeys` turns such presses into presses and releases by
-one rule, the same in the app and in a headless run's ``--typed`` script: a key counts as held
-while it keeps arriving; the keyboard is released when no key has come for :data:`RELEASE_GAP`
-seconds of simulated time, or when a different key arrives (released first, then pressed).
+one rule, the same in the app, in a headless run's ``--typed`` script and at the live keyboard
+of ``viple run --connect``: a key counts as held while it keeps arriving; the keyboard is
+released when no key has come for :data:`RELEASE_GAP` seconds, or when a different key arrives
+(released first, then pressed). The seconds are those of the clock the caller passes in:
+simulated time in the app and in headless runs, the wall clock when a program drives a real
+robot, which runs in real time.
 """
 
 from __future__ import annotations
@@ -27,9 +30,20 @@ KEY_NAMES.update({36: "up", 37: "left", 38: "right", 39: "down", 59: "space"})
 KEY_NUMBERS = {name: number for number, name in KEY_NAMES.items()}
 MAX_KEY_EVENTS = 10_000
 RELEASE = "release"
-#: simulated seconds without a key after which a typed key counts as released: longer than a
-#: keyboard's delay before auto-repeat starts (0.25 to 0.66 s), so a held key stays held
+#: seconds without a key after which a typed key counts as released: longer than a keyboard's
+#: delay before auto-repeat starts (0.25 to 0.66 s), so a held key stays held
 RELEASE_GAP = 0.75
+
+
+def known_key(name: str) -> str | None:
+    """A key as a terminal or the app names it (``W``, `` ``, ``space``, ``up``) as VIPLE's
+    key name (``w``, ``space``, ``up``); None for a key VIPLE has no number for. A capital
+    letter is its letter: Shift is not a key of its own."""
+    if name == " ":
+        name = "space"
+    if len(name) == 1:
+        name = name.lower()
+    return name if name in KEY_NUMBERS else None
 
 
 class KeyScriptError(ValueError):
@@ -78,7 +92,9 @@ def parse_key_script(text: str) -> tuple[KeyEvent, ...]:
 
 
 class TypedKeys:
-    """Key presses from a terminal (no key-up) as the presses and releases a program sees."""
+    """Key presses from a terminal (no key-up) as the presses and releases a program sees.
+
+    It keeps no clock of its own: every call says the time ``t`` on the caller's clock."""
 
     def __init__(self, gap: float = RELEASE_GAP) -> None:
         self.gap = gap

@@ -48,6 +48,7 @@ from .host import (
     ShowsStatus,
     StartEndpoint,
     StationChanged,
+    TakesAllKeys,
 )
 from .keys import bindings
 from .screens.editor import EditorScreen
@@ -246,7 +247,11 @@ class WorkbenchApp(ScreenHost[None]):
                 self.pop_screen()
 
     def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None:
-        """While the terminal is too small only quitting works."""
+        """While the terminal is too small, or while the screen takes every key (all keys to a
+        running program), only quitting works."""
+        screen = self.screen_stack[-1] if self.screen_stack else None
+        if isinstance(screen, TakesAllKeys) and screen.takes_all_keys:
+            return action == "quit"
         return self._too_small is None or action == "quit"
 
     # -- what screens ask for -------------------------------------------------------------------

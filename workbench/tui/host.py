@@ -63,6 +63,16 @@ class FollowsUnicode:
         def set_unicode(self, unicode: bool) -> None: ...
 
 
+class TakesAllKeys:
+    """A screen that may, for a while, take every key itself (the main screen while all keys
+    go to a running program): the app then answers only its quit key (``takes_all_keys``)."""
+
+    if TYPE_CHECKING:
+
+        @property
+        def takes_all_keys(self) -> bool: ...
+
+
 class ToggleUnicode(Message):
     """Switch the drawing between Unicode and ASCII, on every screen."""
 

@@ -186,10 +186,33 @@ KEYS: dict[str, Key] = {
         "keys to a program",
         "While a VIPLE program drives, w a s d, the arrows, the digits and letters the screen "
         "does not use go to its Key Press events; a key counts as released 0.75 s after it "
-        "stops repeating, or when another key comes. Space stops the program.",
+        "stops repeating, or when another key comes. Space stops the program; p, r and the "
+        "screen's other keys stay the workbench's (ctrl+k sends them to the program too).",
         show=False,
         priority=True,
         display="arrows",
+    ),
+    "program.all_keys": Key(
+        "ctrl+k",
+        "all_keys_to_program",
+        "All keys",
+        "Algorithm",
+        "all keys to a program",
+        "While a VIPLE program drives: every key, space, p and r too, goes to the program "
+        "until ctrl+k gives the keys back; only ctrl+k and ctrl+q stay the workbench's.",
+        show=False,
+        priority=True,
+        display="^k",
+    ),
+    "program.keys_back": Key(
+        "ctrl+k",
+        "keys_back",
+        "Keys back",
+        "Algorithm",
+        "keys back to the workbench",
+        "After ctrl+k sent every key to a program: the keys are the workbench's again.",
+        priority=True,
+        display="^k",
     ),
     "algorithm.fix": Key(
         "f",

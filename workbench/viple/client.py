@@ -19,7 +19,12 @@ on the robot. Waiting a little long only leaves the robot standing still for tha
 wait too short would cut the turn off, so the margin errs on the long side.
 
 Reports do not say when the robot reaches the exit, so the client cannot know: a run ends when
-``duration`` has passed, when the simulator closes the connection, or when the user stops it.
+``duration`` has passed, when the simulator closes the connection, or when the user stops it
+(a signal, or :meth:`VipleClient.stop` from a front end's quit key).
+
+A brain that answers keys (:class:`TakesKeys`, a VIPLE program) gets the keys a front end hands
+to :meth:`VipleClient.press`, on the client's clock, and ticks at once so the robot answers
+without waiting for the next report.
 """
 
 from __future__ import annotations
@@ -34,7 +39,7 @@ import socket
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Any, Protocol, runtime_checkable
 from urllib.parse import urlsplit
 
 from websockets.asyncio.server import ServerConnection, serve
@@ -150,6 +155,13 @@ class Brain(Protocol):
     def next_tick(self) -> float: ...
 
     def tick(self, t: float) -> Step: ...
+
+
+@runtime_checkable
+class TakesKeys(Protocol):
+    """A brain that answers keys typed while it drives (a VIPLE program's Key Press events)."""
+
+    def type_key(self, key: str, t: float) -> None: ...
 
 
 @dataclass(frozen=True)
@@ -366,7 +378,8 @@ class ClientResult:
     endpoint: str
     algorithm: str
     profile: str
-    #: "duration", "closed", "interrupted", "error" or "no connection"
+    #: "duration", "closed", "stopped" (the user's quit key), "interrupted" (a signal),
+    #: "error" or "no connection"
     ended: str
     exit_code: int
     time: float = 0.0
@@ -406,6 +419,18 @@ class _Interrupted:
 
 
 @dataclass(frozen=True)
+class _Stopped:
+    """The user asked to stop (a front end's quit key): the robot stops, the run ends well."""
+
+    message: str
+
+
+@dataclass(frozen=True)
+class _Key:
+    key: str
+
+
+@dataclass(frozen=True)
 class _Received:
     lines: list[str]
     problems: list[str]
@@ -438,6 +463,15 @@ class VipleClient:
     def interrupt(self, signum: int = signal.SIGINT) -> None:
         """Stop the run (from a signal handler): stop the robot, close, summarise."""
         self.inbox.put_nowait(_Interrupted(signum))
+
+    def stop(self, message: str) -> None:
+        """Stop the run because the user asked to (exit code 0): stop the robot, close."""
+        self.inbox.put_nowait(_Stopped(message))
+
+    def press(self, key: str) -> None:
+        """A key typed while driving; it reaches a brain that takes keys (others ignore it,
+        as do runs not yet connected)."""
+        self.inbox.put_nowait(_Key(key))
 
     async def run(self) -> ClientResult:
         try:
@@ -501,8 +535,7 @@ class VipleClient:
             )
             while True:
                 item = await self.inbox.get()
-                if isinstance(item, _Interrupted):
-                    self._interrupted(item)
+                if self._ends(item):
                     return
                 if isinstance(item, _Connected):
                     self.log(f"the simulator connected from {item.peer}")
@@ -527,10 +560,7 @@ class VipleClient:
                 item = await self.inbox.get()
         except TimeoutError:
             return False
-        if isinstance(item, _Interrupted):
-            self._interrupted(item)
-            return True
-        return False
+        return self._ends(item)
 
     # -- driving -------------------------------------------------------------------------
 
@@ -569,9 +599,14 @@ class VipleClient:
                 continue
             if isinstance(item, _Received):
                 await self._reports(channel, fsm, item)
-            elif isinstance(item, _Interrupted):
+            elif isinstance(item, _Key):
+                if isinstance(fsm, TakesKeys):
+                    now = self._now()
+                    fsm.type_key(item.key, now)
+                    await self._send(channel, self._shown(fsm.tick(now), fsm))
+            elif isinstance(item, (_Interrupted, _Stopped)):
                 await self._stop_robot(channel)
-                self._interrupted(item)
+                self._ends(item)
                 return
             elif isinstance(item, _Closed):
                 self._closed()
@@ -639,9 +674,16 @@ class VipleClient:
                 "closed", EXIT_FAILED, "the simulator closed the connection before any report"
             )
 
-    def _interrupted(self, item: _Interrupted) -> None:
-        name = signal.Signals(item.signum).name
-        self._end("interrupted", 128 + item.signum, f"stopped by {name}")
+    def _ends(self, item: object) -> bool:
+        """End the run if ``item`` asks to (a signal or the user's stop); False otherwise."""
+        if isinstance(item, _Interrupted):
+            name = signal.Signals(item.signum).name
+            self._end("interrupted", 128 + item.signum, f"stopped by {name}")
+            return True
+        if isinstance(item, _Stopped):
+            self._end("stopped", EXIT_OK, item.message)
+            return True
+        return False
 
     def _end(self, ended: str, code: int, message: str) -> None:
         self.result.ended = ended
@@ -657,19 +699,28 @@ async def run_client(
     setup: ClientSetup,
     log: Callable[[str], None] = print,
     on_step: Callable[[Step, str], None] | None = None,
+    attach: Callable[[VipleClient], Callable[[], None]] | None = None,
 ) -> ClientResult:
-    """Run the client until the run ends; SIGINT and SIGTERM end it cleanly."""
+    """Run the client until the run ends; SIGINT and SIGTERM end it cleanly.
+
+    ``attach`` hooks a front end to the client before it starts (a live keyboard calls
+    :meth:`VipleClient.press` and :meth:`VipleClient.stop`); what it returns unhooks it when
+    the run ends, however it ends.
+    """
     client = VipleClient(setup, log, on_step)
     loop = asyncio.get_running_loop()
     signals = (signal.SIGINT, signal.SIGTERM)
     for signum in signals:
         loop.add_signal_handler(signum, client.interrupt, signum)
+    detach = attach(client) if attach is not None else None
     try:
         return await client.run()
     except _Abort as exc:
         client._end("error", EXIT_FAILED, str(exc))
         return client.result
     finally:
+        if detach is not None:
+            detach()
         for signum in signals:
             loop.remove_signal_handler(signum)
 

@@ -22,6 +22,7 @@ from textual.widgets import Footer
 from workbench.control.fsm import FsmError
 from workbench.control.station import ALGORITHM_FAILED, LabStation, Notice
 from workbench.files.workspace import OutsideWorkspace
+from workbench.program.keys import known_key
 from workbench.sim.maze import MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.sensors import SensorConfigError
@@ -36,6 +37,7 @@ from ..host import (
     ShowsStatus,
     StartEndpoint,
     StationChanged,
+    TakesAllKeys,
     ToggleUnicode,
 )
 from ..keys import bindings
@@ -51,7 +53,7 @@ from ..widgets.sensor_readings import SensorReadings
 PANEL_HZ = 4.0
 
 
-class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, Screen[None]):
+class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Screen[None]):
     """Drive, watch and set up the robot."""
 
     # the keys pressed again and again while driving are priority bindings: the screen takes
@@ -80,6 +82,8 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, Screen[None]):
             "screen.labs",
             "viple.ws",
             "program.keys",
+            "program.all_keys",
+            "program.keys_back",
         )
     ]
     #: keys a running VIPLE program may have besides the drive keys and the arrows
@@ -114,6 +118,8 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, Screen[None]):
         self._said = ""
         self._connection = ""
         self._notice: Notice | None = station.notice
+        #: every key goes to the running program (ctrl+k), not only the free ones
+        self._all_keys = False
 
     def compose(self) -> ComposeResult:
         station = self.station
@@ -162,6 +168,9 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, Screen[None]):
         station = self.station
         self.snapshot = snapshot
         unicode = self.unicode
+        if self._all_keys and station.program_run is None:
+            self._all_keys = False  # the program stopped: the keys are the workbench's
+            self.refresh_bindings()
         if station.controller is not self._controller:
             self._controller = station.controller
             if station.controller is not None:
@@ -181,6 +190,7 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, Screen[None]):
             snapshot.state,
             self._connection,
             station.program,
+            self._all_keys,
         )
         if station.paused or moment != self._moment or now - self._panels_at >= 1 / PANEL_HZ:
             self._moment = moment
@@ -191,7 +201,7 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, Screen[None]):
             self._algorithm.display = not program
             self._program.display = program
             if program:
-                self._program.show(station)
+                self._program.show(station, self._all_keys)
             else:
                 self._algorithm.show(station, unicode)
             self._message.message = self._said
@@ -228,20 +238,49 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, Screen[None]):
             self._said = "program stopped: the keys drive"
         self.refresh_views()
 
+    @property
+    def takes_all_keys(self) -> bool:
+        """Every key but ctrl+k and ctrl+q goes to the running program."""
+        return self._all_keys and self.station.program_run is not None
+
     def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None:
+        running = self.station.program_run is not None
         if action == "program_key":
-            return self.station.program_run is not None
-        return True
+            return running
+        if action == "all_keys_to_program":
+            return running and not self._all_keys
+        if action == "keys_back":
+            return self.takes_all_keys
+        return not self.takes_all_keys
 
     def action_program_key(self, key: str) -> None:
         """An arrow while a program drives."""
         self.station.key(key)
         self.refresh_views()
 
+    def action_all_keys_to_program(self) -> None:
+        self._all_keys = True
+        self.refresh_bindings()
+        self.say("every key goes to the program: ctrl+k gives the keys back, ctrl+q quits")
+
+    def action_keys_back(self) -> None:
+        self._all_keys = False
+        self.refresh_bindings()
+        self.say("the keys are the workbench's again (space stops the program)")
+
     def on_key(self, event: events.Key) -> None:
-        """Arrows, digits and the free letters reach a running program."""
+        """Arrows, digits and the free letters reach a running program; every key does
+        while all keys go to it (keys VIPLE has no number for do nothing then)."""
         key = event.key
         if self.station.program_run is None:
+            return
+        if self.takes_all_keys:
+            event.stop()
+            event.prevent_default()
+            name = known_key(key)
+            if name is not None:
+                self.station.type_to_program(name)
+                self.refresh_views()
             return
         if key in self.PROGRAM_KEYS:
             event.stop()

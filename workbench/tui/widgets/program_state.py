@@ -82,7 +82,8 @@ class ProgramState(Vertical):
         """The console's lines, oldest first (what a student reads there)."""
         return list(self._log.lines)
 
-    def show(self, station: LabStation) -> None:
+    def show(self, station: LabStation, all_keys: bool = False) -> None:
+        """Follow the station's program; ``all_keys``: every key goes to it (ctrl+k)."""
         choice = station.program
         run = station.program_run
         set_border_title(self, f"Program {choice.name}" if choice else "Program")
@@ -95,7 +96,11 @@ class ProgramState(Vertical):
             self._printed = 0
             self._log.clear()
         held = "+".join(sorted(run.held))
-        self.summary = "running" + (f", holds {held}" if held else "")
+        holds = f", holds {held}" if held else ""
+        if all_keys:
+            self.summary = f"ALL KEYS go to it{holds} (^k: back)"
+        else:
+            self.summary = f"running{holds} (^k: all keys)"
         self.flows = _flows(run)
         self.variables = " ".join(f"{name}={_value(v)}" for name, v in run.variables.items())
         self.events = "\n".join(f"{f.time:5.1f} s {f.what}" for f in run.fired[-SHOWN_EVENTS:])
