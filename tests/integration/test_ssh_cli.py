@@ -81,7 +81,7 @@ def test_serve_ssh_refuses_a_broken_users_file_naming_line_and_fix(tmp_path):
     )
     assert done.returncode == 2
     assert f"{users}:3:11: users.ann.role: unknown role 'pupil'" in done.stderr
-    assert "(fix: write student or instructor)" in done.stderr
+    assert "(hint: use one of student, instructor)" in done.stderr
     assert "the server did not start" in done.stderr
 
 
