@@ -19,6 +19,7 @@ from textual import events
 from textual.binding import Binding, BindingType
 from textual.reactive import var
 from textual.screen import Screen
+from textual.timer import Timer
 
 from workbench.control.station import LabStation
 from workbench.files.bundled import default_maze_path
@@ -54,6 +55,9 @@ from .screens.runs import RunsScreen
 
 #: the smallest terminal the layout is made for (columns, rows)
 MIN_SIZE = (80, 24)
+#: how often the clock ticks while the station is at rest (paused, or the robot standing with
+#: nobody driving it): time passes as before, in larger steps, and nothing else needs drawing
+REST_HZ = 1.0
 ROLES = ("student", "instructor")
 
 
@@ -133,6 +137,11 @@ class WorkbenchApp(ScreenHost[None]):
         self.tick_hz = tick_hz
         self.set_reactive(WorkbenchApp.unicode, unicode)
         self._last_tick = perf_counter()
+        #: the clock ticks at REST_HZ (True) or at tick_hz (False)
+        self._resting = False
+        self._rest_period = max(1.0 / REST_HZ, 1.0 / tick_hz)
+        self._fast: Timer | None = None
+        self._slow: Timer | None = None
         self._drawn: tuple[object, ...] = ()
         self._too_small: TooSmallScreen | None = None
         self._main: MainScreen | None = None
@@ -159,7 +168,11 @@ class WorkbenchApp(ScreenHost[None]):
         self.mark_ascii()
         self._show_maze_title()
         self._last_tick = perf_counter()
-        self.set_interval(1.0 / self.tick_hz, self._tick, name="simulation")
+        self._fast = self.set_interval(1.0 / self.tick_hz, self._tick, name="simulation")
+        self._slow = self.set_interval(
+            self._rest_period, self._tick, name="simulation at rest", pause=True
+        )
+        self.station.on_activity = self.wake
         if self.connect_hint:
             self.station.message = self.hint_line()
         self._check_size(self.size.width, self.size.height)
@@ -188,16 +201,48 @@ class WorkbenchApp(ScreenHost[None]):
 
     # -- time --------------------------------------------------------------------------------
     def _tick(self) -> None:
+        station = self.station
+        if self.endpoints is not None:
+            station.connection = self.endpoints.summary()
+        steps = self._advance()
+        state = (station.paused, station.message, station.controller, len(station.runs))
+        if steps or state != self._drawn:
+            self.refresh_views()
+        self._rest(station.at_rest)
+
+    def _advance(self) -> int:
+        """Hand the station the real time since the last tick."""
         now = perf_counter()
         elapsed = now - self._last_tick
         self._last_tick = now
         station = self.station
-        if self.endpoints is not None:
-            station.connection = self.endpoints.summary()
-        steps = station.advance(elapsed)
-        state = (station.paused, station.message, station.controller, len(station.runs))
-        if steps or state != self._drawn:
-            self.refresh_views()
+        # at rest the ticks are far apart on purpose: all the time they owe is kept
+        lag = self._rest_period + station.pacer.max_lag if self._resting else None
+        return station.advance(elapsed, lag)
+
+    def _rest(self, resting: bool) -> None:
+        """Tick at REST_HZ while the station is at rest, else at the full rate."""
+        if resting == self._resting or self._fast is None or self._slow is None:
+            return
+        self._resting = resting
+        if resting:
+            self._fast.pause()
+            self._slow.resume()
+        else:
+            self._slow.pause()
+            self._fast.resume()
+
+    def wake(self) -> None:
+        """Something is about to change the station (a key, a click, a VIPLE command): the time
+        owed at rest is run first, as it would have been, and the clock ticks at full rate."""
+        if self._resting:
+            self._advance()
+            self._rest(False)
+
+    async def on_event(self, event: events.Event) -> None:
+        if isinstance(event, (events.Key, events.MouseDown)):
+            self.wake()
+        await super().on_event(event)
 
     def refresh_views(self) -> None:
         """Draw the station's current snapshot on every screen of the stack that shows one."""
@@ -234,6 +279,7 @@ class WorkbenchApp(ScreenHost[None]):
 
     # -- what screens ask for -------------------------------------------------------------------
     def on_station_changed(self, message: StationChanged) -> None:
+        self.wake()
         self.refresh_views()
 
     def on_maze_changed(self, message: MazeChanged) -> None:

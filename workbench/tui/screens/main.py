@@ -171,8 +171,8 @@ class MainScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             self._message.message = station.message
 
     def refresh_views(self) -> None:
-        """Redraw after an action: through the app, so open dialogs follow too."""
-        self.show_snapshot(self.station.snapshot())
+        """Redraw after an action: the app draws every screen that shows the station, this one
+        and the dialogs over it."""
         self.post_message(StationChanged())
 
     def say(self, message: str) -> None:
