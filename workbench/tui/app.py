@@ -8,9 +8,11 @@ snapshot on every screen that shows it.
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import getpass
 import os
+import threading
 from pathlib import Path
 from time import perf_counter
 from typing import ClassVar
@@ -26,7 +28,8 @@ from workbench.files.bundled import default_maze_path
 from workbench.files.workspace import LOCAL, FileAccess
 from workbench.labs.model import Setup
 from workbench.labs.names import NameProblem, check_pair
-from workbench.labs.store import Store
+from workbench.labs.pending import pending_path
+from workbench.labs.store import Store, resolve_data_dir
 from workbench.sim.maze import Maze, MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.noise import NOISE_LEVELS
@@ -55,6 +58,8 @@ from .screens.runs import RunsScreen
 
 #: the smallest terminal the layout is made for (columns, rows)
 MIN_SIZE = (80, 24)
+#: seconds between tries to write what the course database did not get
+STORE_RETRY_SECONDS = 2.0
 #: how often the clock ticks while the station is at rest (paused, or the robot standing with
 #: nobody driving it): time passes as before, in larger steps, and nothing else needs drawing
 REST_HZ = 1.0
@@ -124,6 +129,7 @@ class WorkbenchApp(ScreenHost[None]):
         #: the course's PostgreSQL database (None: the SQLite file in the data folder)
         self.db = db
         self.store: Store | None = None
+        self._store_lock = threading.Lock()
         self.store_problem = ""
         self._labs: LabsScreen | None = None
         self._viple_configs = (tcp, ws)
@@ -176,6 +182,9 @@ class WorkbenchApp(ScreenHost[None]):
         if self.connect_hint:
             self.station.message = self.hint_line()
         self._check_size(self.size.width, self.size.height)
+        if self.db and self._pending_file().is_file():
+            # what an earlier app could not save: written as soon as the database answers
+            self.run_worker(self._save_kept(), group="store")
         if self._ask_names:
             from .dialogs.identity import IdentityDialog
 
@@ -346,13 +355,48 @@ class WorkbenchApp(ScreenHost[None]):
         self.push_screen("labs")
 
     def _open_store(self) -> None:
+        with self._store_lock:  # the labs (here) or the saving of kept changes (a thread)
+            self._open_store_once()
+
+    def _open_store_once(self) -> None:
+        if self.store is not None:
+            return
         try:
             # a course database that is down now still gets the work once it is back
-            self.store = Store.open(self.data_dir, db=self.db, offline_ok=True)
+            store = Store.open(self.data_dir, db=self.db, offline_ok=True)
         except Exception as exc:  # the labs work without saving rather than not at all
             self.store = None
             where = "the course database" if self.db else "the data folder"
             self.store_problem = f"cannot open {where}, so nothing is saved: {exc}"
+            return
+        if self.db:
+            # what waits for the database is kept in a file too: it outlives this app
+            for problem in store.keep_pending_in(self._pending_file(), self.student):
+                self.log.warning(problem)
+        self.store = store
+
+    def _pending_file(self) -> Path:
+        return pending_path(resolve_data_dir(self.data_dir), self.student)
+
+    async def _save_kept(self) -> None:
+        """Write the changes an earlier app kept because the course database was away: one
+        try at a time, in a thread (a database that does not answer makes a try wait for the
+        connection's timeout), until they are written; then say so."""
+        await asyncio.to_thread(self._open_store)
+        store = self.store
+        if store is None:
+            return
+        while store.pending:
+            try:
+                done = await asyncio.to_thread(store.flush)
+            except Exception as exc:  # written by no retry: say why, keep working
+                self._say(f"changes kept from before were not saved: {exc}")
+                return
+            if done:
+                self._say("saving resumed: the changes kept while the course database was away "
+                          "are saved")  # fmt: skip
+                return
+            await asyncio.sleep(STORE_RETRY_SECONDS)
 
     def set_up_done(self, setup: Setup | None = None) -> None:
         """A lab's set-up changed the station: follow its maze and profile, and start the VIPLE
@@ -400,9 +444,11 @@ class WorkbenchApp(ScreenHost[None]):
     async def _shut_down(self) -> None:
         self.station.close()
         if self.store is not None:
-            # a last try for what the database did not get yet (never shown as saved)
-            with contextlib.suppress(Exception):
-                self.store.flush()
+            # a last try for what the database did not get yet (never shown as saved); while
+            # it is away the pending writes are in their file already, for the next app
+            if not self.store.offline:
+                with contextlib.suppress(Exception):
+                    self.store.flush()
             self.store.close()
         if self.endpoints is not None:
             await self.endpoints.close()

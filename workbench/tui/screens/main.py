@@ -184,7 +184,10 @@ class MainScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         station = self.station
         station.message = ""
         station.key(key)
-        self.refresh_views()
+        if station.paused:
+            self.refresh_views()
+        # else the next tick draws it, within 1/20 s, with the robot already moving: drawing
+        # now as well would draw every key twice while a student drives
 
     def action_pause(self) -> None:
         paused = self.station.toggle_pause()
