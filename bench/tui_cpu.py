@@ -32,6 +32,7 @@ import argparse
 import asyncio
 import contextlib
 import os
+import re
 import signal
 import socket
 import statistics
@@ -135,11 +136,13 @@ async def one_run(
         stats = data / "app.prof"
         if profile:
             command = (sys.executable, str(ROOT / "bench" / "profiled_app.py"), str(stats))
+        env = spec.env()
+        env["TEXTUAL_DRIVER"] = tree_driver(tree)
         screen = Screen()
         here = os.getcwd()
         os.chdir(tree)  # ``python -m workbench`` imports the tree it is started in
         try:
-            app = AppProcess(spec.argv(command), spec.env(), data / "app.log", screen.feed)
+            app = AppProcess(spec.argv(command), env, data / "app.log", screen.feed)
             await app.start()
         finally:
             os.chdir(here)
@@ -183,6 +186,13 @@ async def one_run(
         finally:
             await app.stop(grace=10.0)
         return results
+
+
+def tree_driver(tree: Path) -> str:
+    """The Textual driver the lab server of ``tree`` runs its apps with."""
+    source = (tree / "workbench" / "ssh" / "appproc.py").read_text()
+    found = re.search(r'^DRIVER = "([^"]+)"', source, re.MULTILINE)
+    return found.group(1) if found else "textual.drivers.web_driver:WebDriver"
 
 
 def export(rev: str, where: Path) -> Path:
