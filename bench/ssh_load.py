@@ -9,15 +9,22 @@ simulates at its own 20 Hz tick). Now and then a session stops driving for a mom
 presses `p` (pause), then `p` again, timing each press until the screen shows the change
 (PAUSED / running): the keypress-to-screen latency through SSH, the server and the app process.
 
+By default two rounds, the targets: 30 students all at once, then 60 arriving over --spread
+seconds; ``--sessions N...`` runs each N both ways instead (``--sessions 4 --seconds 10`` is a
+quick check). After driving, each session sits idle for --idle seconds (robot stopped, no keys).
+
 Printed for each N and arrival: time to first screen (connect to the names dialog on the
 screen, p50/p95), memory per session (RSS of each app process, and PSS from
 /proc/PID/smaps_rollup, which shares out the pages the processes have in common), the server
 process's own growth, CPU of the server and its app processes (as % of one core and of the
-whole machine), and the keypress latency (p50/p95). The SSH clients run in this process on the
+whole machine), the CPU of one app process while driving and while idle (as % of one core),
+and the keypress latency (p50/p95). The SSH clients run in this process on the
 same machine and their CPU is printed too. The apps are forked from the server's fork server
 unless --no-fork-server (the fork server's own memory is printed apart; the pages it shares
-with the apps count in their PSS too). Targets on a 2-core machine: 30 sessions held; first
-screen p95 <= 3 s; keypress-to-screen p95 <= 150 ms at 30 sessions; <= 60 MB per session.
+with the apps count in their PSS too). Targets on a 2-core machine: 60 sessions
+arriving over 30 s held with keypress-to-screen p95 <= 150 ms; 30 at once: first screen p95
+<= 3 s and keypress-to-screen p95 <= 150 ms; an idle session <= 0.3 % of a core; <= 60 MB per
+session.
 Figures vary from run to run.
 """
 
@@ -166,8 +173,9 @@ class Student:
         return True
 
     async def run(
-        self, start: float, seconds: float, hz: float, offset: float, arrive: float
-    ) -> None:
+        self, start: float, seconds: float, hz: float, offset: float, arrive: float,
+        idle: float = 0.0,
+    ) -> None:  # fmt: skip
         await asyncio.sleep(max(0.0, arrive - time.perf_counter()))
         t0 = time.perf_counter()
         conn = await asyncssh.connect(
@@ -204,6 +212,9 @@ class Student:
                 step += 1
                 tick += period
                 await asyncio.sleep(max(0.0, tick - time.perf_counter()))
+            if idle > 0:  # the robot stops; the student reads, presses nothing
+                proc.stdin.write(b" ")
+                await asyncio.sleep(max(0.0, end + idle - time.perf_counter()))
             reader.cancel()
         finally:
             conn.close()
@@ -239,7 +250,13 @@ def start_server(data: Path, port: int, sessions: int, fork: bool) -> subprocess
     return server
 
 
-async def round_of(n: int, seconds: float, hz: float, spread: float, fork: bool) -> None:
+def apps_cpu(apps: list[int]) -> float:
+    return sum(cpu_seconds(p) for p in apps)
+
+
+async def round_of(
+    n: int, seconds: float, hz: float, spread: float, fork: bool, idle: float
+) -> None:
     with tempfile.TemporaryDirectory(prefix="ssh-load-") as tmp:
         data = Path(tmp)
         keys = {}
@@ -269,12 +286,15 @@ async def round_of(n: int, seconds: float, hz: float, spread: float, fork: bool)
                     hz,
                     offset=(i % 20) * PROBE_EVERY / 20,
                     arrive=t0 + spread * i / n,
+                    idle=idle,
                 )
             )
             for i, s in enumerate(students)
         ]
         await asyncio.sleep(max(0.0, start - time.perf_counter()) + 1.0)
         cpu0, wall0 = tree_cpu(server.pid), time.perf_counter()
+        apps0 = apps_of(server.pid)[0]
+        app_cpu0 = apps_cpu(apps0)
         await asyncio.sleep(seconds / 2)
         apps, forkservers = apps_of(server.pid)
         rss = [rss_bytes(p) for p in apps]
@@ -284,6 +304,13 @@ async def round_of(n: int, seconds: float, hz: float, spread: float, fork: bool)
         server_growth = rss_bytes(server.pid) - base_rss
         await asyncio.sleep(max(0.0, seconds / 2 - 2.0))
         cpu1, wall1 = tree_cpu(server.pid), time.perf_counter()
+        app_cpu1 = apps_cpu(apps0)
+        idle_cpu = idle_wall = 0.0
+        if idle > 0:  # from 2 s after the drive ended to 1 s before the students leave
+            await asyncio.sleep(max(0.0, start + seconds + 2.0 - time.perf_counter()))
+            idle_cpu0, idle_wall0 = apps_cpu(apps0), time.perf_counter()
+            await asyncio.sleep(max(0.5, idle - 3.0))
+            idle_cpu, idle_wall = apps_cpu(apps0) - idle_cpu0, time.perf_counter() - idle_wall0
         await asyncio.gather(*tasks, return_exceptions=True)
         own_cpu = time.process_time() - own_cpu0
         deadline = time.monotonic() + 20
@@ -325,6 +352,16 @@ async def round_of(n: int, seconds: float, hz: float, spread: float, fork: bool)
         f"machine ({cores} cores); the SSH clients here: {100 * own_cpu / (wall1 - start):.0f}%"
         f" of one core"
     )
+    per_app = (app_cpu1 - app_cpu0) / (wall1 - wall0) / max(1, len(apps0))
+    print(
+        f"  CPU per session  driving {100 * per_app:.2f}% of a core"
+        + (
+            f";  idle {100 * idle_cpu / idle_wall / max(1, len(apps0)):.2f}% of a core "
+            f"(nothing moving, no keys, {idle_wall:.0f} s)"
+            if idle_wall
+            else ""
+        )
+    )
     print(
         f"  keys sent        {result.keys_sent} ({result.keys_sent / n / seconds:.1f}/s per "
         f"session); app processes left after disconnect: {left}"
@@ -336,7 +373,16 @@ async def round_of(n: int, seconds: float, hz: float, spread: float, fork: bool)
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--sessions", type=int, nargs="+", default=[10, 30])
+    parser.add_argument(
+        "--sessions", type=int, nargs="+",
+        help="each N both all at once and spread (default: the targets, 30 all at once and 60 "
+        "spread over --spread seconds)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--idle", type=float, default=20.0,
+        help="seconds each session then sits idle (robot stopped, no keys), for the idle CPU "
+        "per session (0: none; default 20)",
+    )  # fmt: skip
     parser.add_argument("--seconds", type=float, default=30.0)
     parser.add_argument("--hz", type=float, default=20.0)
     parser.add_argument(
@@ -349,9 +395,17 @@ def main() -> None:
         help="the server starts each app as a new process (as before the fork server)",
     )  # fmt: skip
     args = parser.parse_args()
-    for n in args.sessions:
-        for spread in (0.0, args.spread) if args.spread > 0 else (0.0,):
-            asyncio.run(round_of(n, args.seconds, args.hz, spread, not args.no_fork_server))
+    if args.sessions:
+        rounds = [
+            (n, spread)
+            for n in args.sessions
+            for spread in ((0.0, args.spread) if args.spread > 0 else (0.0,))
+        ]
+    else:
+        rounds = [(30, 0.0), (60, args.spread)]
+    print(f"{os.cpu_count()} cores; load average before: {os.getloadavg()[0]:.2f}")
+    for n, spread in rounds:
+        asyncio.run(round_of(n, args.seconds, args.hz, spread, not args.no_fork_server, args.idle))
 
 
 if __name__ == "__main__":

@@ -1,21 +1,29 @@
-"""CPU of one workbench app process while the robot drives, as an SSH session runs it.
+"""CPU of one workbench app process while the robot drives and while it sits idle, as an SSH
+session runs it.
 
 Starts the app the way the SSH server does (``python -m workbench`` under Textual's web driver,
 packets over pipes, the student's VIPLE TCP and WebSocket endpoints on, 80x24, the names dialog
-at start), passes the names dialog, and drives the robot on the bundled Unity maze for
---seconds:
+at start), passes the names dialog, and then, for each mode of --modes:
 
-  * ``--keys ssh`` (default): the key pattern of ``bench/ssh_load.py`` at --hz keys a second
-    (forward, a turn now and then, stop now and then), as the load station sends it;
-  * ``--keys drive``: ``w`` once, then a turn (``a`` or ``d``) every 1.5 s, no other keys.
+  * ``ssh``: the key pattern of ``bench/ssh_load.py`` at --hz keys a second (forward, a turn now
+    and then, stop now and then), as the load station sends it, for --seconds;
+  * ``drive``: ``w`` once, then a turn (``a`` or ``d``) every 1.5 s, no other keys, --seconds;
+  * ``idle``: no key at all for --idle-seconds (nothing moves): what a student who has logged
+    in and is reading costs the server. After a driving mode the robot is stopped first (space)
+    and its run stays open, recorded as it stands.
 
-The app ticks its simulation at its own 20 Hz either way. Printed: the app process's CPU
-(user + system, from /proc) per second of driving, i.e. CPU seconds per simulated-and-drawn
-second at 1x speed, as % of one core; the screen output in bytes a second. Each of --runs runs
-is a fresh process; the median is printed last.
+The app ticks its simulation at its own 20 Hz. Printed: the app process's CPU (user + system,
+from /proc) per second of the mode, as % of one core (at 1x speed, CPU seconds per simulated
+and drawn second); the screen output in bytes a second. Each of --runs runs is a fresh process;
+the median is printed last.
 
-``--profile FILE`` runs the app under cProfile (slower; the figures are then only relative)
-and writes its stats to FILE at the end, printing the top functions by own and total time.
+``--compare REV`` measures the workbench of git revision REV (exported to a temporary folder)
+in the same run, alternating with this tree, and prints both medians and their ratio: a
+before/after taken under the same load from other processes on the machine.
+
+``--profile PREFIX`` runs the app under cProfile, switched on only for the measured stretch of
+each mode (start-up and the names dialog are left out; the figures are then only relative), and
+writes ``PREFIX-MODE.prof``, printing the top functions by own and total time.
 """
 
 from __future__ import annotations
@@ -24,8 +32,11 @@ import argparse
 import asyncio
 import contextlib
 import os
+import re
+import signal
 import socket
 import statistics
+import subprocess
 import sys
 import tempfile
 import time
@@ -38,7 +49,8 @@ from workbench.ssh.appproc import AppProcess, AppSpec  # noqa: E402
 
 CLK_TCK = os.sysconf("SC_CLK_TCK")
 SSH_PATTERN = "wwwwawwwwdww wwwwdwwwwaww "
-SETTLE = 1.0  # seconds of driving before the CPU is counted
+SETTLE = 1.0  # seconds of the mode before the CPU is counted
+MODES = ("ssh", "drive", "idle")
 
 
 def cpu_seconds(pid: int) -> float:
@@ -78,7 +90,36 @@ class Screen:
                 await asyncio.wait_for(self.arrived.wait(), left)
 
 
-async def one_run(seconds: float, hz: float, keys: str, profile: str | None) -> dict[str, float]:
+async def drive(app: AppProcess, mode: str, seconds: float, hz: float) -> None:
+    """Send the mode's keys for ``seconds``."""
+    period = 1.0 / hz
+    start = time.perf_counter()
+    end = start + seconds
+    step = 0
+    tick = start
+    turn_at = start + 1.5
+    if mode == "drive":
+        app.send_keys(b"w")
+    while (now := time.perf_counter()) < end:
+        if mode == "ssh":
+            app.send_keys(SSH_PATTERN[step % len(SSH_PATTERN)].encode())
+            step += 1
+            tick += period
+        elif mode == "drive" and now >= turn_at:
+            app.send_keys(b"ad"[step % 2 : step % 2 + 1])
+            step += 1
+            turn_at += 1.5
+            tick = min(turn_at, now + 0.1)
+        else:
+            tick = min(turn_at if mode == "drive" else end, now + 0.1)
+        await asyncio.sleep(max(0.0, tick - time.perf_counter()))
+
+
+async def one_run(
+    tree: Path, modes: list[str], seconds: float, idle_seconds: float, hz: float,
+    profile: str | None,
+) -> dict[str, dict[str, float]]:  # fmt: skip
+    """One fresh app process of the workbench in ``tree``: each mode's CPU and output rate."""
     with tempfile.TemporaryDirectory(prefix="tui-cpu-") as tmp:
         data = Path(tmp)
         spec = AppSpec(
@@ -91,12 +132,21 @@ async def one_run(seconds: float, hz: float, keys: str, profile: str | None) -> 
             record_dir=data / "runs",
             workspace=data,
         )
-        command = None
+        command: tuple[str, ...] = (sys.executable, "-m", "workbench")
+        stats = data / "app.prof"
         if profile:
-            command = (sys.executable, "-m", "cProfile", "-o", profile, "-m", "workbench")
+            command = (sys.executable, str(ROOT / "bench" / "profiled_app.py"), str(stats))
+        env = spec.env()
+        env["TEXTUAL_DRIVER"] = tree_driver(tree)
         screen = Screen()
-        app = AppProcess(spec.argv(command), spec.env(), data / "app.log", screen.feed)
-        await app.start()
+        here = os.getcwd()
+        os.chdir(tree)  # ``python -m workbench`` imports the tree it is started in
+        try:
+            app = AppProcess(spec.argv(command), env, data / "app.log", screen.feed)
+            await app.start()
+        finally:
+            os.chdir(here)
+        results: dict[str, dict[str, float]] = {}
         try:
             await screen.wait_for(b"Who is at this robot", 60)
             screen.buffer.clear()
@@ -105,69 +155,115 @@ async def one_run(seconds: float, hz: float, keys: str, profile: str | None) -> 
             await asyncio.sleep(0.5)
             pid = app.pid
             assert pid is not None
-            period = 1.0 / hz
-            start = time.perf_counter()
-            end = start + SETTLE + seconds
-            cpu0 = bytes0 = t0 = None
-            step = 0
-            tick = start
-            turn_at = start + 1.5
-            if keys == "drive":
-                app.send_keys(b"w")
-            while (now := time.perf_counter()) < end:
-                if cpu0 is None and now >= start + SETTLE:
-                    cpu0, bytes0, t0 = cpu_seconds(pid), screen.bytes, now
-                if keys == "ssh":
-                    app.send_keys(SSH_PATTERN[step % len(SSH_PATTERN)].encode())
-                    step += 1
-                    tick += period
-                elif now >= turn_at:
-                    app.send_keys(b"ad"[step % 2 : step % 2 + 1])
-                    step += 1
-                    turn_at += 1.5
-                    tick = min(turn_at, now + 0.1)
-                else:
-                    tick = min(turn_at, now + 0.1)
-                await asyncio.sleep(max(0.0, tick - time.perf_counter()))
-            cpu1, bytes1, t1 = cpu_seconds(pid), screen.bytes, time.perf_counter()
+            driven = False
+            for mode in modes:
+                if mode == "idle" and driven:
+                    app.send_keys(b" ")  # the robot stops and then stands still
+                driven = driven or mode != "idle"
+                length = idle_seconds if mode == "idle" else seconds
+                settle = asyncio.create_task(drive(app, mode, SETTLE + length, hz))
+                await asyncio.sleep(SETTLE)
+                if profile:
+                    os.kill(pid, signal.SIGUSR1)
+                cpu0, bytes0, t0 = cpu_seconds(pid), screen.bytes, time.perf_counter()
+                await settle
+                cpu1, bytes1, t1 = cpu_seconds(pid), screen.bytes, time.perf_counter()
+                if profile:
+                    with contextlib.suppress(FileNotFoundError):
+                        stats.unlink()
+                    os.kill(pid, signal.SIGUSR2)
+                    deadline = time.monotonic() + 30
+                    while not stats.exists() and time.monotonic() < deadline:
+                        await asyncio.sleep(0.1)
+                    await asyncio.sleep(0.5)
+                    if stats.exists():
+                        stats.replace(f"{profile}-{mode}.prof")  # the last of each mode
+                label = mode if mode not in results else f"{mode} again"
+                results[label] = {
+                    "cpu": (cpu1 - cpu0) / (t1 - t0),
+                    "bytes": (bytes1 - bytes0) / (t1 - t0),
+                }
         finally:
             await app.stop(grace=10.0)
-        assert cpu0 is not None and bytes0 is not None and t0 is not None
-        return {"cpu": (cpu1 - cpu0) / (t1 - t0), "bytes": (bytes1 - bytes0) / (t1 - t0)}
+        return results
+
+
+def tree_driver(tree: Path) -> str:
+    """The Textual driver the lab server of ``tree`` runs its apps with."""
+    source = (tree / "workbench" / "ssh" / "appproc.py").read_text()
+    found = re.search(r'^DRIVER = "([^"]+)"', source, re.MULTILINE)
+    return found.group(1) if found else "textual.drivers.web_driver:WebDriver"
+
+
+def export(rev: str, where: Path) -> Path:
+    """The workbench of git revision ``rev``, exported into ``where``."""
+    archive = subprocess.run(
+        ["git", "-C", str(ROOT), "archive", rev], capture_output=True, check=True
+    ).stdout
+    subprocess.run(["tar", "-x", "-C", str(where)], input=archive, check=True)
+    return where
 
 
 def show_profile(path: str) -> None:
     import pstats
 
     stats = pstats.Stats(path)
-    stats.sort_stats("tottime").print_stats(30)
-    stats.sort_stats("cumulative").print_stats(50)
+    stats.sort_stats("tottime").print_stats(25)
+    stats.sort_stats("cumulative").print_stats(40)
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=20.0, help="driving time per run")
-    parser.add_argument("--hz", type=float, default=20.0, help="keys a second (--keys ssh)")
-    parser.add_argument("--keys", choices=("ssh", "drive"), default="ssh")
+    parser.add_argument("--idle-seconds", type=float, default=30.0, help="idle time per run")
+    parser.add_argument("--hz", type=float, default=20.0, help="keys a second (ssh mode)")
+    parser.add_argument("--modes", nargs="+", choices=MODES, default=["idle", "ssh"])
     parser.add_argument("--runs", type=int, default=3, help="fresh app processes")
-    parser.add_argument("--profile", metavar="FILE", help="run under cProfile, stats to FILE")
+    parser.add_argument("--compare", metavar="REV", help="also measure git revision REV")
+    parser.add_argument("--profile", metavar="PREFIX", help="cProfile stats to PREFIX-MODE.prof")
     args = parser.parse_args()
     runs = 1 if args.profile else args.runs
     print(
-        f"app CPU while driving: web driver, 80x24, unity maze, keys {args.keys}"
-        f"{f' at {args.hz:g}/s' if args.keys == 'ssh' else ''}, {args.seconds:g} s x {runs}"
+        f"app CPU: web driver, 80x24, unity maze; modes {', '.join(args.modes)} "
+        f"(ssh keys at {args.hz:g}/s, {args.seconds:g} s; idle {args.idle_seconds:g} s) x {runs}"
     )
-    results = []
-    for i in range(runs):
-        r = asyncio.run(one_run(args.seconds, args.hz, args.keys, args.profile))
-        results.append(r)
-        cpu, out = 100 * r["cpu"], r["bytes"] / 1000
-        print(f"  run {i + 1}: CPU {cpu:5.2f}% of a core   {out:6.2f} KB/s")
-    cpu = statistics.median(r["cpu"] for r in results)
-    out = statistics.median(r["bytes"] for r in results)
-    print(f"  median: CPU {100 * cpu:5.2f}% of a core   {out / 1000:6.2f} KB/s")
+    with tempfile.TemporaryDirectory(prefix="tui-cpu-rev-") as tmp:
+        trees = {"this tree": ROOT}
+        if args.compare:
+            trees = {args.compare: export(args.compare, Path(tmp)), "this tree": ROOT}
+        results: dict[str, list[dict[str, dict[str, float]]]] = {name: [] for name in trees}
+        for i in range(runs):
+            for name, tree in trees.items():
+                r = asyncio.run(
+                    one_run(
+                        tree, args.modes, args.seconds, args.idle_seconds, args.hz, args.profile
+                    )
+                )
+                results[name].append(r)
+                shown = "   ".join(
+                    f"{mode} {100 * v['cpu']:5.2f}% ({v['bytes'] / 1000:.2f} KB/s)"
+                    for mode, v in r.items()
+                )
+                print(f"  run {i + 1} {name:>10}: {shown}")
+    medians = {
+        name: {mode: statistics.median(r[mode]["cpu"] for r in rs) for mode in rs[0]}
+        for name, rs in results.items()
+    }
+    for name, by_mode in medians.items():
+        shown = "   ".join(f"{mode} {100 * cpu:5.2f}% of a core" for mode, cpu in by_mode.items())
+        print(f"  median {name:>10}: {shown}")
+    if args.compare:
+        before, after = medians[args.compare], medians["this tree"]
+        shown = "   ".join(
+            f"{mode} x{after[mode] / before[mode]:.2f}" if before[mode] else f"{mode} -"
+            for mode in after
+        )
+        print(f"  this tree / {args.compare}: {shown}")
     if args.profile:
-        show_profile(args.profile)
+        for mode in dict.fromkeys(args.modes):
+            if Path(f"{args.profile}-{mode}.prof").exists():
+                print(f"\n=== profile: {mode} ===")
+                show_profile(f"{args.profile}-{mode}.prof")
 
 
 if __name__ == "__main__":

@@ -9,10 +9,11 @@ import time
 from textual.pilot import Pilot
 from textual.widgets import Input
 
+from workbench.labs.pending import pending_path
 from workbench.labs.store import Store
 
 from .labs_support import DRIVE, lab_app, open_exercise, text
-from .support import run
+from .support import run, said
 
 
 def test_a_student_resumes_on_another_server_where_they_left_off(tmp_path, pg_url):
@@ -72,3 +73,83 @@ def test_the_database_going_away_is_shown_and_the_work_is_saved_when_it_is_back(
     with Store.open(tmp_path / "elsewhere", db=pg_url) as store:
         saved = store.progress("ana")[("unity-simulator", "drive-by-wire")]
     assert saved["answers"] == {"tcp-port": "1350"}
+
+
+def test_changes_kept_while_the_database_is_down_outlive_the_app_and_are_saved_by_the_next(
+    tmp_path, pg_server, pg_url
+):
+    data = tmp_path / "data"
+    first = lab_app(data, db=pg_url)
+    kept = pending_path(data, "ana")
+
+    async def work_offline(pilot: Pilot) -> None:
+        screen = await open_exercise(pilot, DRIVE)
+        pg_server.stop()
+        screen.query_one("#q-tcp-port", Input).value = "4242"
+        await pilot.pause()
+        assert "saved as soon as it is back" in text(screen, "#labs-message")
+        assert kept.is_file()  # kept in the data folder at once, not only at the end
+        await pilot.press("ctrl+q")
+
+    try:
+        run(first, work_offline)
+        assert kept.is_file()  # the student quit with the database still down
+    finally:
+        pg_server.start()
+    second = lab_app(data, db=pg_url)  # the next start, the database back
+
+    async def resume(pilot: Pilot) -> None:
+        deadline = time.monotonic() + 15
+        while kept.is_file() and time.monotonic() < deadline:
+            await asyncio.sleep(0.2)
+        await pilot.pause()
+        assert said(second).startswith("saving resumed")
+        assert "saving resumed" in str(second.screen.query_one("#message").render())
+
+    run(second, resume)
+    assert not kept.is_file()
+    with Store.open(tmp_path / "elsewhere", db=pg_url) as store:
+        saved = store.progress("ana")[("unity-simulator", "drive-by-wire")]
+    assert saved["answers"] == {"tcp-port": "4242"}
+
+
+def test_retries_run_beside_the_app_one_at_a_time(tmp_path, pg_server, pg_url, monkeypatch):
+    monkeypatch.setattr("workbench.tui.screens.labs.RETRY_SECONDS", 0.1)
+    app = lab_app(tmp_path / "data", db=pg_url)
+    running, most = 0, 0
+
+    async def body(pilot: Pilot) -> None:
+        nonlocal running, most
+        screen = await open_exercise(pilot, DRIVE)
+        store = app.store
+        flush = store.flush
+
+        def slow_flush() -> bool:  # a database that does not answer: each try waits
+            nonlocal running, most
+            running += 1
+            most = max(most, running)
+            time.sleep(3.0)
+            running -= 1
+            return flush()
+
+        monkeypatch.setattr(store, "flush", slow_flush)
+        pg_server.stop()
+        try:
+            screen.query_one("#q-tcp-port", Input).value = "77"
+            await pilot.pause()
+            await asyncio.sleep(0.5)  # a retry is under way now
+            frames = app.frames
+            started = time.monotonic()
+            await pilot.press("escape", "p")  # back on the main screen, running
+            await pilot.pause(0.5)
+            assert time.monotonic() - started < 2.5  # keys were not held up by the 3 s try
+            assert app.frames > frames  # and the screen kept being drawn
+        finally:
+            pg_server.start()
+        deadline = time.monotonic() + 15
+        while store.pending and time.monotonic() < deadline:
+            await asyncio.sleep(0.2)
+        assert not store.pending
+
+    run(app, body)
+    assert most == 1

@@ -186,6 +186,10 @@ class LabStation:
     program: ProgramChoice | None = None
     #: the program driving now
     program_run: ProgramDriver | None = None
+    #: called just before a command from outside (a drive key, a VIPLE program) changes the
+    #: robot: a front end that advances time in larger steps while the station is at rest
+    #: (see :attr:`at_rest`) brings the clock up to now first
+    on_activity: Callable[[], None] | None = None
     _run_open: bool = False
     _run_driver: Driver = KEYS
     _run_source: str | None = None
@@ -215,16 +219,18 @@ class LabStation:
         self.pacer = Pacer(self.session)
         self.session.driver = KEYS
         self.session.on_command = self._commanded
+        self.session.before_command = self._activity
 
     # -- time ----------------------------------------------------------------------------
-    def advance(self, wall_seconds: float) -> int:
+    def advance(self, wall_seconds: float, lag: float | None = None) -> int:
         """Run real time forward; closes the run when the robot gets out.
 
+        ``lag`` is the most wall time owed that is kept (the pacer's ``max_lag`` if None).
         An algorithm whose guard or action fails is stopped with the reason in :attr:`notice`
         and the simulation paused, so a front end never sees the exception.
         """
         try:
-            steps = self.pacer.advance(wall_seconds)
+            steps = self.pacer.advance(wall_seconds, lag)
         except FsmRuntimeError as exc:
             self._algorithm_failed(exc)
             return 0
@@ -239,6 +245,20 @@ class LabStation:
             self._algorithm_failed(exc)
             return
         self._after_steps()
+
+    @property
+    def at_rest(self) -> bool:
+        """True while time changes nothing but the clock until someone acts: paused, or (at a
+        set speed) the robot standing with its motors off and no algorithm or VIPLE program
+        driving it. Stepping then gives the same run however seldom a front end ticks."""
+        if self.pacer.paused:
+            return True
+        session = self.session
+        return self.pacer.speed is not None and session.still and not session.driver.is_viple
+
+    def _activity(self) -> None:
+        if self.on_activity is not None:
+            self.on_activity()
 
     def _algorithm_failed(self, exc: FsmRuntimeError) -> None:
         self.stop_algorithm("error")

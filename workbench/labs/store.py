@@ -21,6 +21,7 @@ from __future__ import annotations
 import json
 import os
 import sqlite3
+import threading
 import urllib.request
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -44,6 +45,7 @@ from .database import (
 )
 from .lastpair import name_key
 from .migrations import RECORD_COLUMNS, SIGNOFF_LOCK, check_version, latest, migrate
+from .pending import FIELDS, PendingWrite, load_pending, save_pending
 from .signlog import GENESIS, entry_hash, parse_metrics, signed_payload
 
 __all__ = [
@@ -62,6 +64,25 @@ DB_NAME = "workbench.sqlite3"
 ENV_DATA_DIR = "WORKBENCH_DATA"
 SCHEMA_VERSION = latest("sqlite")
 MAX_SEQ = 2**53  # sequence numbers stay exact wherever the log is kept (JSON, any database)
+#: the table of each kind of write that may be kept pending (its columns: pending.FIELDS)
+TABLES = {"progress": "progress", "place": "places", "driver": "drivers"}
+
+
+def upsert(kind: str, only_newer: bool = False) -> str:
+    """The statement that saves one write of ``kind`` (see :mod:`.pending`). ``only_newer``
+    leaves a row alone that was saved later than the write (a write kept in a file by an
+    earlier app must not undo what the student saved since, on this server or another)."""
+    table, fields = TABLES[kind], FIELDS[kind]
+    key = {"progress": "student, lab, exercise", "place": "student",
+           "driver": "student, partner, lab, exercise"}[kind]  # fmt: skip
+    changed = [f for f in fields if f not in key.split(", ")]
+    sql = (
+        f"INSERT INTO {table} ({', '.join(fields)}) VALUES ({', '.join('?' for _ in fields)}) "
+        f"ON CONFLICT ({key}) DO UPDATE SET " + ", ".join(f"{f} = excluded.{f}" for f in changed)
+    )
+    if only_newer:
+        sql += f" WHERE {table}.updated_at <= excluded.updated_at"
+    return sql
 
 
 def default_data_dir() -> Path:
@@ -158,9 +179,13 @@ class Store:
     :meth:`open`; close it (or use ``with``).
 
     Saving progress, places and drivers never fails because a PostgreSQL server is down: the
-    write is kept pending (the newest per exercise) and written with the next write or
-    :meth:`flush`; their return value says whether it reached the database. Sign-offs and the
-    lockout need the database and raise :class:`StoreUnavailable` while it is away."""
+    write is kept pending (the newest per exercise) and written by :meth:`flush`; their return
+    value says whether it reached the database. While the database is away (the last write
+    could not reach it) a new write does not try it again: a front end calls :meth:`flush`
+    now and then, in a thread of its own (each call may wait for the connection's timeout),
+    and the store is safe to use from two threads. With :meth:`keep_pending_in` what is
+    pending is also kept in a file, so that a later app writes it. Sign-offs and the lockout
+    need the database and raise :class:`StoreUnavailable` while it is away."""
 
     def __init__(self, data_dir: Path, backend: Backend):
         self.data_dir = data_dir
@@ -168,8 +193,18 @@ class Store:
         #: the SQLite file (``None`` for PostgreSQL)
         self.path: Path | None = backend.path if isinstance(backend, SqliteBackend) else None
         self.where = backend.where
-        self._pending: dict[tuple[str, ...], tuple[str, tuple[Any, ...]]] = {}
+        #: what waits for the database, by key; True for a write kept from an earlier app
+        self._pending: dict[tuple[str, ...], tuple[PendingWrite, bool]] = {}
         self._migrated = False
+        #: the database did not answer the last write: new ones wait for :meth:`flush`
+        self.offline = False
+        #: guards what is pending (held briefly), and the connection (held while it is used)
+        self._lock = threading.RLock()
+        self._io = threading.RLock()
+        self._pending_file: Path | None = None
+        self._pending_student = ""
+        #: why the pending writes could not be kept in their file ("" when they could)
+        self.pending_file_problem = ""
 
     @classmethod
     def open(
@@ -247,7 +282,8 @@ class Store:
         return len(self._pending)
 
     def close(self) -> None:
-        self.backend.close()
+        with self._io:
+            self.backend.close()
 
     def __enter__(self) -> Store:
         return self
@@ -258,42 +294,82 @@ class Store:
     @contextmanager
     def _write(self) -> Iterator[Tx]:
         """One write transaction; on SQLite taken at once (IMMEDIATE) so writers queue."""
-        self._ensure_schema()
-        with self.backend.write() as tx:
-            yield tx
+        with self._io:
+            self._ensure_schema()
+            with self.backend.write() as tx:
+                yield tx
 
     def _read(self, sql: str, params: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
-        self._ensure_schema()
-        return self.backend.read(sql, params)
+        with self._io:
+            self._ensure_schema()
+            return self.backend.read(sql, params)
 
-    def _keep(self, key: tuple[str, ...], sql: str, params: tuple[Any, ...]) -> bool:
+    def _keep(self, write: PendingWrite) -> bool:
         """Write one upsert, or keep it pending while the database is away; the newest write
         of a key replaces an older pending one. True when it (and all pending) was written."""
-        self._pending.pop(key, None)
-        self._pending[key] = (sql, params)
+        with self._lock:
+            self._pending.pop(write.key, None)
+            self._pending[write.key] = (write, False)
+            if self.offline:
+                self._persist()
+                return False  # no new try here: flush() does it, off the caller's thread
         return self.flush()
 
     def flush(self) -> bool:
         """Write everything pending in one transaction. True when nothing is left pending;
         False while the database cannot be reached. Other errors drop what was pending (it
         would fail again) and are raised."""
-        if not self._pending:
-            return True
-        batch = dict(self._pending)
+        with self._lock:
+            if not self._pending:
+                self.offline = False
+                return True
+            batch = dict(self._pending)
         try:
             with self._write() as tx:
-                for sql, params in batch.values():
-                    tx.execute(sql, params)
+                for write, earlier in batch.values():
+                    tx.execute(upsert(write.kind, only_newer=earlier), write.values)
         except StoreUnavailable:
+            with self._lock:
+                self.offline = True
+                self._persist()
             return False
         except StoreError:
-            for key in batch:
-                self._pending.pop(key, None)
+            with self._lock:
+                for key in batch:
+                    self._pending.pop(key, None)
+                self._persist()
             raise
-        for key, value in batch.items():
-            if self._pending.get(key) == value:
-                del self._pending[key]
-        return not self._pending
+        with self._lock:
+            self.offline = False
+            for key, value in batch.items():
+                if self._pending.get(key) == value:
+                    del self._pending[key]
+            self._persist()
+            return not self._pending
+
+    def keep_pending_in(self, path: Path, student: str) -> list[str]:
+        """Keep ``student``'s pending writes in the file ``path`` from now on, and take up the
+        writes an earlier app kept there (they are saved by the next :meth:`flush`, each only
+        where the database holds nothing newer). Returns what was left out of the file."""
+        writes, problems = load_pending(path, student)
+        with self._lock:
+            self._pending_file = path
+            self._pending_student = student
+            for write in writes:
+                self._pending.setdefault(write.key, (write, True))
+        return problems
+
+    def _persist(self) -> None:
+        path = self._pending_file
+        if path is None:
+            return
+        student = self._pending_student
+        mine = [w for w, _ in self._pending.values() if w.values[0] == student]
+        try:
+            save_pending(path, student, mine)
+            self.pending_file_problem = ""
+        except OSError as exc:
+            self.pending_file_problem = f"cannot keep the pending writes in {path}: {exc}"
 
     def schema_version(self) -> int:
         rows = self._read("SELECT value FROM meta WHERE key = 'schema_version'")
@@ -382,13 +458,8 @@ class Store:
         """Replace the saved progress of one student in one exercise (any JSON object).
         True when written; False when kept pending (the database is away)."""
         text = json.dumps(progress, sort_keys=True, allow_nan=False)
-        return self._keep(
-            ("progress", student, lab, exercise),
-            "INSERT INTO progress (student, lab, exercise, progress, updated_at) "
-            "VALUES (?, ?, ?, ?, ?) ON CONFLICT (student, lab, exercise) DO UPDATE SET "
-            "progress = excluded.progress, updated_at = excluded.updated_at",
-            (student, lab, exercise, text, utc_iso(now or _now())),
-        )
+        stamp = utc_iso(now or _now())
+        return self._keep(PendingWrite("progress", (student, lab, exercise, text, stamp)))
 
     def progress(self, student: str, lab: str | None = None) -> dict[tuple[str, str], dict]:
         """Saved progress by (lab, exercise), including what is still pending."""
@@ -406,9 +477,12 @@ class Store:
                     f"{self.where}: the saved progress of {student} in {lab_id}/{exercise} "
                     "is not JSON"
                 ) from None
-        for key, (_, params_) in self._pending.items():
+        with self._lock:
+            waiting = [w for w, _ in self._pending.values()]
+        for write in waiting:
+            key = write.key
             if key[0] == "progress" and key[1] == student and (not lab or key[2] == lab):
-                out[(key[2], key[3])] = json.loads(params_[3])
+                out[(key[2], key[3])] = json.loads(write.values[3])
         return out
 
     def spelling(self, name: str) -> str:
@@ -430,19 +504,14 @@ class Store:
 
     def set_place(self, student: str, lab: str, exercise: str, now: datetime | None = None) -> bool:
         """Remember the exercise ``student`` has open (the labs reopen there)."""
-        return self._keep(
-            ("place", student),
-            "INSERT INTO places (student, lab, exercise, updated_at) VALUES (?, ?, ?, ?) "
-            "ON CONFLICT (student) DO UPDATE SET lab = excluded.lab, "
-            "exercise = excluded.exercise, updated_at = excluded.updated_at",
-            (student, lab, exercise, utc_iso(now or _now())),
-        )
+        stamp = utc_iso(now or _now())
+        return self._keep(PendingWrite("place", (student, lab, exercise, stamp)))
 
     def place(self, student: str) -> tuple[str, str] | None:
         """The (lab, exercise) ``student`` had open last, if any."""
         pending = self._pending.get(("place", student))
         if pending is not None:
-            return (pending[1][1], pending[1][2])
+            return (pending[0].values[1], pending[0].values[2])
         rows = self._read("SELECT lab, exercise FROM places WHERE student = ?", (student,))
         return (rows[0][0], rows[0][1]) if rows else None
 
@@ -458,13 +527,8 @@ class Store:
         now: datetime | None = None,
     ) -> bool:
         """Record who drove (did the typing in) an exercise for a student or a pair."""
-        return self._keep(
-            ("driver", student, partner, lab, exercise),
-            "INSERT INTO drivers (student, partner, lab, exercise, driver, updated_at) "
-            "VALUES (?, ?, ?, ?, ?, ?) ON CONFLICT (student, partner, lab, exercise) "
-            "DO UPDATE SET driver = excluded.driver, updated_at = excluded.updated_at",
-            (student, partner, lab, exercise, driver, utc_iso(now or _now())),
-        )
+        stamp = utc_iso(now or _now())
+        return self._keep(PendingWrite("driver", (student, partner, lab, exercise, driver, stamp)))
 
     def drivers(self, student: str, partner: str = "") -> dict[tuple[str, str], str]:
         rows = self._read(

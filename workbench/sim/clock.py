@@ -32,8 +32,12 @@ class Pacer:
     clock: Callable[[], float] = field(default=time.perf_counter)
     _debt: float = 0.0
 
-    def advance(self, wall_seconds: float) -> int:
-        """Run the steps ``wall_seconds`` of real time call for; returns how many ran."""
+    def advance(self, wall_seconds: float, lag: float | None = None) -> int:
+        """Run the steps ``wall_seconds`` of real time call for; returns how many ran.
+
+        ``lag`` overrides :attr:`max_lag` for this call: a front end that ticks seldom on
+        purpose (while nothing moves) keeps all the time it owes.
+        """
         if self.paused:
             self._debt = 0.0
             return 0
@@ -50,7 +54,8 @@ class Pacer:
                         return n
                 if self.clock() >= deadline:
                     return n
-        self._debt = min(self._debt + wall_seconds * self.speed, self.max_lag * self.speed)
+        keep = self.max_lag if lag is None else lag
+        self._debt = min(self._debt + wall_seconds * self.speed, keep * self.speed)
         n = int(self._debt / dt + 1e-9)
         self._debt -= n * dt
         deadline = self.clock() + self.budget

@@ -75,6 +75,9 @@ class Session:
         self.driver = NOBODY
         #: told of every command from outside the controller, with the driver that sent it
         self.on_command: Callable[[Any, Driver], None] | None = None
+        #: told just before such a command changes the robot (a front end that lets time pass
+        #: in larger steps while nothing moves catches up then)
+        self.before_command: Callable[[], None] | None = None
         self._reset_run_state()
 
     def _reset_run_state(self) -> None:
@@ -107,6 +110,8 @@ class Session:
 
         It cancels a command still waiting from :meth:`command_after`.
         """
+        if self.before_command is not None:
+            self.before_command()
         self._scheduled = None
         self.world.apply(cmd)
         self._commands.append(cmd)
@@ -219,6 +224,12 @@ class Session:
             self._events = []
         if self._commands:
             self._commands = []
+
+    @property
+    def still(self) -> bool:
+        """True while nothing on the robot changes but the clock: it stands with its motors off,
+        no controller drives it and no command waits to be applied."""
+        return self.controller is None and self._scheduled is None and self.world.still
 
     @property
     def reached_exit(self) -> bool:

@@ -288,6 +288,7 @@ class World:
         self._wheels = (0.0, 0.0)
         self._v = 0.0
         self._w = 0.0
+        self._moved = 0.0
         self._reaim = False
         self._turn_target: float | None = None
         self._readings = None
@@ -473,6 +474,7 @@ class World:
         self.time = t = self._steps * dt
         self._distance += moved
         self._turned += turned
+        self._moved = moved or turned
         self._x = x
         self._y = y
         self._angle = a
@@ -600,6 +602,12 @@ class World:
         """The maze block (x, y) the robot's centre is in."""
         inv = self._inv_cell
         return int(self._x * inv), int(self._y * inv)
+
+    @property
+    def still(self) -> bool:
+        """True while the robot stands: its motors are off, no turn is under way and the last
+        step moved it not at all (so the next steps will not either)."""
+        return self._turn_target is None and not (self._v or self._w or self._moved)
 
     @property
     def in_contact(self) -> bool:

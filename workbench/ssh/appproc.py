@@ -27,7 +27,8 @@ if TYPE_CHECKING:
 
 log = logging.getLogger("workbench.ssh")
 
-DRIVER = "textual.drivers.web_driver:WebDriver"
+#: Textual's web driver, with an input thread that sleeps while no key comes
+DRIVER = "workbench.tui.driver:SessionDriver"
 #: what the terminal is set back to when an app ends (the web driver leaves it to the server)
 RESTORE_TERMINAL = (
     b"\x1b[?1000l\x1b[?1003l\x1b[?1015l\x1b[?1006l"  # mouse reporting off

@@ -47,7 +47,7 @@ from pathlib import Path
 log = logging.getLogger("workbench.ssh")
 
 #: modules the app imports, loaded once in the fork server
-PRELOAD = ("textual.drivers.web_driver",)
+PRELOAD = ("textual.drivers.web_driver", "workbench.tui.driver")
 #: packages whose every module is loaded too (the app imports many of them only when used)
 PRELOAD_PACKAGES = (
     "workbench.sim",

@@ -8,9 +8,11 @@ snapshot on every screen that shows it.
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import getpass
 import os
+import threading
 from pathlib import Path
 from time import perf_counter
 from typing import ClassVar
@@ -19,6 +21,7 @@ from textual import events
 from textual.binding import Binding, BindingType
 from textual.reactive import var
 from textual.screen import Screen
+from textual.timer import Timer
 
 from workbench.control.station import LabStation
 from workbench.files.bundled import default_maze_path
@@ -26,6 +29,7 @@ from workbench.files.workspace import LOCAL, FileAccess
 from workbench.labs.lastpair import read_last_pair, save_last_pair
 from workbench.labs.model import Setup
 from workbench.labs.names import NameProblem, check_pair
+from workbench.labs.pending import pending_path
 from workbench.labs.store import Store, resolve_data_dir
 from workbench.sim.maze import Maze, MazeError
 from workbench.sim.mazeio import load_maze
@@ -58,6 +62,11 @@ from .screens.runs import RunsScreen
 
 #: the smallest terminal the layout is made for (columns, rows)
 MIN_SIZE = (80, 24)
+#: seconds between tries to write what the course database did not get
+STORE_RETRY_SECONDS = 2.0
+#: how often the clock ticks while the station is at rest (paused, or the robot standing with
+#: nobody driving it): time passes as before, in larger steps, and nothing else needs drawing
+REST_HZ = 1.0
 ROLES = ("student", "instructor")
 
 
@@ -123,6 +132,7 @@ class WorkbenchApp(ScreenHost[None]):
         #: the course's PostgreSQL database (None: the SQLite file in the data folder)
         self.db = db
         self.store: Store | None = None
+        self._store_lock = threading.Lock()
         self.store_problem = ""
         self._labs: LabsScreen | None = None
         self._viple_configs = (tcp, ws)
@@ -138,6 +148,11 @@ class WorkbenchApp(ScreenHost[None]):
         self.tick_hz = tick_hz
         self.set_reactive(WorkbenchApp.unicode, unicode)
         self._last_tick = perf_counter()
+        #: the clock ticks at REST_HZ (True) or at tick_hz (False)
+        self._resting = False
+        self._rest_period = max(1.0 / REST_HZ, 1.0 / tick_hz)
+        self._fast: Timer | None = None
+        self._slow: Timer | None = None
         self._drawn: tuple[object, ...] = ()
         self._too_small: TooSmallScreen | None = None
         self._main: MainScreen | None = None
@@ -166,10 +181,17 @@ class WorkbenchApp(ScreenHost[None]):
         self.mark_ascii()
         self._show_maze_title()
         self._last_tick = perf_counter()
-        self.set_interval(1.0 / self.tick_hz, self._tick, name="simulation")
+        self._fast = self.set_interval(1.0 / self.tick_hz, self._tick, name="simulation")
+        self._slow = self.set_interval(
+            self._rest_period, self._tick, name="simulation at rest", pause=True
+        )
+        self.station.on_activity = self.wake
         if self.connect_hint:
             self.say(self.hint_line())
         self._check_size(self.size.width, self.size.height)
+        if self.db and self._pending_file().is_file():
+            # what an earlier app could not save: written as soon as the database answers
+            self.run_worker(self._save_kept(), group="store")
         if self._ask_names:
             from .dialogs.identity import IdentityDialog
 
@@ -206,16 +228,48 @@ class WorkbenchApp(ScreenHost[None]):
 
     # -- time --------------------------------------------------------------------------------
     def _tick(self) -> None:
+        station = self.station
+        if self.endpoints is not None:
+            self._show_connection(self.endpoints.summary())
+        steps = self._advance()
+        state = (station.paused, station.notice, station.controller, len(station.runs))
+        if steps or state != self._drawn:
+            self.refresh_views()
+        self._rest(station.at_rest)
+
+    def _advance(self) -> int:
+        """Hand the station the real time since the last tick."""
         now = perf_counter()
         elapsed = now - self._last_tick
         self._last_tick = now
         station = self.station
-        if self.endpoints is not None:
-            self._show_connection(self.endpoints.summary())
-        steps = station.advance(elapsed)
-        state = (station.paused, station.notice, station.controller, len(station.runs))
-        if steps or state != self._drawn:
-            self.refresh_views()
+        # at rest the ticks are far apart on purpose: all the time they owe is kept
+        lag = self._rest_period + station.pacer.max_lag if self._resting else None
+        return station.advance(elapsed, lag)
+
+    def _rest(self, resting: bool) -> None:
+        """Tick at REST_HZ while the station is at rest, else at the full rate."""
+        if resting == self._resting or self._fast is None or self._slow is None:
+            return
+        self._resting = resting
+        if resting:
+            self._fast.pause()
+            self._slow.resume()
+        else:
+            self._slow.pause()
+            self._fast.resume()
+
+    def wake(self) -> None:
+        """Something is about to change the station (a key, a click, a VIPLE command): the time
+        owed at rest is run first, as it would have been, and the clock ticks at full rate."""
+        if self._resting:
+            self._advance()
+            self._rest(False)
+
+    async def on_event(self, event: events.Event) -> None:
+        if isinstance(event, (events.Key, events.MouseDown)):
+            self.wake()
+        await super().on_event(event)
 
     def refresh_views(self) -> None:
         """Draw the station's current snapshot on every screen of the stack that shows one."""
@@ -256,6 +310,7 @@ class WorkbenchApp(ScreenHost[None]):
 
     # -- what screens ask for -------------------------------------------------------------------
     def on_station_changed(self, message: StationChanged) -> None:
+        self.wake()
         self.refresh_views()
 
     def on_maze_changed(self, message: MazeChanged) -> None:
@@ -342,13 +397,48 @@ class WorkbenchApp(ScreenHost[None]):
             self._named((student, partner))
 
     def _open_store(self) -> None:
+        with self._store_lock:  # the labs (here) or the saving of kept changes (a thread)
+            self._open_store_once()
+
+    def _open_store_once(self) -> None:
+        if self.store is not None:
+            return
         try:
             # a course database that is down now still gets the work once it is back
-            self.store = Store.open(self.data_dir, db=self.db, offline_ok=True)
+            store = Store.open(self.data_dir, db=self.db, offline_ok=True)
         except Exception as exc:  # the labs work without saving rather than not at all
             self.store = None
             where = "the course database" if self.db else "the data folder"
             self.store_problem = f"cannot open {where}, so nothing is saved: {exc}"
+            return
+        if self.db:
+            # what waits for the database is kept in a file too: it outlives this app
+            for problem in store.keep_pending_in(self._pending_file(), self.student):
+                self.log.warning(problem)
+        self.store = store
+
+    def _pending_file(self) -> Path:
+        return pending_path(resolve_data_dir(self.data_dir), self.student)
+
+    async def _save_kept(self) -> None:
+        """Write the changes an earlier app kept because the course database was away: one
+        try at a time, in a thread (a database that does not answer makes a try wait for the
+        connection's timeout), until they are written; then say so."""
+        await asyncio.to_thread(self._open_store)
+        store = self.store
+        if store is None:
+            return
+        while store.pending:
+            try:
+                done = await asyncio.to_thread(store.flush)
+            except Exception as exc:  # written by no retry: say why, keep working
+                self._say(f"changes kept from before were not saved: {exc}")
+                return
+            if done:
+                self._say("saving resumed: the changes kept while the course database was away "
+                          "are saved")  # fmt: skip
+                return
+            await asyncio.sleep(STORE_RETRY_SECONDS)
 
     def set_up_done(self, setup: Setup | None = None) -> None:
         """A lab's set-up changed the station: follow its maze and profile, and start the VIPLE
@@ -405,9 +495,11 @@ class WorkbenchApp(ScreenHost[None]):
     async def _shut_down(self) -> None:
         self.station.close()
         if self.store is not None:
-            # a last try for what the database did not get yet (never shown as saved)
-            with contextlib.suppress(Exception):
-                self.store.flush()
+            # a last try for what the database did not get yet (never shown as saved); while
+            # it is away the pending writes are in their file already, for the next app
+            if not self.store.offline:
+                with contextlib.suppress(Exception):
+                    self.store.flush()
             self.store.close()
         if self.endpoints is not None:
             await self.endpoints.close()

@@ -11,6 +11,7 @@ changes; an objective that passed once stays passed, with its evidence, after a 
 
 from __future__ import annotations
 
+import asyncio
 import json
 from typing import ClassVar, NamedTuple
 
@@ -148,6 +149,7 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self._signed: dict[tuple[str, str], str] = {}
         self._drivers: dict[tuple[str, str], str] = {}
         self._retry_timer: Timer | None = None
+        self._retrying = False
         self._reload_when_back = False
         self.unicode = False
         self._load_saved()
@@ -219,19 +221,27 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         if self._retry_timer is None and self._ready:
             self._retry_timer = self.set_interval(RETRY_SECONDS, self._retry_store)
 
-    def _retry_store(self) -> None:
+    async def _retry_store(self) -> None:
+        """One try to write what is kept here, in a thread: a database that does not answer
+        makes the try wait for its connection timeout, and the screen must not wait with it.
+        One try at a time."""
         store = self.store
-        if store is None:
+        if store is None or self._retrying:
             return
+        self._retrying = True
         try:
-            done = store.flush()
+            done = await asyncio.to_thread(store.flush)
             if done and self._reload_when_back:
+                # raises while the database is still away
+                await asyncio.to_thread(store.progress, self.student)
                 self._load_saved_again()
         except StoreUnavailable:
             return
         except Exception as exc:
             self.say(f"progress not saved: {exc}")
             done = True
+        finally:
+            self._retrying = False
         if not done:
             return
         if self._retry_timer is not None:
@@ -243,7 +253,6 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         """Read the saved progress the database could not give at the start (what this
         session changed meanwhile was written first, so it reads back as it is here)."""
         assert self.store is not None
-        self.store.progress(self.student)  # raises while the database is still away
         self._reload_when_back = False
         self._store_problem = ""
         self._load_saved()

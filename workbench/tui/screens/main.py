@@ -207,8 +207,8 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Scree
             self._message.message = self._said
 
     def refresh_views(self) -> None:
-        """Redraw after an action: through the app, so open dialogs follow too."""
-        self.show_snapshot(self.station.snapshot())
+        """Redraw after an action: the app draws every screen that shows the station, this one
+        and the dialogs over it."""
         self.post_message(StationChanged())
 
     @property
@@ -236,7 +236,10 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Scree
         station.key(key)
         if program and station.program_run is None:
             self._said = "program stopped: the keys drive"
-        self.refresh_views()
+        if station.paused or program:
+            self.refresh_views()
+        # else the next tick draws it, within 1/20 s, with the robot already moving: drawing
+        # now as well would draw every key twice while a student drives
 
     @property
     def takes_all_keys(self) -> bool:

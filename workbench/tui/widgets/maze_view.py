@@ -161,6 +161,8 @@ class MazeView(ScrollView, can_focus=False):
         self._cursor: Cell | None = None
         self._robot: Cell | None = None
         self._last_show: tuple[Snapshot, float] | None = None
+        #: what the robot and its sensors were last drawn from (a show with the same is skipped)
+        self._shown: tuple[object, ...] | None = None
         self._trail: set[Cell] = set()
         self._sprites: dict[Cell, Token] = {}
         self._sprite_rows: dict[int, dict[int, Token]] = {}
@@ -201,6 +203,7 @@ class MazeView(ScrollView, can_focus=False):
         """Show ``maze`` (typically an edit of the current one); only changed rows repaint."""
         old = self._maze
         self._maze = maze
+        self._shown = None
         if (old.width, old.height) != (maze.width, maze.height):
             self._base_rows = [None] * maze.height
             self._strips = [None] * maze.height
@@ -247,6 +250,10 @@ class MazeView(ScrollView, can_focus=False):
         blocks.
         """
         self._last_show = (snapshot, cell_size)
+        shown = (snapshot.pose, snapshot.readings, snapshot.sensors, cell_size)
+        if shown == self._shown:
+            return  # the robot and its sensors are drawn as they are now
+        self._shown = shown
         maze = self._maze
         pose = snapshot.pose
         bx = min(max(math.floor(pose.x / cell_size), 0), max(maze.width - 1, 0))
@@ -265,6 +272,7 @@ class MazeView(ScrollView, can_focus=False):
     def hide_robot(self) -> None:
         """Stop drawing the robot and its sensors (the trail stays until cleared)."""
         self._last_show = None
+        self._shown = None
         self._robot = None
         self._apply(self._spans(self._set_sprites({})))
 

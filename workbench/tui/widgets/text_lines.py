@@ -44,6 +44,9 @@ class TextLines(Widget):
         self._lines: list[str | Text] = list(lines)
         self._strips: list[Strip | None] = [None] * len(self._lines)
         self._width = 0
+        #: the widget's own style, kept until the styles change (Textual works it out afresh
+        #: from every ancestor's on each call)
+        self._base: Style | None = None
 
     def _rows(self, lines: Sequence[str | Text], width: int) -> list[str | Text]:
         """The rows ``lines`` take at ``width`` (themselves, unless wrapped)."""
@@ -78,6 +81,11 @@ class TextLines(Widget):
                 if self.is_mounted:
                     self.refresh(Region(0, y, width, 1))
 
+    def notify_style_update(self) -> None:
+        super().notify_style_update()
+        self._base = None
+        self._strips = [None] * len(self._lines)
+
     def get_content_height(self, container: Size, viewport: Size, width: int) -> int:
         return len(self._rows(self._source, width))
 
@@ -90,13 +98,15 @@ class TextLines(Widget):
             self._width = width
             self._lines = self._rows(self._source, width)
             self._strips = [None] * len(self._lines)
+        base = self._base
+        if base is None:
+            base = self._base = self.rich_style
         if not 0 <= y < len(self._lines):
-            return Strip.blank(width, self.rich_style)
+            return Strip.blank(width, base)
         strip = self._strips[y]
         if strip is None:
             line = self._lines[y]
             text = line if isinstance(line, Text) else Text(line, no_wrap=True, overflow="crop")
-            base: Style = self.rich_style
             segments = [
                 Segment(seg.text, base + seg.style if seg.style else base)
                 for seg in text.render(self.app.console)

@@ -1,0 +1,86 @@
+"""The app at rest: while nothing moves its clock ticks once a second and it draws nothing new
+but the time; a key wakes it, after the time owed at rest has run, so the robot moves from the
+moment of the key on."""
+
+from __future__ import annotations
+
+import asyncio
+import re
+from time import perf_counter
+
+import pytest
+from textual.pilot import Pilot
+
+from tests.app.support import run
+from workbench.tui.app import REST_HZ, make_app
+from workbench.tui.widgets.run_status import RunStatus
+
+ROOM = "#########\n#.......#\n#...S...#\n#.......#\n#########\n"
+
+
+def maze(tmp_path) -> str:
+    path = tmp_path / "room.txt"
+    path.write_text(f"---\nname: room\nprofile: unity\n---\n{ROOM}")
+    return str(path)
+
+
+def shown_time(app) -> float:
+    clock = str(app.screen.query_one(RunStatus).lines[1])  # running at 1x | t 2.3 s
+    return float(re.search(r" t ([0-9.]+) s", clock).group(1))
+
+
+def test_an_idle_app_draws_about_once_a_second_and_its_clock_still_runs(tmp_path):
+    app = make_app(maze(tmp_path), noise="off")
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.pause(0.3)
+        assert app._resting  # nothing moves: the clock ticks at REST_HZ
+        frames, t0 = app.frames, app.station.session.world.time
+        await pilot.pause(2.5)
+        drawn = app.frames - frames
+        assert 1 <= drawn <= 2.5 * REST_HZ + 1  # at 20 Hz it would be 50
+        t1 = app.station.session.world.time
+        assert t1 - t0 == pytest.approx(2.5, abs=1.1 / REST_HZ)  # simulated time goes on
+        assert shown_time(app) == pytest.approx(t1, abs=0.051)
+
+    run(app, body)
+
+
+def test_a_key_wakes_the_app_after_the_time_owed_at_rest_has_run(tmp_path):
+    app = make_app(maze(tmp_path), noise="off")
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.pause(0.3)
+        start = app.station.session.world.pose
+        await asyncio.sleep(0.8)  # up to a second owed since the last rest tick
+        mounted = perf_counter() - app.station.session.world.time
+        await pilot.press("w")
+        assert not app._resting
+        world = app.station.session.world
+        # at the key the clock was brought up to now (the robot stood still all the while)
+        assert perf_counter() - mounted - world.time < 0.2
+        await pilot.pause(0.5)
+        moved = world.pose.x - start.x, world.pose.y - start.y
+        # it moved for about half a second, not for the second it stood before the key
+        assert 0 < abs(moved[0]) + abs(moved[1]) < 0.9 * app.station.session.profile.move_speed
+        await pilot.press("space")
+        await pilot.pause(0.3)
+        assert app._resting
+
+    run(app, body)
+
+
+def test_paused_the_app_rests_and_p_wakes_it(tmp_path):
+    app = make_app(maze(tmp_path), paused=True)
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.pause(0.2)
+        assert app._resting
+        await pilot.press("w")  # motors on, but paused: nothing moves, still at rest
+        await pilot.pause(0.2)
+        assert app._resting
+        await pilot.press("p")
+        await pilot.pause(0.2)
+        assert not app._resting and "running" in str(app.screen.query_one(RunStatus).lines[1])
+
+    run(app, body)
