@@ -240,7 +240,7 @@ class Walkthrough:
         ):
             assert text in shown, (text, panel)
 
-    def evidence_as_headless(self, screen: LabsScreen) -> None:
+    def evidence_as_headless(self, screen: LabsScreen, ex: Exercise) -> None:
         """The runs the sign-off keeps as evidence carry ``workbench run``'s figures."""
         assert screen.progress is not None
         runs = []
@@ -248,6 +248,9 @@ class Walkthrough:
             if "metrics" in state.evidence:
                 runs.append(state.evidence)
             runs.extend(state.evidence.get("runs", []))
+        kinds = [o.kind for o in ex.objectives]
+        compared = sum(len(o.mazes) * len(o.algorithms) for o in ex.objectives)
+        assert len(runs) == kinds.count("exit") + compared, runs
         for evidence in runs:
             want = self.headless[(evidence["maze_digest"], evidence["driver"], evidence["profile"])]
             for key in MEASURES:
@@ -382,8 +385,8 @@ class Walkthrough:
         await self.pilot.pause()
 
     # -- sign-off --------------------------------------------------------------------------
-    async def sign_off(self, screen: LabsScreen, next_driver: str) -> None:
-        self.evidence_as_headless(screen)
+    async def sign_off(self, screen: LabsScreen, ex: Exercise, next_driver: str) -> None:
+        self.evidence_as_headless(screen, ex)
         await self.press("i")
         modal = self.app.screen
         assert isinstance(modal, SignoffModal)
@@ -479,7 +482,7 @@ def test_a_pair_completes_and_signs_off_every_exercise_in_the_app(tmp_path, lab)
             assert all(line.startswith("[X]") for line in lines), (lab.id, ex.id, lines)
             assert screen.progress is not None and screen.progress.passed
             await w.objectives_readable(screen)  # the passed lines, with their figures
-            await w.sign_off(screen, PAIR[(n + 1) % 2])
+            await w.sign_off(screen, ex, PAIR[(n + 1) % 2])
         listing = screen.query_one("#labs-list", OptionList)
         for ex in lab.exercises:
             assert str(listing.get_option(f"{lab.id}/{ex.id}").prompt).startswith("[*]")
