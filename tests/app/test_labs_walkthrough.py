@@ -8,6 +8,12 @@ objective must show as passed ([X] in ASCII mode) on the labs screen without an 
 then the instructor signs the exercise off (i) and the pair swaps the driver. At the end the
 store holds one signed record per exercise, the records verify and the gradebook has a row per
 student per exercise.
+
+All of it at 80x24 in ASCII mode, read off the terminal as the students see it: every
+objective's line (its text and its reason) can be read whole at some scroll position of the
+exercise pane, and the figures of every finished run (run panel, run record and the evidence the
+sign-off keeps) are those ``workbench run`` gives for the same maze, profile, sensors, seed,
+noise and parameters. One test per lab, so the three run side by side.
 """
 
 from __future__ import annotations
@@ -16,6 +22,7 @@ import asyncio
 import csv
 from pathlib import Path
 
+import pytest
 from textual.pilot import Pilot
 from textual.widgets import Input, OptionList, Select, Static
 from websockets.asyncio.server import serve
@@ -23,30 +30,39 @@ from websockets.asyncio.server import serve
 from tests.integration.test_labs_completable import DRIVE, SOLUTIONS, answer, free_port
 from workbench.cli import main
 from workbench.control.algorithms import list_algorithms
+from workbench.control.headless import RunSpec
+from workbench.control.headless import run as headless_run
 from workbench.labs import signoff as so
 from workbench.labs.model import Exercise, Lab, LabMaze, Objective, load_labs
 from workbench.labs.store import Store
+from workbench.sim.mazeio import save_maze
+from workbench.sim.profiles import get_profile
 from workbench.tui.app import WorkbenchApp, make_app
 from workbench.tui.dialogs.algorithm import AlgorithmModal
 from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.dialogs.sensor_ports import SensorPortsModal
 from workbench.tui.dialogs.signoff import SignoffModal
+from workbench.tui.plain import prose
 from workbench.tui.screens.editor import EditorScreen
 from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
 from workbench.tui.widgets.param_editor import ParamEditor
 from workbench.tui.widgets.sensor_row_editor import SensorRowEditor
+from workbench.tui.widgets.text import degrees, number
 from workbench.viple.tcp_server import TcpConfig
 from workbench.viple.ws_client import WsConfig
 
-from .support import run, said
+from .support import run, run_panel, said, screen_lines
 
 FAST = so.KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
 INSTRUCTOR = "Dr Chen"
 PASS = "correct horse battery"
 PAIR = ("ana", "ben")
 LABS = load_labs()
-EXERCISES = [(lab, ex) for lab in LABS for ex in lab.exercises]
+#: the exercise pane's first column at 80x24 (the lab list is 28 wide, then one blank)
+PANE = 29
+#: measures of a run the app shows and ``workbench run`` prints
+MEASURES = ("reached_exit", "exit_time", "distance", "turn_degrees", "turns", "collisions")
 
 
 class Walkthrough:
@@ -58,6 +74,8 @@ class Walkthrough:
         self.tmp = tmp
         #: the built-in algorithms picked in the dialog so far
         self.met: set[str] = set()
+        #: ``workbench run``'s metrics of each run to the exit, by (maze digest, driver, profile)
+        self.headless: dict[tuple[str, str, str], dict] = {}
 
     @property
     def station(self):
@@ -184,6 +202,59 @@ class Walkthrough:
         last = station.runs[-1]
         assert len(station.runs) > done and last.ended == "exit", (last, said(self.app))
         await self.pilot.pause()
+        self.same_as_headless()
+
+    def same_as_headless(self) -> None:
+        """The finished run's figures, in the run record and on the run panel, are those of
+        ``workbench run`` for the same maze, profile, sensors, seed, noise and parameters."""
+        station = self.station
+        last = station.runs[-1]
+        maze = self.tmp / f"maze-{last.maze_digest[:12]}.txt"
+        save_maze(maze, station.maze)
+        definition = station.algorithm
+        assert definition is not None
+        spec = RunSpec(
+            maze=str(maze),
+            algorithm=definition.source if definition.source else definition.name,
+            profile=station.profile,
+            sensors=tuple(str(s) for s in station.sensors),
+            seed=station.seed,
+            noise="off",
+            params=tuple(f"{k}={v!r}" for k, v in station.params().items()),
+        )
+        want = headless_run(spec).metrics
+        got = last.metrics.as_dict()
+        for key in MEASURES:
+            assert got[key] == pytest.approx(want[key], abs=1e-9), (key, got, want)
+        self.headless[(last.maze_digest, str(last.driver), last.profile)] = want
+        # the run panel, as the students read it after the run
+        self.app.refresh_views()
+        panel = run_panel(self.app)
+        unit = get_profile(station.profile).unit
+        shown = " ".join(panel.split())
+        for text in (
+            f"out at {want['exit_time']:.1f} s",
+            f"distance {number(want['distance'], unit)} {unit}",
+            f"turned {degrees(want['turn_degrees'], False)} in {want['turns']} turn",
+            f"collisions {want['collisions']}",
+        ):
+            assert text in shown, (text, panel)
+
+    def evidence_as_headless(self, screen: LabsScreen, ex: Exercise) -> None:
+        """The runs the sign-off keeps as evidence carry ``workbench run``'s figures."""
+        assert screen.progress is not None
+        runs = []
+        for state in screen.progress.objectives:
+            if "metrics" in state.evidence:
+                runs.append(state.evidence)
+            runs.extend(state.evidence.get("runs", []))
+        kinds = [o.kind for o in ex.objectives]
+        compared = sum(len(o.mazes) * len(o.algorithms) for o in ex.objectives)
+        assert len(runs) == kinds.count("exit") + compared, runs
+        for evidence in runs:
+            want = self.headless[(evidence["maze_digest"], evidence["driver"], evidence["profile"])]
+            for key in MEASURES:
+                assert evidence["metrics"][key] == pytest.approx(want[key], abs=1e-9), key
 
     async def reach_exit(self, ex: Exercise, obj: Objective) -> None:
         assert obj.maze is not None
@@ -283,8 +354,39 @@ class Walkthrough:
                 await self.edit_maze()
         await self.answer_questions(ex)
 
+    # -- reading the terminal ----------------------------------------------------------------
+    async def objectives_readable(self, screen: LabsScreen) -> None:
+        """Scroll the exercise pane with the keys, from the top down past the objectives, and
+        read the terminal at each position: every objective's line (mark, text and reason)
+        must be seen whole in one view, words unbroken, in plain ASCII."""
+        assert screen.progress is not None
+        marks = screen.marks
+        wanted = {
+            " ".join(prose(f"{marks.passed if o.passed else marks.failed} {o.text}: {o.reason}",
+                           False).split())
+            for o in screen.progress.objectives
+        }  # fmt: skip
+        pane = screen.query_one("#labs-scroll")
+        objectives_height = screen.query_one("#labs-objectives").region.height
+        pane.focus()
+        pane.scroll_home(animate=False)
+        await self.pilot.pause()
+        views = []
+        for _ in range(objectives_height + 1):
+            lines = screen_lines(self.app)
+            assert all(line.isascii() for line in lines), "\n".join(lines)
+            views.append(" ".join(" ".join(line[PANE:].split()) for line in lines[:-2]))
+            if pane.scroll_y >= min(objectives_height, pane.max_scroll_y):
+                break
+            await self.press("down")
+        unseen = [text for text in wanted if not any(text in view for view in views)]
+        assert unseen == [], (unseen, views)
+        screen.query_one("#labs-list").focus()
+        await self.pilot.pause()
+
     # -- sign-off --------------------------------------------------------------------------
-    async def sign_off(self, screen: LabsScreen, next_driver: str) -> None:
+    async def sign_off(self, screen: LabsScreen, ex: Exercise, next_driver: str) -> None:
+        self.evidence_as_headless(screen, ex)
         await self.press("i")
         modal = self.app.screen
         assert isinstance(modal, SignoffModal)
@@ -343,7 +445,8 @@ async def viple_over_websocket(w: Walkthrough, screen: LabsScreen, lab: Lab, ex:
     await w.open(lab, ex)
 
 
-def test_a_pair_completes_and_signs_off_every_exercise_in_the_app(tmp_path):
+@pytest.mark.parametrize("lab", LABS, ids=[lab.id for lab in LABS])
+def test_a_pair_completes_and_signs_off_every_exercise_in_the_app(tmp_path, lab):
     data = tmp_path / "data"
     kept_roster = tmp_path / "instructor" / "roster.json"  # the instructor's own copy
     so.create_instructor(data, INSTRUCTOR, PASS, kdf=FAST, trusted=kept_roster)
@@ -359,11 +462,12 @@ def test_a_pair_completes_and_signs_off_every_exercise_in_the_app(tmp_path):
             WsConfig(url=f"ws://127.0.0.1:{free_port()}/", retry_seconds=0.2),
         )
         w = Walkthrough(pilot, tmp_path)
-        for n, (lab, ex) in enumerate(EXERCISES):
+        for n, ex in enumerate(lab.exercises):
             driver = PAIR[n % 2]
             screen = await w.open(lab, ex)
             assert screen.driver == driver, (lab.id, ex.id)
             assert not all(line.startswith("[X]") for line in objectives(screen))
+            await w.objectives_readable(screen)  # what is still to do, with its reasons
             if ex.setup.controller.kind == "viple":
                 await viple_over_websocket(w, screen, lab, ex)
             else:
@@ -377,9 +481,10 @@ def test_a_pair_completes_and_signs_off_every_exercise_in_the_app(tmp_path):
             assert len(lines) == len(ex.objectives)
             assert all(line.startswith("[X]") for line in lines), (lab.id, ex.id, lines)
             assert screen.progress is not None and screen.progress.passed
-            await w.sign_off(screen, PAIR[(n + 1) % 2])
+            await w.objectives_readable(screen)  # the passed lines, with their figures
+            await w.sign_off(screen, ex, PAIR[(n + 1) % 2])
         listing = screen.query_one("#labs-list", OptionList)
-        for lab, ex in EXERCISES:
+        for ex in lab.exercises:
             assert str(listing.get_option(f"{lab.id}/{ex.id}").prompt).startswith("[*]")
         await pilot.press("ctrl+q")
 
@@ -389,7 +494,7 @@ def test_a_pair_completes_and_signs_off_every_exercise_in_the_app(tmp_path):
         rows = sorted(store.signoffs(), key=lambda r: r.id)
         roster = so.load_roster(so.roster_path(data))
         verdicts = so.verify_all(store, roster)
-    assert [(r.lab, r.exercise) for r in rows] == [(lab.id, ex.id) for lab, ex in EXERCISES]
+    assert [(r.lab, r.exercise) for r in rows] == [(lab.id, ex.id) for ex in lab.exercises]
     assert not any(r.override for r in rows)
     assert [r.driver for r in rows] == [PAIR[n % 2] for n in range(len(rows))]
     assert {(r.student, r.partner, r.instructor) for r in rows} == {("ana", "ben", INSTRUCTOR)}
@@ -401,8 +506,8 @@ def test_a_pair_completes_and_signs_off_every_exercise_in_the_app(tmp_path):
     assert main(["signoff", "export", "--csv", str(gradebook), *trusted]) == 0
     with gradebook.open(newline="") as f:
         table = list(csv.DictReader(f))
-    assert len(table) == 2 * len(EXERCISES) == 28
+    assert len(table) == 2 * len(lab.exercises)
     assert {(r["student"], r["lab"], r["exercise"]) for r in table} == {
-        (who, lab.id, ex.id) for who in PAIR for lab, ex in EXERCISES
+        (who, lab.id, ex.id) for who in PAIR for ex in lab.exercises
     }
     assert {r["override"] for r in table} == {"no"}

@@ -9,10 +9,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
 from textual.pilot import Pilot
 from textual.widgets import Checkbox, Input, OptionList
 
 from workbench.labs import signoff as so
+from workbench.labs.model import load_labs
 from workbench.tui.app import WorkbenchApp, make_app
 
 FAST = so.KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
@@ -88,4 +90,25 @@ def test_names_dialog_at_start(snap_compare, tmp_path):
         still(pilot)
         await pilot.pause()
 
+    assert snap_compare(app, terminal_size=SIZE, run_before=before)
+
+
+LABS = load_labs()
+EXERCISES = [f"{lab.id}/{ex.id}" for lab in LABS for ex in lab.exercises]
+
+
+@pytest.mark.parametrize("option_id", EXERCISES, ids=[o.replace("/", ".") for o in EXERCISES])
+def test_every_lab_exercise_at_80x24(snap_compare, tmp_path, option_id):
+    """Each exercise as a pair first sees it: chosen in the list, not set up, ASCII marks."""
+
+    async def before(pilot: Pilot) -> None:
+        await pilot.press("l")
+        await pilot.pause()
+        listing = pilot.app.screen.query_one("#labs-list", OptionList)
+        listing.highlighted = listing.get_option_index(option_id)
+        await pilot.pause()
+        still(pilot)
+        await pilot.pause()
+
+    app = lab_app(tmp_path / "data", instructor=False)
     assert snap_compare(app, terminal_size=SIZE, run_before=before)
