@@ -6,7 +6,7 @@ import pytest
 from textual.pilot import Pilot
 from textual.widgets import Input, OptionList, Select, Static
 
-from tests.app.support import run, said
+from tests.app.support import run, said, screen_lines
 from workbench.sim.sensors import SensorSpec
 from workbench.tui.app import WorkbenchApp, make_app
 from workbench.tui.dialogs.algorithm import AlgorithmModal
@@ -424,5 +424,26 @@ def test_the_message_line_follows_what_the_student_does(tmp_path):
         assert said(app) == "algorithm stopped: the keys drive"
         await pilot.press("r")
         assert said(app) == ""
+
+    run(app, body)
+
+
+def test_a_long_message_wraps_onto_more_rows_and_back(tmp_path):
+    app = unity_app()
+    long = (
+        "cannot start: programs/right-wall.viple: panel Main: activity 20 (kind 22, Robot "
+        "Touch Sensor): it reads port 2, but the robot has distance:2:front there"
+    )
+
+    async def body(pilot: Pilot) -> None:
+        main = app.screen
+        assert isinstance(main, MainScreen)
+        main.say(long)
+        await pilot.pause()
+        shown = " ".join(" ".join(screen_lines(app)).split())
+        assert "it reads port 2, but the robot has distance:2:front there" in shown
+        main.say("paused")
+        await pilot.pause()
+        assert app.screen.query_one("#message").size.height == 1
 
     run(app, body)

@@ -28,6 +28,8 @@ class MessageBar(Static):
     def __init__(self, who: str = "", *, id: str | None = None, classes: str | None = None):
         super().__init__(id=id, classes=classes, markup=False)
         self.set_reactive(MessageBar.who, who)
+        #: the text took more than one row when last painted
+        self._wrapped = False
 
     def on_mount(self) -> None:
         self._paint()
@@ -45,7 +47,11 @@ class MessageBar(Static):
         width = max(self.size.width - 2, 0)
         if who and width and len(text) + len(who) + 2 <= width:
             text = text + " " * (width - len(text) - len(who)) + who
-        self.update(text, layout=False)
+        wrapped = bool(width) and len(text) > width
+        # a one-row text repaints in place (the common case, many times a second); a text
+        # that wraps, or one that wrapped before, makes the bar take the rows it needs
+        self.update(text, layout=wrapped or self._wrapped)
+        self._wrapped = wrapped
 
     def on_resize(self) -> None:
         self._paint()
