@@ -61,7 +61,8 @@ def program_choice(compiled: Compiled, shown: str) -> ProgramChoice:
         problems = check_sensors(compiled, list(sensors))
         if not problems:
             return None
-        return "\n".join(str(replace(p, source=shown)) for p in problems)
+        # the hints name command-line options; in the app the sensor ports panel sets them
+        return "\n".join(str(replace(p, source=shown, hint="")) for p in problems)
 
     return ProgramChoice(
         name=os.path.basename(shown),
