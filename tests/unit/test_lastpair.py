@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from workbench.labs.lastpair import FILE_NAME, name_key, read_last_pair, save_last_pair
+from workbench.labs.lastpair import FILE_NAME, read_last_pair, save_last_pair
+from workbench.labs.names import name_key
 from workbench.labs.store import Store
 
 

@@ -6,6 +6,8 @@ import argparse
 import json
 import os
 import sys
+from collections.abc import Callable
+from typing import Any
 
 from workbench.control.evaluate import EvalError, evaluate, format_table, write_csv
 from workbench.control.headless import RunSetupError, RunSpec, run
@@ -91,14 +93,15 @@ def cmd_run(args: argparse.Namespace) -> int:
     except RunSetupError as exc:
         print(f"workbench run: {exc}", file=sys.stderr)
         return 2
+    return report(result, args.json, describe_run)
+
+
+def report(result, as_json: bool, describe: Callable[[Any], str]) -> int:
+    """Print a finished run (as JSON or as ``describe`` words it); the exit code is 0 when the
+    robot got out or the maze has no exit, 1 when it did not get out."""
     data = result.as_dict()
-    if args.json:
-        print(json.dumps(data, sort_keys=False))
-    else:
-        print(describe_run(result))
-    if not result.maze.exits:
-        return 0
-    return 0 if data["reached_exit"] else 1
+    print(json.dumps(data, sort_keys=False) if as_json else describe(result))
+    return 0 if not result.maze.exits or data["reached_exit"] else 1
 
 
 def describe_run(result) -> str:

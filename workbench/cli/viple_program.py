@@ -25,7 +25,7 @@ from workbench.viple.client import (
 from workbench.viple.codec import WheelPorts
 
 from .keyboard import QUIT_KEYS, attach_keyboard, raw_terminal
-from .run import _simulation_options, describe_measures
+from .run import _simulation_options, describe_measures, report
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -155,14 +155,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     except RunSetupError as exc:
         print(f"workbench viple run: {exc}", file=sys.stderr)
         return 2
-    data = result.as_dict()
-    if args.json:
-        print(json.dumps(data, sort_keys=False))
-    else:
-        print(describe_program_run(result))
-    if not result.maze.exits:
-        return 0
-    return 0 if data["reached_exit"] else 1
+    return report(result, args.json, describe_program_run)
 
 
 def describe_program_run(result) -> str:

@@ -20,11 +20,6 @@ FILE_NAME = "last-pair.json"
 MAX_BYTES = 4096
 
 
-def name_key(name: str) -> str:
-    """How names are matched: case and spacing do not count ("alice  DOE" is "Alice Doe")."""
-    return " ".join(name.split()).casefold()
-
-
 def read_last_pair(data_dir: str | os.PathLike) -> tuple[str, str] | None:
     """The pair saved last in ``data_dir`` (None when there is none that can be used)."""
     path = Path(data_dir) / FILE_NAME

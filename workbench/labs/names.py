@@ -125,3 +125,8 @@ def check_pair(student: str, partner: str = "") -> tuple[str, str]:
     if partner and partner.casefold() == student.casefold():
         raise NameProblem("the partner is the student: leave the partner empty when alone")
     return student, partner
+
+
+def name_key(name: str) -> str:
+    """How names are matched: case and spacing do not count ("alice  DOE" is "Alice Doe")."""
+    return " ".join(name.split()).casefold()

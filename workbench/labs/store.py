@@ -43,8 +43,8 @@ from .database import (
     Tx,
     resolve_db,
 )
-from .lastpair import name_key
 from .migrations import RECORD_COLUMNS, SIGNOFF_LOCK, check_version, latest, migrate
+from .names import name_key
 from .pending import FIELDS, PendingWrite, load_pending, save_pending
 from .signlog import GENESIS, entry_hash, parse_metrics, signed_payload
 
