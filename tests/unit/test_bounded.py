@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 import pytest
 
 from workbench.files.bounded import (
@@ -123,8 +125,17 @@ def test_read_text_and_a_missing_file(tmp_path):
     assert read_text(path, SMALL) == "hello\n"
     with pytest.raises(BoundedFileError, match=r"missing\.txt: cannot read the file: No such"):
         read_text(tmp_path / "missing.txt", SMALL)
-    with pytest.raises(BoundedFileError, match="cannot read the file"):
+    with pytest.raises(BoundedFileError, match="cannot read the file: it is a folder"):
         read_text(tmp_path, SMALL)
+
+
+def test_a_named_pipe_is_refused_at_once_instead_of_waiting_for_a_writer(tmp_path):
+    pipe = tmp_path / "maze.txt"
+    os.mkfifo(pipe)
+    with pytest.raises(
+        BoundedFileError, match=r"maze\.txt: cannot read the file: it is a named pipe"
+    ):
+        read_text(pipe, SMALL)
 
 
 # -- YAML ----------------------------------------------------------------------------------

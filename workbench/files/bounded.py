@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import stat
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -96,7 +97,11 @@ def read_bytes(path: str | os.PathLike, limits: Limits, source: str | None = Non
     """The bytes of ``path``, refused unread when the file is larger than ``limits`` allow."""
     source = str(path) if source is None else source
     try:
-        with open(path, "rb") as fh:
+        # Opened without blocking, so that a pipe or a device named as a file is refused at
+        # once instead of holding the caller until something writes to it.
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+        _refuse_unless_plain(fd, source)
+        with open(fd, "rb") as fh:
             size = os.fstat(fh.fileno()).st_size
             if size > limits.max_bytes:
                 raise _too_big(source, size, limits)
@@ -109,6 +114,29 @@ def read_bytes(path: str | os.PathLike, limits: Limits, source: str | None = Non
     if len(data) > limits.max_bytes:
         raise _too_big(source, len(data), limits)
     return data
+
+
+def _refuse_unless_plain(fd: int, source: str) -> None:
+    """Nothing for a regular file; otherwise closes ``fd`` and names what it is."""
+    mode = os.fstat(fd).st_mode
+    if stat.S_ISREG(mode):
+        return
+    os.close(fd)
+    raise BoundedFileError(
+        source, f"cannot read the file: it is {_kind(mode)}", "give the path of a plain file"
+    )
+
+
+def _kind(mode: int) -> str:
+    if stat.S_ISDIR(mode):
+        return "a folder"
+    if stat.S_ISFIFO(mode):
+        return "a named pipe"
+    if stat.S_ISSOCK(mode):
+        return "a socket"
+    if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
+        return "a device"
+    return "not a plain file"
 
 
 def read_text(path: str | os.PathLike, limits: Limits, source: str | None = None) -> str:
