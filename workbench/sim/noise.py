@@ -9,7 +9,7 @@ Levels (standard deviations; ``c`` is the profile's block size):
 level       motor imbalance   turn error          distance, relative  distance, absolute
 ==========  ================  ==================  ==================  ====================
 off         0                 0                   0                   0
-low         0.02 % per wheel  0.1 % of each turn  0.2 % of reading    0.001 c
+low         0.001 % per wheel 0.05 % of each turn 0.2 % of reading    0.001 c
 realistic   0.5 % per wheel   2 % of each turn    2 % of reading      0.005 c
 ==========  ================  ==================  ==================  ====================
 
@@ -30,7 +30,7 @@ from .profiles import NOISE_LEVELS, Profile
 #: level -> (motor_imbalance, turn_error, distance_relative, distance_absolute / cell)
 _LEVELS: dict[str, tuple[float, float, float, float]] = {
     "off": (0.0, 0.0, 0.0, 0.0),
-    "low": (0.0002, 0.001, 0.002, 0.001),
+    "low": (0.00001, 0.0005, 0.002, 0.001),
     "realistic": (0.005, 0.02, 0.02, 0.005),
 }
 _MAX_FRACTION = 0.5
