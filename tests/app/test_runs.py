@@ -128,9 +128,7 @@ async def test_touches_show_apart_from_collisions_in_the_table_and_the_replay(tm
         await pilot.pause()
         table = app.screen.query_one(DataTable)
         assert table_rows(table)[0][7] == f"0/{m.touches}"
-        assert "Hit/Tch = collisions/touch-sensor bumps" in text(
-            app.screen.query_one("#runs-help")
-        )
+        assert "Hit/Tch = collisions/touch-sensor bumps" in text(app.screen.query_one("#runs-help"))
         detail = text(app.screen.query_one("#runs-detail"))
         assert f"0 collisions, {m.touches} touches;" in detail
         await pilot.press("enter")
