@@ -10,6 +10,7 @@ from textual.widgets import DataTable, Input, Static
 from tests.app.support import sync
 from workbench.control.station import LabStation
 from workbench.sim.mazefile import parse_maze
+from workbench.sim.mazeio import load_maze
 from workbench.sim.record import FORMAT
 from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.host import ScreenHost
@@ -75,7 +76,7 @@ async def test_the_table_shows_each_run_with_its_measures(tmp_path):
             "Blocks",
             "Turn deg",
             "Turns",
-            "Hits",
+            "Hit/Tch",
             "Eff",
             "Ended",
             "Rec",
@@ -90,7 +91,7 @@ async def test_the_table_shows_each_run_with_its_measures(tmp_path):
                 "9.52",
                 "180",
                 "2",
-                "0",
+                "0/0",
                 "1.00",
                 "exit",
                 "yes",
@@ -104,7 +105,7 @@ async def test_the_table_shows_each_run_with_its_measures(tmp_path):
                 "9.67",
                 "900",
                 "6",
-                "0",
+                "0/0",
                 "0.98",
                 "exit",
                 "yes",
@@ -112,6 +113,35 @@ async def test_the_table_shows_each_run_with_its_measures(tmp_path):
             ],
         ]
         assert text(app.screen.query_one("#runs-title")).startswith("Runs on this bench: 2")
+
+
+@sync
+async def test_touches_show_apart_from_collisions_in_the_table_and_the_replay(tmp_path):
+    # the Web wall-following program feels for the wall ahead with its touch sensor
+    maze = load_maze("mazes/web.txt")
+    station = LabStation.open(maze, "web", noise="off", record_dir=str(tmp_path / "runs"))
+    run = run_algorithms(station, "web-wall-following").runs[0]
+    m = run.metrics
+    assert run.ended == "exit" and m.collisions == 0 and m.touches >= 5
+    app = Host(RunsScreen(station, unicode=False))
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        table = app.screen.query_one(DataTable)
+        assert table_rows(table)[0][7] == f"0/{m.touches}"
+        assert "Hit/Tch = collisions/touch-sensor bumps" in text(app.screen.query_one("#runs-help"))
+        detail = text(app.screen.query_one("#runs-detail"))
+        assert f"0 collisions, {m.touches} touches;" in detail
+        await pilot.press("enter")
+        await pilot.pause()
+        replay_screen = app.screen
+        assert isinstance(replay_screen, ReplayScreen)
+        panel = text(replay_screen.query_one("#replay-tick"))
+        assert "touch" not in panel.split("So far")[1]  # no bump yet at the first tick
+        await pilot.press("end")
+        await pilot.pause()
+        panel = text(replay_screen.query_one("#replay-tick"))
+        assert f"0 collisions,\n{m.touches} touches (touch sensor)" in panel
+        assert panel.endswith("End: out through the exit")
 
 
 @sync

@@ -5,18 +5,21 @@ gives the same run and a different seed (with noise on) a different one.
 
 Levels (standard deviations; ``c`` is the profile's block size):
 
-==========  ================  ==================  ==================  ====================
-level       motor imbalance   turn error          distance, relative  distance, absolute
-==========  ================  ==================  ==================  ====================
-off         0                 0                   0                   0
-low         0.02 % per wheel  0.1 % of each turn  0.2 % of reading    0.001 c
-realistic   0.5 % per wheel   2 % of each turn    2 % of reading      0.005 c
-==========  ================  ==================  ==================  ====================
+==========  =================  ===================  ==================  ====================
+level       motor imbalance    turn error           distance, relative  distance, absolute
+==========  =================  ===================  ==================  ====================
+off         0                  0                    0                   0
+low         0.001 % per wheel  0.05 % of each turn  0.2 % of reading    0.001 c
+realistic   0.5 % per wheel    2 % of each turn     2 % of reading      0.005 c
+==========  =================  ===================  ==================  ====================
 
-Driving straight, the motor imbalance turns the robot slowly (measured over 200 seeds, web
-at power 0.5): "low" about 1 degree per minute (90 % of seeds under 2), "realistic" about 22
-degrees per minute (90 % under 51), enough that a program without corrections ends up at a
-wall, which is what the course's self-adjusting exercise is about.
+Driving straight, the motor imbalance turns the robot slowly (``bench/fidelity.py``, 200
+seeds, web at power 0.5): "low" about 0.05 degrees per minute (90 % of seeds under 0.1),
+"realistic" about 25 degrees per minute (90 % under 51), enough that a program without
+corrections ends up at a wall, which is what the course's self-adjusting exercise is about.
+"low" stays near exact because a plain wall follower never measures its heading: whatever
+the motors and turns get wrong adds up over a whole run, and a 16 x 16 maze takes some 40
+simulated minutes (docs/profiles.md, "Noise levels").
 """
 
 from __future__ import annotations
@@ -30,7 +33,7 @@ from .profiles import NOISE_LEVELS, Profile
 #: level -> (motor_imbalance, turn_error, distance_relative, distance_absolute / cell)
 _LEVELS: dict[str, tuple[float, float, float, float]] = {
     "off": (0.0, 0.0, 0.0, 0.0),
-    "low": (0.0002, 0.001, 0.002, 0.001),
+    "low": (0.00001, 0.0005, 0.002, 0.001),
     "realistic": (0.005, 0.02, 0.02, 0.005),
 }
 _MAX_FRACTION = 0.5

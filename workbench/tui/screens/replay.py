@@ -29,6 +29,7 @@ from workbench.sim.replay import Replay, load_replay, replay_maze
 from ..host import FollowsUnicode, ToggleUnicode
 from ..keys import bindings
 from ..widgets.maze_view import MazeView
+from ..widgets.text import count
 
 #: how often the view is redrawn while playing (frames per second of wall time)
 PLAY_HZ = 20
@@ -43,10 +44,6 @@ def _number(value: object) -> str:
     if isinstance(value, int):
         return str(value)
     return f"{value:.1f}"
-
-
-def _count(n: int, thing: str) -> str:
-    return f"{n} {thing}" if n == 1 else f"{n} {thing}s"
 
 
 def _command(cmd: object) -> str:
@@ -251,8 +248,11 @@ class ReplayScreen(FollowsUnicode, Screen[None]):
         m = replay.metrics()
         text.append(
             f"So far {m.distance_cells:.2f} blocks, {m.turn_degrees:.0f}{deg}\n"
-            f"{_count(m.turns, 'turn')}, {_count(m.collisions, 'collision')}"
+            f"{count(m.turns, 'turn')}, {count(m.collisions, 'collision')}"
         )
+        if m.touches:
+            # bumps a touch sensor was meant to feel, apart from the collisions
+            text.append(f",\n{count(m.touches, 'touch', 'touches')} (touch sensor)")
         if replay.at_end and replay.summary is not None:
             s = replay.summary
             ended = s.get("ended", "stopped")

@@ -25,6 +25,7 @@ from workbench.sim.session import Snapshot
 from ..dialogs.path import PathDialog
 from ..host import FollowsUnicode, ShowsSnapshot, ToggleUnicode
 from ..keys import bindings
+from ..widgets.text import count
 from .replay import ReplayScreen
 
 #: column key, heading (ASCII), heading (Unicode)
@@ -36,7 +37,7 @@ COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("distance", "Blocks", "Blocks"),
     ("turning", "Turn deg", "Turn °"),
     ("turns", "Turns", "Turns"),
-    ("collisions", "Hits", "Hits"),
+    ("contacts", "Hit/Tch", "Hit/Tch"),
     ("efficiency", "Eff", "Eff"),
     ("ended", "Ended", "Ended"),
     ("record", "Rec", "Rec"),
@@ -61,7 +62,7 @@ def run_cells(run: RunEntry, unicode: bool) -> tuple[str, ...]:
         f"{m.distance_cells:.2f}",
         f"{m.turn_degrees:.0f}",
         str(m.turns),
-        str(m.collisions),
+        f"{m.collisions}/{m.touches}",
         f"{m.efficiency:.2f}" if m.efficiency is not None else "-",
         run.ended,
         yes if run.record else "-",
@@ -70,12 +71,14 @@ def run_cells(run: RunEntry, unicode: bool) -> tuple[str, ...]:
 
 
 def run_detail(run: RunEntry) -> str:
-    """The chosen run in words, whole: who drove, on which maze and profile, its record (the
-    table's last columns do not fit 80 columns)."""
+    """The chosen run in words, whole: who drove, on which maze and profile, its collisions
+    and touches, its record (the table's last columns do not fit 80 columns)."""
+    m = run.metrics
     record = f"record {Path(run.record).name}" if run.record else "not recorded"
     return (
         f"run {run.number}: {run.driver} on {run.maze or '-'} ({run.profile}, seed {run.seed}), "
-        f"ended by {run.ended}; {record}"
+        f"ended by {run.ended}; {count(m.collisions, 'collision')}, "
+        f"{count(m.touches, 'touch', 'touches')}; {record}"
     )
 
 
@@ -173,8 +176,8 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         )
         if runs:
             help_text = (
-                "Compare time, distance and turning of runs on the same maze. "
-                "Enter replays a run with a record; o opens a record file."
+                "Compare runs on one maze; Hit/Tch = collisions/touch-sensor bumps. "
+                "Enter replays a recorded run; o opens a record file."
             )
         else:
             help_text = (

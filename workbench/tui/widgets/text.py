@@ -19,6 +19,11 @@ def separator(unicode: bool) -> str:
     return " · " if unicode else " | "
 
 
+def count(n: int, one: str, many: str = "") -> str:
+    """``n`` things in words: "1 turn", "3 turns", "2 touches" (``many`` for odd plurals)."""
+    return f"{n} {one}" if n == 1 else f"{n} {many or one + 's'}"
+
+
 def number(value: float | int | None, unit: str = "") -> str:
     """A reading or a length: whole pixels, two decimals for metre-like units."""
     if value is None:
