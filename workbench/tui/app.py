@@ -40,6 +40,7 @@ from workbench.viple.link import REPORT_MS_DEFAULT
 from workbench.viple.tcp_server import TcpConfig
 from workbench.viple.ws_client import WsConfig
 
+from . import warmup
 from .commands import WorkbenchCommands
 from .dialogs.help import HelpScreen
 from .dialogs.too_small import TooSmallScreen
@@ -147,6 +148,9 @@ class WorkbenchApp(ScreenHost[None]):
         self.role = role
         self.tick_hz = tick_hz
         self.set_reactive(WorkbenchApp.unicode, unicode)
+        self.mark_ascii(update=False)
+        # the stylesheets as the fork server parsed them (a served app), else parsed here
+        warmup.seed(self.stylesheet)
         self._last_tick = perf_counter()
         #: the clock ticks at REST_HZ (True) or at tick_hz (False)
         self._resting = False
@@ -155,6 +159,8 @@ class WorkbenchApp(ScreenHost[None]):
         self._slow: Timer | None = None
         self._drawn: tuple[object, ...] = ()
         self._too_small: TooSmallScreen | None = None
+        #: the size the app started with was announced again (see _on_resize)
+        self._sized = False
         self._main: MainScreen | None = None
         #: the maze the message line last named
         self._maze_named = station.maze
@@ -286,6 +292,16 @@ class WorkbenchApp(ScreenHost[None]):
 
     # -- size --------------------------------------------------------------------------------
     def on_resize(self, event: events.Resize) -> None:
+        known = self._size  # None until Textual has handled the app's first resize
+        if known is not None and not self._sized:
+            self._sized = True
+            if event.size == known:
+                # Textual's web driver announces, once the app runs, the size the app
+                # started with, and Textual then lays out and draws every screen again: a
+                # quarter of a served app's work to its first screen. That one is let go (a
+                # later resize to the same size still redraws all, as after a reattach).
+                event.prevent_default()
+                return
         self._check_size(event.size.width, event.size.height)
 
     def _check_size(self, width: int, height: int) -> None:
