@@ -278,12 +278,17 @@ class WorkbenchApp(ScreenHost[None]):
         await super().on_event(event)
 
     def refresh_views(self) -> None:
-        """Draw the station's current snapshot on every screen of the stack that shows one."""
+        """Draw the station's current snapshot on every screen of the stack that shows one;
+        at rest (nothing moves, only the clock runs) on the top screen only: a screen under
+        a dialog or another screen is brought up to date when it is on top again. Under the
+        names dialog that a served student sees first, the clock behind it had redrawn the
+        whole dimmed screen every second (8 KB a second through the SSH server)."""
         station = self.station
         self._drawn = (station.paused, station.notice, station.controller, len(station.runs))
         snapshot = station.snapshot()
+        top = self.screen_stack[-1] if station.at_rest and self.screen_stack else None
         for screen in self.screen_stack:
-            if isinstance(screen, ShowsSnapshot):
+            if isinstance(screen, ShowsSnapshot) and top in (None, screen):
                 screen.show_snapshot(snapshot)
         labs = self._labs
         if labs is not None and labs not in self.screen_stack:
