@@ -11,15 +11,16 @@ rather than wall time, so the figures hold up while other work runs on the machi
 2. --students log in at the same moment, as a class does at the start of a lab: the same
    figures per student, and the wall time to the first screen (p50/p95; this one depends on
    what else the machine does).
-3. every student passes the names dialog and then presses nothing for --idle seconds (the
-   robot stands still): the CPU of one idle app, of the server process and of the fork server,
-   as % of one core.
+3. the class sits at the names dialog for up to 10 s, then every student passes it and presses
+   nothing for --idle seconds (the robot stands still): the CPU of one idle app (at the dialog,
+   and at the main screen), of the server process and of the fork server, as % of one core.
 
 ``--compare REV`` measures the workbench of git revision REV (exported to a temporary folder)
 in the same run, before this tree, and prints the ratios: a before/after under the same load.
 
-``--profile PREFIX`` also writes cProfile statistics: ``PREFIX-server.prof`` (the server
-process while the --students arrive; run under ``bench/profiled_app.py``) and
+``--profile PREFIX`` also writes cProfile statistics: ``PREFIX-after-server.prof`` (the server
+process while the --students arrive; run under ``bench/profiled_app.py``; with --compare also
+``PREFIX-before-server.prof``) and
 ``PREFIX-app.prof`` (one app from its fork to its first screen, forked from a fork server as
 the lab server does), and prints their top entries. The profiler slows what it watches, so
 its times are only relative.
@@ -115,7 +116,8 @@ class Figures:
     one_by_one: list[Arrival] = field(default_factory=list)
     together: list[Arrival] = field(default_factory=list)
     together_server_cpu: float = 0.0  # per student
-    idle_app: float = 0.0  # % of a core, per session
+    idle_dialog: float = 0.0  # share of a core, per session at the names dialog
+    idle_app: float = 0.0  # share of a core, per session at the main screen
     idle_server: float = 0.0
     idle_forkserver: float = 0.0
     failures: list[str] = field(default_factory=list)
@@ -259,6 +261,14 @@ async def measure(tree: Path, students: int, one_by_one: int, idle: float, profi
             if profile:
                 os.kill(server.pid, signal.SIGUSR2)
             arrived = [s for s in class_ if s.proc is not None]
+            # first the class sits at the names dialog (the screen they see first)
+            await asyncio.sleep(2.0)
+            pids = [server.app_pids()[s.name] for s in arrived]
+            before = [cpu_seconds(p) for p in pids]
+            t0 = time.perf_counter()
+            await asyncio.sleep(min(10.0, idle))
+            used = sum(cpu_seconds(p) for p in pids) - sum(before)
+            figures.idle_dialog = used / (time.perf_counter() - t0) / max(1, len(pids))
             await asyncio.gather(*(s.pass_names() for s in arrived), return_exceptions=True)
             await asyncio.sleep(3.0)  # the main screens settle
             pids = [server.app_pids()[s.name] for s in arrived]
@@ -292,6 +302,7 @@ def report(name: str, f: Figures) -> dict[str, float]:
         "app CPU, fork to first screen (all at once)": statistics.median(
             a.app_cpu for a in together
         ),
+        "idle app at the names dialog, % of a core": 100 * f.idle_dialog,
         "idle app, % of a core": 100 * f.idle_app,
         "idle server process, % of a core": 100 * f.idle_server,
         "idle fork server, % of a core": 100 * f.idle_forkserver,
@@ -312,7 +323,8 @@ def report(name: str, f: Figures) -> dict[str, float]:
         f"{pct(walls, 0.95):.2f} s (wall: depends on the machine's other load)"
     )
     print(
-        f"  idle: an app {100 * f.idle_app:.3f}% of a core; the server process "
+        f"  idle: an app at the names dialog {100 * f.idle_dialog:.3f}% of a core, at the main "
+        f"screen {100 * f.idle_app:.3f}%; the server process "
         f"{100 * f.idle_server:.3f}%, the fork server {100 * f.idle_forkserver:.3f}%"
     )
     for failure in f.failures[:5]:
@@ -394,7 +406,8 @@ def main() -> None:
             trees = {args.compare: export(args.compare, Path(tmp)), "this tree": ROOT}
         headlines = {}
         for name, tree in trees.items():
-            profile = args.profile if args.profile and name == "this tree" else ""
+            label = "before" if name != "this tree" else "after"
+            profile = f"{args.profile}-{label}" if args.profile else ""
             figures = asyncio.run(measure(tree, args.students, args.one_by_one, args.idle, profile))
             headlines[name] = report(name, figures)
     if args.compare:
@@ -405,7 +418,8 @@ def main() -> None:
             print(f"  {key:45} {before[key]:8.3f} -> {after[key]:8.3f}  {ratio}")
     if args.profile:
         asyncio.run(profile_app(args.profile))
-        show_profile(f"{args.profile}-server.prof")
+        for label in ("before", "after") if args.compare else ("after",):
+            show_profile(f"{args.profile}-{label}-server.prof")
         show_profile(f"{args.profile}-app.prof")
 
 
