@@ -20,7 +20,7 @@ from typing import ClassVar
 from textual import events
 from textual.binding import Binding, BindingType
 from textual.reactive import var
-from textual.screen import Screen
+from textual.screen import ModalScreen, Screen
 from textual.timer import Timer
 
 from workbench.control.station import LabStation
@@ -279,14 +279,16 @@ class WorkbenchApp(ScreenHost[None]):
 
     def refresh_views(self) -> None:
         """Draw the station's current snapshot on every screen of the stack that shows one;
-        at rest (nothing moves, only the clock runs) on the top screen only: a screen under
-        a dialog or another screen is brought up to date when it is on top again. Under the
+        at rest (nothing moves, only the clock runs) with a dialog open, on the dialog only:
+        the screen dimmed under it is brought up to date when it is on top again. Under the
         names dialog that a served student sees first, the clock behind it had redrawn the
         whole dimmed screen every second (8 KB a second through the SSH server)."""
         station = self.station
         self._drawn = (station.paused, station.notice, station.controller, len(station.runs))
         snapshot = station.snapshot()
-        top = self.screen_stack[-1] if station.at_rest and self.screen_stack else None
+        stack = self.screen_stack
+        dialog = stack[-1] if stack and isinstance(stack[-1], ModalScreen) else None
+        top = dialog if station.at_rest else None
         for screen in self.screen_stack:
             if isinstance(screen, ShowsSnapshot) and top in (None, screen):
                 screen.show_snapshot(snapshot)
