@@ -4,6 +4,8 @@
 as ``python -m workbench`` would; SIGUSR1 starts cProfile on the app's main thread (where
 Textual and the simulation run), SIGUSR2 stops it and writes the stats to STATS_FILE. So a
 profile holds only the stretch the bench measures (driving, or sitting idle), not the start-up.
+:func:`from_start` is the other way round, an entry point for a fork server (``bench/startup.py``):
+the profile runs from the fork until SIGUSR2 and goes to ``$WORKBENCH_PROFILE_TO``.
 Times are the main thread's CPU time, not wall time: other processes on a busy machine do not
 show up in them.
 """
@@ -36,6 +38,21 @@ def run(stats_file: str, options: list[str]) -> int:
 
     signal.signal(signal.SIGUSR1, start)
     signal.signal(signal.SIGUSR2, stop)
+    return main(options)
+
+
+def from_start(options: list[str]) -> int:
+    """The app as a fork server runs it, profiled from here (just after the fork) to SIGUSR2."""
+    from workbench.cli import main
+
+    profiler = cProfile.Profile(time.thread_time)
+
+    def stop(*_: object) -> None:
+        profiler.disable()
+        profiler.dump_stats(os.environ["WORKBENCH_PROFILE_TO"])
+
+    signal.signal(signal.SIGUSR2, stop)
+    profiler.enable()
     return main(options)
 
 

@@ -24,8 +24,8 @@ def maze(tmp_path) -> str:
     return str(path)
 
 
-def shown_time(app) -> float:
-    clock = str(app.screen.query_one(RunStatus).lines[1])  # running at 1x | t 2.3 s
+def shown_time(app, screen=None) -> float:
+    clock = str((screen or app.screen).query_one(RunStatus).lines[1])  # running at 1x | t 2.3 s
     return float(re.search(r" t ([0-9.]+) s", clock).group(1))
 
 
@@ -82,5 +82,28 @@ def test_paused_the_app_rests_and_p_wakes_it(tmp_path):
         await pilot.press("p")
         await pilot.pause(0.2)
         assert not app._resting and "running" in str(app.screen.query_one(RunStatus).lines[1])
+
+    run(app, body)
+
+
+def test_at_rest_a_screen_under_a_dialog_draws_nothing_until_it_is_on_top_again(tmp_path):
+    # the names dialog a served student sees first: the main screen dimmed behind it
+    app = make_app(maze(tmp_path), noise="off", student="ann", ask_names=True)
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.pause(0.3)
+        main = app.screen_stack[0]
+        assert app._resting and app.screen is not main
+        shown, lines = shown_time(app, main), list(main.query_one(RunStatus).lines)
+        await pilot.pause(2.5)
+        assert app.station.session.world.time > shown + 2.0  # time went on...
+        assert shown_time(app, main) == shown  # ...but the covered screen was not redrawn
+        assert list(main.query_one(RunStatus).lines) == lines
+        await pilot.press("enter")  # the dialog closes: the clock is right when seen
+        await pilot.pause(0.2)
+        assert app.screen is main
+        # (the key woke the clock: for a moment it ticks at full rate, the panel at 4 Hz)
+        assert shown_time(app) == pytest.approx(app.station.session.world.time, abs=0.3)
+        assert shown_time(app) > shown + 2.0
 
     run(app, body)

@@ -75,3 +75,22 @@ async def test_repeated_failures_from_one_address_are_answered_more_slowly(tmp_p
             times.append(asyncio.get_running_loop().time() - start)
         # no wait for the first failure, then 0.2 s doubling: 0.8 s before the fourth answer
         assert times[3] > times[0] + 0.6, times
+
+
+@sync
+async def test_a_client_that_prefers_chacha20_gets_aes_and_one_with_only_chacha20_is_refused(
+    tmp_path,
+):
+    # OpenSSH offers chacha20-poly1305 first; the server takes AES only (far cheaper per packet)
+    openssh_order = ["chacha20-poly1305@openssh.com", "aes128-ctr", "aes128-gcm@openssh.com"]
+    async with lab_host(tmp_path, [Account("ann")]) as host:
+        conn = await host.connect("ann", encryption_algs=openssh_order)
+        assert conn.get_extra_info("send_cipher") == "aes128-ctr"
+        assert conn.get_extra_info("send_mac") == "hmac-sha2-256-etm@openssh.com"
+        conn.close()
+        conn = await host.connect("ann")  # asyncssh's own order: GCM, which needs no MAC
+        assert conn.get_extra_info("send_cipher").startswith("aes")
+        assert "gcm" in conn.get_extra_info("send_cipher")
+        conn.close()
+        with pytest.raises(asyncssh.KeyExchangeFailed):
+            await host.connect("ann", encryption_algs=["chacha20-poly1305@openssh.com"])

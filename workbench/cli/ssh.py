@@ -18,11 +18,17 @@ from workbench.ssh.appproc import AppEntry
 from .common import db_option
 
 #: the app every SSH session runs: this Python's ``-m workbench``, or forked from the fork
-#: server as :func:`workbench.cli.main` with the app's modules imported beforehand
+#: server as :func:`workbench.cli.main` with the app's modules imported beforehand and its
+#: first screen's common work done once (the command line's parser, and
+#: :func:`workbench.tui.warmup.prepare`)
 WORKBENCH_APP = AppEntry(
     command=(sys.executable, "-m", "workbench"),
     main="workbench.cli:main",
-    preload=("workbench.cli", "workbench.tui.app"),
+    preload=(
+        "workbench.cli:shared_parser",
+        "workbench.tui.app",
+        "workbench.tui.warmup:prepare",
+    ),
 )
 
 

@@ -48,7 +48,8 @@ class AppEntry:
     command: tuple[str, ...]
     #: the same app as a function for the fork server: ``module:function`` taking the options
     main: str
-    #: modules the fork server imports before it forks (the app's own)
+    #: modules the fork server imports before it forks (the app's own), and functions
+    #: (``module:function``) it calls once they are imported
     preload: tuple[str, ...] = ()
 
 

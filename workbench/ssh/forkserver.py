@@ -7,14 +7,18 @@ Two halves live here:
 - the fork server process (``python -m workbench.ssh.forkserver FD MAIN [MODULE...]``): started
   by the lab server with the apps' environment and the app's entry point (``MAIN``, as
   ``module:function``, handed down by whoever starts the lab server), it imports the modules it
-  is given, the :data:`PRELOAD` list and every module of the workbench packages the app uses,
-  freezes them out of the garbage collector's reach (so the pages stay shared with the
-  children) and waits on a Unix socket.
+  is given, the :data:`PRELOAD` list and every module of the workbench packages the app uses;
+  then it calls each ``module:function`` among the modules given (work every app would do the
+  same way, done once here: the app's is :func:`workbench.tui.warmup.prepare`), freezes it all
+  out of the garbage collector's reach (so the pages stay shared with the children) and waits
+  on a Unix socket.
   Each request carries the app's options and environment and two file descriptors (SCM_RIGHTS):
   the socket that becomes the app's standard input and output, and its error log. It forks; the
   child starts a new session (its own process group), puts the descriptors on 0, 1 and 2, sets
   the environment and runs the entry point with the app's options, ending with the
-  interpreter's ordinary exit. The fork server answers with the child's pid, reaps children
+  interpreter's ordinary exit. An app runs :data:`APP_NICENESS` steps below the lab server, so
+  the server's own work (handshakes, logins, passing keys and screens on) goes first when a
+  whole class arrives at once. The fork server answers with the child's pid, reaps children
   as they end and reports each one's exit status.
 - :class:`ForkServer`, the lab server's side: starts that process, sends requests and turns the
   answers into :class:`ForkedApp` objects that look like an ``asyncio.subprocess.Process``
@@ -57,6 +61,8 @@ PRELOAD_PACKAGES = (
     "workbench.tui",
 )
 MAX_MESSAGE = 1 << 20
+#: how much lower an app's scheduling priority is than the lab server's (``nice``)
+APP_NICENESS = 5
 #: exit status given for an app whose status could not be learnt (the fork server was lost)
 UNKNOWN_STATUS = 1
 
@@ -87,8 +93,10 @@ def entry_point(main: str) -> Callable[[list[str]], int]:
 
 
 def preload(modules: tuple[str, ...] = ()) -> int:
-    """Import what the app will import; the number of modules loaded in all."""
-    for name in (*modules, *PRELOAD):
+    """Import what the app will import, then call each ``module:function`` of ``modules``; the
+    number of modules loaded in all."""
+    names = [name.partition(":")[0] for name in modules]
+    for name in (*names, *PRELOAD):
         importlib.import_module(name)
     for package in PRELOAD_PACKAGES:
         path = importlib.import_module(package).__path__
@@ -99,6 +107,9 @@ def preload(modules: tuple[str, ...] = ()) -> int:
                 importlib.import_module(info.name)
             except Exception as exc:  # the app itself will report it, if it uses the module
                 print(f"fork server: not preloaded: {info.name}: {exc}", file=sys.stderr)
+    for name in modules:
+        if ":" in name:
+            entry_point(name)()
     return len(sys.modules)
 
 
@@ -201,6 +212,8 @@ def _run_app(
         if fd > 2:
             os.close(fd)
     signal.signal(signal.SIGINT, signal.default_int_handler)
+    with contextlib.suppress(OSError):
+        os.nice(APP_NICENESS)
     os.environ.clear()
     os.environ.update(env)
     if cwd:

@@ -37,6 +37,24 @@ NOT_A_TERMINAL = (
 )
 NO_COMMANDS = "This lab server runs the workbench only: no commands ({what} refused)."
 NO_FILES = "This lab server runs the workbench only: no file transfer ({what} refused)."
+#: the ciphers the server takes, AES only: a client picks the first of its own list the server
+#: has, and OpenSSH's list starts with chacha20-poly1305, which asyncssh does per packet in
+#: several Python calls (about five times the CPU of AES-GCM, measured in bench/startup.py);
+#: AES-GCM, and AES-CTR with an SHA-2 MAC, are as strong and every SSH client offers them
+CIPHERS = (
+    "aes128-gcm@openssh.com",
+    "aes256-gcm@openssh.com",
+    "aes128-ctr",
+    "aes192-ctr",
+    "aes256-ctr",
+)
+#: MACs for the CTR ciphers (GCM carries its own): SHA-2 only, encrypt-then-MAC first
+MACS = (
+    "hmac-sha2-256-etm@openssh.com",
+    "hmac-sha2-512-etm@openssh.com",
+    "hmac-sha2-256",
+    "hmac-sha2-512",
+)
 #: checked against when a user is unknown, so a wrong name costs the same time as a wrong password
 _DUMMY_HASH = hash_password("not a real password")
 
@@ -150,6 +168,8 @@ class LabServer:
             config.bind or None,
             config.port,
             server_host_keys=[self.host_key],
+            encryption_algs=CIPHERS,
+            mac_algs=MACS,
             encoding=None,
             line_editor=False,
             allow_scp=False,

@@ -20,7 +20,7 @@ from typing import ClassVar
 from textual import events
 from textual.binding import Binding, BindingType
 from textual.reactive import var
-from textual.screen import Screen
+from textual.screen import ModalScreen, Screen
 from textual.timer import Timer
 
 from workbench.control.station import LabStation
@@ -40,6 +40,7 @@ from workbench.viple.link import REPORT_MS_DEFAULT
 from workbench.viple.tcp_server import TcpConfig
 from workbench.viple.ws_client import WsConfig
 
+from . import warmup
 from .commands import WorkbenchCommands
 from .dialogs.help import HelpScreen
 from .dialogs.too_small import TooSmallScreen
@@ -147,6 +148,9 @@ class WorkbenchApp(ScreenHost[None]):
         self.role = role
         self.tick_hz = tick_hz
         self.set_reactive(WorkbenchApp.unicode, unicode)
+        self.mark_ascii(update=False)
+        # the stylesheets as the fork server parsed them (a served app), else parsed here
+        warmup.seed(self.stylesheet)
         self._last_tick = perf_counter()
         #: the clock ticks at REST_HZ (True) or at tick_hz (False)
         self._resting = False
@@ -155,6 +159,8 @@ class WorkbenchApp(ScreenHost[None]):
         self._slow: Timer | None = None
         self._drawn: tuple[object, ...] = ()
         self._too_small: TooSmallScreen | None = None
+        #: the size the app started with was announced again (see _on_resize)
+        self._sized = False
         self._main: MainScreen | None = None
         #: the maze the message line last named
         self._maze_named = station.maze
@@ -272,12 +278,19 @@ class WorkbenchApp(ScreenHost[None]):
         await super().on_event(event)
 
     def refresh_views(self) -> None:
-        """Draw the station's current snapshot on every screen of the stack that shows one."""
+        """Draw the station's current snapshot on every screen of the stack that shows one;
+        at rest (nothing moves, only the clock runs) with a dialog open, on the dialog only:
+        the screen dimmed under it is brought up to date when it is on top again. Under the
+        names dialog that a served student sees first, the clock behind it had redrawn the
+        whole dimmed screen every second (8 KB a second through the SSH server)."""
         station = self.station
         self._drawn = (station.paused, station.notice, station.controller, len(station.runs))
         snapshot = station.snapshot()
+        stack = self.screen_stack
+        dialog = stack[-1] if stack and isinstance(stack[-1], ModalScreen) else None
+        top = dialog if station.at_rest else None
         for screen in self.screen_stack:
-            if isinstance(screen, ShowsSnapshot):
+            if isinstance(screen, ShowsSnapshot) and top in (None, screen):
                 screen.show_snapshot(snapshot)
         labs = self._labs
         if labs is not None and labs not in self.screen_stack:
@@ -286,6 +299,16 @@ class WorkbenchApp(ScreenHost[None]):
 
     # -- size --------------------------------------------------------------------------------
     def on_resize(self, event: events.Resize) -> None:
+        known = self._size  # None until Textual has handled the app's first resize
+        if known is not None and not self._sized:
+            self._sized = True
+            if event.size == known:
+                # Textual's web driver announces, once the app runs, the size the app
+                # started with, and Textual then lays out and draws every screen again: a
+                # quarter of a served app's work to its first screen. That one is let go (a
+                # later resize to the same size still redraws all, as after a reattach).
+                event.prevent_default()
+                return
         self._check_size(event.size.width, event.size.height)
 
     def _check_size(self, width: int, height: int) -> None:

@@ -172,10 +172,11 @@ class ScreenHost(App[ReturnType]):
             if isinstance(screen, FollowsUnicode):
                 screen.set_unicode(unicode)
 
-    def mark_ascii(self) -> None:
+    def mark_ascii(self, update: bool = True) -> None:
         """The app's CSS class for plain-ASCII drawing (panel borders and frames, scroll bars,
-        the glyphs of Textual's own widgets: see :mod:`workbench.tui.plain`)."""
-        self.set_class(not self.unicode, "-ascii")
+        the glyphs of Textual's own widgets: see :mod:`workbench.tui.plain`); ``update=False``
+        before the app runs, so the first styling of every widget has it already."""
+        self.set_class(not self.unicode, "-ascii", update=update)
 
     def get_key_display(self, binding: Binding) -> str:
         """A key as the footer shows it; in ASCII mode arrows are named (``right``, not ``→``)."""

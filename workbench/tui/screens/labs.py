@@ -21,7 +21,7 @@ from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.screen import Screen
 from textual.timer import Timer
-from textual.widgets import Footer, Input, Markdown, OptionList, Static
+from textual.widgets import Input, Markdown, OptionList, Static
 from textual.widgets.option_list import Option
 
 from workbench.control.station import LabStation
@@ -34,6 +34,7 @@ from ..host import FollowsUnicode, SetUpDone, ShowsSnapshot
 from ..keys import bindings
 from ..plain import follow_app, prose
 from ..widgets.field import Field
+from ..widgets.key_bar import KeyBar
 
 
 class Marks(NamedTuple):
@@ -270,7 +271,7 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
                     yield Markdown("", id="labs-instructions")
                     yield Vertical(id="labs-questions")
         yield Static("", id="labs-message", markup=False)
-        yield Footer(compact=True, show_command_palette=False)
+        yield KeyBar()
 
     @property
     def marks(self) -> Marks:

@@ -17,7 +17,6 @@ from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical
 from textual.reactive import var
 from textual.screen import Screen
-from textual.widgets import Footer
 
 from workbench.control.fsm import FsmError
 from workbench.control.station import ALGORITHM_FAILED, LabStation, Notice
@@ -42,6 +41,7 @@ from ..host import (
 )
 from ..keys import bindings
 from ..widgets.algorithm_state import AlgorithmState
+from ..widgets.key_bar import KeyBar
 from ..widgets.key_legend import KeyLegend
 from ..widgets.maze_view import MazeView
 from ..widgets.message_bar import MessageBar
@@ -142,7 +142,7 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Scree
                 yield self._algorithm
                 yield self._program
         yield self._message
-        yield Footer(compact=True, show_command_palette=False)
+        yield KeyBar()
 
     def on_mount(self) -> None:
         self._ready = True

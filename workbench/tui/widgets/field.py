@@ -4,6 +4,9 @@ Textual's ``Input`` inserts a printable key as soon as it arrives but runs its e
 (backspace, arrows, ctrl+u...) as bindings once the key has bubbled up to the app. Over SSH
 a typist's keys arrive together, so "backspace 5" became "5, then backspace" and the 5 was
 lost. :class:`Field` runs its own editing bindings when the key reaches it, in order.
+
+Its cursor does not blink: a blinking cursor redraws the field twice a second, which a served
+student sitting at the names dialog pays for in the app and again in the SSH server.
 """
 
 from __future__ import annotations
@@ -22,7 +25,11 @@ _EDITING = {
 
 
 class Field(Input):
-    """``Input`` with typed-ahead editing keys kept in order."""
+    """``Input`` with typed-ahead editing keys kept in order and a steady cursor."""
+
+    def __init__(self, *args: object, **kwargs: object) -> None:
+        super().__init__(*args, **kwargs)  # type: ignore[arg-type]
+        self.set_reactive(Input.cursor_blink, False)
 
     async def _on_key(self, event: events.Key) -> None:
         action = _EDITING.get(event.key)

@@ -1,0 +1,64 @@
+"""Work every served app does the same way at start, done once in the fork server.
+
+Each SSH session's app is forked from the lab server's fork server (``workbench/ssh/
+forkserver.py``), which calls :func:`prepare` before it forks. :func:`prepare` runs the app
+once, headless, up to the screen a student sees first (the names dialog over the main screen),
+and keeps what Textual parsed of the stylesheets on the way: every app parses the same CSS
+(the app's file and the widgets' defaults) into the same rules, about a fifth of its CPU to
+the first screen. The run also fills the caches of the libraries beneath (Rich's cell widths,
+parsed colours and styles, Textual's compiled markup), which the forked apps then share.
+
+A new app's stylesheet takes the kept rules in :func:`seed`, only when its CSS variables are
+the ones they were parsed with (a different theme is parsed afresh, as before).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import tempfile
+
+from textual.css.stylesheet import Stylesheet
+
+#: the rules parsed ahead: Textual's parse cache key -> rule sets, and the variables used
+_parsed: dict[tuple, list] = {}
+_variables: dict[str, str] = {}
+
+
+def prepare() -> None:
+    """Run the app headless to its first screen and keep the parsed stylesheets."""
+    from .app import make_app
+
+    async def first_screen() -> None:
+        async with app.run_test(size=(80, 24)) as pilot:
+            await pilot.pause()
+
+    with tempfile.TemporaryDirectory(prefix="workbench-warmup-") as folder:
+        app = make_app(
+            student="warmup",
+            ask_names=True,
+            student_fixed=True,
+            data_dir=folder,
+            workspace=folder,
+            connect_hint="VIPLE: warming up",
+        )
+        asyncio.run(first_screen())
+    keep(app.stylesheet)
+
+
+def keep(stylesheet: Stylesheet) -> None:
+    """Keep what ``stylesheet`` has parsed, for the apps made after this."""
+    cache = stylesheet._parse_cache
+    _parsed.clear()
+    _parsed.update((key, cache[key]) for key in list(cache.keys()))
+    _variables.clear()
+    _variables.update(stylesheet._variables)
+
+
+def seed(stylesheet: Stylesheet) -> int:
+    """Give a new app's stylesheet the rules parsed ahead; how many sources it was given."""
+    if not _parsed or stylesheet._variables != _variables:
+        return 0
+    cache = stylesheet._parse_cache
+    for key, rules in _parsed.items():
+        cache[key] = rules
+    return len(_parsed)
