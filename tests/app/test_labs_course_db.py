@@ -4,6 +4,7 @@ keeps working while the database restarts."""
 from __future__ import annotations
 
 import asyncio
+import threading
 import time
 
 from textual.pilot import Pilot
@@ -123,12 +124,13 @@ def test_retries_run_beside_the_app_one_at_a_time(tmp_path, pg_server, pg_url, m
         screen = await open_exercise(pilot, DRIVE)
         store = app.store
         flush = store.flush
+        back = threading.Event()
 
-        def slow_flush() -> bool:  # a database that does not answer: each try waits
-            nonlocal running, most
+        def slow_flush() -> bool:  # a database that does not answer: each try waits 3 s
+            nonlocal running, most  # (or until the server is back)
             running += 1
             most = max(most, running)
-            time.sleep(3.0)
+            back.wait(3.0)
             running -= 1
             return flush()
 
@@ -146,6 +148,7 @@ def test_retries_run_beside_the_app_one_at_a_time(tmp_path, pg_server, pg_url, m
             assert app.frames > frames  # and the screen kept being drawn
         finally:
             pg_server.start()
+            back.set()
         deadline = time.monotonic() + 15
         while store.pending and time.monotonic() < deadline:
             await asyncio.sleep(0.2)
