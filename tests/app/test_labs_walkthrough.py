@@ -445,6 +445,7 @@ async def viple_over_websocket(w: Walkthrough, screen: LabsScreen, lab: Lab, ex:
     await w.open(lab, ex)
 
 
+@pytest.mark.long
 @pytest.mark.parametrize("lab", LABS, ids=[lab.id for lab in LABS])
 def test_a_pair_completes_and_signs_off_every_exercise_in_the_app(tmp_path, lab):
     data = tmp_path / "data"
