@@ -208,10 +208,48 @@ def run_command(bad: BadFile, path: Path, args: list[str], timeout: float = 60.0
     return Outcome(bad, argv, proc.returncode, output, seconds, usage.ru_maxrss)
 
 
-def run_corpus(folder: Path, jobs: int = 8) -> list[Outcome]:
-    """Every command of :data:`COMMANDS` on every bad file written into ``folder``."""
+def run_corpus(folder: Path, jobs: int = 8, *, forked: bool = False) -> list[Outcome]:
+    """Every command of :data:`COMMANDS` on every bad file written into ``folder``, ``jobs``
+    at a time: each in a process started afresh, or with ``forked`` each in a process forked
+    from one that has imported the command line already (tests/cli_forker.py: the same code
+    on the same file, its own process and output, without the interpreter's start)."""
+    work = [(bad, path, args) for bad, path in write_corpus(folder) for args in COMMANDS[bad.kind]]
+    if forked:
+        return _run_forked(folder, work, jobs)
     from concurrent.futures import ThreadPoolExecutor
 
-    work = [(bad, path, args) for bad, path in write_corpus(folder) for args in COMMANDS[bad.kind]]
     with ThreadPoolExecutor(max_workers=jobs) as pool:
         return list(pool.map(lambda job: run_command(*job), work))
+
+
+def _run_forked(
+    folder: Path, work: list[tuple[BadFile, Path, list[str]]], jobs: int, timeout: int = 60
+) -> list[Outcome]:
+    import json
+    import subprocess
+    import sys
+
+    outputs = folder / "outputs"
+    outputs.mkdir(exist_ok=True)
+    argvs = [[a.replace("{}", str(path)) for a in args] for _bad, path, args in work]
+    specs = [{"argv": argv, "out": str(outputs / f"{n}.out")} for n, argv in enumerate(argvs)]
+    jobs_file, results_file = folder / "jobs.json", folder / "results.json"
+    jobs_file.write_text(json.dumps(specs))
+    done = subprocess.run(
+        [sys.executable, "-m", "tests.cli_forker", str(jobs_file), str(results_file),
+         "--jobs", str(jobs), "--timeout", str(timeout)],
+        cwd=ROOT, capture_output=True, text=True, timeout=timeout * len(work),
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    results = json.loads(results_file.read_text())
+    return [
+        Outcome(
+            bad,
+            argv,
+            result["code"],
+            Path(spec["out"]).read_bytes().decode("utf-8", "replace"),
+            result["seconds"],
+            result["max_rss_kib"],
+        )
+        for (bad, _path, _args), argv, spec, result in zip(work, argvs, specs, results, strict=True)
+    ]

@@ -1,4 +1,5 @@
-"""Fixtures shared by every test folder: a PostgreSQL server for the store's tests.
+"""Fixtures shared by every test folder: a PostgreSQL server for the store's tests; and the
+order the tests run in.
 
 One server per test process (each pytest-xdist worker is one), started the first time a test
 asks for it and stopped when the process ends; each test gets a database of its own on it.
@@ -14,6 +15,13 @@ import pytest
 from .pgserver import NoServer, PgServer
 
 _names = itertools.count(1)
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Tests marked ``long`` run first, the rest in their usual order. With several workers
+    (``-n``) a long test that started last would keep the run going on one worker while the
+    others have finished; started first, the short ones fill in around it."""
+    items.sort(key=lambda item: item.get_closest_marker("long") is None)
 
 
 @pytest.fixture(scope="session")

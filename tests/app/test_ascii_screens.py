@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
 from textual.pilot import Pilot
 from textual.widgets import Input
 
@@ -46,6 +47,7 @@ class Walk:
         await self.pilot.pause()
 
 
+@pytest.mark.long
 def test_every_screen_and_dialog_is_plain_ascii_in_ascii_mode(tmp_path: Path):
     data = tmp_path / "data"
     so.create_instructor(data, "Dr Chen", "correct horse battery", kdf=FAST)

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import pytest
 from textual.pilot import Pilot
-from textual.widgets import Input, OptionList, Select, Static
+from textual.widgets import Input, Markdown, OptionList, Select, Static
 from websockets.asyncio.server import serve
 
 from tests.integration.test_labs_completable import DRIVE, SOLUTIONS, answer, free_port
@@ -104,6 +104,11 @@ class Walkthrough:
         screen = await self.labs()
         listing = screen.query_one("#labs-list", OptionList)
         listing.highlighted = listing.get_option_index(f"{lab.id}/{ex.id}")
+        await self.pilot.pause()
+        # the instructions are parsed in a thread, then mounted, under the lock of their
+        # Markdown widget: wait for that, so the objectives below them are where they stay
+        async with screen.query_one("#labs-instructions", Markdown).lock:
+            pass
         await self.pilot.pause()
         assert str(screen.query_one("#labs-title").render()) == f"{lab.title}: {ex.title}"
         return screen
@@ -445,6 +450,7 @@ async def viple_over_websocket(w: Walkthrough, screen: LabsScreen, lab: Lab, ex:
     await w.open(lab, ex)
 
 
+@pytest.mark.long
 @pytest.mark.parametrize("lab", LABS, ids=[lab.id for lab in LABS])
 def test_a_pair_completes_and_signs_off_every_exercise_in_the_app(tmp_path, lab):
     data = tmp_path / "data"

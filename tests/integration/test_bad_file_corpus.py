@@ -1,5 +1,10 @@
 """The command line on a corpus of bad files: every one is refused by name, quickly, with no
-traceback. The slowest run and the largest process are printed (run with -s to see them)."""
+traceback. The slowest run and the largest process are printed (run with -s to see them).
+
+Each command runs in a process of its own, forked from one that has imported the command line
+(tests/cli_forker.py), so the seconds and the memory are those of refusing the file, without
+the interpreter's start that is the same for every file (bench/bad_files.py times whole
+processes started afresh)."""
 
 from __future__ import annotations
 
@@ -17,7 +22,7 @@ MAX_RSS_MIB = 200
 
 @pytest.fixture(scope="module")
 def outcomes(tmp_path_factory):
-    return run_corpus(tmp_path_factory.mktemp("corpus"))
+    return run_corpus(tmp_path_factory.mktemp("corpus"), jobs=2, forked=True)
 
 
 def test_every_bad_file_is_refused_by_name_without_a_traceback(outcomes):

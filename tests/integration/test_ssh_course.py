@@ -3,6 +3,8 @@ objective on one finds it passed on the other, where the labs reopen at the same
 
 from __future__ import annotations
 
+import pytest
+
 from tests.app.support import sync
 from workbench.labs.store import Store
 
@@ -12,6 +14,7 @@ DRIVE = "Unity simulator: Drive by wire"
 KEYS_DONE = "[X] drove with w, a, s, d and space"
 
 
+@pytest.mark.long
 @sync
 async def test_a_student_moves_between_two_servers_sharing_one_database(
     tmp_path, pg_url, monkeypatch

@@ -503,6 +503,7 @@ def in_process(tmp_path_factory) -> dict:
     return {**result.metrics, "final_state": result.final_state}
 
 
+@pytest.mark.long
 @pytest.mark.parametrize("role", ["tcp", "ws"])
 def test_viple_client_drives_out_through_serve_like_the_in_process_run(tmp_path, in_process, role):
     at_exit, summary, out = served_run(tmp_path, role)
