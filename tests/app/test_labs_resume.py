@@ -96,6 +96,32 @@ def test_over_ssh_the_student_name_is_fixed_and_escape_keeps_the_defaults(tmp_pa
     run(app, body)
 
 
+def test_a_served_students_first_screen_is_the_names_dialog_alone_then_the_main_screen(
+    tmp_path,
+):
+    # the main screen is built once the names are given (a class logging in at once waits
+    # less for its first screens); what was said before it existed is on its message line
+    hint = "VIPLE: on your computer run  ssh -N -p 2222 -L 1350:localhost:41000 ana@lab"
+    app = make_app(paused=True, student="ana", data_dir=tmp_path, ask_names=True,
+                   student_fixed=True, connect_hint=hint)  # fmt: skip
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.pause()
+        assert isinstance(app.screen, IdentityDialog)
+        assert not any(isinstance(s, MainScreen) for s in app.screen_stack)
+        await pilot.press("enter")
+        await pilot.pause()
+        assert isinstance(app.screen, MainScreen)
+        assert text(app.screen, "#message").startswith("VIPLE from your computer: press ?")
+        assert text(app.screen, "#message").rstrip().endswith("ana (student)")
+        await pilot.press("w")  # the main screen drives at once
+        await pilot.press("p")
+        await pilot.pause(0.3)
+        assert app.station.session.world.time > 0
+
+    run(app, body)
+
+
 def test_a_connect_hint_is_shown_at_start_and_in_the_help(tmp_path):
     hint = "VIPLE: on your computer run  ssh -N -p 2222 -L 1350:localhost:41000 ana@lab"
     app = make_app(paused=True, student="ana", data_dir=tmp_path, connect_hint=hint)

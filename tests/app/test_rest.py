@@ -10,6 +10,7 @@ from time import perf_counter
 
 import pytest
 from textual.pilot import Pilot
+from textual.screen import ModalScreen
 
 from tests.app.support import run
 from workbench.tui.app import REST_HZ, make_app
@@ -87,19 +88,21 @@ def test_paused_the_app_rests_and_p_wakes_it(tmp_path):
 
 
 def test_at_rest_a_screen_under_a_dialog_draws_nothing_until_it_is_on_top_again(tmp_path):
-    # the names dialog a served student sees first: the main screen dimmed behind it
-    app = make_app(maze(tmp_path), noise="off", student="ann", ask_names=True)
+    # a dialog over the main screen (here the sensor ports), the student reading it
+    app = make_app(maze(tmp_path), noise="off", student="ann")
 
     async def body(pilot: Pilot) -> None:
         await pilot.pause(0.3)
-        main = app.screen_stack[0]
-        assert app._resting and app.screen is not main
+        main = app.screen
+        await pilot.press("o")
+        await pilot.pause(0.3)
+        assert app._resting and isinstance(app.screen, ModalScreen)
         shown, lines = shown_time(app, main), list(main.query_one(RunStatus).lines)
         await pilot.pause(2.5)
         assert app.station.session.world.time > shown + 2.0  # time went on...
         assert shown_time(app, main) == shown  # ...but the covered screen was not redrawn
         assert list(main.query_one(RunStatus).lines) == lines
-        await pilot.press("enter")  # the dialog closes: the clock is right when seen
+        await pilot.press("escape")  # the dialog closes: the clock is right when seen
         await pilot.pause(0.2)
         assert app.screen is main
         # (the key woke the clock: for a moment it ticks at full rate, the panel at 4 Hz)

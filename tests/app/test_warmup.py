@@ -69,7 +69,7 @@ def test_after_the_warm_up_an_app_parses_no_css_and_shows_the_same_first_screen(
     warmup.prepare()
     warm: list[str] = []
     after = first_screen(tmp_path / "warm", warm)
-    assert warm == []
+    assert warm == [], warm
     assert after == before
 
 

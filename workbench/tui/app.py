@@ -56,6 +56,7 @@ from .host import (
     TakesAllKeys,
 )
 from .keys import bindings
+from .screens.arrival import ArrivalScreen
 from .screens.editor import EditorScreen
 from .screens.labs import LabsScreen
 from .screens.main import MainScreen
@@ -162,6 +163,9 @@ class WorkbenchApp(ScreenHost[None]):
         #: the size the app started with was announced again (see _on_resize)
         self._sized = False
         self._main: MainScreen | None = None
+        #: the names dialog was answered; what the message line last said
+        self._named_once = False
+        self._last_said = ""
         #: the maze the message line last named
         self._maze_named = station.maze
 
@@ -173,10 +177,32 @@ class WorkbenchApp(ScreenHost[None]):
         return f"{names} ({self.role})"
 
     def get_default_screen(self) -> Screen:
+        if self._ask_names:
+            return ArrivalScreen()  # the main screen follows the names (see open_main)
+        return self._new_main()
+
+    def _new_main(self) -> MainScreen:
         self._main = MainScreen(
             self.station, unicode=self.unicode, who=self.who(), maze_path=self.maze_path
         )
         return self._main
+
+    def open_main(self) -> None:
+        """Put the main screen in the arrival screen's place once the names are given and the
+        arrival screen is on top (not while the terminal is too small, say)."""
+        if self._main is not None or not self._named_once:
+            return
+        if not isinstance(self.screen, ArrivalScreen):
+            return
+        main = self._new_main()
+        main.show_message(self._last_said)
+        main.show_connection(self._connection)
+        self.add_mode("main", lambda: main)  # its own stack: the arrival screen stays below
+        self.switch_mode("main")
+
+    def say(self, text: str) -> None:
+        self._last_said = text  # for the main screen when it comes after the names
+        super().say(text)
 
     async def on_mount(self) -> None:
         tcp, ws = self._viple_configs
@@ -223,6 +249,8 @@ class WorkbenchApp(ScreenHost[None]):
         return "VIPLE from your computer: press ? for the ssh command"
 
     def _named(self, names: tuple[str, str] | None) -> None:
+        self._named_once = True
+        self.call_later(self.open_main)
         if names is None:
             return
         self.student, self.partner = names  # before the labs open: the dialog is modal

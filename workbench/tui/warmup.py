@@ -2,9 +2,9 @@
 
 Each SSH session's app is forked from the lab server's fork server (``workbench/ssh/
 forkserver.py``), which calls :func:`prepare` before it forks. :func:`prepare` runs the app
-once, headless, up to the screen a student sees first (the names dialog over the main screen),
-and keeps what Textual parsed of the stylesheets on the way: every app parses the same CSS
-(the app's file and the widgets' defaults) into the same rules, about a fifth of its CPU to
+once, headless, to the screen a student sees first (the names dialog) and past it to the main
+screen, and keeps what Textual parsed of the stylesheets on the way: every app parses the same
+CSS (the app's file and the widgets' defaults) into the same rules, about a fifth of its CPU to
 the first screen. The run also fills the caches of the libraries beneath (Rich's cell widths,
 parsed colours and styles, Textual's compiled markup), which the forked apps then share.
 
@@ -22,6 +22,8 @@ from textual.css.stylesheet import Stylesheet
 #: the rules parsed ahead: Textual's parse cache key -> rule sets, and the variables used
 _parsed: dict[tuple, list] = {}
 _variables: dict[str, str] = {}
+#: room in a stylesheet's parse cache for every source the app and its screens parse
+PARSE_CACHE = 256
 
 
 def prepare() -> None:
@@ -31,6 +33,10 @@ def prepare() -> None:
     async def first_screen() -> None:
         async with app.run_test(size=(80, 24)) as pilot:
             await pilot.pause()
+            keep(app.stylesheet)
+            await pilot.press("enter")  # past the names dialog: the main screen's CSS too
+            await pilot.pause()
+            keep(app.stylesheet)  # (Textual starts its parse cache afresh on the way)
 
     with tempfile.TemporaryDirectory(prefix="workbench-warmup-") as folder:
         app = make_app(
@@ -41,14 +47,19 @@ def prepare() -> None:
             workspace=folder,
             connect_hint="VIPLE: warming up",
         )
+        # more sources than Textual's parse cache holds by default (64): none may drop out
+        app.stylesheet._parse_cache.maxsize = PARSE_CACHE
+        _parsed.clear()
+        _variables.clear()
         asyncio.run(first_screen())
-    keep(app.stylesheet)
 
 
 def keep(stylesheet: Stylesheet) -> None:
-    """Keep what ``stylesheet`` has parsed, for the apps made after this."""
+    """Keep what ``stylesheet`` has parsed, beside what was kept before with the same CSS
+    variables, for the apps made after this."""
+    if _variables and stylesheet._variables != _variables:
+        _parsed.clear()
     cache = stylesheet._parse_cache
-    _parsed.clear()
     _parsed.update((key, cache[key]) for key in list(cache.keys()))
     _variables.clear()
     _variables.update(stylesheet._variables)
@@ -59,6 +70,7 @@ def seed(stylesheet: Stylesheet) -> int:
     if not _parsed or stylesheet._variables != _variables:
         return 0
     cache = stylesheet._parse_cache
+    cache.maxsize = max(cache.maxsize, PARSE_CACHE)
     for key, rules in _parsed.items():
         cache[key] = rules
     return len(_parsed)
