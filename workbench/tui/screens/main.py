@@ -15,8 +15,6 @@ from textual import events
 from textual.app import ComposeResult
 from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical
-from textual.reactive import var
-from textual.screen import Screen
 from textual.widgets import Footer
 
 from workbench.control.fsm import FsmError
@@ -28,6 +26,7 @@ from workbench.sim.mazeio import load_maze
 from workbench.sim.sensors import SensorConfigError
 from workbench.sim.session import Snapshot
 
+from ..binding_chain import CachedBindingChain
 from ..compositor import LiveCompositor
 from ..host import (
     FollowsUnicode,
@@ -53,7 +52,7 @@ from ..widgets.sensor_readings import SensorReadings
 PANEL_HZ = 4.0
 
 
-class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Screen[None]):
+class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, CachedBindingChain):
     """Drive, watch and set up the robot."""
 
     # the keys pressed again and again while driving are priority bindings: the screen takes
@@ -89,8 +88,8 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Scree
     #: keys a running VIPLE program may have besides the drive keys and the arrows
     PROGRAM_KEYS = frozenset("bchijkqyz0123456789")
 
-    #: the last snapshot drawn (per-tick state: never repaints by itself)
-    snapshot: var[Snapshot | None] = var(None)
+    #: the last snapshot drawn (a plain attribute: set on every tick, it never repaints)
+    snapshot: Snapshot | None = None
 
     def __init__(
         self,
