@@ -48,8 +48,11 @@ from ..widgets.program_state import ProgramState
 from ..widgets.run_status import RunStatus
 from ..widgets.sensor_readings import SensorReadings
 
-#: how often the text panels follow a running robot (the maze view follows every tick)
-PANEL_HZ = 4.0
+#: how often the text panels follow a running robot (the maze view follows every tick): twice a
+#: second is as often as a person reads a changing figure, and each update is a frame of its own
+#: (at 4 Hz the panels made most of a driving session's frames); paused, stepped or ended, the
+#: panels show the exact figures at once
+PANEL_HZ = 2.0
 
 
 class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, CachedBindingChain):
