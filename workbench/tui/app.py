@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import gc
 import getpass
 import os
 import threading
@@ -42,6 +43,7 @@ from workbench.viple.ws_client import WsConfig
 from .commands import WorkbenchCommands
 from .dialogs.help import HelpScreen
 from .dialogs.too_small import TooSmallScreen
+from .driver import SessionDriver
 from .host import (
     MazeChanged,
     OpenScreen,
@@ -188,6 +190,11 @@ class WorkbenchApp(ScreenHost[None]):
         if self.connect_hint:
             self.say(self.hint_line())
         self._check_size(self.size.width, self.size.height)
+        if isinstance(self._driver, SessionDriver):
+            # a served session's process holds this one app for the whole class: what start-up
+            # built lives as long as it, so the garbage collector's full passes (some 70 ms
+            # each while a student drives) leave it alone from the first screen on
+            self.call_after_refresh(gc.freeze)
         if self.db and self._pending_file().is_file():
             # what an earlier app could not save: written as soon as the database answers
             self.run_worker(self._save_kept(), group="store")
