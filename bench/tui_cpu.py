@@ -12,14 +12,20 @@ at start), passes the names dialog, and then, for each mode of --modes:
     in and is reading costs the server. After a driving mode the robot is stopped first (space)
     and its run stays open, recorded as it stands.
 
-The app ticks its simulation at its own 20 Hz. Printed: the app process's CPU (user + system,
-from /proc) per second of the mode, as % of one core (at 1x speed, CPU seconds per simulated
-and drawn second); the screen output in bytes a second. Each of --runs runs is a fresh process;
-the median is printed last.
+The app ticks its simulation at its own 20 Hz. The bench answers the app's question whether
+the terminal draws synchronized updates as most terminals do (yes), so the app writes its frames
+as a student's terminal gets them. Printed per mode: the app process's CPU (user + system, from
+/proc) per second of the mode, as % of one core (at 1x speed, CPU seconds per simulated and drawn
+second); the screen output in bytes and in writes a second (each write the server hands to the
+SSH channel: one SSH packet); and the CPU of this bench's own process, which does the server's
+part of a session without SSH (reads the app's packets, hands on the screen output, sends the
+keys). Each of --runs runs is a fresh process; the medians are printed last.
 
 ``--compare REV`` measures the workbench of git revision REV (exported to a temporary folder)
-in the same run, alternating with this tree, and prints both medians and their ratio: a
-before/after taken under the same load from other processes on the machine.
+in the same run, alternating with this tree, and prints both medians and their ratios (app CPU,
+and the server's part): a before/after taken under the same load from other processes on the
+machine. The older revision's app is read with that revision's own server code
+(``workbench/ssh/appproc.py`` and ``packets.py``), so a change there is measured too.
 
 ``--profile PREFIX`` runs the app under cProfile, switched on only for the measured stretch of
 each mode (start-up and the names dialog are left out; the figures are then only relative), and
@@ -31,6 +37,8 @@ from __future__ import annotations
 import argparse
 import asyncio
 import contextlib
+import importlib
+import importlib.util
 import os
 import re
 import signal
@@ -40,6 +48,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -50,6 +59,9 @@ from workbench.ssh.appproc import AppProcess, AppSpec  # noqa: E402
 CLK_TCK = os.sysconf("SC_CLK_TCK")
 SSH_PATTERN = "wwwwawwwwdww wwwwdwwwwaww "
 SETTLE = 1.0  # seconds of the mode before the CPU is counted
+#: the app asks whether the terminal draws synchronized updates; most terminals answer yes
+SYNC_QUERY = b"\x1b[?2026$p"
+SYNC_ANSWER = b"\x1b[?2026;2$y"
 MODES = ("ssh", "drive", "idle")
 
 
@@ -70,10 +82,16 @@ class Screen:
     def __init__(self) -> None:
         self.buffer = bytearray()
         self.bytes = 0
+        self.writes = 0
         self.arrived = asyncio.Event()
+        #: sends bytes to the app as typed (set once the app runs)
+        self.answer: Callable[[bytes], None] | None = None
 
     def feed(self, data: bytes) -> None:
         self.bytes += len(data)
+        self.writes += 1
+        if SYNC_QUERY in data and self.answer is not None:
+            self.answer(SYNC_ANSWER)
         self.buffer += data
         if len(self.buffer) > 1 << 20:
             del self.buffer[: -(1 << 16)]
@@ -142,10 +160,12 @@ async def one_run(
         here = os.getcwd()
         os.chdir(tree)  # ``python -m workbench`` imports the tree it is started in
         try:
-            app = AppProcess(spec.argv(command), env, data / "app.log", screen.feed)
+            server_side = tree_app_process(tree)
+            app = server_side(spec.argv(command), env, data / "app.log", screen.feed)
             await app.start()
         finally:
             os.chdir(here)
+        screen.answer = app.send_keys
         results: dict[str, dict[str, float]] = {}
         try:
             await screen.wait_for(b"Who is at this robot", 60)
@@ -166,8 +186,10 @@ async def one_run(
                 if profile:
                     os.kill(pid, signal.SIGUSR1)
                 cpu0, bytes0, t0 = cpu_seconds(pid), screen.bytes, time.perf_counter()
+                writes0, own0 = screen.writes, time.process_time()
                 await settle
                 cpu1, bytes1, t1 = cpu_seconds(pid), screen.bytes, time.perf_counter()
+                writes1, own1 = screen.writes, time.process_time()
                 if profile:
                     with contextlib.suppress(FileNotFoundError):
                         stats.unlink()
@@ -182,10 +204,28 @@ async def one_run(
                 results[label] = {
                     "cpu": (cpu1 - cpu0) / (t1 - t0),
                     "bytes": (bytes1 - bytes0) / (t1 - t0),
+                    "writes": (writes1 - writes0) / (t1 - t0),
+                    "server": (own1 - own0) / (t1 - t0),
                 }
         finally:
             await app.stop(grace=10.0)
         return results
+
+
+def tree_app_process(tree: Path) -> type[AppProcess]:
+    """The server side of a session (``AppProcess``) as the workbench in ``tree`` has it."""
+    if tree == ROOT:
+        return AppProcess
+    folder = tree / "workbench" / "ssh"
+    name = f"_ssh_of_{len(sys.modules)}"
+    found = importlib.util.spec_from_file_location(
+        name, folder / "__init__.py", submodule_search_locations=[str(folder)]
+    )
+    assert found is not None and found.loader is not None
+    package = importlib.util.module_from_spec(found)
+    sys.modules[name] = package
+    found.loader.exec_module(package)
+    return importlib.import_module(f"{name}.appproc").AppProcess
 
 
 def tree_driver(tree: Path) -> str:
@@ -241,22 +281,34 @@ def main() -> None:
                 )
                 results[name].append(r)
                 shown = "   ".join(
-                    f"{mode} {100 * v['cpu']:5.2f}% ({v['bytes'] / 1000:.2f} KB/s)"
+                    f"{mode} {100 * v['cpu']:5.2f}% ({v['bytes'] / 1000:.2f} KB/s in "
+                    f"{v['writes']:.1f} writes/s; server part {100 * v['server']:.2f}%)"
                     for mode, v in r.items()
                 )
                 print(f"  run {i + 1} {name:>10}: {shown}")
     medians = {
-        name: {mode: statistics.median(r[mode]["cpu"] for r in rs) for mode in rs[0]}
+        name: {
+            mode: {key: statistics.median(r[mode][key] for r in rs) for key in rs[0][mode]}
+            for mode in rs[0]
+        }
         for name, rs in results.items()
     }
     for name, by_mode in medians.items():
-        shown = "   ".join(f"{mode} {100 * cpu:5.2f}% of a core" for mode, cpu in by_mode.items())
+        shown = "   ".join(
+            f"{mode} {100 * v['cpu']:5.2f}% of a core (server part {100 * v['server']:.2f}%, "
+            f"{v['writes']:.1f} writes/s)"
+            for mode, v in by_mode.items()
+        )
         print(f"  median {name:>10}: {shown}")
     if args.compare:
         before, after = medians[args.compare], medians["this tree"]
+
+        def ratio(mode: str, key: str) -> str:
+            was = before[mode][key]
+            return f"x{after[mode][key] / was:.2f}" if was else "-"
+
         shown = "   ".join(
-            f"{mode} x{after[mode] / before[mode]:.2f}" if before[mode] else f"{mode} -"
-            for mode in after
+            f"{mode} app {ratio(mode, 'cpu')} server part {ratio(mode, 'server')}" for mode in after
         )
         print(f"  this tree / {args.compare}: {shown}")
     if args.profile:

@@ -365,3 +365,36 @@ def test_the_run_panel_counts_a_bumper_touch_apart_from_collisions(tmp_path):
         assert (metrics.collisions, metrics.touches) == (0, 1)
 
     run(app, body)
+
+
+def test_drive_keys_follow_the_focus_and_a_new_keymap_though_bindings_are_looked_up_once(
+    tmp_path,
+):
+    """The main screen builds its key bindings once and keeps them while nothing they depend on
+    changes; moving the focus or changing the keymap builds them again, so keys keep working."""
+    app = make_app(maze_file(tmp_path, ROOM, "unity"), paused=True, noise="off")
+
+    def heading() -> float:
+        app.station.step(60 * 4)
+        return app.station.snapshot().pose.heading
+
+    async def body(pilot: Pilot) -> None:
+        screen = app.screen
+        assert isinstance(screen, MainScreen)
+        chain = screen._binding_chain
+        assert screen._binding_chain is chain  # looked up once, not for every key
+        await pilot.press("d")
+        assert heading() == pytest.approx(90, abs=0.5)
+        assert app.focused is not None
+        screen.set_focus(None)
+        await pilot.pause()
+        assert screen._binding_chain is not chain  # the focus moved: built again
+        await pilot.press("d")
+        assert heading() == pytest.approx(180, abs=0.5)
+        app.set_keymap({"drive.right": "l"})
+        await pilot.press("l")
+        assert heading() == pytest.approx(270, abs=0.5)
+        await pilot.press("d")  # no longer a drive key
+        assert heading() == pytest.approx(270, abs=0.5)
+
+    run(app, body)

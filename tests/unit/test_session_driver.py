@@ -1,58 +1,152 @@
-"""The served app's input thread: it sleeps while no key comes, yet a lone Escape still arrives
-and ending the app wakes it at once."""
+"""The served app's input: read on the app's event loop (no thread), keys in the order typed,
+a lone Escape still arrives, nothing runs while no key comes; a frame leaves as one packet."""
 
 from __future__ import annotations
 
+import asyncio
 import os
 import threading
 import time
 
-from textual import events
+import pytest
+from textual import events, messages
+from textual._ansi_sequences import SYNC_END, SYNC_START
 from textual._xterm_parser import XTermParser
+from textual.drivers import web_driver
 
-from workbench.tui.driver import InputWaiter, parser_wait
-
-
-def read_in_thread(reader: InputWaiter) -> tuple[threading.Thread, list[bytes]]:
-    got: list[bytes] = []
-    thread = threading.Thread(target=lambda: got.extend(reader), daemon=True)
-    thread.start()
-    return thread, got
+from workbench.ssh import packets
+from workbench.tui.driver import LoopInput, SessionDriver, parser_wait
 
 
-def test_an_idle_reader_does_not_wake_and_ends_at_once_when_closed():
+class UnusedReader:
+    """Stands in for Textual's own input reader, which the session driver never uses (it
+    watches the test runner's standard input, which cannot be waited on here)."""
+
+    def close(self) -> None:
+        pass
+
+
+@pytest.fixture(autouse=True)
+def no_textual_reader(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(web_driver, "InputReader", UnusedReader)
+
+
+class PostBox:
+    """What the driver hands to the app, and on which thread."""
+
+    def __init__(self) -> None:
+        self.messages: list[object] = []
+        self.threads: set[int] = set()
+
+    def post_message(self, message: object) -> bool:
+        self.messages.append(message)
+        self.threads.add(threading.get_ident())
+        return True
+
+    def keys(self) -> list[str]:
+        return [m.key for m in self.messages if isinstance(m, events.Key)]
+
+
+async def started_driver(box: PostBox) -> tuple[SessionDriver, int]:
+    """A driver reading a pipe of our own as its standard input; returns the pipe's write end."""
+    driver = SessionDriver(box)  # type: ignore[arg-type]
     r, w = os.pipe()
-    try:
-        reader = InputWaiter(r)
-        reader.wait = lambda: None  # no escape sequence pending: wait for input only
-        thread, got = read_in_thread(reader)
-        time.sleep(0.5)
-        assert got == []  # Textual's own reader would have woken five times by now
-        os.write(w, b"w")
+    reading = LoopInput(driver, r)
+    driver._key_thread = reading  # type: ignore[assignment]
+    driver._input_reader = reading  # type: ignore[assignment]
+    reading.start()
+    await asyncio.sleep(0)  # it reads from the next turn of the loop on
+    assert reading.reading
+    return driver, w
+
+
+async def settle(box: PostBox, count: int, timeout: float = 5.0) -> None:
+    deadline = time.monotonic() + timeout
+    while len(box.messages) < count and time.monotonic() < deadline:
+        await asyncio.sleep(0.01)
+
+
+def test_keys_arrive_in_order_on_the_apps_thread_and_no_thread_reads():
+    async def go() -> None:
+        box = PostBox()
+        threads = threading.active_count()
+        driver, w = await started_driver(box)
+        try:
+            assert threading.active_count() == threads  # no input thread
+            os.write(w, packets.data(b"ww"))
+            os.write(w, packets.data(b"a") + packets.data(b" d"))
+            await settle(box, 5)
+            assert box.keys() == ["w", "w", "a", "space", "d"]
+            assert box.threads == {threading.get_ident()}
+            # nothing pending: no timer waits to wake the loop while no key comes
+            assert driver._input_reader._escape is None  # type: ignore[attr-defined]
+        finally:
+            driver._input_reader.close()
+            os.close(w)
+
+    asyncio.run(go())
+
+
+def test_a_lone_escape_arrives_at_the_parsers_time_limit():
+    async def go() -> None:
+        box = PostBox()
+        driver, w = await started_driver(box)
+        try:
+            os.write(w, packets.data(b"\x1b"))
+            await settle(box, 1)
+            assert box.keys() == ["escape"]
+            os.write(w, packets.data(b"\x1b[A"))  # a whole sequence is one key at once
+            await settle(box, 2)
+            assert box.keys() == ["escape", "up"]
+        finally:
+            driver._input_reader.close()
+            os.close(w)
+
+    asyncio.run(go())
+
+
+def test_meta_packets_reach_the_app_and_the_end_of_input_stops_reading():
+    async def go() -> None:
+        box = PostBox()
+        driver, w = await started_driver(box)
+        os.write(w, packets.resize(100, 30) + packets.quit_message())
+        await settle(box, 2)
+        resize, leave = box.messages
+        assert isinstance(resize, events.Resize) and resize.size == (100, 30)
+        assert isinstance(leave, messages.ExitApp)
+        os.close(w)
+        reading = driver._input_reader
         deadline = time.monotonic() + 5
-        while got != [b"w", b""] and time.monotonic() < deadline:
-            time.sleep(0.01)
-        assert got == [b"w", b""]
-        started = time.monotonic()
-        reader.close()
-        thread.join(5)
-        assert not thread.is_alive() and time.monotonic() - started < 1.0
-    finally:
-        os.close(r)
-        os.close(w)
+        while reading.reading and time.monotonic() < deadline:  # type: ignore[attr-defined]
+            await asyncio.sleep(0.01)
+        assert not reading.reading  # type: ignore[attr-defined]
+
+    asyncio.run(go())
 
 
-def test_a_reader_whose_input_ends_stops():
-    r, w = os.pipe()
-    try:
-        reader = InputWaiter(r)
-        reader.wait = lambda: None
-        thread, got = read_in_thread(reader)
-        os.close(w)
-        thread.join(5)
-        assert not thread.is_alive() and got == []
-    finally:
-        os.close(r)
+def test_a_synchronized_update_leaves_as_one_packet():
+    async def go() -> None:
+        r, w = os.pipe()
+        try:
+            driver = SessionDriver(PostBox())  # type: ignore[arg-type]
+            driver._write = lambda data: os.write(w, data)
+            driver.write(SYNC_START)
+            driver.write("\x1b[3;5Hw ")
+            driver.write("\x1b[24;1H")
+            driver.write(SYNC_END)
+            driver.write("plain")
+            reader = packets.PacketReader()
+            reader.feed(packets.GANGLION)
+            got = reader.feed(os.read(r, 4096))
+            assert got == [
+                (packets.DATA, f"{SYNC_START}\x1b[3;5Hw \x1b[24;1H{SYNC_END}".encode()),
+                (packets.DATA, b"plain"),
+            ]
+        finally:
+            os.close(r)
+            os.close(w)
+
+    asyncio.run(go())
 
 
 def test_the_wait_follows_the_parser_so_a_lone_escape_still_arrives():

@@ -3,13 +3,15 @@ forwarding rules, session limits and the slow-down of failed logins."""
 
 from __future__ import annotations
 
+import asyncio
 import json
 import socket
+import sys
 
 import pytest
 
 from workbench.ssh import packets
-from workbench.ssh.appproc import AppSpec, forward_hint
+from workbench.ssh.appproc import AppProcess, AppSpec, forward_hint
 from workbench.ssh.forwarding import local_forward_refusal, remote_forward_refusal
 from workbench.ssh.limits import SessionLimits, describe_duration
 from workbench.ssh.passwords import (
@@ -132,6 +134,26 @@ def test_the_app_is_started_with_the_users_name_ports_and_terminal():
         "-R 41001:localhost:8124 ann@lab.example  then VIPLE uses localhost:1350"
     )
     assert "-p " not in forward_hint("ann", "lab.example", 22, 41000, 41001)
+
+
+def test_the_screen_output_of_one_read_reaches_the_client_in_one_write(tmp_path):
+    """A frame the app wrote as several packets (begin-update, the frame, end-update) goes to
+    the client's channel as one write, in order; a meta packet between splits it."""
+    frame = packets.data(b"\x1b[?2026h") + packets.data(b"\x1b[3;5Hw ") + packets.data(b"<")
+    tail = packets.meta({"type": "exit"}) + packets.data(b"bye")
+    script = (
+        "import os, sys; os.write(1, sys.argv[1].encode('latin-1') + bytes.fromhex(sys.argv[2]))"
+    )
+    argv = [sys.executable, "-c", script, packets.GANGLION.decode(), (frame + tail).hex()]
+    writes: list[bytes] = []
+
+    async def go() -> int:
+        app = AppProcess(argv, {}, tmp_path / "app.log", writes.append)
+        await app.start()
+        return await app.wait()
+
+    assert asyncio.run(go()) == 0
+    assert writes == [b"\x1b[?2026h\x1b[3;5Hw <", b"bye"]
 
 
 # -- forwarding, limits, failed logins ----------------------------------------------------

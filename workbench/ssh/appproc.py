@@ -219,11 +219,19 @@ class AppProcess:
                 chunk = await stdout.read(READ_SIZE)
                 if not chunk:
                     break
+                # the screen output of one read goes on as one piece (one write to the
+                # client's channel, one SSH packet), however many packets it came in
+                screen: list[bytes] = []
                 for kind, payload in reader.feed(chunk):
                     if kind == packets.DATA:
-                        self.on_output(payload)
+                        screen.append(payload)
                     elif kind == packets.META:
+                        if screen:
+                            self.on_output(b"".join(screen))
+                            screen.clear()
                         self._on_meta(payload)
+                if screen:
+                    self.on_output(b"".join(screen))
         except packets.PacketError as exc:
             log.error("app %s: %s; ending it", self.pid, exc)
             self._kill(signal.SIGKILL)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import gc
 import getpass
 import os
 import threading
@@ -19,7 +20,6 @@ from typing import ClassVar
 
 from textual import events
 from textual.binding import Binding, BindingType
-from textual.reactive import var
 from textual.screen import ModalScreen, Screen
 from textual.timer import Timer
 
@@ -44,6 +44,7 @@ from . import warmup
 from .commands import WorkbenchCommands
 from .dialogs.help import HelpScreen
 from .dialogs.too_small import TooSmallScreen
+from .driver import SessionDriver
 from .host import (
     MazeChanged,
     OpenScreen,
@@ -97,8 +98,8 @@ class WorkbenchApp(ScreenHost[None]):
         *FOCUS_BINDINGS,
     ]
 
-    #: frames drawn so far (per-tick state: no repaint)
-    frames: var[int] = var(0)
+    #: frames drawn so far (a plain attribute: a reactive one costs a lookup on every tick)
+    frames: int = 0
 
     def __init__(
         self,
@@ -221,6 +222,11 @@ class WorkbenchApp(ScreenHost[None]):
         if self.connect_hint:
             self.say(self.hint_line())
         self._check_size(self.size.width, self.size.height)
+        if isinstance(self._driver, SessionDriver):
+            # a served session's process holds this one app for the whole class: what start-up
+            # built lives as long as it, so the garbage collector's full passes (some 70 ms
+            # each while a student drives) leave it alone from the first screen on
+            self.call_after_refresh(gc.freeze)
         if self.db and self._pending_file().is_file():
             # what an earlier app could not save: written as soon as the database answers
             self.run_worker(self._save_kept(), group="store")

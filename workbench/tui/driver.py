@@ -1,25 +1,31 @@
-"""The terminal driver of a served app: Textual's web driver, with an input thread that sleeps
-while no key comes.
+"""The terminal driver of a served app: Textual's web driver, reading its input on the app's
+event loop instead of in a thread.
 
 The lab server runs each session's app with Textual's web driver (packets over a pipe, see
-``workbench/ssh/packets.py``). That driver's input thread wakes ten times a second, key or no
-key, to look for a lone Escape whose sequence never finished: about a third of what an idle
-session costs the server. :class:`SessionDriver` reads the same packets the same way, but its
-thread waits for input without a time limit unless the key parser is waiting for the rest of an
-escape sequence, and then only until the parser's own time limit. Ending the app wakes it at
-once through a pipe of its own.
+``workbench/ssh/packets.py``). That driver reads them in a thread of its own that wakes ten times
+a second, key or no key (to look for a lone Escape whose sequence never finished), and hands
+each key to the app's loop wrapped in a coroutine, a task and a pair of futures. With twenty
+keys a second from a student driving, that thread and the hand-over were a fifth of what the app
+cost. :class:`SessionDriver` reads the same packets the same way, on the event loop when the
+pipe has data: nothing runs while no key comes, except a timer at the key parser's own time
+limit while it waits for the rest of an escape sequence, and a key goes straight into the
+app's message queue, in the order typed.
+
+A synchronized update (the terminal's begin-update, the frame and end-update: three writes when
+the student's terminal supports them) leaves the app as one packet, so the server reads and
+forwards a frame in one piece.
 """
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import os
-import selectors
 import sys
 from codecs import getincrementaldecoder
-from collections.abc import Callable, Iterator
 
-from textual import log
+from textual import log, messages
+from textual._ansi_sequences import SYNC_END, SYNC_START
 from textual._time import get_time
 from textual._xterm_parser import XTermParser
 from textual.drivers._byte_stream import ByteStream
@@ -27,12 +33,14 @@ from textual.drivers.web_driver import WebDriver, _ExitInput
 
 #: how long to wait while the parser's own time limit cannot be read (Textual's interval)
 FALLBACK_WAIT = 0.1
+#: the most bytes taken from the pipe at once
+READ_SIZE = 65536
 _UNKNOWN = object()
 
 
 def parser_wait(parser: XTermParser) -> float | None:
-    """How long the input thread may wait for input: until the parser's time limit for an
-    unfinished escape sequence, or for ever (None) when it waits for none."""
+    """How long input may be waited for: until the parser's time limit for an unfinished
+    escape sequence, or for ever (None) when it waits for none."""
     deadline = getattr(parser, "_timeout_time", _UNKNOWN)
     if deadline is _UNKNOWN or not isinstance(deadline, (float, int, type(None))):
         return FALLBACK_WAIT  # another Textual: wake as often as its own driver does
@@ -41,80 +49,115 @@ def parser_wait(parser: XTermParser) -> float | None:
     return max(0.0, deadline - get_time())
 
 
-class InputWaiter:
-    """Standard input as chunks of bytes (``b""`` when a wait ran out), read until closed."""
+class LoopInput:
+    """The server's packets on standard input, read on the event loop and handed to a driver.
 
-    def __init__(self, fileno: int | None = None) -> None:
-        self._fileno = sys.__stdin__.fileno() if fileno is None else fileno
-        self._wake_r, self._wake_w = os.pipe()
-        self._selector = selectors.DefaultSelector()
-        self._selector.register(self._fileno, selectors.EVENT_READ)
-        self._selector.register(self._wake_r, selectors.EVENT_READ)
-        self._closed = False
-        #: how long the next wait may last (None: until input comes or the reader is closed)
-        self.wait: Callable[[], float | None] = lambda: FALLBACK_WAIT
+    Stands in for the web driver's input thread (``start``) and its reader (``close``).
+    """
+
+    def __init__(self, driver: SessionDriver, fileno: int | None = None) -> None:
+        self._driver = driver
+        self.fileno = sys.__stdin__.fileno() if fileno is None else fileno
+        self._parser = XTermParser(debug=driver._debug)
+        self._decode = getincrementaldecoder("utf-8")().decode
+        self._packets = ByteStream()
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._escape: asyncio.TimerHandle | None = None
+        self.reading = False
+
+    def start(self) -> None:
+        """Read from the next turn of the loop on: what the driver posted while starting (the
+        terminal's size) reaches the app before the first key."""
+        self._loop = loop = asyncio.get_running_loop()
+        loop.call_soon(self._begin)
+
+    def _begin(self) -> None:
+        if self._loop is not None and not self.reading:
+            self.reading = True
+            self._loop.add_reader(self.fileno, self._read)
 
     def close(self) -> None:
-        """Stop reading: a waiting thread wakes at once."""
-        if self._closed:
-            return
-        self._closed = True
-        with contextlib.suppress(OSError):
-            os.write(self._wake_w, b"x")
+        """Stop reading (the app ends, or the server closed the pipe)."""
+        loop = self._loop
+        if self._escape is not None:
+            self._escape.cancel()
+            self._escape = None
+        if self.reading and loop is not None:
+            self.reading = False
+            with contextlib.suppress(Exception):
+                loop.remove_reader(self.fileno)
+        self._loop = None
 
-    def __iter__(self) -> Iterator[bytes]:
+    def _read(self) -> None:
         try:
-            while not self._closed:
-                for key, _ in self._selector.select(self.wait()):
-                    if key.fd == self._wake_r:
-                        return
-                    data = os.read(self._fileno, 1024)
-                    if not data:
-                        return
-                    yield data
-                yield b""
-        finally:
-            self._selector.close()
-            for fd in (self._wake_r, self._wake_w):
-                with contextlib.suppress(OSError):
-                    os.close(fd)
+            data = os.read(self.fileno, READ_SIZE)
+        except (BlockingIOError, InterruptedError):
+            return
+        except OSError:
+            data = b""
+        if not data:
+            self.close()
+            return
+        driver = self._driver
+        try:
+            for packet_type, payload in self._packets.feed(data):
+                if packet_type == "D":
+                    for event in self._parser.feed(self._decode(payload)):
+                        driver.process_message(event)
+                else:
+                    driver._on_meta(packet_type, payload)
+        except _ExitInput:
+            self.close()
+            return
+        except Exception:
+            from traceback import format_exc
+
+            log(format_exc())
+            self.close()
+            return
+        self._tick()
+
+    def _tick(self) -> None:
+        """Hand on what the parser's time limit settled (a lone Escape), and wake again at its
+        next limit while it waits for the rest of a sequence."""
+        self._escape = None
+        for event in self._parser.tick():
+            self._driver.process_message(event)
+        wait = parser_wait(self._parser)
+        if wait is not None and self.reading and self._loop is not None:
+            self._escape = self._loop.call_later(wait, self._tick)
 
 
 class SessionDriver(WebDriver):
-    """Textual's web driver with an input thread that sleeps while no key comes."""
+    """Textual's web driver reading its input on the app's event loop (see the module)."""
 
     def __init__(self, *args: object, **kwargs: object) -> None:
         super().__init__(*args, **kwargs)  # type: ignore[arg-type]
         selector = getattr(self._input_reader, "_selector", None)
         if selector is not None:
             selector.close()  # the web driver's own reader, never used
-        self._input_reader = InputWaiter()  # type: ignore[assignment]
+        reading = LoopInput(self)
+        # the web driver starts its input thread and closes its reader: both are the loop's
+        self._key_thread = reading  # type: ignore[assignment]
+        self._input_reader = reading  # type: ignore[assignment]
+        #: the writes of a synchronized update so far (None: no update is open)
+        self._frame: list[str] | None = None
 
-    def run_input_thread(self) -> None:
-        """Wait for input and dispatch events (as the web driver does)."""
-        reader = self._input_reader
-        parser = XTermParser(debug=self._debug)
-        assert isinstance(reader, InputWaiter)
-        reader.wait = lambda: parser_wait(parser)
-        decode = getincrementaldecoder("utf-8")().decode
-        # the server sends a stream of bytes: the user's keys, and meta packets in band
-        byte_stream = ByteStream()
-        try:
-            for data in reader:
-                if data:
-                    for packet_type, payload in byte_stream.feed(data):
-                        if packet_type == "D":
-                            for event in parser.feed(decode(payload)):
-                                self.process_message(event)
-                        else:
-                            self._on_meta(packet_type, payload)
-                for event in parser.tick():
-                    self.process_message(event)
-        except _ExitInput:
-            pass
-        except Exception:
-            from traceback import format_exc
+    def send_message(self, message: messages.Message) -> None:
+        """Hand a message to the app (on its loop: straight into its queue)."""
+        self._app.post_message(message)
 
-            log(format_exc())
-        finally:
-            reader.close()
+    def write(self, data: str) -> None:
+        """Write terminal output; a synchronized update is held until it ends and then written
+        as one packet."""
+        if data == SYNC_START:
+            self._frame = [data]
+            return
+        frame = self._frame
+        if frame is not None:
+            frame.append(data)
+            if data != SYNC_END:
+                return
+            self._frame = None
+            data = "".join(frame)
+        super().write(data)

@@ -15,8 +15,6 @@ from textual import events
 from textual.app import ComposeResult
 from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical
-from textual.reactive import var
-from textual.screen import Screen
 
 from workbench.control.fsm import FsmError
 from workbench.control.station import ALGORITHM_FAILED, LabStation, Notice
@@ -27,6 +25,7 @@ from workbench.sim.mazeio import load_maze
 from workbench.sim.sensors import SensorConfigError
 from workbench.sim.session import Snapshot
 
+from ..binding_chain import CachedBindingChain
 from ..compositor import LiveCompositor
 from ..host import (
     FollowsUnicode,
@@ -49,11 +48,14 @@ from ..widgets.program_state import ProgramState
 from ..widgets.run_status import RunStatus
 from ..widgets.sensor_readings import SensorReadings
 
-#: how often the text panels follow a running robot (the maze view follows every tick)
-PANEL_HZ = 4.0
+#: how often the text panels follow a running robot (the maze view follows every tick): twice a
+#: second is as often as a person reads a changing figure, and each update is a frame of its own
+#: (at 4 Hz the panels made most of a driving session's frames); paused, stepped or ended, the
+#: panels show the exact figures at once
+PANEL_HZ = 2.0
 
 
-class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Screen[None]):
+class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, CachedBindingChain):
     """Drive, watch and set up the robot."""
 
     # the keys pressed again and again while driving are priority bindings: the screen takes
@@ -89,8 +91,8 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Scree
     #: keys a running VIPLE program may have besides the drive keys and the arrows
     PROGRAM_KEYS = frozenset("bchijkqyz0123456789")
 
-    #: the last snapshot drawn (per-tick state: never repaints by itself)
-    snapshot: var[Snapshot | None] = var(None)
+    #: the last snapshot drawn (a plain attribute: set on every tick, it never repaints)
+    snapshot: Snapshot | None = None
 
     def __init__(
         self,

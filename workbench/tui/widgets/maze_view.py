@@ -31,8 +31,9 @@ from textual.message import Message
 from textual.scroll_view import ScrollView
 from textual.scrollbar import ScrollDown, ScrollLeft, ScrollRight, ScrollTo, ScrollUp
 from textual.strip import Strip
+from textual.visual import VisualType
 
-from workbench.sim.maze import Cell, Maze
+from workbench.sim.maze import WALL, Cell, Maze
 from workbench.sim.mazeview import ARROWS_ASCII, ARROWS_UNICODE, block_text
 from workbench.sim.sensors import MOUNT_ANGLES
 from workbench.sim.session import Snapshot
@@ -170,6 +171,10 @@ class MazeView(ScrollView, can_focus=False):
         self._strips: list[Strip | None] = [None] * maze.height
         self._styles: dict[str, Style] = {}
         self._tooltip_text = ""
+        #: the readings changed since the tooltip was last worded (it is worded when read)
+        self._tooltip_stale = False
+        #: what the view last scrolled to follow: the robot's block and the view's sizes
+        self._followed: tuple[object, ...] | None = None
         #: how many row strips have been rendered since the widget was made (for tests/stations)
         self.strips_built = 0
 
@@ -266,8 +271,16 @@ class MazeView(ScrollView, can_focus=False):
             if self._show_trail:
                 changed.add(robot)
         self._apply(self._spans(changed))
-        self._follow_robot()
-        self._update_tooltip(snapshot)
+        followed = (robot, self.size, self.virtual_size, self.scroll_offset)
+        if followed != self._followed:
+            # the robot changed blocks, or the view its size or scroll: follow it (within a
+            # block the view would not scroll)
+            self._followed = followed
+            self._follow_robot()
+        # the tooltip is worded when it is read, live only while the mouse rests on the view
+        self._tooltip_stale = True
+        if self.mouse_hover:
+            self._update_tooltip(snapshot)
 
     def hide_robot(self) -> None:
         """Stop drawing the robot and its sensors (the trail stays until cleared)."""
@@ -519,7 +532,9 @@ class MazeView(ScrollView, can_focus=False):
         limit = max(reading, 0.0) + _RAY_SLACK
         path: list[Cell] = []
         special = {maze.start, *maze.exits}
-        for _ in range(maze.width + maze.height + 2):
+        rows = maze.rows
+        width, height = maze.width, maze.height
+        for _ in range(width + height + 2):
             if next_x < next_y:
                 t = next_x
                 ix += step_x
@@ -528,15 +543,28 @@ class MazeView(ScrollView, can_focus=False):
                 t = next_y
                 iy += step_y
                 next_y += delta_y
-            if t > limit or not maze.in_bounds(ix, iy):
+            if t > limit or not (0 <= ix < width and 0 <= iy < height):
                 return path, None
-            if maze.is_wall(ix, iy):
+            if rows[iy][ix] == WALL:
                 return path, (ix, iy)
             if (ix, iy) not in special:
                 path.append((ix, iy))
         return path, None
 
+    @property
+    def tooltip(self) -> VisualType | None:
+        """The sensors' readings as last shown, one line per port (None with no sensor)."""
+        if self._tooltip_stale and self._last_show is not None:
+            self._update_tooltip(self._last_show[0])
+        return self._tooltip
+
+    @tooltip.setter
+    def tooltip(self, tooltip: VisualType | None) -> None:
+        self._tooltip_stale = False
+        ScrollView.tooltip.fset(self, tooltip)  # type: ignore[attr-defined]
+
     def _update_tooltip(self, snapshot: Snapshot) -> None:
+        self._tooltip_stale = False
         lines = []
         for spec in sorted(snapshot.sensors, key=lambda s: s.port):
             value = snapshot.readings.get(spec.port)

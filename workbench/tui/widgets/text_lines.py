@@ -74,12 +74,14 @@ class TextLines(Widget):
             self.refresh(layout=True)
             return
         width = self.size.width
+        changed = []
         for y, (old, new) in enumerate(zip(self._lines, lines, strict=True)):
             if old != new:
                 self._lines[y] = new
                 self._strips[y] = None
-                if self.is_mounted:
-                    self.refresh(Region(0, y, width, 1))
+                changed.append(Region(0, y, width, 1))
+        if changed and self.is_mounted:
+            self.refresh(*changed)  # one refresh for all the changed rows
 
     def notify_style_update(self) -> None:
         super().notify_style_update()
