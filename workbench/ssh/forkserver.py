@@ -62,7 +62,7 @@ PRELOAD_PACKAGES = (
 )
 MAX_MESSAGE = 1 << 20
 #: how much lower an app's scheduling priority is than the lab server's (``nice``)
-APP_NICENESS = 5
+APP_NICENESS = 10
 #: exit status given for an app whose status could not be learnt (the fork server was lost)
 UNKNOWN_STATUS = 1
 

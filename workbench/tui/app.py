@@ -92,7 +92,6 @@ class WorkbenchApp(ScreenHost[None]):
     CSS_PATH = "app.tcss"
     TITLE = "VIPLE Maze Lab Workbench"
     COMMANDS = ScreenHost.COMMANDS | {WorkbenchCommands}
-    HORIZONTAL_BREAKPOINTS: ClassVar[list[tuple[int, str]]] = [(0, "-narrow"), (110, "-wide")]
     BINDINGS: ClassVar[list[BindingType]] = [
         *bindings("app.quit", "app.help", "app.commands"),
         *FOCUS_BINDINGS,
@@ -166,6 +165,8 @@ class WorkbenchApp(ScreenHost[None]):
         self._main: MainScreen | None = None
         #: the names dialog was answered; what the message line last said
         self._named_once = False
+        #: a key or a click has come from the terminal
+        self._input_seen = False
         self._last_said = ""
         #: the maze the message line last named
         self._maze_named = station.maze
@@ -308,8 +309,16 @@ class WorkbenchApp(ScreenHost[None]):
 
     async def on_event(self, event: events.Event) -> None:
         if isinstance(event, (events.Key, events.MouseDown)):
+            self._input_seen = True
             self.wake()
         await super().on_event(event)
+
+    def on_app_blur(self, event: events.AppBlur) -> None:
+        """A served app's driver reports the terminal unfocused as it starts (it was made for
+        a web page): over SSH the student is typing into that terminal, so a blur before any
+        input is not taken (it restyled the whole first screen, and the first key again)."""
+        if not self._input_seen:
+            event.prevent_default()
 
     def refresh_views(self) -> None:
         """Draw the station's current snapshot on every screen of the stack that shows one;

@@ -58,6 +58,10 @@ PANEL_HZ = 2.0
 class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, CachedBindingChain):
     """Drive, watch and set up the robot."""
 
+    # the side panel moves beside the maze on a wide terminal (app.tcss); only this screen
+    # has the classes, so the dialogs are not restyled for them when they open
+    HORIZONTAL_BREAKPOINTS: ClassVar[list[tuple[int, str]]] = [(0, "-narrow"), (110, "-wide")]
+
     # the keys pressed again and again while driving are priority bindings: the screen takes
     # them before the focused widget (the transition log, which has no use for them) would, so
     # a key press runs its action at once instead of bubbling up through the side panel
