@@ -47,6 +47,8 @@ import asyncssh
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from procfs import children_by_parent  # noqa: E402
+
 from workbench.ssh.users import add_user  # noqa: E402
 
 PATTERN = "wwwwawwwwdww wwwwdwwwwaww "
@@ -100,18 +102,6 @@ def pss_bytes(pid: int) -> int | None:
     except OSError:
         return None
     return None
-
-
-def children_by_parent() -> dict[int, list[int]]:
-    parents: dict[int, list[int]] = {}
-    for entry in Path("/proc").iterdir():
-        if entry.name.isdigit():
-            try:
-                stat = (entry / "stat").read_text()
-            except OSError:
-                continue
-            parents.setdefault(int(stat.rsplit(")", 1)[1].split()[1]), []).append(int(entry.name))
-    return parents
 
 
 def descendants(pid: int) -> list[int]:

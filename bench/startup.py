@@ -48,6 +48,9 @@ import asyncssh
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
+from gitrev import export  # noqa: E402
+from procfs import children  # noqa: E402
+
 from workbench.ssh.users import add_user  # noqa: E402
 
 NAMES_DIALOG = b"Who is at this robot"
@@ -66,19 +69,6 @@ def cpu_seconds(pid: int) -> float:
     except OSError:
         return 0.0
     return total / 1e9
-
-
-def children(pid: int) -> list[int]:
-    found = []
-    for entry in Path("/proc").iterdir():
-        if entry.name.isdigit():
-            try:
-                stat = (entry / "stat").read_text()
-            except OSError:
-                continue
-            if int(stat.rsplit(")", 1)[1].split()[1]) == pid:
-                found.append(int(entry.name))
-    return found
 
 
 def cmdline(pid: int) -> bytes:
@@ -330,15 +320,6 @@ def report(name: str, f: Figures) -> dict[str, float]:
     for failure in f.failures[:5]:
         print(f"  FAILED {failure}")
     return headline
-
-
-def export(rev: str, where: Path) -> Path:
-    """The workbench of git revision ``rev``, exported into ``where``."""
-    archive = subprocess.run(
-        ["git", "-C", str(ROOT), "archive", rev], capture_output=True, check=True
-    ).stdout
-    subprocess.run(["tar", "-x", "-C", str(where)], input=archive, check=True)
-    return where
 
 
 async def profile_app(prefix: str) -> None:

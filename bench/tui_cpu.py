@@ -44,7 +44,6 @@ import re
 import signal
 import socket
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
@@ -53,6 +52,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
+
+from gitrev import export  # noqa: E402
 
 from workbench.ssh.appproc import AppProcess, AppSpec  # noqa: E402
 
@@ -233,15 +234,6 @@ def tree_driver(tree: Path) -> str:
     source = (tree / "workbench" / "ssh" / "appproc.py").read_text()
     found = re.search(r'^DRIVER = "([^"]+)"', source, re.MULTILINE)
     return found.group(1) if found else "textual.drivers.web_driver:WebDriver"
-
-
-def export(rev: str, where: Path) -> Path:
-    """The workbench of git revision ``rev``, exported into ``where``."""
-    archive = subprocess.run(
-        ["git", "-C", str(ROOT), "archive", rev], capture_output=True, check=True
-    ).stdout
-    subprocess.run(["tar", "-x", "-C", str(where)], input=archive, check=True)
-    return where
 
 
 def show_profile(path: str) -> None:
