@@ -252,6 +252,27 @@ def test_a_terminal_below_80x24_gets_a_message_instead_of_the_layout(tmp_path):
     run(app, body, size=(70, 20))
 
 
+def test_a_small_terminal_at_the_names_dialog_then_enlarged_reaches_the_main_screen(tmp_path):
+    # the size message covers the names dialog; once the terminal is big enough the dialog
+    # is back, and after it the main screen (not the size message again)
+    app = make_app(maze_file(tmp_path, ROOM, "unity"), paused=True, student="ann",
+                   ask_names=True, data_dir=tmp_path / "data")  # fmt: skip
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.pause()
+        assert isinstance(app.screen, TooSmallScreen)
+        await pilot.resize_terminal(80, 24)
+        await pilot.pause(0.1)
+        assert not isinstance(app.screen, TooSmallScreen)
+        assert "Who is at this robot?" in str(app.screen.query_one("#dialog").border_title)
+        await pilot.press("enter")
+        await pilot.pause(0.2)
+        assert isinstance(app.screen, MainScreen)
+        assert not any(isinstance(s, TooSmallScreen) for s in app.screen_stack)
+
+    run(app, body, size=(70, 20))
+
+
 def test_ctrl_q_in_the_editor_with_unsaved_changes_asks_first(tmp_path):
     app = make_app(maze_file(tmp_path, ROOM, "unity"), paused=True)
 

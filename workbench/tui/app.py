@@ -165,6 +165,7 @@ class WorkbenchApp(ScreenHost[None]):
         self._main: MainScreen | None = None
         #: the names dialog was answered; what the message line last said
         self._named_once = False
+        self._names_asked = False
         #: a key or a click has come from the terminal
         self._input_seen = False
         self._last_said = ""
@@ -222,7 +223,6 @@ class WorkbenchApp(ScreenHost[None]):
         self.station.on_activity = self.wake
         if self.connect_hint:
             self.say(self.hint_line())
-        self._check_size(self.size.width, self.size.height)
         if isinstance(self._driver, SessionDriver):
             # a served session's process holds this one app for the whole class: what start-up
             # built lives as long as it, so the garbage collector's full passes (some 70 ms
@@ -231,13 +231,21 @@ class WorkbenchApp(ScreenHost[None]):
         if self.db and self._pending_file().is_file():
             # what an earlier app could not save: written as soon as the database answers
             self.run_worker(self._save_kept(), group="store")
-        if self._ask_names:
-            from .dialogs.identity import IdentityDialog
-
-            dialog = IdentityDialog(self.student, self.partner, student_fixed=self.student_fixed)
-            self.push_screen(dialog, self._named)
-        elif self._names_given:
+        if self._names_given and not self._ask_names:
             self._remember_pair()
+        self._check_size(self.size.width, self.size.height)
+        self._ask_for_names()
+
+    def _ask_for_names(self) -> None:
+        """The names dialog, once, when the terminal is big enough for it (else the size
+        message comes first and the dialog after it)."""
+        if not self._ask_names or self._names_asked or self._too_small is not None:
+            return
+        from .dialogs.identity import IdentityDialog
+
+        self._names_asked = True
+        dialog = IdentityDialog(self.student, self.partner, student_fixed=self.student_fixed)
+        self.push_screen(dialog, self._named)
 
     def _remember_pair(self) -> None:
         """Keep the pair for the next start at this workbench (never for a served student:
@@ -365,6 +373,7 @@ class WorkbenchApp(ScreenHost[None]):
             screen, self._too_small = self._too_small, None
             if self.screen is screen:
                 self.pop_screen()
+            self._ask_for_names()
 
     def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None:
         """While the terminal is too small, or while the screen takes every key (all keys to a

@@ -35,6 +35,13 @@ class TooSmallScreen(Screen[None]):
     def on_mount(self) -> None:
         self.show_size(self.app.size.width, self.app.size.height)
 
+    def on_screen_resume(self) -> None:
+        # a screen pushed over this one while the terminal grew (the names dialog at start)
+        # has gone: nothing is too small any more
+        width, height = self.app.size
+        if width >= self.minimum[0] and height >= self.minimum[1]:
+            self.app.pop_screen()
+
     def show_size(self, width: int, height: int) -> None:
         min_w, min_h = self.minimum
         self.query_one(Static).update(
