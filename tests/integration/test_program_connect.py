@@ -90,7 +90,9 @@ def test_a_program_drives_the_served_robot_and_reads_its_sensors(tmp_path, capsy
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )  # fmt: skip
     try:
-        code = main(["viple", "run", program, "--connect", "--duration", "6", "--json"])
+        # the robot is within a unit of the wall after about 5.5 s, counted from the program's
+        # start (which includes waiting for the server): 8 s leave a margin on a busy machine
+        code = main(["viple", "run", program, "--connect", "--duration", "8", "--json"])
     finally:
         serve.send_signal(signal.SIGINT)
         serve.communicate(timeout=15)
