@@ -163,9 +163,9 @@ class WorkbenchApp(ScreenHost[None]):
         #: the size the app started with was announced again (see _on_resize)
         self._sized = False
         self._main: MainScreen | None = None
-        #: the names dialog was answered; what the message line last said
-        self._named_once = False
+        #: the names dialog was shown, and answered; what the message line last said
         self._names_asked = False
+        self._named = False
         #: a key or a click has come from the terminal
         self._input_seen = False
         self._last_said = ""
@@ -193,9 +193,7 @@ class WorkbenchApp(ScreenHost[None]):
     def open_main(self) -> None:
         """Put the main screen in the arrival screen's place once the names are given and the
         arrival screen is on top (not while the terminal is too small, say)."""
-        if self._main is not None or not self._named_once:
-            return
-        if not isinstance(self.screen, ArrivalScreen):
+        if self._main is not None or not self._named or not isinstance(self.screen, ArrivalScreen):
             return
         main = self._new_main()
         main.show_message(self._last_said)
@@ -245,7 +243,7 @@ class WorkbenchApp(ScreenHost[None]):
 
         self._names_asked = True
         dialog = IdentityDialog(self.student, self.partner, student_fixed=self.student_fixed)
-        self.push_screen(dialog, self._named)
+        self.push_screen(dialog, self._on_names)
 
     def _remember_pair(self) -> None:
         """Keep the pair for the next start at this workbench (never for a served student:
@@ -263,12 +261,16 @@ class WorkbenchApp(ScreenHost[None]):
             return self.connect_hint
         return "VIPLE from your computer: press ? for the ssh command"
 
-    def _named(self, names: tuple[str, str] | None) -> None:
-        self._named_once = True
-        self.call_later(self.open_main)
-        if names is None:
-            return
-        self.student, self.partner = names  # before the labs open: the dialog is modal
+    def _on_names(self, names: tuple[str, str] | None) -> None:
+        """The names dialog's answer (None: the names it opened with); the main screen, built
+        now, shows them."""
+        self._named = True
+        if names is not None:
+            self._set_names(*names)  # before the labs open: the dialog is modal
+
+    def _set_names(self, student: str, partner: str) -> None:
+        """Who is at the robot, kept for the next start and shown on every message line."""
+        self.student, self.partner = student, partner
         self._remember_pair()
         for screen in self.screen_stack:
             bar = screen.query("#message")
@@ -331,9 +333,8 @@ class WorkbenchApp(ScreenHost[None]):
     def refresh_views(self) -> None:
         """Draw the station's current snapshot on every screen of the stack that shows one;
         at rest (nothing moves, only the clock runs) with a dialog open, on the dialog only:
-        the screen dimmed under it is brought up to date when it is on top again. Under the
-        names dialog that a served student sees first, the clock behind it had redrawn the
-        whole dimmed screen every second (8 KB a second through the SSH server)."""
+        the screen dimmed under it is brought up to date when it is on top again (the clock
+        had redrawn a whole dimmed screen every second, 8 KB a second over SSH)."""
         station = self.station
         self._drawn = (station.paused, station.notice, station.controller, len(station.runs))
         snapshot = station.snapshot()
@@ -395,7 +396,9 @@ class WorkbenchApp(ScreenHost[None]):
         self.set_up_done(message.setup)
 
     def on_open_screen(self, message: OpenScreen) -> None:
-        if message.screen == "editor":
+        if message.screen == "main":
+            self.open_main()
+        elif message.screen == "editor":
             self.open_editor()
         elif message.screen == "runs":
             self.open_runs()
@@ -469,7 +472,7 @@ class WorkbenchApp(ScreenHost[None]):
         except Exception:  # the store may be away; the names stay as typed
             return
         if (student, partner) != (self.student, self.partner):
-            self._named((student, partner))
+            self._set_names(student, partner)
 
     def _open_store(self) -> None:
         with self._store_lock:  # the labs (here) or the saving of kept changes (a thread)

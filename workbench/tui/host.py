@@ -28,7 +28,7 @@ from .plain import PlainCommandPalette, follow
 
 ReturnType = TypeVar("ReturnType")
 #: the screens a screen may ask the app to open
-ScreenName = Literal["editor", "runs", "labs"]
+ScreenName = Literal["editor", "runs", "labs", "main"]
 
 
 class ShowsSnapshot:

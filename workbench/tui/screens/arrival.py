@@ -9,10 +9,12 @@ from __future__ import annotations
 
 from textual.screen import Screen
 
+from ..host import OpenScreen
+
 
 class ArrivalScreen(Screen[None]):
-    """An empty screen under the names dialog; the app puts the main screen in its place
-    whenever it is on top after the names are given (see ``WorkbenchApp.open_main``)."""
+    """An empty screen under the names dialog; each time it is on top it asks for the main
+    screen, which the app opens once the names are given (see ``WorkbenchApp.open_main``)."""
 
     def on_screen_resume(self) -> None:
-        self.app.call_later(self.app.open_main)  # type: ignore[attr-defined]
+        self.post_message(OpenScreen("main"))
