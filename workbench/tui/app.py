@@ -341,7 +341,7 @@ class WorkbenchApp(ScreenHost[None]):
         stack = self.screen_stack
         dialog = stack[-1] if stack and isinstance(stack[-1], ModalScreen) else None
         top = dialog if station.at_rest else None
-        for screen in self.screen_stack:
+        for screen in stack:
             if isinstance(screen, ShowsSnapshot) and top in (None, screen):
                 screen.show_snapshot(snapshot)
         labs = self._labs
