@@ -25,7 +25,8 @@ keys). Each of --runs runs is a fresh process; the medians are printed last.
 in the same run, alternating with this tree, and prints both medians and their ratios (app CPU,
 and the server's part): a before/after taken under the same load from other processes on the
 machine. The older revision's app is read with that revision's own server code
-(``workbench/ssh/appproc.py`` and ``packets.py``), so a change there is measured too.
+(``workbench/ssh/appproc.py``, with the packets module it imports), so a change there is measured
+too.
 
 ``--profile PREFIX`` runs the app under cProfile, switched on only for the measured stretch of
 each mode (start-up and the names dialog are left out; the figures are then only relative), and

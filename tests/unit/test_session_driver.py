@@ -14,8 +14,8 @@ from textual._ansi_sequences import SYNC_END, SYNC_START
 from textual._xterm_parser import XTermParser
 from textual.drivers import web_driver
 
-from workbench.ssh import packets
-from workbench.tui.driver import LoopInput, SessionDriver, parser_wait
+from workbench.tui import packets
+from workbench.tui.driver import LoopInput, SessionDriver, parser_wait, plain_keys
 
 
 class UnusedReader:
@@ -165,3 +165,42 @@ def test_a_key_sequence_leaves_nothing_pending():
     parser = XTermParser()
     keys = [e.key for e in parser.feed("\x1b[A") if isinstance(e, events.Key)]
     assert keys == ["up"] and parser_wait(parser) is None
+
+
+def test_typed_characters_make_the_keys_textuals_parser_makes():
+    table = plain_keys()
+    assert set(table) == {chr(c) for c in range(0x20, 0x7F)}
+    for character, (key, typed) in table.items():
+        made = [e for e in XTermParser().feed(character) if isinstance(e, events.Key)]
+        assert [(e.key, e.character) for e in made] == [(key, typed)]
+    assert table["w"] == ("w", "w") and table[" "] == ("space", " ")
+    assert table["W"][1] == "W" and table["?"] == ("question_mark", "?")
+
+
+def test_typed_text_after_an_escape_or_inside_a_paste_goes_through_the_parser():
+    async def go() -> None:
+        box = PostBox()
+        driver, w = await started_driver(box)
+        try:
+            os.write(w, packets.data(b"w"))
+            # a paste whose start mark is split over two packets, its text in a third
+            os.write(w, packets.data(b"\x1b[20"))
+            os.write(w, packets.data(b"0~"))
+            os.write(w, packets.data(b"wasd "))
+            os.write(w, packets.data(b"x\x1b[201~"))
+            os.write(w, packets.data(b"d"))
+            # an Alt+a: the plain "a" right after an Escape belongs to it
+            os.write(w, packets.data(b"\x1b"))
+            os.write(w, packets.data(b"a"))
+            await settle(box, 4)
+            got = [
+                m.key if isinstance(m, events.Key) else ("paste", m.text)
+                for m in box.messages
+                if isinstance(m, events.Key | events.Paste)
+            ]
+            assert got == ["w", ("paste", "wasd x"), "d", "alt+a"]
+        finally:
+            driver._input_reader.close()
+            os.close(w)
+
+    asyncio.run(go())

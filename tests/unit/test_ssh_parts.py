@@ -10,7 +10,6 @@ import sys
 
 import pytest
 
-from workbench.ssh import packets
 from workbench.ssh.appproc import AppProcess, AppSpec, forward_hint
 from workbench.ssh.forwarding import local_forward_refusal, remote_forward_refusal
 from workbench.ssh.limits import SessionLimits, describe_duration
@@ -22,6 +21,7 @@ from workbench.ssh.passwords import (
     verify_password,
 )
 from workbench.ssh.ports import PoolExhausted, PortPool, parse_range, port_is_free
+from workbench.tui import packets
 
 
 # -- passwords ------------------------------------------------------------------------------

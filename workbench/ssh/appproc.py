@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from . import packets
+from workbench.tui import packets
 
 if TYPE_CHECKING:
     from .forkserver import ForkedApp, ForkServer

@@ -21,7 +21,6 @@ from typing import ClassVar
 from textual import events
 from textual.binding import Binding, BindingType
 from textual.screen import ModalScreen, Screen
-from textual.timer import Timer
 
 from workbench.control.station import LabStation
 from workbench.files.bundled import default_maze_path
@@ -41,6 +40,7 @@ from workbench.viple.tcp_server import TcpConfig
 from workbench.viple.ws_client import WsConfig
 
 from . import warmup
+from .clock import LoopClock
 from .commands import WorkbenchCommands
 from .dialogs.help import HelpScreen
 from .dialogs.too_small import TooSmallScreen
@@ -156,8 +156,7 @@ class WorkbenchApp(ScreenHost[None]):
         #: the clock ticks at REST_HZ (True) or at tick_hz (False)
         self._resting = False
         self._rest_period = max(1.0 / REST_HZ, 1.0 / tick_hz)
-        self._fast: Timer | None = None
-        self._slow: Timer | None = None
+        self._clock: LoopClock | None = None
         self._drawn: tuple[object, ...] = ()
         self._too_small: TooSmallScreen | None = None
         #: the size the app started with was announced again (see _on_resize)
@@ -214,10 +213,7 @@ class WorkbenchApp(ScreenHost[None]):
         self.mark_ascii()
         self._show_maze_title()
         self._last_tick = perf_counter()
-        self._fast = self.set_interval(1.0 / self.tick_hz, self._tick, name="simulation")
-        self._slow = self.set_interval(
-            self._rest_period, self._tick, name="simulation at rest", pause=True
-        )
+        self._clock = LoopClock(self._tick, 1.0 / self.tick_hz, self._handle_exception)
         self.station.on_activity = self.wake
         if self.connect_hint:
             self.say(self.hint_line())
@@ -279,6 +275,10 @@ class WorkbenchApp(ScreenHost[None]):
 
     # -- time --------------------------------------------------------------------------------
     def _tick(self) -> None:
+        if not self.is_running:  # the app is closing its screens: the clock stops
+            if self._clock is not None:
+                self._clock.stop()
+            return
         station = self.station
         if self.endpoints is not None:
             self._show_connection(self.endpoints.summary())
@@ -300,15 +300,10 @@ class WorkbenchApp(ScreenHost[None]):
 
     def _rest(self, resting: bool) -> None:
         """Tick at REST_HZ while the station is at rest, else at the full rate."""
-        if resting == self._resting or self._fast is None or self._slow is None:
+        if resting == self._resting or self._clock is None:
             return
         self._resting = resting
-        if resting:
-            self._fast.pause()
-            self._slow.resume()
-        else:
-            self._slow.pause()
-            self._fast.resume()
+        self._clock.set_period(self._rest_period if resting else 1.0 / self.tick_hz)
 
     def wake(self) -> None:
         """Something is about to change the station (a key, a click, a VIPLE command): the time

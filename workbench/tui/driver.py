@@ -2,7 +2,7 @@
 event loop instead of in a thread.
 
 The lab server runs each session's app with Textual's web driver (packets over a pipe, see
-``workbench/ssh/packets.py``). That driver reads them in a thread of its own that wakes ten times
+``workbench/tui/packets.py``). That driver reads them in a thread of its own that wakes ten times
 a second, key or no key (to look for a lone Escape whose sequence never finished), and hands
 each key to the app's loop wrapped in a coroutine, a task and a pair of futures. With twenty
 keys a second from a student driving, that thread and the hand-over were a fifth of what the app
@@ -10,6 +10,11 @@ cost. :class:`SessionDriver` reads the same packets the same way, on the event l
 pipe has data: nothing runs while no key comes, except a timer at the key parser's own time
 limit while it waits for the rest of an escape sequence, and a key goes straight into the
 app's message queue, in the order typed.
+
+Typed characters (printable ASCII, outside an escape sequence and a bracketed paste) become
+their keys without going through Textual's key parser, which logs a description of every key it
+makes whether or not logging is on; the keys are the ones the parser makes for them
+(:func:`plain_keys`).
 
 A synchronized update (the terminal's begin-update, the frame and end-update: three writes when
 the student's terminal supports them) leaves the app as one packet, so the server reads and
@@ -23,19 +28,38 @@ import contextlib
 import os
 import sys
 from codecs import getincrementaldecoder
+from functools import lru_cache
 
-from textual import log, messages
+from textual import events, log, messages
 from textual._ansi_sequences import SYNC_END, SYNC_START
 from textual._time import get_time
 from textual._xterm_parser import XTermParser
-from textual.drivers._byte_stream import ByteStream
 from textual.drivers.web_driver import WebDriver, _ExitInput
+
+from .packets import DATA, PacketReader
 
 #: how long to wait while the parser's own time limit cannot be read (Textual's interval)
 FALLBACK_WAIT = 0.1
 #: the most bytes taken from the pipe at once
 READ_SIZE = 65536
 _UNKNOWN = object()
+#: the bracketed paste's start and end (Textual's parser keeps typed text in a paste as the paste)
+PASTE_START = "\x1b[200~"
+PASTE_END = "\x1b[201~"
+#: characters typed as themselves: printable ASCII
+PLAIN = frozenset(chr(c) for c in range(0x20, 0x7F))
+
+
+@lru_cache(maxsize=1)
+def plain_keys() -> dict[str, tuple[str, str | None]]:
+    """The key (name, character) Textual's parser makes for each printable ASCII character
+    typed on its own."""
+    table: dict[str, tuple[str, str | None]] = {}
+    for character in sorted(PLAIN):
+        made = [e for e in XTermParser().feed(character) if isinstance(e, events.Key)]
+        if len(made) == 1:
+            table[character] = (made[0].key, made[0].character)
+    return table
 
 
 def parser_wait(parser: XTermParser) -> float | None:
@@ -60,10 +84,15 @@ class LoopInput:
         self.fileno = sys.__stdin__.fileno() if fileno is None else fileno
         self._parser = XTermParser(debug=driver._debug)
         self._decode = getincrementaldecoder("utf-8")().decode
-        self._packets = ByteStream()
+        self._packets = PacketReader(marked=False)
         self._loop: asyncio.AbstractEventLoop | None = None
         self._escape: asyncio.TimerHandle | None = None
         self.reading = False
+        self._plain = plain_keys()
+        #: inside a bracketed paste (the parser's text so far says so)
+        self._pasting = False
+        #: the end of the text the parser was last given, for a paste mark split over packets
+        self._tail = ""
 
     def start(self) -> None:
         """Read from the next turn of the loop on: what the driver posted while starting (the
@@ -101,11 +130,10 @@ class LoopInput:
         driver = self._driver
         try:
             for packet_type, payload in self._packets.feed(data):
-                if packet_type == "D":
-                    for event in self._parser.feed(self._decode(payload)):
-                        driver.process_message(event)
+                if packet_type == DATA:
+                    self._typed(self._decode(payload))
                 else:
-                    driver._on_meta(packet_type, payload)
+                    driver._on_meta(packet_type.decode(), payload)
         except _ExitInput:
             self.close()
             return
@@ -116,6 +144,29 @@ class LoopInput:
             self.close()
             return
         self._tick()
+
+    def _typed(self, text: str) -> None:
+        """Hand on the keys of some typed text: plain characters straight, anything else
+        through Textual's parser."""
+        driver = self._driver
+        plain = self._plain
+        parser = self._parser
+        if (
+            not self._pasting
+            and parser_wait(parser) is None
+            and all(character in plain for character in text)
+        ):
+            for character in text:
+                driver.process_message(events.Key(*plain[character]))
+            self._tail = ""
+            return
+        seen = self._tail + text
+        started, ended = seen.rfind(PASTE_START), seen.rfind(PASTE_END)
+        if started != ended:  # both -1 when neither is there
+            self._pasting = started > ended
+        self._tail = seen[-(len(PASTE_START) - 1) :]
+        for event in parser.feed(text):
+            driver.process_message(event)
 
     def _tick(self) -> None:
         """Hand on what the parser's time limit settled (a lone Escape), and wake again at its

@@ -271,7 +271,8 @@ class MazeView(ScrollView, can_focus=False):
             if self._show_trail:
                 changed.add(robot)
         self._apply(self._spans(changed))
-        followed = (robot, self.size, self.virtual_size, self.scroll_offset)
+        # (the widget's outer size and raw scroll: read every tick, the cheapest that change)
+        followed = (robot, self.outer_size, self.virtual_size, self.scroll_x, self.scroll_y)
         if followed != self._followed:
             # the robot changed blocks, or the view its size or scroll: follow it (within a
             # block the view would not scroll)

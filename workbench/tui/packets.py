@@ -50,15 +50,17 @@ def quit_message() -> bytes:
 
 
 class PacketReader:
-    """Splits the app's output stream into ``(type, payload)`` packets, fed in any chunks.
+    """Splits a stream into ``(type, payload)`` packets, fed in any chunks.
 
     Output before the ``__GANGLION__`` line (a warning printed by a library, say) is kept in
     :attr:`preamble` and not treated as packets.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, marked: bool = True) -> None:
+        """``marked``: the stream starts with the ``__GANGLION__`` line (the app's output; the
+        server's packets to the app have none)."""
         self._buffer = bytearray()
-        self.started = False
+        self.started = not marked
         self.preamble = b""
 
     def feed(self, chunk: bytes) -> list[tuple[bytes, bytes]]:
