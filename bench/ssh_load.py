@@ -32,13 +32,20 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import contextlib
+import fcntl
 import os
+import pty
+import shutil
 import socket
 import statistics
+import struct
 import subprocess
 import sys
 import tempfile
+import termios
 import time
+from collections.abc import AsyncIterator, Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -147,17 +154,24 @@ def student_address(index: int) -> str:
 
 class Student:
     def __init__(
-        self, name: str, key: asyncssh.SSHKey, port: int, result: Result, address: str
-    ) -> None:
+        self, name: str, key: asyncssh.SSHKey, port: int, result: Result, address: str,
+        client: str, key_file: Path,
+    ) -> None:  # fmt: skip
         self.name, self.key, self.port, self.result = name, key, port, result
         self.address = address
+        self.client, self.key_file = client, key_file
         self.buffer = bytearray()
         self.arrived = asyncio.Event()
+        #: CPU seconds of this student's ssh client process (OpenSSH), read as it ends
+        self.client_cpu = 0.0
+
+    def _feed(self, chunk: bytes) -> None:
+        self.buffer += chunk
+        self.arrived.set()
 
     async def _read(self, stdout) -> None:
         while chunk := await stdout.read(65536):
-            self.buffer += chunk
-            self.arrived.set()
+            self._feed(chunk)
 
     async def wait_for(self, needle: bytes, since: int, timeout: float) -> bool:
         deadline = time.perf_counter() + timeout
@@ -172,12 +186,14 @@ class Student:
                 return False
         return True
 
-    async def run(
-        self, start: float, seconds: float, hz: float, offset: float, arrive: float,
-        idle: float = 0.0,
-    ) -> None:  # fmt: skip
-        await asyncio.sleep(max(0.0, arrive - time.perf_counter()))
-        t0 = time.perf_counter()
+    @contextlib.asynccontextmanager
+    async def terminal(self) -> AsyncIterator[Callable[[bytes], None] | None]:
+        """An SSH session at 80x24 whose output is fed to the buffer; yields the function
+        that types bytes into it (None: it could not connect, noted as a failure)."""
+        if self.client == "openssh":
+            async with self._openssh() as write:
+                yield write
+            return
         try:
             conn = await asyncssh.connect(
                 "127.0.0.1", self.port, username=self.name, client_keys=[self.key],
@@ -185,18 +201,73 @@ class Student:
             )  # fmt: skip
         except (OSError, asyncssh.Error) as exc:
             self.result.failures.append(f"{self.name}: cannot connect: {exc}")
+            yield None
             return
         try:
             proc = await conn.create_process(
                 term_type="xterm-256color", term_size=(80, 24), encoding=None
             )
             reader = asyncio.create_task(self._read(proc.stdout))
+            yield proc.stdin.write
+            reader.cancel()
+        finally:
+            conn.close()
+
+    @contextlib.asynccontextmanager
+    async def _openssh(self) -> AsyncIterator[Callable[[bytes], None] | None]:
+        """OpenSSH's client on a pseudo-terminal of 80x24, as a student runs it."""
+        master, slave = pty.openpty()
+        fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 80, 0, 0))
+        proc = await asyncio.create_subprocess_exec(
+            "ssh", "-p", str(self.port), "-i", str(self.key_file), "-e", "none",
+            "-b", self.address, "-o", "IdentitiesOnly=yes", "-o", "BatchMode=yes",
+            "-o", "StrictHostKeyChecking=no", "-o", "UserKnownHostsFile=/dev/null",
+            "-o", "LogLevel=ERROR", "-t", f"{self.name}@127.0.0.1",
+            stdin=slave, stdout=slave, stderr=slave, start_new_session=True,
+            env={**os.environ, "TERM": "xterm-256color"},
+        )  # fmt: skip
+        os.close(slave)
+        os.set_blocking(master, False)
+        loop = asyncio.get_running_loop()
+
+        def readable() -> None:
+            try:
+                chunk = os.read(master, 65536)
+            except (BlockingIOError, InterruptedError):
+                return
+            except OSError:
+                chunk = b""
+            if chunk:
+                self._feed(chunk)
+            else:
+                loop.remove_reader(master)
+
+        loop.add_reader(master, readable)
+        try:
+            yield lambda data: os.write(master, data)
+        finally:
+            self.client_cpu = cpu_seconds(proc.pid)
+            loop.remove_reader(master)
+            if proc.returncode is None:
+                proc.terminate()
+            await proc.wait()
+            os.close(master)
+
+    async def run(
+        self, start: float, seconds: float, hz: float, offset: float, arrive: float,
+        idle: float = 0.0,
+    ) -> None:  # fmt: skip
+        await asyncio.sleep(max(0.0, arrive - time.perf_counter()))
+        t0 = time.perf_counter()
+        async with self.terminal() as write:
+            if write is None:
+                return
             if not await self.wait_for(b"Who is at this robot", 0, 120):
                 self.result.failures.append(f"{self.name}: no names dialog")
                 return
             self.result.first_screen.append(time.perf_counter() - t0)
             mark = len(self.buffer)
-            proc.stdin.write(b"\r")
+            write(b"\r")
             if not await self.wait_for(b"running", mark, 60):
                 self.result.failures.append(f"{self.name}: no main screen")
                 return
@@ -208,27 +279,24 @@ class Student:
             tick = time.perf_counter()
             while time.perf_counter() < end:
                 if time.perf_counter() >= next_probe:
-                    await self.probe(proc)
+                    await self.probe(write)
                     next_probe = time.perf_counter() + PROBE_EVERY
                     tick = time.perf_counter()
-                proc.stdin.write(PATTERN[step % len(PATTERN)].encode())
+                write(PATTERN[step % len(PATTERN)].encode())
                 self.result.keys_sent += 1
                 step += 1
                 tick += period
                 await asyncio.sleep(max(0.0, tick - time.perf_counter()))
             if idle > 0:  # the robot stops; the student reads, presses nothing
-                proc.stdin.write(b" ")
+                write(b" ")
                 await asyncio.sleep(max(0.0, end + idle - time.perf_counter()))
-            reader.cancel()
-        finally:
-            conn.close()
 
-    async def probe(self, proc) -> None:
+    async def probe(self, write: Callable[[bytes], None]) -> None:
         for key, shows in ((b"p", b"PAUSED"), (b"p", b"running")):
             await asyncio.sleep(0.1)  # let the drive keys' output settle
             mark = len(self.buffer)
             sent = time.perf_counter()
-            proc.stdin.write(key)
+            write(key)
             if await self.wait_for(shows, mark, 5):
                 self.result.latency.append(time.perf_counter() - sent)
             else:
@@ -259,7 +327,7 @@ def apps_cpu(apps: list[int]) -> float:
 
 
 async def round_of(
-    n: int, seconds: float, hz: float, spread: float, fork: bool, idle: float
+    n: int, seconds: float, hz: float, spread: float, fork: bool, idle: float, client: str
 ) -> None:
     with tempfile.TemporaryDirectory(prefix="ssh-load-") as tmp:
         data = Path(tmp)
@@ -267,6 +335,8 @@ async def round_of(
         for i in range(n):
             name = f"s{i:02d}"
             keys[name] = asyncssh.generate_private_key("ssh-ed25519")
+            keys[name].write_private_key(data / f"{name}.key")
+            (data / f"{name}.key").chmod(0o600)  # ssh refuses a key others can read
             add_user(data / "ssh-users.yaml", name, "student",
                      [keys[name].export_public_key().decode()])  # fmt: skip
         port = free_port()
@@ -282,7 +352,7 @@ async def round_of(
         t0 = time.perf_counter()
         start = t0 + spread + max(10.0, 0.6 * n)
         students = [
-            Student(name, key, port, result, student_address(i))
+            Student(name, key, port, result, student_address(i), client, data / f"{name}.key")
             for i, (name, key) in enumerate(keys.items())
         ]
         tasks = [
@@ -319,7 +389,7 @@ async def round_of(
             await asyncio.sleep(max(0.5, idle - 3.0))
             idle_cpu, idle_wall = apps_cpu(apps0) - idle_cpu0, time.perf_counter() - idle_wall0
         await asyncio.gather(*tasks, return_exceptions=True)
-        own_cpu = time.process_time() - own_cpu0
+        own_cpu = time.process_time() - own_cpu0 + sum(s.client_cpu for s in students)
         deadline = time.monotonic() + 20
         while apps_of(server.pid)[0] and time.monotonic() < deadline:
             await asyncio.sleep(0.1)
@@ -356,8 +426,8 @@ async def round_of(
     )
     print(
         f"  CPU server+apps  {100 * used:.0f}% of one core, {100 * used / cores:.0f}% of the "
-        f"machine ({cores} cores); the SSH clients here: {100 * own_cpu / (wall1 - start):.0f}%"
-        f" of one core"
+        f"machine ({cores} cores); the SSH clients here ({client}): "
+        f"{100 * own_cpu / (wall1 - start):.0f}% of one core"
     )
     per_app = (app_cpu1 - app_cpu0) / (wall1 - wall0) / max(1, len(apps0))
     print(
@@ -403,7 +473,17 @@ def main() -> None:
         "--no-fork-server", action="store_true",
         help="the server starts each app as a new process (as before the fork server)",
     )  # fmt: skip
+    parser.add_argument(
+        "--client", choices=("asyncssh", "openssh"), default="asyncssh",
+        help="the students' SSH client: asyncssh in this process (default), or OpenSSH's ssh "
+        "on a pseudo-terminal of its own for each student, as students run it (about as much "
+        "CPU on this machine, and each start costs more)",
+    )  # fmt: skip
     args = parser.parse_args()
+    if args.client == "openssh" and shutil.which("ssh") is None:
+        raise SystemExit(
+            "no ssh client here (apt-get install openssh-client), or --client asyncssh"
+        )
     if args.sessions:
         rounds = [
             (n, spread)
@@ -414,7 +494,11 @@ def main() -> None:
         rounds = [(30, 0.0), (60, args.spread)]
     print(f"{os.cpu_count()} cores; load average before: {os.getloadavg()[0]:.2f}")
     for n, spread in rounds:
-        asyncio.run(round_of(n, args.seconds, args.hz, spread, not args.no_fork_server, args.idle))
+        asyncio.run(
+            round_of(
+                n, args.seconds, args.hz, spread, not args.no_fork_server, args.idle, args.client
+            )
+        )
 
 
 if __name__ == "__main__":

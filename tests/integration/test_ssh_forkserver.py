@@ -18,7 +18,7 @@ from tests.app.support import sync
 from workbench.cli.ssh import WORKBENCH_APP
 from workbench.ssh import forkserver as forkserver_module
 from workbench.ssh.appproc import app_env
-from workbench.ssh.forkserver import ForkServer, ForkServerError
+from workbench.ssh.forkserver import APP_NICENESS, ForkServer, ForkServerError
 
 from .ssh_support import Account, lab_host, moved
 
@@ -62,6 +62,13 @@ async def test_the_fork_server_runs_apps_with_their_options_errors_and_exit_stat
         assert parent_of(app.pid) == server.pid
         first = await asyncio.wait_for(app.stdout.readexactly(13), 20)
         assert first == b"__GANGLION__\n"  # the web driver talks on the socket given
+        # the app runs below the server's priority, also where the kernel weighs each
+        # session as a group (autogroup): there the group's nice value is what counts
+        ours = os.getpriority(os.PRIO_PROCESS, 0)
+        assert os.getpriority(os.PRIO_PROCESS, app.pid) == min(19, ours + APP_NICENESS)
+        group = Path(f"/proc/{app.pid}/autogroup")
+        if group.exists():
+            assert group.read_text().split()[-1] == str(APP_NICENESS)
         assert app.returncode is None
         os.killpg(app.pid, signal.SIGKILL)
         assert await asyncio.wait_for(app.wait(), 10) == -signal.SIGKILL

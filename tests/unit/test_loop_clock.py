@@ -1,75 +1,121 @@
-"""The app's clock: steady ticks on the loop, a new rate at once, no bunched catch-up ticks
-after a busy loop, and an error that stops it and reaches the app."""
+"""The app's clock: steady ticks on a grid, a new rate at once, a tick at once when woken, no
+bunched catch-up ticks after a busy loop, and an error that stops it and reaches the app.
+
+Run on a loop whose time the test moves (the clock only asks a loop for the time and to call
+it at a time), and once on a real loop."""
 
 from __future__ import annotations
 
 import asyncio
-import time
+import heapq
+import itertools
 
 import pytest
 
 from workbench.tui.clock import LoopClock
 
 
-def test_it_ticks_at_its_rate_and_changes_rate_at_once():
-    async def go() -> tuple[list[float], list[float]]:
-        fast: list[float] = []
-        slow: list[float] = []
-        ticks = fast
-        clock = LoopClock(lambda: ticks.append(time.monotonic()), 0.02, pytest.fail)
-        await asyncio.sleep(0.5)
-        ticks = slow
-        clock.set_period(0.2)
-        await asyncio.sleep(0.5)
-        clock.stop()
-        assert not clock.running
-        await asyncio.sleep(0.3)
-        return fast, slow
+class Handle:
+    def __init__(self) -> None:
+        self.cancelled = False
 
-    fast, slow = asyncio.run(go())
-    assert 15 <= len(fast) <= 26  # 25 at 50 Hz, less when the machine is busy
-    assert 1 <= len(slow) <= 3  # 2 at 5 Hz, none after the stop
+    def cancel(self) -> None:
+        self.cancelled = True
+
+
+class SteppedLoop:
+    """A loop's clock and its timed calls, moved on by the test."""
+
+    def __init__(self) -> None:
+        self.now = 0.0
+        self._calls: list[tuple[float, int, Handle, object]] = []
+        self._order = itertools.count()
+
+    def time(self) -> float:
+        return self.now
+
+    def call_at(self, when: float, callback) -> Handle:
+        handle = Handle()
+        heapq.heappush(self._calls, (when, next(self._order), handle, callback))
+        return handle
+
+    def run_until(self, end: float, busy_until: float = -1.0) -> None:
+        """Run the calls due up to ``end``; until ``busy_until`` the loop is held (calls due
+        then run when it is free)."""
+        while self._calls and self._calls[0][0] <= end:
+            when, _, handle, callback = heapq.heappop(self._calls)
+            if handle.cancelled:
+                continue
+            self.now = max(self.now, when, busy_until if when < busy_until else when)
+            callback()
+        self.now = end
+
+
+def clock_on(loop: SteppedLoop, period: float) -> tuple[LoopClock, list[float]]:
+    ticks: list[float] = []
+    clock = LoopClock(lambda: ticks.append(loop.now), period, pytest.fail, loop=loop)  # type: ignore[arg-type]
+    return clock, ticks
+
+
+def test_it_ticks_on_its_grid_and_slows_down_from_now():
+    loop = SteppedLoop()
+    clock, ticks = clock_on(loop, 0.05)
+    loop.run_until(0.26)
+    assert ticks == pytest.approx([0.05, 0.10, 0.15, 0.20, 0.25])
+    clock.set_period(2.0)  # at rest: the next tick one rest period from now
+    loop.run_until(4.5)
+    assert ticks[5:] == pytest.approx([2.26, 4.26])
+    clock.stop()
+    loop.run_until(10.0)
+    assert len(ticks) == 7 and not clock.running
+
+
+def test_woken_at_once_it_ticks_now_and_then_on_its_grid():
+    loop = SteppedLoop()
+    clock, ticks = clock_on(loop, 0.05)
+    clock.set_period(2.0)
+    loop.run_until(3.33)
+    assert ticks == pytest.approx([2.0])
+    clock.set_period(0.05, at_once=True)  # a key: drawn at once
+    loop.run_until(3.5)
+    assert ticks[1:] == pytest.approx([3.33, 3.35, 3.40, 3.45, 3.50])
 
 
 def test_a_busy_loop_gets_one_late_tick_not_a_burst():
-    async def go() -> list[float]:
-        ticks: list[float] = []
-        clock = LoopClock(lambda: ticks.append(time.monotonic()), 0.05, pytest.fail)
-        await asyncio.sleep(0.12)
-        time.sleep(0.5)  # the loop is held: ten ticks fall due
-        blocked = len(ticks)
-        await asyncio.sleep(0.12)
-        clock.stop()
-        return ticks[blocked:]
-
-    after = asyncio.run(go())
-    assert 1 <= len(after) <= 3  # one late tick, then the rate again
-    if len(after) > 1:
-        assert after[1] - after[0] >= 0.04
+    loop = SteppedLoop()
+    clock, ticks = clock_on(loop, 0.05)
+    loop.run_until(0.99, busy_until=0.52)  # ten ticks fall due while the loop is held
+    assert ticks[:2] == pytest.approx([0.52, 0.55])  # one late tick, then the grid
+    assert len(ticks) == 10  # 0.52, then 0.55 to 0.95
 
 
 def test_an_error_stops_the_clock_and_reaches_the_app():
-    async def go() -> tuple[list[Exception], LoopClock]:
-        errors: list[Exception] = []
+    loop = SteppedLoop()
+    errors: list[Exception] = []
 
-        def tick() -> None:
-            raise RuntimeError("a broken tick")
+    def tick() -> None:
+        raise RuntimeError("a broken tick")
 
-        clock = LoopClock(tick, 0.01, errors.append)
-        await asyncio.sleep(0.1)
-        return errors, clock
-
-    errors, clock = asyncio.run(go())
+    clock = LoopClock(tick, 0.01, errors.append, loop=loop)  # type: ignore[arg-type]
+    loop.run_until(1.0)
     assert [str(e) for e in errors] == ["a broken tick"] and not clock.running
 
 
 def test_a_period_must_be_positive():
-    async def go() -> None:
-        with pytest.raises(ValueError, match="positive"):
-            LoopClock(lambda: None, 0, pytest.fail)
-        clock = LoopClock(lambda: None, 1.0, pytest.fail)
-        with pytest.raises(ValueError, match="positive"):
-            clock.set_period(-1.0)
-        clock.stop()
+    loop = SteppedLoop()
+    with pytest.raises(ValueError, match="positive"):
+        clock_on(loop, 0)
+    clock, _ = clock_on(loop, 1.0)
+    with pytest.raises(ValueError, match="positive"):
+        clock.set_period(-1.0)
 
-    asyncio.run(go())
+
+def test_it_ticks_on_a_real_loop():
+    async def go() -> int:
+        ticks: list[float] = []
+        clock = LoopClock(lambda: ticks.append(0.0), 0.01, pytest.fail)
+        await asyncio.sleep(0.3)
+        clock.stop()
+        return len(ticks)
+
+    assert 5 <= asyncio.run(go()) <= 31

@@ -196,6 +196,20 @@ class _Zygote:
             _send(self.control, {"exit": pid, "code": os.waitstatus_to_exitcode(status)})
 
 
+def lower_priority(niceness: int) -> None:
+    """Run this process ``niceness`` lower than the server (in a session of its own).
+
+    Where the kernel groups processes by session for scheduling (Linux's autogroup, on by
+    default in most distributions), a process in a session of its own is weighed as a group,
+    against the server's group, and only the group's nice value tells: the process's own would
+    change nothing. Both are set; either may be refused (then it runs as it is).
+    """
+    with contextlib.suppress(OSError):
+        os.nice(niceness)
+    with contextlib.suppress(OSError), open("/proc/self/autogroup", "w") as group:
+        group.write(str(niceness))
+
+
 def _run_app(
     main: Callable[[list[str]], int],
     options: list[str],
@@ -212,8 +226,7 @@ def _run_app(
         if fd > 2:
             os.close(fd)
     signal.signal(signal.SIGINT, signal.default_int_handler)
-    with contextlib.suppress(OSError):
-        os.nice(APP_NICENESS)
+    lower_priority(APP_NICENESS)
     os.environ.clear()
     os.environ.update(env)
     if cwd:

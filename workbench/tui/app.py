@@ -303,7 +303,10 @@ class WorkbenchApp(ScreenHost[None]):
         if resting == self._resting or self._clock is None:
             return
         self._resting = resting
-        self._clock.set_period(self._rest_period if resting else 1.0 / self.tick_hz)
+        if resting:
+            self._clock.set_period(self._rest_period)
+        else:  # what woke it is drawn at once, then the clock ticks at its rate
+            self._clock.set_period(1.0 / self.tick_hz, at_once=True)
 
     def wake(self) -> None:
         """Something is about to change the station (a key, a click, a VIPLE command): the time

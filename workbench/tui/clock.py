@@ -5,9 +5,10 @@ would run each tick as a task waking from a sleep (a future, a timer handle, a t
 the timer's own checks); this clock is one timer handle per tick on the app's loop, in the
 app's context, so each tick costs the call and little else.
 
-A tick that falls behind (the loop was busy) runs as soon as it can, and the next one keeps the
-rate from there: ticks are never bunched up to catch up (the simulation is handed the real time
-that passed, whatever it is).
+The ticks fall on a grid of times one period apart from the clock's start. A tick that falls
+behind (the loop was busy) runs as soon as it can and the next one is the grid's next time:
+ticks are never bunched up to catch up (the simulation is handed the real time that passed,
+whatever it is).
 """
 
 from __future__ import annotations
@@ -24,32 +25,45 @@ class LoopClock:
     """
 
     def __init__(
-        self, tick: Callable[[], None], period: float, on_error: Callable[[Exception], None]
+        self,
+        tick: Callable[[], None],
+        period: float,
+        on_error: Callable[[Exception], None],
+        loop: asyncio.AbstractEventLoop | None = None,
     ) -> None:
+        """``loop``: the running loop unless given."""
         if period <= 0:
             raise ValueError(f"a clock period must be positive, not {period}")
         self._tick = tick
         self._on_error = on_error
         self.period = period
-        self._loop = asyncio.get_running_loop()
-        self._due = self._loop.time() + period
+        self._loop = loop or asyncio.get_running_loop()
+        self._start = self._loop.time()
+        self._due = self._start + period
         self._handle: asyncio.TimerHandle | None = self._loop.call_at(self._due, self._run)
 
     @property
     def running(self) -> bool:
         return self._handle is not None
 
-    def set_period(self, period: float) -> None:
-        """Tick every ``period`` seconds from now on (the next tick one period from now)."""
+    def set_period(self, period: float, at_once: bool = False) -> None:
+        """Tick every ``period`` seconds from now on: the next tick one period from now, or
+        with ``at_once`` a tick as soon as the loop is free and then on the clock's own grid
+        (the times one period apart from its start), as before it slowed down."""
         if period <= 0:
             raise ValueError(f"a clock period must be positive, not {period}")
-        if period == self.period or self._handle is None:
-            self.period = period
-            return
+        changed = period != self.period
         self.period = period
+        if self._handle is None or not (changed or at_once):
+            return
         self._handle.cancel()
-        self._due = self._loop.time() + period
-        self._handle = self._loop.call_at(self._due, self._run)
+        now = self._loop.time()
+        if at_once:  # this tick stands for the grid's last time; the next is its next
+            self._due = now - (now - self._start) % period
+            self._handle = self._loop.call_at(now, self._run)
+        else:
+            self._due = now + period
+            self._handle = self._loop.call_at(self._due, self._run)
 
     def stop(self) -> None:
         if self._handle is not None:
@@ -58,9 +72,12 @@ class LoopClock:
 
     def _run(self) -> None:
         loop = self._loop
-        due = self._due + self.period
+        period = self.period
         now = loop.time()
-        self._due = due if due > now else now + self.period
+        due = self._due + period
+        if due <= now:  # late: on to the grid's next time
+            due = now + period - (now - self._start) % period
+        self._due = due
         self._handle = loop.call_at(self._due, self._run)
         try:
             self._tick()
