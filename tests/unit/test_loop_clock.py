@@ -83,7 +83,7 @@ def test_woken_at_once_it_ticks_now_and_then_on_its_grid():
 
 def test_a_busy_loop_gets_one_late_tick_not_a_burst():
     loop = SteppedLoop()
-    clock, ticks = clock_on(loop, 0.05)
+    _, ticks = clock_on(loop, 0.05)
     loop.run_until(0.99, busy_until=0.52)  # ten ticks fall due while the loop is held
     assert ticks[:2] == pytest.approx([0.52, 0.55])  # one late tick, then the grid
     assert len(ticks) == 10  # 0.52, then 0.55 to 0.95
