@@ -269,7 +269,8 @@ class Student:
             mark = len(self.buffer)
             write(b"\r")
             if not await self.wait_for(b"running", mark, 60):
-                self.result.failures.append(f"{self.name}: no main screen")
+                tail = bytes(self.buffer[-160:])
+                self.result.failures.append(f"{self.name}: no main screen; last {tail!r}")
                 return
             await asyncio.sleep(max(0.0, start - time.perf_counter()))  # all drive together
             end = time.perf_counter() + seconds
@@ -396,6 +397,12 @@ async def round_of(
         left = len(apps_of(server.pid)[0])
         server.terminate()
         server.wait(30)
+        failed = sorted({f.split(":", 1)[0] for f in result.failures})
+        app_logs = {
+            name: "".join(log.read_text(errors="replace")[-600:]
+                          for log in sorted((data / "logs" / name).glob("*.log")))
+            for name in failed[:3]
+        }  # fmt: skip
 
     cores = os.cpu_count() or 1
     used = (cpu1 - cpu0) / (wall1 - wall0)
@@ -447,6 +454,8 @@ async def round_of(
         print(f"  FAILED           {len(result.failures)} of {n} sessions:")
     for failure in result.failures[:5]:
         print(f"    {failure}")
+    for name, text in app_logs.items():
+        print(f"    {name}'s app log: {text.strip() or '(empty)'}")
     # fmt: on
 
 

@@ -81,6 +81,25 @@ async def test_the_fork_server_runs_apps_with_their_options_errors_and_exit_stat
 
 
 @sync
+async def test_an_app_whose_server_is_gone_ends(tmp_path):
+    """A server that dies without ending its apps (killed, out of memory) leaves no app
+    running for ever: each sees its input end and ends."""
+    server = ForkServer(app_env(), WORKBENCH_APP.main, WORKBENCH_APP.preload)
+    await server.start()
+    try:
+        options = ["--tcp-port", "0", "--student", "ann", "--data-dir", str(tmp_path / "d"),
+                   "--record-dir", str(tmp_path / "runs")]  # fmt: skip
+        app = await server.spawn(options, app_env(), tmp_path / "app.log")
+        assert await asyncio.wait_for(app.stdout.readexactly(13), 20) == b"__GANGLION__\n"
+        app.stdin.close()  # the server's end of the app's input and output
+        await eventually(lambda: gone(app.pid) or app.returncode is not None, "app ended", 20)
+    finally:
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(app.pid, signal.SIGKILL)
+        await server.close()
+
+
+@sync
 async def test_two_forked_sessions_at_once_resize_and_end_with_ctrl_q(tmp_path, caplog):
     caplog.set_level(logging.INFO, "workbench.ssh")
     async with lab_host(tmp_path, [Account("ann"), Account("ben")]) as host:

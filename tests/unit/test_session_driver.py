@@ -105,7 +105,7 @@ def test_a_lone_escape_arrives_at_the_parsers_time_limit():
     asyncio.run(go())
 
 
-def test_meta_packets_reach_the_app_and_the_end_of_input_stops_reading():
+def test_meta_packets_reach_the_app_and_the_end_of_input_ends_it():
     async def go() -> None:
         box = PostBox()
         driver, w = await started_driver(box)
@@ -120,6 +120,8 @@ def test_meta_packets_reach_the_app_and_the_end_of_input_stops_reading():
         while reading.reading and time.monotonic() < deadline:  # type: ignore[attr-defined]
             await asyncio.sleep(0.01)
         assert not reading.reading  # type: ignore[attr-defined]
+        # with the server gone (its end of the pipe closed) the app ends, saving as it ends
+        assert isinstance(box.messages[-1], messages.ExitApp) and len(box.messages) == 3
 
     asyncio.run(go())
 

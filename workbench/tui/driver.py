@@ -124,8 +124,9 @@ class LoopInput:
             return
         except OSError:
             data = b""
-        if not data:
+        if not data:  # the server is gone: nobody can type or see the screen any more
             self.close()
+            self._driver.send_message(messages.ExitApp())
             return
         driver = self._driver
         try:
