@@ -1,5 +1,6 @@
-"""The app's clock: steady ticks on a grid, a new rate at once, a tick at once when woken, no
-bunched catch-up ticks after a busy loop, and an error that stops it and reaches the app.
+"""The app's clock: steady ticks, a new rate at once, a tick at once when woken, ticks brought
+by keys (one wake for both) but never faster than the clock's rate, no bunched catch-up ticks
+after a busy loop, and an error that stops it and reaches the app.
 
 Run on a loop whose time the test moves (the clock only asks a loop for the time and to call
 it at a time), and once on a real loop."""
@@ -57,7 +58,7 @@ def clock_on(loop: SteppedLoop, period: float) -> tuple[LoopClock, list[float]]:
     return clock, ticks
 
 
-def test_it_ticks_on_its_grid_and_slows_down_from_now():
+def test_it_ticks_at_its_rate_without_drift_and_slows_down_from_now():
     loop = SteppedLoop()
     clock, ticks = clock_on(loop, 0.05)
     loop.run_until(0.26)
@@ -70,23 +71,63 @@ def test_it_ticks_on_its_grid_and_slows_down_from_now():
     assert len(ticks) == 7 and not clock.running
 
 
-def test_woken_at_once_it_ticks_now_and_then_on_its_grid():
+def test_woken_at_once_it_ticks_now_and_then_at_its_rate():
     loop = SteppedLoop()
     clock, ticks = clock_on(loop, 0.05)
     clock.set_period(2.0)
     loop.run_until(3.33)
     assert ticks == pytest.approx([2.0])
-    clock.set_period(0.05, at_once=True)  # a key: drawn at once
+    clock.set_period(0.05, at_once=True)  # a VIPLE command: drawn at once
     loop.run_until(3.5)
-    assert ticks[1:] == pytest.approx([3.33, 3.35, 3.40, 3.45, 3.50])
+    assert ticks[1:] == pytest.approx([3.33, 3.38, 3.43, 3.48])
 
 
 def test_a_busy_loop_gets_one_late_tick_not_a_burst():
     loop = SteppedLoop()
     _, ticks = clock_on(loop, 0.05)
     loop.run_until(0.99, busy_until=0.52)  # ten ticks fall due while the loop is held
-    assert ticks[:2] == pytest.approx([0.52, 0.55])  # one late tick, then the grid
-    assert len(ticks) == 10  # 0.52, then 0.55 to 0.95
+    assert ticks[:3] == pytest.approx([0.52, 0.57, 0.62])  # one late tick, then the rate
+    assert len(ticks) == 10
+
+
+def keys_at(loop: SteppedLoop, clock: LoopClock, times: list[float]) -> list[bool]:
+    """Nudge the clock at each time, as keys do; whether each nudge ticked."""
+    ticked = []
+    for at in times:
+        loop.run_until(at)
+        ticked.append(clock.nudge())
+    return ticked
+
+
+def test_keys_at_the_tick_rate_bring_the_ticks_and_the_timer_stays_asleep():
+    loop = SteppedLoop()
+    clock, ticks = clock_on(loop, 0.05)
+    # a student's keys twenty times a second, a little uneven, out of step with the clock
+    keys = [0.013 + 0.05 * i + (0.004 if i % 3 else -0.004) for i in range(40)]
+    ticked = keys_at(loop, clock, keys)
+    assert ticked[0] is False  # 9 ms after the clock started
+    assert all(ticked[1:])  # from the second key on, every key brings a tick
+    assert ticks == pytest.approx(keys[1:])  # and no tick comes without a key: one wake each
+    loop.run_until(keys[-1] + 0.2)  # the keys stop: the clock goes on on its own
+    assert ticks[39:] == pytest.approx([keys[-1] + 0.06, keys[-1] + 0.11, keys[-1] + 0.16])
+
+
+def test_faster_keys_tick_at_most_a_third_faster_than_the_clock():
+    loop = SteppedLoop()
+    clock, ticks = clock_on(loop, 0.05)
+    keys = [0.01 * i for i in range(1, 101)]  # a hundred keys a second for a second
+    keys_at(loop, clock, keys)
+    gaps = [b - a for a, b in itertools.pairwise(ticks)]
+    assert min(gaps) >= 0.75 * 0.05 - 1e-9 and 18 <= len(ticks) <= 27
+
+
+def test_a_key_just_after_a_tick_puts_the_next_tick_off_but_ticks_no_more():
+    loop = SteppedLoop()
+    clock, ticks = clock_on(loop, 0.05)
+    loop.run_until(0.06)
+    assert keys_at(loop, clock, [0.07]) == [False]  # 20 ms after the tick at 0.05
+    loop.run_until(0.2)  # no more keys: the next tick a period and the slack after the key
+    assert ticks == pytest.approx([0.05, 0.13, 0.18])
 
 
 def test_an_error_stops_the_clock_and_reaches_the_app():

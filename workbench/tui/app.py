@@ -319,6 +319,10 @@ class WorkbenchApp(ScreenHost[None]):
         if isinstance(event, (events.Key, events.MouseDown)):
             self._input_seen = True
             self.wake()
+            await super().on_event(event)
+            if self._clock is not None:
+                self._clock.nudge()  # awake anyway: the tick (with the key in it) comes now
+            return
         await super().on_event(event)
 
     def on_app_blur(self, event: events.AppBlur) -> None:
