@@ -306,6 +306,9 @@ class Student:
 
 # -- one round -----------------------------------------------------------------------------
 def start_server(data: Path, port: int, sessions: int, fork: bool) -> subprocess.Popen:
+    """The lab server in a session of its own, as a service manager starts it: where the
+    kernel weighs sessions as groups for scheduling (Linux's autogroup), a server in this
+    bench's session would share one group's CPU with the bench's SSH clients."""
     first = 42000 + (port % 100) * 100
     server = subprocess.Popen(
         [sys.executable, "-m", "workbench", "serve-ssh", "--bind", "127.0.0.1",
@@ -313,6 +316,7 @@ def start_server(data: Path, port: int, sessions: int, fork: bool) -> subprocess
          "--port-range", f"{first}-{first + 2 * sessions + 40}",
          "--max-sessions", str(max(60, sessions)), *([] if fork else ["--no-fork-server"])],
         cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+        start_new_session=True,  # as a service runs: not in this bench's session (see below)
     )  # fmt: skip
     log = data / "ssh.log"
     deadline = time.monotonic() + 60
@@ -488,6 +492,11 @@ def main() -> None:
         "on a pseudo-terminal of its own for each student, as students run it (about as much "
         "CPU on this machine, and each start costs more)",
     )  # fmt: skip
+    parser.add_argument(
+        "--only", choices=("together", "spread"),
+        help="run only the rounds where the students arrive all at once, or only those where "
+        "they arrive over --spread seconds",
+    )  # fmt: skip
     args = parser.parse_args()
     if args.client == "openssh" and shutil.which("ssh") is None:
         raise SystemExit(
@@ -501,6 +510,10 @@ def main() -> None:
         ]
     else:
         rounds = [(30, 0.0), (60, args.spread)]
+    if args.only == "together":
+        rounds = [(n, spread) for n, spread in rounds if spread == 0]
+    elif args.only == "spread":
+        rounds = [(n, spread) for n, spread in rounds if spread > 0]
     print(f"{os.cpu_count()} cores; load average before: {os.getloadavg()[0]:.2f}")
     for n, spread in rounds:
         asyncio.run(
