@@ -4,9 +4,11 @@ a lone Escape still arrives, nothing runs while no key comes; a frame leaves as 
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import os
 import threading
 import time
+from collections.abc import AsyncIterator
 
 import pytest
 from textual import events, messages
@@ -60,6 +62,18 @@ async def started_driver(box: PostBox) -> tuple[SessionDriver, int]:
     return driver, w
 
 
+@contextlib.asynccontextmanager
+async def reading_driver() -> AsyncIterator[tuple[PostBox, SessionDriver, int]]:
+    """A started driver, what it hands the app, and the write end of its input; closed after."""
+    box = PostBox()
+    driver, w = await started_driver(box)
+    try:
+        yield box, driver, w
+    finally:
+        driver._input_reader.close()
+        os.close(w)
+
+
 async def settle(box: PostBox, count: int, timeout: float = 5.0) -> None:
     deadline = time.monotonic() + timeout
     while len(box.messages) < count and time.monotonic() < deadline:
@@ -68,10 +82,8 @@ async def settle(box: PostBox, count: int, timeout: float = 5.0) -> None:
 
 def test_keys_arrive_in_order_on_the_apps_thread_and_no_thread_reads():
     async def go() -> None:
-        box = PostBox()
         threads = threading.active_count()
-        driver, w = await started_driver(box)
-        try:
+        async with reading_driver() as (box, driver, w):
             assert threading.active_count() == threads  # no input thread
             os.write(w, packets.data(b"ww"))
             os.write(w, packets.data(b"a") + packets.data(b" d"))
@@ -80,27 +92,19 @@ def test_keys_arrive_in_order_on_the_apps_thread_and_no_thread_reads():
             assert box.threads == {threading.get_ident()}
             # nothing pending: no timer waits to wake the loop while no key comes
             assert driver._input_reader._escape is None  # type: ignore[attr-defined]
-        finally:
-            driver._input_reader.close()
-            os.close(w)
 
     asyncio.run(go())
 
 
 def test_a_lone_escape_arrives_at_the_parsers_time_limit():
     async def go() -> None:
-        box = PostBox()
-        driver, w = await started_driver(box)
-        try:
+        async with reading_driver() as (box, _, w):
             os.write(w, packets.data(b"\x1b"))
             await settle(box, 1)
             assert box.keys() == ["escape"]
             os.write(w, packets.data(b"\x1b[A"))  # a whole sequence is one key at once
             await settle(box, 2)
             assert box.keys() == ["escape", "up"]
-        finally:
-            driver._input_reader.close()
-            os.close(w)
 
     asyncio.run(go())
 
@@ -181,9 +185,7 @@ def test_typed_characters_make_the_keys_textuals_parser_makes():
 
 def test_typed_text_after_an_escape_or_inside_a_paste_goes_through_the_parser():
     async def go() -> None:
-        box = PostBox()
-        driver, w = await started_driver(box)
-        try:
+        async with reading_driver() as (box, _, w):
             os.write(w, packets.data(b"w"))
             # a paste whose start mark is split over two packets, its text in a third
             os.write(w, packets.data(b"\x1b[20"))
@@ -201,8 +203,5 @@ def test_typed_text_after_an_escape_or_inside_a_paste_goes_through_the_parser():
                 if isinstance(m, events.Key | events.Paste)
             ]
             assert got == ["w", ("paste", "wasd x"), "d", "alt+a"]
-        finally:
-            driver._input_reader.close()
-            os.close(w)
 
     asyncio.run(go())
