@@ -53,6 +53,9 @@ from ..widgets.sensor_readings import SensorReadings
 #: (at 4 Hz the panels made most of a driving session's frames); paused, stepped or ended, the
 #: panels show the exact figures at once
 PANEL_HZ = 2.0
+#: the share of a panel period after which the panels also follow in a frame the maze view
+#: draws anyway: one frame instead of two, at about the same rate
+PANEL_WITH_MAZE = 0.6
 
 
 class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, CachedBindingChain):
@@ -181,9 +184,10 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Cache
             self._controller = station.controller
             if station.controller is not None:
                 self._maze_view.clear_trail()  # a new run starts from the start block
-        self._maze_view.show(snapshot, station.session.world.cell)
-        # the text panels follow at PANEL_HZ while the robot runs (every byte counts over SSH);
-        # at once when paused (steps, snapshots) and when who drives or the state changes
+        drawn = self._maze_view.show(snapshot, station.session.world.cell)
+        # the text panels follow at PANEL_HZ while the robot runs (every byte counts over SSH),
+        # early in a frame the maze view draws anyway; at once when paused (steps, snapshots)
+        # and when who drives or the state changes
         now = monotonic()
         if station.notice is not self._notice:
             self._notice = station.notice
@@ -198,7 +202,13 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Cache
             station.program,
             self._all_keys,
         )
-        if station.paused or moment != self._moment or now - self._panels_at >= 1 / PANEL_HZ:
+        since = (now - self._panels_at) * PANEL_HZ  # in panel periods
+        if (
+            station.paused
+            or moment != self._moment
+            or since >= 1
+            or (drawn and since >= PANEL_WITH_MAZE)
+        ):
             self._moment = moment
             self._panels_at = now
             self._readings.show(snapshot, station.profile)

@@ -248,8 +248,9 @@ class MazeView(ScrollView, can_focus=False):
                 spans[y] = (x0, x1) if span is None else (min(span[0], x0), max(span[1], x1))
         self._apply(spans)
 
-    def show(self, snapshot: Snapshot, cell_size: float) -> None:
-        """Draw the robot, its sensors and its trail from a session snapshot.
+    def show(self, snapshot: Snapshot, cell_size: float) -> bool:
+        """Draw the robot, its sensors and its trail from a session snapshot; returns whether
+        a cell of the view changed (it is redrawn in the screen's next update).
 
         ``cell_size`` is the block size in world units (``world.cell``), to turn the pose into
         blocks.
@@ -257,7 +258,7 @@ class MazeView(ScrollView, can_focus=False):
         self._last_show = (snapshot, cell_size)
         shown = (snapshot.pose, snapshot.readings, snapshot.sensors, cell_size)
         if shown == self._shown:
-            return  # the robot and its sensors are drawn as they are now
+            return False  # the robot and its sensors are drawn as they are now
         self._shown = shown
         maze = self._maze
         pose = snapshot.pose
@@ -270,10 +271,12 @@ class MazeView(ScrollView, can_focus=False):
             self._trail.add(robot)
             if self._show_trail:
                 changed.add(robot)
-        self._apply(self._spans(changed))
+        spans = self._spans(changed)
+        self._apply(spans)
         # (the widget's outer size and raw scroll: read every tick, the cheapest that change)
         followed = (robot, self.outer_size, self.virtual_size, self.scroll_x, self.scroll_y)
-        if followed != self._followed:
+        moved = followed != self._followed
+        if moved:
             # the robot changed blocks, or the view its size or scroll: follow it (within a
             # block the view would not scroll)
             self._followed = followed
@@ -282,6 +285,7 @@ class MazeView(ScrollView, can_focus=False):
         self._tooltip_stale = True
         if self.mouse_hover:
             self._update_tooltip(snapshot)
+        return bool(spans) or moved
 
     def hide_robot(self) -> None:
         """Stop drawing the robot and its sensors (the trail stays until cleared)."""
