@@ -27,8 +27,12 @@ PARSE_CACHE = 256
 
 
 def prepare() -> None:
-    """Run the app headless to its first screen and keep the parsed stylesheets."""
+    """Run the app headless to its first screen and keep the parsed stylesheets (and the
+    session driver's table of typed keys)."""
     from .app import make_app
+    from .driver import plain_keys
+
+    plain_keys()
 
     async def first_screen() -> None:
         async with app.run_test(size=(80, 24)) as pilot:
