@@ -14,6 +14,7 @@ import time
 import asyncssh
 import pytest
 
+from workbench.ssh.server import ServerConfig
 from workbench.ssh.users import load_users
 
 
@@ -102,9 +103,14 @@ def test_serve_ssh_refuses_bad_options_before_it_starts(tmp_path, options, messa
 
 
 def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
+    """A free port outside the sessions' default VIPLE range (which the server refuses)."""
+    low, high = ServerConfig.port_range
+    while True:
+        with socket.socket() as sock:
+            sock.bind(("127.0.0.1", 0))
+            port = sock.getsockname()[1]
+        if not low <= port <= high:
+            return port
 
 
 def test_serve_ssh_makes_a_private_host_key_logs_and_stops_on_sigterm(tmp_path):
