@@ -11,6 +11,8 @@ import time
 from collections.abc import AsyncIterator
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from textual import events, messages
 from textual._ansi_sequences import SYNC_END, SYNC_START
 from textual._xterm_parser import XTermParser
@@ -205,3 +207,49 @@ def test_typed_text_after_an_escape_or_inside_a_paste_goes_through_the_parser():
             assert got == ["w", ("paste", "wasd x"), "d", "alt+a"]
 
     asyncio.run(go())
+
+
+class Collected:
+    """Stands in for the driver: what ``LoopInput`` hands it, in order."""
+
+    _debug = False
+
+    def __init__(self) -> None:
+        self.made: list[object] = []
+
+    def process_message(self, message: object) -> None:
+        self.made.append(message)
+
+
+def described(messages_made: list[object]) -> list[tuple[str, object]]:
+    return [
+        ("key", (m.key, m.character)) if isinstance(m, events.Key) else ("paste", m.text)
+        for m in messages_made
+        if isinstance(m, events.Key | events.Paste)
+    ]
+
+
+TYPED = st.lists(
+    st.text(
+        alphabet=st.sampled_from([*"wasd pq?A~[0129;", "\x1b", "\r", "\t", "\x7f", "é"]),
+        max_size=12,
+    )
+    | st.sampled_from(["\x1b[200~", "\x1b[201~", "\x1b[A", "\x1b[<0;3;4M"]),
+    max_size=12,
+)
+
+
+@settings(max_examples=300, deadline=None)
+@given(TYPED)
+def test_typed_text_makes_the_same_keys_as_textuals_parser_however_it_comes(chunks):
+    """Whatever is typed, in whatever packets: the keys and pastes are the ones Textual's parser
+    makes from the same packets (the plain characters only skip its work)."""
+    ours = Collected()
+    reading = LoopInput(ours, fileno=-1)  # type: ignore[arg-type]
+    parser = XTermParser()
+    theirs: list[object] = []
+    for chunk in chunks:
+        reading._typed(chunk)
+        if chunk:  # (an empty packet is no input; the parser would take it as the end)
+            theirs.extend(parser.feed(chunk))
+    assert described(ours.made) == described(theirs)

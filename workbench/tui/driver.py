@@ -148,7 +148,9 @@ class LoopInput:
 
     def _typed(self, text: str) -> None:
         """Hand on the keys of some typed text: plain characters straight, anything else
-        through Textual's parser."""
+        through Textual's parser (never with nothing: the parser takes that as the end)."""
+        if not text:
+            return
         driver = self._driver
         plain = self._plain
         parser = self._parser
