@@ -46,8 +46,6 @@ _UNKNOWN = object()
 #: the bracketed paste's start and end (Textual's parser keeps typed text in a paste as the paste)
 PASTE_START = "\x1b[200~"
 PASTE_END = "\x1b[201~"
-#: characters typed as themselves: printable ASCII
-PLAIN = frozenset(chr(c) for c in range(0x20, 0x7F))
 
 
 @lru_cache(maxsize=1)
@@ -55,7 +53,7 @@ def plain_keys() -> dict[str, tuple[str, str | None]]:
     """The key (name, character) Textual's parser makes for each printable ASCII character
     typed on its own."""
     table: dict[str, tuple[str, str | None]] = {}
-    for character in sorted(PLAIN):
+    for character in map(chr, range(0x20, 0x7F)):
         made = [e for e in XTermParser().feed(character) if isinstance(e, events.Key)]
         if len(made) == 1:
             table[character] = (made[0].key, made[0].character)
