@@ -216,9 +216,24 @@ class Collected:
 
     def __init__(self) -> None:
         self.made: list[object] = []
+        self._app: object = None
 
     def process_message(self, message: object) -> None:
         self.made.append(message)
+
+
+class QuickApp:
+    """Stands in for an app that runs some typed keys at once (``take_typed_key``): what it
+    takes goes in the same list, in order, as the key events the driver makes."""
+
+    def __init__(self, made: list[object], takes: frozenset[str]) -> None:
+        self.made, self.takes = made, takes
+
+    def take_typed_key(self, key: str) -> bool:
+        if key not in self.takes:
+            return False
+        self.made.append(("taken", key))
+        return True
 
 
 def described(messages_made: list[object]) -> list[tuple[str, object]]:
@@ -227,6 +242,16 @@ def described(messages_made: list[object]) -> list[tuple[str, object]]:
         for m in messages_made
         if isinstance(m, events.Key | events.Paste)
     ]
+
+
+def in_order(made: list[object]) -> list[tuple[str, object]]:
+    """Keys (by name) and pastes in the order the app gets them, taken at once or as events."""
+    return [
+        ("key", m[1]) if isinstance(m, tuple) else ("key", m.key) if isinstance(m, events.Key)
+        else ("paste", m.text)
+        for m in made
+        if isinstance(m, tuple | events.Key | events.Paste)
+    ]  # fmt: skip
 
 
 TYPED = st.lists(
@@ -253,3 +278,26 @@ def test_typed_text_makes_the_same_keys_as_textuals_parser_however_it_comes(chun
         if chunk:  # (an empty packet is no input; the parser would take it as the end)
             theirs.extend(parser.feed(chunk))
     assert described(ours.made) == described(theirs)
+
+
+@settings(max_examples=300, deadline=None)
+@given(TYPED, st.frozensets(st.sampled_from(["w", "a", "d", "space", "p", "q"])))
+def test_keys_an_app_takes_at_once_keep_their_place_among_the_others(chunks, takes):
+    """An app that runs some keys at once gets them where they were typed among the key events
+    (and pastes) the driver makes, and is never offered a key inside a paste or an escape
+    sequence; within one packet, no key is offered once one before it became a key event."""
+    ours = Collected()
+    ours._app = QuickApp(ours.made, takes)
+    reading = LoopInput(ours, fileno=-1)  # type: ignore[arg-type]
+    parser = XTermParser()
+    theirs: list[object] = []
+    for chunk in chunks:
+        before = len(ours.made)
+        reading._typed(chunk)
+        if chunk:
+            theirs.extend(parser.feed(chunk))
+        this_packet = ours.made[before:]
+        events_at = [i for i, m in enumerate(this_packet) if isinstance(m, events.Key)]
+        taken_at = [i for i, m in enumerate(this_packet) if isinstance(m, tuple)]
+        assert not (events_at and taken_at and min(events_at) < max(taken_at))
+    assert in_order(ours.made) == in_order(theirs)

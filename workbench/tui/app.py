@@ -57,6 +57,7 @@ from .host import (
     TakesAllKeys,
 )
 from .keys import bindings
+from .quick_keys import QuickKeys
 from .screens.arrival import ArrivalScreen
 from .screens.editor import EditorScreen
 from .screens.labs import LabsScreen
@@ -317,13 +318,42 @@ class WorkbenchApp(ScreenHost[None]):
 
     async def on_event(self, event: events.Event) -> None:
         if isinstance(event, (events.Key, events.MouseDown)):
-            self._input_seen = True
-            self.wake()
+            self._input_comes()
             await super().on_event(event)
-            if self._clock is not None:
-                self._clock.nudge()  # awake anyway: the tick (with the key in it) comes now
+            self._input_taken()
             return
         await super().on_event(event)
+
+    def _input_comes(self) -> None:
+        self._input_seen = True
+        self.wake()
+
+    def _input_taken(self) -> None:
+        if self._clock is not None:
+            self._clock.nudge()  # awake anyway: the tick (with the key in it) comes now
+
+    def take_typed_key(self, key: str) -> bool:
+        """Run a typed key's action at once when the screen has it as a quick action
+        (``workbench/tui/quick_keys.py``); False: the key goes the usual way, as a key event."""
+        screen = self.screen
+        if not isinstance(screen, QuickKeys):
+            return False
+        self._input_comes()  # the time owed at rest first, as for a key event
+        action = screen.quick_action(key)
+        if action is None:
+            return False
+        # what Textual does at the app for any key press
+        if not self.app_focus:
+            self.app_focus = True
+        if self.focused is not None:
+            screen._clear_tooltip()
+        try:
+            action()
+        except Exception as error:  # as an action's error in a key event: shown, the app ends
+            self._handle_exception(error)
+            return True
+        self._input_taken()
+        return True
 
     def on_app_blur(self, event: events.AppBlur) -> None:
         """A served app's driver reports the terminal unfocused as it starts (it was made for

@@ -14,7 +14,10 @@ app's message queue, in the order typed.
 Typed characters (printable ASCII, outside an escape sequence and a bracketed paste) become
 their keys without going through Textual's key parser, which logs a description of every key it
 makes whether or not logging is on; the keys are the ones the parser makes for them
-(:func:`plain_keys`).
+(:func:`plain_keys`). An app that can (:class:`TakesTypedKeys`) is offered each of them first,
+and runs the action of a driving key at once, without a key event
+(``workbench/tui/quick_keys.py``); once a key goes the usual way, the rest of that text follows
+it, so keys stay in the order typed.
 
 A synchronized update (the terminal's begin-update, the frame and end-update: three writes when
 the student's terminal supports them) leaves the app as one packet, so the server reads and
@@ -29,6 +32,7 @@ import os
 import sys
 from codecs import getincrementaldecoder
 from functools import lru_cache
+from typing import Protocol, runtime_checkable
 
 from textual import events, log, messages
 from textual._ansi_sequences import SYNC_END, SYNC_START
@@ -71,6 +75,16 @@ def parser_wait(parser: XTermParser) -> float | None:
     return max(0.0, deadline - get_time())
 
 
+@runtime_checkable
+class TakesTypedKeys(Protocol):
+    """An app that may run a typed key's action at once, without a key event
+    (``workbench/tui/quick_keys.py``)."""
+
+    def take_typed_key(self, key: str) -> bool:
+        """Run what ``key`` does now and say so, or say no: it then comes as a key event."""
+        ...
+
+
 class LoopInput:
     """The server's packets on standard input, read on the event loop and handed to a driver.
 
@@ -87,6 +101,9 @@ class LoopInput:
         self._escape: asyncio.TimerHandle | None = None
         self.reading = False
         self._plain = plain_keys()
+        #: the app's quick way for a typed key, tried first (None: every key is a key event)
+        app = driver._app
+        self._take = app.take_typed_key if isinstance(app, TakesTypedKeys) else None
         #: inside a bracketed paste (the parser's text so far says so)
         self._pasting = False
         #: the end of the text the parser was last given, for a paste mark split over packets
@@ -157,8 +174,13 @@ class LoopInput:
             and parser_wait(parser) is None
             and all(character in plain for character in text)
         ):
+            take = self._take
             for character in text:
-                driver.process_message(events.Key(*plain[character]))
+                key, char = plain[character]
+                if take is not None and take(key):
+                    continue
+                driver.process_message(events.Key(key, char))
+                take = None  # the rest of the text follows that key the same way, in order
             self._tail = ""
             return
         seen = self._tail + text

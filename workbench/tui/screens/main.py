@@ -25,7 +25,6 @@ from workbench.sim.mazeio import load_maze
 from workbench.sim.sensors import SensorConfigError
 from workbench.sim.session import Snapshot
 
-from ..binding_chain import CachedBindingChain
 from ..compositor import LiveCompositor
 from ..host import (
     FollowsUnicode,
@@ -39,6 +38,8 @@ from ..host import (
     ToggleUnicode,
 )
 from ..keys import bindings
+from ..prompt_frames import PromptFrames
+from ..quick_keys import QuickKeys
 from ..widgets.algorithm_state import AlgorithmState
 from ..widgets.key_bar import KeyBar
 from ..widgets.key_legend import KeyLegend
@@ -58,7 +59,7 @@ PANEL_HZ = 2.0
 PANEL_WITH_MAZE = 0.6
 
 
-class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, CachedBindingChain):
+class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, QuickKeys, PromptFrames):
     """Drive, watch and set up the robot."""
 
     # the side panel moves beside the maze on a wide terminal (app.tcss); only this screen
@@ -68,6 +69,8 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Cache
     # the keys pressed again and again while driving are priority bindings: the screen takes
     # them before the focused widget (the transition log, which has no use for them) would, so
     # a key press runs its action at once instead of bubbling up through the side panel
+    #: the driving keys' actions, run straight from the key on a served session (QuickKeys)
+    QUICK_ACTIONS: ClassVar[frozenset[str]] = frozenset({"drive", "pause", "step", "speed"})
     BINDINGS: ClassVar[list[BindingType]] = [
         *bindings(
             "drive.forward",

@@ -1,0 +1,82 @@
+"""Typed keys that a screen runs straight from the served session's input, without a key event.
+
+A student driving over SSH types up to twenty keys a second, nearly all of them a few letters
+the main screen binds with priority (``w``, ``a``, ``d``, space). As key events, each was made,
+queued for the app, woken for, dispatched, looked up in the binding chain, its action string
+parsed and checked, the action invoked through Textual's signature-inspecting helper, and each
+message then followed by the idle round every message pump makes. Measured with
+``bench/tui_cpu.py``, that was about a quarter of what a served app costs while a student drives.
+
+:class:`QuickKeys` (a screen) answers, for a typed key, with the action Textual would run for it
+when that is one of the screen's own ``QUICK_ACTIONS`` (plain methods that only change the
+station and draw):
+
+  * the binding is the key's first priority binding in the chain from the app down to the
+    focused widget, the order Textual tries them in; any other binding first (the app's own,
+    a widget's) and the key goes the usual way;
+  * its action is parsed once per binding chain, and ``check_action`` is asked at each press,
+    as Textual asks;
+  * only when every message pump a key passes through (the focused widget, its ancestors, the
+    screen and the app) has nothing queued: a key taken at once never overtakes one typed
+    before it that is still on its way.
+
+The served app's driver (``workbench/tui/driver.py``) offers each typed key to the app first
+(``WorkbenchApp.take_typed_key``), which runs the action with what Textual does for any key
+press at the app (the app focused, a tooltip cleared) and what the workbench does (the clock
+woken and nudged).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from functools import partial
+from typing import ClassVar
+
+from textual.actions import parse
+from textual.binding import BindingsMap
+from textual.dom import DOMNode
+
+from .binding_chain import CachedBindingChain
+
+#: what a key is bound to, for the quick path: the action's name and parameters, or None when
+#: its first priority binding is not a quick action of the screen
+QuickBinding = tuple[str, tuple[object, ...]] | None
+
+
+class QuickKeys(CachedBindingChain):
+    """A screen whose quick actions run straight from a typed key (see the module)."""
+
+    #: the actions run straight from a key: synchronous ``action_*`` methods of the screen
+    QUICK_ACTIONS: ClassVar[frozenset[str]] = frozenset()
+
+    _quick_chain: list[tuple[DOMNode, BindingsMap]] | None = None
+    _quick_table: dict[str, QuickBinding]
+
+    def quick_action(self, key: str) -> Callable[[], object] | None:
+        """The action to run for ``key`` now, or None for the usual way of a key event."""
+        chain = self._binding_chain
+        if chain is not self._quick_chain:
+            self._quick_table = self._quick_bindings(chain)
+            self._quick_chain = chain
+        found = self._quick_table.get(key)
+        if found is None:
+            return None
+        for node, _ in chain:
+            if node.message_queue_size:
+                return None  # something typed before may still be on its way
+        name, params = found
+        if not self.check_action(name, params):
+            return None
+        return partial(getattr(self, f"action_{name}"), *params)
+
+    def _quick_bindings(self, chain: list[tuple[DOMNode, BindingsMap]]) -> dict[str, QuickBinding]:
+        table: dict[str, QuickBinding] = {}
+        for node, bindings in reversed(chain):  # from the app down, as Textual looks
+            for key, key_bindings in bindings.key_to_bindings.items():
+                for binding in key_bindings:
+                    if not binding.priority or key in table:
+                        continue
+                    namespace, name, params = parse(binding.action)
+                    quick = node is self and not namespace and name in self.QUICK_ACTIONS
+                    table[key] = (name, params) if quick else None
+        return table
