@@ -4,11 +4,13 @@ is drawn in the wake that made it, at most at Textual's frame rate."""
 
 from __future__ import annotations
 
+import asyncio
 from time import monotonic
 
 import pytest
 from textual import events
 from textual.pilot import Pilot
+from textual.widgets import Tooltip
 
 from tests.app.support import run
 from workbench.tui.app import WorkbenchApp, make_app
@@ -129,3 +131,20 @@ def test_a_change_is_drawn_at_once_and_the_next_within_a_frame_waits_for_the_tim
         assert resumed  # within a frame period of the last: the timer draws it
 
     run(app, body)
+
+
+def test_a_quick_key_clears_a_tooltip_as_a_key_event_does(tmp_path):
+    app = make_app(room(tmp_path), paused=True, noise="off")
+
+    async def go() -> None:
+        async with app.run_test(size=(80, 24), tooltips=True) as pilot:
+            screen = app.screen
+            await pilot.hover("#maze", offset=(3, 2))
+            await pilot.pause(1.0)
+            tips = [c for c in screen.children if isinstance(c, Tooltip)]
+            assert tips and tips[0].display  # the maze view's tooltip, where the mouse rests
+            assert app.take_typed_key("d")
+            await pilot.pause()
+            assert not tips[0].display
+
+    asyncio.run(go())

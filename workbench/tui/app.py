@@ -21,6 +21,7 @@ from typing import ClassVar
 from textual import events
 from textual.binding import Binding, BindingType
 from textual.screen import ModalScreen, Screen
+from textual.widgets import Tooltip
 
 from workbench.control.station import LabStation
 from workbench.files.bundled import default_maze_path
@@ -345,7 +346,9 @@ class WorkbenchApp(ScreenHost[None]):
         # what Textual does at the app for any key press
         if not self.app_focus:
             self.app_focus = True
-        if self.focused is not None:
+        if self.focused is not None and any(
+            isinstance(child, Tooltip) and child.display for child in screen.children
+        ):  # (looked for here: Textual's own lookup words an error when there is none)
             screen._clear_tooltip()
         try:
             action()
