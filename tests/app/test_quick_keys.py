@@ -32,6 +32,12 @@ def heading(app: WorkbenchApp) -> float:
     return app.station.snapshot().pose.heading
 
 
+def main_screen(app: WorkbenchApp) -> MainScreen:
+    screen = app.screen
+    assert isinstance(screen, MainScreen)
+    return screen
+
+
 def status(app: WorkbenchApp) -> str:
     return "\n".join(app.screen.query_one(RunStatus).lines)
 
@@ -96,8 +102,7 @@ def test_a_quick_key_is_refused_where_the_screen_refuses_its_action(tmp_path):
     app = make_app(room(tmp_path), paused=True, noise="off")
 
     async def body(pilot: Pilot) -> None:
-        screen = app.screen
-        assert isinstance(screen, MainScreen)
+        screen = main_screen(app)
         refused = {"drive"}
         checked = screen.check_action
         screen.check_action = lambda action, params: (  # type: ignore[method-assign]
@@ -113,8 +118,7 @@ def test_a_change_is_drawn_at_once_and_the_next_within_a_frame_waits_for_the_tim
     app = make_app(room(tmp_path), paused=True, noise="off")
 
     async def body(pilot: Pilot) -> None:
-        screen = app.screen
-        assert isinstance(screen, MainScreen)
+        screen = main_screen(app)
         await pilot.pause(0.1)
         resumed = []
         timer = screen._update_timer
