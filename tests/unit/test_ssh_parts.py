@@ -5,12 +5,15 @@ from __future__ import annotations
 
 import asyncio
 import json
+import os
 import socket
 import sys
+from pathlib import Path
 
 import pytest
 
 from workbench.ssh.appproc import AppProcess, AppSpec, forward_hint
+from workbench.ssh.forkserver import APP_NICENESS
 from workbench.ssh.forwarding import local_forward_refusal, remote_forward_refusal
 from workbench.ssh.limits import SessionLimits, describe_duration
 from workbench.ssh.passwords import (
@@ -154,6 +157,28 @@ def test_the_screen_output_of_one_read_reaches_the_client_in_one_write(tmp_path)
 
     assert asyncio.run(go()) == 0
     assert writes == [b"\x1b[?2026h\x1b[3;5Hw <", b"bye"]
+
+
+def test_an_app_started_as_a_new_process_runs_below_the_server_as_a_forked_one_does(tmp_path):
+    """Without the fork server (``--no-fork-server``, or once it is lost) an app still runs ten
+    nice steps below the server, its own session's group too where the kernel weighs sessions
+    as groups (autogroup)."""
+    argv = [sys.executable, "-c", "import sys; sys.stdin.buffer.read()"]
+
+    async def go() -> tuple[int, str | None]:
+        app = AppProcess(argv, {}, tmp_path / "app.log", lambda data: None)
+        await app.start()
+        assert app.pid is not None and not app.forked
+        niceness = os.getpriority(os.PRIO_PROCESS, app.pid)
+        group = Path(f"/proc/{app.pid}/autogroup")
+        grouped = group.read_text().split()[-1] if group.exists() else None
+        app.process.stdin.close()
+        assert await app.wait() == 0
+        return niceness, grouped
+
+    niceness, grouped = asyncio.run(go())
+    assert niceness == min(19, os.getpriority(os.PRIO_PROCESS, 0) + APP_NICENESS)
+    assert grouped in (None, str(APP_NICENESS))
 
 
 # -- forwarding, limits, failed logins ----------------------------------------------------

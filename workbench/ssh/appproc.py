@@ -177,6 +177,9 @@ class AppProcess:
                     env=self.env,
                     start_new_session=True,
                 )
+            from .forkserver import APP_NICENESS, lower_priority
+
+            lower_priority(APP_NICENESS, self.process.pid)  # as a forked app runs
         for packet in self._pending:
             self._write(packet)
         self._pending.clear()

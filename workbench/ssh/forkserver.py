@@ -196,8 +196,9 @@ class _Zygote:
             _send(self.control, {"exit": pid, "code": os.waitstatus_to_exitcode(status)})
 
 
-def lower_priority(niceness: int) -> None:
-    """Run this process ``niceness`` lower than the server (in a session of its own).
+def lower_priority(niceness: int, pid: int = 0) -> None:
+    """Run process ``pid`` (0: this one), in a session of its own, ``niceness`` steps lower
+    than this process runs.
 
     Where the kernel groups processes by session for scheduling (Linux's autogroup, on by
     default in most distributions), a process in a session of its own is weighed as a group,
@@ -205,8 +206,9 @@ def lower_priority(niceness: int) -> None:
     change nothing. Both are set; either may be refused (then it runs as it is).
     """
     with contextlib.suppress(OSError):
-        os.nice(niceness)
-    with contextlib.suppress(OSError), open("/proc/self/autogroup", "w") as group:
+        ours = os.getpriority(os.PRIO_PROCESS, 0)
+        os.setpriority(os.PRIO_PROCESS, pid, min(19, ours + niceness))
+    with contextlib.suppress(OSError), open(f"/proc/{pid or 'self'}/autogroup", "w") as group:
         group.write(str(niceness))
 
 
