@@ -62,6 +62,7 @@ def test_a_driving_key_taken_at_once_drives_as_its_key_event_does(tmp_path):
 
 def test_keys_whose_binding_is_not_a_quick_action_come_as_key_events(tmp_path):
     app = make_app(room(tmp_path), paused=True, noise="off")
+    assert not app.take_typed_key("w")  # no screen yet (as while the app starts or ends)
 
     async def body(pilot: Pilot) -> None:
         assert not app.take_typed_key("e")  # opens the editor: a key event does that

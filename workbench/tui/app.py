@@ -336,7 +336,8 @@ class WorkbenchApp(ScreenHost[None]):
     def take_typed_key(self, key: str) -> bool:
         """Run a typed key's action at once when the screen has it as a quick action
         (``workbench/tui/quick_keys.py``); False: the key goes the usual way, as a key event."""
-        screen = self.screen
+        stack = self.screen_stack  # (empty while the app starts or ends)
+        screen = stack[-1] if stack else None
         if not isinstance(screen, QuickKeys):
             return False
         self._input_comes()  # the time owed at rest first, as for a key event
