@@ -4,6 +4,7 @@ PostgreSQL database (a real server the test session starts, see tests/conftest.p
 from __future__ import annotations
 
 import os
+import socket
 import subprocess
 import sys
 import threading
@@ -245,6 +246,27 @@ def test_a_database_that_is_not_the_workbenchs_is_refused(pg_url, tmp_path):
         conn.execute("CREATE TABLE customers (id int)")
     with pytest.raises(StoreError, match="not a workbench database"):
         Store.open(tmp_path, db=pg_url)
+
+
+def test_a_database_host_lost_without_a_word_is_noticed_within_seconds(pg_url, tmp_path):
+    """The connection's socket gives up on a write the host does not acknowledge after 10 s
+    (the kernel's TCP user timeout) and probes an idle link with keepalives, instead of the
+    system's TCP retries (about 15 minutes) during which a save would wait; a URL that sets
+    its own value keeps it."""
+
+    def socket_settings(url: str) -> tuple[int, int, int]:
+        with Store.open(tmp_path, db=url) as store:
+            store.save_progress("ana", "lab", "exercise", "{}")
+            sock = socket.socket(fileno=os.dup(store.backend.conn.fileno()))
+            with sock:
+                return (
+                    sock.getsockopt(socket.IPPROTO_TCP, socket.TCP_USER_TIMEOUT),
+                    sock.getsockopt(socket.SOL_SOCKET, socket.SO_KEEPALIVE),
+                    sock.getsockopt(socket.IPPROTO_TCP, socket.TCP_KEEPIDLE),
+                )
+
+    assert socket_settings(pg_url) == (10_000, 1, 30)
+    assert socket_settings(pg_url + "?tcp_user_timeout=2500")[0] == 2500
 
 
 def test_an_unreachable_server_is_named_without_its_password(tmp_path):

@@ -25,6 +25,19 @@ BUSY_TIMEOUT_MS = 10_000
 CONNECT_TIMEOUT_S = 3
 #: after a failed connection, seconds before the next attempt (writes queue meanwhile)
 RETRY_AFTER_S = 1.0
+#: how the connection to a course database is made, unless its URL says otherwise: besides the
+#: connect timeout, a database host lost without a word (its network gone, the machine off) is
+#: noticed within seconds, not after the system's TCP retries (about 15 minutes): a write not
+#: acknowledged for TCP_USER_TIMEOUT_MS fails, and an idle connection is probed by keepalives
+LINK_DEFAULTS: dict[str, object] = {
+    "connect_timeout": CONNECT_TIMEOUT_S,
+    "application_name": "viple-workbench",
+    "tcp_user_timeout": 10_000,
+    "keepalives": 1,
+    "keepalives_idle": 30,
+    "keepalives_interval": 10,
+    "keepalives_count": 3,
+}
 MAX_URL = 2048
 POSTGRES_SCHEMES = ("postgresql://", "postgres://")
 
@@ -195,6 +208,7 @@ class PostgresBackend(Backend):
 
     def connection(self) -> Any:
         import psycopg
+        from psycopg.conninfo import conninfo_to_dict
 
         conn = self.conn
         if conn is not None and not conn.closed and not conn.broken:
@@ -209,8 +223,7 @@ class PostgresBackend(Backend):
             conn = psycopg.connect(
                 self.url,
                 autocommit=True,
-                connect_timeout=CONNECT_TIMEOUT_S,
-                application_name="viple-workbench",
+                **{**LINK_DEFAULTS, **conninfo_to_dict(self.url)},  # the URL's own settings win
             )
         except psycopg.OperationalError as exc:
             self._next_try = now + RETRY_AFTER_S
