@@ -28,7 +28,7 @@ RETRY_AFTER_S = 1.0
 #: how the connection to a course database is made, unless its URL says otherwise: besides the
 #: connect timeout, a database host lost without a word (its network gone, the machine off) is
 #: noticed within seconds, not after the system's TCP retries (about 15 minutes): a write not
-#: acknowledged for TCP_USER_TIMEOUT_MS fails, and an idle connection is probed by keepalives
+#: acknowledged for 10 s fails, and an idle connection is probed by keepalives
 LINK_DEFAULTS: dict[str, object] = {
     "connect_timeout": CONNECT_TIMEOUT_S,
     "application_name": "viple-workbench",
