@@ -66,11 +66,12 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
     # has the classes, so the dialogs are not restyled for them when they open
     HORIZONTAL_BREAKPOINTS: ClassVar[list[tuple[int, str]]] = [(0, "-narrow"), (110, "-wide")]
 
+    #: the driving keys' actions, run straight from the key on a served session (QuickKeys)
+    QUICK_ACTIONS: ClassVar[frozenset[str]] = frozenset({"drive", "pause", "step", "speed"})
+
     # the keys pressed again and again while driving are priority bindings: the screen takes
     # them before the focused widget (the transition log, which has no use for them) would, so
     # a key press runs its action at once instead of bubbling up through the side panel
-    #: the driving keys' actions, run straight from the key on a served session (QuickKeys)
-    QUICK_ACTIONS: ClassVar[frozenset[str]] = frozenset({"drive", "pause", "step", "speed"})
     BINDINGS: ClassVar[list[BindingType]] = [
         *bindings(
             "drive.forward",
