@@ -41,7 +41,23 @@ def pg_url(pg_server: PgServer) -> str:
 
 
 @pytest.fixture(autouse=True)
-def _own_data_folder(tmp_path_factory, monkeypatch):
-    """Every test's default data folder is a fresh one (never the user's): the app keeps the
-    last pair of names and the labs' progress there."""
-    monkeypatch.setenv("WORKBENCH_DATA", str(tmp_path_factory.mktemp("data")))
+def _own_folders(tmp_path_factory, monkeypatch):
+    """Every test runs with a home, configuration and data folders of its own (never the
+    user's): the app keeps the last pair of names and the labs' progress in the data folder,
+    and ``instructor add`` writes the trusted roster to the configuration folder. Whatever a
+    test or a program it starts writes by default lands inside its temporary folders."""
+    base = tmp_path_factory.mktemp("home")
+    folders = {
+        "HOME": base,
+        "XDG_CONFIG_HOME": base / ".config",
+        "XDG_DATA_HOME": base / ".local" / "share",
+        "XDG_STATE_HOME": base / ".local" / "state",
+        "XDG_CACHE_HOME": base / ".cache",
+        "WORKBENCH_CONFIG": base / "workbench-config",
+        "WORKBENCH_DATA": base / "workbench-data",
+    }
+    for name, folder in folders.items():
+        folder.mkdir(parents=True, exist_ok=True)
+        monkeypatch.setenv(name, str(folder))
+    # a course database named by the environment would be the user's, not the test's
+    monkeypatch.delenv("WORKBENCH_DB", raising=False)

@@ -47,6 +47,30 @@ def find_binaries() -> Path:
     )
 
 
+def reachable_by_anyone(path: Path) -> bool:
+    """Whether every folder from the root down to ``path`` lets any account pass through it
+    (the "others" execute bit), so that an unprivileged account can run what is inside."""
+    for folder in [path, *path.parents]:
+        if not os.stat(folder).st_mode & 0o001:
+            return False
+    return True
+
+
+def copy_installation(binaries: Path, into: Path) -> Path:
+    """A copy of the PostgreSQL installation ``binaries`` belongs to (its ``bin`` and the
+    ``lib`` and ``share`` beside it) inside ``into``; returns the copy's ``bin``. Every file
+    and folder is readable (and the programs runnable) by any account."""
+    install = binaries.parent
+    target = into / "install"
+    for part in ("bin", "lib", "share"):
+        if (install / part).is_dir():
+            shutil.copytree(install / part, target / part, symlinks=True)
+    for folder in [into, *(p for p in target.rglob("*") if p.is_dir() and not p.is_symlink())]:
+        os.chmod(folder, 0o755)
+    os.chmod(target, 0o755)
+    return target / "bin"
+
+
 def _run_as() -> pwd.struct_passwd | None:
     if os.geteuid() != 0:
         return None
@@ -98,6 +122,8 @@ class PgServer:
         account = _run_as()
         folder = Path(tempfile.mkdtemp(prefix="workbench-pg-"))
         if account is not None:
+            if not reachable_by_anyone(binaries):
+                binaries = copy_installation(binaries, folder)
             os.chown(folder, account.pw_uid, account.pw_gid)
         server = cls(binaries, folder, free_port(), account)
         done = server._run(
