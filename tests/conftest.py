@@ -12,6 +12,9 @@ import itertools
 
 import pytest
 
+import workbench.sim.record
+
+from .full_disk import FakeDisk
 from .pgserver import NoServer, PgServer
 
 _names = itertools.count(1)
@@ -45,3 +48,11 @@ def _own_data_folder(tmp_path_factory, monkeypatch):
     """Every test's default data folder is a fresh one (never the user's): the app keeps the
     last pair of names and the labs' progress there."""
     monkeypatch.setenv("WORKBENCH_DATA", str(tmp_path_factory.mktemp("data")))
+
+
+@pytest.fixture
+def disk(monkeypatch: pytest.MonkeyPatch) -> FakeDisk:
+    """Run records are written to a disk a test can fill (``disk.full = True``)."""
+    fake = FakeDisk()
+    monkeypatch.setattr(workbench.sim.record, "open", fake.open, raising=False)
+    return fake
