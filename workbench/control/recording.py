@@ -115,26 +115,27 @@ def folder_usage(folder: str | os.PathLike, limit: int = COUNT_LIMIT) -> int | N
     return total
 
 
-def _make_folder(folder: Path, workspace: Path | None) -> tuple[bool, RecordTrouble | None]:
+def _make_folder(folder: Path, workspace: Path | None) -> RecordTrouble | None:
     """Make the record folder; a file of the student's in its way (inside the workspace) is
-    renamed ``NAME.taken-N``. True when the folder is there."""
+    renamed ``NAME.taken-N`` (MOVED_ASIDE). The folder is there unless another trouble says
+    why not."""
     try:
         folder.mkdir(parents=True, exist_ok=True)
-        return True, None
+        return None
     except (FileExistsError, NotADirectoryError) as exc:
         blocker = _first_non_folder(folder)
         if blocker is None or workspace is None or not _strictly_inside(blocker, workspace):
-            return False, RecordTrouble(NO_FOLDER, str(folder), _words(exc))
+            return RecordTrouble(NO_FOLDER, str(folder), _words(exc))
         aside = _free_name(blocker)
         try:
             blocker.rename(aside)
             folder.mkdir(parents=True, exist_ok=True)
         except OSError as again:
-            return False, RecordTrouble(NO_FOLDER, str(folder), _words(again))
+            return RecordTrouble(NO_FOLDER, str(folder), _words(again))
         log.warning("run records: %s was a file in the way: moved to %s", blocker, aside)
-        return True, RecordTrouble(MOVED_ASIDE, str(blocker), str(aside))
+        return RecordTrouble(MOVED_ASIDE, str(blocker), str(aside))
     except OSError as exc:
-        return False, RecordTrouble(_kind(exc), str(folder), _words(exc))
+        return RecordTrouble(_kind(exc), str(folder), _words(exc))
 
 
 def _first_non_folder(folder: Path) -> Path | None:
