@@ -195,3 +195,16 @@ def test_outside_a_workspace_a_file_in_the_way_is_left_alone(tmp_path):
     assert station.notice is not None and station.notice.recording.kind == "no folder"
     assert (tmp_path / "runs").read_text() == "mine\n"
     assert station.snapshot().time == pytest.approx(1, abs=0.05)
+
+
+def test_serve_ssh_hands_its_record_caps_to_every_session_s_app():
+    from workbench.cli import build_parser
+    from workbench.cli.ssh import record_quota_argv
+
+    parser = build_parser()
+    args = parser.parse_args(["serve-ssh", "--record-cap", "5M", "--runs-quota", "0"])
+    options = record_quota_argv(args)
+    assert options == ("--record-cap", "5000000", "--runs-quota", "0")
+    app = parser.parse_args(list(options))
+    assert (app.record_cap, app.runs_quota) == (5_000_000, None)
+    assert parser.parse_args([]).record_cap == 20_000_000
