@@ -39,7 +39,8 @@ def test_a_full_disk_leaves_the_app_driving_and_recording_comes_back(tmp_path, d
 
     async def body(pilot: Pilot) -> None:
         await pilot.press("a")  # the robot spins: a run, recorded
-        await until(pilot, lambda: station.snapshot().time > 1.2, "a second recorded")
+        started = station.snapshot().time
+        await until(pilot, lambda: station.snapshot().time > started + 1.5, "a second recorded")
         disk.full = True
         await until(pilot, lambda: "no room on the disk" in said(app), "the disk-full message")
         assert "the run goes on unrecorded" in said(app)
