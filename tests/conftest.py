@@ -12,6 +12,9 @@ import itertools
 
 import pytest
 
+import workbench.sim.record
+
+from .full_disk import FakeDisk
 from .pgserver import NoServer, PgServer
 
 _names = itertools.count(1)
@@ -61,3 +64,11 @@ def _own_folders(tmp_path_factory, monkeypatch):
         monkeypatch.setenv(name, str(folder))
     # a course database named by the environment would be the user's, not the test's
     monkeypatch.delenv("WORKBENCH_DB", raising=False)
+
+
+@pytest.fixture
+def disk(monkeypatch: pytest.MonkeyPatch) -> FakeDisk:
+    """Run records are written to a disk a test can fill (``disk.full = True``)."""
+    fake = FakeDisk()
+    monkeypatch.setattr(workbench.sim.record, "open", fake.open, raising=False)
+    return fake

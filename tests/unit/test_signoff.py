@@ -564,3 +564,11 @@ def test_signing_after_a_tampered_sequence_number_goes_on_or_says_why(store, dat
     conn.close()
     with pytest.raises(StoreError, match="more than it can hold"):
         so.sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+
+
+def test_a_note_longer_than_the_cap_is_refused_and_nothing_is_signed(store, run_record):
+    with pytest.raises(so.SignoffError, match=f"keep it to {so.MAX_NOTE}"):
+        so.sign_off(store, "Dr Chen", PASS, fields(run_record), note="x" * (8 << 20))
+    assert store.signoffs() == []
+    _, record = so.sign_off(store, "Dr Chen", PASS, fields(run_record), note="y" * so.MAX_NOTE)
+    assert record.note == "y" * so.MAX_NOTE

@@ -9,6 +9,7 @@ import sys
 from collections.abc import Sequence
 
 from workbench import __version__
+from workbench.control.recording import RecordQuota
 from workbench.files.bundled import default_maze_path
 from workbench.labs.store import StoreError, resolve_db
 
@@ -23,7 +24,7 @@ from . import ssh as ssh_cmd
 from . import store as store_cmd
 from . import viple_client as viple_client_cmd
 from . import viple_program as viple_program_cmd
-from .common import db_option, error, new_runs_dir, runs_home
+from .common import db_option, error, new_runs_dir, record_quota_options, runs_home
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -84,6 +85,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="where lab progress and sign-offs are kept (default: $WORKBENCH_DATA "
         "or the user data folder)",
     )
+    record_quota_options(parser)
     db_option(parser, top=True)
     parser.add_argument(
         "--workspace",
@@ -153,6 +155,7 @@ def open_app(args: argparse.Namespace) -> int:
             ws_url=args.ws_url,
             ws_at_start=not args.ws_when_asked,
             record_dir=args.record_dir or new_runs_dir(),
+            record_quota=RecordQuota(args.record_cap, args.runs_quota, _counted_runs(args)),
             student=args.student,
             partner=args.partner,
             data_dir=args.data_dir,
@@ -173,6 +176,14 @@ def open_app(args: argparse.Namespace) -> int:
         return demo(args)
     app.run()
     return app.return_code or 0
+
+
+def _counted_runs(args: argparse.Namespace) -> str | None:
+    """The folder the runs quota counts: the workspace's ``runs``, the app's own runs folder,
+    or (None) just the record folder given."""
+    if args.workspace:
+        return os.path.join(args.workspace, "runs")
+    return None if args.record_dir else str(runs_home())
 
 
 def demo(args: argparse.Namespace) -> int:

@@ -22,6 +22,39 @@ def new_runs_dir() -> str:
     return str(runs_home() / time.strftime("%Y%m%d-%H%M%S"))
 
 
+def size(text: str) -> int | None:
+    """A size option's value: bytes, or None for 0 (no limit)."""
+    from workbench.control.recording import parse_size
+
+    try:
+        value = parse_size(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return value or None
+
+
+def record_quota_options(parser: argparse.ArgumentParser) -> None:
+    """``--record-cap`` and ``--runs-quota``: how much room run records may take."""
+    from workbench.control.recording import RECORD_CAP, RUNS_QUOTA, shown_size
+
+    parser.add_argument(
+        "--record-cap",
+        type=size,
+        default=RECORD_CAP,
+        metavar="SIZE",
+        help="the largest one run record may grow; past it the run goes on unrecorded "
+        f"(e.g. 20M; 0: no limit; default {shown_size(RECORD_CAP)})",
+    )
+    parser.add_argument(
+        "--runs-quota",
+        type=size,
+        default=RUNS_QUOTA,
+        metavar="SIZE",
+        help="the most all run records of a student (their ~/runs on a server) may take; "
+        f"past it runs go unrecorded (0: no limit; default {shown_size(RUNS_QUOTA)})",
+    )
+
+
 def db_option(parser: argparse.ArgumentParser, top: bool = False) -> None:
     """``--db URL``: given before or after the command (a command's own --db wins)."""
     parser.add_argument(

@@ -15,7 +15,7 @@ from workbench.labs.database import ENV_DB
 from workbench.labs.store import Store, StoreError, StoreUnavailable, resolve_data_dir, resolve_db
 from workbench.ssh.appproc import AppEntry
 
-from .common import db_option
+from .common import db_option, record_quota_options
 
 #: the app every SSH session runs: this Python's ``-m workbench``, or forked from the fork
 #: server as :func:`workbench.cli.main` with the app's modules imported beforehand and its
@@ -84,6 +84,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--password-lock-for", type=float, default=900,
         help="seconds an account takes no passwords once locked; keys still work (default 900)",
     )  # fmt: skip
+    record_quota_options(serve)
     serve.add_argument(
         "--no-fork-server", action="store_true",
         help="start each session's app as a new Python process instead of forking it from a "
@@ -277,6 +278,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
         logins=logins,
         fork_server=not args.no_fork_server,
         app=WORKBENCH_APP,
+        app_options=record_quota_argv(args),
     )
     try:
         log_path = setup_logging(data_dir)
@@ -296,6 +298,11 @@ def cmd_serve(args: argparse.Namespace) -> int:
         return asyncio.run(_serve(server))
     except OSError as exc:
         return fail("serve-ssh", f"cannot listen on port {args.port}: {exc.strerror or exc}")
+
+
+def record_quota_argv(args: argparse.Namespace) -> tuple[str, ...]:
+    """The run records' caps as every session's app is given them (0: no limit)."""
+    return ("--record-cap", str(args.record_cap or 0), "--runs-quota", str(args.runs_quota or 0))
 
 
 def _prepare_course_store(data_dir: Path, db: str) -> str:

@@ -9,7 +9,6 @@ from __future__ import annotations
 import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any, Protocol
 
 from workbench.files.workspace import LOCAL, FileAccess
@@ -20,7 +19,7 @@ from workbench.sim.maze import Maze
 from workbench.sim.metrics import Metrics
 from workbench.sim.noise import NoiseSettings
 from workbench.sim.profiles import get_profile
-from workbench.sim.record import Recorder
+from workbench.sim.record import CAPPED, Recorder
 from workbench.sim.sensors import (
     KINDS,
     MOUNTS,
@@ -35,6 +34,7 @@ from .algorithms import load_algorithm
 from .fsm import FsmController, FsmDefinition, FsmRuntimeError, bind_sensors, preset_sensors
 from .fsmfile import parse_param_overrides
 from .manual import exact_move, key_command
+from .recording import RecordQuota, RecordTrouble, open_record, record_stopped
 
 #: the sensor presets of the course's simulators (Web Simulator panel, Unity simulator)
 PRESETS: dict[str, tuple[SensorSpec, ...]] = {
@@ -76,6 +76,7 @@ class RunEntry:
 #: the kinds of :class:`Notice`
 ALGORITHM_FAILED = "algorithm failed"
 OUT = "out"
+RECORDING = "recording"
 
 
 @dataclass(frozen=True)
@@ -84,8 +85,10 @@ class Notice:
     words it for the person at the station. A new value each time, so it can be told apart
     from the last one seen."""
 
-    kind: str  # ALGORITHM_FAILED (detail: why) or OUT (the run finished at the exit)
+    kind: str  # ALGORITHM_FAILED (detail: why), OUT (the run finished at the exit), RECORDING
     detail: str = ""
+    #: RECORDING: why the run goes unrecorded, or what was done to record it
+    recording: RecordTrouble | None = None
 
 
 class ProgramDriver(Controller, Protocol):
@@ -169,6 +172,8 @@ class LabStation:
     seed: int = 0
     noise: NoiseSettings | str | None = None
     record_dir: str | None = None
+    #: how much room the run records may take (:mod:`.recording`)
+    record_quota: RecordQuota = field(default_factory=RecordQuota)
     #: which files the student may open (all of them, unless served in a workspace)
     files: FileAccess = LOCAL
     session: Session = field(init=False)
@@ -197,6 +202,8 @@ class LabStation:
     _odometry_seen: tuple[float, float] = (0.0, 0.0)
     _recorder: Recorder | None = None
     _record_path: str | None = None
+    #: the record stopped mid-run, and the person at the station was told
+    _record_stop_told: bool = False
     #: paused because the robot got out: the next drive, reset, start or maze goes on
     _held_at_exit: bool = False
 
@@ -267,6 +274,11 @@ class LabStation:
 
     def _after_steps(self) -> None:
         self._watch_viple()
+        recorder = self._recorder
+        if recorder is not None and recorder.stopped is not None and not self._record_stop_told:
+            self._tell_record_stopped(recorder)  # the run goes on unrecorded
+            if recorder.stopped.reason != CAPPED:  # a capped record still takes its summary
+                self._drop_recorder()
         if self._run_open and self.maze.exits and self.session.reached_exit:
             self._close_run("exit")
             self.pause()
@@ -571,12 +583,21 @@ class LabStation:
         self._run_source = self.algorithm.source if self.controller and self.algorithm else None
         if self.program_run is not None and self.program is not None:
             self._run_source = self.program.source
+        self._record_stop_told = False
         if self.record_dir:
-            Path(self.record_dir).mkdir(parents=True, exist_ok=True)
-            path = os.path.join(self.record_dir, f"run-{len(self.runs) + 1:03d}.jsonl")
-            self._recorder = Recorder(path)
-            self._record_path = path
-            self.session.recorder = self._recorder
+            recorder, trouble = open_record(
+                self.record_dir,
+                f"run-{len(self.runs) + 1:03d}.jsonl",
+                self.record_quota,
+                self.files.workspace,
+            )
+            if trouble is not None:
+                self._recording_trouble(trouble)
+            if recorder is None:
+                return
+            self._recorder = recorder
+            self._record_path = str(recorder.path)
+            self.session.recorder = recorder
             self.session.record_header(
                 algorithm=self.algorithm.name
                 if self.controller and self.algorithm
@@ -589,6 +610,21 @@ class LabStation:
                     else {}
                 ),
             )
+
+    def _tell_record_stopped(self, recorder: Recorder) -> None:
+        assert recorder.stopped is not None
+        self._record_stop_told = True
+        self._recording_trouble(record_stopped(str(self._record_path), recorder.stopped))
+
+    def _recording_trouble(self, trouble: RecordTrouble) -> None:
+        self.notice = Notice(RECORDING, trouble.detail, trouble)
+
+    def _drop_recorder(self) -> None:
+        """The run goes on unrecorded (its record stopped); the next run tries a new one."""
+        if self._recorder is not None:
+            self._recorder.close()
+        self.session.recorder = None
+        self._recorder = None
 
     def _close_run(self, ended: str) -> None:
         self._run_open = False
@@ -607,15 +643,17 @@ class LabStation:
             maze_digest=self.maze.digest(),
         )
         self.runs.append(entry)
-        if self._recorder is not None:
+        recorder = self._recorder
+        if recorder is not None:
             running = self.controller or self.program_run
             self.session.record_summary(
                 ended=ended, final_state=running.state if running is not None else None
             )
-            self._recorder.close()
-            self.session.recorder = None
-            self._recorder = None
-            self._record_path = None
+            recorder.close()
+            if recorder.stopped is not None and not self._record_stop_told:
+                self._tell_record_stopped(recorder)
+            self._drop_recorder()
+        self._record_path = None
 
     def close(self) -> None:
         """End the session: an open run is kept (with its record) as stopped."""

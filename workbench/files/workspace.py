@@ -25,6 +25,8 @@ BUNDLED = (
     _PACKAGE.parent / "labs",
     _PACKAGE / "control" / "algorithms",
 )
+#: the folders the app keeps in a workspace (its run records): never a student's file's name
+RESERVED = ("runs",)
 #: a login name as a folder name: what the users file allows, nothing that walks
 _FOLDER_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,63}")
 
@@ -94,7 +96,14 @@ class FileAccess:
                 f"{self.shown(typed)} is a bundled file, kept as shipped for everyone: save your "
                 f"own copy under another name{self._in_workspace()}"
             )
-        if self.workspace is None or self._inside(path, (self.workspace,)):
+        if self.workspace is None:
+            return path
+        if self._inside(path, (self.workspace,)):
+            if path.parent == self.workspace and path.name in RESERVED:
+                raise OutsideWorkspace(
+                    f"{self.shown(path)} is the folder the workbench keeps your run records "
+                    f"in: save under another name, e.g. ~/{path.name}-maze.txt"
+                )
             return path
         raise OutsideWorkspace(
             f"{self.shown(typed)} is outside your workspace: you can save only in your "

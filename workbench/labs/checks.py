@@ -40,6 +40,29 @@ class ObjectiveState:
     evidence: dict[str, Any] = field(default_factory=dict)
 
 
+#: the longest answer kept, in characters (an answer is a number or a choice: a few words),
+#: and the most answers one exercise keeps
+MAX_ANSWER = 200
+MAX_ANSWERS = 100
+
+
+def capped_answers(answers: Mapping[Any, Any]) -> tuple[dict[str, str], tuple[str, ...]]:
+    """The answers as kept: at most :data:`MAX_ANSWERS`, each cut to :data:`MAX_ANSWER`
+    characters; and the questions whose answers were cut (or dropped)."""
+    kept: dict[str, str] = {}
+    cut: list[str] = []
+    for key, value in answers.items():
+        name, text = str(key)[:MAX_ANSWER], str(value)
+        if len(kept) >= MAX_ANSWERS:
+            cut.append(name)
+            continue
+        if len(text) > MAX_ANSWER:
+            cut.append(name)
+            text = text[:MAX_ANSWER]
+        kept[name] = text
+    return kept, tuple(cut)
+
+
 @dataclass
 class ExerciseProgress:
     """Where one exercise stands: every objective's state (and the answers given)."""
@@ -48,13 +71,20 @@ class ExerciseProgress:
     exercise: str
     objectives: list[ObjectiveState]
     answers: dict[str, str] = field(default_factory=dict)
+    #: questions whose answers, as read back, were longer than is kept and were cut
+    cut: tuple[str, ...] = field(default=(), compare=False)
+
+    def __post_init__(self) -> None:
+        self.answers, cut = capped_answers(self.answers)
+        self.cut = (*self.cut, *cut)
 
     @property
     def passed(self) -> bool:
         return all(o.passed for o in self.objectives)
 
     def to_json(self) -> str:
-        return json.dumps({**asdict(self), "passed": self.passed}, sort_keys=True)
+        data = {k: v for k, v in asdict(self).items() if k != "cut"}
+        return json.dumps({**data, "passed": self.passed}, sort_keys=True)
 
     @classmethod
     def from_json(cls, text: str) -> ExerciseProgress:
@@ -65,7 +95,7 @@ class ExerciseProgress:
         """Progress as saved (:meth:`to_json`); ValueError when it is not in that shape."""
         try:
             objectives = [ObjectiveState(**o) for o in data["objectives"]]
-            answers = {str(k): str(v) for k, v in dict(data.get("answers") or {}).items()}
+            answers = dict(data.get("answers") or {})
             return cls(str(data["lab"]), str(data["exercise"]), objectives, answers)
         except (KeyError, TypeError, ValueError) as exc:
             raise ValueError(f"saved progress is not in the expected shape: {exc}") from None
@@ -313,6 +343,7 @@ def check_compare(obj: Objective, exercise: Exercise, station: LabStation) -> Ch
 
 
 def check_questions(exercise: Exercise, answers: Mapping[str, str]) -> Check:
+    answers, _ = capped_answers(answers)
     unanswered = [q.id for q in exercise.questions if not str(answers.get(q.id, "")).strip()]
     wrong = [q.id for q in exercise.questions if q.id not in unanswered
              and not q.check(answers[q.id])[0]]  # fmt: skip

@@ -46,6 +46,10 @@ class LabFileError(ValueError):
 
 
 # -- answers --------------------------------------------------------------------------------
+#: past this a number is no lab's answer (and rounding it to a step would overflow)
+LARGEST_ANSWER = 1e15
+
+
 def normalise_choice(text: str) -> str:
     return " ".join(str(text).split()).casefold()
 
@@ -111,6 +115,8 @@ class Question:
                 return False, f"{answer!r} is not a number"
             if not math.isfinite(value):
                 return False, f"{answer!r} is not a number"
+            if abs(value) > LARGEST_ANSWER:
+                return False, f"{answer[:20]!r}... is far larger than any answer here"
             text = _grid_text(value, self.step or "1")
         else:
             text = normalise_choice(answer)

@@ -55,6 +55,8 @@ ENV_CONFIG_DIR = "WORKBENCH_CONFIG"
 KEYS_DIR = "instructors"
 MIN_PASSPHRASE = 10
 MAX_NAME = 64
+#: the longest note a sign-off keeps, in characters
+MAX_NOTE = 500
 FAILURE_LIMIT = 5
 LOCK_SECONDS = 60.0
 
@@ -595,6 +597,10 @@ def sign_off(
     :class:`SignoffError`.
     """
     note = note.strip()
+    if len(note) > MAX_NOTE:
+        raise SignoffError(
+            f"the note is {len(note)} characters: keep it to {MAX_NOTE} (a sentence or two)"
+        )
     if not record_fields.objectives_passed and not override:
         raise SignoffError("the objectives have not all passed: sign off with an override")
     if override and not note:

@@ -6,6 +6,8 @@ flushed regularly, so a crash loses at most the last second of a run.
 
 from __future__ import annotations
 
+import contextlib
+import errno
 import hashlib
 import json
 import os
@@ -57,26 +59,117 @@ def command_json(cmd: object) -> dict[str, Any]:
     raise TypeError(f"{cmd!r} is not a motor command")
 
 
-class Recorder:
-    """Writes a run record to a file (or any text stream)."""
+#: why a record stopped before its run ended (:attr:`Recorder.stopped`)
+CAPPED = "cap"
+DISK_FULL = "disk full"
+IO_ERROR = "i/o error"
+#: the errors that mean no room is left (the disk, the user's quota, the largest file allowed)
+NO_ROOM = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG)
+#: room kept under a record's cap for its summary line, written even when the cap was reached
+SUMMARY_ROOM = 4096
 
-    def __init__(self, target: str | os.PathLike | IO[str]):
+
+@dataclass(frozen=True)
+class RecordStop:
+    """Why a record stopped taking lines while its run went on."""
+
+    reason: str  # CAPPED, DISK_FULL or IO_ERROR
+    #: the cap in bytes (CAPPED), or the system's words for the error
+    detail: str = ""
+    #: simulated time of the last line kept
+    t: float = 0.0
+
+
+class Recorder:
+    """Writes a run record to a file (or any text stream).
+
+    With a ``cap`` (bytes) the record stops taking tick lines before it grows past it, and with
+    ``keep_going`` a write that fails (a full disk, an I/O error) stops the record instead of
+    raising: either way :attr:`stopped` says why, the run goes on, and the file keeps every
+    whole line written before (a capped record still gets its summary).
+    """
+
+    def __init__(
+        self,
+        target: str | os.PathLike | IO[str],
+        cap: int | None = None,
+        keep_going: bool = False,
+    ):
+        self.cap = cap
+        self.keep_going = keep_going
+        self.stopped: RecordStop | None = None
+        #: bytes of whole lines handed to the file so far
+        self.size = 0
+        #: simulated time of the last line written, and of the last one on disk
+        self._t = 0.0
+        self._t_kept = 0.0
+        self._buffer: list[bytes] = []
+        self._lines = 0
+        self._file: IO[bytes] | None = None
+        self._stream: IO[str] | None = None
         if isinstance(target, str | os.PathLike):
             self.path: Path | None = Path(target)
-            self._fh: IO[str] = open(self.path, "w", encoding="utf-8")  # noqa: SIM115
-            self._owned = True
+            self._file = open(self.path, "wb", buffering=0)  # noqa: SIM115
         else:
             self.path = None
-            self._fh = target
-            self._owned = False
-        self._pending = 0
+            self._stream = target
+        #: bytes on disk known to end with a whole line (a failed write is cut back to it)
+        self._kept = 0
 
-    def _write(self, obj: dict[str, Any]) -> None:
-        self._fh.write(json.dumps(obj, separators=(",", ":")) + "\n")
-        self._pending += 1
-        if self._pending >= FLUSH_EVERY:
-            self._fh.flush()
-            self._pending = 0
+    def _write(self, obj: dict[str, Any], summary: bool = False, t: float | None = None) -> None:
+        if self.stopped is not None and not (summary and self.stopped.reason == CAPPED):
+            return
+        data = (json.dumps(obj, separators=(",", ":")) + "\n").encode()
+        if self.cap is not None:
+            room = self.cap if summary else self.cap - SUMMARY_ROOM
+            if self.size + len(data) > room:
+                if self.stopped is None:
+                    self.stopped = RecordStop(CAPPED, str(self.cap), self._t)
+                self.flush()
+                return
+        self.size += len(data)
+        self._buffer.append(data)
+        self._lines += 1
+        if t is not None:
+            self._t = t
+        if self._stream is not None:
+            self._stream.write(data.decode())  # a stream keeps its own buffer
+            self._buffer.clear()
+        if summary or self._lines % FLUSH_EVERY == 0:
+            self.flush()
+
+    def flush(self) -> None:
+        """Hand the lines written so far to the file; a failure stops the record (with
+        ``keep_going``) or raises."""
+        lines, self._buffer = b"".join(self._buffer), []
+        if self.stopped is not None and self.stopped.reason != CAPPED:
+            return
+        try:
+            if self._stream is not None:
+                self._stream.flush()
+            elif self._file is not None:
+                view = memoryview(lines)
+                while view:
+                    written = self._file.write(view)
+                    if not written:
+                        raise OSError(errno.EIO, "the file took no bytes")
+                    view = view[written:]
+                self._kept += len(lines)
+        except OSError as exc:
+            if not self.keep_going:
+                raise
+            self._failed(exc)
+        else:
+            self._t_kept = self._t
+
+    def _failed(self, exc: OSError) -> None:
+        reason = DISK_FULL if exc.errno in NO_ROOM else IO_ERROR
+        self.stopped = RecordStop(reason, exc.strerror or str(exc), self._t_kept)
+        if self._file is not None:
+            with contextlib.suppress(OSError):  # a half line would make the record unreadable
+                os.ftruncate(self._file.fileno(), self._kept)
+            with contextlib.suppress(OSError):
+                self._file.close()
 
     def header(self, **fields: Any) -> None:
         self._write({"type": "header", "format": FORMAT, **fields, "versions": versions()})
@@ -91,6 +184,8 @@ class Recorder:
         events: list[str],
         variables: dict[str, Any] | None = None,
     ) -> None:
+        if self.stopped is not None:
+            return
         line: dict[str, Any] = {
             "t": _r(t),
             "pose": [_r(pose[0]), _r(pose[1]), _r(pose[2])],
@@ -104,15 +199,23 @@ class Recorder:
             line["vars"] = {k: (_r(v) if isinstance(v, float) else v) for k, v in variables.items()}
         if events:
             line["events"] = events
-        self._write(line)
+        self._write(line, t=t)
 
     def summary(self, metrics: dict[str, Any], **extra: Any) -> None:
-        self._write({"type": "summary", **metrics, **extra})
+        stop = self.stopped
+        if stop is not None and stop.reason == CAPPED:
+            extra = {**extra, "record_capped": {"bytes": self.cap, "t": _r(stop.t)}}
+        self._write({"type": "summary", **metrics, **extra}, summary=True)
 
     def close(self) -> None:
-        self._fh.flush()
-        if self._owned:
-            self._fh.close()
+        self.flush()
+        if self._file is not None and not self._file.closed:
+            try:
+                self._file.close()
+            except OSError as exc:
+                if not self.keep_going:
+                    raise
+                self._failed(exc)
 
 
 @dataclass

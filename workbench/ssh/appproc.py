@@ -69,6 +69,8 @@ class AppSpec:
     width: int = 80
     height: int = 24
     term: str = "xterm-256color"
+    #: the server's options for every app (after the session's own)
+    extra: tuple[str, ...] = ()
 
     def argv(self, command: tuple[str, ...]) -> list[str]:
         return [*command, *self.options()]
@@ -86,6 +88,7 @@ class AppSpec:
             "--data-dir", str(self.data_dir),
             "--record-dir", str(self.record_dir),
             "--workspace", str(self.workspace),
+            *self.extra,
         ]  # fmt: skip
 
     def env(self, base: dict[str, str] | None = None) -> dict[str, str]:

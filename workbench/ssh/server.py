@@ -79,6 +79,8 @@ class ServerConfig:
     keepalive_interval: float = 30.0
     #: the app each session runs
     app: AppEntry = field(kw_only=True)
+    #: options every session's app gets after its own (the run records' caps, say)
+    app_options: tuple[str, ...] = field(default=(), kw_only=True)
 
     def __post_init__(self) -> None:
         self.data_dir = Path(self.data_dir)
@@ -638,6 +640,7 @@ class LabSession(asyncssh.SSHServerSession):
             width,
             height,
             self.term,
+            config.app_options,
         )
         log_path = config.data_dir / "logs" / user / f"{stamp}-{self.id}.log"
         self.app = AppProcess(

@@ -23,6 +23,7 @@ from textual.binding import Binding, BindingType
 from textual.screen import ModalScreen, Screen
 from textual.widgets import Tooltip
 
+from workbench.control.recording import RecordQuota
 from workbench.control.station import LabStation
 from workbench.files.bundled import default_maze_path
 from workbench.files.workspace import LOCAL, FileAccess
@@ -631,6 +632,7 @@ def make_app(
     tick_hz: float = 20,
     unicode: bool = False,
     record_dir: str | None = None,
+    record_quota: RecordQuota | None = None,
     tcp_port: int | None = None,
     ws_url: str | None = None,
     report_ms: int = REPORT_MS_DEFAULT,
@@ -657,7 +659,8 @@ def make_app(
     when ``student_fixed``, as for an SSH login); ``connect_hint`` tells the user how to reach the
     VIPLE endpoints (shown at start and in the help). With a ``workspace`` folder (a served
     student) the app opens files only there and in the bundled mazes, labs and starters, and
-    writes only there.
+    writes only there. Each run is recorded in ``record_dir`` within ``record_quota`` (default:
+    the usual caps); a run that cannot be recorded goes on unrecorded, with a message.
 
     Raises :class:`AppSetupError` with a message for the user when the maze cannot be read or
     an argument is not one the workbench knows.
@@ -699,7 +702,13 @@ def make_app(
         raise AppSetupError(f"cannot use the workspace folder {workspace}: {exc}") from None
     try:
         station = LabStation.open(
-            maze, profile, seed=seed, noise=noise, record_dir=record_dir, files=files
+            maze,
+            profile,
+            seed=seed,
+            noise=noise,
+            record_dir=record_dir,
+            record_quota=record_quota or RecordQuota(),
+            files=files,
         )
     except ValueError as exc:
         raise AppSetupError(f"cannot set up the robot: {exc}") from None

@@ -12,7 +12,7 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical
 from textual.widgets import Button, Input, Label, Static
 
-from workbench.labs.names import NameProblem, check_pair
+from workbench.labs.names import MAX_STUDENT_NAME, NameProblem, check_pair
 
 from ..widgets.field import Field
 from .frame import Dialog
@@ -42,7 +42,11 @@ class IdentityDialog(Dialog[tuple[str, str] | None]):
             with Horizontal(classes="field"):
                 yield Label("Student")
                 yield Field(
-                    self._student, id="student", compact=True, disabled=self._fixed, max_length=40
+                    self._student,
+                    id="student",
+                    compact=True,
+                    disabled=self._fixed,
+                    max_length=MAX_STUDENT_NAME,
                 )
             with Horizontal(classes="field"):
                 yield Label("Partner")
@@ -51,7 +55,7 @@ class IdentityDialog(Dialog[tuple[str, str] | None]):
                     id="partner",
                     compact=True,
                     placeholder="optional",
-                    max_length=40,
+                    max_length=MAX_STUDENT_NAME,
                 )
             yield Static("", id="error", classes="-empty")
             with Horizontal(id="buttons"):
@@ -62,6 +66,10 @@ class IdentityDialog(Dialog[tuple[str, str] | None]):
 
     def action_cancel(self) -> None:
         self.dismiss((self._student, self._partner))
+
+    @on(Field.Capped)
+    def _name_too_long(self, event: Field.Capped) -> None:
+        self.show_error(f"a name is at most {event.limit} characters: the rest was not kept")
 
     @on(Input.Submitted)
     @on(Button.Pressed, "#ok")

@@ -19,6 +19,7 @@ from textual.widgets import Button, Checkbox, Input, Label, Select, Static
 
 from workbench.labs.checks import ExerciseProgress
 from workbench.labs.signoff import (
+    MAX_NOTE,
     Evidence,
     LockedOut,
     RecordFields,
@@ -164,6 +165,7 @@ class SignoffModal(ModalScreen[str | None]):
                         placeholder="optional; required with an override",
                         id="signoff-note",
                         compact=True,
+                        max_length=MAX_NOTE,
                     )
                 yield Tick(
                     "Override: sign off although objectives have not passed",
@@ -196,6 +198,10 @@ class SignoffModal(ModalScreen[str | None]):
     # -- signing ---------------------------------------------------------------------------
     def _say(self, message: str) -> None:
         self.query_one("#signoff-status", Static).update(message)
+
+    @on(Field.Capped, "#signoff-note")
+    def _note_too_long(self, event: Field.Capped) -> None:
+        self._say(f"a note is at most {event.limit} characters: the rest was not kept")
 
     @on(Input.Submitted, "#signoff-passphrase")
     @on(Input.Submitted, "#signoff-note")

@@ -25,7 +25,13 @@ from textual.widgets import Input, Markdown, OptionList, Static
 from textual.widgets.option_list import Option
 
 from workbench.control.station import LabStation
-from workbench.labs.checks import ExerciseProgress, apply_setup, evaluate, keep_passed
+from workbench.labs.checks import (
+    MAX_ANSWER,
+    ExerciseProgress,
+    apply_setup,
+    evaluate,
+    keep_passed,
+)
 from workbench.labs.model import Exercise, Lab, LabFileError, load_labs
 from workbench.labs.store import Store, StoreUnavailable
 from workbench.sim.session import Snapshot
@@ -173,19 +179,25 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         except Exception as exc:  # a damaged database must not stop the lab
             self._store_problem = f"cannot read saved progress: {exc}"
             return
-        damaged = []
+        damaged, cut = [], []
         for key, data in saved.items():
             try:
                 progress = ExerciseProgress.from_dict(data)
             except ValueError:
                 damaged.append("/".join(key))
                 continue
+            cut += [f"{'/'.join(key)} {question}" for question in progress.cut]
             self._saved[key] = progress
             if progress.passed:
                 self._done.add(key)
             self.answers[key] = dict(progress.answers)
         if damaged:
             self._store_problem = f"saved progress unreadable (starts afresh): {', '.join(damaged)}"
+        elif cut:
+            self._store_problem = (
+                f"saved answers longer than {MAX_ANSWER} characters were cut to their first "
+                f"{MAX_ANSWER}: {', '.join(cut[:3])}{' ...' if len(cut) > 3 else ''}"
+            )
         self._signed = {
             (row.lab, row.exercise): _by(row.instructor, row.signed_at) for row in signed
         }
@@ -386,6 +398,7 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
                 answers.get(q.id, ""),
                 placeholder=" / ".join(q.choices) if q.choices else q.unit or "answer",
                 id=f"q-{q.id}",
+                max_length=MAX_ANSWER,
             )
             box.mount(
                 Vertical(
@@ -427,6 +440,11 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
                 self._answer_reason(exercise, question_id)
             )
         self.show_snapshot(self.station.snapshot())
+
+    @on(Field.Capped)
+    def _answer_too_long(self, event: Field.Capped) -> None:
+        if (event.field.id or "").startswith("q-"):
+            self.say(f"an answer is at most {event.limit} characters: the rest was not kept")
 
     # -- live checks ---------------------------------------------------------------------
     def track(self) -> ExerciseProgress | None:

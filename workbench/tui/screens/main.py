@@ -7,6 +7,8 @@ footer. Every action here calls the station; the screen only draws what the stat
 
 from __future__ import annotations
 
+import os
+from collections.abc import Callable
 from pathlib import Path
 from time import monotonic
 from typing import ClassVar
@@ -40,6 +42,7 @@ from ..host import (
 from ..keys import bindings
 from ..prompt_frames import PromptFrames
 from ..quick_keys import QuickKeys
+from ..record_words import record_words
 from ..widgets.algorithm_state import AlgorithmState
 from ..widgets.key_bar import KeyBar
 from ..widgets.key_legend import KeyLegend
@@ -196,7 +199,7 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
         if station.notice is not self._notice:
             self._notice = station.notice
             if station.notice is not None:
-                self._said = worded(station.notice)
+                self._said = worded(station.notice, station.files.shown)
         moment = (
             station.paused,
             self._said,
@@ -449,8 +452,11 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
         self.post_message(StartEndpoint("ws"))
 
 
-def worded(notice: Notice) -> str:
-    """What the message line says of something the station did on its own."""
+def worded(notice: Notice, shown: Callable[[str | os.PathLike], str] = str) -> str:
+    """What the message line says of something the station did on its own (``shown`` gives a
+    path as the student sees it)."""
     if notice.kind == ALGORITHM_FAILED:
         return f"algorithm stopped: {notice.detail}"
+    if notice.recording is not None:
+        return record_words(notice.recording, shown)
     return "the robot is out: run finished (r resets the robot)"

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from textual import events
 from textual.binding import Binding
+from textual.message import Message
 from textual.widgets import Input
 
 #: every key Input binds, and the action it runs
@@ -25,11 +26,39 @@ _EDITING = {
 
 
 class Field(Input):
-    """``Input`` with typed-ahead editing keys kept in order and a steady cursor."""
+    """``Input`` with typed-ahead editing keys kept in order and a steady cursor.
+
+    With a ``max_length``, text typed or pasted past it is cut to fit (Textual's ``Input``
+    would refuse all of it) and :class:`Field.Capped` tells the screen, to say so.
+    """
+
+    class Capped(Message):
+        """Text did not fit in the field: only its first ``limit`` characters are kept."""
+
+        def __init__(self, field: Field, limit: int) -> None:
+            super().__init__()
+            self.field = field
+            self.limit = limit
+
+        @property
+        def control(self) -> Field:
+            return self.field
 
     def __init__(self, *args: object, **kwargs: object) -> None:
         super().__init__(*args, **kwargs)  # type: ignore[arg-type]
         self.set_reactive(Input.cursor_blink, False)
+
+    def replace(self, text: str, start: int, end: int) -> None:
+        limit = self.max_length
+        if limit:
+            value = self.value
+            low, high = sorted((max(0, start), min(len(value), end)))
+            room = max(0, limit - (len(value) - (high - low)))
+            if len(text) > room:
+                super().replace(text[:room], start, end)
+                self.post_message(self.Capped(self, limit))
+                return
+        super().replace(text, start, end)
 
     async def _on_key(self, event: events.Key) -> None:
         action = _EDITING.get(event.key)
