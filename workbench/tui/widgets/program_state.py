@@ -10,8 +10,8 @@ from textual.reactive import var
 from textual.widgets import Log, Static
 
 from workbench.control.station import LabStation
-from workbench.program.expr import show
 from workbench.program.interp import ProgramController
+from workbench.program.viple_expr import show
 
 from .text import set_border_title
 
