@@ -2,5 +2,6 @@
 
 The package is core code: it never imports Textual. :mod:`.loader` reads and checks a file,
 :mod:`.viple_expr` holds VIPLE's expression language, :mod:`.interp` runs a loaded program as a
-controller of a simulation session, and :mod:`.headless` runs one on a maze for the command line.
+controller of a simulation session, and :mod:`.pilot` lets one drive the station's robot or a
+headless run on a maze.
 """
