@@ -343,3 +343,30 @@ def test_pausing_is_one_switch_on_the_station():
     assert b.paused and b.advance(1.0) == 0
     assert b.toggle_pause() is False and not b.paused
     assert b.advance(0.5) > 0
+
+
+def test_one_driving_slot_the_latest_choice_drives_and_stops_one_way():
+    from workbench.program.choice import choose_program
+
+    sensors = [SensorSpec.parse("distance:1:right"), SensorSpec.parse("touch:2:front")]
+    b = station(load_maze("mazes/web.txt"), "web", sensors=sensors)
+    b.select_algorithm("web-wall-following")
+    choose_program(b, "programs/right-wall.viple")  # the latest choice wins
+    b.start()
+    assert str(b.snapshot().driver) == "VIPLE program right-wall.viple" and b.program_drives
+    assert b.session.binding == {"port 1": 1, "port 2": 2}  # a program reads sensors by port
+    b.apply_sensors([SensorSpec.parse("distance:1:right"), SensorSpec.parse("touch:4:front")])
+    assert b.session.binding == {"port 1": 1, "port 4": 4}
+    b.step(60)
+    b.key("space")  # space stops a program, as it stops the robot
+    assert b.driving is None and str(b.snapshot().driver) == "keys"
+    assert (b.runs[-1].ended, b.runs[-1].source) == ("stopped", "programs/right-wall.viple")
+    b.select_algorithm("web-wall-following")
+    b.apply_algorithm_preset()
+    b.start()
+    assert str(b.snapshot().driver) == "algorithm web-wall-following" and not b.program_drives
+    b.step(60)
+    b.stop()
+    assert b.driving is None and b.runs[-1].driver == Driver.algorithm("web-wall-following")
+    with pytest.raises(ValueError, match="choose an algorithm first"):
+        LabStation.open(ROOM).start()
