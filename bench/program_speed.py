@@ -11,10 +11,9 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from workbench.control.headless import RunSpec
-from workbench.control.headless import prepare as prepare_fsm
-from workbench.program.headless import ProgramRunSpec
-from workbench.program.headless import prepare as prepare_program
+from workbench.control.headless import AlgorithmPilot, RunSpec, prepare
+from workbench.program.interp import ProgramController
+from workbench.program.pilot import ProgramPilot
 
 ROOT = Path(__file__).resolve().parents[1]
 MAZE = str(ROOT / "mazes" / "web.txt")
@@ -34,10 +33,11 @@ def timed(session) -> float:
 
 
 def main() -> None:
-    fsm_session, _, _, _ = prepare_fsm(RunSpec(maze=MAZE, algorithm="right-wall", profile="web"))
-    fsm = timed(fsm_session)
-    session, controller, _ = prepare_program(ProgramRunSpec(PROGRAM, MAZE, profile="web"))
-    program = timed(session)
+    fsm = timed(prepare(RunSpec(MAZE, AlgorithmPilot("right-wall"), profile="web")).session)
+    ready = prepare(RunSpec(MAZE, ProgramPilot(PROGRAM), profile="web"))
+    program = timed(ready.session)
+    controller = ready.driving.controller
+    assert isinstance(controller, ProgramController)
     print(f"maze {Path(MAZE).name}, {SECONDS:g} simulated s, best of {REPEATS}")
     print(f"  FSM right-wall          {fsm:8.0f}x real time")
     print(

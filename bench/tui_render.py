@@ -213,7 +213,7 @@ async def measure_app(maze: Maze, seconds: float, hz: float, speed: float) -> di
             station.pacer.speed = speed
             station.select_algorithm(ALGORITHM)
             station.apply_algorithm_preset()
-            station.start_algorithm()
+            station.start()
             stats = Stats()
             _Timing.stats = stats
             driver = app._driver

@@ -212,7 +212,7 @@ def test_start_and_the_state_display_follows_the_engine():
         await click(pilot, "#alg-start")
         await pilot.pause()
         assert isinstance(app.screen, MainScreen)
-        assert station.controller is not None and not station.pacer.paused
+        assert station.driving is not None and not station.pacer.paused
         station.pacer.paused = True
         state = app.screen.query_one(AlgorithmState)
         seen = set()
@@ -220,19 +220,19 @@ def test_start_and_the_state_display_follows_the_engine():
             station.step(60)
             app.refresh_views()
             await pilot.pause()
-            assert state.highlighted == station.controller.state
+            assert state.highlighted == station.driving.controller.state
             seen.add(state.highlighted)
         assert len(seen) >= 3
-        assert state.summary.startswith(f"in {station.controller.state}")
-        last = station.controller.history[-1]
+        assert state.summary.startswith(f"in {station.driving.controller.state}")
+        last = station.driving.controller.history[-1]
         assert state.last.startswith(f"{last.time:.1f} s {last.source} -> {last.target}")
         log = app.screen.query_one(TransitionLog)
         # each transition is in the log whole: long ones wrap inside the panel, none is cut
-        assert log.line_count >= len(station.controller.history)
+        assert log.line_count >= len(station.driving.controller.history)
         width = log.scrollable_content_region.width
         assert all(len(line) <= width for line in log.lines), (width, log.lines)
         logged = " ".join(" ".join(log.lines).split())
-        for tr in station.controller.history:
+        for tr in station.driving.controller.history:
             assert f"{tr.time:.1f} {tr.source} -> {tr.target}" in logged
         assert "driver: algorithm right-wall" in "\n".join(app.screen.query_one("#run").lines)
 
@@ -256,7 +256,7 @@ def test_pause_step_and_reset_from_the_dialog():
         assert station.snapshot().time == pytest.approx(t + station.session.every / 60)
         assert "running, in" in str(screen.query_one("#alg-live").render())
         await click(pilot, "#alg-reset")
-        assert station.controller is None and station.snapshot().time == 0
+        assert station.driving is None and station.snapshot().time == 0
         assert station.runs[-1].ended == "reset"
 
     run(app, body, size=(120, 40))
@@ -268,9 +268,9 @@ def test_x_starts_and_stops_the_chosen_algorithm_from_the_main_screen():
 
     async def body(pilot: Pilot) -> None:
         await pilot.press("x")
-        assert app.station.controller is not None
+        assert app.station.driving is not None
         await pilot.press("x")
-        assert app.station.controller is None
+        assert app.station.driving is None
         assert str(app.station.snapshot().driver) == "keys"
 
     run(app, body)
@@ -286,7 +286,7 @@ def test_a_missing_sensor_is_explained_with_a_one_key_fix():
         state = app.screen.query_one(AlgorithmState)
         assert "cannot start" in state.summary and "f fits" in state.summary
         await pilot.press("x")
-        assert station.controller is None
+        assert station.driving is None
         assert "f fits the sensors it needs" in said(app)
         await pilot.press("f")
         assert station.missing_sensors() is None
@@ -295,7 +295,7 @@ def test_a_missing_sensor_is_explained_with_a_one_key_fix():
             SensorSpec("distance", 2, "front"),
         ]
         await pilot.press("x")
-        assert station.controller is not None
+        assert station.driving is not None
 
     run(app, body)
 
@@ -310,12 +310,12 @@ def test_the_dialog_explains_a_missing_sensor_and_f_fixes_it():
         missing = screen.query_one("#alg-missing", Static)
         assert missing.display and "needs a distance sensor mounted right" in text_of(missing)
         await click(pilot, "#alg-start")
-        assert app.station.controller is None
+        assert app.station.driving is None
         assert "press f" in text_of(screen.query_one("#alg-error", Static))
         await pilot.press("f")
         assert app.station.missing_sensors() is None and not missing.display
         await click(pilot, "#alg-start")
-        assert app.station.controller is not None
+        assert app.station.driving is not None
 
     run(app, body, size=(120, 40))
 
@@ -373,7 +373,7 @@ def test_parameters_are_checked_as_typed_and_reset_to_defaults():
         assert editor.invalid
         assert "above its maximum 1" in text_of(editor.query_one(".param-error", Static))
         await click(pilot, "#alg-start")
-        assert app.station.controller is None
+        assert app.station.driving is None
         assert "forward_power" in text_of(screen.query_one("#alg-error", Static))
         editor.query_one(Input).value = "0.5"
         await pilot.pause()
@@ -400,7 +400,7 @@ def test_a_failing_algorithm_stops_with_its_reason_on_the_message_line(tmp_path)
     async def body(pilot: Pilot) -> None:
         await pilot.press("x")
         await pilot.pause(0.3)
-        assert app.station.controller is None
+        assert app.station.driving is None
         message = app.screen.query_one("#message").message
         assert message.startswith("algorithm stopped: failing, state Go")
 
@@ -419,7 +419,7 @@ def test_the_message_line_follows_what_the_student_does(tmp_path):
         assert said(app) == "chose right-wall: Start (or x) runs it"
         await pilot.press("escape", "x")
         await pilot.pause()
-        assert station.controller is not None and said(app) == ""
+        assert station.driving is not None and said(app) == ""
         await pilot.press("x")
         assert said(app) == "algorithm stopped: the keys drive"
         await pilot.press("r")

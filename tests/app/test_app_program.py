@@ -85,7 +85,7 @@ def test_a_program_loads_drives_answers_keys_and_prints(tmp_path):
         station.step(60)  # one second: w is released after the quiet gap
         moved = station.snapshot().pose
         assert moved.x != start.x or moved.y != start.y
-        run_ = station.program_run
+        run_ = station.driving.controller
         assert [f.what for f in run_.fired] == ["key w", "key release"]
         assert run_.fired[1].time - run_.fired[0].time >= RELEASE_GAP - 0.05
         station.step(30)
@@ -105,7 +105,7 @@ def test_a_program_loads_drives_answers_keys_and_prints(tmp_path):
         assert run_.held == frozenset({"up"})
         # space stops the program; the keys drive again
         await pilot.press("space")
-        assert station.program_run is None
+        assert station.driving is None
         assert station.runs[-1].driver.digest == station.program.digest
         await pilot.press("w")
         assert station.keys_used == {"w"}
@@ -126,10 +126,11 @@ def test_a_held_key_repeating_stays_held(tmp_path):
         for _ in range(10):  # auto-repeat: a w every 0.2 s for 2 s
             await pilot.press("w")
             station.step(12)
-        assert [f.what for f in station.program_run.fired] == ["key w"]
+        run_ = station.driving.controller
+        assert [f.what for f in run_.fired] == ["key w"]
         await pilot.press("d")  # another key: w is released, then d pressed
         station.step(3)
-        assert [f.what for f in station.program_run.fired] == ["key w", "key release", "key d"]
+        assert [f.what for f in run_.fired] == ["key w", "key release", "key d"]
 
     run(app, body)
 
@@ -189,7 +190,7 @@ def test_a_program_lacking_a_sensor_cannot_start_and_says_which(tmp_path):
         await pilot.pause()
         assert isinstance(app.screen, AlgorithmModal)
         assert "cannot start" in str(dialog.query_one("#alg-error", Static).render())
-        assert app.station.program_run is None
+        assert app.station.driving is None
 
     run(app, body)
 
@@ -220,7 +221,7 @@ def test_ctrl_k_sends_every_key_to_the_program_until_pressed_again(tmp_path):
         await pilot.press("ctrl+k")  # no program runs yet: nothing happens
         assert not app.screen.takes_all_keys
         await pilot.press("x")
-        run_ = station.program_run
+        run_ = station.driving.controller
         station.pause()
         # p is the workbench's: it resumes the simulation, and the program never sees it
         await pilot.press("p")
@@ -235,7 +236,7 @@ def test_ctrl_k_sends_every_key_to_the_program_until_pressed_again(tmp_path):
         for key in ("p", "r", "space", "R", "ctrl+p", "tab", "question_mark"):
             await pilot.press(key)
             station.step(2)
-        assert station.paused and station.program_run is run_  # nothing of the workbench ran
+        assert station.paused and station.driving.controller is run_  # nothing of the workbench ran
         assert app.screen is app.screen_stack[-1] and len(app.screen_stack) == 1
         app.refresh_views()
         await pilot.pause()
@@ -244,7 +245,7 @@ def test_ctrl_k_sends_every_key_to_the_program_until_pressed_again(tmp_path):
         await pilot.press("ctrl+k")  # the keys come back
         assert not app.screen.takes_all_keys and "pause" in active_actions(app)
         await pilot.press("space")  # space stops the program again
-        assert station.program_run is None
+        assert station.driving is None
 
     run(app, body)
 
@@ -258,7 +259,7 @@ def test_all_keys_end_when_the_program_stops(tmp_path):
         await load(pilot, path)
         await pilot.press("escape", "x", "ctrl+k")
         assert app.screen.takes_all_keys
-        station.stop_program("stopped")  # e.g. a lab's set-up changes the controller
+        station.stop("stopped")  # e.g. a lab's set-up changes the controller
         app.refresh_views()
         await pilot.pause()
         assert not app.screen.takes_all_keys

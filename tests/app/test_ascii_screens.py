@@ -70,11 +70,11 @@ def test_every_screen_and_dialog_is_plain_ascii_in_ascii_mode(tmp_path: Path):
         await w.look("main screen")
         station.select_algorithm("right-wall")
         station.apply_algorithm_preset()
-        station.start_algorithm()
+        station.start()
         station.step(60 * 30)
         assert [run.ended for run in station.runs] == ["exit"]
         await w.look("main screen, a run finished")
-        station.start_algorithm()
+        station.start()
         station.step(60 * 12)
         await w.look("main screen, an algorithm running")
         await w.press("g")

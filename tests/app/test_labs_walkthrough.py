@@ -30,7 +30,7 @@ from websockets.asyncio.server import serve
 from tests.integration.test_labs_completable import DRIVE, SOLUTIONS, answer, free_port
 from workbench.cli import main
 from workbench.control.algorithms import list_algorithms
-from workbench.control.headless import RunSpec
+from workbench.control.headless import AlgorithmPilot, RunSpec
 from workbench.control.headless import run as headless_run
 from workbench.labs import signoff as so
 from workbench.labs.model import Exercise, Lab, LabMaze, Objective, load_labs
@@ -141,7 +141,7 @@ class Walkthrough:
         if name in self.met:
             station.select_algorithm(name)
             station.apply_algorithm_preset()
-            station.start_algorithm()
+            station.start()
             await self.run_to_exit()
             return
         self.met.add(name)
@@ -163,7 +163,7 @@ class Walkthrough:
         if definition is not None and definition.source == path and self.completed(definition):
             await self.main_screen()
             await self.press("x")
-            assert station.controller is not None, said(self.app)
+            assert station.driving is not None, said(self.app)
             await self.run_to_exit()
             return
         modal = await self.algorithm_dialog()
@@ -193,7 +193,7 @@ class Walkthrough:
         await self.pilot.click("#alg-start")
         await self.pilot.pause()
         assert self.app.screen is not modal, str(modal.query_one("#alg-error").render())
-        assert self.station.controller is not None
+        assert self.station.driving is not None
         await self.run_to_exit()
 
     async def run_to_exit(self) -> None:
@@ -220,12 +220,14 @@ class Walkthrough:
         assert definition is not None
         spec = RunSpec(
             maze=str(maze),
-            algorithm=definition.source if definition.source else definition.name,
+            pilot=AlgorithmPilot(
+                definition.source if definition.source else definition.name,
+                tuple(f"{k}={v!r}" for k, v in station.params().items()),
+            ),
             profile=station.profile,
             sensors=tuple(str(s) for s in station.sensors),
             seed=station.seed,
             noise="off",
-            params=tuple(f"{k}={v!r}" for k, v in station.params().items()),
         )
         want = headless_run(spec).metrics
         got = last.metrics.as_dict()

@@ -39,7 +39,7 @@ def run_algorithms(station: LabStation, *names: str) -> LabStation:
     for name in names:
         station.select_algorithm(name)
         station.apply_algorithm_preset()
-        station.start_algorithm()
+        station.start()
         before = len(station.runs)
         for _ in range(200):
             station.step(60)

@@ -6,7 +6,7 @@ import pytest
 
 from workbench.cli import main
 from workbench.control.evaluate import evaluate
-from workbench.control.headless import RunSetupError, RunSpec, run
+from workbench.control.headless import AlgorithmPilot, RunSetupError, RunSpec, run
 
 ALL = [
     "right-wall",
@@ -19,7 +19,7 @@ ALL = [
 
 
 def result(maze, algorithm, profile="erobotic", **kw):
-    return run(RunSpec(maze=f"mazes/{maze}.txt", algorithm=algorithm, profile=profile, **kw))
+    return run(RunSpec(f"mazes/{maze}.txt", AlgorithmPilot(algorithm), profile=profile, **kw))
 
 
 @pytest.mark.parametrize("profile", ["erobotic", "unity", "web"])

@@ -9,7 +9,7 @@ from workbench.cli import main
 from workbench.control.algorithms import load_algorithm
 from workbench.control.evaluate import evaluate, format_table
 from workbench.control.fsm import FsmController, bind_sensors, preset_sensors
-from workbench.control.headless import RunSpec, run
+from workbench.control.headless import AlgorithmPilot, RunSpec, run
 from workbench.sim.driver import Driver
 from workbench.sim.generate import generate
 from workbench.sim.session import Session
@@ -70,10 +70,10 @@ RANKED = {
 def test_ranking_mazes_show_their_winner_under_their_own_profiles_default_noise(maze):
     winner, others = RANKED[maze]
     for seed in range(10):
-        mine = run(RunSpec(maze=f"mazes/{maze}.txt", algorithm=winner, seed=seed)).as_dict()
+        mine = run(RunSpec(f"mazes/{maze}.txt", AlgorithmPilot(winner), seed=seed)).as_dict()
         assert mine["reached_exit"], seed
         for other in others:
-            theirs = run(RunSpec(maze=f"mazes/{maze}.txt", algorithm=other, seed=seed)).as_dict()
+            theirs = run(RunSpec(f"mazes/{maze}.txt", AlgorithmPilot(other), seed=seed)).as_dict()
             if theirs["reached_exit"]:
                 assert mine["distance_cells"] < theirs["distance_cells"], (seed, other)
                 assert mine["turn_degrees"] < theirs["turn_degrees"], (seed, other)

@@ -43,7 +43,7 @@ def fresh_station(ex: Exercise) -> LabStation:
 
 
 def run_to_exit(station: LabStation, limit_s: int = 600) -> None:
-    station.start_algorithm()
+    station.start()
     done = len(station.runs)
     for _ in range(limit_s):
         station.step(60)
@@ -198,7 +198,7 @@ def test_web_sensors_left_at_the_default_show_what_is_missing():
 def test_a_starter_run_as_given_does_not_count_as_getting_out():
     ex = LABS["unity-simulator"].exercise("wall-following")
     station = fresh_station(ex)
-    station.start_algorithm()
+    station.start()
     station.step(60 * 120)
     assert reasons("unity-simulator", "wall-following", station)[:2] == [
         "✓ sensors are distance:1:right, distance:2:front",

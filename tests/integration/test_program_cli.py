@@ -9,6 +9,8 @@ import pytest
 
 from tests.program.builder import ProgramBuilder
 from workbench.cli import main
+from workbench.sim.driver import Driver
+from workbench.sim.record import read_record, recorded_driver
 
 REAL = Path(__file__).resolve().parents[3] / "shared" / "viple-programs"
 WEB_MAZE = str(Path(__file__).resolve().parents[2] / "mazes" / "web.txt")
@@ -62,6 +64,18 @@ def test_run_json_is_deterministic(tmp_path, capsys):
     assert len(data["program_sha256"]) == 64
 
 
+def test_a_run_record_says_the_program_drove_as_the_app_s_records_do(tmp_path, capsys):
+    path = forward_program(tmp_path)
+    record = tmp_path / "run.jsonl"
+    args = ["viple", "run", path, "--maze", WEB_MAZE, "--keys", "w@0.2", "--max-time", "2"]
+    main([*args, "--record", str(record), "--json"])
+    digest = json.loads(capsys.readouterr().out)["program_sha256"]
+    header = read_record(record).header
+    assert recorded_driver(header) == Driver.program("forward.viple", digest)
+    assert (header["program"], header["program_sha256"]) == ("forward.viple", digest)
+    assert header["algorithm"] == "VIPLE program forward.viple" and header["params"] == {}
+
+
 def test_missing_sensor_is_an_error_before_the_run(tmp_path, capsys):
     b = ProgramBuilder()
     m = b.panel("Main")
@@ -85,9 +99,9 @@ class TestRealPrograms:
         [("w", (0.5, 0.5)), ("a", (-1.0, 1.0)), ("d", (1.0, -1.0)), ("s", (-0.5, -0.5))],
     )
     def test_drive_by_wire_answers_its_keys(self, key, powers):
-        from workbench.program.headless import load_compiled
         from workbench.program.interp import ProgramController
         from workbench.program.keys import parse_key_script
+        from workbench.program.pilot import load_compiled
 
         compiled = load_compiled(str(REAL / "DriveByWire.viple"))
         c = ProgramController(compiled, parse_key_script(f"{key}@0.1 release@0.2"))
@@ -96,9 +110,9 @@ class TestRealPrograms:
         assert [(cmd.left, cmd.right) for cmd in commands] == [powers, (0.0, 0.0)]
 
     def test_servo_control_arrow_keys(self):
-        from workbench.program.headless import load_compiled
         from workbench.program.interp import ProgramController
         from workbench.program.keys import parse_key_script
+        from workbench.program.pilot import load_compiled
 
         compiled = load_compiled(str(REAL / "servo-control.xml"))
         script = (

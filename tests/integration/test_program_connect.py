@@ -13,7 +13,7 @@ import pytest
 from tests.integration.test_viple_client import free_port
 from tests.program.builder import ProgramBuilder
 from workbench.cli import main
-from workbench.program.headless import load_compiled
+from workbench.program.pilot import load_compiled
 from workbench.program.problems import ProgramError
 from workbench.program.remote import RemoteProgram, robot_settings, wheel_ports
 

@@ -12,7 +12,7 @@ import pytest
 
 from workbench.control.algorithms import load_algorithm
 from workbench.control.fsm import resolve_params
-from workbench.control.headless import RunSpec
+from workbench.control.headless import AlgorithmPilot, RunSpec
 from workbench.labs.model import load_labs
 from workbench.tui.widgets.param_editor import fill_in_hint
 
@@ -49,10 +49,9 @@ def test_those_values_get_out_of_every_maze_of_the_exercise(seed):
     for objective in exits:
         result = RunSpec(
             maze=str(objective.maze.path),
-            algorithm=STARTER,
+            pilot=AlgorithmPilot(STARTER, right_wall_values()),
             profile="unity",
             seed=seed,
-            params=right_wall_values(),
         ).execute()
         assert result["reached_exit"], (objective.text, seed)
         if objective.max_collisions is not None:

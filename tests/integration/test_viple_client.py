@@ -17,7 +17,7 @@ import pytest
 from websockets.asyncio.client import connect as ws_connect
 
 from workbench.cli import main
-from workbench.control.headless import RunSpec, run
+from workbench.control.headless import AlgorithmPilot, RunSpec, run
 from workbench.sim.commands import MoveAtPower, Stop, TurnByDegrees
 from workbench.sim.noise import noise_settings
 from workbench.sim.profiles import get_profile
@@ -496,7 +496,8 @@ def in_process(tmp_path_factory) -> dict:
     maze = folder / "one-corner.txt"
     maze.write_text(ONE_CORNER)
     record = folder / "run.jsonl"
-    result = run(RunSpec(str(maze), ALGORITHM, profile="erobotic", record=str(record)))
+    spec = RunSpec(str(maze), AlgorithmPilot(ALGORITHM), profile="erobotic", record=str(record))
+    result = run(spec)
     at_exit = metrics_at_exit(record)
     assert at_exit["distance"] == pytest.approx(result.metrics["distance"], abs=1e-6)
     assert at_exit["turn_degrees"] == pytest.approx(result.metrics["turn_degrees"], abs=1e-6)

@@ -47,7 +47,7 @@ async def drive_a_little(pilot: Pilot) -> None:
 async def run_right_wall(pilot: Pilot) -> None:
     station = pilot.app.station
     station.select_algorithm("right-wall")
-    station.start_algorithm()  # what x does; paused again before the clock can run it
+    station.start()  # what x does; paused again before the clock can run it
     station.pacer.paused = True
     station.step(60 * 25)
     pilot.app.refresh_views()
@@ -115,7 +115,7 @@ def test_main_screen_with_a_program_driving(snap_compare, size, unicode, tmp_pat
     async def before(pilot: Pilot) -> None:
         station = pilot.app.station
         choose_program(station, "wire.viple")
-        station.start_program()
+        station.start()
         station.pacer.paused = True
         station.step(6)
         await pilot.press("w")
@@ -141,7 +141,7 @@ def test_main_screen_with_every_key_going_to_the_program(
     async def before(pilot: Pilot) -> None:
         station = pilot.app.station
         choose_program(station, "wire.viple")
-        station.start_program()
+        station.start()
         station.pacer.paused = True
         station.step(6)
         await pilot.press("ctrl+k", "w")

@@ -65,7 +65,7 @@ def web_runs(tmp_path_factory) -> LabStation:
     for name in ("web-wall-following", "two-distance-local-best"):
         station.select_algorithm(name)
         station.apply_algorithm_preset()
-        station.start_algorithm()
+        station.start()
         before = len(station.runs)
         for _ in range(400):
             station.step(60)

@@ -106,17 +106,17 @@ def test_missing_sensor_is_explained_and_fixed_with_the_preset():
     b.select_algorithm("right-wall")
     assert "needs a distance sensor mounted right" in b.missing_sensors()
     with pytest.raises(SensorBindingError):
-        b.start_algorithm()
+        b.start()
     b.apply_algorithm_preset()
     assert b.missing_sensors() is None
-    b.start_algorithm()
+    b.start()
     assert str(b.snapshot().driver) == "algorithm right-wall"
 
 
 def test_algorithm_run_to_the_exit_is_recorded_in_runs(tmp_path):
     b = station(load_maze("mazes/rank-wall-wins.txt"), record_dir=str(tmp_path))
     b.select_algorithm("right-wall")
-    b.start_algorithm()
+    b.start()
     for _ in range(200):
         b.step(60)
         if b.runs:
@@ -142,10 +142,10 @@ def test_parameters_are_validated_before_any_is_kept():
 def test_keys_take_over_from_an_algorithm_and_close_its_run():
     b = station(load_maze("mazes/erobotic.txt"))
     b.select_algorithm("farthest-distance")
-    b.start_algorithm()
+    b.start()
     b.step(60)
     b.key("space")
-    assert b.controller is None and b.runs[-1].ended == "stopped"
+    assert b.driving is None and b.runs[-1].ended == "stopped"
     assert str(b.snapshot().driver) == "keys"
 
 
@@ -197,12 +197,12 @@ def test_a_failing_algorithm_is_stopped_with_the_reason_instead_of_raising(tmp_p
     path.write_text(FAILING_FSM)
     b = station()
     b.select_algorithm(path)
-    b.start_algorithm()
+    b.start()
     if how == "step":
         b.step(30)
     else:
         b.advance(0.5)
-    assert b.controller is None and b.pacer.paused
+    assert b.driving is None and b.pacer.paused
     assert b.notice.kind == ALGORITHM_FAILED
     assert b.notice.detail.startswith("failing, state Go: guard")
     assert b.runs[-1].ended == "error"
@@ -267,11 +267,11 @@ def test_a_viple_program_that_takes_the_robot_from_an_algorithm_ends_its_run():
 
     b = station(CORRIDOR, profile="unity")
     b.select_algorithm("right-wall")
-    b.start_algorithm()
+    b.start()
     b.step(20)
     Link(b.session, "tcp").connect("127.0.0.1:1")
     b.step(1)
-    assert b.controller is None
+    assert b.driving is None
     assert str(b.runs[-1].driver) == "algorithm right-wall"
     assert b.runs[-1].source.endswith("right-wall.yaml")
 
@@ -302,7 +302,7 @@ def test_after_a_run_ends_at_the_exit_the_next_drive_key_drives():
     b = station(load_maze("mazes/rank-wall-wins.txt"), "unity")
     b.select_algorithm("right-wall")
     b.apply_algorithm_preset()
-    b.start_algorithm()
+    b.start()
     while not b.runs:
         b.step(60)
     assert b.pacer.paused and b.notice == Notice(OUT)
@@ -343,3 +343,30 @@ def test_pausing_is_one_switch_on_the_station():
     assert b.paused and b.advance(1.0) == 0
     assert b.toggle_pause() is False and not b.paused
     assert b.advance(0.5) > 0
+
+
+def test_one_driving_slot_the_latest_choice_drives_and_stops_one_way():
+    from workbench.program.choice import choose_program
+
+    sensors = [SensorSpec.parse("distance:1:right"), SensorSpec.parse("touch:2:front")]
+    b = station(load_maze("mazes/web.txt"), "web", sensors=sensors)
+    b.select_algorithm("web-wall-following")
+    choose_program(b, "programs/right-wall.viple")  # the latest choice wins
+    b.start()
+    assert str(b.snapshot().driver) == "VIPLE program right-wall.viple" and b.program_drives
+    assert b.session.binding == {"port 1": 1, "port 2": 2}  # a program reads sensors by port
+    b.apply_sensors([SensorSpec.parse("distance:1:right"), SensorSpec.parse("touch:4:front")])
+    assert b.session.binding == {"port 1": 1, "port 4": 4}
+    b.step(60)
+    b.key("space")  # space stops a program, as it stops the robot
+    assert b.driving is None and str(b.snapshot().driver) == "keys"
+    assert (b.runs[-1].ended, b.runs[-1].source) == ("stopped", "programs/right-wall.viple")
+    b.select_algorithm("web-wall-following")
+    b.apply_algorithm_preset()
+    b.start()
+    assert str(b.snapshot().driver) == "algorithm web-wall-following" and not b.program_drives
+    b.step(60)
+    b.stop()
+    assert b.driving is None and b.runs[-1].driver == Driver.algorithm("web-wall-following")
+    with pytest.raises(ValueError, match="choose an algorithm first"):
+        LabStation.open(ROOM).start()

@@ -64,7 +64,7 @@ def test_a_station_record_holds_the_driver_both_ways(tmp_path):
     link.disconnect()
     b.step(1)
     b.select_algorithm("right-wall")
-    b.start_algorithm()
+    b.start()
     b.step(30)
     b.close()
     viple, algorithm = (read_record(run.record).header for run in b.runs)

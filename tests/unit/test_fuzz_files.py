@@ -8,7 +8,7 @@ import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from workbench.control.expr import ExprError, compile_expr
+from workbench.control.fsm_expr import ExprError, compile_expr
 from workbench.control.fsmfile import FsmFileError, loads_fsm
 from workbench.files.bounded import BoundedFileError, Limits, compose_yaml, decode_text
 from workbench.sim.maze import MazeError

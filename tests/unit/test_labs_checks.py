@@ -53,7 +53,7 @@ def check(obj, ex, b, answers=None):
 
 
 def run_to_exit(b, limit_s=400):
-    b.start_algorithm()
+    b.start()
     done = len(b.runs)
     for _ in range(limit_s):
         b.step(60)
@@ -260,9 +260,9 @@ def test_every_starter_loads_and_runs_but_does_not_get_out_as_given(starter):
     b = LabStation.open(EROBOTIC.maze, "unity" if "unity" in starter.name else "web", noise="off")
     b.select_algorithm(starter)
     b.apply_algorithm_preset()
-    b.start_algorithm()
+    b.start()
     b.step(60 * 120)
-    assert b.notice is None and b.controller is not None
+    assert b.notice is None and b.driving is not None
     assert not b.session.reached_exit
 
 
@@ -364,7 +364,7 @@ def test_a_viple_exercise_passes_with_the_students_program_run_here():
                   (for_viple, for_fsm), ())  # fmt: skip
     b = station_for(ex)
     choose_program(b, "programs/right-wall.viple")
-    b.start_program()
+    b.start()
     for _ in range(200):
         b.step(60)
         if b.runs and b.runs[-1].ended == "exit":

@@ -43,7 +43,7 @@ def lab_in(tmp_path, controller="algorithm right-wall", driver="algorithm right-
 
 
 def run_to_exit(b, limit_s=200):
-    b.start_algorithm()
+    b.start()
     done = len(b.runs)
     for _ in range(limit_s):
         b.step(60)

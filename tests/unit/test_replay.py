@@ -145,7 +145,7 @@ def station_record(tmp_path):
     b = LabStation.open(BEND, "erobotic", noise="off", record_dir=str(tmp_path))
     b.select_algorithm("right-wall")
     b.apply_algorithm_preset()
-    b.start_algorithm()
+    b.start()
     for _ in range(100):
         b.step(60)
         if b.runs:

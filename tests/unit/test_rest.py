@@ -43,12 +43,12 @@ def test_a_turn_an_algorithm_or_max_speed_is_never_rest_but_pause_always_is():
     assert s.at_rest
     s.select_algorithm("right-wall")
     s.apply_algorithm_preset()
-    s.start_algorithm()
+    s.start()
     assert not s.at_rest
     s.pause()
     assert s.at_rest
     s.pause(False)
-    s.stop_algorithm()
+    s.stop()
     s.step(1)
     assert s.at_rest
     s.pacer.speed = None  # max: as many steps as the frame allows, so every frame counts

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pytest
 
-from workbench.control.headless import RunSpec, run
+from workbench.control.headless import AlgorithmPilot, RunSpec, run
 from workbench.control.station import LabStation
 from workbench.sim.clock import SPEEDS
 from workbench.sim.mazeio import load_maze
@@ -16,7 +16,7 @@ MAZE = "mazes/rank-wall-wins.txt"
 
 
 def headless(record: str | None = None) -> dict:
-    return run(RunSpec(maze=MAZE, algorithm="right-wall", seed=3, record=record)).metrics
+    return run(RunSpec(MAZE, AlgorithmPilot("right-wall"), seed=3, record=record)).metrics
 
 
 def ticks(path) -> list[str]:
@@ -28,7 +28,7 @@ def station_run(speed: float | None, single: int | None = None, record_dir=None)
     station = LabStation.open(load_maze(MAZE), seed=3, record_dir=record_dir)
     station.select_algorithm("right-wall")
     station.apply_algorithm_preset()
-    station.start_algorithm()
+    station.start()
     station.pacer.speed = speed
     for _ in range(100_000):
         if station.runs:

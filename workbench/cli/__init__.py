@@ -31,6 +31,9 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="workbench",
         description="VIPLE Maze Lab Workbench: maze simulator and lab workbench for ASU VIPLE.",
+        # a command's own options (``run --record``) would otherwise be read as shortened
+        # forms of the app's (``--record-dir``, ``--record-cap``)
+        allow_abbrev=False,
     )
     parser.add_argument("--version", action="version", version=f"workbench {__version__}")
     parser.add_argument("--maze", help="maze file to open (default: the bundled Unity maze)")

@@ -7,11 +7,10 @@ import json
 import os
 import sys
 from collections.abc import Callable
-from typing import Any
 
 from workbench.control.evaluate import EvalError, evaluate, format_table, write_csv
-from workbench.control.headless import RunSetupError, RunSpec, run
-from workbench.program.headless import program_entrant
+from workbench.control.headless import AlgorithmPilot, RunResult, RunSetupError, RunSpec, run
+from workbench.program.pilot import program_entrant
 from workbench.sim.noise import NOISE_LEVELS
 from workbench.sim.profiles import PROFILES
 
@@ -78,13 +77,12 @@ def register(sub: argparse._SubParsersAction) -> None:
 def cmd_run(args: argparse.Namespace) -> int:
     spec = RunSpec(
         maze=args.maze,
-        algorithm=args.algorithm,
+        pilot=AlgorithmPilot(args.algorithm, tuple(args.param)),
         profile=args.profile,
         sensors=tuple(args.sensor),
         seed=args.seed,
         noise=args.noise,
         noise_params=tuple(args.noise_set),
-        params=tuple(args.param),
         max_time=args.max_time,
         record=args.record,
     )
@@ -93,10 +91,10 @@ def cmd_run(args: argparse.Namespace) -> int:
     except RunSetupError as exc:
         print(f"workbench run: {exc}", file=sys.stderr)
         return 2
-    return report(result, args.json, describe_run)
+    return report(result, args.json, describe_run(args.algorithm))
 
 
-def report(result, as_json: bool, describe: Callable[[Any], str]) -> int:
+def report(result: RunResult, as_json: bool, describe: Callable[[RunResult], str]) -> int:
     """Print a finished run (as JSON or as ``describe`` words it); the exit code is 0 when the
     robot got out or the maze has no exit, 1 when it did not get out."""
     data = result.as_dict()
@@ -104,13 +102,21 @@ def report(result, as_json: bool, describe: Callable[[Any], str]) -> int:
     return 0 if not result.maze.exits or data["reached_exit"] else 1
 
 
-def describe_run(result) -> str:
-    d = result.as_dict()
-    head = f"{result.spec.algorithm} on {result.maze.name} ({result.profile}, seed {d['seed']})"
-    return "\n".join([head, *describe_measures(result)])
+def describe_run(name: str) -> Callable[[RunResult], str]:
+    """How ``workbench run`` words a run of the algorithm ``name`` (as it was given)."""
+
+    def describe(result: RunResult) -> str:
+        return "\n".join([run_head(result, name), *describe_measures(result)])
+
+    return describe
 
 
-def describe_measures(result) -> list[str]:
+def run_head(result: RunResult, name: str) -> str:
+    """What ran, on which maze, with which profile and seed."""
+    return f"{name} on {result.maze.name} ({result.profile}, seed {result.spec.seed})"
+
+
+def describe_measures(result: RunResult) -> list[str]:
     """The measures of a run, one per line (an algorithm's or a VIPLE program's)."""
     d = result.as_dict()
     m = result.metrics

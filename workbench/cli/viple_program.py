@@ -8,9 +8,10 @@ import json
 import os
 import sys
 
-from workbench.control.headless import RunSetupError
-from workbench.program.headless import ProgramRunSpec, load_compiled, run_program
+from workbench.control.headless import RunResult, RunSetupError, RunSpec, run
+from workbench.program.interp import ProgramController
 from workbench.program.keys import KeyScriptError, parse_key_script, typed_events
+from workbench.program.pilot import ProgramPilot, load_compiled
 from workbench.program.problems import ProgramError
 from workbench.program.remote import RemoteProgram, robot_settings, wheel_ports
 from workbench.program.show import describe_program
@@ -25,7 +26,7 @@ from workbench.viple.client import (
 from workbench.viple.codec import WheelPorts
 
 from .keyboard import QUIT_KEYS, attach_keyboard, raw_terminal
-from .run import _simulation_options, describe_measures, report
+from .run import _simulation_options, describe_measures, report, run_head
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -132,14 +133,11 @@ def cmd_run(args: argparse.Namespace) -> int:
     if args.max_time is not None and not 0 < args.max_time <= 24 * 3600:
         print("workbench viple run: --max-time must be above 0 and at most a day", file=sys.stderr)
         return 2
-    spec = ProgramRunSpec(
-        program=args.file,
+    spec = RunSpec(
         maze=args.maze,
+        pilot=ProgramPilot(args.file, keys=args.keys, typed=args.typed, kinds=args.kinds),
         profile=args.profile,
         sensors=tuple(args.sensor),
-        keys=args.keys,
-        typed=args.typed,
-        kinds=args.kinds,
         seed=args.seed,
         noise=args.noise,
         noise_params=tuple(args.noise_set),
@@ -147,7 +145,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         record=args.record,
     )
     try:
-        result = run_program(spec)
+        result = run(spec)
     except ProgramError as exc:
         for problem in exc.problems:
             print(problem, file=sys.stderr)
@@ -158,24 +156,25 @@ def cmd_run(args: argparse.Namespace) -> int:
     return report(result, args.json, describe_program_run)
 
 
-def describe_program_run(result) -> str:
-    d = result.as_dict()
-    head = f"{result.program_name} on {result.maze.name} ({result.profile}, seed {d['seed']})"
-    lines = [head, *describe_measures(result)]
-    shown = result.printed[-10:]
-    if result.printed:
-        more = len(result.printed) + result.printed_dropped - len(shown)
+def describe_program_run(result: RunResult) -> str:
+    program = result.driving.controller
+    assert isinstance(program, ProgramController)
+    lines = [run_head(result, result.driving.driver.name), *describe_measures(result)]
+    printed = program.printed
+    shown = printed[-10:]
+    if printed:
+        more = len(printed) + program.printed_dropped - len(shown)
         lines.append(
-            f"  printed {len(result.printed) + result.printed_dropped} lines"
+            f"  printed {len(printed) + program.printed_dropped} lines"
             + (f"; the last {len(shown)}:" if more else ":")
         )
         lines += [f"    {p.time:7.2f} s  {p.text[:60]}" for p in shown]
-    if result.fired:
-        lines.append(f"  events: {len(result.fired)}")
-        lines += [f"    {f.time:7.2f} s  {f.what}" for f in result.fired[:10]]
-    if result.errors:
-        lines.append(f"  errors: {len(result.errors)}")
-        lines += [f"    {e}" for e in result.errors[:10]]
+    if program.fired:
+        lines.append(f"  events: {len(program.fired)}")
+        lines += [f"    {f.time:7.2f} s  {f.what}" for f in program.fired[:10]]
+    if program.errors:
+        lines.append(f"  errors: {len(program.errors)}")
+        lines += [f"    {e}" for e in program.errors[:10]]
     return "\n".join(lines)
 
 

@@ -1,9 +1,9 @@
 """The entrant x maze matrix: every algorithm (or VIPLE program) on every maze over several
 seeds, in parallel.
 
-An entrant is a name and a way to make the spec of one run (maze, seed); a spec checks itself
-before anything runs and runs itself in a worker process. Algorithms are made here; VIPLE
-programs come from :mod:`workbench.program` the same way.
+An entrant is a name and a way to make the :class:`~.headless.RunSpec` of one run (maze,
+seed); a spec checks itself before anything runs and runs itself in a worker process. An
+algorithm's entrant is made here; a VIPLE program's comes from :mod:`workbench.program.pilot`.
 """
 
 from __future__ import annotations
@@ -13,9 +13,9 @@ import statistics
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
-from typing import Any, Protocol
+from typing import Any
 
-from .headless import RunSetupError, RunSpec
+from .headless import AlgorithmPilot, RunSetupError, RunSpec
 
 MEASURES = ("distance_cells", "turn_degrees", "sim_time", "collisions", "touches", "turns")
 
@@ -24,20 +24,12 @@ class EvalError(ValueError):
     """The evaluation cannot start (named inputs that do not load)."""
 
 
-class Runnable(Protocol):
-    """One run's spec: sent to a worker process, so a picklable value."""
-
-    def check(self) -> None: ...
-
-    def execute(self) -> dict[str, Any]: ...
-
-
 @dataclass(frozen=True)
 class Entrant:
     """What takes part: its name in the table, and the spec of its run on a maze with a seed."""
 
     name: str
-    spec: Callable[[str, int], Runnable]
+    spec: Callable[[str, int], RunSpec]
 
 
 def algorithm_entrant(
@@ -50,7 +42,7 @@ def algorithm_entrant(
     def spec(maze: str, seed: int) -> RunSpec:
         return RunSpec(
             maze=maze,
-            algorithm=algorithm,
+            pilot=AlgorithmPilot(algorithm),
             profile=profile,
             seed=seed,
             noise=noise,
@@ -109,7 +101,7 @@ class EvalResult:
         }
 
 
-def _one(spec: Runnable) -> dict[str, Any]:
+def _one(spec: RunSpec) -> dict[str, Any]:
     return spec.execute()
 
 

@@ -13,7 +13,7 @@ from collections import deque
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 
-from workbench.control.expr import Expr, Fn, Value, compile_expr
+from workbench.control.fsm_expr import Expr, Fn, Value, compile_expr
 from workbench.control.fsmdef import (
     EVENTS,
     PROFILES,

@@ -12,7 +12,7 @@ import keyword
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 
-from workbench.control.expr import FUNCTIONS, ExprError, Value, compile_expr
+from workbench.control.fsm_expr import FUNCTIONS, ExprError, Value, compile_expr
 from workbench.sim.sensors import KINDS, MOUNTS, PORT_RANGE, SensorSpec
 
 PROFILES = ("unity", "web", "erobotic")

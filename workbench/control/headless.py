@@ -1,24 +1,29 @@
-"""Running an algorithm on a maze without a screen: the engine behind `workbench run` and `eval`."""
+"""Running an algorithm or a VIPLE program on a maze without a screen: the engine behind
+``workbench run``, ``eval`` and ``viple run``.
+
+A :class:`RunSpec` names the maze, the simulation's settings and its :class:`Pilot`: what
+drives, as a value a worker process can take. An algorithm's pilot is here; a program's comes
+from :mod:`workbench.program.pilot` (the layer above), and both runs go the one way below.
+"""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
-from typing import Any
+from dataclasses import dataclass
+from typing import Any, Protocol
 
-from workbench.sim.driver import Driver
 from workbench.sim.maze import Maze, MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.noise import noise_settings
 from workbench.sim.profiles import Profile, get_profile
 from workbench.sim.record import Recorder
-from workbench.sim.sensors import SensorConfigError, SensorSpec, check_ports
+from workbench.sim.sensors import SensorSpec, check_ports
 from workbench.sim.session import Session
-from workbench.sim.world import WorldError
 
 from .algorithms import load_algorithm
-from .fsm import FsmController, FsmError, bind_sensors, preset_sensors
-from .fsmfile import FsmFileError, parse_param_overrides
+from .driving import Driving, algorithm_driving, record_fields
+from .fsm import bind_sensors, preset_sensors
+from .fsmfile import parse_param_overrides
 
 #: keys of `workbench run --json`, in this order
 RESULT_KEYS = (
@@ -41,26 +46,42 @@ class RunSetupError(ValueError):
     """The run cannot start: a bad maze, algorithm, sensor, parameter or noise setting."""
 
 
+class Pilot(Protocol):
+    """What drives a headless run, as a picklable value (a run may go to a worker process)."""
+
+    def drive(
+        self, profile: Profile, sensors: list[SensorSpec] | None
+    ) -> tuple[Driving, list[SensorSpec]]:
+        """Load what drives and make it ready for the robot's ``sensors`` (None: the ones it
+        would have); return it with the sensors the robot carries. Bad input raises
+        :class:`RunSetupError` (a program's problems raise its own error, one per line)."""
+        ...
+
+    def result(self, run: RunResult) -> dict[str, Any]:
+        """The finished run as ``--json`` gives it."""
+        ...
+
+
 @dataclass(frozen=True)
 class RunSpec:
     maze: str
-    algorithm: str
+    pilot: Pilot
     profile: str | None = None
+    #: the robot's sensors as KIND:PORT:MOUNT (none: the ones the pilot would have)
     sensors: tuple[str, ...] = ()
     seed: int = 0
     noise: str | None = None
     noise_params: tuple[str, ...] = ()
-    params: tuple[str, ...] = ()
     max_time: float | None = None
     record: str | None = None
     dt: float = 1 / 60
 
     def check(self) -> None:
-        """Raise :class:`RunSetupError` when this run cannot start (nothing runs)."""
+        """Raise :class:`RunSetupError` (or the pilot's error) when this run cannot start."""
         prepare(self)
 
     def execute(self) -> dict[str, Any]:
-        """Run it; the result as ``workbench run --json`` gives it."""
+        """Run it; the result as ``--json`` gives it."""
         return run(self).as_dict()
 
 
@@ -69,19 +90,51 @@ class RunResult:
     spec: RunSpec
     maze: Maze
     profile: str
+    driving: Driving
     metrics: dict[str, Any]
-    final_state: str
     cut_by_limit: bool
     max_time: float
-    params: dict[str, float] = field(default_factory=dict)
 
-    def as_dict(self) -> dict[str, Any]:
-        values = {
+    @property
+    def final_state(self) -> str:
+        return self.driving.controller.state or ""
+
+    def measures(self) -> dict[str, Any]:
+        """Every measure and how the run ended, before the pilot picks and adds its own."""
+        return {
             **self.metrics,
             "final_state": self.final_state,
             "seed": self.spec.seed,
             "cut_by_limit": self.cut_by_limit,
         }
+
+    def as_dict(self) -> dict[str, Any]:
+        return self.spec.pilot.result(self)
+
+
+@dataclass(frozen=True)
+class AlgorithmPilot:
+    """An algorithm drives: a built-in name or an FSM file, with ``NAME=VALUE`` parameters."""
+
+    algorithm: str
+    params: tuple[str, ...] = ()
+
+    def drive(
+        self, profile: Profile, sensors: list[SensorSpec] | None
+    ) -> tuple[Driving, list[SensorSpec]]:
+        try:
+            definition = load_algorithm(self.algorithm)
+            if sensors is None:
+                sensors = preset_sensors(definition, profile.name)
+            bind_sensors(definition, sensors, profile.name)  # a missing sensor before the params
+            overrides = parse_param_overrides(definition, self.params)
+            driving = algorithm_driving(definition, overrides, profile.name)
+        except ValueError as exc:  # the file, a sensor it lacks, a parameter (FsmFileError...)
+            raise RunSetupError(str(exc)) from None
+        return driving, sensors
+
+    def result(self, run: RunResult) -> dict[str, Any]:
+        values = run.measures()
         return {key: values[key] for key in RESULT_KEYS}
 
 
@@ -107,8 +160,18 @@ def parse_noise_params(items: Sequence[str]) -> dict[str, float]:
     return out
 
 
-def prepare(spec: RunSpec) -> tuple[Session, FsmController, dict[str, float], float]:
-    """Load and check everything the run needs; bad input is a :class:`RunSetupError`."""
+@dataclass(frozen=True)
+class Prepared:
+    """A run ready to go: its session with the driving attached, and its time limit."""
+
+    session: Session
+    driving: Driving
+    max_time: float
+
+
+def prepare(spec: RunSpec) -> Prepared:
+    """Load and check everything the run needs; bad input is a :class:`RunSetupError` (or the
+    pilot's own error)."""
     try:
         maze = load_maze(spec.maze)
     except MazeError as exc:
@@ -118,40 +181,33 @@ def prepare(spec: RunSpec) -> tuple[Session, FsmController, dict[str, float], fl
         raise RunSetupError("\n".join(str(p) for p in problems))
     try:
         profile = get_profile(spec.profile or maze.profile or "unity")
-        definition = load_algorithm(spec.algorithm)
-        if spec.sensors:
-            sensors = check_ports(SensorSpec.parse(s) for s in spec.sensors)
-        else:
-            sensors = preset_sensors(definition, profile.name)
-        binding = bind_sensors(definition, sensors, profile.name)
-        overrides = parse_param_overrides(definition, spec.params)
-        controller = FsmController(definition, overrides, profile.name)
+        given = check_ports(SensorSpec.parse(s) for s in spec.sensors) if spec.sensors else None
+    except ValueError as exc:  # an unknown profile, a bad sensor (SensorConfigError)
+        raise RunSetupError(str(exc)) from None
+    driving, sensors = spec.pilot.drive(profile, given)
+    try:
         noise = noise_settings(
             spec.noise or profile.noise, profile, **parse_noise_params(spec.noise_params)
         )
         recorder = Recorder(spec.record) if spec.record else None
         session = Session(maze, profile.name, sensors, noise, spec.seed, spec.dt, recorder=recorder)
-    except (FsmFileError, FsmError, SensorConfigError, WorldError, ValueError) as exc:
+    except ValueError as exc:  # a bad noise setting, sensor or world (WorldError...)
         raise RunSetupError(str(exc)) from None
     except OSError as exc:
         raise RunSetupError(f"{exc.filename}: cannot write the record: {exc.strerror}") from None
-    session.attach(controller, binding, Driver.algorithm(definition.name))
+    session.attach(driving.controller, driving.bind(sensors), driving.driver)
     max_time = spec.max_time or default_max_time(maze, profile, session.world.cell)
-    return session, controller, controller.params, max_time
+    return Prepared(session, driving, max_time)
 
 
 def run(spec: RunSpec) -> RunResult:
-    session, controller, params, max_time = prepare(spec)
-    session.record_header(
-        algorithm=controller.definition.name,
-        driven_by=session.driver.as_json(),
-        params=params,
-        max_time=max_time,
-    )
+    ready = prepare(spec)
+    session, driving = ready.session, ready.driving
+    session.record_header(**record_fields(driving.driver, driving), max_time=ready.max_time)
     try:
-        metrics = session.run(max_time)
+        metrics = session.run(ready.max_time)
         cut = bool(session.maze.exits) and not metrics.reached_exit
-        session.record_summary(final_state=controller.state, cut_by_limit=cut)
+        session.record_summary(final_state=driving.controller.state, cut_by_limit=cut)
     finally:
         if session.recorder is not None:
             session.recorder.close()
@@ -159,9 +215,8 @@ def run(spec: RunSpec) -> RunResult:
         spec=spec,
         maze=session.maze,
         profile=session.profile.name,
+        driving=driving,
         metrics=metrics.as_dict(),
-        final_state=controller.state,
         cut_by_limit=cut,
-        max_time=max_time,
-        params=params,
+        max_time=ready.max_time,
     )

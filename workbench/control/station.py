@@ -9,7 +9,7 @@ from __future__ import annotations
 import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Any
 
 from workbench.files.workspace import LOCAL, FileAccess
 from workbench.sim.clock import Pacer
@@ -28,9 +28,10 @@ from workbench.sim.sensors import (
     SensorSpec,
     check_ports,
 )
-from workbench.sim.session import Controller, Session, Snapshot
+from workbench.sim.session import Session, Snapshot
 
 from .algorithms import load_algorithm
+from .driving import Driving, algorithm_driving, record_fields
 from .fsm import FsmController, FsmDefinition, FsmRuntimeError, bind_sensors, preset_sensors
 from .fsmfile import parse_param_overrides
 from .manual import exact_move, key_command
@@ -91,14 +92,6 @@ class Notice:
     recording: RecordTrouble | None = None
 
 
-class ProgramDriver(Controller, Protocol):
-    """A controller that also answers typed keys (a VIPLE program: ``workbench.program``)."""
-
-    def reset(self) -> None: ...
-
-    def type_key(self, key: str, t: float) -> None: ...
-
-
 @dataclass(frozen=True)
 class ProgramChoice:
     """A program file chosen to drive, read and checked by the layer that knows programs."""
@@ -108,8 +101,8 @@ class ProgramChoice:
     #: the path it was read from, and sha256 of its bytes
     source: str
     digest: str
-    #: a fresh controller running the program
-    make: Callable[[], ProgramDriver]
+    #: the program driving afresh, from its start
+    make: Callable[[], Driving]
     #: why the program cannot run with these sensors (None when it can)
     needs: Callable[[Sequence[SensorSpec]], str | None]
     #: a few lines on what the program is and what it answers (keys, sensors)
@@ -178,9 +171,9 @@ class LabStation:
     files: FileAccess = LOCAL
     session: Session = field(init=False)
     pacer: Pacer = field(init=False)
+    #: the algorithm chosen, and the parameters edited for it
     algorithm: FsmDefinition | None = None
     overrides: dict[str, float] = field(default_factory=dict)
-    controller: FsmController | None = None
     runs: list[RunEntry] = field(default_factory=list)
     keys_used: set[str] = field(default_factory=set)
     #: the last thing the station did on its own that the person at it should hear of
@@ -189,8 +182,9 @@ class LabStation:
     viple: list[VipleConnection] = field(default_factory=list)
     #: the program file chosen to drive (most recent choice wins over :attr:`algorithm`)
     program: ProgramChoice | None = None
-    #: the program driving now
-    program_run: ProgramDriver | None = None
+    #: what drives the robot now: the chosen algorithm or program, from :meth:`start` until
+    #: :meth:`stop` (None while the keys or a VIPLE program over the network drive)
+    driving: Driving | None = None
     #: called just before a command from outside (a drive key, a VIPLE program) changes the
     #: robot: a front end that advances time in larger steps while the station is at rest
     #: (see :attr:`at_rest`) brings the clock up to now first
@@ -268,7 +262,7 @@ class LabStation:
             self.on_activity()
 
     def _algorithm_failed(self, exc: FsmRuntimeError) -> None:
-        self.stop_algorithm("error")
+        self.stop("error")
         self.pause()
         self.notice = Notice(ALGORITHM_FAILED, str(exc))
 
@@ -302,16 +296,12 @@ class LabStation:
         role, peer = driver.role, driver.peer
         now = self._viple_now
         if now is None or (now.role, now.peer) != (role, peer):  # another program took over
-            self._viple_now = VipleConnection(role, peer)
-            self.viple.append(self._viple_now)
-        self._viple_now.distance += seen[0] - last[0]
-        self._viple_now.turn_degrees += seen[1] - last[1]
-        if self.controller is not None and self.session.controller is None:
-            self.controller = None  # the program took the robot from the algorithm
-            if self._run_open:
-                self._close_run("stopped")
-        if self.program_run is not None and self.session.controller is None:
-            self.program_run = None  # the VIPLE link took the robot from the program file
+            now = self._viple_now = VipleConnection(role, peer)
+            self.viple.append(now)
+        now.distance += seen[0] - last[0]
+        now.turn_degrees += seen[1] - last[1]
+        if self.driving is not None and self.session.controller is None:
+            self.driving = None  # the VIPLE program took the robot from the algorithm or file
             if self._run_open:
                 self._close_run("stopped")
         if self._run_open and self._run_driver != driver:
@@ -366,9 +356,9 @@ class LabStation:
         While a program file drives, every key but space goes to the program (its Key Press
         events); space stops the program, as it stops the robot.
         """
-        if self.program_run is not None:
+        if self.program_drives:
             if key == "space":
-                self.stop_program("stopped")
+                self.stop("stopped")
             else:
                 self.type_to_program(key)
             return True
@@ -376,8 +366,7 @@ class LabStation:
         if cmd is None:
             return False
         self._go_on_after_exit()
-        if self.controller is not None:
-            self.stop_algorithm("stopped")
+        self.stop("stopped")
         if self._run_open and self._run_driver != KEYS:
             self._close_run("stopped")  # the keys take the robot from a VIPLE program
         if not self._run_open and not self.session.reached_exit:
@@ -389,12 +378,17 @@ class LabStation:
             self.session.command_after(self.session.world.cell / profile.move_speed, Stop())
         return True
 
+    @property
+    def program_drives(self) -> bool:
+        """True while a program file drives: it answers typed keys (its Key Press events)."""
+        return self.driving is not None and self.driving.type_key is not None
+
     def type_to_program(self, key: str) -> bool:
         """Any key (space too) for the running program's Key Press events, at the simulated
         time; False when no program drives."""
-        if self.program_run is None:
+        if self.driving is None or self.driving.type_key is None:
             return False
-        self.program_run.type_key(key, self.session.world.time)
+        self.driving.type_key(key, self.session.world.time)
         return True
 
     # -- sensors -------------------------------------------------------------------------
@@ -428,10 +422,8 @@ class LabStation:
         specs = check_ports(specs)
         self.session.set_sensors(specs)
         self.sensors = list(specs)
-        if self.controller is not None:
-            self.session.binding = bind_sensors(self.algorithm, specs, self.profile)
-        if self.program_run is not None:
-            self.session.binding = _port_binding(specs)
+        if self.driving is not None:
+            self.session.binding = self.driving.bind(specs)
 
     def apply_preset(self, name: str) -> None:
         try:
@@ -451,9 +443,7 @@ class LabStation:
 
     def use_algorithm(self, definition: FsmDefinition) -> FsmDefinition:
         """Choose an algorithm already read (a lab's starter as the lab was loaded)."""
-        if self.controller is not None:
-            self.stop_algorithm("stopped")
-        self.stop_program("stopped")
+        self.stop("stopped")
         self.algorithm = definition
         self.program = None
         self.overrides = {}
@@ -491,65 +481,46 @@ class LabStation:
         if self.algorithm is not None:
             self.apply_sensors(preset_sensors(self.algorithm, self.profile))
 
-    def start_algorithm(self) -> None:
-        """Robot back to the start and the chosen algorithm driving (a new run)."""
-        if self.algorithm is None:
-            raise ValueError("choose an algorithm first")
-        binding = bind_sensors(self.algorithm, self.sensors, self.profile)
-        controller = FsmController(self.algorithm, self.overrides, self.profile)
-        self.stop_program("stopped")
-        if self._run_open:
-            self._close_run("stopped")
-        self._go_on_after_exit()
-        self.session.reset()
-        self.controller = controller
-        self.session.attach(controller, binding, Driver.algorithm(self.algorithm.name))
-        self._open_run(self.session.driver)
-        self.pause(False)
-
     # -- program files -------------------------------------------------------------------
     def use_program(self, choice: ProgramChoice) -> None:
         """Choose a program file to drive (the choice of algorithm is kept for later)."""
-        self.stop_algorithm("stopped")
-        self.stop_program("stopped")
+        self.stop("stopped")
         self.program = choice
 
-    def start_program(self) -> None:
-        """Robot back to the start and the chosen program driving (a new run)."""
+    # -- driving -------------------------------------------------------------------------
+    def start(self) -> None:
+        """Robot back to the start and the chosen program, else the chosen algorithm, driving
+        (a new run). A ``ValueError`` when nothing is chosen or the robot lacks a sensor it
+        reads (nothing changes then)."""
         choice = self.program
-        if choice is None:
-            raise ValueError("choose a program first")
-        missing = choice.needs(self.sensors)
-        if missing:
-            raise ValueError(missing)
-        controller = choice.make()
-        self.stop_algorithm("stopped")
-        self.stop_program("stopped")
+        if choice is not None:
+            missing = choice.needs(self.sensors)
+            if missing:
+                raise ValueError(missing)
+            driving = choice.make()
+        elif self.algorithm is not None:
+            driving = algorithm_driving(self.algorithm, self.overrides, self.profile)
+        else:
+            raise ValueError("choose an algorithm first")
+        binding = driving.bind(self.sensors)
+        self.stop("stopped")
         if self._run_open:
             self._close_run("stopped")
         self._go_on_after_exit()
         self.session.reset()
-        self.program_run = controller
-        driver = Driver.program(choice.name, choice.digest)
-        self.session.attach(controller, _port_binding(self.sensors), driver)
-        self._open_run(driver)
+        self.driving = driving
+        self.session.attach(driving.controller, binding, driving.driver)
+        self._open_run(driving.driver)
         self.pause(False)
 
-    def stop_program(self, ended: str = "stopped") -> None:
-        if self.program_run is None:
+    def stop(self, ended: str = "stopped") -> None:
+        """What drives lets go of the robot, which stops; the keys drive (nothing when the
+        keys or a VIPLE program over the network drive)."""
+        if self.driving is None:
             return
         self.session.command(Stop())
         self.session.detach(KEYS)
-        self.program_run = None
-        if self._run_open:
-            self._close_run(ended)
-
-    def stop_algorithm(self, ended: str = "stopped") -> None:
-        if self.controller is None:
-            return
-        self.session.command(Stop())
-        self.session.detach(KEYS)
-        self.controller = None
+        self.driving = None
         if self._run_open:
             self._close_run(ended)
 
@@ -559,9 +530,7 @@ class LabStation:
         self._go_on_after_exit()
         if self._run_open:
             self._close_run("reset")
-        if self.controller is not None:
-            self.stop_algorithm("reset")
-        self.stop_program("reset")
+        self.stop("reset")
         self.session.reset()
         self.session.driver = KEYS
 
@@ -570,8 +539,7 @@ class LabStation:
         self._go_on_after_exit()
         if self._run_open:
             self._close_run("maze changed")
-        self.stop_algorithm("maze changed")
-        self.stop_program("maze changed")
+        self.stop("maze changed")
         self.maze = maze
         self.session.load_maze(maze, self.profile, self.sensors, self.noise, self.seed)
         self.session.driver = KEYS
@@ -580,9 +548,7 @@ class LabStation:
     def _open_run(self, driver: Driver) -> None:
         self._run_open = True
         self._run_driver = driver
-        self._run_source = self.algorithm.source if self.controller and self.algorithm else None
-        if self.program_run is not None and self.program is not None:
-            self._run_source = self.program.source
+        self._run_source = self.driving.source if self.driving is not None else None
         self._record_stop_told = False
         if self.record_dir:
             recorder, trouble = open_record(
@@ -598,18 +564,7 @@ class LabStation:
             self._recorder = recorder
             self._record_path = str(recorder.path)
             self.session.recorder = recorder
-            self.session.record_header(
-                algorithm=self.algorithm.name
-                if self.controller and self.algorithm
-                else str(driver),
-                driven_by=driver.as_json(),
-                params=self.params() if self.controller else {},
-                **(
-                    {"program": self.program.name, "program_sha256": self.program.digest}
-                    if self.program_run is not None and self.program is not None
-                    else {}
-                ),
-            )
+            self.session.record_header(**record_fields(driver, self.driving))
 
     def _tell_record_stopped(self, recorder: Recorder) -> None:
         assert recorder.stopped is not None
@@ -645,9 +600,9 @@ class LabStation:
         self.runs.append(entry)
         recorder = self._recorder
         if recorder is not None:
-            running = self.controller or self.program_run
+            driving = self.driving
             self.session.record_summary(
-                ended=ended, final_state=running.state if running is not None else None
+                ended=ended, final_state=driving.controller.state if driving is not None else None
             )
             recorder.close()
             if recorder.stopped is not None and not self._record_stop_told:
@@ -660,7 +615,3 @@ class LabStation:
         if self._run_open:
             self._close_run("stopped")
 
-
-def _port_binding(sensors: Sequence[SensorSpec]) -> dict[str, int]:
-    """A program reads sensors by port: each one under the name ``port N``."""
-    return {f"port {s.port}": s.port for s in sensors}

@@ -2,8 +2,8 @@
 
 :func:`choose_program` reads the file through the station's file rules (a served student
 reaches only their workspace), loads, checks and compiles it, and hands the station a
-:class:`~workbench.control.station.ProgramChoice`: a maker of fresh controllers, the check of
-the robot's sensors, and the lines that describe the program.
+:class:`~workbench.control.station.ProgramChoice`: a maker of the program driving afresh, the
+check of the robot's sensors, and the lines that describe the program.
 """
 
 from __future__ import annotations
@@ -17,8 +17,7 @@ from workbench.sim.sensors import SensorSpec
 
 from . import kinds as K
 from .compiled import Compiled
-from .headless import check_sensors, load_compiled
-from .interp import ProgramController
+from .pilot import check_sensors, load_compiled, program_driving
 from .problems import ProgramError
 
 #: the file endings the app takes for a VIPLE program (VIPLE 4.x, and 3.x XML)
@@ -68,7 +67,7 @@ def program_choice(compiled: Compiled, shown: str) -> ProgramChoice:
         name=os.path.basename(shown),
         source=shown,
         digest=program.digest,
-        make=lambda: ProgramController(compiled),
+        make=lambda: program_driving(compiled, shown),
         needs=needs,
         summary=tuple(describe_choice(compiled)),
     )

@@ -11,7 +11,7 @@ from __future__ import annotations
 import json
 import re
 
-from .expr import Value
+from .viple_expr import Value
 
 MAX_JSON = 64 * 1024
 

@@ -11,10 +11,10 @@ from dataclasses import dataclass, field
 
 from . import kinds as K
 from .code import CodeRefused, recognise
-from .expr import ExprError, Expression, Value, literal, parse
 from .keys import KEY_NAMES
 from .model import Activity, Program
 from .problems import Problem, ProgramError
+from .viple_expr import ExprError, Expression, Value, literal, parse
 
 #: a Variable's declared type -> the value an unset variable holds
 DEFAULTS: dict[str, Value] = {

@@ -25,9 +25,9 @@ from workbench.sim.commands import MotorPower, MoveAtPower, TurnByDegrees, Wheel
 from . import kinds as K
 from .code import first_sensor_value
 from .compiled import DEFAULTS, Compiled
-from .expr import ExprError, Scope, Value, show, type_name
 from .keys import KeyEvent, TypedKeys
 from .model import ELSE
+from .viple_expr import ExprError, Scope, Value, show, type_name
 
 SLICE = 50
 FLOW_TICK_STEPS = 5_000

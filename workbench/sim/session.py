@@ -27,8 +27,11 @@ _NONE: frozenset[str] = frozenset()
 class Controller(Protocol):
     """What decides motor commands each control tick (the FSM engine is one)."""
 
-    state: str | None
-    variables: dict[str, Any]
+    @property
+    def state(self) -> str | None: ...
+
+    @property
+    def variables(self) -> dict[str, Any]: ...
 
     def start(self, t: float) -> list[Any]: ...
 

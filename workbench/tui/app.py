@@ -286,7 +286,7 @@ class WorkbenchApp(ScreenHost[None]):
         if self.endpoints is not None:
             self._show_connection(self.endpoints.summary())
         steps = self._advance()
-        state = (station.paused, station.notice, station.controller, len(station.runs))
+        state = (station.paused, station.notice, station.driving, len(station.runs))
         if steps or state != self._drawn:
             self.refresh_views()
         self._rest(station.at_rest)
@@ -373,7 +373,7 @@ class WorkbenchApp(ScreenHost[None]):
         the screen dimmed under it is brought up to date when it is on top again (the clock
         had redrawn a whole dimmed screen every second, 8 KB a second over SSH)."""
         station = self.station
-        self._drawn = (station.paused, station.notice, station.controller, len(station.runs))
+        self._drawn = (station.paused, station.notice, station.driving, len(station.runs))
         snapshot = station.snapshot()
         stack = self.screen_stack
         dialog = stack[-1] if stack and isinstance(stack[-1], ModalScreen) else None

@@ -4,6 +4,7 @@ write, run by the same engine)."""
 from __future__ import annotations
 
 import difflib
+import os
 from collections.abc import Callable
 from functools import cache
 from pathlib import Path
@@ -34,7 +35,7 @@ def list_algorithms() -> list[str]:
 
 
 def load_algorithm(
-    name_or_path: str | Path, resolve: Callable[[str], Path] = Path
+    name_or_path: str | os.PathLike[str], resolve: Callable[[str], Path] = Path
 ) -> FsmDefinition:
     """A built-in algorithm by name, or an FSM file by path; raises :class:`FsmFileError`.
 

@@ -297,12 +297,13 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
             return  # the app ticks while the dialog is still being built
         station = self.station
         paused = " (paused)" if station.paused else ""
-        if station.controller is not None:
-            text = f"running, in {station.controller.state}{paused}"
-        elif station.program_run is not None:
-            text = f"program running, {station.program_run.state}{paused}"
-        else:
+        driving = station.driving
+        if driving is None:
             text = f"driver: {snapshot.driver}{paused}"
+        elif station.program_drives:
+            text = f"program running, {driving.controller.state}{paused}"
+        else:
+            text = f"running, in {driving.controller.state}{paused}"
         self.query_one("#alg-live", Label).update(text)
         self.query_one("#alg-pause", Button).label = "Resume" if station.paused else "Pause"
 
@@ -375,34 +376,33 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
     # -- actions ----------------------------------------------------------------------------------
     def action_start(self) -> None:
         station = self.station
-        if station.program is not None:
-            try:
-                station.start_program()
-            except ValueError as exc:
-                self._error(f"cannot start: {exc.args[0].splitlines()[0]}")
-                return
-            self.post_message(Say(""))
-            self._refresh_all()
-            self.dismiss()
-            return
-        if station.algorithm is None:
-            self._error("pick an algorithm first")
-            return
-        bad = [e.parameter.name for e in self.query(ParamEditor) if e.invalid]
-        if bad:
-            self._error(f"fix the parameters marked in red first: {', '.join(bad)}")
-            return
-        if station.missing_sensors():
-            self._error("the robot lacks a sensor this algorithm reads: press f to fit them")
+        program = station.program is not None
+        if not program and not self._algorithm_ready():
             return
         try:
-            station.start_algorithm()
+            station.start()
         except (FsmError, ValueError) as exc:
-            self._error(f"cannot start: {exc}")
+            # a program's missing sensors take a line each: the first says enough here
+            self._error(f"cannot start: {exc.args[0].splitlines()[0] if program else exc}")
             return
         self.post_message(Say(""))
         self._refresh_all()
         self.dismiss()
+
+    def _algorithm_ready(self) -> bool:
+        """The chosen algorithm can start; else the dialog says what to do first."""
+        station = self.station
+        if station.algorithm is None:
+            self._error("pick an algorithm first")
+            return False
+        bad = [e.parameter.name for e in self.query(ParamEditor) if e.invalid]
+        if bad:
+            self._error(f"fix the parameters marked in red first: {', '.join(bad)}")
+            return False
+        if station.missing_sensors():
+            self._error("the robot lacks a sensor this algorithm reads: press f to fit them")
+            return False
+        return True
 
     def action_pause(self) -> None:
         self.station.toggle_pause()

@@ -127,7 +127,7 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
         self._ready = False
         self._unicode = unicode
         self._trail = trail
-        self._controller: object = None
+        self._driving: object = None
         self._moment: tuple[object, ...] = ()
         self._panels_at = 0.0
         #: the message line's text, and the VIPLE endpoints' status line
@@ -184,12 +184,12 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
         station = self.station
         self.snapshot = snapshot
         unicode = self.unicode
-        if self._all_keys and station.program_run is None:
+        if self._all_keys and not station.program_drives:
             self._all_keys = False  # the program stopped: the keys are the workbench's
             self.refresh_bindings()
-        if station.controller is not self._controller:
-            self._controller = station.controller
-            if station.controller is not None:
+        if station.driving is not self._driving:
+            self._driving = station.driving
+            if station.driving is not None:
                 self._maze_view.clear_trail()  # a new run starts from the start block
         drawn = self._maze_view.show(snapshot, station.session.world.cell)
         # the text panels follow at PANEL_HZ while the robot runs (every byte counts over SSH),
@@ -254,10 +254,10 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
     # -- actions -------------------------------------------------------------------------------
     def action_drive(self, key: str) -> None:
         station = self.station
-        program = station.program_run is not None
+        program = station.program_drives
         self._said = ""
         station.key(key)
-        if program and station.program_run is None:
+        if program and not station.program_drives:
             self._said = "program stopped: the keys drive"
         if station.paused or program:
             self.refresh_views()
@@ -267,10 +267,10 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
     @property
     def takes_all_keys(self) -> bool:
         """Every key but ctrl+k and ctrl+q goes to the running program."""
-        return self._all_keys and self.station.program_run is not None
+        return self._all_keys and self.station.program_drives
 
     def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None:
-        running = self.station.program_run is not None
+        running = self.station.program_drives
         if action == "program_key":
             return running
         if action == "all_keys_to_program":
@@ -298,7 +298,7 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
         """Arrows, digits and the free letters reach a running program; every key does
         while all keys go to it (keys VIPLE has no number for do nothing then)."""
         key = event.key
-        if self.station.program_run is None:
+        if not self.station.program_drives:
             return
         if self.takes_all_keys:
             event.stop()
@@ -345,33 +345,25 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
 
     def action_run_algorithm(self) -> None:
         station = self.station
-        if station.controller is not None:
-            station.stop_algorithm("stopped")
-            self.say("algorithm stopped: the keys drive")
+        if station.driving is not None:
+            what = "program" if station.program_drives else "algorithm"
+            station.stop("stopped")
+            self.say(f"{what} stopped: the keys drive")
             return
-        if station.program_run is not None:
-            station.stop_program("stopped")
-            self.say("program stopped: the keys drive")
-            return
-        if station.program is not None:
-            try:
-                station.start_program()
-            except ValueError as exc:
-                self.say(f"cannot start: {exc.args[0].splitlines()[0]} (o sets the ports)")
-                return
-            self.say("")
-            return
-        if station.algorithm is None:
+        program = station.program is not None
+        if not program and station.algorithm is None:
             self.action_algorithm()
             return
-        missing = station.missing_sensors()
-        if missing:
+        if not program and station.missing_sensors():
             self.say("the algorithm lacks a sensor: f fits the sensors it needs")
             return
         try:
-            station.start_algorithm()
+            station.start()
         except (FsmError, ValueError) as exc:
-            self.say(f"cannot start: {exc}")
+            if program:  # a missing sensor takes a line each: the first says enough here
+                self.say(f"cannot start: {exc.args[0].splitlines()[0]} (o sets the ports)")
+            else:
+                self.say(f"cannot start: {exc}")
             return
         self.say("")
 

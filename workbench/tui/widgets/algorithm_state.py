@@ -10,6 +10,7 @@ from textual.content import Content
 from textual.reactive import var
 from textual.widgets import Static
 
+from workbench.control.fsm import FsmController
 from workbench.control.station import LabStation
 from workbench.sim.profiles import get_profile
 
@@ -72,7 +73,8 @@ class AlgorithmState(Vertical):
 
     def show(self, station: LabStation, unicode: bool) -> None:
         definition = station.algorithm
-        controller = station.controller
+        running = station.driving.controller if station.driving is not None else None
+        controller = running if isinstance(running, FsmController) else None
         unit = get_profile(station.profile).unit
         log = self._log
         if definition is None:

@@ -10,8 +10,8 @@ from textual.reactive import var
 from textual.widgets import Log, Static
 
 from workbench.control.station import LabStation
-from workbench.program.expr import show
 from workbench.program.interp import ProgramController
+from workbench.program.viple_expr import show
 
 from .text import set_border_title
 
@@ -85,7 +85,7 @@ class ProgramState(Vertical):
     def show(self, station: LabStation, all_keys: bool = False) -> None:
         """Follow the station's program; ``all_keys``: every key goes to it (ctrl+k)."""
         choice = station.program
-        run = station.program_run
+        run = station.driving.controller if station.driving is not None else None
         set_border_title(self, f"Program {choice.name}" if choice else "Program")
         if not isinstance(run, ProgramController):
             self.summary = "not running: x starts it, g changes it." if choice else ""

@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from workbench.program.expr import MAX_DEPTH, ExprError, Scope, literal, parse, show
+from workbench.program.viple_expr import MAX_DEPTH, ExprError, Scope, literal, parse, show
 
 SCOPE = Scope(
     value=25,
