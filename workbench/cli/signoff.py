@@ -35,7 +35,7 @@ from workbench.labs.store import (
     resolve_data_dir,
     resolve_db,
 )
-from workbench.sim.mazefile import write_text_atomic
+from workbench.files.atomic import write_text_atomic
 
 from .common import db_option
 from .instructor import data_dir_option

@@ -37,7 +37,7 @@ from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey,
 from cryptography.hazmat.primitives.ciphers.aead import AESGCM
 from cryptography.hazmat.primitives.kdf.scrypt import Scrypt
 
-from workbench.sim.mazefile import write_text_atomic
+from workbench.files.atomic import write_text_atomic
 from workbench.sim.record import file_sha256
 
 from . import signlog
