@@ -11,7 +11,7 @@ from pathlib import Path
 from textual.pilot import Pilot
 from textual.widgets import Input
 
-from workbench.labs import signoff as so
+from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.store import Store
 from workbench.tui.dialogs.algorithm import AlgorithmModal
 from workbench.tui.dialogs.signoff import SignoffModal
@@ -21,13 +21,13 @@ from .support import run
 
 PROGRAM = Path(__file__).resolve().parents[2] / "programs" / "right-wall.viple"
 EXERCISE = "web-simulator/wall-activities"
-FAST = so.KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
+FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
 PASS = "correct horse battery"
 
 
 def test_a_viple_exercise_is_passed_and_signed_off_with_the_students_program(tmp_path):
     data = tmp_path / "data"
-    so.create_instructor(data, "Dr Chen", PASS, kdf=FAST)
+    create_instructor(data, "Dr Chen", PASS, kdf=FAST)
     app = lab_app(data)
     digest = hashlib.sha256(PROGRAM.read_bytes()).hexdigest()
 

@@ -7,7 +7,10 @@ from textual.pilot import Pilot
 from textual.widgets import Button, Checkbox, Input, OptionList, Select, Static
 
 from workbench.cli import build_parser
-from workbench.labs import signoff as so
+from workbench.labs.instructors import KdfParams, create_instructor
+from workbench.labs.signing import FAILURE_LIMIT, sign_off
+from workbench.labs.signoff_errors import WrongPassphrase
+from workbench.labs.signoff_record import RecordFields
 from workbench.labs.store import Store
 from workbench.tui.dialogs.signoff import SignoffModal
 from workbench.tui.screens.labs import LabsScreen
@@ -16,7 +19,7 @@ from workbench.tui.screens.main import MainScreen
 from .labs_support import DRIVE, lab_app, open_exercise, text
 from .support import run
 
-FAST = so.KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
+FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
 PASS = "correct horse battery"
 
 
@@ -98,7 +101,7 @@ def test_a_question_is_checked_as_it_is_answered(tmp_path):
 
 def test_sign_off_happy_path_then_the_driver_changes(tmp_path):
     data = tmp_path / "data"
-    so.create_instructor(data, "Dr Chen", PASS, kdf=FAST)
+    create_instructor(data, "Dr Chen", PASS, kdf=FAST)
     app = lab_app(data)
 
     async def body(pilot: Pilot) -> None:
@@ -164,7 +167,7 @@ def test_sign_off_happy_path_then_the_driver_changes(tmp_path):
 
 def test_a_wrong_passphrase_is_shown_and_nothing_is_signed(tmp_path):
     data = tmp_path / "data"
-    so.create_instructor(data, "Dr Chen", PASS, kdf=FAST)
+    create_instructor(data, "Dr Chen", PASS, kdf=FAST)
     app = lab_app(data)
 
     async def body(pilot: Pilot) -> None:
@@ -187,12 +190,12 @@ def test_a_wrong_passphrase_is_shown_and_nothing_is_signed(tmp_path):
 
 def test_a_locked_out_instructor_is_told_for_how_long(tmp_path):
     data = tmp_path / "data"
-    so.create_instructor(data, "Dr Chen", PASS, kdf=FAST)
-    fields = so.RecordFields("ana", "unity-simulator", "drive-by-wire", objectives_passed=True)
+    create_instructor(data, "Dr Chen", PASS, kdf=FAST)
+    fields = RecordFields("ana", "unity-simulator", "drive-by-wire", objectives_passed=True)
     with Store.open(data) as store:
-        for _ in range(so.FAILURE_LIMIT - 1):
-            with pytest.raises(so.WrongPassphrase):
-                so.sign_off(store, "Dr Chen", "not the passphrase", fields)
+        for _ in range(FAILURE_LIMIT - 1):
+            with pytest.raises(WrongPassphrase):
+                sign_off(store, "Dr Chen", "not the passphrase", fields)
     app = lab_app(data)
 
     async def body(pilot: Pilot) -> None:
@@ -228,7 +231,7 @@ def test_the_command_line_names_the_student_partner_and_data_folder():
 
 def test_an_override_without_a_note_is_refused(tmp_path):
     data = tmp_path / "data"
-    so.create_instructor(data, "Dr Chen", PASS, kdf=FAST)
+    create_instructor(data, "Dr Chen", PASS, kdf=FAST)
     app = lab_app(data)
 
     async def body(pilot: Pilot) -> None:

@@ -18,14 +18,10 @@ from textual.screen import ModalScreen
 from textual.widgets import Button, Checkbox, Input, Label, Select, Static
 
 from workbench.labs.checks import ExerciseProgress
-from workbench.labs.signoff import (
-    Evidence,
-    LockedOut,
-    RecordFields,
-    SignoffError,
-    offered_roster,
-    sign_off,
-)
+from workbench.labs.roster import offered_roster
+from workbench.labs.signing import sign_off
+from workbench.labs.signoff_errors import LockedOut, SignoffError
+from workbench.labs.signoff_record import Evidence, RecordFields
 from workbench.labs.store import Store, StoreError
 
 from ..keys import bindings
