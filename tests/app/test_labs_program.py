@@ -16,7 +16,7 @@ from workbench.labs.store import Store
 from workbench.tui.dialogs.algorithm import AlgorithmModal
 from workbench.tui.dialogs.signoff import SignoffModal
 
-from .labs_support import lab_app, open_exercise, text
+from .labs_support import lab_app, open_exercise, signing_over, text
 from .support import run
 
 PROGRAM = Path(__file__).resolve().parents[2] / "programs" / "right-wall.viple"
@@ -74,7 +74,7 @@ def test_a_viple_exercise_is_passed_and_signed_off_with_the_students_program(tmp
         field.value = PASS
         field.focus()
         await pilot.press("enter")
-        await pilot.pause()
+        await signing_over(pilot, modal)
         assert "Signed off by Dr Chen" in text(modal, "#signoff-done")
         with Store.open(data) as store:
             (row,) = store.signoffs(student="ana")

@@ -27,6 +27,7 @@ from textual.pilot import Pilot
 from textual.widgets import Input, Markdown, OptionList, Select, Static
 from websockets.asyncio.server import serve
 
+from tests.app.labs_support import signing_over
 from tests.integration.test_labs_completable import DRIVE, SOLUTIONS, answer, free_port
 from workbench.cli import main
 from workbench.control.algorithms import list_algorithms
@@ -403,6 +404,7 @@ class Walkthrough:
         field.value = PASS
         field.focus()
         await self.press("enter")
+        await signing_over(self.pilot, modal)
         done = str(modal.query_one("#signoff-done").render())
         assert done == f"Signed off by {INSTRUCTOR}.", str(
             modal.query_one("#signoff-status").render()

@@ -13,6 +13,7 @@ import pytest
 from textual.pilot import Pilot
 from textual.widgets import Checkbox, Input, OptionList
 
+from tests.app.labs_support import signing_over
 from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.model import load_labs
 from workbench.tui.app import WorkbenchApp, make_app
@@ -74,7 +75,7 @@ def test_driver_change_prompt_after_an_override(snap_compare, tmp_path):
         field.value = PASS
         field.focus()
         await pilot.press("enter")
-        await pilot.pause()
+        await signing_over(pilot, modal)
         still(pilot)
         await pilot.pause()
 

@@ -116,11 +116,11 @@ def create_instructor(
     name = check_name(name)
     check_passphrase(passphrase)
     params = kdf or KdfParams()
-    in_database = store is not None and store.keeps_roster
+    database = store if store is not None and store.keeps_roster else None
     roster_file = roster_path(data_dir)
-    roster = offered_roster(store) if in_database else load_roster(roster_file)
+    roster = offered_roster(database) if database is not None else load_roster(roster_file)
     if name in roster:
-        where = store.where if in_database and store is not None else roster_file
+        where = database.where if database is not None else roster_file
         raise SignoffError(f"{name} is already in the roster {where}")
     kept = load_roster(trusted) if trusted is not None else {}
     if name in kept:
@@ -129,7 +129,7 @@ def create_instructor(
             "another name, or remove the old entry from that file first"
         )
     target = key_path(data_dir, name)
-    if not in_database and target.exists():
+    if database is None and target.exists():
         raise SignoffError(f"{target}: a key for {name} already exists")
     private = Ed25519PrivateKey.generate()
     instructor = Instructor(name, private)
@@ -155,9 +155,9 @@ def create_instructor(
         "encrypted_private_key": to_b64(sealed),
     }
     entry = RosterEntry(name, public, utc_iso(now or datetime.now(UTC)))
-    if in_database and store is not None:
+    if database is not None:
         try:
-            store.add_instructor(name, public, entry.added, json.dumps(data, indent=2) + "\n")
+            database.add_instructor(name, public, entry.added, json.dumps(data, indent=2) + "\n")
         except StoreError as exc:
             raise SignoffError(str(exc)) from None
     else:

@@ -84,7 +84,7 @@ def _front_matter(lines: list[str], source: str) -> tuple[dict, int, list[Proble
             ],
         )
     problems = []
-    key_lines = {}
+    key_lines: dict[str, int] = {}
     for i, raw in enumerate(lines[1:end], start=2):
         key = raw.split(":", 1)[0].strip()
         key_lines.setdefault(key, i)
