@@ -8,6 +8,7 @@ from textual.pilot import Pilot
 from textual.widgets import OptionList, Static
 
 from workbench.tui.app import WorkbenchApp, make_app
+from workbench.tui.dialogs.signoff import SignoffModal
 from workbench.tui.screens.labs import LabsScreen
 
 DRIVE = "unity-simulator/drive-by-wire"
@@ -32,3 +33,11 @@ async def open_exercise(pilot: Pilot, option_id: str = DRIVE) -> LabsScreen:
     listing.highlighted = listing.get_option_index(option_id)
     await pilot.pause()
     return screen
+
+
+async def signing_over(pilot: Pilot, modal: SignoffModal) -> None:
+    """Wait until the sign-off the dialog started (its key unlocked in a thread) is over:
+    signed, or refused with the reason shown."""
+    if modal.signing is not None:
+        await modal.signing.wait()
+    await pilot.pause()

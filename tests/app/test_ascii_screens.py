@@ -16,7 +16,7 @@ from textual.pilot import Pilot
 from textual.widgets import Input
 
 from workbench.files.bundled import MAZE_DIR
-from workbench.labs import signoff as so
+from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.tui.app import make_app
 from workbench.tui.screens.replay import ReplayScreen
 from workbench.tui.screens.runs import RunsScreen
@@ -24,7 +24,7 @@ from workbench.tui.screens.runs import RunsScreen
 from .labs_support import open_exercise
 from .support import run, screen_lines
 
-FAST = so.KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
+FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
 BAD_MAZE = "---\nname: broken\n---\n" + "\n".join("#.?x" * 5 for _ in range(40)) + "\n"
 
 
@@ -50,7 +50,7 @@ class Walk:
 @pytest.mark.long
 def test_every_screen_and_dialog_is_plain_ascii_in_ascii_mode(tmp_path: Path):
     data = tmp_path / "data"
-    so.create_instructor(data, "Dr Chen", "correct horse battery", kdf=FAST)
+    create_instructor(data, "Dr Chen", "correct horse battery", kdf=FAST)
     bad = tmp_path / "bad.txt"
     bad.write_text(BAD_MAZE)
     app = make_app(

@@ -11,23 +11,23 @@ from pathlib import Path
 from textual.pilot import Pilot
 from textual.widgets import Input
 
-from workbench.labs import signoff as so
+from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.store import Store
 from workbench.tui.dialogs.algorithm import AlgorithmModal
 from workbench.tui.dialogs.signoff import SignoffModal
 
-from .labs_support import lab_app, open_exercise, text
+from .labs_support import lab_app, open_exercise, signing_over, text
 from .support import run
 
 PROGRAM = Path(__file__).resolve().parents[2] / "programs" / "right-wall.viple"
 EXERCISE = "web-simulator/wall-activities"
-FAST = so.KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
+FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
 PASS = "correct horse battery"
 
 
 def test_a_viple_exercise_is_passed_and_signed_off_with_the_students_program(tmp_path):
     data = tmp_path / "data"
-    so.create_instructor(data, "Dr Chen", PASS, kdf=FAST)
+    create_instructor(data, "Dr Chen", PASS, kdf=FAST)
     app = lab_app(data)
     digest = hashlib.sha256(PROGRAM.read_bytes()).hexdigest()
 
@@ -74,7 +74,7 @@ def test_a_viple_exercise_is_passed_and_signed_off_with_the_students_program(tmp
         field.value = PASS
         field.focus()
         await pilot.press("enter")
-        await pilot.pause()
+        await signing_over(pilot, modal)
         assert "Signed off by Dr Chen" in text(modal, "#signoff-done")
         with Store.open(data) as store:
             (row,) = store.signoffs(student="ana")

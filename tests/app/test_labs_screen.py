@@ -2,21 +2,27 @@
 
 from __future__ import annotations
 
+import asyncio
+import threading
+
 import pytest
 from textual.pilot import Pilot
 from textual.widgets import Button, Checkbox, Input, OptionList, Select, Static
 
 from workbench.cli import build_parser
-from workbench.labs import signoff as so
+from workbench.labs.instructors import KdfParams, SealedKey, create_instructor
+from workbench.labs.signing import FAILURE_LIMIT, sign_off
+from workbench.labs.signoff_errors import WrongPassphrase
+from workbench.labs.signoff_record import RecordFields
 from workbench.labs.store import Store
 from workbench.tui.dialogs.signoff import SignoffModal
 from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
 
-from .labs_support import DRIVE, lab_app, open_exercise, text
+from .labs_support import DRIVE, lab_app, open_exercise, signing_over, text
 from .support import run
 
-FAST = so.KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
+FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
 PASS = "correct horse battery"
 
 
@@ -98,7 +104,7 @@ def test_a_question_is_checked_as_it_is_answered(tmp_path):
 
 def test_sign_off_happy_path_then_the_driver_changes(tmp_path):
     data = tmp_path / "data"
-    so.create_instructor(data, "Dr Chen", PASS, kdf=FAST)
+    create_instructor(data, "Dr Chen", PASS, kdf=FAST)
     app = lab_app(data)
 
     async def body(pilot: Pilot) -> None:
@@ -115,7 +121,7 @@ def test_sign_off_happy_path_then_the_driver_changes(tmp_path):
         field.value = PASS
         field.focus()
         await pilot.press("enter")
-        await pilot.pause()
+        await signing_over(pilot, modal)
         assert "Signed off by Dr Chen" in text(modal, "#signoff-done")
         await pilot.click("#signoff-driver-1")
         await pilot.pause()
@@ -164,7 +170,7 @@ def test_sign_off_happy_path_then_the_driver_changes(tmp_path):
 
 def test_a_wrong_passphrase_is_shown_and_nothing_is_signed(tmp_path):
     data = tmp_path / "data"
-    so.create_instructor(data, "Dr Chen", PASS, kdf=FAST)
+    create_instructor(data, "Dr Chen", PASS, kdf=FAST)
     app = lab_app(data)
 
     async def body(pilot: Pilot) -> None:
@@ -175,7 +181,7 @@ def test_a_wrong_passphrase_is_shown_and_nothing_is_signed(tmp_path):
         modal = app.screen
         modal.query_one("#signoff-passphrase", Input).value = "not the passphrase"
         await pilot.click("#signoff-sign")
-        await pilot.pause()
+        await signing_over(pilot, modal)
         assert text(modal, "#signoff-status") == "wrong passphrase for Dr Chen"
         assert modal.query_one("#signoff-passphrase", Input).value == ""
         assert app.store.signoffs() == []
@@ -187,12 +193,12 @@ def test_a_wrong_passphrase_is_shown_and_nothing_is_signed(tmp_path):
 
 def test_a_locked_out_instructor_is_told_for_how_long(tmp_path):
     data = tmp_path / "data"
-    so.create_instructor(data, "Dr Chen", PASS, kdf=FAST)
-    fields = so.RecordFields("ana", "unity-simulator", "drive-by-wire", objectives_passed=True)
+    create_instructor(data, "Dr Chen", PASS, kdf=FAST)
+    fields = RecordFields("ana", "unity-simulator", "drive-by-wire", objectives_passed=True)
     with Store.open(data) as store:
-        for _ in range(so.FAILURE_LIMIT - 1):
-            with pytest.raises(so.WrongPassphrase):
-                so.sign_off(store, "Dr Chen", "not the passphrase", fields)
+        for _ in range(FAILURE_LIMIT - 1):
+            with pytest.raises(WrongPassphrase):
+                sign_off(store, "Dr Chen", "not the passphrase", fields)
     app = lab_app(data)
 
     async def body(pilot: Pilot) -> None:
@@ -206,15 +212,67 @@ def test_a_locked_out_instructor_is_told_for_how_long(tmp_path):
         field.value = "still not the passphrase"
         field.focus()
         await pilot.press("enter")
-        await pilot.pause()
+        await signing_over(pilot, modal)
         assert text(modal, "#signoff-status").startswith(
             "sign-off by Dr Chen is locked for 60 s more"
         )
         field.value = PASS
         await pilot.press("enter")
-        await pilot.pause()
+        await signing_over(pilot, modal)
         assert "is locked for" in text(modal, "#signoff-status")
         assert app.store.signoffs() == []
+
+    run(app, body)
+
+
+def test_the_app_keeps_answering_while_the_key_is_unlocked(tmp_path, monkeypatch):
+    """scrypt runs in a thread: while it works the dialog says so, typed keys arrive, a
+    second enter starts no second sign-off, and escape closes once the sign-off is done."""
+    data = tmp_path / "data"
+    create_instructor(data, "Dr Chen", PASS, kdf=FAST)
+    unlocking, release = threading.Event(), threading.Event()
+    unlocks = []
+    unlock = SealedKey.unlock
+
+    def held(key: SealedKey, passphrase: str):
+        unlocks.append(key.name)
+        unlocking.set()
+        if threading.current_thread() is threading.main_thread():
+            raise AssertionError("the key is unlocked on the event loop")
+        release.wait(timeout=60)
+        return unlock(key, passphrase)
+
+    monkeypatch.setattr(SealedKey, "unlock", held)
+    app = lab_app(data)
+
+    async def body(pilot: Pilot) -> None:
+        screen = await open_exercise(pilot)
+        await complete_drive_by_wire(pilot, screen)
+        await pilot.press("i")
+        await pilot.pause()
+        modal = app.screen
+        assert isinstance(modal, SignoffModal)
+        field = modal.query_one("#signoff-passphrase", Input)
+        field.value = PASS
+        field.focus()
+        await pilot.press("enter")
+        await asyncio.to_thread(unlocking.wait, 60)
+        assert text(modal, "#signoff-status") == "unlocking the key of Dr Chen..."
+        note = modal.query_one("#signoff-note", Input)
+        note.focus()
+        await pilot.press("o", "k")
+        assert note.value == "ok"  # keys typed while the key is unlocked arrive
+        await pilot.press("enter")  # a second enter while the first sign-off is under way
+        await pilot.press("escape")
+        assert app.screen is modal
+        assert text(modal, "#signoff-status") == "closing once the key is unlocked..."
+        release.set()
+        await signing_over(pilot, modal)
+        assert app.screen is screen  # closed once signed, the driver kept
+        assert unlocks == ["Dr Chen"]
+        (row,) = app.store.signoffs(student="ana")
+        assert row.instructor == "Dr Chen" and not row.note
+        assert text(screen, "#labs-message") == "signed off; ana drives next"
 
     run(app, body)
 
@@ -228,7 +286,7 @@ def test_the_command_line_names_the_student_partner_and_data_folder():
 
 def test_an_override_without_a_note_is_refused(tmp_path):
     data = tmp_path / "data"
-    so.create_instructor(data, "Dr Chen", PASS, kdf=FAST)
+    create_instructor(data, "Dr Chen", PASS, kdf=FAST)
     app = lab_app(data)
 
     async def body(pilot: Pilot) -> None:
@@ -241,17 +299,17 @@ def test_an_override_without_a_note_is_refused(tmp_path):
         modal.query_one("#signoff-passphrase", Input).value = PASS
         note.focus()
         await pilot.press("enter")  # as the Sign off button does
-        await pilot.pause()
+        await signing_over(pilot, modal)
         assert "sign off with an override" in text(modal, "#signoff-status")
         modal.query_one("#signoff-override", Checkbox).value = True
         modal.query_one("#signoff-passphrase", Input).value = PASS
         await pilot.press("enter")
-        await pilot.pause()
+        await signing_over(pilot, modal)
         assert text(modal, "#signoff-status") == "an override needs a note saying why"
         note.value = "showed it on the lab robot"
         modal.query_one("#signoff-passphrase", Input).value = PASS
         await pilot.press("enter")
-        await pilot.pause()
+        await signing_over(pilot, modal)
         assert "(override)" in text(modal, "#signoff-done")
         (row,) = app.store.signoffs()
         assert row.override and row.note == "showed it on the lab robot"

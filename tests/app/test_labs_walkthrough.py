@@ -27,14 +27,17 @@ from textual.pilot import Pilot
 from textual.widgets import Input, Markdown, OptionList, Select, Static
 from websockets.asyncio.server import serve
 
+from tests.app.labs_support import signing_over
 from tests.integration.test_labs_completable import DRIVE, SOLUTIONS, answer, free_port
 from workbench.cli import main
 from workbench.control.algorithms import list_algorithms
 from workbench.control.headless import AlgorithmPilot, RunSpec
 from workbench.control.headless import run as headless_run
-from workbench.labs import signoff as so
+from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.model import Exercise, Lab, LabMaze, Objective, load_labs
+from workbench.labs.roster import load_roster, roster_path
 from workbench.labs.store import Store
+from workbench.labs.verify import verify_all
 from workbench.sim.mazeio import save_maze
 from workbench.sim.profiles import get_profile
 from workbench.tui.app import WorkbenchApp, make_app
@@ -54,7 +57,7 @@ from workbench.viple.ws_client import WsConfig
 
 from .support import run, run_panel, said, screen_lines
 
-FAST = so.KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
+FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
 INSTRUCTOR = "Dr Chen"
 PASS = "correct horse battery"
 PAIR = ("ana", "ben")
@@ -403,6 +406,7 @@ class Walkthrough:
         field.value = PASS
         field.focus()
         await self.press("enter")
+        await signing_over(self.pilot, modal)
         done = str(modal.query_one("#signoff-done").render())
         assert done == f"Signed off by {INSTRUCTOR}.", str(
             modal.query_one("#signoff-status").render()
@@ -457,7 +461,7 @@ async def viple_over_websocket(w: Walkthrough, screen: LabsScreen, lab: Lab, ex:
 def test_a_pair_completes_and_signs_off_every_exercise_in_the_app(tmp_path, lab):
     data = tmp_path / "data"
     kept_roster = tmp_path / "instructor" / "roster.json"  # the instructor's own copy
-    so.create_instructor(data, INSTRUCTOR, PASS, kdf=FAST, trusted=kept_roster)
+    create_instructor(data, INSTRUCTOR, PASS, kdf=FAST, trusted=kept_roster)
     # paused and noise off: every run is stepped by the test, in large batches, and comes out
     # the same each time; the app ticks only to draw, so slowly
     app = make_app(paused=True, noise="off", tick_hz=2, student="ana", partner="ben", data_dir=data)
@@ -500,8 +504,8 @@ def test_a_pair_completes_and_signs_off_every_exercise_in_the_app(tmp_path, lab)
 
     with Store.open(data) as store:
         rows = sorted(store.signoffs(), key=lambda r: r.id)
-        roster = so.load_roster(so.roster_path(data))
-        verdicts = so.verify_all(store, roster)
+        roster = load_roster(roster_path(data))
+        verdicts = verify_all(store, roster)
     assert [(r.lab, r.exercise) for r in rows] == [(lab.id, ex.id) for ex in lab.exercises]
     assert not any(r.override for r in rows)
     assert [r.driver for r in rows] == [PAIR[n % 2] for n in range(len(rows))]

@@ -9,11 +9,13 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from workbench.cli import main
-from workbench.labs import signoff as so
+from workbench.labs.instructors import KdfParams
+from workbench.labs.signing import sign_off
+from workbench.labs.signoff_record import Evidence, RecordFields
 from workbench.labs.store import DB_NAME, Store
 
 PASS = "correct horse battery"
-FAST = so.KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only; defaults are untouched
+FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only; defaults are untouched
 
 
 def add_instructor(monkeypatch, data_dir: Path, name: str, passphrase: str = PASS) -> int:
@@ -30,18 +32,18 @@ def sign(
     instructor: str = "Dr Chen",
     passphrase: str = PASS,
 ) -> None:
-    fields = so.RecordFields(
+    fields = RecordFields(
         student=student,
         partner=partner,
         driver=student,
         lab="web-simulator",
         exercise=exercise,
-        evidence=so.Evidence("", "", {"collisions": 1}),
+        evidence=Evidence("", "", {"collisions": 1}),
         objectives_passed=True,
     )
     moment = datetime(2026, 3, 2, 10, when, tzinfo=UTC)
     with Store.open(data_dir) as store:
-        so.sign_off(store, instructor, passphrase, fields, clock=lambda: moment)
+        sign_off(store, instructor, passphrase, fields, clock=lambda: moment)
 
 
 def sql(data_dir: Path, *statements: str, params: tuple = ()) -> list[tuple]:

@@ -11,7 +11,8 @@ from pathlib import Path
 import pytest
 
 from workbench.cli import main
-from workbench.labs import signoff as so
+from workbench.labs.instructors import create_instructor, unlock_instructor
+from workbench.labs.roster import load_roster, roster_path
 from workbench.labs.store import DB_NAME, Store
 
 from .signoff_support import FAST, PASS, add_instructor, sign
@@ -29,7 +30,7 @@ def config_dir(tmp_path, monkeypatch) -> Path:
 def data_dir(tmp_path, monkeypatch, config_dir) -> Path:
     d = tmp_path / "data"
     d.mkdir()
-    so.create_instructor(d, "Dr Chen", PASS, kdf=FAST, trusted=config_dir / "roster.json")
+    create_instructor(d, "Dr Chen", PASS, kdf=FAST, trusted=config_dir / "roster.json")
     Store.open(d).close()
     monkeypatch.delenv("WORKBENCH_DATA", raising=False)
     return d
@@ -41,9 +42,9 @@ def test_instructor_add_with_the_default_kdf_and_list(tmp_path, monkeypatch, cap
     out = capsys.readouterr().out
     assert "added Prof. Ada Lovelace" in out and "encrypted" in out
     assert f"trusted roster {config_dir / 'roster.json'}" in out
-    assert so.unlock_instructor(d, "Prof. Ada Lovelace", PASS).name == "Prof. Ada Lovelace"
-    kept = so.load_roster(config_dir / "roster.json")["Prof. Ada Lovelace"]
-    assert kept == so.load_roster(so.roster_path(d))["Prof. Ada Lovelace"]
+    assert unlock_instructor(d, "Prof. Ada Lovelace", PASS).name == "Prof. Ada Lovelace"
+    kept = load_roster(config_dir / "roster.json")["Prof. Ada Lovelace"]
+    assert kept == load_roster(roster_path(d))["Prof. Ada Lovelace"]
     assert main(["instructor", "list", "--data-dir", str(d)]) == 0
     assert "Prof. Ada Lovelace" in capsys.readouterr().out
 
@@ -52,7 +53,7 @@ def test_instructor_add_reads_the_environment_data_dir(tmp_path, monkeypatch, ca
     monkeypatch.setenv("WORKBENCH_DATA", str(tmp_path / "env"))
     monkeypatch.setattr(sys, "stdin", io.StringIO(PASS + "\n"))
     assert main(["instructor", "add", "Dr Env", "--passphrase-stdin"]) == 0
-    assert "Dr Env" in so.load_roster(tmp_path / "env" / "roster.json")
+    assert "Dr Env" in load_roster(tmp_path / "env" / "roster.json")
 
 
 def test_instructor_add_refuses_short_passphrases_and_duplicates(data_dir, monkeypatch, capsys):
@@ -69,7 +70,7 @@ def test_instructor_add_asks_twice_on_a_terminal(data_dir, monkeypatch, capsys):
     monkeypatch.setattr("getpass.getpass", lambda prompt="": next(answers))
     assert main(["instructor", "add", "Dr Lee", "--data-dir", str(data_dir)]) == 2
     assert "the two passphrases differ" in capsys.readouterr().err
-    assert "Dr Lee" not in so.load_roster(so.roster_path(data_dir))
+    assert "Dr Lee" not in load_roster(roster_path(data_dir))
 
 
 def test_instructor_add_without_a_terminal_says_what_to_do(data_dir, monkeypatch, capsys):
@@ -107,8 +108,8 @@ def test_verify_says_what_it_checks_and_lists_every_failure(data_dir, capsys):
 def test_verify_against_another_roster(data_dir, tmp_path, capsys):
     sign(data_dir, "alice", "sensors")
     course = tmp_path / "course"
-    so.create_instructor(course, "Dr Chen", PASS, kdf=FAST)  # same name, different key
-    roster = str(so.roster_path(course))
+    create_instructor(course, "Dr Chen", PASS, kdf=FAST)  # same name, different key
+    roster = str(roster_path(course))
     assert main(["signoff", "verify", "--roster", roster, "--data-dir", str(data_dir)]) == 1
     assert "not the trusted one" in capsys.readouterr().out
     assert main(["signoff", "verify", "--roster", "nope.json", "--data-dir", str(data_dir)]) == 2

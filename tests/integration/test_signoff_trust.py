@@ -8,13 +8,17 @@ from __future__ import annotations
 import csv
 import json
 import shutil
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
+from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
 
 from workbench.cli import main
-from workbench.labs import signoff as so
+from workbench.labs.instructors import Instructor, create_instructor, key_path
+from workbench.labs.roster import load_roster, roster_path
 from workbench.labs.signlog import GENESIS, entry_hash
+from workbench.labs.signoff_record import record_from_stored
 from workbench.labs.store import DB_NAME, Store, read_signoffs
 
 from .signoff_support import FAST, PASS, add_instructor, sign, sql
@@ -31,7 +35,7 @@ def config_dir(tmp_path, monkeypatch) -> Path:
 @pytest.fixture
 def data_dir(tmp_path, config_dir) -> Path:
     d = tmp_path / "data"
-    so.create_instructor(d, "Dr Chen", PASS, kdf=FAST, trusted=config_dir / "roster.json")
+    create_instructor(d, "Dr Chen", PASS, kdf=FAST, trusted=config_dir / "roster.json")
     Store.open(d).close()
     return d
 
@@ -150,7 +154,7 @@ def test_reordered_records_are_found(three, capsys):
 
 def test_a_record_inserted_with_another_key_is_found(three, tmp_path, capsys):
     rogue = tmp_path / "rogue"
-    so.create_instructor(rogue, "Dr Chen", "a student's passphrase", kdf=FAST)
+    create_instructor(rogue, "Dr Chen", "a student's passphrase", kdf=FAST)
     sign(rogue, "mallory", "sensors", passphrase="a student's passphrase")
     [forged] = read_signoffs(rogue)
     values = {k: v for k, v in forged.__dict__.items() if k not in ("id", "seq")}
@@ -230,9 +234,9 @@ def test_an_instructor_re_keyed_in_the_data_folder_fails_and_is_not_exported(
 ):
     sign(data_dir, "alice", "sensors")
     # a student replaces Dr Chen's key pair in the data folder with one of their own
-    so.key_path(data_dir, "Dr Chen").unlink()
-    so.roster_path(data_dir).unlink()
-    so.create_instructor(data_dir, "Dr Chen", "a student's passphrase", kdf=FAST)
+    key_path(data_dir, "Dr Chen").unlink()
+    roster_path(data_dir).unlink()
+    create_instructor(data_dir, "Dr Chen", "a student's passphrase", kdf=FAST)
     sign(data_dir, "bob", "sensors", when=1, passphrase="a student's passphrase")
     code, out = verify(capsys, data_dir)
     assert code == 1
@@ -262,14 +266,14 @@ def test_look_alike_and_invisible_instructor_names_are_refused(
 ):
     assert add_instructor(monkeypatch, data_dir, name) == 2
     assert reason in capsys.readouterr().err
-    assert list(so.load_roster(so.roster_path(data_dir))) == ["Dr Chen"]
+    assert list(load_roster(roster_path(data_dir))) == ["Dr Chen"]
 
 
 def test_names_are_normalised_when_added(tmp_path, monkeypatch, capsys, config_dir):
     d = tmp_path / "fresh"
     assert add_instructor(monkeypatch, d, "Ｄｒ Ｌｅｅ") == 0  # full-width letters
     assert "added Dr Lee" in capsys.readouterr().out
-    assert list(so.load_roster(config_dir / "roster.json")) == ["Dr Lee"]
+    assert list(load_roster(config_dir / "roster.json")) == ["Dr Lee"]
     assert add_instructor(monkeypatch, d, "Dr Lee") == 2  # the same name
 
 
@@ -284,12 +288,12 @@ def test_a_roster_holding_a_look_alike_name_is_refused(three, config_dir, capsys
 
 
 def test_a_record_by_a_look_alike_instructor_is_not_a_grade(three, tmp_path, capsys):
-    impostor = so.Instructor("Dr Сhen", so.Ed25519PrivateKey.generate())  # a Cyrillic С
+    impostor = Instructor("Dr Сhen", Ed25519PrivateKey.generate())  # a Cyrillic С
     [genuine] = read_signoffs(three)[:1]
-    fields = so.record_from_stored(genuine)
+    fields = record_from_stored(genuine)
 
     def signed(seq: int, prev: str) -> dict:
-        record = so.replace(fields, student="dave", instructor="Dr Сhen", seq=seq, prev=prev)
+        record = replace(fields, student="dave", instructor="Dr Сhen", seq=seq, prev=prev)
         return record.columns(impostor.sign(record.canonical()))
 
     with Store.open(three) as store:

@@ -8,13 +8,13 @@ import subprocess
 import sys
 
 from tests.app.support import sync
-from workbench.labs import signoff as so
+from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.store import Store
 
 from .ssh_support import Account, lab_host, open_exercise
 
 PASSPHRASE = "correct horse battery"
-FAST = so.KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
+FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
 
 
 def override_ticked(text: str) -> bool:
@@ -29,7 +29,7 @@ async def test_an_instructor_signs_off_an_exercise_from_the_students_session(tmp
     accounts = [Account("ann"), Account("ito", role="instructor")]
     async with lab_host(tmp_path, accounts) as host:
         kept = tmp_path / "instructor" / "roster.json"  # the instructor's own copy
-        so.create_instructor(host.data_dir, "ito", PASSPHRASE, kdf=FAST, trusted=kept)
+        create_instructor(host.data_dir, "ito", PASSPHRASE, kdf=FAST, trusted=kept)
         term = await host.terminal("ann", size=(100, 30))
         await term.start_app()
         await open_exercise(term, "Unity simulator: Drive by wire")

@@ -14,10 +14,20 @@ from pathlib import Path
 
 import pytest
 
-from workbench.labs import signoff as so
+from workbench.labs.instructors import KdfParams, create_instructor
+from workbench.labs.roster import RosterEntry, offered_roster
+from workbench.labs.signing import sign_off
+from workbench.labs.signoff_errors import (
+    LockedOut,
+    SignoffError,
+    UnknownInstructor,
+    WrongPassphrase,
+)
+from workbench.labs.signoff_record import Evidence, RecordFields
 from workbench.labs.store import LogMissing, Store, StoreError, read_signoffs
+from workbench.labs.verify import verify_log
 
-FAST = so.KdfParams(n=2**10, r=8, p=1)
+FAST = KdfParams(n=2**10, r=8, p=1)
 PASS = "correct horse battery"
 T0 = datetime(2026, 3, 2, 14, 5, 9, tzinfo=UTC)
 ROOT = Path(__file__).resolve().parents[2]
@@ -40,11 +50,11 @@ class Where:
 
     def add_instructor(self, name: str = "Dr Chen") -> None:
         with self.open() as store:
-            so.create_instructor(self.data_dir, name, PASS, kdf=FAST, store=store)
+            create_instructor(self.data_dir, name, PASS, kdf=FAST, store=store)
 
-    def roster(self) -> dict[str, so.RosterEntry]:
+    def roster(self) -> dict[str, RosterEntry]:
         with self.open() as store:
-            return so.offered_roster(store)
+            return offered_roster(store)
 
 
 @pytest.fixture(params=["sqlite", "postgresql"])
@@ -53,18 +63,18 @@ def where(request, tmp_path: Path) -> Where:
     return Where(tmp_path / "data", db)
 
 
-def fields(student: str = "alice", **kw) -> so.RecordFields:
+def fields(student: str = "alice", **kw) -> RecordFields:
     base = dict(
         student=student,
         partner="bob",
         driver=student,
         lab="unity-simulator",
         exercise="wall-following",
-        evidence=so.Evidence("", "", {"exit_time": 41.5}),
+        evidence=Evidence("", "", {"exit_time": 41.5}),
         objectives_passed=True,
     )
     base.update(kw)
-    return so.RecordFields(**base)
+    return RecordFields(**base)
 
 
 def test_progress_places_and_drivers_are_saved_replaced_and_read_back(where):
@@ -113,29 +123,29 @@ def test_signoffs_form_one_log_that_verifies_and_reads_back_the_same(where):
     assert list(roster) == ["Dr Chen"]
     with where.open() as s:
         for student in ("alice", "carol", "dave"):
-            so.sign_off(s, "Dr Chen", PASS, fields(student))
+            sign_off(s, "Dr Chen", PASS, fields(student))
         stored = s.signoffs()
         assert [r.student for r in s.signoffs(student="bob")] == ["alice", "carol", "dave"]
     assert [r.seq for r in stored] == [1, 2, 3]
     read = read_signoffs(where.data_dir, where.db)
     assert read == stored
-    log = so.verify_log(read, roster)
+    log = verify_log(read, roster)
     assert log.ok and log.head.seq == 3
 
 
 def test_a_record_edited_in_the_database_fails_verify(where):
     where.add_instructor()
     with where.open() as s:
-        so.sign_off(s, "Dr Chen", PASS, fields())
+        sign_off(s, "Dr Chen", PASS, fields())
     where.raw("UPDATE signoffs SET note = 'great work'")
-    [verdict] = so.verify_log(read_signoffs(where.data_dir, where.db), where.roster()).verdicts
+    [verdict] = verify_log(read_signoffs(where.data_dir, where.db), where.roster()).verdicts
     assert any("signature does not match" in p for p in verdict.problems)
 
 
 def test_a_sequence_number_is_taken_once(where):
     where.add_instructor()
     with where.open() as s:
-        so.sign_off(s, "Dr Chen", PASS, fields())
+        sign_off(s, "Dr Chen", PASS, fields())
     columns = (
         "student, partner, driver, lab, exercise, instructor, signed_at, note, override, "
         "run_record, evidence_digest, metrics, signature, seq"
@@ -147,11 +157,11 @@ def test_a_sequence_number_is_taken_once(where):
 def test_the_lockout_counts_across_a_reopen(where):
     where.add_instructor()
     for _ in range(4):
-        with where.open() as s, pytest.raises(so.WrongPassphrase):
-            so.sign_off(s, "Dr Chen", "wrong wrong wrong", fields(), clock=lambda: T0)
+        with where.open() as s, pytest.raises(WrongPassphrase):
+            sign_off(s, "Dr Chen", "wrong wrong wrong", fields(), clock=lambda: T0)
     with where.open() as s:
-        with pytest.raises(so.LockedOut, match="60 s more"):
-            so.sign_off(s, "Dr Chen", "wrong wrong wrong", fields(), clock=lambda: T0)
+        with pytest.raises(LockedOut, match="60 s more"):
+            sign_off(s, "Dr Chen", "wrong wrong wrong", fields(), clock=lambda: T0)
         assert [e.event for e in s.events("Dr Chen")] == ["wrong-passphrase"] * 5 + ["locked"]
 
 
@@ -181,14 +191,15 @@ def test_two_threads_write_at_the_same_time(where):
 
 SIGNER = """
 import sys, time
-from workbench.labs import signoff as so
+from workbench.labs.signing import sign_off
+from workbench.labs.signoff_record import RecordFields
 from workbench.labs.store import Store
 data_dir, db, who, start = sys.argv[1], sys.argv[2] or None, sys.argv[3], float(sys.argv[4])
-fields = so.RecordFields(student=who, lab="lab", exercise="ex", objectives_passed=True)
+fields = RecordFields(student=who, lab="lab", exercise="ex", objectives_passed=True)
 with Store.open(data_dir, db=db) as store:
     time.sleep(max(0.0, start - time.time()))
     for i in range(10):
-        so.sign_off(store, "Dr Chen", "correct horse battery", fields)
+        sign_off(store, "Dr Chen", "correct horse battery", fields)
 """
 
 
@@ -206,7 +217,7 @@ def test_two_processes_signing_at_once_make_one_log(where):
     rows = read_signoffs(where.data_dir, where.db)
     assert [r.seq for r in rows] == list(range(1, 21))
     assert sorted(r.student for r in rows) == ["alice"] * 10 + ["bob"] * 10
-    log = so.verify_log(rows, where.roster())
+    log = verify_log(rows, where.roster())
     assert log.ok, (log.breaks, [v.problems for v in log.verdicts if not v.ok])
 
 
@@ -221,14 +232,14 @@ def test_a_course_database_holds_the_roster_and_the_keys(pg_url, tmp_path):
     assert not (tmp_path / "one" / "instructors").exists()
     assert not (tmp_path / "one" / "roster.json").exists()
     with two.open() as s:
-        assert list(so.offered_roster(s)) == ["Dr Chen"]
+        assert list(offered_roster(s)) == ["Dr Chen"]
         assert '"encrypted_private_key"' in (s.instructor_key("Dr Chen") or "")
-        so.sign_off(s, "Dr Chen", PASS, fields())
-        with pytest.raises(so.WrongPassphrase):
-            so.sign_off(s, "Dr Chen", "not the passphrase", fields())
-        with pytest.raises(so.UnknownInstructor, match="no key for instructor Dr Lee"):
-            so.sign_off(s, "Dr Lee", PASS, fields())
-    with pytest.raises(so.SignoffError, match="already in the roster"):
+        sign_off(s, "Dr Chen", PASS, fields())
+        with pytest.raises(WrongPassphrase):
+            sign_off(s, "Dr Chen", "not the passphrase", fields())
+        with pytest.raises(UnknownInstructor, match="no key for instructor Dr Lee"):
+            sign_off(s, "Dr Lee", PASS, fields())
+    with pytest.raises(SignoffError, match="already in the roster"):
         two.add_instructor("Dr Chen")
 
 

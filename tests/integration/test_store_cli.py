@@ -12,7 +12,11 @@ from pathlib import Path
 import pytest
 
 from workbench.cli import main
-from workbench.labs import signoff as so
+from workbench.labs.instructors import create_instructor
+from workbench.labs.roster import load_roster
+from workbench.labs.signing import sign_off
+from workbench.labs.signoff_errors import WrongPassphrase
+from workbench.labs.signoff_record import RecordFields
 from workbench.labs.store import Store
 
 from .signoff_support import FAST, PASS, sign
@@ -32,16 +36,16 @@ def section(tmp_path, config_dir) -> Path:
     """A lab machine's data folder after a week of labs: an instructor, three sign-offs, a
     wrong passphrase, progress, places and drivers."""
     d = tmp_path / "data"
-    so.create_instructor(d, "Dr Chen", PASS, kdf=FAST, trusted=config_dir / "roster.json")
+    create_instructor(d, "Dr Chen", PASS, kdf=FAST, trusted=config_dir / "roster.json")
     for n, student in enumerate(("ana", "ben", "cy")):
         sign(d, student, f"ex{n}", when=n)
     with Store.open(d) as store:
         store.save_progress("ana", "web", "ex1", {"answers": {"q1": "3"}})
         store.set_place("ana", "web", "ex1")
         store.set_driver("ana", "", "web", "ex2", "ana")
-        fields = so.RecordFields(student="ana", lab="web", exercise="ex1", objectives_passed=True)
-        with pytest.raises(so.WrongPassphrase):
-            so.sign_off(store, "Dr Chen", "not the passphrase", fields)
+        fields = RecordFields(student="ana", lab="web", exercise="ex1", objectives_passed=True)
+        with pytest.raises(WrongPassphrase):
+            sign_off(store, "Dr Chen", "not the passphrase", fields)
     return d
 
 
@@ -71,11 +75,11 @@ def test_migrate_copies_a_data_folder_and_checks_the_copy(section, pg_url, capsy
         assert store.place("ana") == ("web", "ex1")
         assert store.drivers("ana") == {("web", "ex2"): "ana"}
         # the instructor's key came along: signing goes on from the copied head
-        _, record = so.sign_off(
+        _, record = sign_off(
             store,
             "Dr Chen",
             PASS,
-            so.RecordFields(student="dee", lab="web", exercise="ex4", objectives_passed=True),
+            RecordFields(student="dee", lab="web", exercise="ex4", objectives_passed=True),
         )
         assert store.lockout("Dr Chen").failures == 0
     assert record.seq == 4
@@ -108,15 +112,15 @@ def test_instructors_and_sign_offs_on_a_course_database_from_the_environment(
     out = capsys.readouterr().out
     assert "encrypted in the course database postgresql://postgres@127.0.0.1" in out
     assert not (data / "roster.json").exists()
-    assert "Dr Lee" in so.load_roster(config_dir / "roster.json")  # the trusted copy
+    assert "Dr Lee" in load_roster(config_dir / "roster.json")  # the trusted copy
     assert main(["instructor", "list"]) == 0
     listed = capsys.readouterr().out
     assert "Dr Lee" in listed and "key here" in listed and "trusted" in listed
 
     with Store.open(tmp_path / "other", db=pg_url) as store:
         moment = datetime(2026, 3, 2, 10, tzinfo=UTC)
-        fields = so.RecordFields(student="ana", lab="web", exercise="ex1", objectives_passed=True)
-        so.sign_off(store, "Dr Lee", PASS, fields, clock=lambda: moment)
+        fields = RecordFields(student="ana", lab="web", exercise="ex1", objectives_passed=True)
+        sign_off(store, "Dr Lee", PASS, fields, clock=lambda: moment)
     assert main(["signoff", "list"]) == 0
     assert "#1  2026-03-02T10:00:00Z  ana  web/ex1  by Dr Lee" in capsys.readouterr().out
     csv_path = tmp_path / "grades.csv"

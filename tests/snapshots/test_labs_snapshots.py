@@ -13,18 +13,19 @@ import pytest
 from textual.pilot import Pilot
 from textual.widgets import Checkbox, Input, OptionList
 
-from workbench.labs import signoff as so
+from tests.app.labs_support import signing_over
+from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.model import load_labs
 from workbench.tui.app import WorkbenchApp, make_app
 
-FAST = so.KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
+FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
 PASS = "correct horse battery"
 SIZE = (80, 24)
 
 
 def lab_app(data_dir: Path, instructor: bool = True) -> WorkbenchApp:
     if instructor:
-        so.create_instructor(data_dir, "Dr Chen", PASS, kdf=FAST)
+        create_instructor(data_dir, "Dr Chen", PASS, kdf=FAST)
     return make_app(paused=True, student="ana", partner="ben", data_dir=data_dir)
 
 
@@ -74,7 +75,7 @@ def test_driver_change_prompt_after_an_override(snap_compare, tmp_path):
         field.value = PASS
         field.focus()
         await pilot.press("enter")
-        await pilot.pause()
+        await signing_over(pilot, modal)
         still(pilot)
         await pilot.pause()
 

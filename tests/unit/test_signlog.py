@@ -10,17 +10,20 @@ from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from workbench.labs import signoff as so
+from workbench.labs.instructors import Instructor
+from workbench.labs.roster import RosterEntry
 from workbench.labs.signlog import EMPTY_HEAD, GENESIS, Head, LogError, entry_hash
+from workbench.labs.signoff_record import Evidence, SignoffRecord
 from workbench.labs.store import StoredSignoff
+from workbench.labs.verify import verify_log
 
-CHEN = so.Instructor("Dr Chen", Ed25519PrivateKey.generate())
-ROGUE = so.Instructor("Dr Chen", Ed25519PrivateKey.generate())  # same name, another key
-ROSTER = {"Dr Chen": so.RosterEntry("Dr Chen", CHEN.public_key_b64(), "")}
+CHEN = Instructor("Dr Chen", Ed25519PrivateKey.generate())
+ROGUE = Instructor("Dr Chen", Ed25519PrivateKey.generate())  # same name, another key
+ROSTER = {"Dr Chen": RosterEntry("Dr Chen", CHEN.public_key_b64(), "")}
 
 
-def record(n: int, student: str = "") -> so.SignoffRecord:
-    return so.SignoffRecord(
+def record(n: int, student: str = "") -> SignoffRecord:
+    return SignoffRecord(
         student=student or f"student{n}",
         partner="",
         driver="",
@@ -30,11 +33,11 @@ def record(n: int, student: str = "") -> so.SignoffRecord:
         signed_at=f"2026-03-02T10:{n:02d}:00Z",
         note="",
         override=False,
-        evidence=so.Evidence("", "sha256:" + "ab" * 32, {"n": n}),
+        evidence=Evidence("", "sha256:" + "ab" * 32, {"n": n}),
     )
 
 
-def stored(rec: so.SignoffRecord, signer: so.Instructor, row_id: int) -> StoredSignoff:
+def stored(rec: SignoffRecord, signer: Instructor, row_id: int) -> StoredSignoff:
     """A record signed at its place and stored as the database stores it."""
     signature = signer.sign(rec.canonical())
     columns = rec.columns(signature)
@@ -47,7 +50,7 @@ def stored(rec: so.SignoffRecord, signer: so.Instructor, row_id: int) -> StoredS
     )
 
 
-def append(rows: list[StoredSignoff], rec: so.SignoffRecord, signer=CHEN) -> None:
+def append(rows: list[StoredSignoff], rec: SignoffRecord, signer=CHEN) -> None:
     prev = rows[-1].entry_hash if rows else GENESIS
     seq = (rows[-1].seq or 0) + 1 if rows else 1
     rows.append(stored(replace(rec, seq=seq, prev=prev), signer, len(rows) + 1))
@@ -61,7 +64,7 @@ def signed_log(n: int) -> list[StoredSignoff]:
 
 
 LOG = signed_log(5)
-HEAD = so.verify_log(LOG, ROSTER).head
+HEAD = verify_log(LOG, ROSTER).head
 
 
 def relinked(rows: list[StoredSignoff]) -> list[StoredSignoff]:
@@ -77,16 +80,16 @@ def relinked(rows: list[StoredSignoff]) -> list[StoredSignoff]:
 
 
 def test_an_untouched_log_verifies_and_its_head_is_the_last_record():
-    log = so.verify_log(LOG, ROSTER)
+    log = verify_log(LOG, ROSTER)
     assert log.ok and [v.problems for v in log.verdicts] == [()] * 5
     assert log.head == Head(5, LOG[-1].entry_hash)
-    assert so.verify_log(LOG, ROSTER, kept=HEAD).ok
-    assert so.verify_log(LOG, ROSTER, kept=so.verify_log(LOG[:2], ROSTER).head).ok  # it grew
-    assert so.verify_log([], ROSTER).head == EMPTY_HEAD and so.verify_log([], ROSTER).ok
+    assert verify_log(LOG, ROSTER, kept=HEAD).ok
+    assert verify_log(LOG, ROSTER, kept=verify_log(LOG[:2], ROSTER).head).ok  # it grew
+    assert verify_log([], ROSTER).head == EMPTY_HEAD and verify_log([], ROSTER).ok
 
 
 def test_a_deleted_record_breaks_the_chain_where_it_was():
-    log = so.verify_log(LOG[:2] + LOG[3:], ROSTER)
+    log = verify_log(LOG[:2] + LOG[3:], ROSTER)
     assert not log.ok
     assert log.breaks == ("the log breaks before sequence 4: record(s) 3 are missing (deleted)",)
     [problem] = log.verdicts[2].problems
@@ -95,28 +98,28 @@ def test_a_deleted_record_breaks_the_chain_where_it_was():
 
 
 def test_the_last_records_deleted_are_found_with_the_kept_head_only():
-    assert so.verify_log(LOG[:3], ROSTER).ok  # nothing in the log itself shows it
-    log = so.verify_log(LOG[:3], ROSTER, kept=HEAD)
+    assert verify_log(LOG[:3], ROSTER).ok  # nothing in the log itself shows it
+    log = verify_log(LOG[:3], ROSTER, kept=HEAD)
     assert log.breaks == (
         "the log ends at sequence 3 but the kept head is at 5: records were removed from the "
         "end, or the database was rolled back to an older copy",
     )
-    assert not so.verify_log([], ROSTER, kept=HEAD).ok
+    assert not verify_log([], ROSTER, kept=HEAD).ok
 
 
 def test_a_log_rewritten_from_the_kept_head_on_is_found():
     other: list[StoredSignoff] = list(LOG[:2])  # the same start, then other records
     for i in range(3, 7):
         append(other, record(i, "zoe"))
-    log = so.verify_log(other, ROSTER, kept=HEAD)
+    log = verify_log(other, ROSTER, kept=HEAD)
     assert log.breaks and "is not the one the kept head 5:" in log.breaks[0]
     assert [v.ok for v in log.verdicts] == [True] * 6
 
 
 def test_a_duplicated_record_is_found_even_relinked():
-    copied = so.verify_log([*LOG, LOG[1]], ROSTER)
+    copied = verify_log([*LOG, LOG[1]], ROSTER)
     assert "sequence number 2 appears again" in copied.verdicts[5].problems[0]
-    log = so.verify_log(relinked([*LOG, LOG[1]]), ROSTER)
+    log = verify_log(relinked([*LOG, LOG[1]]), ROSTER)
     problems = log.verdicts[5].problems
     assert any("signature does not match" in p for p in problems)
     assert any("copy of the record with id 2" in p for p in problems)
@@ -124,7 +127,7 @@ def test_a_duplicated_record_is_found_even_relinked():
 
 def test_reordered_records_fail_their_signatures():
     swapped = [LOG[0], LOG[2], LOG[1], LOG[3], LOG[4]]
-    log = so.verify_log(relinked(swapped), ROSTER)
+    log = verify_log(relinked(swapped), ROSTER)
     # every record from the swap on was signed at another place in the log
     assert [v.ok for v in log.verdicts] == [True, False, False, False, False]
     assert all("signature does not match" in v.problems[0] for v in log.verdicts[1:])
@@ -133,7 +136,7 @@ def test_reordered_records_fail_their_signatures():
 def test_an_inserted_record_signed_with_another_key_fails():
     forged: list[StoredSignoff] = list(LOG[:2])
     append(forged, record(9, "mallory"), signer=ROGUE)
-    log = so.verify_log(relinked(forged + LOG[2:]), ROSTER)
+    log = verify_log(relinked(forged + LOG[2:]), ROSTER)
     assert "signature does not match" in log.verdicts[2].problems[0]
     assert not log.verdicts[3].ok  # the genuine record after it lost its place
 
@@ -146,22 +149,22 @@ def test_a_legacy_record_cannot_be_replayed_after_chained_ones():
     )
     rows = [legacy]
     append(rows, record(2))
-    log = so.verify_log(rows, ROSTER)
+    log = verify_log(rows, ROSTER)
     assert log.ok and log.legacy == 1
     assert "legacy record" in log.verdicts[0].notes[0]
     replayed = relinked([*rows, replace(legacy, legacy=True)])
     assert "legacy records can only come first" in " ".join(
-        so.verify_log(replayed, ROSTER).verdicts[2].problems
+        verify_log(replayed, ROSTER).verdicts[2].problems
     )
 
 
 def test_a_record_by_a_key_or_a_name_not_in_the_trusted_roster_fails():
     rows = list(LOG[:1])
     lookalike = replace(record(2), instructor="Dr Сhen")  # a Cyrillic С
-    append(rows, lookalike, signer=so.Instructor("Dr Сhen", ROGUE.private_key))
+    append(rows, lookalike, signer=Instructor("Dr Сhen", ROGUE.private_key))
     append(rows, record(3), signer=ROGUE)
-    local = {"Dr Chen": so.RosterEntry("Dr Chen", ROGUE.public_key_b64(), "")}
-    log = so.verify_log(rows, ROSTER, local=local)
+    local = {"Dr Chen": RosterEntry("Dr Chen", ROGUE.public_key_b64(), "")}
+    log = verify_log(rows, ROSTER, local=local)
     assert log.verdicts[1].problems == ("instructor 'Dr Сhen' is not in the trusted roster",)
     assert "re-keyed in the data folder" in log.verdicts[2].problems[0]
 
@@ -169,7 +172,7 @@ def test_a_record_by_a_key_or_a_name_not_in_the_trusted_roster_fails():
 def test_a_look_alike_student_name_in_a_signed_record_fails():
     rows: list[StoredSignoff] = []
     append(rows, record(1, "аlice"))  # a Cyrillic а, signed by the real key
-    [problem] = so.verify_log(rows, ROSTER).verdicts[0].problems
+    [problem] = verify_log(rows, ROSTER).verdicts[0].problems
     assert "mixes letters of different scripts (Cyrillic, Latin)" in problem
 
 
@@ -213,7 +216,7 @@ def test_any_single_change_to_the_log_is_found_with_the_kept_head(case):
     same = [(r.seq, r.prev_hash, r.entry_hash, r.signature, r.signed_bytes()) for r in rows] == [
         (r.seq, r.prev_hash, r.entry_hash, r.signature, r.signed_bytes()) for r in LOG
     ]
-    log = so.verify_log(rows, ROSTER, kept=HEAD)
+    log = verify_log(rows, ROSTER, kept=HEAD)
     assert log.ok == same, (kind, log.breaks, [v.problems for v in log.verdicts])
 
 
@@ -244,9 +247,7 @@ def hostile_rows(draw) -> StoredSignoff:
     """A row as anyone who can write the database might leave it."""
     genuine = draw(st.sampled_from(LOG))
     metrics = draw(
-        st.sampled_from(
-            ['{"n":1}', "NaN", '{"n":1e999}', "[" * 5000 + "]" * 5000, "9" * 5000, "{"]
-        )
+        st.sampled_from(['{"n":1}', "NaN", '{"n":1e999}', "[" * 5000 + "]" * 5000, "9" * 5000, "{"])
         | row_text
     )
     return replace(
@@ -265,6 +266,6 @@ def hostile_rows(draw) -> StoredSignoff:
 @settings(max_examples=200, deadline=None)
 @given(st.lists(hostile_rows(), max_size=6))
 def test_whatever_the_rows_hold_checking_gives_a_verdict(rows):
-    log = so.verify_log(rows, ROSTER, kept=HEAD)
+    log = verify_log(rows, ROSTER, kept=HEAD)
     assert len(log.verdicts) == len(rows)
     assert not log.ok  # none of these is the kept log

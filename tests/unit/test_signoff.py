@@ -16,11 +16,29 @@ from pathlib import Path
 
 import pytest
 
-from workbench.labs import signoff as so
-from workbench.labs.signlog import GENESIS
+from workbench.labs.gradebook import gradebook_rows
+from workbench.labs.instructors import KdfParams, create_instructor, key_path, unlock_instructor
+from workbench.labs.roster import RosterEntry, load_roster, roster_path
+from workbench.labs.signing import MAX_NOTE, sign_off
+from workbench.labs.signlog import GENESIS, RECORD_FORMAT
+from workbench.labs.signoff_errors import (
+    LockedOut,
+    PassphraseTooShort,
+    SignoffError,
+    UnknownInstructor,
+    WrongPassphrase,
+)
+from workbench.labs.signoff_record import (
+    Evidence,
+    RecordFields,
+    SignoffRecord,
+    record_digest,
+    record_from_stored,
+)
 from workbench.labs.store import DB_NAME, Store, StoreError, read_signoffs, resolve_data_dir
+from workbench.labs.verify import verify_all, verify_log
 
-FAST = so.KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only; defaults are untouched
+FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only; defaults are untouched
 PASS = "correct horse battery"
 T0 = datetime(2026, 3, 2, 14, 5, 9, tzinfo=UTC)
 
@@ -43,7 +61,7 @@ def data_dir(tmp_path: Path) -> Path:
 
 @pytest.fixture
 def store(data_dir: Path):
-    so.create_instructor(data_dir, "Dr Chen", PASS, kdf=FAST)
+    create_instructor(data_dir, "Dr Chen", PASS, kdf=FAST)
     with Store.open(data_dir) as s:
         yield s
 
@@ -55,8 +73,8 @@ def run_record(tmp_path: Path) -> Path:
     return p
 
 
-def fields(run_record: Path | None = None, passed: bool = True, **kw) -> so.RecordFields:
-    evidence = so.Evidence(
+def fields(run_record: Path | None = None, passed: bool = True, **kw) -> RecordFields:
+    evidence = Evidence(
         str(run_record) if run_record else "", "", {"exit_time": 41.5, "collisions": 0}
     )
     base = dict(
@@ -69,64 +87,64 @@ def fields(run_record: Path | None = None, passed: bool = True, **kw) -> so.Reco
         objectives_passed=passed,
     )
     base.update(kw)
-    return so.RecordFields(**base)
+    return RecordFields(**base)
 
 
-def roster(data_dir: Path) -> dict[str, so.RosterEntry]:
-    return so.load_roster(so.roster_path(data_dir))
+def roster(data_dir: Path) -> dict[str, RosterEntry]:
+    return load_roster(roster_path(data_dir))
 
 
 def problems(store: Store, data_dir: Path) -> list[tuple[str, ...]]:
-    return [v.problems for v in so.verify_all(store, roster(data_dir))]
+    return [v.problems for v in verify_all(store, roster(data_dir))]
 
 
 # keys and roster
 
 
 def test_default_kdf_is_memory_hard():
-    assert so.KdfParams() == so.KdfParams(n=2**17, r=8, p=1)
+    assert KdfParams() == KdfParams(n=2**17, r=8, p=1)
 
 
 def test_instructor_key_is_encrypted_and_the_public_key_joins_the_roster(data_dir):
-    entry = so.create_instructor(data_dir, "Dr Chen", PASS, kdf=FAST, now=T0)
-    key_file = so.key_path(data_dir, "Dr Chen")
+    entry = create_instructor(data_dir, "Dr Chen", PASS, kdf=FAST, now=T0)
+    key_file = key_path(data_dir, "Dr Chen")
     data = json.loads(key_file.read_text())
     assert data["kdf"]["name"] == "scrypt" and data["kdf"]["n"] == 2**10
     assert data["cipher"]["name"] == "AES-256-GCM"
     assert oct(key_file.stat().st_mode & 0o777) == "0o600"
     assert roster(data_dir)["Dr Chen"] == entry
     assert entry.added == "2026-03-02T14:05:09Z"
-    unlocked = so.unlock_instructor(data_dir, "Dr Chen", PASS)
+    unlocked = unlock_instructor(data_dir, "Dr Chen", PASS)
     assert unlocked.public_key_b64() == entry.public_key
 
 
 def test_short_passphrase_is_refused_with_the_minimum(data_dir):
-    with pytest.raises(so.PassphraseTooShort, match="at least 10 characters"):
-        so.create_instructor(data_dir, "Dr Chen", "short", kdf=FAST)
-    assert not so.roster_path(data_dir).exists()
+    with pytest.raises(PassphraseTooShort, match="at least 10 characters"):
+        create_instructor(data_dir, "Dr Chen", "short", kdf=FAST)
+    assert not roster_path(data_dir).exists()
 
 
 def test_same_instructor_twice_and_bad_names_are_refused(data_dir):
-    so.create_instructor(data_dir, "Dr Chen", PASS, kdf=FAST)
-    with pytest.raises(so.SignoffError, match="already in the roster"):
-        so.create_instructor(data_dir, "Dr Chen", PASS, kdf=FAST)
+    create_instructor(data_dir, "Dr Chen", PASS, kdf=FAST)
+    with pytest.raises(SignoffError, match="already in the roster"):
+        create_instructor(data_dir, "Dr Chen", PASS, kdf=FAST)
     for bad in ("", "  ", " Dr Chen", "a\tb", "x" * 65):
-        with pytest.raises(so.SignoffError):
-            so.create_instructor(data_dir, bad, PASS, kdf=FAST)
+        with pytest.raises(SignoffError):
+            create_instructor(data_dir, bad, PASS, kdf=FAST)
 
 
 def test_wrong_passphrase_is_a_specific_error(data_dir):
-    so.create_instructor(data_dir, "Dr Chen", PASS, kdf=FAST)
-    with pytest.raises(so.WrongPassphrase, match="wrong passphrase for Dr Chen"):
-        so.unlock_instructor(data_dir, "Dr Chen", "not the passphrase")
-    with pytest.raises(so.UnknownInstructor, match="no key for instructor Dr Who"):
-        so.unlock_instructor(data_dir, "Dr Who", PASS)
+    create_instructor(data_dir, "Dr Chen", PASS, kdf=FAST)
+    with pytest.raises(WrongPassphrase, match="wrong passphrase for Dr Chen"):
+        unlock_instructor(data_dir, "Dr Chen", "not the passphrase")
+    with pytest.raises(UnknownInstructor, match="no key for instructor Dr Who"):
+        unlock_instructor(data_dir, "Dr Who", PASS)
 
 
 def test_a_damaged_roster_is_reported_with_its_file(data_dir):
     data_dir.mkdir()
-    so.roster_path(data_dir).write_text("{not json")
-    with pytest.raises(so.SignoffError, match=r"roster.json: the roster is not JSON"):
+    roster_path(data_dir).write_text("{not json")
+    with pytest.raises(SignoffError, match=r"roster.json: the roster is not JSON"):
         roster(data_dir)
 
 
@@ -135,27 +153,27 @@ def test_a_damaged_roster_is_reported_with_its_file(data_dir):
 
 def test_happy_path_signs_stores_and_verifies(store, data_dir, run_record):
     clock = Clock()
-    row_id, record = so.sign_off(store, "Dr Chen", PASS, fields(run_record), clock=clock)
+    row_id, record = sign_off(store, "Dr Chen", PASS, fields(run_record), clock=clock)
     assert record.signed_at == "2026-03-02T14:05:09Z"
-    assert record.evidence.digest == so.record_digest(run_record)
+    assert record.evidence.digest == record_digest(run_record)
     assert record.evidence.digest.startswith("sha256:") and not record.override
     [row] = store.signoffs()
     assert row.id == row_id and row.student == "alice" and row.partner == "bob"
-    assert so.record_from_stored(row) == record
+    assert record_from_stored(row) == record
     assert problems(store, data_dir) == [()]
 
 
 def test_canonical_bytes_are_stable_and_cover_every_field(run_record):
-    record = so.SignoffRecord(
+    record = SignoffRecord(
         "alice", "", "alice", "lab", "ex", "Dr Chen", "2026-03-02T14:05:09Z", "", False,
-        so.Evidence("r.jsonl", "sha256:00", {"b": 1, "a": 0.5}),
+        Evidence("r.jsonl", "sha256:00", {"b": 1, "a": 0.5}),
     )  # fmt: skip
-    again = replace(record, evidence=so.Evidence("r.jsonl", "sha256:00", {"a": 0.5, "b": 1}))
+    again = replace(record, evidence=Evidence("r.jsonl", "sha256:00", {"a": 0.5, "b": 1}))
     assert record.canonical() == again.canonical()
     assert json.loads(record.canonical())["format"] == "workbench-signoff/1"  # legacy: no place
     placed = replace(record, seq=3, prev=GENESIS)
     data = json.loads(placed.canonical())
-    assert data["format"] == so.RECORD_FORMAT == "workbench-signoff/2"
+    assert data["format"] == RECORD_FORMAT == "workbench-signoff/2"
     assert (data["seq"], data["prev"]) == (3, GENESIS)
     assert set(data) >= {"student", "partner", "driver", "lab", "exercise", "instructor"}
     assert set(data) >= {"signed_at", "note", "override", "evidence"}
@@ -164,12 +182,12 @@ def test_canonical_bytes_are_stable_and_cover_every_field(run_record):
 
 
 def test_signing_needs_passed_objectives_or_an_override_with_a_note(store, data_dir):
-    with pytest.raises(so.SignoffError, match="objectives have not all passed"):
-        so.sign_off(store, "Dr Chen", PASS, fields(passed=False))
-    with pytest.raises(so.SignoffError, match="override needs a note"):
-        so.sign_off(store, "Dr Chen", PASS, fields(passed=False), override=True, note="  ")
+    with pytest.raises(SignoffError, match="objectives have not all passed"):
+        sign_off(store, "Dr Chen", PASS, fields(passed=False))
+    with pytest.raises(SignoffError, match="override needs a note"):
+        sign_off(store, "Dr Chen", PASS, fields(passed=False), override=True, note="  ")
     assert store.signoffs() == []
-    _, record = so.sign_off(
+    _, record = sign_off(
         store, "Dr Chen", PASS, fields(passed=False), override=True, note="timer was off"
     )
     assert record.override and record.note == "timer was off"
@@ -177,37 +195,37 @@ def test_signing_needs_passed_objectives_or_an_override_with_a_note(store, data_
 
 
 def test_bad_record_fields_are_refused(store, tmp_path):
-    with pytest.raises(so.SignoffError, match="student is missing"):
-        so.sign_off(store, "Dr Chen", PASS, fields(student=""))
-    with pytest.raises(so.SignoffError, match="driver carol is neither"):
-        so.sign_off(store, "Dr Chen", PASS, fields(driver="carol"))
-    with pytest.raises(so.SignoffError, match="cannot read the run record"):
-        so.sign_off(store, "Dr Chen", PASS, fields(tmp_path / "missing.jsonl"))
-    with pytest.raises(so.SignoffError, match="cannot be recorded"):
-        bad = replace(fields(), evidence=so.Evidence("", "", {"t": float("nan")}))
-        so.sign_off(store, "Dr Chen", PASS, bad)
+    with pytest.raises(SignoffError, match="student is missing"):
+        sign_off(store, "Dr Chen", PASS, fields(student=""))
+    with pytest.raises(SignoffError, match="driver carol is neither"):
+        sign_off(store, "Dr Chen", PASS, fields(driver="carol"))
+    with pytest.raises(SignoffError, match="cannot read the run record"):
+        sign_off(store, "Dr Chen", PASS, fields(tmp_path / "missing.jsonl"))
+    with pytest.raises(SignoffError, match="cannot be recorded"):
+        bad = replace(fields(), evidence=Evidence("", "", {"t": float("nan")}))
+        sign_off(store, "Dr Chen", PASS, bad)
 
 
 def test_a_bare_hex_digest_of_the_run_record_is_accepted(store, run_record):
-    bare = so.record_digest(run_record).removeprefix("sha256:")
-    ev = so.Evidence(str(run_record), bare, {"runs": [{"t": 1.5}]})
-    _, record = so.sign_off(store, "Dr Chen", PASS, replace(fields(), evidence=ev))
+    bare = record_digest(run_record).removeprefix("sha256:")
+    ev = Evidence(str(run_record), bare, {"runs": [{"t": 1.5}]})
+    _, record = sign_off(store, "Dr Chen", PASS, replace(fields(), evidence=ev))
     assert record.evidence.digest == f"sha256:{bare}"
-    assert so.record_from_stored(store.signoffs()[0]) == record
+    assert record_from_stored(store.signoffs()[0]) == record
 
 
 def test_a_run_record_changed_before_signing_is_refused(store, run_record):
-    ev = so.Evidence(str(run_record), "sha256:" + "0" * 64, {})
-    with pytest.raises(so.SignoffError, match="changed since it was checked"):
-        so.sign_off(store, "Dr Chen", PASS, replace(fields(), evidence=ev))
+    ev = Evidence(str(run_record), "sha256:" + "0" * 64, {})
+    with pytest.raises(SignoffError, match="changed since it was checked"):
+        sign_off(store, "Dr Chen", PASS, replace(fields(), evidence=ev))
 
 
 # lockout
 
 
 def test_wrong_passphrase_is_rejected_and_logged(store):
-    with pytest.raises(so.WrongPassphrase):
-        so.sign_off(store, "Dr Chen", "wrong wrong wrong", fields(), clock=Clock())
+    with pytest.raises(WrongPassphrase):
+        sign_off(store, "Dr Chen", "wrong wrong wrong", fields(), clock=Clock())
     assert store.signoffs() == []
     assert [e.event for e in store.events("Dr Chen")] == ["wrong-passphrase"]
 
@@ -215,36 +233,36 @@ def test_wrong_passphrase_is_rejected_and_logged(store):
 def test_five_failures_lock_for_a_minute_even_across_restarts(store, data_dir):
     clock = Clock()
     for _ in range(4):
-        with pytest.raises(so.WrongPassphrase):
-            so.sign_off(store, "Dr Chen", "wrong wrong wrong", fields(), clock=clock)
-    with pytest.raises(so.LockedOut, match="locked for 60 s"):
-        so.sign_off(store, "Dr Chen", "wrong wrong wrong", fields(), clock=clock)
+        with pytest.raises(WrongPassphrase):
+            sign_off(store, "Dr Chen", "wrong wrong wrong", fields(), clock=clock)
+    with pytest.raises(LockedOut, match="locked for 60 s"):
+        sign_off(store, "Dr Chen", "wrong wrong wrong", fields(), clock=clock)
     clock.advance(30)
-    with Store.open(data_dir) as reopened, pytest.raises(so.LockedOut, match="30 s more"):
-        so.sign_off(reopened, "Dr Chen", PASS, fields(), clock=clock)
+    with Store.open(data_dir) as reopened, pytest.raises(LockedOut, match="30 s more"):
+        sign_off(reopened, "Dr Chen", PASS, fields(), clock=clock)
     assert store.signoffs() == []
     events = [e.event for e in store.events("Dr Chen")]
     assert events == ["wrong-passphrase"] * 5 + ["locked"]
     clock.advance(31)
-    so.sign_off(store, "Dr Chen", PASS, fields(), clock=clock)
+    sign_off(store, "Dr Chen", PASS, fields(), clock=clock)
     assert len(store.signoffs()) == 1
 
 
 def test_the_lockout_is_per_instructor_and_a_success_resets_the_count(store, data_dir):
-    so.create_instructor(data_dir, "Dr Lee", "another long passphrase", kdf=FAST)
+    create_instructor(data_dir, "Dr Lee", "another long passphrase", kdf=FAST)
     clock = Clock()
     for _ in range(5):
-        with pytest.raises(so.SignoffError):
-            so.sign_off(store, "Dr Chen", "wrong wrong wrong", fields(), clock=clock)
-    so.sign_off(store, "Dr Lee", "another long passphrase", fields(), clock=clock)
+        with pytest.raises(SignoffError):
+            sign_off(store, "Dr Chen", "wrong wrong wrong", fields(), clock=clock)
+    sign_off(store, "Dr Lee", "another long passphrase", fields(), clock=clock)
     clock.advance(61)
     for _ in range(4):
-        with pytest.raises(so.WrongPassphrase):
-            so.sign_off(store, "Dr Chen", "wrong wrong wrong", fields(), clock=clock)
-    so.sign_off(store, "Dr Chen", PASS, fields(), clock=clock)
+        with pytest.raises(WrongPassphrase):
+            sign_off(store, "Dr Chen", "wrong wrong wrong", fields(), clock=clock)
+    sign_off(store, "Dr Chen", PASS, fields(), clock=clock)
     assert store.lockout("Dr Chen").failures == 0
-    with pytest.raises(so.WrongPassphrase):
-        so.sign_off(store, "Dr Chen", "wrong wrong wrong", fields(), clock=clock)
+    with pytest.raises(WrongPassphrase):
+        sign_off(store, "Dr Chen", "wrong wrong wrong", fields(), clock=clock)
 
 
 # verification
@@ -266,8 +284,8 @@ def test_the_lockout_is_per_instructor_and_a_success_resets_the_count(store, dat
     ],
 )
 def test_a_record_edited_in_the_database_fails_verify(store, data_dir, column, value):
-    so.create_instructor(data_dir, "Dr Lee", "another long passphrase", kdf=FAST)
-    so.sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+    create_instructor(data_dir, "Dr Lee", "another long passphrase", kdf=FAST)
+    sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
     assert problems(store, data_dir) == [()]
     with sqlite3.connect(store.path) as conn:
         conn.execute(f"UPDATE signoffs SET {column} = ?", (value,))
@@ -276,23 +294,23 @@ def test_a_record_edited_in_the_database_fails_verify(store, data_dir, column, v
 
 
 def test_a_changed_run_record_fails_and_a_missing_one_is_only_noted(store, data_dir, run_record):
-    so.sign_off(store, "Dr Chen", PASS, fields(run_record), clock=Clock())
+    sign_off(store, "Dr Chen", PASS, fields(run_record), clock=Clock())
     run_record.write_text(run_record.read_text() + '{"t":1}\n')
-    [verdict] = so.verify_all(store, roster(data_dir))
+    [verdict] = verify_all(store, roster(data_dir))
     assert not verdict.ok and "no longer has the signed digest" in verdict.problems[0]
     run_record.unlink()
-    [verdict] = so.verify_all(store, roster(data_dir))
+    [verdict] = verify_all(store, roster(data_dir))
     assert verdict.ok and "not present" in verdict.notes[0]
 
 
 def test_a_key_not_in_the_roster_fails(store, data_dir, tmp_path):
     other = tmp_path / "elsewhere"
-    so.create_instructor(other, "Dr Fake", PASS, kdf=FAST)
-    so.create_instructor(other, "Dr Chen", PASS, kdf=FAST)
+    create_instructor(other, "Dr Fake", PASS, kdf=FAST)
+    create_instructor(other, "Dr Chen", PASS, kdf=FAST)
     with Store.open(other) as rogue:
-        so.sign_off(rogue, "Dr Fake", PASS, fields(), clock=Clock())
-        so.sign_off(rogue, "Dr Chen", PASS, fields(), clock=Clock())
-    rogue_log = so.verify_log(read_signoffs(other), roster(data_dir))  # chain and all
+        sign_off(rogue, "Dr Fake", PASS, fields(), clock=Clock())
+        sign_off(rogue, "Dr Chen", PASS, fields(), clock=Clock())
+    rogue_log = verify_log(read_signoffs(other), roster(data_dir))  # chain and all
     found = [v.problems for v in rogue_log.verdicts]
     assert found[0] == ("instructor 'Dr Fake' is not in the trusted roster",)
     assert len(found[1]) == 1 and "signature does not match" in found[1][0]
@@ -300,17 +318,15 @@ def test_a_key_not_in_the_roster_fails(store, data_dir, tmp_path):
 
 def test_gradebook_has_one_row_per_student_and_exercise_from_verified_records(store, data_dir):
     clock = Clock()
-    so.sign_off(store, "Dr Chen", PASS, fields(), clock=clock)
+    sign_off(store, "Dr Chen", PASS, fields(), clock=clock)
     clock.advance(60)
-    so.sign_off(store, "Dr Chen", PASS, fields(), clock=clock)
-    so.sign_off(
-        store, "Dr Chen", PASS, fields(student="carol", partner="", driver="", exercise="x")
-    )
-    so.sign_off(store, "Dr Chen", PASS, fields(student="dave", partner="", driver=""))
+    sign_off(store, "Dr Chen", PASS, fields(), clock=clock)
+    sign_off(store, "Dr Chen", PASS, fields(student="carol", partner="", driver="", exercise="x"))
+    sign_off(store, "Dr Chen", PASS, fields(student="dave", partner="", driver=""))
     with sqlite3.connect(store.path) as conn:
         conn.execute("UPDATE signoffs SET note = 'edited' WHERE student = 'dave'")
-    log = so.verify_log(store.signoffs(), roster(data_dir))
-    rows = so.gradebook_rows(log.verified_rows(), log.head)
+    log = verify_log(store.signoffs(), roster(data_dir))
+    rows = gradebook_rows(log.verified_rows(), log.head)
     keys = [(r["student"], r["exercise"]) for r in rows]
     assert keys == [("alice", "wall-following"), ("bob", "wall-following"), ("carol", "x")]
     assert rows[0]["signed_at"] == "2026-03-02T14:06:09Z"
@@ -428,7 +444,7 @@ def test_a_killed_process_keeps_what_it_committed(data_dir):
 def test_evidence_of_an_exercise_points_at_the_run_record_it_rests_on(tmp_path):
     from types import SimpleNamespace
 
-    from workbench.labs.signoff import Evidence, record_digest
+    from workbench.labs.signoff_record import Evidence, record_digest
 
     record = tmp_path / "run-001.jsonl"
     record.write_text('{"type":"header"}\n')
@@ -467,13 +483,13 @@ CREATE TABLE signoffs (
 
 def v1_database(data_dir: Path, students: list[str]) -> None:
     """A database as the workbench wrote it before the log was chained (schema 1)."""
-    signer = so.unlock_instructor(data_dir, "Dr Chen", PASS)
+    signer = unlock_instructor(data_dir, "Dr Chen", PASS)
     conn = sqlite3.connect(data_dir / DB_NAME)
     conn.executescript(V1_SCHEMA)
     for n, student in enumerate(students):
-        record = so.SignoffRecord(
+        record = SignoffRecord(
             student, "", student, "web-simulator", f"ex{n}", "Dr Chen",
-            f"2026-01-0{n + 1}T10:00:00Z", "", False, so.Evidence("", "sha256:00", {"n": n}),
+            f"2026-01-0{n + 1}T10:00:00Z", "", False, Evidence("", "sha256:00", {"n": n}),
         )  # fmt: skip
         columns = record.columns(signer.sign(record.canonical()))
         columns["override"] = int(columns["override"])
@@ -486,30 +502,30 @@ def v1_database(data_dir: Path, students: list[str]) -> None:
 
 
 def test_records_made_before_the_chain_are_read_as_legacy_then_chained_by_the_upgrade(data_dir):
-    so.create_instructor(data_dir, "Dr Chen", PASS, kdf=FAST)
+    create_instructor(data_dir, "Dr Chen", PASS, kdf=FAST)
     v1_database(data_dir, ["ana", "ben"])
     before = (data_dir / DB_NAME).read_bytes()
-    read_only = so.verify_log(read_signoffs(data_dir), roster(data_dir))
+    read_only = verify_log(read_signoffs(data_dir), roster(data_dir))
     assert read_only.ok and read_only.legacy == 2 and read_only.head.seq == 2
     assert all("legacy record" in v.notes[0] for v in read_only.verdicts)
     assert (data_dir / DB_NAME).read_bytes() == before  # reading did not upgrade it
     with Store.open(data_dir) as store:
         assert store.schema_version() == 2
         assert store.signoffs() == read_signoffs(data_dir)  # upgraded to what was read
-        so.sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
-        log = so.verify_log(store.signoffs(), roster(data_dir), kept=read_only.head)
+        sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+        log = verify_log(store.signoffs(), roster(data_dir), kept=read_only.head)
     assert log.ok and log.legacy == 2 and log.head.seq == 3
     assert [v.row.legacy for v in log.verdicts] == [True, True, False]
     sql_edit = "UPDATE signoffs SET student = 'zed' WHERE seq = 1"
     with sqlite3.connect(data_dir / DB_NAME) as conn:
         conn.execute(sql_edit)
     conn.close()
-    [first, *_] = so.verify_log(read_signoffs(data_dir), roster(data_dir)).verdicts
+    [first, *_] = verify_log(read_signoffs(data_dir), roster(data_dir)).verdicts
     assert any("signature does not match" in p for p in first.problems)
 
 
 def test_a_sequence_number_is_taken_once(store):
-    so.sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+    sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
     with sqlite3.connect(store.path) as conn, pytest.raises(sqlite3.IntegrityError):
         conn.execute(
             "INSERT INTO signoffs (student, partner, driver, lab, exercise, instructor, "
@@ -523,14 +539,15 @@ def test_a_sequence_number_is_taken_once(store):
 SIGNER = """
 import sys, time
 from datetime import UTC, datetime
-from workbench.labs import signoff as so
+from workbench.labs.signing import sign_off
+from workbench.labs.signoff_record import RecordFields
 from workbench.labs.store import Store
 data_dir, who, start = sys.argv[1], sys.argv[2], float(sys.argv[3])
-fields = so.RecordFields(student=who, lab="lab", exercise="ex", objectives_passed=True)
+fields = RecordFields(student=who, lab="lab", exercise="ex", objectives_passed=True)
 with Store.open(data_dir) as store:
     time.sleep(max(0.0, start - time.time()))
     for i in range(12):
-        so.sign_off(store, "Dr Chen", "correct horse battery", fields)
+        sign_off(store, "Dr Chen", "correct horse battery", fields)
 """
 
 
@@ -545,30 +562,30 @@ def test_two_processes_signing_at_once_never_fork_the_chain(store, data_dir):
     rows = read_signoffs(data_dir)
     assert [r.seq for r in rows] == list(range(1, 25))
     assert sorted(r.student for r in rows) == ["alice"] * 12 + ["bob"] * 12
-    log = so.verify_log(rows, roster(data_dir))
+    log = verify_log(rows, roster(data_dir))
     assert log.ok, (log.breaks, [v.problems for v in log.verdicts if not v.ok])
 
 
 def test_signing_after_a_tampered_sequence_number_goes_on_or_says_why(store, data_dir):
-    so.sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
-    so.sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+    sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+    sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
     with sqlite3.connect(store.path) as conn:
         conn.execute("UPDATE signoffs SET seq = 'last' WHERE seq = 2")
     conn.close()
-    _, record = so.sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+    _, record = sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
     assert record.seq == 2  # after the last numbered record; verify names the damaged one
-    log = so.verify_log(read_signoffs(data_dir), roster(data_dir))
+    log = verify_log(read_signoffs(data_dir), roster(data_dir))
     assert [v.row.label() for v in log.verdicts if not v.ok] == ["row id 2"]
     with sqlite3.connect(store.path) as conn:
         conn.execute("UPDATE signoffs SET seq = ? WHERE id = 3", (2**62,))
     conn.close()
     with pytest.raises(StoreError, match="more than it can hold"):
-        so.sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+        sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
 
 
 def test_a_note_longer_than_the_cap_is_refused_and_nothing_is_signed(store, run_record):
-    with pytest.raises(so.SignoffError, match=f"keep it to {so.MAX_NOTE}"):
-        so.sign_off(store, "Dr Chen", PASS, fields(run_record), note="x" * (8 << 20))
+    with pytest.raises(SignoffError, match=f"keep it to {MAX_NOTE}"):
+        sign_off(store, "Dr Chen", PASS, fields(run_record), note="x" * (8 << 20))
     assert store.signoffs() == []
-    _, record = so.sign_off(store, "Dr Chen", PASS, fields(run_record), note="y" * so.MAX_NOTE)
-    assert record.note == "y" * so.MAX_NOTE
+    _, record = sign_off(store, "Dr Chen", PASS, fields(run_record), note="y" * MAX_NOTE)
+    assert record.note == "y" * MAX_NOTE

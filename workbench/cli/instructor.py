@@ -7,19 +7,16 @@ import getpass
 import sys
 from pathlib import Path
 
-from workbench.labs.signoff import (
-    MIN_PASSPHRASE,
+from workbench.labs.instructors import MIN_PASSPHRASE, check_passphrase, create_instructor, key_path
+from workbench.labs.roster import (
     ROSTER_NAME,
-    SignoffError,
     check_name,
-    check_passphrase,
     config_dir,
-    create_instructor,
-    key_path,
     load_roster,
     offered_roster,
     roster_path,
 )
+from workbench.labs.signoff_errors import SignoffError
 from workbench.labs.store import Store, StoreError, resolve_data_dir, resolve_db
 
 from .common import db_option

@@ -15,19 +15,11 @@ import io
 import sys
 from pathlib import Path
 
+from workbench.files.atomic import write_text_atomic
+from workbench.labs.gradebook import GRADEBOOK_COLUMNS, gradebook_rows, head_from_gradebook
+from workbench.labs.roster import load_roster, roster_path, trusted_roster_path
 from workbench.labs.signlog import Head, LogError
-from workbench.labs.signoff import (
-    GRADEBOOK_COLUMNS,
-    LogVerdict,
-    SignoffError,
-    UntrustedRoster,
-    gradebook_rows,
-    head_from_gradebook,
-    load_roster,
-    roster_path,
-    trusted_roster_path,
-    verify_log,
-)
+from workbench.labs.signoff_errors import SignoffError, UntrustedRoster
 from workbench.labs.store import (
     StoredSignoff,
     StoreError,
@@ -35,7 +27,7 @@ from workbench.labs.store import (
     resolve_data_dir,
     resolve_db,
 )
-from workbench.sim.mazefile import write_text_atomic
+from workbench.labs.verify import LogVerdict, verify_log
 
 from .common import db_option
 from .instructor import data_dir_option

@@ -11,9 +11,9 @@ import argparse
 import sys
 
 from workbench.labs.database import StoreError, resolve_db
-from workbench.labs.signoff import log_head
 from workbench.labs.store import Store, resolve_data_dir
 from workbench.labs.storecopy import copy_store, counts
+from workbench.labs.verify import log_head
 
 from .common import db_option
 from .instructor import data_dir_option

@@ -176,7 +176,6 @@ class FsmController:
         self._deadline: float | None = None
         self._unseen = set(self._sensor_names)
         self._started = False
-        self.entered_at = 0.0
         self.history.clear()
 
     def start(self, t: float = 0.0) -> list[Command]:
@@ -253,7 +252,6 @@ class FsmController:
     def _enter(self, node: _Node, t: float, out: list[Command]) -> None:
         env = self._env
         self._current = node
-        self.entered_at = t
         self._deadline = None
         env["turn_done"] = False
         env["timer_done"] = False

@@ -20,7 +20,6 @@ import re
 import stat
 from collections.abc import Callable
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TypeVar
 
 import yaml
@@ -372,9 +371,3 @@ def load_yaml(text: str, source: str, limits: Limits, first_line: int = 1) -> ob
     if node is None:
         return None
     return SafeConstructor().construct_document(node)
-
-
-def read_yaml(path: str | Path, limits: Limits, source: str | None = None) -> Node | None:
-    """The checked node tree of the YAML file at ``path``."""
-    source = str(path) if source is None else source
-    return compose_yaml(read_text(path, limits, source), source, limits)

@@ -13,6 +13,8 @@ import json
 import os
 from pathlib import Path
 
+from workbench.files.atomic import write_text_atomic
+
 from .names import NameProblem, check_pair
 
 FILE_NAME = "last-pair.json"
@@ -39,6 +41,4 @@ def save_last_pair(data_dir: str | os.PathLike, student: str, partner: str = "")
     folder = Path(data_dir)
     folder.mkdir(parents=True, exist_ok=True)
     path = folder / FILE_NAME
-    part = path.with_suffix(".json.part")
-    part.write_text(json.dumps({"student": student, "partner": partner}), encoding="utf-8")
-    os.replace(part, path)
+    write_text_atomic(path, json.dumps({"student": student, "partner": partner}))

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from workbench.files.atomic import write_text_atomic
 from workbench.files.bounded import Limits, read_text
 
 #: the values of each kind of write, in the order of its statement
@@ -68,9 +69,7 @@ def save_pending(path: Path, student: str, writes: list[PendingWrite]) -> None:
         "student": student,
         "writes": [{"kind": w.kind, "values": list(w.values)} for w in writes],
     }
-    new = path.with_name(f".{path.name}.{os.getpid()}.new")
-    new.write_text(json.dumps(data, ensure_ascii=False, indent=1), encoding="utf-8")
-    os.replace(new, path)
+    write_text_atomic(path, json.dumps(data, ensure_ascii=False, indent=1))
 
 
 def load_pending(path: Path, student: str) -> tuple[list[PendingWrite], list[str]]:

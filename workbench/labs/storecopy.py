@@ -12,9 +12,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from .instructors import key_path
+from .roster import load_roster, roster_path
 from .signlog import Head
-from .signoff import key_path, load_roster, log_head, roster_path
 from .store import SIGNOFF_COLUMNS, Store, StoreError
+from .verify import log_head
 
 TABLES: dict[str, tuple[str, ...]] = {
     "signoffs": SIGNOFF_COLUMNS,

@@ -138,7 +138,6 @@ class ProgramController:
         self.printed_total = 0
         self.recent: deque[Printed] = deque(maxlen=RECENT_PRINTED)
         self.fired: list[Fired] = []
-        self.fired_dropped = 0
         self.errors: list[RunError] = []
         self.commands: list[Any] = []
         self.changes = 0
@@ -253,8 +252,6 @@ class ProgramController:
     def _fired(self, aid: int, what: str) -> None:
         if len(self.fired) < MAX_FIRED:
             self.fired.append(Fired(self.now, aid, what))
-        else:
-            self.fired_dropped += 1
 
     def _fire(self, aid: int, value: Value, what: str | None = None) -> None:
         act = self.program.activities[aid]

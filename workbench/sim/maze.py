@@ -22,8 +22,6 @@ MAX_SIZE = 200
 
 #: heading name -> unit step (dx, dy) in grid coordinates (y grows downwards)
 HEADINGS: dict[str, Cell] = {"up": (0, -1), "right": (1, 0), "down": (0, 1), "left": (-1, 0)}
-#: heading name -> degrees clockwise from "up" (compass-like, as seen on the screen)
-HEADING_DEGREES: dict[str, int] = {"up": 0, "right": 90, "down": 180, "left": 270}
 PROFILES = ("unity", "web", "erobotic")
 
 

@@ -14,13 +14,11 @@ profile: unity
 
 from __future__ import annotations
 
-import contextlib
 import os
-import tempfile
-from pathlib import Path
 
 import yaml
 
+from workbench.files.atomic import write_text_atomic
 from workbench.files.bounded import MAZE_LIMITS, BoundedFileError, check_text, load_yaml
 
 from .maze import FLOOR, MAX_SIZE, PROFILES, WALL, Maze, MazeError, Problem
@@ -86,7 +84,7 @@ def _front_matter(lines: list[str], source: str) -> tuple[dict, int, list[Proble
             ],
         )
     problems = []
-    key_lines = {}
+    key_lines: dict[str, int] = {}
     for i, raw in enumerate(lines[1:end], start=2):
         key = raw.split(":", 1)[0].strip()
         key_lines.setdefault(key, i)
@@ -270,38 +268,6 @@ def format_maze(maze: Maze, front_matter: bool = True) -> str:
             chars[maze.start[0]] = HEADING_CHARS[maze.heading]
         out.append("".join(chars))
     return "\n".join(out) + "\n"
-
-
-def write_text_atomic(path: str | os.PathLike, text: str) -> None:
-    """Write ``text`` so that a crash leaves either the old file or the new one, never half."""
-    write_bytes_atomic(path, text.encode("utf-8"))
-
-
-def write_bytes_atomic(path: str | os.PathLike, data: bytes) -> None:
-    """Write ``data`` so that a crash leaves either the old file or the new one, never half."""
-    p = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=p.parent or ".")
-    try:
-        os.fchmod(fd, _mode_for(p))
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.replace(tmp, p)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        raise
-
-
-def _mode_for(path: Path) -> int:
-    """Keep an existing file's permissions; a new file gets the usual umask-based ones."""
-    try:
-        return path.stat().st_mode & 0o7777
-    except OSError:
-        umask = os.umask(0)
-        os.umask(umask)
-        return 0o666 & ~umask
 
 
 def write_maze(path: str | os.PathLike, maze: Maze) -> None:

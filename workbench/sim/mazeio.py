@@ -9,6 +9,7 @@ import re
 from dataclasses import replace
 from pathlib import Path
 
+from workbench.files.atomic import write_bytes_atomic, write_text_atomic
 from workbench.files.bounded import (
     MAZE_LIMITS,
     BoundedFileError,
@@ -19,7 +20,7 @@ from workbench.files.bounded import (
 
 from .maz import format_maz, parse_maz
 from .maze import Maze, MazeError, Problem
-from .mazefile import format_maze, parse_maze, write_bytes_atomic, write_text_atomic
+from .mazefile import format_maze, parse_maze
 from .micromouse import format_micromouse, parse_micromouse, parse_mms_map, parse_mms_num
 from .wallmaze import to_blocks
 

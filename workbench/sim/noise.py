@@ -120,11 +120,3 @@ def turn_factor(settings: NoiseSettings, rng: random.Random) -> float:
     """How much of a commanded Turn by Degree the robot really turns (1.0 = exact)."""
     sigma = settings.turn_error
     return max(0.0, 1.0 + rng.gauss(0.0, sigma)) if sigma else 1.0
-
-
-def noisy_distance(settings: NoiseSettings, rng: random.Random, distance: float) -> float:
-    """A true distance with sensor noise added (never below zero)."""
-    sigma = settings.distance_relative * distance + settings.distance_absolute
-    if not sigma:
-        return distance
-    return max(0.0, distance + rng.gauss(0.0, sigma))

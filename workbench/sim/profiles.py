@@ -119,11 +119,6 @@ class Profile:
     def sensor_offset(self, mount: str) -> float:
         return self.sensor_offsets[MOUNTS.index(mount)]
 
-    @property
-    def spin_rate(self) -> float:
-        """Degrees per second of a spin in place at wheel powers (1, -1)."""
-        return math.degrees(2 * self.max_wheel_speed / self.track_width)
-
     def centred_reading(self, mount: str = "right", cell: float | None = None) -> float:
         """What a side sensor reads with the robot centred in a one-block corridor."""
         return (cell or self.cell) / 2 - self.sensor_offset(mount)

@@ -5,8 +5,8 @@ corner of block (0, 0); x grows to the right and y grows *downwards*, like the g
 (i, j) spans ``[i*cell, (i+1)*cell] x [j*cell, (j+1)*cell]``.
 
 Headings are degrees in [0, 360): 0 = +x (right/east on the screen), 90 = +y (down the
-page), i.e. clockwise on the screen, so a positive change of heading is a right turn. (The
-maze's ``HEADING_DEGREES`` are compass-like, 0 = up; :data:`HEADING_ANGLES` converts.)
+page), i.e. clockwise on the screen, so a positive change of heading is a right turn.
+:data:`HEADING_ANGLES` gives the angle of each of a maze's start headings.
 
 Walls are pymunk segments on the exposed faces of wall blocks, collinear faces merged, with
 the grid's outer edge closed as well, so a robot leaving through an exit on the boundary

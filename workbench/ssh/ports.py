@@ -61,9 +61,6 @@ class PortPool:
     def in_use(self) -> frozenset[int]:
         return frozenset(self._in_use)
 
-    def capacity(self, count: int = 2) -> int:
-        return (self.last - self.first + 1) // count
-
     def _usable(self, port: int, owned: frozenset[int]) -> bool:
         return port not in self._in_use and (port in owned or self._is_free(port))
 

@@ -299,8 +299,6 @@ class LabConnection(asyncssh.SSHServer):
         self.remote_ports: Counter[int] = Counter()
         #: counted among the connections that have not logged in yet
         self.counted = False
-        #: closed at once: too many connections had not logged in
-        self.turned_away = False
         self._pending_key = "?"
 
     # -- connection --------------------------------------------------------------------------
@@ -312,7 +310,6 @@ class LabConnection(asyncssh.SSHServer):
         self.peer = str(peer[0]) if peer else "?"
         why = server.gate.refuse_connection(self.peer)
         if why is not None:
-            self.turned_away = True
             server.say_now_and_then(
                 f"turned away {self.peer}", "connection from %s closed: %s", self.peer, why
             )

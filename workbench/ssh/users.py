@@ -24,6 +24,7 @@ from pathlib import Path
 import asyncssh
 import yaml
 
+from workbench.files.atomic import write_text_atomic
 from workbench.files.bounded import (
     USERS_LIMITS,
     BoundedFileError,
@@ -254,15 +255,7 @@ def save_users(path: str | os.PathLike, users: Iterable[User]) -> None:
     """Write the users file in one step, readable by its owner only (it holds hashes)."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    temp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    fd = os.open(temp, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as out:
-            out.write(dump_users(users))
-        os.replace(temp, path)
-    except BaseException:
-        temp.unlink(missing_ok=True)
-        raise
+    write_text_atomic(path, dump_users(users), mode=0o600)
 
 
 def add_user(

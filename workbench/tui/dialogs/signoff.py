@@ -8,6 +8,7 @@ drives next and records it; it returns that driver (None when closed without sig
 
 from __future__ import annotations
 
+import asyncio
 from typing import ClassVar
 
 from textual import on
@@ -16,17 +17,13 @@ from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical
 from textual.screen import ModalScreen
 from textual.widgets import Button, Checkbox, Input, Label, Select, Static
+from textual.worker import Worker
 
 from workbench.labs.checks import ExerciseProgress
-from workbench.labs.signoff import (
-    MAX_NOTE,
-    Evidence,
-    LockedOut,
-    RecordFields,
-    SignoffError,
-    offered_roster,
-    sign_off,
-)
+from workbench.labs.roster import offered_roster
+from workbench.labs.signing import MAX_NOTE, PendingSignoff, prepare_signoff
+from workbench.labs.signoff_errors import SignoffError
+from workbench.labs.signoff_record import Evidence, RecordFields
 from workbench.labs.store import Store, StoreError
 
 from ..keys import bindings
@@ -115,6 +112,10 @@ class SignoffModal(ModalScreen[str | None]):
         self.partner = partner
         self.driver = driver or student
         self.signed = False
+        #: the sign-off under way (its key being unlocked), if any
+        self.signing: Worker[None] | None = None
+        #: escape was pressed while a sign-off was under way
+        self.close_asked = False
         try:
             self.roster = sorted(offered_roster(store))
             self.roster_problem = "" if self.roster else "the roster has no instructors yet"
@@ -207,7 +208,7 @@ class SignoffModal(ModalScreen[str | None]):
     @on(Input.Submitted, "#signoff-note")
     @on(Button.Pressed, "#signoff-sign")
     def _sign(self) -> None:
-        if self.signed:
+        if self.signed or self.signing is not None:
             return
         if not self.roster:
             self._say(self.roster_problem)
@@ -230,11 +231,7 @@ class SignoffModal(ModalScreen[str | None]):
             objectives_passed=progress.passed,
         )
         try:
-            sign_off(self.store, instructor, passphrase.value, fields, override, note)
-        except LockedOut as exc:
-            passphrase.value = ""
-            self._say(str(exc))
-            return
+            pending = prepare_signoff(self.store, instructor, fields, override, note)
         except SignoffError as exc:
             passphrase.value = ""
             self._say(str(exc))
@@ -242,25 +239,57 @@ class SignoffModal(ModalScreen[str | None]):
         except Exception as exc:
             self._say(f"not signed: {exc}")
             return
+        self._say(f"unlocking the key of {instructor}...")
+        self.signing = self.run_worker(
+            self._unlock_and_sign(pending, passphrase.value), group="signoff", exit_on_error=False
+        )
+
+    async def _unlock_and_sign(self, pending: PendingSignoff, passphrase: str) -> None:
+        """Unlock the key in a thread (scrypt: the app keeps answering), then sign or count
+        the failure here, where the store is used."""
+        try:
+            signer = await asyncio.to_thread(pending.unlock, passphrase)
+            pending.complete(signer)
+        except SignoffError as exc:
+            self.query_one("#signoff-passphrase", Input).value = ""
+            self._say(str(exc))
+        except Exception as exc:
+            self._say(f"not signed: {exc}")
+        else:
+            self._signed(pending.record.instructor, pending.record.override)
+        finally:
+            self.signing = None
+        if self.close_asked:
+            self.action_close()
+
+    def _signed(self, instructor: str, override: bool) -> None:
         self.signed = True
+        progress = self.progress
         try:
             self.store.set_driver(
                 self.student, self.partner, progress.lab, progress.exercise, self.driver
             )
         except Exception as exc:
             self._say(f"signed, but the driver was not recorded: {exc}")
+        else:
+            if not self.roster_problem:
+                self._say("")
         self.query_one("#signoff-form").display = False
         self.query_one("#signoff-state").display = False
         self.query_one("#signoff-done", Static).update(
             f"Signed off by {instructor}{' (override)' if override else ''}."
         )
         self.query_one("#signoff-next").display = True
-        if not self.roster_problem:
-            self._say("")
         self.query_one("#signoff-driver-0", Button).focus()
 
     @on(Button.Pressed, "#signoff-cancel")
     def action_close(self) -> None:
+        """Close the dialog; while a key is being unlocked, once that attempt is over (so a
+        wrong passphrase is always counted)."""
+        if self.signing is not None:
+            self.close_asked = True
+            self._say("closing once the key is unlocked...")
+            return
         self.dismiss(self.driver if self.signed else None)
 
     @on(Button.Pressed, ".button-row Button")

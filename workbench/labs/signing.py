@@ -1,0 +1,184 @@
+"""Making a sign-off: an instructor's passphrase unlocks their key, which signs the record
+that joins the log.
+
+Wrong passphrases are counted per instructor in the store: the fifth in a row locks signing by
+that instructor for a minute, and each is written to the store's event log. Unlocking the key
+runs scrypt (~128 MiB, a fraction of a second), so signing comes in three steps: check
+(:func:`prepare_signoff`), unlock (:meth:`PendingSignoff.unlock`, which touches no store and
+may run in a thread) and complete (:meth:`PendingSignoff.complete`); :func:`sign_off` takes
+them one after the other.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from datetime import UTC, datetime
+from typing import Any
+
+from .instructors import Instructor, SealedKey, read_key
+from .signoff_errors import LockedOut, SignoffError, WrongPassphrase
+from .signoff_record import (
+    Evidence,
+    RecordFields,
+    SignoffRecord,
+    canonical_json,
+    name_problems,
+    record_digest,
+)
+from .store import Store, utc_iso
+
+log = logging.getLogger(__name__)
+
+FAILURE_LIMIT = 5
+#: the longest note a sign-off keeps, in characters
+MAX_NOTE = 500
+LOCK_SECONDS = 60.0
+
+
+def _now() -> datetime:
+    return datetime.now(UTC)
+
+
+def _check_fields(fields: RecordFields) -> Evidence:
+    for label, value in (
+        ("student", fields.student),
+        ("lab", fields.lab),
+        ("exercise", fields.exercise),
+    ):
+        if not value.strip():
+            raise SignoffError(f"the {label} is missing")
+    for problem in name_problems(fields.student, fields.partner):
+        raise SignoffError(problem)
+    people = {fields.student, fields.partner} - {""}
+    if fields.driver and fields.driver not in people:
+        raise SignoffError(f"the driver {fields.driver} is neither the student nor the partner")
+    ev = fields.evidence
+    if not isinstance(ev.metrics, dict):
+        raise SignoffError("the evidence metrics must be a mapping")
+    metrics = json.loads(canonical_json(ev.metrics))
+    digest = ev.digest
+    if ev.run_record:
+        actual = record_digest(ev.run_record)
+        expected = digest if not digest or digest.startswith("sha256:") else f"sha256:{digest}"
+        if expected and expected != actual:
+            raise SignoffError(
+                f"{ev.run_record}: the run record changed since it was checked "
+                f"(digest {actual}, expected {expected})"
+            )
+        digest = actual
+    return Evidence(str(ev.run_record), digest, metrics)
+
+
+def sign_off(
+    store: Store,
+    instructor: str,
+    passphrase: str,
+    record_fields: RecordFields,
+    override: bool = False,
+    note: str = "",
+    *,
+    clock: Callable[[], datetime] = _now,
+) -> tuple[int, SignoffRecord]:
+    """Sign and store a record; returns its id and the record.
+
+    Allowed when ``record_fields.objectives_passed`` or with ``override`` (which needs a note).
+    Raises :class:`LockedOut` while locked, :class:`WrongPassphrase` (counted: the fifth in a
+    row locks this instructor for a minute), :class:`UnknownInstructor`, or
+    :class:`SignoffError`. An app that must stay responsive takes the three steps itself:
+    :func:`prepare_signoff`, then :meth:`PendingSignoff.unlock` in a thread, then
+    :meth:`PendingSignoff.complete`.
+    """
+    pending = prepare_signoff(store, instructor, record_fields, override, note, clock=clock)
+    return pending.complete(pending.unlock(passphrase))
+
+
+@dataclass(frozen=True)
+class PendingSignoff:
+    """A sign-off that is checked and waits only for the instructor's key to be unlocked."""
+
+    store: Store
+    record: SignoffRecord
+    key: SealedKey
+    #: wrong passphrases in a row before this attempt
+    failures: int
+    now: datetime
+
+    def unlock(self, passphrase: str) -> Instructor | None:
+        """The instructor, their key opened with ``passphrase``; None when it is the wrong
+        one. The slow step (scrypt); it touches neither the store nor anything else, so it is
+        the one to run off an event loop."""
+        try:
+            return self.key.unlock(passphrase)
+        except WrongPassphrase:
+            return None
+
+    def complete(self, signer: Instructor | None) -> tuple[int, SignoffRecord]:
+        """Sign and store the record with the unlocked key, returning its id and the record;
+        or, given None (a wrong passphrase), count the failure and raise
+        :class:`WrongPassphrase`, or :class:`LockedOut` when it was one too many."""
+        store, record, now = self.store, self.record, self.now
+        instructor = record.instructor
+        if signer is None:
+            after = store.record_failure(instructor, now, FAILURE_LIMIT, LOCK_SECONDS)
+            where = f"{record.student} {record.lab}/{record.exercise}"
+            store.log_event(instructor, "wrong-passphrase", where, now)
+            log.info("wrong passphrase for instructor %s at %s", instructor, where)
+            if after.locked_until:
+                store.log_event(instructor, "locked", f"for {LOCK_SECONDS:g} s", now)
+                log.info("sign-off by %s locked for %g s", instructor, LOCK_SECONDS)
+                raise LockedOut(instructor, LOCK_SECONDS, FAILURE_LIMIT)
+            raise WrongPassphrase(f"wrong passphrase for {instructor}")
+        if self.failures:
+            store.clear_failures(instructor, now)
+
+        def sign_at(seq: int, prev: str) -> dict[str, Any]:
+            placed = replace(record, seq=seq, prev=prev)
+            return placed.columns(signer.sign(placed.canonical()))
+
+        stored = store.append_signoff(sign_at)
+        return stored.id, replace(record, seq=stored.seq, prev=stored.prev_hash)
+
+
+def prepare_signoff(
+    store: Store,
+    instructor: str,
+    record_fields: RecordFields,
+    override: bool = False,
+    note: str = "",
+    *,
+    clock: Callable[[], datetime] = _now,
+) -> PendingSignoff:
+    """Check a sign-off before the passphrase is tried: the fields and evidence, the override
+    and its note, the lock, and the instructor's key (read, still sealed). Raises
+    :class:`LockedOut`, :class:`UnknownInstructor` or :class:`SignoffError`."""
+    note = note.strip()
+    if len(note) > MAX_NOTE:
+        raise SignoffError(
+            f"the note is {len(note)} characters: keep it to {MAX_NOTE} (a sentence or two)"
+        )
+    if not record_fields.objectives_passed and not override:
+        raise SignoffError("the objectives have not all passed: sign off with an override")
+    if override and not note:
+        raise SignoffError("an override needs a note saying why")
+    evidence = _check_fields(record_fields)
+    now = clock()
+    state = store.lockout(instructor)
+    if state.locked_until > now.timestamp():
+        raise LockedOut(instructor, state.locked_until - now.timestamp(), FAILURE_LIMIT)
+    key = read_key(store.data_dir, instructor, store)
+    record = SignoffRecord(
+        student=record_fields.student,
+        partner=record_fields.partner,
+        driver=record_fields.driver,
+        lab=record_fields.lab,
+        exercise=record_fields.exercise,
+        instructor=instructor,
+        signed_at=utc_iso(now),
+        note=note,
+        override=override,
+        evidence=evidence,
+    )
+    return PendingSignoff(store, record, key, state.failures, now)
