@@ -100,7 +100,7 @@ async def lab_host(
             bind="127.0.0.1",
             port_range=port_range(),
             public_host="lab.example",
-            app=WORKBENCH_APP,
+            app=config.pop("app", WORKBENCH_APP),
             limits=limits or SessionLimits(),
             **({"logins": LoginPolicy(first_delay=0.05, max_delay=0.2)} | config),
         )

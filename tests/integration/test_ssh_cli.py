@@ -93,6 +93,11 @@ def test_serve_ssh_refuses_a_broken_users_file_naming_line_and_fix(tmp_path):
         (["--port", "41500"], "--port 41500 lies inside --port-range 41000-41999"),
         (["--port-range", "5-3"], "--port-range '5-3': ports must be 1024-65535"),
         (["--max-sessions", "0"], "must be > 0"),
+        (["--max-connections-per-user", "0"], "--max-connections-per-user 0: must be at least 1"),
+        (["--max-terminal", "wide"], "--max-terminal 'wide': write it as COLUMNSxROWS"),
+        (["--max-terminal", "40x10"], "the app needs at least 80x24"),
+        (["--app-memory", "10"], "--app-memory 10: give at least 64"),
+        (["--penalty-max", "-1"], "--penalty-min and --penalty-max must be 0 or more"),
     ],
 )
 def test_serve_ssh_refuses_bad_options_before_it_starts(tmp_path, options, message):

@@ -109,3 +109,92 @@ def test_a_repeated_warning_is_said_once_per_period_with_the_count_held_back():
     assert quiet.due("other") == 0
     clock.now = 10
     assert quiet.due("flood") == 5
+
+
+def test_sources_are_ipv4_addresses_and_ipv6_networks_of_64():
+    from workbench.ssh.sources import source_of
+
+    assert source_of("10.0.0.7") == "10.0.0.7"
+    assert source_of("::ffff:10.0.0.7") == "10.0.0.7"
+    assert (
+        source_of("2001:db8:1:2::5")
+        == source_of("2001:db8:1:2:ffff:1:2:3")
+        == ("2001:db8:1:2::/64")
+    )
+    assert source_of("2001:db8:1:3::5") != source_of("2001:db8:1:2::5")
+    assert source_of("fe80::1%eth0") == "fe80::/64"
+    assert source_of("?") == "?"
+
+
+def test_one_ipv6_network_is_capped_as_one_address():
+    gate = ConnectionGate(LoginPolicy(max_unauthenticated=50, max_unauthenticated_per_address=3))
+    for n in range(3):
+        assert gate.refuse_connection(f"2001:db8:0:1::{n + 1}") is None
+        gate.opened(f"2001:db8:0:1::{n + 1}")
+    why = gate.refuse_connection("2001:db8:0:1:abcd::99")  # a fresh address of the same /64
+    assert why == "3 connections from 2001:db8:0:1::/64 have not logged in yet"
+    assert gate.refuse_connection("2001:db8:0:2::1") is None
+
+
+def test_past_the_start_new_connections_are_dropped_ever_more_often_the_same_way_per_seed():
+    def fill(seed: int) -> list[bool]:
+        policy = LoginPolicy(
+            max_unauthenticated=40, max_unauthenticated_per_address=40, unauthenticated_start=10,
+            start_drop=0.3, seed=seed,
+        )  # fmt: skip
+        gate = ConnectionGate(policy)
+        let_in = []
+        for n in range(200):
+            address = f"10.1.{n // 250}.{n % 250}"
+            ok = gate.refuse_connection(address) is None
+            if ok:
+                gate.opened(address)
+            let_in.append(ok)
+        return let_in
+
+    first = fill(seed=3)
+    assert first[:10] == [True] * 10  # below the start, everyone
+    assert first == fill(seed=3)  # the same seed, the same drops
+    assert first != fill(seed=4)
+    assert first[10:].count(False) > 0 and sum(first) == 40  # still fills up, in the end
+    drops_early = first[10:40].count(False)
+    assert 0 < drops_early < 30
+
+
+def test_a_source_holding_places_without_logging_in_is_refused_for_a_while():
+    clock = Clock()
+    policy = LoginPolicy(penalty_least=90, penalty_longest=600)
+    gate = ConnectionGate(policy, clock)
+    # a lab behind one address: one student gave up at the password prompt after 30 s
+    gate.opened(STUDENT_PC)
+    assert gate.settled(STUDENT_PC, held=30, logged_in=False) is False
+    assert gate.refuse_connection(STUDENT_PC) is None
+    gate.opened(STUDENT_PC)
+    assert gate.settled(STUDENT_PC, held=40, logged_in=True) is False  # logged in: no charge
+    # ten idle connections that time out after 30 s each
+    starts = []
+    for _ in range(10):
+        gate.opened("10.6.6.6")
+    for _ in range(10):
+        starts.append(gate.settled("10.6.6.6", held=30, logged_in=False))
+    assert starts == [False, False, True] + [False] * 7
+    assert "refused for another 300 s" in gate.refuse_connection("10.6.6.6")
+    assert gate.refuse_connection(STUDENT_PC) is None
+    clock.now = 299
+    assert gate.refuse_connection("10.6.6.6") is not None
+    clock.now = 300
+    assert gate.refuse_connection("10.6.6.6") is None  # served: let in again
+
+
+def test_penalties_last_at_most_their_longest_and_can_be_turned_off():
+    clock = Clock()
+    gate = ConnectionGate(LoginPolicy(penalty_least=10, penalty_longest=60), clock)
+    for _ in range(10):
+        gate.opened("10.6.6.6")
+        gate.settled("10.6.6.6", held=30, logged_in=False)
+    assert "another 60 s" in gate.refuse_connection("10.6.6.6")
+    off = ConnectionGate(LoginPolicy(penalty_longest=0), clock)
+    for _ in range(10):
+        off.opened("10.6.6.6")
+        assert off.settled("10.6.6.6", held=30, logged_in=False) is False
+    assert off.refuse_connection("10.6.6.6") is None

@@ -65,6 +65,19 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="seconds without input before a session is closed (default 7200)",
     )  # fmt: skip
     serve.add_argument(
+        "--max-connections-per-user", type=int, default=10,
+        help="connections one user may hold logged in, with or without a session (default 10)",
+    )  # fmt: skip
+    serve.add_argument(
+        "--max-terminal", default="500x200", metavar="COLSxROWS",
+        help="the largest terminal an app is given; larger ones are clamped (default 500x200)",
+    )  # fmt: skip
+    serve.add_argument(
+        "--app-memory", type=int, default=512, metavar="MIB",
+        help="memory each session's app may use, in MiB; an app past it is ended with a "
+        "message (default 512; 0: no cap)",
+    )  # fmt: skip
+    serve.add_argument(
         "--login-timeout", type=float, default=30,
         help="seconds a connection has to log in (default 30)",
     )  # fmt: skip
@@ -75,6 +88,21 @@ def register(sub: argparse._SubParsersAction) -> None:
     serve.add_argument(
         "--max-unauthenticated-per-address", type=int, default=10,
         help="connections not logged in yet from one address (default 10)",
+    )  # fmt: skip
+    serve.add_argument(
+        "--unauthenticated-start", type=int, default=50,
+        help="from this many connections not logged in yet, new ones are dropped at random, "
+        "more often the nearer --max-unauthenticated (default 50)",
+    )  # fmt: skip
+    serve.add_argument(
+        "--penalty-min", type=float, default=90,
+        help="seconds of places at the login held by connections that went without logging "
+        "in, beyond what time has paid back, before their address (IPv6: /64) is refused "
+        "(default 90)",
+    )  # fmt: skip
+    serve.add_argument(
+        "--penalty-max", type=float, default=600,
+        help="the longest an address is refused for that (default 600; 0: no penalties)",
     )  # fmt: skip
     serve.add_argument(
         "--password-lock-after", type=int, default=10,
@@ -236,6 +264,29 @@ def cmd_serve(args: argparse.Namespace) -> int:
         )
     if args.max_per_user < 1 or args.max_sessions < 1 or not args.idle_timeout > 0:
         return fail("serve-ssh", "--max-per-user, --max-sessions and --idle-timeout must be > 0")
+    if args.max_connections_per_user < 1:
+        return fail(
+            "serve-ssh",
+            f"--max-connections-per-user {args.max_connections_per_user}: must be at least 1 "
+            "(default 10)",
+        )
+    try:
+        columns, rows = parse_terminal(args.max_terminal)
+    except ValueError as exc:
+        return fail("serve-ssh", f"--max-terminal {args.max_terminal!r}: {exc}")
+    if args.app_memory < 0 or 0 < args.app_memory < 64:
+        return fail(
+            "serve-ssh",
+            f"--app-memory {args.app_memory}: give at least 64 (MiB; an app needs about 50) or "
+            "0 for no cap (default 512)",
+        )
+    penalties = (args.penalty_min, args.penalty_max)
+    if not all(math.isfinite(x) and x >= 0 for x in penalties) or args.unauthenticated_start < 1:
+        return fail(
+            "serve-ssh",
+            "--penalty-min and --penalty-max must be 0 or more (0: no penalties), and "
+            "--unauthenticated-start at least 1",
+        )
     login_numbers = (
         args.login_timeout,
         args.max_unauthenticated,
@@ -255,6 +306,9 @@ def cmd_serve(args: argparse.Namespace) -> int:
         max_unauthenticated_per_address=args.max_unauthenticated_per_address,
         lock_after=args.password_lock_after,
         lock_for=args.password_lock_for,
+        unauthenticated_start=args.unauthenticated_start,
+        penalty_least=args.penalty_min,
+        penalty_longest=args.penalty_max,
     )
     data_dir = resolve_data_dir(args.data_dir)
     try:
@@ -274,7 +328,15 @@ def cmd_serve(args: argparse.Namespace) -> int:
         users_file=Path(args.users) if args.users else None,
         port_range=port_range,
         public_host=args.public_host,
-        limits=SessionLimits(args.max_per_user, args.max_sessions, args.idle_timeout),
+        limits=SessionLimits(
+            args.max_per_user,
+            args.max_sessions,
+            args.idle_timeout,
+            connections_per_user=args.max_connections_per_user,
+            max_columns=columns,
+            max_rows=rows,
+            app_memory=args.app_memory,
+        ),
         logins=logins,
         fork_server=not args.no_fork_server,
         app=WORKBENCH_APP,
@@ -303,6 +365,17 @@ def cmd_serve(args: argparse.Namespace) -> int:
 def record_quota_argv(args: argparse.Namespace) -> tuple[str, ...]:
     """The run records' caps as every session's app is given them (0: no limit)."""
     return ("--record-cap", str(args.record_cap or 0), "--runs-quota", str(args.runs_quota or 0))
+
+
+def parse_terminal(text: str) -> tuple[int, int]:
+    """``"500x200"`` as ``(500, 200)``; ValueError saying what is wrong."""
+    columns, sep, rows = text.lower().partition("x")
+    if not sep or not columns.strip().isdigit() or not rows.strip().isdigit():
+        raise ValueError("write it as COLUMNSxROWS, e.g. 500x200")
+    size = int(columns), int(rows)
+    if size[0] < 80 or size[1] < 24:
+        raise ValueError("the app needs at least 80x24")
+    return size
 
 
 def _prepare_course_store(data_dir: Path, db: str) -> str:

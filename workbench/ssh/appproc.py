@@ -37,6 +37,10 @@ RESTORE_TERMINAL = (
     b"\x1b[?1049l"  # back from the alternate screen
 )
 READ_SIZE = 65536
+#: how an app that ran out of memory says so on its error output (Python, the C library)
+OUT_OF_MEMORY = (b"MemoryError", b"Cannot allocate memory", b"std::bad_alloc")
+#: how much of the end of an app's error output is searched for them
+LOG_TAIL = 256 * 1024
 
 
 @dataclass(frozen=True)
@@ -134,15 +138,19 @@ class AppProcess:
         *,
         forkserver: ForkServer | None = None,
         options: list[str] | None = None,
+        memory: int = 0,
     ) -> None:
         """``argv`` starts the app as a new process; with a running ``forkserver`` the app is
-        forked from it with ``options`` instead (``argv`` stays the way if that fails)."""
+        forked from it with ``options`` instead (``argv`` stays the way if that fails). The
+        app may have ``memory`` bytes (0: no cap)."""
         self.argv = argv
         self.env = env
         self.log_path = log_path
         self.on_output = on_output
         self.forkserver = forkserver
         self.options = options
+        self.memory = memory
+        self._log_start = 0
         self.forked = False
         self.process: asyncio.subprocess.Process | ForkedApp | None = None
         self.said_exit = False  # the app announced its end itself
@@ -161,12 +169,16 @@ class AppProcess:
 
     async def start(self) -> None:
         self.log_path.parent.mkdir(parents=True, exist_ok=True)
+        with contextlib.suppress(OSError):
+            self._log_start = self.log_path.stat().st_size
         forkserver = self.forkserver
         if forkserver is not None and forkserver.running and self.options is not None:
             from .forkserver import ForkServerError
 
             try:
-                self.process = await forkserver.spawn(self.options, self.env, self.log_path)
+                self.process = await forkserver.spawn(
+                    self.options, self.env, self.log_path, memory=self.memory
+                )
                 self.forked = True
             except ForkServerError as exc:
                 log.warning("app not forked (%s): starting it as a new process", exc)
@@ -180,9 +192,10 @@ class AppProcess:
                     env=self.env,
                     start_new_session=True,
                 )
-            from .forkserver import APP_NICENESS, lower_priority
+            from .forkserver import APP_NICENESS, limit_memory, lower_priority
 
             lower_priority(APP_NICENESS, self.process.pid)  # as a forked app runs
+            limit_memory(self.memory, self.process.pid)
         for packet in self._pending:
             self._write(packet)
         self._pending.clear()
@@ -263,6 +276,20 @@ class AppProcess:
         if not getattr(self.process, "status_known", True) and self.said_exit:
             code = 0  # its fork server was lost, but the app said it ended by itself
         return code
+
+    def ran_out_of_memory(self) -> bool:
+        """Whether the app, ended with an error, says on its error output that memory ran out
+        (under its cap, an allocation past it fails)."""
+        if self.memory <= 0 or not self.returncode:
+            return False
+        try:
+            with open(self.log_path, "rb") as errors:
+                size = errors.seek(0, os.SEEK_END)
+                errors.seek(max(self._log_start, size - LOG_TAIL))
+                tail = errors.read(LOG_TAIL)
+        except OSError:
+            return False
+        return any(sign in tail for sign in OUT_OF_MEMORY)
 
     def _close_input(self) -> None:
         process = self.process

@@ -18,7 +18,8 @@ Two halves live here:
   the environment and runs the entry point with the app's options, ending with the
   interpreter's ordinary exit. An app runs :data:`APP_NICENESS` steps below the lab server, so
   the server's own work (handshakes, logins, passing keys and screens on) goes first when a
-  whole class arrives at once. The fork server answers with the child's pid, reaps children
+  whole class arrives at once, and under the memory cap the request names
+  (:func:`limit_memory`). The fork server answers with the child's pid, reaps children
   as they end and reports each one's exit status.
 - :class:`ForkServer`, the lab server's side: starts that process, sends requests and turns the
   answers into :class:`ForkedApp` objects that look like an ``asyncio.subprocess.Process``
@@ -39,6 +40,7 @@ import json
 import logging
 import os
 import pkgutil
+import resource
 import selectors
 import signal
 import socket
@@ -65,6 +67,10 @@ MAX_MESSAGE = 1 << 20
 APP_NICENESS = 10
 #: exit status given for an app whose status could not be learnt (the fork server was lost)
 UNKNOWN_STATUS = 1
+#: the limit an app's memory cap is set on: on Linux the data segment and private writable
+#: mappings (the memory an app can fill, not the address space it only reserves, which grows
+#: by tens of MB with each thread), elsewhere the address space
+MEMORY_LIMIT = resource.RLIMIT_DATA if sys.platform == "linux" else resource.RLIMIT_AS
 
 
 #: an app's exit status, None when it could not be learnt
@@ -157,6 +163,7 @@ class _Zygote:
             request = json.loads(message)
             options = [str(o) for o in request["argv"]]
             env = {str(k): str(v) for k, v in request["env"].items()}
+            memory = int(request.get("memory", 0))
             if len(fds) != 2:
                 raise ValueError(f"{len(fds)} descriptors instead of 2")
         except (ValueError, KeyError, TypeError, AttributeError) as exc:
@@ -176,7 +183,7 @@ class _Zygote:
             os.setsid()  # its own session and process group, before the server learns its pid
             os.close(ready_r)
             os.close(ready_w)
-            return lambda: _run_app(self.main, options, env, fds, request.get("cwd"))
+            return lambda: _run_app(self.main, options, env, fds, request.get("cwd"), memory)
         for fd in (*fds, ready_w):
             os.close(fd)
         with contextlib.suppress(OSError):
@@ -212,12 +219,29 @@ def lower_priority(niceness: int, pid: int = 0) -> None:
         group.write(str(niceness))
 
 
+def limit_memory(cap: int, pid: int = 0) -> None:
+    """Let process ``pid`` (0: this one) have at most ``cap`` bytes of memory (0: no cap): past
+    it, its allocations fail (Python's MemoryError) and it ends. A cap the system refuses
+    leaves it as it is."""
+    if cap <= 0:
+        return
+    with contextlib.suppress(OSError, ValueError):
+        _, hard = resource.getrlimit(MEMORY_LIMIT)
+        if hard != resource.RLIM_INFINITY:
+            cap = min(cap, hard)
+        if pid:
+            resource.prlimit(pid, MEMORY_LIMIT, (cap, cap))
+        else:
+            resource.setrlimit(MEMORY_LIMIT, (cap, cap))
+
+
 def _run_app(
     main: Callable[[list[str]], int],
     options: list[str],
     env: dict[str, str],
     fds: list[int],
     cwd: str | None,
+    memory: int = 0,
 ) -> int:
     """In the forked child: become the session's app."""
     io, errors = fds
@@ -229,6 +253,7 @@ def _run_app(
             os.close(fd)
     signal.signal(signal.SIGINT, signal.default_int_handler)
     lower_priority(APP_NICENESS)
+    limit_memory(memory)
     os.environ.clear()
     os.environ.update(env)
     if cwd:
@@ -453,13 +478,21 @@ class ForkServer:
         loop.add_reader(fd, gone)
 
     async def spawn(
-        self, options: list[str], env: dict[str, str], log_path: Path, cwd: str | None = None
+        self,
+        options: list[str],
+        env: dict[str, str],
+        log_path: Path,
+        cwd: str | None = None,
+        memory: int = 0,
     ) -> ForkedApp:
-        """A new app with these options and environment, its errors appended to ``log_path``."""
+        """A new app with these options and environment, its errors appended to ``log_path``,
+        under a cap of ``memory`` bytes (0: none)."""
         if not self._running or self._sock is None:
             raise ForkServerError("the fork server is not running")
         loop = asyncio.get_running_loop()
-        request = json.dumps({"argv": options, "env": env, "cwd": cwd or os.getcwd()}).encode()
+        request = json.dumps(
+            {"argv": options, "env": env, "cwd": cwd or os.getcwd(), "memory": memory}
+        ).encode()
         ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_STREAM)
         try:
             with open(log_path, "ab") as errors:

@@ -1,4 +1,6 @@
-"""The server's session limits: sessions per user and in all, and the idle timeout."""
+"""The server's limits on what one user may spend: sessions per user and in all, the idle
+timeout, connections per user, the terminal's size and how often it may change, and each
+app's memory."""
 
 from __future__ import annotations
 
@@ -10,6 +12,15 @@ class SessionLimits:
     per_user: int = 2
     total: int = 60
     idle_timeout: float = 7200.0
+    #: connections one user may hold logged in, with or without a session (forwarding-only
+    #: ``ssh -N`` ones and lost ones not yet timed out count too)
+    connections_per_user: int = 10
+    #: the largest terminal an app is given, and how often a resize is passed on (seconds)
+    max_columns: int = 500
+    max_rows: int = 200
+    resize_every: float = 0.1
+    #: each app's memory, in MiB (0: no cap)
+    app_memory: int = 512
 
     def refusal(self, user_sessions: int, all_sessions: int) -> str | None:
         """The message for a user who would open one more session, or None when it may."""
@@ -23,6 +34,35 @@ class SessionLimits:
                 "user may have; quit one (ctrl+q) and try again."
             )
         return None
+
+    def connection_refusal(self, user_connections: int) -> str | None:
+        """The message for a user who would hold one more connection, or None when they may."""
+        if user_connections < self.connections_per_user:
+            return None
+        many = "connection" if self.connections_per_user == 1 else "connections"
+        return (
+            f"You already have {self.connections_per_user} {many} to the lab server, the most "
+            "one user may have: close the ones you do not use (lost ones end within a few "
+            "minutes) and try again."
+        )
+
+    def terminal_size(self, width: int, height: int) -> tuple[int, int]:
+        """The size an app is given for a terminal of ``width`` x ``height``."""
+        return min(width, self.max_columns), min(height, self.max_rows)
+
+    def memory_message(self) -> str:
+        share = describe_memory(self.app_memory)
+        return (
+            f"Your workbench used more than its share of memory ({share}) and was ended. "
+            "Your lab progress is saved; log in again to go on."
+        )
+
+
+def describe_memory(mib: int) -> str:
+    """``1024`` as ``"1 GiB"``, ``300`` as ``"300 MiB"``."""
+    if mib >= 1024 and mib % 1024 == 0:
+        return f"{mib // 1024} GiB"
+    return f"{mib} MiB"
 
 
 def describe_duration(seconds: float) -> str:

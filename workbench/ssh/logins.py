@@ -10,16 +10,22 @@ Plain bookkeeping with an injectable clock; the server does the waiting. Three r
   with the address's, past a small allowance for a lab behind one address), up to a maximum;
   after ``lock_after`` failures the account takes no passwords for ``lock_for`` seconds (its
   keys still work);
-- connections that have not logged in are capped in all and per address, and so are the
-  password attempts waiting out a delay, so neither can pile up.
+- connections that have not logged in are capped in all and per source (an IPv4 address, an
+  IPv6 /64, see :mod:`.sources`), and so are the password attempts waiting out a delay, so
+  neither can pile up; past a start threshold new connections are dropped at random, more
+  often the fuller it is (as OpenSSH's MaxStartups), and a source whose connections hold
+  places without logging in is refused for a while (its penalty).
 """
 
 from __future__ import annotations
 
+import random
 import time
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass
+
+from .sources import Penalties, source_of
 
 Clock = Callable[[], float]
 
@@ -39,11 +45,22 @@ class LoginPolicy:
     #: password attempts waiting out a delay at once, in all and from one address
     max_waiting: int = 32
     max_waiting_per_address: int = 4
-    #: connections that have not logged in yet, in all and from one address
+    #: connections that have not logged in yet, in all and from one source
     max_unauthenticated: int = 100
     max_unauthenticated_per_address: int = 10
+    #: from this many connections not logged in, a new one is dropped at random: with
+    #: ``start_drop`` chance at first, rising evenly to certainty at ``max_unauthenticated``
+    unauthenticated_start: int = 50
+    start_drop: float = 0.3
+    #: a source is refused once its connections that went without logging in held places for
+    #: ``penalty_least`` seconds more than time has paid back; for at most ``penalty_longest``
+    #: seconds (0: no penalties)
+    penalty_least: float = 90.0
+    penalty_longest: float = 600.0
     #: seconds a connection has to log in
     login_timeout: float = 30.0
+    #: the random early drop's seed (None: from the system)
+    seed: int | None = None
 
     def delay_after(self, failures: int) -> float:
         if failures <= 0:
@@ -145,33 +162,57 @@ class LoginGuard:
 
 
 class ConnectionGate:
-    """Caps on connections not logged in yet and on password attempts waiting out a delay."""
+    """Caps on connections not logged in yet and on password attempts waiting out a delay.
 
-    def __init__(self, policy: LoginPolicy) -> None:
+    Connections are counted by source (:func:`.sources.source_of`), password attempts by
+    address."""
+
+    def __init__(self, policy: LoginPolicy, clock: Clock = time.monotonic) -> None:
         self.policy = policy
         self.unauthenticated: Counter[str] = Counter()
         self.waiting: Counter[str] = Counter()
+        self.penalties = Penalties(policy.penalty_least, policy.penalty_longest, clock)
+        self._random = random.Random(policy.seed)
 
     def refuse_connection(self, address: str) -> str | None:
         """Why a new connection from ``address`` is closed at once, or None to let it in."""
         policy = self.policy
-        if self.unauthenticated[address] >= policy.max_unauthenticated_per_address:
+        source = source_of(address)
+        penalty = self.penalties.refused_for(source)
+        if penalty:
             return (
-                f"{policy.max_unauthenticated_per_address} connections from this address "
+                f"refused for another {penalty:.0f} s: connections from {source} held places "
+                "at the login without logging in"
+            )
+        if self.unauthenticated[source] >= policy.max_unauthenticated_per_address:
+            where = "this address" if source == address else source
+            return (
+                f"{policy.max_unauthenticated_per_address} connections from {where} "
                 "have not logged in yet"
             )
-        if self.unauthenticated.total() >= policy.max_unauthenticated:
+        waiting = self.unauthenticated.total()
+        if waiting >= policy.max_unauthenticated:
             return f"{policy.max_unauthenticated} connections have not logged in yet"
+        start = policy.unauthenticated_start
+        if waiting >= start:
+            share = (waiting - start) / (policy.max_unauthenticated - start)
+            chance = policy.start_drop + (1 - policy.start_drop) * share
+            if self._random.random() < chance:
+                return f"dropped at random: {waiting} connections have not logged in yet"
         return None
 
     def opened(self, address: str) -> None:
-        self.unauthenticated[address] += 1
+        self.unauthenticated[source_of(address)] += 1
 
-    def settled(self, address: str) -> None:
-        """The connection logged in or went away: it no longer counts as waiting to log in."""
-        self.unauthenticated[address] -= 1
-        if self.unauthenticated[address] <= 0:
-            del self.unauthenticated[address]
+    def settled(self, address: str, held: float = 0.0, logged_in: bool = True) -> bool:
+        """The connection logged in or went away after ``held`` seconds: it no longer counts
+        as waiting to log in; one that went without logging in is charged to its source.
+        True when that starts the source's penalty."""
+        source = source_of(address)
+        self.unauthenticated[source] -= 1
+        if self.unauthenticated[source] <= 0:
+            del self.unauthenticated[source]
+        return not logged_in and self.penalties.charge(source, held)
 
     def start_waiting(self, address: str) -> bool:
         """Take a place for a password attempt to wait in; False when none is free."""

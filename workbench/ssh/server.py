@@ -23,10 +23,12 @@ from .appproc import RESTORE_TERMINAL, AppEntry, AppProcess, AppSpec, app_env, f
 from .forkserver import ForkServer, ForkServerError
 from .forwarding import local_forward_refusal, remote_forward_refusal
 from .hostkey import host_key_path, load_or_create_host_key
-from .limits import SessionLimits, describe_duration
+from .limits import SessionLimits, describe_duration, describe_memory
 from .logins import ConnectionGate, LoginGuard, LoginPolicy, QuietLog
+from .openfiles import Handler, near_the_limit, quiet_accept_errors, raise_file_limit
 from .passwords import hash_password, verify_password
 from .ports import PoolExhausted, PortPool
+from .sources import source_of
 from .users import User, UsersFile, users_path
 
 log = logging.getLogger("workbench.ssh")
@@ -37,6 +39,12 @@ NOT_A_TERMINAL = (
 )
 NO_COMMANDS = "This lab server runs the workbench only: no commands ({what} refused)."
 NO_FILES = "This lab server runs the workbench only: no file transfer ({what} refused)."
+#: what a client closed before it logs in reads (as the reason of the SSH disconnect)
+TOO_MANY_WAITING = (
+    "The lab server has too many connections waiting to log in from your network or in all; "
+    "try again in a minute."
+)
+OUT_OF_FILES = "The lab server is full; try again in a few minutes."
 #: the ciphers the server takes, AES only: a client picks the first of its own list the server
 #: has, and OpenSSH's list starts with chacha20-poly1305, which asyncssh does per packet in
 #: several Python calls (about five times the CPU of AES-GCM, measured in bench/startup.py);
@@ -121,6 +129,9 @@ class LabServer:
         self.pool = PortPool(*config.port_range)
         self.sessions: dict[int, LabSession] = {}
         self.connections: set[LabConnection] = set()
+        #: connections logged in, per user
+        self.user_connections: Counter[str] = Counter()
+        self.file_limit = 0
         self.remote_listens: dict[str, Counter[int]] = {}
         self.guard = LoginGuard(config.logins)
         self.gate = ConnectionGate(config.logins)
@@ -132,6 +143,7 @@ class LabServer:
         self._acceptor: asyncssh.SSHAcceptor | None = None
         self._sweeper: asyncio.Task[None] | None = None
         self._closing = False
+        self._previous_handler: Handler = None
         self.forkserver: ForkServer | None = None
 
     @property
@@ -141,6 +153,10 @@ class LabServer:
 
     async def start(self) -> None:
         config = self.config
+        files_before, self.file_limit = raise_file_limit()
+        self._previous_handler = quiet_accept_errors(
+            asyncio.get_running_loop(), lambda key, line: self.say_now_and_then(key, "%s", line)
+        )
         await self._start_forkserver()
         try:
             self._acceptor = await self._listen()
@@ -161,6 +177,15 @@ class LabServer:
             logins.login_timeout, logins.max_unauthenticated,
             logins.max_unauthenticated_per_address, describe_duration(logins.lock_for),
             logins.lock_after,
+        )  # fmt: skip
+        limits = config.limits
+        raised = f" (raised from {files_before})" if files_before != self.file_limit else ""
+        log.info(
+            "limits: %d connections per user; terminals at most %dx%d; app memory %s; "
+            "%d open files%s",
+            limits.connections_per_user, limits.max_columns, limits.max_rows,
+            describe_memory(limits.app_memory) if limits.app_memory else "not capped",
+            self.file_limit, raised,
         )  # fmt: skip
 
     async def _listen(self) -> asyncssh.SSHAcceptor:
@@ -225,6 +250,7 @@ class LabServer:
             await self._acceptor.wait_closed()
         if self.forkserver is not None:
             await self.forkserver.close()
+        asyncio.get_running_loop().set_exception_handler(self._previous_handler)
 
     async def __aenter__(self) -> LabServer:
         await self.start()
@@ -299,7 +325,13 @@ class LabConnection(asyncssh.SSHServer):
         self.remote_ports: Counter[int] = Counter()
         #: counted among the connections that have not logged in yet
         self.counted = False
+        #: counted among its user's logged-in connections
+        self.holds_place = False
+        #: logged in, and closed at once: its user held too many connections
+        self.over_cap = False
+        self.opened_at = time.monotonic()
         self._pending_key = "?"
+        self._login: tuple[User, str] | None = None
 
     # -- connection --------------------------------------------------------------------------
     def connection_made(self, conn: asyncssh.SSHServerConnection) -> None:
@@ -308,12 +340,17 @@ class LabConnection(asyncssh.SSHServer):
         server.connections.add(self)
         peer = conn.get_extra_info("peername")
         self.peer = str(peer[0]) if peer else "?"
+        sock = conn.get_extra_info("socket")
+        if sock is not None and near_the_limit(sock.fileno(), server.file_limit):
+            self._turn_away(
+                "out of files",
+                f"{sock.fileno()} of the server's {server.file_limit} open files are in use",
+                OUT_OF_FILES,
+            )
+            return
         why = server.gate.refuse_connection(self.peer)
         if why is not None:
-            server.say_now_and_then(
-                f"turned away {self.peer}", "connection from %s closed: %s", self.peer, why
-            )
-            asyncio.get_running_loop().call_soon(conn.abort)
+            self._turn_away(f"turned away {self.peer}", why, TOO_MANY_WAITING)
             return
         server.gate.opened(self.peer)
         self.counted = True
@@ -321,15 +358,43 @@ class LabConnection(asyncssh.SSHServer):
         conn.create_agent_listener = self._refuse_agent  # type: ignore[method-assign]
         conn.attach_x11_listener = self._refuse_x11  # type: ignore[method-assign]
 
-    def _settle(self) -> None:
+    def _turn_away(self, key: str, why: str, message: str) -> None:
+        """Close the connection at once with ``message`` for the client; log ``why`` (the
+        same ``key`` at most once per 10 s)."""
+        self.server.say_now_and_then(key, "connection from %s closed: %s", self.peer, why)
+        assert self.conn is not None
+        # after asyncssh has sent its version, so the client reads the reason
+        asyncio.get_running_loop().call_soon(
+            self.conn.disconnect, asyncssh.DISC_TOO_MANY_CONNECTIONS, message
+        )
+
+    def _settle(self, logged_in: bool) -> None:
         if self.counted:
             self.counted = False
-            self.server.gate.settled(self.peer)
+            server = self.server
+            held = time.monotonic() - self.opened_at
+            if server.gate.settled(self.peer, held, logged_in):
+                penalties = server.gate.penalties
+                source = source_of(self.peer)
+                server.say_now_and_then(
+                    f"penalty {source}",
+                    "connections from %s refused for %.0f s: they held places at the login "
+                    "without logging in",
+                    source,
+                    penalties.refused_for(source),
+                )
 
     def connection_lost(self, exc: Exception | None) -> None:
-        self._settle()
+        self._settle(logged_in=False)
         self.server.connections.discard(self)
-        if self.username and self.user is None and not self.failed:
+        if self.holds_place:
+            self.holds_place = False
+            assert self.user is not None
+            counts = self.server.user_connections
+            counts[self.user.name] -= 1
+            if counts[self.user.name] <= 0:
+                del counts[self.user.name]
+        if self.username and self.user is None and not self.failed and not self.over_cap:
             # every offered key was refused and the client gave up
             self.server.guard.key_failed(self.peer)
             self.server.say_now_and_then(
@@ -382,8 +447,25 @@ class LabConnection(asyncssh.SSHServer):
             self.server.say_now_and_then(key, message, shown(username), self.peer, why)
 
     def _accepted(self, user: User, how: str) -> None:
+        """Let the user in, unless they hold as many connections as one user may."""
+        server = self.server
+        self._settle(logged_in=True)
+        why = server.config.limits.connection_refusal(server.user_connections[user.name])
+        if why is not None:
+            self.over_cap = True
+            server.say_now_and_then(
+                f"connections of {user.name}",
+                "login refused: %s from %s: %d connections logged in already",
+                user.name,
+                self.peer,
+                server.user_connections[user.name],
+            )
+            assert self.conn is not None
+            self.conn.disconnect(asyncssh.DISC_TOO_MANY_CONNECTIONS, why)
+            return
         self.user = user
-        self._settle()
+        self.holds_place = True
+        server.user_connections[user.name] += 1
         log.info("login: %s (%s) from %s with %s", user.name, user.role, self.peer, how)
 
     def public_key_auth_supported(self) -> bool:
@@ -397,10 +479,13 @@ class LabConnection(asyncssh.SSHServer):
         return False
 
     def auth_completed(self) -> None:
-        if self.user is None:  # by key: validate_public_key cannot tell a query from a login
-            user = self._known(self.username)
-            if user is not None:
-                self._accepted(user, f"key {self._pending_key}")
+        if self._login is not None:  # by password
+            self._accepted(*self._login)
+            return
+        # by key: validate_public_key cannot tell a query from a login
+        user = self._known(self.username)
+        if user is not None:
+            self._accepted(user, f"key {self._pending_key}")
 
     def password_auth_supported(self) -> bool:
         return True
@@ -432,7 +517,7 @@ class LabConnection(asyncssh.SSHServer):
         ok = await asyncio.to_thread(verify_password, password, stored)
         if user is not None and ok and user.password:
             guard.password_succeeded(username)
-            self._accepted(user, "password")
+            self._login = (user, "password")
             return True
         locks = guard.password_failed(username, self.peer)
         self._refused(username, "unknown user" if user is None else "wrong password")
@@ -526,6 +611,10 @@ class LabSession(asyncssh.SSHServerSession):
         self._ending: asyncio.Task[None] | None = None
         self._runner: asyncio.Task[None] | None = None
         self._closed = False
+        #: the size the app was last given, when, and the pass-on of a newer one, if waiting
+        self._app_size = self.size
+        self._resized_at = 0.0
+        self._resize: asyncio.TimerHandle | None = None
 
     @property
     def running(self) -> bool:
@@ -540,8 +629,19 @@ class LabSession(asyncssh.SSHServerSession):
         self.term = term_type or "xterm-256color"
         width, height = term_size[0], term_size[1]
         if width > 0 and height > 0:
-            self.size = (width, height)
+            self.size = self._clamped(width, height)
         return True
+
+    def _clamped(self, width: int, height: int) -> tuple[int, int]:
+        """The terminal size the app is given (a huge one would take its memory and CPU)."""
+        size = self.server.config.limits.terminal_size(width, height)
+        if size != (width, height):
+            self.server.say_now_and_then(
+                f"terminal of {self.user.name}",
+                "terminal of %s from %s is %dx%d: the app is given %dx%d",
+                self.user.name, self.connection.peer, width, height, *size,
+            )  # fmt: skip
+        return size
 
     def shell_requested(self) -> bool:
         self.request = "shell"
@@ -624,7 +724,7 @@ class LabSession(asyncssh.SSHServerSession):
         ):
             record_dir = runs / f"{stamp}-{self.id}"
         hint = forward_hint(user, config.public_host, server.port, tcp_port, ws_port)
-        width, height = self.size
+        width, height = self._app_size = self.size
         self.spec = AppSpec(
             user,
             self.user.role,
@@ -647,6 +747,7 @@ class LabSession(asyncssh.SSHServerSession):
             self._output,
             forkserver=server.forkserver,
             options=self.spec.options(),
+            memory=config.limits.app_memory * 1024 * 1024,
         )
         try:
             await self.app.start()
@@ -673,6 +774,13 @@ class LabSession(asyncssh.SSHServerSession):
         code = await self.app.wait()
         if self._ending is None:  # the app ended by itself (ctrl+q, or a crash)
             message = "" if code == 0 else f"The workbench ended with an error ({code})."
+            if code and self.app.ran_out_of_memory():
+                limits = config.limits
+                log.warning(
+                    "session %d: %s's app ended at its memory cap (%s)",
+                    self.id, user, describe_memory(limits.app_memory),
+                )  # fmt: skip
+                message = limits.memory_message()
             await self._finish(message, code)
 
     def _output(self, data: bytes) -> None:
@@ -706,6 +814,9 @@ class LabSession(asyncssh.SSHServerSession):
             )
         server.pool.release(self.ports)
         self.ports = ()
+        if self._resize is not None:
+            self._resize.cancel()
+            self._resize = None
         if self.chan is not None and not self._closed:
             with contextlib.suppress(Exception):
                 self.chan.write(RESTORE_TERMINAL)
@@ -727,9 +838,26 @@ class LabSession(asyncssh.SSHServerSession):
             self.app.send_keys(data)
 
     def terminal_size_changed(self, width: int, height: int, pixwidth: int, pixheight: int) -> None:
-        self.size = (width, height)
-        if self.app is not None:
-            self.app.resize(width, height)
+        """Pass the new size on, clamped, at most once per ``resize_every`` seconds: of a
+        storm of changes the app gets the latest only."""
+        if width <= 0 or height <= 0:
+            return
+        self.size = self._clamped(width, height)
+        if self._resize is not None:
+            return  # a pass-on is waiting: it takes the size as it is then
+        wait = self._resized_at + self.server.config.limits.resize_every - time.monotonic()
+        if wait <= 0:
+            self._pass_size_on()
+        else:
+            self._resize = asyncio.get_running_loop().call_later(wait, self._pass_size_on)
+
+    def _pass_size_on(self) -> None:
+        self._resize = None
+        if self.app is None or self.size == self._app_size:
+            return
+        self._resized_at = time.monotonic()
+        self._app_size = self.size
+        self.app.resize(*self.size)
 
     def eof_received(self) -> bool:
         self._client_gone("end of input")
