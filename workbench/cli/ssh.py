@@ -17,18 +17,14 @@ from workbench.ssh.appproc import AppEntry
 
 from .common import db_option
 
-#: the app every SSH session runs: this Python's ``-m workbench``, or forked from the fork
-#: server as :func:`workbench.cli.main` with the app's modules imported beforehand and its
-#: first screen's common work done once (the command line's parser, and
-#: :func:`workbench.tui.warmup.prepare`)
+#: the app every SSH session runs, given the session's settings as JSON (see
+#: :mod:`workbench.cli.served`): this Python's ``-m workbench.cli.served``, or forked from the
+#: fork server as :func:`workbench.cli.served.main` with the app's modules imported beforehand
+#: and its first screen's common work done once (:func:`workbench.tui.warmup.prepare`)
 WORKBENCH_APP = AppEntry(
-    command=(sys.executable, "-m", "workbench"),
-    main="workbench.cli:main",
-    preload=(
-        "workbench.cli:shared_parser",
-        "workbench.tui.app",
-        "workbench.tui.warmup:prepare",
-    ),
+    command=(sys.executable, "-m", "workbench.cli.served"),
+    main="workbench.cli.served:main",
+    preload=("workbench.tui.app", "workbench.tui.warmup:prepare"),
 )
 
 

@@ -69,7 +69,7 @@ class ServerConfig:
     port_range: tuple[int, int] = (41000, 41999)
     public_host: str = ""
     limits: SessionLimits = field(default_factory=SessionLimits)
-    #: the app's command before its options, instead of the entry's (no fork server then)
+    #: the app's command before its settings, instead of the entry's (no fork server then)
     app_command: tuple[str, ...] | None = None
     #: fork each app from a fork server that has the app imported (not with ``app_command``)
     fork_server: bool = True
@@ -646,7 +646,7 @@ class LabSession(asyncssh.SSHServerSession):
             log_path,
             self._output,
             forkserver=server.forkserver,
-            options=self.spec.options(),
+            settings=self.spec.settings().to_json(),
         )
         try:
             await self.app.start()
