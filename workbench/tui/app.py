@@ -12,6 +12,7 @@ import asyncio
 import contextlib
 import gc
 import getpass
+import math
 import os
 import threading
 from collections.abc import Callable
@@ -625,8 +626,8 @@ def make_app(settings: AppSettings) -> WorkbenchApp:
     except NameProblem as exc:
         raise AppSetupError(str(exc)) from None
     tick_hz = settings.tick_hz
-    if not tick_hz > 0:
-        raise AppSetupError(f"the tick rate must be above 0 Hz, not {tick_hz}")
+    if not (math.isfinite(tick_hz) and tick_hz > 0):
+        raise AppSetupError(f"the tick rate must be a number of Hz above 0, not {tick_hz}")
     try:
         viple_configs(settings)
     except ValueError as exc:

@@ -111,6 +111,15 @@ class AppSettings:
 
 #: the settings that name a file or folder
 _PATHS = ("maze_path", "record_dir", "data_dir", "workspace")
+#: each kind of setting as the JSON it takes
+_WORDS: dict[type, str] = {
+    str: "text",
+    Path: "text",
+    int: "a whole number",
+    float: "a number",
+    bool: "true or false",
+    type(None): "null",
+}
 
 
 def _kinds() -> dict[str, tuple[type, ...]]:
@@ -138,13 +147,3 @@ def _read(name: str, kinds: tuple[type, ...], value: object) -> object:
     wanted = " or ".join(dict.fromkeys(_WORDS[k] for k in kinds))
     raise SettingsError(f"setting {name!r} must be {wanted}, not {value!r:.60}")
 
-
-#: each kind of setting as the JSON it takes
-_WORDS: dict[type, str] = {
-    str: "text",
-    Path: "text",
-    int: "a whole number",
-    float: "a number",
-    bool: "true or false",
-    type(None): "null",
-}
