@@ -29,14 +29,22 @@ def test_a_name_typed_in_lower_case_resumes_the_saved_progress(tmp_path):
         assert text(screen, "#labs-objectives").startswith("[X] drove with w, a, s, d")
 
     run(first, drive)
-    again = make_app(AppSettings(paused=True, student=" alice doe ", data_dir=data))
+    again = make_app(
+        AppSettings(paused=True, student=" alice doe ", data_dir=data, ask_names=True)
+    )
 
     async def resume(pilot: Pilot) -> None:
+        await pilot.press("enter")  # the names as given
+        await pilot.pause()
         screen = await open_exercise(pilot, DRIVE)
         assert screen.student == again.student == "Alice Doe"
         assert text(screen, "#labs-objectives").startswith(
             "[X] drove with w, a, s, d and space: passed earlier"
         )
+        await pilot.press("escape")
+        await pilot.pause()
+        # the message line names the student as the saved progress spells the name
+        assert text(pilot.app.screen, "#message").rstrip().endswith("Alice Doe (student)")
 
     run(again, resume)
 
