@@ -41,9 +41,10 @@ def run(stats_file: str, options: list[str]) -> int:
     return main(options)
 
 
-def from_start(options: list[str]) -> int:
-    """The app as a fork server runs it, profiled from here (just after the fork) to SIGUSR2."""
-    from workbench.cli import main
+def from_start(settings: object) -> int:
+    """The app as a fork server runs it (with its settings, a JSON object), profiled from here
+    (just after the fork) to SIGUSR2."""
+    from workbench.cli.served import main
 
     profiler = cProfile.Profile(time.thread_time)
 
@@ -53,7 +54,7 @@ def from_start(options: list[str]) -> int:
 
     signal.signal(signal.SIGUSR2, stop)
     profiler.enable()
-    return main(options)
+    return main(settings)
 
 
 if __name__ == "__main__":

@@ -342,7 +342,7 @@ async def profile_app(prefix: str) -> None:
         student = Student("s00", None, 0, "")  # type: ignore[arg-type]
         app = AppProcess([], spec.env(env), data / "app.log",
                          lambda b: (student.buffer.extend(b), student.arrived.set()),
-                         forkserver=forkserver, options=spec.options())  # fmt: skip
+                         forkserver=forkserver, settings=spec.settings().to_json())  # fmt: skip
         await app.start()
         await student.wait_for(NAMES_DIALOG)
         assert app.pid is not None

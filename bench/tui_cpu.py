@@ -1,9 +1,11 @@
 """CPU of one workbench app process while the robot drives and while it sits idle, as an SSH
 session runs it.
 
-Starts the app the way the SSH server does (``python -m workbench`` under Textual's web driver,
-packets over pipes, the student's VIPLE TCP and WebSocket endpoints on, 80x24, the names dialog
-at start), passes the names dialog, and then, for each mode of --modes:
+Starts the app as the SSH server does (under Textual's web driver, packets over pipes, the
+student's VIPLE TCP and WebSocket endpoints on, 80x24, the names dialog at start), with a
+session's settings given as ``python -m workbench`` options (which every revision takes, so
+``--compare`` can start an older one the same way), passes the names dialog, and then, for each
+mode of --modes:
 
   * ``ssh``: the key pattern of ``bench/ssh_load.py`` at --hz keys a second (forward, a turn now
     and then, stop now and then), as the load station sends it, for --seconds;
@@ -163,7 +165,8 @@ async def one_run(
         os.chdir(tree)  # ``python -m workbench`` imports the tree it is started in
         try:
             server_side = tree_app_process(tree)
-            app = server_side(spec.argv(command), env, data / "app.log", screen.feed)
+            argv = [*command, *app_options(spec)]
+            app = server_side(argv, env, data / "app.log", screen.feed)
             await app.start()
         finally:
             os.chdir(here)
@@ -212,6 +215,23 @@ async def one_run(
         finally:
             await app.stop(grace=10.0)
         return results
+
+
+def app_options(spec: AppSpec) -> list[str]:
+    """A session's settings as the command line's options."""
+    settings = spec.settings()
+    return [
+        "--student", spec.user,
+        "--ask-partner",
+        "--role", settings.role,
+        "--tcp-port", str(settings.tcp_port),
+        "--ws-url", str(settings.ws_url),
+        "--ws-when-asked",
+        "--connect-hint", settings.connect_hint,
+        "--data-dir", str(settings.data_dir),
+        "--record-dir", str(settings.record_dir),
+        "--workspace", str(settings.workspace),
+    ]  # fmt: skip
 
 
 def tree_app_process(tree: Path) -> type[AppProcess]:

@@ -37,6 +37,7 @@ from workbench.sim.maze import Maze
 from workbench.sim.mazefile import write_maze
 from workbench.sim.session import Session
 from workbench.tui.app import make_app
+from workbench.tui.settings import AppSettings
 from workbench.tui.widgets import MazeView
 
 SIZE = (80, 24)
@@ -206,7 +207,7 @@ async def measure_app(maze: Maze, seconds: float, hz: float, speed: float) -> di
     with tempfile.TemporaryDirectory() as tmp:
         path = os.path.join(tmp, "station-maze.txt")
         write_maze(path, maze)
-        app = make_app(path, PROFILE, noise="off", tick_hz=hz)
+        app = make_app(AppSettings(path, PROFILE, noise="off", tick_hz=hz))
         async with app.run_test(size=SIZE) as pilot:
             await pilot.pause()
             station = app.station

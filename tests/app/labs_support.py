@@ -10,13 +10,14 @@ from textual.widgets import OptionList, Static
 from workbench.tui.app import WorkbenchApp, make_app
 from workbench.tui.dialogs.signoff import SignoffModal
 from workbench.tui.screens.labs import LabsScreen
+from workbench.tui.settings import AppSettings
 
 DRIVE = "unity-simulator/drive-by-wire"
 
 
 def lab_app(data_dir: Path, **kw) -> WorkbenchApp:
     """The app, paused, for the pair ana and ben, keeping its data in ``data_dir``."""
-    return make_app(paused=True, student="ana", partner="ben", data_dir=data_dir, **kw)
+    return make_app(AppSettings(paused=True, student="ana", partner="ben", data_dir=data_dir, **kw))
 
 
 def text(screen, selector: str) -> str:

@@ -24,6 +24,7 @@ from workbench.tui.keys import KEYS
 from workbench.tui.screens.editor import EditorScreen
 from workbench.tui.screens.main import MainScreen
 from workbench.tui.screens.runs import RunsScreen
+from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.key_legend import KeyLegend
 from workbench.tui.widgets.maze_view import MazeView
 from workbench.tui.widgets.run_status import RunStatus
@@ -46,7 +47,7 @@ def status(app: WorkbenchApp) -> str:
 
 
 def test_unity_keys_turn_by_degree_and_move_at_power(tmp_path):
-    app = make_app(maze_file(tmp_path, ROOM, "unity"), paused=True, noise="off")
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM, "unity"), paused=True, noise="off"))
     start = app.station.snapshot().pose
 
     async def body(pilot: Pilot) -> None:
@@ -69,7 +70,7 @@ def test_unity_keys_turn_by_degree_and_move_at_power(tmp_path):
 
 
 def test_web_keys_spin_until_the_next_key(tmp_path):
-    app = make_app(maze_file(tmp_path, ROOM, "web"), paused=True, noise="off")
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM, "web"), paused=True, noise="off"))
 
     async def body(pilot: Pilot) -> None:
         await pilot.press("a")
@@ -84,7 +85,7 @@ def test_web_keys_spin_until_the_next_key(tmp_path):
 
 
 def test_erobotic_w_drives_exactly_one_block(tmp_path):
-    app = make_app(maze_file(tmp_path, CORRIDOR, "erobotic"), paused=True)
+    app = make_app(AppSettings(maze_file(tmp_path, CORRIDOR, "erobotic"), paused=True))
     start = app.station.maze.start
 
     async def body(pilot: Pilot) -> None:
@@ -102,7 +103,7 @@ def test_erobotic_w_drives_exactly_one_block(tmp_path):
 
 @pytest.mark.parametrize("profile", ["unity", "web", "erobotic"])
 def test_the_key_legend_follows_the_profile(tmp_path, profile):
-    app = make_app(maze_file(tmp_path, ROOM, profile), paused=True)
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM, profile), paused=True))
 
     async def body(pilot: Pilot) -> None:
         legend = app.screen.query_one(KeyLegend)
@@ -118,7 +119,7 @@ def test_the_key_legend_follows_the_profile(tmp_path, profile):
 
 
 def test_pause_step_speed_and_reset(tmp_path):
-    app = make_app(maze_file(tmp_path, ROOM, "unity"), noise="off")
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM, "unity"), noise="off"))
     station = app.station
 
     async def body(pilot: Pilot) -> None:
@@ -149,7 +150,7 @@ def test_pause_step_speed_and_reset(tmp_path):
 
 
 def test_a_slow_frame_loses_no_simulated_time(tmp_path):
-    app = make_app(maze_file(tmp_path, ROOM, "unity"), paused=True, tick_hz=20)
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM, "unity"), paused=True, tick_hz=20))
 
     async def body(pilot: Pilot) -> None:
         app.station.pacer.paused = False
@@ -167,7 +168,7 @@ KEYED_APP_BINDINGS = [b for b in WorkbenchApp.BINDINGS if b not in FOCUS_BINDING
 
 
 def test_help_explains_every_key(tmp_path):
-    app = make_app(maze_file(tmp_path, ROOM, "web"), paused=True)
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM, "web"), paused=True))
 
     async def body(pilot: Pilot) -> None:
         await pilot.press("question_mark")
@@ -193,7 +194,7 @@ def test_every_binding_has_an_id_and_a_help_entry():
 
 
 def test_the_command_palette_offers_the_bindings_and_runs_them(tmp_path):
-    app = make_app(maze_file(tmp_path, ROOM, "unity"), paused=True)
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM, "unity"), paused=True))
 
     async def body(pilot: Pilot) -> None:
         provider = WorkbenchCommands(app.screen)
@@ -218,7 +219,7 @@ def test_the_command_palette_offers_the_bindings_and_runs_them(tmp_path):
 
 
 def test_unicode_and_trail_toggles(tmp_path):
-    app = make_app(maze_file(tmp_path, ROOM, "unity"), paused=True)
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM, "unity"), paused=True))
 
     async def body(pilot: Pilot) -> None:
         view = app.screen.query_one(MazeView)
@@ -233,7 +234,7 @@ def test_unicode_and_trail_toggles(tmp_path):
 
 
 def test_a_terminal_below_80x24_gets_a_message_instead_of_the_layout(tmp_path):
-    app = make_app(maze_file(tmp_path, ROOM, "unity"), paused=True)
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM, "unity"), paused=True))
 
     async def body(pilot: Pilot) -> None:
         assert isinstance(app.screen, TooSmallScreen)
@@ -255,8 +256,8 @@ def test_a_terminal_below_80x24_gets_a_message_instead_of_the_layout(tmp_path):
 def test_a_small_terminal_at_the_names_dialog_then_enlarged_reaches_the_main_screen(tmp_path):
     # the size message covers the names dialog; once the terminal is big enough the dialog
     # is back, and after it the main screen (not the size message again)
-    app = make_app(maze_file(tmp_path, ROOM, "unity"), paused=True, student="ann",
-                   ask_names=True, data_dir=tmp_path / "data")  # fmt: skip
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM, "unity"), paused=True, student="ann",
+                   ask_names=True, data_dir=tmp_path / "data"))  # fmt: skip
 
     async def body(pilot: Pilot) -> None:
         await pilot.pause()
@@ -274,7 +275,7 @@ def test_a_small_terminal_at_the_names_dialog_then_enlarged_reaches_the_main_scr
 
 
 def test_ctrl_q_in_the_editor_with_unsaved_changes_asks_first(tmp_path):
-    app = make_app(maze_file(tmp_path, ROOM, "unity"), paused=True)
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM, "unity"), paused=True))
 
     async def body(pilot: Pilot) -> None:
         await pilot.press("e")
@@ -295,7 +296,7 @@ def test_ctrl_q_in_the_editor_with_unsaved_changes_asks_first(tmp_path):
 
 
 def test_ctrl_q_quits_and_keeps_the_open_run(tmp_path):
-    app = make_app(maze_file(tmp_path, ROOM, "unity"), paused=True)
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM, "unity"), paused=True))
 
     async def body(pilot: Pilot) -> None:
         await pilot.press("w")
@@ -309,7 +310,7 @@ def test_ctrl_q_quits_and_keeps_the_open_run(tmp_path):
 
 
 def test_e_opens_the_maze_editor_and_capital_r_the_runs(tmp_path):
-    app = make_app(maze_file(tmp_path, ROOM, "unity"), paused=True)
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM, "unity"), paused=True))
 
     async def body(pilot: Pilot) -> None:
         await pilot.press("w", "r")  # one run, ended by the reset
@@ -339,19 +340,19 @@ def test_e_opens_the_maze_editor_and_capital_r_the_runs(tmp_path):
 
 def test_make_app_reports_bad_arguments_in_words(tmp_path):
     with pytest.raises(AppSetupError, match="unknown profile 'lego'"):
-        make_app(profile="lego")
+        make_app(AppSettings(profile="lego"))
     with pytest.raises(AppSetupError, match="unknown noise level"):
-        make_app(noise="loud")
+        make_app(AppSettings(noise="loud"))
     with pytest.raises(AppSetupError, match="cannot open the maze"):
-        make_app(tmp_path / "missing.txt")
+        make_app(AppSettings(tmp_path / "missing.txt"))
     bad = tmp_path / "bad.txt"
     bad.write_text("#####\n#.X.#\n#####\n")
     with pytest.raises(AppSetupError, match="unknown character"):
-        make_app(bad)
+        make_app(AppSettings(bad))
 
 
 def test_make_app_defaults_to_the_bundled_maze():
-    app = make_app(paused=True)
+    app = make_app(AppSettings(paused=True))
     assert app.station.maze.name == "Unity default" and app.station.profile == "unity"
     assert app.station.pacer.paused
 
@@ -372,7 +373,7 @@ def test_workbench_with_bad_arguments_exits_2_before_the_app(capsys, args, messa
 
 def test_the_run_panel_counts_a_bumper_touch_apart_from_collisions(tmp_path):
     # web: a touch sensor at the front; w drives at the course's Forward speed
-    app = make_app(maze_file(tmp_path, ROOM, "web"), paused=True, noise="off")
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM, "web"), paused=True, noise="off"))
 
     async def body(pilot: Pilot) -> None:
         await pilot.press("w")
@@ -393,7 +394,7 @@ def test_drive_keys_follow_the_focus_and_a_new_keymap_though_bindings_are_looked
 ):
     """The main screen builds its key bindings once and keeps them while nothing they depend on
     changes; moving the focus or changing the keymap builds them again, so keys keep working."""
-    app = make_app(maze_file(tmp_path, ROOM, "unity"), paused=True, noise="off")
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM, "unity"), paused=True, noise="off"))
 
     def heading() -> float:
         app.station.step(60 * 4)

@@ -12,6 +12,7 @@ from workbench.tui.app import WorkbenchApp, make_app
 from workbench.tui.dialogs.algorithm import AlgorithmModal
 from workbench.tui.dialogs.sensor_ports import SensorPortsModal
 from workbench.tui.screens.main import MainScreen
+from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.algorithm_state import AlgorithmState
 from workbench.tui.widgets.param_editor import ParamEditor
 from workbench.tui.widgets.sensor_readings import SensorReadings
@@ -31,7 +32,7 @@ async def click(pilot: Pilot, selector: str) -> None:
 
 
 def unity_app(tmp_path=None, **kw) -> WorkbenchApp:
-    return make_app(paused=True, noise="off", **kw)
+    return make_app(AppSettings(paused=True, noise="off", **kw))
 
 
 def text_of(widget: Static) -> str:

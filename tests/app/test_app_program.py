@@ -11,6 +11,7 @@ from tests.program.builder import ProgramBuilder
 from workbench.program.keys import RELEASE_GAP
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.algorithm import AlgorithmModal
+from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.algorithm_state import AlgorithmState
 from workbench.tui.widgets.program_state import ProgramState
 
@@ -65,7 +66,7 @@ async def load(pilot: Pilot, path: str) -> AlgorithmModal:
 
 
 def test_a_program_loads_drives_answers_keys_and_prints(tmp_path):
-    app = make_app(maze_file(tmp_path), paused=True, noise="off")
+    app = make_app(AppSettings(maze_file(tmp_path), paused=True, noise="off"))
     path = drive_by_wire(tmp_path)
 
     async def body(pilot: Pilot) -> None:
@@ -114,7 +115,7 @@ def test_a_program_loads_drives_answers_keys_and_prints(tmp_path):
 
 
 def test_a_held_key_repeating_stays_held(tmp_path):
-    app = make_app(maze_file(tmp_path), paused=True, noise="off")
+    app = make_app(AppSettings(maze_file(tmp_path), paused=True, noise="off"))
     path = drive_by_wire(tmp_path)
 
     async def body(pilot: Pilot) -> None:
@@ -136,7 +137,7 @@ def test_a_held_key_repeating_stays_held(tmp_path):
 
 
 def test_a_bad_program_lists_every_problem_and_the_app_goes_on(tmp_path):
-    app = make_app(maze_file(tmp_path), paused=True, noise="off")
+    app = make_app(AppSettings(maze_file(tmp_path), paused=True, noise="off"))
     path = bad_program(tmp_path)
 
     async def body(pilot: Pilot) -> None:
@@ -160,7 +161,7 @@ def test_a_served_student_loads_programs_only_from_the_workspace(tmp_path):
     workspace.mkdir()
     drive_by_wire(workspace, "mine.viple")
     outside = drive_by_wire(tmp_path, "theirs.viple")
-    app = make_app(maze_file(tmp_path), paused=True, noise="off", workspace=workspace)
+    app = make_app(AppSettings(maze_file(tmp_path), paused=True, noise="off", workspace=workspace))
 
     async def body(pilot: Pilot) -> None:
         dialog = await load(pilot, outside)
@@ -175,7 +176,7 @@ def test_a_served_student_loads_programs_only_from_the_workspace(tmp_path):
 
 
 def test_a_program_lacking_a_sensor_cannot_start_and_says_which(tmp_path):
-    app = make_app(maze_file(tmp_path), paused=True, noise="off")
+    app = make_app(AppSettings(maze_file(tmp_path), paused=True, noise="off"))
     b = ProgramBuilder()
     main = b.panel("Main")
     b.robot(main)
@@ -211,7 +212,7 @@ def active_actions(app) -> set[str]:
 
 
 def test_ctrl_k_sends_every_key_to_the_program_until_pressed_again(tmp_path):
-    app = make_app(maze_file(tmp_path), paused=True, noise="off")
+    app = make_app(AppSettings(maze_file(tmp_path), paused=True, noise="off"))
     path = screen_keys("keys.viple", tmp_path)
 
     async def body(pilot: Pilot) -> None:
@@ -251,7 +252,7 @@ def test_ctrl_k_sends_every_key_to_the_program_until_pressed_again(tmp_path):
 
 
 def test_all_keys_end_when_the_program_stops(tmp_path):
-    app = make_app(maze_file(tmp_path), paused=True, noise="off")
+    app = make_app(AppSettings(maze_file(tmp_path), paused=True, noise="off"))
     path = screen_keys("keys.viple", tmp_path)
 
     async def body(pilot: Pilot) -> None:

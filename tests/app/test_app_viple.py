@@ -6,6 +6,7 @@ import asyncio
 import socket
 
 from workbench.tui.app import WorkbenchApp, make_app
+from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.run_status import RunStatus
 
 ROOM = "#########\n#.......#\n#...S...#\n#.......#\n#########\n"
@@ -29,7 +30,7 @@ def status(app: WorkbenchApp) -> str:
 
 def test_a_viple_program_drives_the_robot_the_app_shows(tmp_path):
     port = free_port()
-    app = make_app(maze(tmp_path), tcp_port=port, noise="off", tick_hz=50)
+    app = make_app(AppSettings(maze(tmp_path), tcp_port=port, noise="off", tick_hz=50))
 
     async def go() -> None:
         async with app.run_test(size=(80, 24)) as pilot:
@@ -65,7 +66,7 @@ def test_a_port_in_use_is_shown_and_the_app_keeps_working(tmp_path):
         taken.bind(("127.0.0.1", 0))
         taken.listen()
         port = taken.getsockname()[1]
-        app = make_app(maze(tmp_path), tcp_port=port, noise="off", paused=True)
+        app = make_app(AppSettings(maze(tmp_path), tcp_port=port, noise="off", paused=True))
 
         async def go() -> None:
             async with app.run_test(size=(80, 24)) as pilot:

@@ -20,6 +20,7 @@ from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.tui.app import make_app
 from workbench.tui.screens.replay import ReplayScreen
 from workbench.tui.screens.runs import RunsScreen
+from workbench.tui.settings import AppSettings
 
 from .labs_support import open_exercise
 from .support import run, screen_lines
@@ -54,13 +55,15 @@ def test_every_screen_and_dialog_is_plain_ascii_in_ascii_mode(tmp_path: Path):
     bad = tmp_path / "bad.txt"
     bad.write_text(BAD_MAZE)
     app = make_app(
-        MAZE_DIR / "rank-wall-wins.txt",
-        paused=True,
-        noise="off",
-        student="ana",
-        partner="ben",
-        data_dir=data,
-        record_dir=str(tmp_path / "runs"),
+        AppSettings(
+            MAZE_DIR / "rank-wall-wins.txt",
+            paused=True,
+            noise="off",
+            student="ana",
+            partner="ben",
+            data_dir=data,
+            record_dir=str(tmp_path / "runs"),
+        ),
     )
     assert not app.unicode
 
@@ -119,7 +122,9 @@ def test_every_screen_and_dialog_is_plain_ascii_in_ascii_mode(tmp_path: Path):
 
 
 def test_the_names_dialog_at_start_is_plain_ascii(tmp_path: Path):
-    app = make_app(paused=True, student="ana", data_dir=tmp_path / "data", ask_names=True)
+    app = make_app(
+        AppSettings(paused=True, student="ana", data_dir=tmp_path / "data", ask_names=True)
+    )
 
     async def body(pilot: Pilot) -> None:
         await pilot.pause()

@@ -14,6 +14,7 @@ from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.screens import labs as labs_screen
 from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
+from workbench.tui.settings import AppSettings
 
 from .labs_support import lab_app, text
 from .support import run
@@ -35,7 +36,7 @@ def shown(widget: Static) -> str:
 
 @pytest.mark.parametrize("name", MAZES)
 def test_m_with_a_bad_maze_shows_the_error_and_keeps_the_maze(corpus, name):
-    app = make_app(paused=True)
+    app = make_app(AppSettings(paused=True))
     path = corpus[name]
 
     async def body(pilot: Pilot) -> None:
@@ -57,7 +58,7 @@ def test_m_with_a_bad_maze_shows_the_error_and_keeps_the_maze(corpus, name):
 
 @pytest.mark.parametrize("name", FSMS)
 def test_g_with_a_bad_fsm_file_shows_the_error_and_keeps_running(corpus, name):
-    app = make_app(paused=True, profile="unity")
+    app = make_app(AppSettings(paused=True, profile="unity"))
     path = corpus[name]
 
     async def body(pilot: Pilot) -> None:

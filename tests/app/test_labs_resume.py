@@ -10,6 +10,7 @@ from workbench.labs.store import Store
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.identity import IdentityDialog
 from workbench.tui.screens.main import MainScreen
+from workbench.tui.settings import AppSettings
 from workbench.viple.tcp_server import TcpConfig
 
 from .labs_support import DRIVE, lab_app, open_exercise, text
@@ -59,7 +60,7 @@ def test_what_passed_before_a_restart_is_still_passed_after_it(tmp_path):
 
 
 def test_the_names_are_asked_at_start_and_shown_on_the_message_line(tmp_path):
-    app = make_app(paused=True, student="ana", data_dir=tmp_path, ask_names=True)
+    app = make_app(AppSettings(paused=True, student="ana", data_dir=tmp_path, ask_names=True))
 
     async def body(pilot: Pilot) -> None:
         assert isinstance(app.screen, IdentityDialog)
@@ -83,8 +84,8 @@ def test_the_names_are_asked_at_start_and_shown_on_the_message_line(tmp_path):
 
 
 def test_over_ssh_the_student_name_is_fixed_and_escape_keeps_the_defaults(tmp_path):
-    app = make_app(paused=True, student="ana", data_dir=tmp_path, ask_names=True,
-                   student_fixed=True)  # fmt: skip
+    app = make_app(AppSettings(paused=True, student="ana", data_dir=tmp_path, ask_names=True,
+                   student_fixed=True))  # fmt: skip
 
     async def body(pilot: Pilot) -> None:
         assert app.screen.query_one("#student", Input).disabled
@@ -102,8 +103,8 @@ def test_a_served_students_first_screen_is_the_names_dialog_alone_then_the_main_
     # the main screen is built once the names are given (a class logging in at once waits
     # less for its first screens); what was said before it existed is on its message line
     hint = "VIPLE: on your computer run  ssh -N -p 2222 -L 1350:localhost:41000 ana@lab"
-    app = make_app(paused=True, student="ana", data_dir=tmp_path, ask_names=True,
-                   student_fixed=True, connect_hint=hint)  # fmt: skip
+    app = make_app(AppSettings(paused=True, student="ana", data_dir=tmp_path, ask_names=True,
+                   student_fixed=True, connect_hint=hint))  # fmt: skip
 
     async def body(pilot: Pilot) -> None:
         await pilot.pause()
@@ -124,7 +125,7 @@ def test_a_served_students_first_screen_is_the_names_dialog_alone_then_the_main_
 
 def test_a_connect_hint_is_shown_at_start_and_in_the_help(tmp_path):
     hint = "VIPLE: on your computer run  ssh -N -p 2222 -L 1350:localhost:41000 ana@lab"
-    app = make_app(paused=True, student="ana", data_dir=tmp_path, connect_hint=hint)
+    app = make_app(AppSettings(paused=True, student="ana", data_dir=tmp_path, connect_hint=hint))
 
     async def body(pilot: Pilot) -> None:
         await pilot.pause()
@@ -141,8 +142,8 @@ def test_a_connect_hint_too_long_for_the_message_line_points_to_the_help(tmp_pat
         "VIPLE: on your computer run  ssh -N -p 2222 -L 1350:localhost:41000 "
         "-R 41001:localhost:8124 ana@lab.example.edu  then VIPLE uses localhost:1350"
     )
-    app = make_app(paused=True, student="ana", data_dir=tmp_path, connect_hint=hint,
-                   ask_names=True, student_fixed=True)  # fmt: skip
+    app = make_app(AppSettings(paused=True, student="ana", data_dir=tmp_path, connect_hint=hint,
+                   ask_names=True, student_fixed=True))  # fmt: skip
 
     async def body(pilot: Pilot) -> None:
         await pilot.press("enter")  # the names dialog
@@ -262,7 +263,9 @@ def test_the_labs_reopen_at_the_exercise_the_student_had_open(tmp_path):
 
 def test_a_websocket_url_can_wait_until_asked_and_v_connects(tmp_path):
     url = "ws://127.0.0.1:9/"  # nothing listens: the client keeps trying, as it should
-    app = make_app(paused=True, student="ana", data_dir=tmp_path, ws_url=url, ws_at_start=False)
+    app = make_app(
+        AppSettings(paused=True, student="ana", data_dir=tmp_path, ws_url=url, ws_at_start=False)
+    )
 
     async def body(pilot: Pilot) -> None:
         assert app.endpoints is None  # no connection attempts until asked
@@ -278,7 +281,7 @@ def test_a_websocket_url_can_wait_until_asked_and_v_connects(tmp_path):
 
 
 def test_the_names_dialog_refuses_a_look_alike_name_and_normalises_the_rest(tmp_path):
-    app = make_app(paused=True, student="ana", data_dir=tmp_path, ask_names=True)
+    app = make_app(AppSettings(paused=True, student="ana", data_dir=tmp_path, ask_names=True))
 
     async def body(pilot: Pilot) -> None:
         partner = app.screen.query_one("#partner", Input)

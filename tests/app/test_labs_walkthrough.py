@@ -49,6 +49,7 @@ from workbench.tui.plain import prose
 from workbench.tui.screens.editor import EditorScreen
 from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
+from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.param_editor import ParamEditor
 from workbench.tui.widgets.sensor_row_editor import SensorRowEditor
 from workbench.tui.widgets.text import degrees, number
@@ -464,7 +465,11 @@ def test_a_pair_completes_and_signs_off_every_exercise_in_the_app(tmp_path, lab)
     create_instructor(data, INSTRUCTOR, PASS, kdf=FAST, trusted=kept_roster)
     # paused and noise off: every run is stepped by the test, in large batches, and comes out
     # the same each time; the app ticks only to draw, so slowly
-    app = make_app(paused=True, noise="off", tick_hz=2, student="ana", partner="ben", data_dir=data)
+    app = make_app(
+        AppSettings(
+            paused=True, noise="off", tick_hz=2, student="ana", partner="ben", data_dir=data
+        )
+    )
 
     async def body(pilot: Pilot) -> None:
         assert app.endpoints is None  # none asked for at start: a set-up starts what it needs

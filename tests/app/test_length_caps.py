@@ -12,6 +12,7 @@ from workbench.labs.names import MAX_STUDENT_NAME
 from workbench.labs.store import Store
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.identity import IdentityDialog
+from workbench.tui.settings import AppSettings
 
 from .labs_support import DRIVE, lab_app, open_exercise, text
 from .support import run
@@ -81,7 +82,7 @@ def test_progress_keeps_answers_within_the_cap_however_it_is_made():
 
 
 def test_a_name_past_the_cap_is_cut_with_a_message(tmp_path):
-    app = make_app(paused=True, student="ana", data_dir=tmp_path, ask_names=True)
+    app = make_app(AppSettings(paused=True, student="ana", data_dir=tmp_path, ask_names=True))
 
     async def body(pilot: Pilot) -> None:
         partner = app.screen.query_one("#partner", Input)

@@ -23,6 +23,7 @@ from tests.app.support import run
 from workbench.tui.app import WorkbenchApp, make_app
 from workbench.tui.compositor import GroupedUpdate, LiveCompositor
 from workbench.tui.screens.main import MainScreen
+from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.maze_view import MazeView
 
 Cell = tuple[str, Style | None]
@@ -114,7 +115,7 @@ class Checker:
 
 @pytest.mark.parametrize("size", [(80, 24), (120, 40)])
 def test_partial_updates_match_a_full_render_while_the_robot_drives(size):
-    app = make_app(noise="off")
+    app = make_app(AppSettings(noise="off"))
 
     async def body(pilot: Pilot) -> None:
         screen = app.screen
@@ -139,7 +140,7 @@ def test_partial_updates_match_a_full_render_while_the_robot_drives(size):
 
 
 def test_redrawing_an_unchanged_snapshot_refreshes_nothing():
-    app = make_app(noise="off", paused=True)
+    app = make_app(AppSettings(noise="off", paused=True))
 
     async def body(pilot: Pilot) -> None:
         screen = app.screen

@@ -10,6 +10,7 @@ from workbench.sim.mazeio import load_maze
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.screens.main import MainScreen
+from workbench.tui.settings import AppSettings
 
 from .support import run
 
@@ -17,7 +18,7 @@ RANKING = LABS_DIR.parent / "mazes" / "rank-local-best-wins.txt"
 
 
 def test_m_loads_a_maze_file_onto_the_station_and_keeps_the_profile(tmp_path):
-    app = make_app(paused=True, profile="unity")
+    app = make_app(AppSettings(paused=True, profile="unity"))
 
     async def body(pilot: Pilot) -> None:
         await pilot.press("m")
@@ -38,7 +39,7 @@ def test_m_loads_a_maze_file_onto_the_station_and_keeps_the_profile(tmp_path):
 
 
 def test_a_maze_that_cannot_be_read_is_shown_in_the_dialog(tmp_path):
-    app = make_app(paused=True)
+    app = make_app(AppSettings(paused=True))
 
     async def body(pilot: Pilot) -> None:
         before = app.station.maze

@@ -9,6 +9,7 @@ from textual.widgets import Input
 from workbench.files.bundled import MAZE_DIR
 from workbench.labs.model import load_labs
 from workbench.tui.app import make_app
+from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.message_bar import MessageBar
 
 from .labs_support import open_exercise
@@ -26,7 +27,7 @@ async def load(pilot: Pilot, path: str) -> None:
 
 
 def test_loading_the_erobotic_maze_under_unity_says_the_profile_stays(tmp_path):
-    app = make_app(paused=True, data_dir=tmp_path / "data")
+    app = make_app(AppSettings(paused=True, data_dir=tmp_path / "data"))
 
     async def body(pilot: Pilot) -> None:
         assert app.station.profile == "unity"
@@ -44,7 +45,7 @@ def test_loading_the_erobotic_maze_under_unity_says_the_profile_stays(tmp_path):
 
 
 def test_a_lab_set_up_on_another_maze_leaves_no_stale_maze_name(tmp_path):
-    app = make_app(paused=True, data_dir=tmp_path / "data", student="ana")
+    app = make_app(AppSettings(paused=True, data_dir=tmp_path / "data", student="ana"))
 
     async def body(pilot: Pilot) -> None:
         await load(pilot, str(MAZE_DIR / "erobotic.txt"))

@@ -9,6 +9,7 @@ from workbench.labs.checks import apply_setup
 from workbench.labs.model import load_labs
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.algorithm import AlgorithmModal
+from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.param_editor import ParamEditor
 
 from .support import run, screen_lines
@@ -17,7 +18,7 @@ EXERCISE = {lab.id: lab for lab in load_labs()}["unity-simulator"].exercise("wal
 
 
 def test_fill_in_parameters_are_marked_with_their_hint_and_full_range(tmp_path):
-    app = make_app(paused=True, noise="off", data_dir=tmp_path / "data")
+    app = make_app(AppSettings(paused=True, noise="off", data_dir=tmp_path / "data"))
 
     async def body(pilot: Pilot) -> None:
         apply_setup(app.station, EXERCISE.setup)

@@ -16,6 +16,7 @@ from tests.app.support import run
 from workbench.tui.app import WorkbenchApp, make_app
 from workbench.tui.dialogs.help import HelpScreen
 from workbench.tui.screens.main import MainScreen
+from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.run_status import RunStatus
 
 ROOM = "#######\n#.....#\n#..S..#\n#.....#\n#######\n"
@@ -43,7 +44,7 @@ def status(app: WorkbenchApp) -> str:
 
 
 def test_a_driving_key_taken_at_once_drives_as_its_key_event_does(tmp_path):
-    app = make_app(room(tmp_path), paused=True, noise="off")
+    app = make_app(AppSettings(room(tmp_path), paused=True, noise="off"))
 
     async def body(pilot: Pilot) -> None:
         assert app.take_typed_key("d")
@@ -61,7 +62,7 @@ def test_a_driving_key_taken_at_once_drives_as_its_key_event_does(tmp_path):
 
 
 def test_keys_whose_binding_is_not_a_quick_action_come_as_key_events(tmp_path):
-    app = make_app(room(tmp_path), paused=True, noise="off")
+    app = make_app(AppSettings(room(tmp_path), paused=True, noise="off"))
     assert not app.take_typed_key("w")  # no screen yet (as while the app starts or ends)
 
     async def body(pilot: Pilot) -> None:
@@ -79,7 +80,7 @@ def test_keys_whose_binding_is_not_a_quick_action_come_as_key_events(tmp_path):
 
 
 def test_no_key_is_taken_at_once_over_a_dialog_or_while_a_key_before_it_is_on_its_way(tmp_path):
-    app = make_app(room(tmp_path), paused=True, noise="off")
+    app = make_app(AppSettings(room(tmp_path), paused=True, noise="off"))
 
     async def body(pilot: Pilot) -> None:
         await pilot.press("question_mark")
@@ -100,7 +101,7 @@ def test_no_key_is_taken_at_once_over_a_dialog_or_while_a_key_before_it_is_on_it
 
 
 def test_a_quick_key_is_refused_where_the_screen_refuses_its_action(tmp_path):
-    app = make_app(room(tmp_path), paused=True, noise="off")
+    app = make_app(AppSettings(room(tmp_path), paused=True, noise="off"))
 
     async def body(pilot: Pilot) -> None:
         screen = main_screen(app)
@@ -116,7 +117,7 @@ def test_a_quick_key_is_refused_where_the_screen_refuses_its_action(tmp_path):
 
 
 def test_a_change_is_drawn_at_once_and_the_next_within_a_frame_waits_for_the_timer(tmp_path):
-    app = make_app(room(tmp_path), paused=True, noise="off")
+    app = make_app(AppSettings(room(tmp_path), paused=True, noise="off"))
 
     async def body(pilot: Pilot) -> None:
         screen = main_screen(app)
@@ -139,7 +140,7 @@ def test_a_change_is_drawn_at_once_and_the_next_within_a_frame_waits_for_the_tim
 
 
 def test_a_quick_key_clears_a_tooltip_as_a_key_event_does(tmp_path):
-    app = make_app(room(tmp_path), paused=True, noise="off")
+    app = make_app(AppSettings(room(tmp_path), paused=True, noise="off"))
 
     async def go() -> None:
         async with app.run_test(size=(80, 24), tooltips=True) as pilot:

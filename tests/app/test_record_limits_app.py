@@ -14,6 +14,7 @@ from workbench.sim.record import read_record
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.screens.editor import EditorScreen
+from workbench.tui.settings import AppSettings
 
 from .support import run, said
 from .test_workspace_app import type_path
@@ -34,7 +35,7 @@ def test_a_full_disk_leaves_the_app_driving_and_recording_comes_back(tmp_path, d
     maze = tmp_path / "room.txt"
     maze.write_text(ROOM)
     runs = tmp_path / "runs"
-    app = make_app(str(maze), noise="off", record_dir=str(runs))
+    app = make_app(AppSettings(maze, noise="off", record_dir=runs))
     station = app.station
 
     async def body(pilot: Pilot) -> None:
@@ -67,7 +68,7 @@ def test_a_file_named_runs_is_moved_aside_on_the_first_drive_key(tmp_path):
     workspace.mkdir(parents=True)
     (workspace / "runs").write_text("a maze saved as ~/runs\n")
     app = make_app(
-        paused=True, workspace=workspace, record_dir=str(workspace / "runs" / "20250101-1")
+        AppSettings(paused=True, workspace=workspace, record_dir=workspace / "runs" / "20250101-1")
     )
 
     async def body(pilot: Pilot) -> None:
@@ -83,7 +84,7 @@ def test_a_file_named_runs_is_moved_aside_on_the_first_drive_key(tmp_path):
 
 def test_the_editor_will_not_save_a_maze_as_runs(tmp_path):
     workspace: Path = workspace_folder(tmp_path / "data", "ann")
-    app = make_app(paused=True, workspace=workspace)
+    app = make_app(AppSettings(paused=True, workspace=workspace))
 
     async def body(pilot: Pilot) -> None:
         await pilot.press("e")

@@ -14,6 +14,7 @@ from textual.screen import ModalScreen
 
 from tests.app.support import run
 from workbench.tui.app import REST_HZ, make_app
+from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.run_status import RunStatus
 
 ROOM = "#########\n#.......#\n#...S...#\n#.......#\n#########\n"
@@ -31,7 +32,7 @@ def shown_time(app, screen=None) -> float:
 
 
 def test_an_idle_app_draws_about_once_a_second_and_its_clock_still_runs(tmp_path):
-    app = make_app(maze(tmp_path), noise="off")
+    app = make_app(AppSettings(maze(tmp_path), noise="off"))
 
     async def body(pilot: Pilot) -> None:
         await pilot.pause(0.3)
@@ -48,7 +49,7 @@ def test_an_idle_app_draws_about_once_a_second_and_its_clock_still_runs(tmp_path
 
 
 def test_a_key_wakes_the_app_after_the_time_owed_at_rest_has_run(tmp_path):
-    app = make_app(maze(tmp_path), noise="off")
+    app = make_app(AppSettings(maze(tmp_path), noise="off"))
 
     async def body(pilot: Pilot) -> None:
         await pilot.pause(0.3)
@@ -72,7 +73,7 @@ def test_a_key_wakes_the_app_after_the_time_owed_at_rest_has_run(tmp_path):
 
 
 def test_paused_the_app_rests_and_p_wakes_it(tmp_path):
-    app = make_app(maze(tmp_path), paused=True)
+    app = make_app(AppSettings(maze(tmp_path), paused=True))
 
     async def body(pilot: Pilot) -> None:
         await pilot.pause(0.2)
@@ -89,7 +90,7 @@ def test_paused_the_app_rests_and_p_wakes_it(tmp_path):
 
 def test_at_rest_a_screen_under_a_dialog_draws_nothing_until_it_is_on_top_again(tmp_path):
     # a dialog over the main screen (here the sensor ports), the student reading it
-    app = make_app(maze(tmp_path), noise="off", student="ann")
+    app = make_app(AppSettings(maze(tmp_path), noise="off", student="ann"))
 
     async def body(pilot: Pilot) -> None:
         await pilot.pause(0.3)

@@ -9,12 +9,13 @@ from textual.widgets import Input
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.dialogs.size import SizeDialog
+from workbench.tui.settings import AppSettings
 
 from .support import run
 
 
 def test_characters_typed_right_after_tab_go_into_the_next_field(tmp_path):
-    app = make_app(paused=True, student="ana", data_dir=tmp_path)
+    app = make_app(AppSettings(paused=True, student="ana", data_dir=tmp_path))
 
     async def body(pilot: Pilot) -> None:
         app.push_screen(SizeDialog(10, 10))
@@ -33,7 +34,7 @@ def test_characters_typed_right_after_tab_go_into_the_next_field(tmp_path):
 
 
 def test_editing_keys_typed_ahead_act_in_the_order_typed(tmp_path):
-    app = make_app(paused=True, student="ana", data_dir=tmp_path)
+    app = make_app(AppSettings(paused=True, student="ana", data_dir=tmp_path))
 
     async def body(pilot: Pilot) -> None:
         app.push_screen(PathDialog("Load a maze", "help", value="maze3"))

@@ -11,6 +11,7 @@ from textual.css.stylesheet import Stylesheet
 from workbench.ssh.forkserver import preload
 from workbench.tui import warmup
 from workbench.tui.app import make_app
+from workbench.tui.settings import AppSettings
 
 from .support import run, screen_lines
 
@@ -29,13 +30,15 @@ def first_screen(tmp_path, parses: list[str]) -> list[str]:
     """The names dialog over the main screen of a served student's app, as the terminal
     shows it; each CSS source parsed on the way is added to ``parses``."""
     app = make_app(
-        paused=True,  # nothing on the screen changes with time
-        student="ann",
-        ask_names=True,
-        student_fixed=True,
-        data_dir=tmp_path / "data",
-        workspace=tmp_path / "ann",
-        connect_hint="VIPLE: on your computer run ssh",
+        AppSettings(
+            paused=True,  # nothing on the screen changes with time
+            student="ann",
+            ask_names=True,
+            student_fixed=True,
+            data_dir=tmp_path / "data",
+            workspace=tmp_path / "ann",
+            connect_hint="VIPLE: on your computer run ssh",
+        ),
     )
     shown: list[str] = []
 

@@ -4,12 +4,15 @@ the login's own name."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from textual.pilot import Pilot
 from textual.widgets import Input
 
 from workbench.labs.lastpair import save_last_pair
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.identity import IdentityDialog
+from workbench.tui.settings import AppSettings
 
 from .labs_support import DRIVE, open_exercise, text
 from .support import run
@@ -17,7 +20,7 @@ from .support import run
 
 def test_a_name_typed_in_lower_case_resumes_the_saved_progress(tmp_path):
     data = tmp_path / "data"
-    first = make_app(paused=True, student="Alice Doe", data_dir=data)
+    first = make_app(AppSettings(paused=True, student="Alice Doe", data_dir=data))
 
     async def drive(pilot: Pilot) -> None:
         screen = await open_exercise(pilot, DRIVE)
@@ -26,21 +29,29 @@ def test_a_name_typed_in_lower_case_resumes_the_saved_progress(tmp_path):
         assert text(screen, "#labs-objectives").startswith("[X] drove with w, a, s, d")
 
     run(first, drive)
-    again = make_app(paused=True, student=" alice doe ", data_dir=data)
+    again = make_app(
+        AppSettings(paused=True, student=" alice doe ", data_dir=data, ask_names=True)
+    )
 
     async def resume(pilot: Pilot) -> None:
+        await pilot.press("enter")  # the names as given
+        await pilot.pause()
         screen = await open_exercise(pilot, DRIVE)
         assert screen.student == again.student == "Alice Doe"
         assert text(screen, "#labs-objectives").startswith(
             "[X] drove with w, a, s, d and space: passed earlier"
         )
+        await pilot.press("escape")
+        await pilot.pause()
+        # the message line names the student as the saved progress spells the name
+        assert text(pilot.app.screen, "#message").rstrip().endswith("Alice Doe (student)")
 
     run(again, resume)
 
 
 def test_the_last_pair_is_offered_at_start_instead_of_the_login_name(tmp_path):
     data = tmp_path / "data"
-    first = make_app(paused=True, data_dir=data, ask_names=True)
+    first = make_app(AppSettings(paused=True, data_dir=data, ask_names=True))
 
     async def name_them(pilot: Pilot) -> None:
         dialog = pilot.app.screen
@@ -52,7 +63,7 @@ def test_the_last_pair_is_offered_at_start_instead_of_the_login_name(tmp_path):
         assert (first.student, first.partner) == ("Ana Ruiz", "Ben Ortiz")
 
     run(first, name_them)
-    again = make_app(paused=True, data_dir=data, ask_names=True)
+    again = make_app(AppSettings(paused=True, data_dir=data, ask_names=True))
 
     async def offered(pilot: Pilot) -> None:
         dialog = pilot.app.screen
@@ -68,12 +79,16 @@ def test_a_served_student_is_never_offered_another_pair(tmp_path):
     save_last_pair(data, "Alice Doe", "Bo Li")
     workspace = tmp_path / "ws"
     workspace.mkdir()
-    app = make_app(
+    served = AppSettings(
         paused=True,
         data_dir=data,
         workspace=workspace,
-        user="carol",
+        student="carol",
         ask_names=True,
         student_fixed=True,
     )
+    app = make_app(served)
     assert (app.student, app.partner) == ("carol", "")
+    # nor when no name is given: the app's own login name, not the pair kept in the data folder
+    unnamed = make_app(replace(served, student=None, ask_names=False, student_fixed=False))
+    assert unnamed.student != "Alice Doe" and unnamed.partner == ""

@@ -15,6 +15,7 @@ from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.screens.editor import EditorScreen
 from workbench.tui.screens.main import MainScreen
 from workbench.tui.screens.runs import RunsScreen
+from workbench.tui.settings import AppSettings
 
 from .support import run
 
@@ -28,7 +29,7 @@ def served_app(tmp_path: Path):
     data.mkdir()
     (data / "ssh-users.yaml").write_text(SECRET)
     workspace = workspace_folder(data, "ann")
-    app = make_app(paused=True, workspace=workspace, data_dir=data, student="ann")
+    app = make_app(AppSettings(paused=True, workspace=workspace, data_dir=data, student="ann"))
     return app, data, app.station.files.workspace
 
 
@@ -140,7 +141,9 @@ def test_a_run_record_outside_the_workspace_is_not_opened(tmp_path):
 def test_run_records_of_a_served_student_are_kept_in_the_workspace(tmp_path):
     data = tmp_path / "data"
     workspace = workspace_folder(data, "ann")
-    app = make_app(paused=True, workspace=workspace, record_dir=str(workspace / "runs" / "1"))
+    app = make_app(
+        AppSettings(paused=True, workspace=workspace, record_dir=str(workspace / "runs" / "1"))
+    )
 
     async def body(pilot: Pilot) -> None:
         await pilot.press("w", "n", "n", "space")

@@ -43,21 +43,21 @@ async def eventually(check, what: str, timeout: float = 10.0) -> None:
 
 
 @sync
-async def test_the_fork_server_runs_apps_with_their_options_errors_and_exit_status(tmp_path):
+async def test_the_fork_server_runs_apps_with_their_settings_errors_and_exit_status(tmp_path):
     server = ForkServer(app_env(), WORKBENCH_APP.main, WORKBENCH_APP.preload)
     await server.start()
     try:
         assert server.running and server.modules > 100
         log = tmp_path / "app.log"
-        bad = await server.spawn(["--no-such-option"], app_env(), log)
+        bad = await server.spawn({"no_such_setting": 1}, app_env(), log)
         assert await asyncio.wait_for(bad.wait(), 20) == 2
         bad.stdin.close()
-        assert "unrecognized arguments: --no-such-option" in log.read_text()
+        assert "unknown setting 'no_such_setting'" in log.read_text()
 
         env = {**app_env(), "COLUMNS": "90", "ROWS": "30"}
-        options = ["--tcp-port", "0", "--student", "ann", "--data-dir", str(tmp_path / "d"),
-                   "--record-dir", str(tmp_path / "runs")]  # fmt: skip
-        app = await server.spawn(options, env, log)
+        settings = {"student": "ann", "data_dir": str(tmp_path / "d"),
+                    "record_dir": str(tmp_path / "runs")}  # fmt: skip
+        app = await server.spawn(settings, env, log)
         assert os.getsid(app.pid) == app.pid and os.getpgid(app.pid) == app.pid
         assert parent_of(app.pid) == server.pid
         first = await asyncio.wait_for(app.stdout.readexactly(13), 20)
@@ -77,7 +77,7 @@ async def test_the_fork_server_runs_apps_with_their_options_errors_and_exit_stat
         await server.close()
     assert not server.running
     with pytest.raises(ForkServerError):
-        await server.spawn([], app_env(), tmp_path / "app.log")
+        await server.spawn({}, app_env(), tmp_path / "app.log")
 
 
 @sync
@@ -87,9 +87,9 @@ async def test_an_app_whose_server_is_gone_ends(tmp_path):
     server = ForkServer(app_env(), WORKBENCH_APP.main, WORKBENCH_APP.preload)
     await server.start()
     try:
-        options = ["--tcp-port", "0", "--student", "ann", "--data-dir", str(tmp_path / "d"),
-                   "--record-dir", str(tmp_path / "runs")]  # fmt: skip
-        app = await server.spawn(options, app_env(), tmp_path / "app.log")
+        settings = {"student": "ann", "data_dir": str(tmp_path / "d"),
+                    "record_dir": str(tmp_path / "runs")}  # fmt: skip
+        app = await server.spawn(settings, app_env(), tmp_path / "app.log")
         assert await asyncio.wait_for(app.stdout.readexactly(13), 20) == b"__GANGLION__\n"
         app.stdin.close()  # the server's end of the app's input and output
         await eventually(lambda: gone(app.pid) or app.returncode is not None, "app ended", 20)

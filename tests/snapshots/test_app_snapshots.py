@@ -12,6 +12,7 @@ from textual.pilot import Pilot
 from textual.widgets import Input, Select
 
 from workbench.tui.app import WorkbenchApp, make_app
+from workbench.tui.settings import AppSettings
 
 SIZES = {"80x24": (80, 24), "120x40": (120, 40)}
 MODES = {"ascii": False, "unicode": True}
@@ -23,7 +24,7 @@ grid = pytest.mark.parametrize(
 
 
 def app(unicode: bool, **kw) -> WorkbenchApp:
-    return make_app(paused=True, unicode=unicode, **kw)
+    return make_app(AppSettings(paused=True, unicode=unicode, **kw))
 
 
 def still(pilot: Pilot) -> None:

@@ -17,6 +17,7 @@ from tests.app.labs_support import signing_over
 from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.model import load_labs
 from workbench.tui.app import WorkbenchApp, make_app
+from workbench.tui.settings import AppSettings
 
 FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
 PASS = "correct horse battery"
@@ -26,7 +27,7 @@ SIZE = (80, 24)
 def lab_app(data_dir: Path, instructor: bool = True) -> WorkbenchApp:
     if instructor:
         create_instructor(data_dir, "Dr Chen", PASS, kdf=FAST)
-    return make_app(paused=True, student="ana", partner="ben", data_dir=data_dir)
+    return make_app(AppSettings(paused=True, student="ana", partner="ben", data_dir=data_dir))
 
 
 def still(pilot: Pilot) -> None:
@@ -83,7 +84,9 @@ def test_driver_change_prompt_after_an_override(snap_compare, tmp_path):
 
 
 def test_names_dialog_at_start(snap_compare, tmp_path):
-    app = make_app(paused=True, student="ana", data_dir=tmp_path / "data", ask_names=True)
+    app = make_app(
+        AppSettings(paused=True, student="ana", data_dir=tmp_path / "data", ask_names=True)
+    )
 
     async def before(pilot: Pilot) -> None:
         await pilot.pause()

@@ -197,14 +197,20 @@ def test_outside_a_workspace_a_file_in_the_way_is_left_alone(tmp_path):
     assert station.snapshot().time == pytest.approx(1, abs=0.05)
 
 
-def test_serve_ssh_hands_its_record_caps_to_every_session_s_app():
+def test_serve_ssh_hands_its_record_caps_to_every_session_s_app(tmp_path):
     from workbench.cli import build_parser
-    from workbench.cli.ssh import record_quota_argv
+    from workbench.control.recording import RecordQuota
+    from workbench.ssh.appproc import AppSpec
+    from workbench.tui.settings import AppSettings
 
     parser = build_parser()
     args = parser.parse_args(["serve-ssh", "--record-cap", "5M", "--runs-quota", "0"])
-    options = record_quota_argv(args)
-    assert options == ("--record-cap", "5000000", "--runs-quota", "0")
-    app = parser.parse_args(list(options))
-    assert (app.record_cap, app.runs_quota) == (5_000_000, None)
+    assert (args.record_cap, args.runs_quota) == (5_000_000, None)
+    spec = AppSpec(
+        "ann", "student", 5000, 5001, "", tmp_path / "data", tmp_path / "ws" / "runs" / "r1",
+        tmp_path / "ws", record_quota=RecordQuota(args.record_cap, args.runs_quota),
+    )  # fmt: skip
+    # what the session's app reads back from the JSON it is given
+    quota = AppSettings.from_json(spec.settings().to_json()).record_quota
+    assert quota == RecordQuota(5_000_000, None, str(tmp_path / "ws" / "runs"))
     assert parser.parse_args([]).record_cap == 20_000_000

@@ -25,6 +25,7 @@ from workbench.ssh.passwords import (
 )
 from workbench.ssh.ports import PoolExhausted, PortPool, parse_range, port_is_free
 from workbench.tui import packets
+from workbench.tui.settings import AppSettings
 
 
 # -- passwords ------------------------------------------------------------------------------
@@ -121,12 +122,16 @@ def test_the_app_is_started_with_the_users_name_ports_and_terminal():
         "ann", "student", 41000, 41001, "hint", "/d", "/d/w/ann/runs/1", "/d/w/ann",
         100, 30, "xterm",
     )  # fmt: skip
-    argv = spec.argv(("workbench",))
-    assert argv[argv.index("--workspace") + 1] == "/d/w/ann"  # the student's files only
-    assert argv[:5] == ["workbench", "--student", "ann", "--ask-partner", "--role"]
-    assert "--tcp-port" in argv and argv[argv.index("--tcp-port") + 1] == "41000"
-    assert argv[argv.index("--ws-url") + 1] == "ws://127.0.0.1:41001/"
-    assert "--ws-when-asked" in argv  # no WebSocket attempts until the student asks
+    settings = spec.settings()
+    assert settings.workspace == Path("/d/w/ann")  # the student's files only
+    assert (settings.student, settings.role) == ("ann", "student")
+    assert settings.student_fixed and settings.ask_names  # the login's name; the partner asked
+    assert settings.tcp_port == 41000 and settings.ws_url == "ws://127.0.0.1:41001/"
+    assert not settings.ws_at_start  # no WebSocket attempts until the student asks
+    # a new process gets them as one JSON argument, a forked app as the same JSON object
+    argv = spec.argv(("workbench-app",))
+    assert argv[0] == "workbench-app" and len(argv) == 2
+    assert AppSettings.from_json(json.loads(argv[1])) == settings
     env = spec.env({"SSH_CONNECTION": "x", "PATH": "/bin", "TEXTUAL_DEBUG": "1"})
     assert env["TEXTUAL_DRIVER"] == "workbench.tui.driver:SessionDriver"
     assert (env["COLUMNS"], env["ROWS"], env["TERM"]) == ("100", "30", "xterm")

@@ -3,15 +3,15 @@
 from __future__ import annotations
 
 import argparse
-import functools
 import os
 import sys
 from collections.abc import Sequence
+from pathlib import Path
 
 from workbench import __version__
-from workbench.control.recording import RecordQuota
 from workbench.files.bundled import default_maze_path
 from workbench.labs.store import StoreError, resolve_db
+from workbench.tui.settings import AppSettings
 
 from . import algorithms as algorithms_cmd
 from . import instructor as instructor_cmd
@@ -111,15 +111,8 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-@functools.cache
-def shared_parser() -> argparse.ArgumentParser:
-    """The command line's parser, built once per process (a served app is forked from a fork
-    server that built it already: about 12 ms of each app's start)."""
-    return build_parser()
-
-
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = shared_parser()
+    parser = build_parser()
     args = parser.parse_args(argv)
     if args.command is None:
         return open_app(args)
@@ -148,28 +141,7 @@ def open_app(args: argparse.Namespace) -> int:
         error(str(exc))
         return 2
     try:
-        app = make_app(
-            args.maze,
-            args.profile,
-            seed=args.seed,
-            noise=args.noise,
-            unicode=args.unicode,
-            tcp_port=args.tcp_port or None,
-            ws_url=args.ws_url,
-            ws_at_start=not args.ws_when_asked,
-            record_dir=args.record_dir or new_runs_dir(),
-            record_quota=RecordQuota(args.record_cap, args.runs_quota, _counted_runs(args)),
-            student=args.student,
-            partner=args.partner,
-            data_dir=args.data_dir,
-            role=args.role,
-            ask_names=not args.student or args.ask_partner,
-            # over SSH (OpenSSH's ForceCommand, say) the login name is the student's
-            student_fixed=bool(args.student) or "SSH_CONNECTION" in os.environ,
-            connect_hint=args.connect_hint,
-            workspace=args.workspace,
-            db=db,
-        )
+        app = make_app(app_settings(args, db))
     except AppSetupError as exc:
         error(str(exc))
         return 2
@@ -181,12 +153,41 @@ def open_app(args: argparse.Namespace) -> int:
     return app.return_code or 0
 
 
-def _counted_runs(args: argparse.Namespace) -> str | None:
+def app_settings(args: argparse.Namespace, db: str | None) -> AppSettings:
+    """The app's settings from the command line's options (``db``: the course database the
+    options or the environment name)."""
+    return AppSettings(
+        maze_path=Path(args.maze) if args.maze else None,
+        profile=args.profile,
+        seed=args.seed,
+        noise=args.noise,
+        unicode=args.unicode,
+        tcp_port=args.tcp_port or None,
+        ws_url=args.ws_url,
+        ws_at_start=not args.ws_when_asked,
+        record_dir=Path(args.record_dir or new_runs_dir()),
+        record_cap=args.record_cap,
+        runs_quota=args.runs_quota,
+        runs_counted=_counted_runs(args),
+        student=args.student,
+        partner=args.partner,
+        data_dir=Path(args.data_dir) if args.data_dir else None,
+        role=args.role,
+        ask_names=not args.student or args.ask_partner,
+        # over SSH (OpenSSH's ForceCommand, say) the login name is the student's
+        student_fixed=bool(args.student) or "SSH_CONNECTION" in os.environ,
+        connect_hint=args.connect_hint,
+        workspace=Path(args.workspace) if args.workspace else None,
+        db=db,
+    )
+
+
+def _counted_runs(args: argparse.Namespace) -> Path | None:
     """The folder the runs quota counts: the workspace's ``runs``, the app's own runs folder,
     or (None) just the record folder given."""
     if args.workspace:
-        return os.path.join(args.workspace, "runs")
-    return None if args.record_dir else str(runs_home())
+        return Path(args.workspace) / "runs"
+    return None if args.record_dir else Path(runs_home())
 
 
 def demo(args: argparse.Namespace) -> int:

@@ -11,24 +11,21 @@ import signal
 import sys
 from pathlib import Path
 
+from workbench.control.recording import RecordQuota
 from workbench.labs.database import ENV_DB
 from workbench.labs.store import Store, StoreError, StoreUnavailable, resolve_data_dir, resolve_db
 from workbench.ssh.appproc import AppEntry
 
 from .common import db_option, record_quota_options
 
-#: the app every SSH session runs: this Python's ``-m workbench``, or forked from the fork
-#: server as :func:`workbench.cli.main` with the app's modules imported beforehand and its
-#: first screen's common work done once (the command line's parser, and
-#: :func:`workbench.tui.warmup.prepare`)
+#: the app every SSH session runs, given the session's settings as JSON (see
+#: :mod:`workbench.cli.served`): this Python's ``-m workbench.cli.served``, or forked from the
+#: fork server as :func:`workbench.cli.served.main` with the app's modules imported beforehand
+#: and its first screen's common work done once (:func:`workbench.tui.warmup.prepare`)
 WORKBENCH_APP = AppEntry(
-    command=(sys.executable, "-m", "workbench"),
-    main="workbench.cli:main",
-    preload=(
-        "workbench.cli:shared_parser",
-        "workbench.tui.app",
-        "workbench.tui.warmup:prepare",
-    ),
+    command=(sys.executable, "-m", "workbench.cli.served"),
+    main="workbench.cli.served:main",
+    preload=("workbench.tui.app", "workbench.tui.warmup:prepare"),
 )
 
 
@@ -340,7 +337,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
         logins=logins,
         fork_server=not args.no_fork_server,
         app=WORKBENCH_APP,
-        app_options=record_quota_argv(args),
+        record_quota=RecordQuota(args.record_cap, args.runs_quota),
     )
     try:
         log_path = setup_logging(data_dir)
@@ -360,11 +357,6 @@ def cmd_serve(args: argparse.Namespace) -> int:
         return asyncio.run(_serve(server))
     except OSError as exc:
         return fail("serve-ssh", f"cannot listen on port {args.port}: {exc.strerror or exc}")
-
-
-def record_quota_argv(args: argparse.Namespace) -> tuple[str, ...]:
-    """The run records' caps as every session's app is given them (0: no limit)."""
-    return ("--record-cap", str(args.record_cap or 0), "--runs-quota", str(args.runs_quota or 0))
 
 
 def parse_terminal(text: str) -> tuple[int, int]:

@@ -16,11 +16,13 @@ import logging
 import os
 import signal
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from workbench.control.recording import RecordQuota
 from workbench.tui import packets
+from workbench.tui.settings import AppSettings
 
 if TYPE_CHECKING:
     from .forkserver import ForkedApp, ForkServer
@@ -48,9 +50,11 @@ class AppEntry:
     """How the lab server starts a session's app, handed down by the command that starts the
     server (the server itself knows no app)."""
 
-    #: the command that starts the app as a new process; the app's options follow it
+    #: the command that starts the app as a new process; the app's settings follow it, as one
+    #: JSON argument
     command: tuple[str, ...]
-    #: the same app as a function for the fork server: ``module:function`` taking the options
+    #: the same app as a function for the fork server: ``module:function`` taking the
+    #: settings (a JSON object)
     main: str
     #: modules the fork server imports before it forks (the app's own), and functions
     #: (``module:function``) it calls once they are imported
@@ -73,27 +77,33 @@ class AppSpec:
     width: int = 80
     height: int = 24
     term: str = "xterm-256color"
-    #: the server's options for every app (after the session's own)
-    extra: tuple[str, ...] = ()
+    #: how much room the app's run records may take (the folder counted: the workspace's runs)
+    record_quota: RecordQuota = field(default_factory=RecordQuota)
 
     def argv(self, command: tuple[str, ...]) -> list[str]:
-        return [*command, *self.options()]
+        """The command line of the app as a new process: its settings as one JSON argument."""
+        return [*command, json.dumps(self.settings().to_json())]
 
-    def options(self) -> list[str]:
-        """The app's options (its command line without the command)."""
-        return [
-            "--student", self.user,
-            "--ask-partner",
-            "--role", self.role,
-            "--tcp-port", str(self.tcp_port),
-            "--ws-url", f"ws://127.0.0.1:{self.ws_port}/",
-            "--ws-when-asked",
-            "--connect-hint", self.hint,
-            "--data-dir", str(self.data_dir),
-            "--record-dir", str(self.record_dir),
-            "--workspace", str(self.workspace),
-            *self.extra,
-        ]  # fmt: skip
+    def settings(self) -> AppSettings:
+        """The app's settings: the login name is the student's (the partner is asked for),
+        the VIPLE endpoints are the session's ports (the WebSocket one once the student asks
+        for it), and files are opened and saved in the student's workspace only."""
+        return AppSettings(
+            student=self.user,
+            ask_names=True,
+            student_fixed=True,
+            role=self.role,
+            tcp_port=self.tcp_port,
+            ws_url=f"ws://127.0.0.1:{self.ws_port}/",
+            ws_at_start=False,
+            connect_hint=self.hint,
+            data_dir=Path(self.data_dir),
+            record_dir=Path(self.record_dir),
+            workspace=Path(self.workspace),
+            record_cap=self.record_quota.record,
+            runs_quota=self.record_quota.runs,
+            runs_counted=Path(self.workspace) / "runs",
+        )
 
     def env(self, base: dict[str, str] | None = None) -> dict[str, str]:
         env = app_env(base)
@@ -137,18 +147,18 @@ class AppProcess:
         on_output: Callable[[bytes], None],
         *,
         forkserver: ForkServer | None = None,
-        options: list[str] | None = None,
+        settings: dict[str, object] | None = None,
         memory: int = 0,
     ) -> None:
         """``argv`` starts the app as a new process; with a running ``forkserver`` the app is
-        forked from it with ``options`` instead (``argv`` stays the way if that fails). The
-        app may have ``memory`` bytes (0: no cap)."""
+        forked from it with ``settings`` (a JSON object) instead (``argv`` stays the way if
+        that fails). The app may have ``memory`` bytes (0: no cap)."""
         self.argv = argv
         self.env = env
         self.log_path = log_path
         self.on_output = on_output
         self.forkserver = forkserver
-        self.options = options
+        self.settings = settings
         self.memory = memory
         self._log_start = 0
         self.forked = False
@@ -172,12 +182,12 @@ class AppProcess:
         with contextlib.suppress(OSError):
             self._log_start = self.log_path.stat().st_size
         forkserver = self.forkserver
-        if forkserver is not None and forkserver.running and self.options is not None:
+        if forkserver is not None and forkserver.running and self.settings is not None:
             from .forkserver import ForkServerError
 
             try:
                 self.process = await forkserver.spawn(
-                    self.options, self.env, self.log_path, memory=self.memory
+                    self.settings, self.env, self.log_path, memory=self.memory
                 )
                 self.forked = True
             except ForkServerError as exc:

@@ -12,10 +12,11 @@ Two halves live here:
   same way, done once here: the app's is :func:`workbench.tui.warmup.prepare`), freezes it all
   out of the garbage collector's reach (so the pages stay shared with the children) and waits
   on a Unix socket.
-  Each request carries the app's options and environment and two file descriptors (SCM_RIGHTS):
+  Each request carries the app's settings (a JSON object) and environment and two file
+  descriptors (SCM_RIGHTS):
   the socket that becomes the app's standard input and output, and its error log. It forks; the
   child starts a new session (its own process group), puts the descriptors on 0, 1 and 2, sets
-  the environment and runs the entry point with the app's options, ending with the
+  the environment and runs the entry point with the app's settings, ending with the
   interpreter's ordinary exit. An app runs :data:`APP_NICENESS` steps below the lab server, so
   the server's own work (handshakes, logins, passing keys and screens on) goes first when a
   whole class arrives at once, and under the memory cap the request names
@@ -87,7 +88,7 @@ def _send(control: socket.socket, message: dict) -> None:
         control.send(json.dumps(message).encode())
 
 
-def entry_point(main: str) -> Callable[[list[str]], int]:
+def entry_point(main: str) -> Callable[..., int]:
     """The function named ``module:function``; ValueError when it is not one."""
     module, _, function = main.partition(":")
     if not module or not function:
@@ -122,7 +123,7 @@ def preload(modules: tuple[str, ...] = ()) -> int:
 class _Zygote:
     """The fork server's loop: fork on request, reap and report the children's ends."""
 
-    def __init__(self, control: socket.socket, main: Callable[[list[str]], int]) -> None:
+    def __init__(self, control: socket.socket, main: Callable[[object], int]) -> None:
         self.control = control
         self.main = main
 
@@ -161,7 +162,9 @@ class _Zygote:
     def _fork(self, message: bytes, fds: list[int]) -> Callable[[], int] | None:
         try:
             request = json.loads(message)
-            options = [str(o) for o in request["argv"]]
+            settings = request["settings"]
+            if not isinstance(settings, dict):
+                raise TypeError("the settings are not a JSON object")
             env = {str(k): str(v) for k, v in request["env"].items()}
             memory = int(request.get("memory", 0))
             if len(fds) != 2:
@@ -183,7 +186,7 @@ class _Zygote:
             os.setsid()  # its own session and process group, before the server learns its pid
             os.close(ready_r)
             os.close(ready_w)
-            return lambda: _run_app(self.main, options, env, fds, request.get("cwd"), memory)
+            return lambda: _run_app(self.main, settings, env, fds, request.get("cwd"), memory)
         for fd in (*fds, ready_w):
             os.close(fd)
         with contextlib.suppress(OSError):
@@ -236,8 +239,8 @@ def limit_memory(cap: int, pid: int = 0) -> None:
 
 
 def _run_app(
-    main: Callable[[list[str]], int],
-    options: list[str],
+    main: Callable[[object], int],
+    settings: dict,
     env: dict[str, str],
     fds: list[int],
     cwd: str | None,
@@ -259,8 +262,8 @@ def _run_app(
     if cwd:
         with contextlib.suppress(OSError):
             os.chdir(cwd)
-    sys.argv = ["workbench", *options]
-    return main(options)
+    sys.argv = ["workbench"]
+    return main(settings)
 
 
 def serve_main(argv: list[str] | None = None) -> int:
@@ -334,7 +337,7 @@ class ForkServer:
         start_timeout: float = 60.0,
     ) -> None:
         self.env = env
-        #: the app's entry point, ``module:function`` taking the app's options
+        #: the app's entry point, ``module:function`` taking the app's settings (a JSON object)
         self.main = main
         #: modules the fork server imports before it forks (the app's own)
         self.preload = preload
@@ -479,20 +482,19 @@ class ForkServer:
 
     async def spawn(
         self,
-        options: list[str],
+        settings: dict,
         env: dict[str, str],
         log_path: Path,
         cwd: str | None = None,
         memory: int = 0,
     ) -> ForkedApp:
-        """A new app with these options and environment, its errors appended to ``log_path``,
-        under a cap of ``memory`` bytes (0: none)."""
+        """A new app with these settings (a JSON object) and environment, its errors appended
+        to ``log_path``, under a cap of ``memory`` bytes (0: none)."""
         if not self._running or self._sock is None:
             raise ForkServerError("the fork server is not running")
         loop = asyncio.get_running_loop()
-        request = json.dumps(
-            {"argv": options, "env": env, "cwd": cwd or os.getcwd(), "memory": memory}
-        ).encode()
+        fields = {"settings": settings, "env": env, "cwd": cwd or os.getcwd(), "memory": memory}
+        request = json.dumps(fields).encode()
         ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_STREAM)
         try:
             with open(log_path, "ab") as errors:

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import asyncssh
 
+from workbench.control.recording import RecordQuota
 from workbench.files.workspace import workspace_folder
 
 from .appproc import RESTORE_TERMINAL, AppEntry, AppProcess, AppSpec, app_env, forward_hint
@@ -77,7 +78,7 @@ class ServerConfig:
     port_range: tuple[int, int] = (41000, 41999)
     public_host: str = ""
     limits: SessionLimits = field(default_factory=SessionLimits)
-    #: the app's command before its options, instead of the entry's (no fork server then)
+    #: the app's command before its settings, instead of the entry's (no fork server then)
     app_command: tuple[str, ...] | None = None
     #: fork each app from a fork server that has the app imported (not with ``app_command``)
     fork_server: bool = True
@@ -87,8 +88,8 @@ class ServerConfig:
     keepalive_interval: float = 30.0
     #: the app each session runs
     app: AppEntry = field(kw_only=True)
-    #: options every session's app gets after its own (the run records' caps, say)
-    app_options: tuple[str, ...] = field(default=(), kw_only=True)
+    #: how much room each session's run records may take
+    record_quota: RecordQuota = field(default_factory=RecordQuota, kw_only=True)
 
     def __post_init__(self) -> None:
         self.data_dir = Path(self.data_dir)
@@ -737,7 +738,7 @@ class LabSession(asyncssh.SSHServerSession):
             width,
             height,
             self.term,
-            config.app_options,
+            config.record_quota,
         )
         log_path = config.data_dir / "logs" / user / f"{stamp}-{self.id}.log"
         self.app = AppProcess(
@@ -746,7 +747,7 @@ class LabSession(asyncssh.SSHServerSession):
             log_path,
             self._output,
             forkserver=server.forkserver,
-            options=self.spec.options(),
+            settings=self.spec.settings().to_json(),
             memory=config.limits.app_memory * 1024 * 1024,
         )
         try:

@@ -12,8 +12,11 @@ import asyncio
 import contextlib
 import gc
 import getpass
+import math
 import os
 import threading
+from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 from time import perf_counter
 from typing import ClassVar
@@ -23,7 +26,6 @@ from textual.binding import Binding, BindingType
 from textual.screen import ModalScreen, Screen
 from textual.widgets import Tooltip
 
-from workbench.control.recording import RecordQuota
 from workbench.control.station import LabStation
 from workbench.files.bundled import default_maze_path
 from workbench.files.workspace import LOCAL, FileAccess
@@ -37,7 +39,6 @@ from workbench.sim.mazeio import load_maze
 from workbench.sim.noise import NOISE_LEVELS
 from workbench.sim.profiles import PROFILES
 from workbench.viple.hosting import Endpoints
-from workbench.viple.link import REPORT_MS_DEFAULT
 from workbench.viple.tcp_server import TcpConfig
 from workbench.viple.ws_client import WsConfig
 
@@ -51,6 +52,7 @@ from .host import (
     MazeChanged,
     OpenScreen,
     ScreenHost,
+    ScreenName,
     SetUpDone,
     ShowsSnapshot,
     ShowsStatus,
@@ -65,6 +67,7 @@ from .screens.editor import EditorScreen
 from .screens.labs import LabsScreen
 from .screens.main import MainScreen
 from .screens.runs import RunsScreen
+from .settings import AppSettings
 
 #: the smallest terminal the layout is made for (columns, rows)
 MIN_SIZE = (80, 24)
@@ -86,7 +89,7 @@ FOCUS_BINDINGS = (
 
 
 class AppSetupError(ValueError):
-    """The app cannot start with these arguments; the message says what to change."""
+    """The app cannot start with these settings; the message says what to change."""
 
 
 class WorkbenchApp(ScreenHost[None]):
@@ -104,61 +107,34 @@ class WorkbenchApp(ScreenHost[None]):
     frames: int = 0
 
     def __init__(
-        self,
-        station: LabStation,
-        maze_path: Path | None = None,
-        user: str | None = None,
-        role: str = "student",
-        tick_hz: float = 20.0,
-        unicode: bool = False,
-        tcp: TcpConfig | None = None,
-        ws: WsConfig | None = None,
-        report_ms: int = REPORT_MS_DEFAULT,
-        ws_at_start: bool = True,
-        student: str = "",
-        partner: str = "",
-        data_dir: str | os.PathLike | None = None,
-        ask_names: bool = False,
-        student_fixed: bool = False,
-        connect_hint: str = "",
-        db: str | None = None,
-        names_given: bool = False,
+        self, station: LabStation, settings: AppSettings, *, names_given: bool = False
     ) -> None:
+        """The app on ``station`` with ``settings`` as :func:`make_app` completes them (the
+        maze file and the pair named); ``names_given``: whoever started the app named the pair
+        (it is kept as the last pair at this workbench)."""
         super().__init__()
-        #: the pair was named on the command line (kept as the last pair at this workbench)
+        self.settings = settings
         self._names_given = names_given
-        self.student = student or user or _login_name()
-        self.partner = partner
-        self._ask_names = ask_names
-        self.student_fixed = student_fixed
-        #: how to reach this app's VIPLE endpoints from elsewhere (the SSH server sets it)
-        self.connect_hint = connect_hint
-        self.data_dir = data_dir
-        #: the course's PostgreSQL database (None: the SQLite file in the data folder)
-        self.db = db
+        self.student = settings.student or _login_name()
+        self.partner = settings.partner
         self.store: Store | None = None
         self._store_lock = threading.Lock()
         self.store_problem = ""
         self._labs: LabsScreen | None = None
-        self._viple_configs = (tcp, ws)
-        self._ws_at_start = ws_at_start
-        self._report_ms = report_ms
+        self._viple_configs = viple_configs(settings)
         self.endpoints: Endpoints | None = None
         #: the endpoints' status line as last handed to the screens
         self._connection = ""
         self.station = station
-        self.maze_path = maze_path
-        self.user = user
-        self.role = role
-        self.tick_hz = tick_hz
-        self.set_reactive(WorkbenchApp.unicode, unicode)
+        self.maze_path = settings.maze_path
+        self.set_reactive(WorkbenchApp.unicode, settings.unicode)
         self.mark_ascii(update=False)
         # the stylesheets as the fork server parsed them (a served app), else parsed here
         warmup.seed(self.stylesheet)
         self._last_tick = perf_counter()
-        #: the clock ticks at REST_HZ (True) or at tick_hz (False)
+        #: the clock ticks at REST_HZ (True) or at the settings' tick rate (False)
         self._resting = False
-        self._rest_period = max(1.0 / REST_HZ, 1.0 / tick_hz)
+        self._rest_period = max(1.0 / REST_HZ, 1.0 / settings.tick_hz)
         self._clock: LoopClock | None = None
         self._drawn: tuple[object, ...] = ()
         self._too_small: TooSmallScreen | None = None
@@ -173,17 +149,24 @@ class WorkbenchApp(ScreenHost[None]):
         self._last_said = ""
         #: the maze the message line last named
         self._maze_named = station.maze
+        #: the screens a screen may ask for (OpenScreen), each with the way it opens
+        self._screens: dict[ScreenName, Callable[[], None]] = {
+            "main": self._open_main,
+            "editor": self._open_editor,
+            "runs": self._open_runs,
+            "labs": self._open_labs,
+        }
 
     def who(self) -> str:
         """Who is at the robot, for the message line ("" when nobody was named)."""
-        if not (self.user or self._ask_names):
+        if not self.settings.ask_names:
             return ""
         names = self.student + (f" & {self.partner}" if self.partner else "")
-        return f"{names} ({self.role})"
+        return f"{names} ({self.settings.role})"
 
     def get_default_screen(self) -> Screen:
-        if self._ask_names:
-            return ArrivalScreen()  # the main screen follows the names (see open_main)
+        if self.settings.ask_names:
+            return ArrivalScreen()  # the main screen follows the names (see _open_main)
         return self._new_main()
 
     def _new_main(self) -> MainScreen:
@@ -192,7 +175,7 @@ class WorkbenchApp(ScreenHost[None]):
         )
         return self._main
 
-    def open_main(self) -> None:
+    def _open_main(self) -> None:
         """Put the main screen in the arrival screen's place once the names are given and the
         arrival screen is on top (not while the terminal is too small, say)."""
         if self._main is not None or not self._named or not isinstance(self.screen, ArrivalScreen):
@@ -209,26 +192,26 @@ class WorkbenchApp(ScreenHost[None]):
 
     async def on_mount(self) -> None:
         tcp, ws = self._viple_configs
-        if not self._ws_at_start:
+        if not self.settings.ws_at_start:
             ws = None  # later: a WebSocket exercise's set-up or the v key starts it
         if tcp is not None or ws is not None:
             self.endpoints = await Endpoints.open(self.station.session, tcp, ws)
         self.mark_ascii()
         self._show_maze_title()
         self._last_tick = perf_counter()
-        self._clock = LoopClock(self._tick, 1.0 / self.tick_hz, self._handle_exception)
+        self._clock = LoopClock(self._tick, 1.0 / self.settings.tick_hz, self._handle_exception)
         self.station.on_activity = self.wake
-        if self.connect_hint:
+        if self.settings.connect_hint:
             self.say(self.hint_line())
         if isinstance(self._driver, SessionDriver):
             # a served session's process holds this one app for the whole class: what start-up
             # built lives as long as it, so the garbage collector's full passes (some 70 ms
             # each while a student drives) leave it alone from the first screen on
             self.call_after_refresh(gc.freeze)
-        if self.db and self._pending_file().is_file():
+        if self.settings.db and self._pending_file().is_file():
             # what an earlier app could not save: written as soon as the database answers
             self.run_worker(self._save_kept(), group="store")
-        if self._names_given and not self._ask_names:
+        if self._names_given and not self.settings.ask_names:
             self._remember_pair()
         self._check_size(self.size.width, self.size.height)
         self._ask_for_names()
@@ -236,12 +219,14 @@ class WorkbenchApp(ScreenHost[None]):
     def _ask_for_names(self) -> None:
         """The names dialog, once, when the terminal is big enough for it (else the size
         message comes first and the dialog after it)."""
-        if not self._ask_names or self._names_asked or self._too_small is not None:
+        if not self.settings.ask_names or self._names_asked or self._too_small is not None:
             return
         from .dialogs.identity import IdentityDialog
 
         self._names_asked = True
-        dialog = IdentityDialog(self.student, self.partner, student_fixed=self.student_fixed)
+        dialog = IdentityDialog(
+            self.student, self.partner, student_fixed=self.settings.student_fixed
+        )
         self.push_screen(dialog, self._on_names)
 
     def _remember_pair(self) -> None:
@@ -250,14 +235,14 @@ class WorkbenchApp(ScreenHost[None]):
         if self.station.files.confined:
             return
         with contextlib.suppress(OSError):
-            save_last_pair(resolve_data_dir(self.data_dir), self.student, self.partner)
+            save_last_pair(resolve_data_dir(self.settings.data_dir), self.student, self.partner)
 
     def hint_line(self) -> str:
         """The connect hint for the message line: all of it when it fits beside the names,
         else where to find it (the help shows it whole, wrapped)."""
-        room = self.size.width - 4 - len(self.who())
-        if len(self.connect_hint) <= room:
-            return self.connect_hint
+        hint = self.settings.connect_hint
+        if len(hint) <= self.size.width - 4 - len(self.who()):
+            return hint
         return "VIPLE from your computer: press ? for the ssh command"
 
     def _on_names(self, names: tuple[str, str] | None) -> None:
@@ -271,10 +256,10 @@ class WorkbenchApp(ScreenHost[None]):
         """Who is at the robot, kept for the next start and shown on every message line."""
         self.student, self.partner = student, partner
         self._remember_pair()
+        who = self.who()
         for screen in self.screen_stack:
-            bar = screen.query("#message")
-            if bar:
-                bar.first().who = self.who()
+            if isinstance(screen, ShowsStatus):
+                screen.show_who(who)
 
     # -- time --------------------------------------------------------------------------------
     def _tick(self) -> None:
@@ -309,7 +294,7 @@ class WorkbenchApp(ScreenHost[None]):
         if resting:
             self._clock.set_period(self._rest_period)
         else:  # what woke it is drawn at once, then the clock ticks at its rate
-            self._clock.set_period(1.0 / self.tick_hz, at_once=True)
+            self._clock.set_period(1.0 / self.settings.tick_hz, at_once=True)
 
     def wake(self) -> None:
         """Something is about to change the station (a key, a click, a VIPLE command): the time
@@ -433,14 +418,7 @@ class WorkbenchApp(ScreenHost[None]):
         self.set_up_done(message.setup)
 
     def on_open_screen(self, message: OpenScreen) -> None:
-        if message.screen == "main":
-            self.open_main()
-        elif message.screen == "editor":
-            self.open_editor()
-        elif message.screen == "runs":
-            self.open_runs()
-        else:
-            self.open_labs()
+        self._screens[message.screen]()
 
     def on_start_endpoint(self, message: StartEndpoint) -> None:
         self.run_worker(self.open_endpoint(message.role), group="endpoints")
@@ -448,16 +426,15 @@ class WorkbenchApp(ScreenHost[None]):
     # -- screens -------------------------------------------------------------------------------
     def action_help(self) -> None:
         if not isinstance(self.screen, HelpScreen):
-            self.push_screen(HelpScreen(self.station.profile, self.connect_hint))
+            self.push_screen(HelpScreen(self.station.profile, self.settings.connect_hint))
 
-    def open_editor(self) -> None:
+    def _open_editor(self) -> None:
         # the bundled mazes (and the labs' set-up mazes) are never overwritten, nor is a file
         # outside a served student's workspace: saving one asks where to keep the copy
         path = self.maze_path
-        if path is not None and not self.station.files.allows_writing(path):
-            path = None
-        path = str(path) if path is not None else None
-        self.push_screen(EditorScreen(self.station, path, unicode=self.unicode), self._edited)
+        writable = path is not None and self.station.files.allows_writing(path)
+        saves_to = str(path) if writable else None
+        self.push_screen(EditorScreen(self.station, saves_to, unicode=self.unicode), self._edited)
 
     def _edited(self, maze: Maze | None) -> None:
         self.maze_changed()
@@ -468,7 +445,7 @@ class WorkbenchApp(ScreenHost[None]):
         if path is not None:
             self.maze_path = Path(path)
             if self._main is not None:
-                self._main.maze_path = self.maze_path
+                self._main.follow_maze_file(self.maze_path)
         maze = self.station.maze
         if maze is not self._maze_named:
             self._maze_named = maze
@@ -481,10 +458,10 @@ class WorkbenchApp(ScreenHost[None]):
     def _show_maze_title(self) -> None:
         self.sub_title = f"{self.station.maze.name} ({self.station.profile})"
 
-    def open_runs(self) -> None:
+    def _open_runs(self) -> None:
         self.push_screen(RunsScreen(self.station, unicode=self.unicode))
 
-    def open_labs(self) -> None:
+    def _open_labs(self) -> None:
         if self._labs is None:
             self._open_store()
             self._match_stored_names()
@@ -520,20 +497,20 @@ class WorkbenchApp(ScreenHost[None]):
             return
         try:
             # a course database that is down now still gets the work once it is back
-            store = Store.open(self.data_dir, db=self.db, offline_ok=True)
+            store = Store.open(self.settings.data_dir, db=self.settings.db, offline_ok=True)
         except Exception as exc:  # the labs work without saving rather than not at all
             self.store = None
-            where = "the course database" if self.db else "the data folder"
+            where = "the course database" if self.settings.db else "the data folder"
             self.store_problem = f"cannot open {where}, so nothing is saved: {exc}"
             return
-        if self.db:
+        if self.settings.db:
             # what waits for the database is kept in a file too: it outlives this app
             for problem in store.keep_pending_in(self._pending_file(), self.student):
                 self.log.warning(problem)
         self.store = store
 
     def _pending_file(self) -> Path:
-        return pending_path(resolve_data_dir(self.data_dir), self.student)
+        return pending_path(resolve_data_dir(self.settings.data_dir), self.student)
 
     async def _save_kept(self) -> None:
         """Write the changes an earlier app kept because the course database was away: one
@@ -568,21 +545,19 @@ class WorkbenchApp(ScreenHost[None]):
         tcp, ws = self._viple_configs
         if self.endpoints is None:
             self.endpoints = Endpoints()
-        session = self.station.session
+        endpoints, session = self.endpoints, self.station.session
         if role == "tcp":
-            config = tcp or TcpConfig(report_ms=self._report_ms)
-            if await self.endpoints.start_tcp(session, config):
-                text = f"VIPLE: connect your program (TCP) to localhost:{self.endpoints.tcp.port}"
+            if await endpoints.start_tcp(session, tcp or TcpConfig()) and endpoints.tcp:
+                text = f"VIPLE: connect your program (TCP) to localhost:{endpoints.tcp.port}"
             else:
-                text = self.endpoints.problems[-1]
+                text = endpoints.problems[-1]
         else:
-            config = ws or WsConfig(report_ms=self._report_ms)
-            await self.endpoints.start_ws(session, config)
-            url = self.endpoints.ws.config.url
+            await endpoints.start_ws(session, ws or WsConfig())
+            url = endpoints.ws.config.url if endpoints.ws else ""
             text = f"VIPLE: start your program's WebSocket server; the robot connects to {url}"
-        if self.connect_hint:
+        if self.settings.connect_hint:
             text = self.hint_line()
-        self._show_connection(self.endpoints.summary())
+        self._show_connection(endpoints.summary())
         self._say(text)
         return text
 
@@ -621,74 +596,40 @@ class WorkbenchApp(ScreenHost[None]):
         self.exit()
 
 
-def make_app(
-    maze_path: str | os.PathLike | None = None,
-    profile: str | None = None,
-    user: str | None = None,
-    role: str = "student",
-    seed: int = 0,
-    noise: str | None = None,
-    paused: bool = False,
-    tick_hz: float = 20,
-    unicode: bool = False,
-    record_dir: str | None = None,
-    record_quota: RecordQuota | None = None,
-    tcp_port: int | None = None,
-    ws_url: str | None = None,
-    report_ms: int = REPORT_MS_DEFAULT,
-    ws_at_start: bool = True,
-    student: str | None = None,
-    partner: str = "",
-    data_dir: str | os.PathLike | None = None,
-    ask_names: bool = False,
-    student_fixed: bool = False,
-    connect_hint: str = "",
-    workspace: str | os.PathLike | None = None,
-    db: str | None = None,
-) -> WorkbenchApp:
-    """The workbench app on a maze file (default: the bundled Unity maze).
+def make_app(settings: AppSettings) -> WorkbenchApp:
+    """The workbench app with ``settings`` (the maze default: the bundled Unity maze).
 
-    ``tcp_port`` hosts the Unity-simulator role (VIPLE connects to it) and ``ws_url`` the
-    Web-Simulator role (the app connects to VIPLE: from the start, or with ``ws_at_start``
-    False once a WebSocket exercise is set up or the user presses ``v``); neither runs unless
-    asked for (a lab exercise's set-up starts the one it needs).
-    ``student`` (default: the login name) and ``partner`` do the labs; their progress and
-    sign-offs are kept in ``data_dir`` (default: ``$WORKBENCH_DATA`` or the user data folder),
-    or in the course's PostgreSQL database ``db`` (a ``postgresql://`` URL).
-    ``ask_names`` asks for them when the app starts (the student's name cannot be changed there
-    when ``student_fixed``, as for an SSH login); ``connect_hint`` tells the user how to reach the
-    VIPLE endpoints (shown at start and in the help). With a ``workspace`` folder (a served
-    student) the app opens files only there and in the bundled mazes, labs and starters, and
-    writes only there. Each run is recorded in ``record_dir`` within ``record_quota`` (default:
-    the usual caps); a run that cannot be recorded goes on unrecorded, with a message.
+    Neither VIPLE endpoint runs unless the settings ask for it (a lab exercise's set-up starts
+    the one it needs). The student (default: the pair last at this workbench, else the login
+    name) and partner do the labs; with a workspace folder (a served student) the app opens
+    files only there and in the bundled mazes, labs and starters, and writes only there.
 
     Raises :class:`AppSetupError` with a message for the user when the maze cannot be read or
-    an argument is not one the workbench knows.
+    a setting is not one the workbench knows.
     """
-    if maze_path is None:
-        maze_path = default_maze_path()
-    path = Path(maze_path)
+    path = settings.maze_path or default_maze_path()
+    profile, noise, role = settings.profile, settings.noise, settings.role
     if profile is not None and profile not in PROFILES:
         raise AppSetupError(f"unknown profile {profile!r}: use one of {', '.join(PROFILES)}")
     if noise is not None and noise not in NOISE_LEVELS:
         raise AppSetupError(f"unknown noise level {noise!r}: use one of {', '.join(NOISE_LEVELS)}")
     if role not in ROLES:
         raise AppSetupError(f"unknown role {role!r}: use one of {', '.join(ROLES)}")
-    names_given = bool(student)
-    if not student and not user and workspace is None and not student_fixed:
+    student, partner = settings.student, settings.partner
+    if not student and settings.workspace is None and not settings.student_fixed:
         # the pair at this workbench last time, offered instead of the login name
-        last = read_last_pair(resolve_data_dir(data_dir))
+        last = read_last_pair(resolve_data_dir(settings.data_dir))
         if last is not None:
             student, partner = last[0], partner or last[1]
     try:
-        student, partner = check_pair(student or user or _login_name(), partner)
+        student, partner = check_pair(student or _login_name(), partner)
     except NameProblem as exc:
         raise AppSetupError(str(exc)) from None
-    if not tick_hz > 0:
-        raise AppSetupError(f"the tick rate must be above 0 Hz, not {tick_hz}")
+    tick_hz = settings.tick_hz
+    if not (math.isfinite(tick_hz) and tick_hz > 0):
+        raise AppSetupError(f"the tick rate must be a number of Hz above 0, not {tick_hz}")
     try:
-        tcp = TcpConfig(port=tcp_port, report_ms=report_ms) if tcp_port else None
-        ws = WsConfig(url=ws_url, report_ms=report_ms) if ws_url else None
+        viple_configs(settings)
     except ValueError as exc:
         raise AppSetupError(str(exc)) from None
     try:
@@ -696,45 +637,37 @@ def make_app(
     except MazeError as exc:
         problems = "\n".join(f"  {p}" for p in exc.problems)
         raise AppSetupError(f"cannot open the maze {str(path)!r}:\n{problems}") from None
+    workspace = settings.workspace
     try:
         files = FileAccess.confined_to(workspace) if workspace is not None else LOCAL
     except OSError as exc:
         raise AppSetupError(f"cannot use the workspace folder {workspace}: {exc}") from None
+    record_dir = str(settings.record_dir) if settings.record_dir is not None else None
     try:
         station = LabStation.open(
             maze,
             profile,
-            seed=seed,
+            seed=settings.seed,
             noise=noise,
             record_dir=record_dir,
-            record_quota=record_quota or RecordQuota(),
+            record_quota=settings.record_quota,
             files=files,
         )
     except ValueError as exc:
         raise AppSetupError(f"cannot set up the robot: {exc}") from None
-    station.pause(paused)
+    station.pause(settings.paused)
     # max speed may use at most 60 % of each frame, so keys and drawing stay responsive
     station.pacer.budget = 0.6 / tick_hz
-    return WorkbenchApp(
-        station,
-        maze_path=path,
-        user=user,
-        role=role,
-        tick_hz=tick_hz,
-        unicode=unicode,
-        tcp=tcp,
-        ws=ws,
-        report_ms=report_ms,
-        ws_at_start=ws_at_start,
-        student=student,
-        partner=partner,
-        data_dir=data_dir,
-        ask_names=ask_names,
-        student_fixed=student_fixed,
-        connect_hint=connect_hint,
-        db=db,
-        names_given=names_given,
-    )
+    named = replace(settings, maze_path=path, student=student, partner=partner)
+    return WorkbenchApp(station, named, names_given=bool(settings.student))
+
+
+def viple_configs(settings: AppSettings) -> tuple[TcpConfig | None, WsConfig | None]:
+    """The VIPLE endpoints the settings ask for at start (TCP, WebSocket; None: not that
+    one); ValueError names a port or URL that cannot be used."""
+    tcp = TcpConfig(port=settings.tcp_port) if settings.tcp_port else None
+    ws = WsConfig(url=settings.ws_url) if settings.ws_url else None
+    return tcp, ws
 
 
 def maze_message(station: LabStation) -> str:

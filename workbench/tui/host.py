@@ -3,12 +3,12 @@
 A screen never reaches into the app: it posts one of the messages below, which bubbles up to
 the app. The app speaks to its screens only through the small roles a screen may take on:
 :class:`ShowsSnapshot` (draws the station at each tick), :class:`ShowsStatus` (shows the
-workbench's one-line message and the VIPLE connection line) and :class:`FollowsUnicode` (redraws
-when the drawing switches between Unicode and ASCII). :class:`ScreenHost` is the part of an app
-that every host shares, the workbench app and the tests' bare hosts alike: it holds the Unicode
-setting, toggles it when a screen asks and applies it to every screen, and hands what is said
-(:class:`Say`) to every screen that shows it. The words are the TUI's: the station below only
-holds values.
+workbench's one-line message, who is at the robot and the VIPLE connection line) and
+:class:`FollowsUnicode` (redraws when the drawing switches between Unicode and ASCII).
+:class:`ScreenHost` is the part of an app that every host shares, the workbench app and the
+tests' bare hosts alike: it holds the Unicode setting, toggles it when a screen asks and applies
+it to every screen, and hands what is said (:class:`Say`) to every screen that shows it. The
+words are the TUI's: the station below only holds values.
 """
 
 from __future__ import annotations
@@ -44,14 +44,17 @@ class ShowsSnapshot:
 
 
 class ShowsStatus:
-    """A screen with the workbench's message line: the app hands it what is said and the
-    VIPLE endpoints' status (it defines ``show_message`` and ``show_connection``)."""
+    """A screen with the workbench's message line: the app hands it what is said, the VIPLE
+    endpoints' status and who is at the robot (it defines ``show_message``,
+    ``show_connection`` and ``show_who``)."""
 
     if TYPE_CHECKING:
 
         def show_message(self, text: str) -> None: ...
 
         def show_connection(self, text: str) -> None: ...
+
+        def show_who(self, who: str) -> None: ...
 
 
 class FollowsUnicode:

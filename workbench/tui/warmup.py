@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import asyncio
 import tempfile
+from pathlib import Path
 
 from textual.css.stylesheet import Stylesheet
 
@@ -31,6 +32,7 @@ def prepare() -> None:
     session driver's table of typed keys)."""
     from .app import make_app
     from .driver import plain_keys
+    from .settings import AppSettings
 
     plain_keys()
 
@@ -44,12 +46,14 @@ def prepare() -> None:
 
     with tempfile.TemporaryDirectory(prefix="workbench-warmup-") as folder:
         app = make_app(
-            student="warmup",
-            ask_names=True,
-            student_fixed=True,
-            data_dir=folder,
-            workspace=folder,
-            connect_hint="VIPLE: warming up",
+            AppSettings(
+                student="warmup",
+                ask_names=True,
+                student_fixed=True,
+                data_dir=Path(folder),
+                workspace=Path(folder),
+                connect_hint="VIPLE: warming up",
+            )
         )
         # more sources than Textual's parse cache holds by default (64): none may drop out
         app.stylesheet._parse_cache.maxsize = PARSE_CACHE

@@ -247,6 +247,16 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
     def show_connection(self, text: str) -> None:
         self._connection = text
 
+    def show_who(self, who: str) -> None:
+        """Who is at the robot, on the right of the message line."""
+        self.who = who
+        for bar in self.query(MessageBar):  # (none until the screen is composed)
+            bar.who = who
+
+    def follow_maze_file(self, path: Path) -> None:
+        """The file of the maze now on the station: the maze dialog starts in its folder."""
+        self.maze_path = path
+
     def say(self, message: str) -> None:
         self.show_message(message)
         self.refresh_views()
