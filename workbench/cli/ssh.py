@@ -20,14 +20,13 @@ from .common import db_option
 #: the app every SSH session runs: this Python's ``-m workbench``, or forked from the fork
 #: server as :func:`workbench.cli.main` with the app's modules imported beforehand and its
 #: first screen's common work done once (the command line's parser, and
-#: :func:`workbench.tui.warmup.prepare`)
+#: :func:`workbench.tui.app.warm_up`)
 WORKBENCH_APP = AppEntry(
     command=(sys.executable, "-m", "workbench"),
     main="workbench.cli:main",
     preload=(
         "workbench.cli:shared_parser",
-        "workbench.tui.app",
-        "workbench.tui.warmup:prepare",
+        "workbench.tui.app:warm_up",
     ),
 )
 

@@ -11,6 +11,7 @@ from textual.command import DiscoveryHit, Hit, Hits, Provider
 from textual.dom import DOMNode
 
 from .keys import KEYS
+from .serving.internals import bindings_of
 
 
 def key_display(node: DOMNode, binding: Binding) -> str:
@@ -23,7 +24,7 @@ def key_display(node: DOMNode, binding: Binding) -> str:
 def bindings_with_ids(node: DOMNode) -> Iterator[Binding]:
     """The node's bindings that have an id, once each, in declared order."""
     seen: set[str] = set()
-    for _key, binding in node._bindings:
+    for _key, binding in bindings_of(node):
         if binding.id and binding.id not in seen and binding.id in KEYS:
             seen.add(binding.id)
             yield binding

@@ -25,7 +25,6 @@ from workbench.sim.mazeio import load_maze
 from workbench.sim.sensors import SensorConfigError
 from workbench.sim.session import Snapshot
 
-from ..compositor import LiveCompositor
 from ..host import (
     FollowsUnicode,
     MazeChanged,
@@ -38,8 +37,9 @@ from ..host import (
     ToggleUnicode,
 )
 from ..keys import bindings
-from ..prompt_frames import PromptFrames
-from ..quick_keys import QuickKeys
+from ..serving.compositor import use_live_compositor
+from ..serving.prompt_frames import PromptFrames
+from ..serving.quick_keys import QuickKeys
 from ..widgets.algorithm_state import AlgorithmState
 from ..widgets.key_bar import KeyBar
 from ..widgets.key_legend import KeyLegend
@@ -119,7 +119,7 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
         #: the file of the maze on the station (where the maze dialog starts)
         self.maze_path = maze_path
         # the maze and the panels change a few cells at a time, many times a second
-        self._compositor = LiveCompositor()
+        use_live_compositor(self)
         self.station = station
         self._ready = False
         self._unicode = unicode

@@ -15,6 +15,8 @@ from textual import events
 from textual.binding import Binding
 from textual.widgets import Input
 
+from ..serving.internals import KeyFirstInput
+
 #: every key Input binds, and the action it runs
 _EDITING = {
     key.strip(): binding.action
@@ -24,18 +26,18 @@ _EDITING = {
 }
 
 
-class Field(Input):
+class Field(KeyFirstInput):
     """``Input`` with typed-ahead editing keys kept in order and a steady cursor."""
 
     def __init__(self, *args: object, **kwargs: object) -> None:
         super().__init__(*args, **kwargs)  # type: ignore[arg-type]
         self.set_reactive(Input.cursor_blink, False)
 
-    async def _on_key(self, event: events.Key) -> None:
+    async def take_key(self, event: events.Key) -> bool:
         action = _EDITING.get(event.key)
         if action is None:
-            await super()._on_key(event)
-            return
+            return False
         event.stop()
         event.prevent_default()
         await self.run_action(action)
+        return True

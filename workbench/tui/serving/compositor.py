@@ -31,6 +31,7 @@ from collections.abc import Iterable
 from rich.console import Console, ConsoleOptions, RenderResult
 from textual._compositor import ChopsUpdate, Compositor, CompositorUpdate
 from textual.geometry import Region
+from textual.screen import Screen
 from textual.strip import Strip
 from textual.widget import Widget
 
@@ -109,3 +110,8 @@ class LiveCompositor(Compositor):
                 and crop_bottom <= y + height
             ):
                 return  # the crop is all this widget's: nothing behind it shows there
+
+
+def use_live_compositor(screen: Screen[object]) -> None:
+    """Have ``screen`` (not yet shown) drawn by a :class:`LiveCompositor`."""
+    screen._compositor = LiveCompositor()
