@@ -54,7 +54,7 @@ from .host import (
     StationChanged,
     TakesAllKeys,
 )
-from .keys import bindings
+from .keys import APP_KEY_IDS, bindings
 from .screens.arrival import ArrivalScreen
 from .screens.editor import EditorScreen
 from .screens.labs import LabsScreen
@@ -96,7 +96,7 @@ class WorkbenchApp(ScreenHost[None]):
     TITLE = "VIPLE Maze Lab Workbench"
     COMMANDS = ScreenHost.COMMANDS | {WorkbenchCommands}
     BINDINGS: ClassVar[list[BindingType]] = [
-        *bindings("app.quit", "app.help", "app.commands"),
+        *bindings(*APP_KEY_IDS),
         *FOCUS_BINDINGS,
     ]
 

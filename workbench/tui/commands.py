@@ -1,5 +1,5 @@
 """The command palette: the keys of the screen it was opened on (and the app's) as commands,
-named and explained by the one key table, :data:`~workbench.tui.keys.KEYS`."""
+named and explained by the one key table, :data:`~workbench.tui.keys.KEY_TABLE`."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from textual.binding import Binding
 from textual.command import DiscoveryHit, Hit, Hits, Provider
 from textual.dom import DOMNode
 
-from .keys import KEYS
+from .keys import KEY_TABLE
 from .serving.internals import bindings_of
 
 
@@ -25,7 +25,7 @@ def bindings_with_ids(node: DOMNode) -> Iterator[Binding]:
     """The node's bindings that have an id, once each, in declared order."""
     seen: set[str] = set()
     for _key, binding in bindings_of(node):
-        if binding.id and binding.id not in seen and binding.id in KEYS:
+        if binding.id and binding.id not in seen and binding.id in KEY_TABLE:
             seen.add(binding.id)
             yield binding
 
@@ -42,7 +42,7 @@ class WorkbenchCommands(Provider):
                 if binding.id in seen or binding.id == "app.commands":
                     continue
                 seen.add(binding.id)
-                info = KEYS[binding.id]
+                info = KEY_TABLE[binding.id]
                 title = f"{info.group}: {info.title}"
                 help_text = f"key {key_display(node, binding)}: {info.explanation}"
                 out.append((title, help_text, partial(self.app.run_action, binding.action, node)))
