@@ -34,7 +34,7 @@ class WorkbenchCommands(Provider):
     """The key bindings of the current screen and of the app as command palette commands."""
 
     def _commands(self) -> list[tuple[str, str, Callable[[], Awaitable[object]]]]:
-        out = []
+        out: list[tuple[str, str, Callable[[], Awaitable[object]]]] = []
         seen: set[str] = set()
         for node in (self.screen, self.app):
             for binding in bindings_with_ids(node):

@@ -87,7 +87,7 @@ class HelpScreen(ModalScreen[None]):
     }
     """
 
-    BINDINGS: ClassVar[list[BindingType]] = bindings("help.close")
+    BINDINGS: ClassVar[list[BindingType]] = [*bindings("help.close")]
 
     def __init__(self, profile: str, connect_hint: str = "") -> None:
         super().__init__()

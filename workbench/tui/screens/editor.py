@@ -38,7 +38,6 @@ SAVE_HELP = (
 )
 
 
-
 def _problem_line(finding: Finding) -> str:
     if finding.cell is None:
         return finding.message
@@ -109,7 +108,7 @@ class EditorScreen(FollowsUnicode, Screen[Maze | None]):
     }
     """
 
-    BINDINGS: ClassVar[list[BindingType]] = bindings(*EDITOR_KEY_IDS)
+    BINDINGS: ClassVar[list[BindingType]] = [*bindings(*EDITOR_KEY_IDS)]
 
     def __init__(
         self,

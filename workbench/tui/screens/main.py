@@ -72,7 +72,7 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
     # the keys pressed again and again while driving are priority bindings: the screen takes
     # them before the focused widget (the transition log, which has no use for them) would, so
     # a key press runs its action at once instead of bubbling up through the side panel
-    BINDINGS: ClassVar[list[BindingType]] = bindings(*MAIN_KEY_IDS)
+    BINDINGS: ClassVar[list[BindingType]] = [*bindings(*MAIN_KEY_IDS)]
 
     #: the last snapshot drawn (a plain attribute: set on every tick, it never repaints)
     snapshot: Snapshot | None = None

@@ -111,7 +111,7 @@ class ReplayScreen(FollowsUnicode, Screen[None]):
     }
     """
 
-    BINDINGS: ClassVar[list[BindingType]] = bindings(*REPLAY_KEY_IDS)
+    BINDINGS: ClassVar[list[BindingType]] = [*bindings(*REPLAY_KEY_IDS)]
 
     def __init__(
         self,

@@ -114,7 +114,7 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
     }
     """
 
-    BINDINGS: ClassVar[list[BindingType]] = bindings(*RUNS_KEY_IDS)
+    BINDINGS: ClassVar[list[BindingType]] = [*bindings(*RUNS_KEY_IDS)]
 
     def __init__(
         self,

@@ -4,6 +4,8 @@ gives, so that they are all in this package (see its description) and checked in
 
 from __future__ import annotations
 
+from typing import Any
+
 from textual import events
 from textual._context import active_app
 from textual.app import App
@@ -25,7 +27,7 @@ __all__ = [
 ]
 
 
-def current_app() -> App[object] | None:
+def current_app() -> App[Any] | None:
     """The app whose code runs now (None outside any app)."""
     try:
         return active_app.get()
@@ -38,12 +40,12 @@ def bindings_of(node: DOMNode) -> BindingsMap:
     return node._bindings
 
 
-def end_with_error(app: App[object], error: Exception) -> None:
+def end_with_error(app: App[Any], error: Exception) -> None:
     """End the app with ``error`` shown, as Textual does for an error in the app's own code."""
     app._handle_exception(error)
 
 
-def handled_size(app: App[object]) -> Size | None:
+def handled_size(app: App[Any]) -> Size | None:
     """The terminal size the app has handled a resize to (None before the first)."""
     return app._size
 

@@ -30,7 +30,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from functools import partial
-from typing import ClassVar
+from typing import Any, ClassVar
 
 from textual.actions import parse
 from textual.app import App
@@ -85,7 +85,7 @@ class QuickKeys(CachedBindingChain):
         return table
 
 
-def as_key_press(app: App[object], screen: Screen[object]) -> None:
+def as_key_press(app: App[Any], screen: Screen[Any]) -> None:
     """What Textual does at the app for any key press, done for a key taken at once: the app
     focused, and a tooltip shown on ``screen`` cleared."""
     if not app.app_focus:

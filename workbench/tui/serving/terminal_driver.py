@@ -31,7 +31,7 @@ import os
 import sys
 from codecs import getincrementaldecoder
 from functools import lru_cache
-from typing import Protocol, runtime_checkable
+from typing import Any, Protocol, runtime_checkable
 
 from textual import events, log, messages
 from textual._ansi_sequences import SYNC_END, SYNC_START
@@ -93,7 +93,11 @@ class LoopInput:
 
     def __init__(self, driver: ServedTerminalDriver, fileno: int | None = None) -> None:
         self._driver = driver
-        self.fileno = sys.__stdin__.fileno() if fileno is None else fileno
+        if fileno is None:
+            if sys.__stdin__ is None:
+                raise RuntimeError("a served app reads the server's packets on its standard input")
+            fileno = sys.__stdin__.fileno()
+        self.fileno = fileno
         self._parser = XTermParser(debug=driver._debug)
         self._decode = getincrementaldecoder("utf-8")().decode
         self._packets = PacketReader(marked=False)
@@ -237,6 +241,6 @@ class ServedTerminalDriver(WebDriver):
         super().write(data)
 
 
-def serves(app: App[object]) -> bool:
+def serves(app: App[Any]) -> bool:
     """Whether ``app`` runs in a served session (with :class:`ServedTerminalDriver`)."""
     return isinstance(app._driver, ServedTerminalDriver)

@@ -18,6 +18,7 @@ from __future__ import annotations
 import asyncio
 import tempfile
 from collections.abc import Callable
+from typing import Any
 
 from textual.app import App
 from textual.css.stylesheet import Stylesheet
@@ -31,7 +32,7 @@ _variables: dict[str, str] = {}
 PARSE_CACHE = 256
 
 
-def prepare(make_app: Callable[[str], App[None]]) -> None:
+def prepare(make_app: Callable[[str], App[Any]]) -> None:
     """Run the app ``make_app(folder)`` makes (``folder``: an empty temporary folder for its
     data and files) headless to its first screen and keep the parsed stylesheets (and the
     served terminal driver's table of typed keys)."""
