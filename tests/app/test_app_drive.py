@@ -20,7 +20,7 @@ from workbench.tui.commands import WorkbenchCommands
 from workbench.tui.dialogs.help import HelpScreen
 from workbench.tui.dialogs.too_small import TooSmallScreen
 from workbench.tui.dialogs.unsaved import UnsavedDialog
-from workbench.tui.keys import KEYS
+from workbench.tui.keys import KEY_TABLE
 from workbench.tui.screens.editor import EditorScreen
 from workbench.tui.screens.main import MainScreen
 from workbench.tui.screens.runs import RunsScreen
@@ -177,7 +177,7 @@ def test_help_explains_every_key(tmp_path):
         console.print(app.screen.query_one("#help-text", Static).content)
         text = " ".join(console.export_text().split())
         for binding in [*MainScreen.BINDINGS, *KEYED_APP_BINDINGS]:
-            info = KEYS[binding.id]
+            info = KEY_TABLE[binding.id]
             if info.group != "Drive":
                 assert " ".join(info.explanation.split()) in text
         for _key, what in key_legend("web"):
@@ -190,7 +190,7 @@ def test_help_explains_every_key(tmp_path):
 
 def test_every_binding_has_an_id_and_a_help_entry():
     for binding in [*MainScreen.BINDINGS, *KEYED_APP_BINDINGS]:
-        assert binding.id in KEYS, binding
+        assert binding.id in KEY_TABLE, binding
 
 
 def test_the_command_palette_offers_the_bindings_and_runs_them(tmp_path):

@@ -21,8 +21,8 @@ from textual.strip import Strip
 
 from tests.app.support import run
 from workbench.tui.app import WorkbenchApp, make_app
-from workbench.tui.compositor import GroupedUpdate, LiveCompositor
 from workbench.tui.screens.main import MainScreen
+from workbench.tui.serving.compositor import GroupedUpdate, LiveCompositor
 from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.maze_view import MazeView
 

@@ -6,7 +6,7 @@ from textual import events
 from textual.app import App, ComposeResult
 
 from tests.app.support import sync
-from workbench.sim.driver import KEYS
+from workbench.sim.driver import BY_KEYS
 from workbench.sim.generate import generate
 from workbench.sim.maze import Maze
 from workbench.sim.metrics import Metrics
@@ -51,7 +51,7 @@ def snap(
         block=(int(x), int(y)),
         readings=dict(readings or {}),
         sensors=sensors,
-        driver=KEYS,
+        driver=BY_KEYS,
         state=None,
         variables={},
         metrics=METRICS,

@@ -9,8 +9,8 @@ import textual.css.stylesheet as stylesheet_module
 from textual.css.stylesheet import Stylesheet
 
 from workbench.ssh.forkserver import preload
-from workbench.tui import warmup
-from workbench.tui.app import make_app
+from workbench.tui.app import make_app, warm_up
+from workbench.tui.serving import warmup
 from workbench.tui.settings import AppSettings
 
 from .support import run, screen_lines
@@ -69,7 +69,7 @@ def test_after_the_warm_up_an_app_parses_no_css_and_shows_the_same_first_screen(
     assert any("app.tcss" in source for source in cold)
     assert "Who is at this robot?" in "\n".join(before)
 
-    warmup.prepare()
+    warm_up()
     warm: list[str] = []
     after = first_screen(tmp_path / "warm", warm)
     assert warm == [], warm
@@ -77,7 +77,7 @@ def test_after_the_warm_up_an_app_parses_no_css_and_shows_the_same_first_screen(
 
 
 def test_an_app_with_other_css_variables_is_not_given_the_kept_rules(tmp_path, fresh_warmup):
-    warmup.prepare()
+    warm_up()
     kept = len(warmup._parsed)
     assert kept > 10
     same = Stylesheet(variables=dict(warmup._variables))

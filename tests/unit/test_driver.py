@@ -7,7 +7,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from workbench.control.station import LabStation
-from workbench.sim.driver import KEYS, NOBODY, Driver
+from workbench.sim.driver import BY_KEYS, NOBODY, Driver
 from workbench.sim.mazefile import parse_maze
 from workbench.sim.record import FORMAT, read_record, recorded_driver
 from workbench.sim.replay import load_replay
@@ -18,7 +18,7 @@ MOVE = '{"servos":[{"isTurn":false,"servoId":-1,"servoSpeed":1}]}'
 
 
 def test_the_text_of_each_kind_of_driver():
-    assert [str(d) for d in (KEYS, NOBODY)] == ["keys", "nobody"]
+    assert [str(d) for d in (BY_KEYS, NOBODY)] == ["keys", "nobody"]
     assert str(Driver.algorithm("right-wall")) == "algorithm right-wall"
     assert str(Driver.viple("tcp", "127.0.0.1:50312")) == "VIPLE tcp 127.0.0.1:50312"
     assert str(Driver.viple()) == "VIPLE"
@@ -27,7 +27,7 @@ def test_the_text_of_each_kind_of_driver():
 
 def test_a_table_of_runs_names_an_algorithm_by_its_own_name():
     assert Driver.algorithm("right-wall").short == "right-wall"
-    assert KEYS.short == "keys"
+    assert BY_KEYS.short == "keys"
     assert Driver.viple("ws", "ws://localhost:8124/").short == "VIPLE ws ws://localhost:8124/"
 
 
@@ -40,7 +40,7 @@ def test_an_unknown_kind_is_refused_with_the_kinds_allowed():
     ("text", "driver"),
     [
         ("right-wall", Driver.algorithm("right-wall")),
-        ("keys", KEYS),
+        ("keys", BY_KEYS),
         ("VIPLE tcp 127.0.0.1:50312", Driver.viple("tcp", "127.0.0.1:50312")),
         ("VIPLE ws ws://localhost:8124/", Driver.viple("ws", "ws://localhost:8124/")),
     ],
@@ -51,8 +51,8 @@ def test_a_record_written_before_drivers_were_typed_reads_its_driver_from_the_te
 
 def test_older_headless_and_driverless_records_read_as_viple_and_keys():
     assert recorded_driver({"driver": "VIPLE"}) == Driver.viple()
-    assert recorded_driver({}) == KEYS
-    assert recorded_driver({"algorithm": 7}) == KEYS
+    assert recorded_driver({}) == BY_KEYS
+    assert recorded_driver({"algorithm": 7}) == BY_KEYS
 
 
 def test_a_station_record_holds_the_driver_both_ways(tmp_path):

@@ -13,7 +13,7 @@ import itertools
 
 import pytest
 
-from workbench.tui.clock import LoopClock
+from workbench.tui.serving.loop_clock import LoopClock
 
 
 class Handle:

@@ -14,16 +14,22 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from textual import events, messages
-from textual._ansi_sequences import SYNC_END, SYNC_START
-from textual._xterm_parser import XTermParser
 from textual.drivers import web_driver
 
-from workbench.tui import packets
-from workbench.tui.driver import LoopInput, SessionDriver, parser_wait, plain_keys
+from workbench.tui.serving import packets
+from workbench.tui.serving.terminal_driver import (
+    SYNC_END,
+    SYNC_START,
+    LoopInput,
+    ServedTerminalDriver,
+    XTermParser,
+    parser_wait,
+    plain_keys,
+)
 
 
 class UnusedReader:
-    """Stands in for Textual's own input reader, which the session driver never uses (it
+    """Stands in for Textual's own input reader, which the served terminal driver never uses (it
     watches the test runner's standard input, which cannot be waited on here)."""
 
     def close(self) -> None:
@@ -51,9 +57,9 @@ class PostBox:
         return [m.key for m in self.messages if isinstance(m, events.Key)]
 
 
-async def started_driver(box: PostBox) -> tuple[SessionDriver, int]:
+async def started_driver(box: PostBox) -> tuple[ServedTerminalDriver, int]:
     """A driver reading a pipe of our own as its standard input; returns the pipe's write end."""
-    driver = SessionDriver(box)  # type: ignore[arg-type]
+    driver = ServedTerminalDriver(box)  # type: ignore[arg-type]
     r, w = os.pipe()
     reading = LoopInput(driver, r)
     driver._key_thread = reading  # type: ignore[assignment]
@@ -65,7 +71,7 @@ async def started_driver(box: PostBox) -> tuple[SessionDriver, int]:
 
 
 @contextlib.asynccontextmanager
-async def reading_driver() -> AsyncIterator[tuple[PostBox, SessionDriver, int]]:
+async def reading_driver() -> AsyncIterator[tuple[PostBox, ServedTerminalDriver, int]]:
     """A started driver, what it hands the app, and the write end of its input; closed after."""
     box = PostBox()
     driver, w = await started_driver(box)
@@ -136,7 +142,7 @@ def test_a_synchronized_update_leaves_as_one_packet():
     async def go() -> None:
         r, w = os.pipe()
         try:
-            driver = SessionDriver(PostBox())  # type: ignore[arg-type]
+            driver = ServedTerminalDriver(PostBox())  # type: ignore[arg-type]
             driver._write = lambda data: os.write(w, data)
             driver.write(SYNC_START)
             driver.write("\x1b[3;5Hw ")

@@ -24,7 +24,7 @@ from workbench.ssh.passwords import (
     verify_password,
 )
 from workbench.ssh.ports import PoolExhausted, PortPool, parse_range, port_is_free
-from workbench.tui import packets
+from workbench.tui.serving import packets
 from workbench.tui.settings import AppSettings
 
 
@@ -133,7 +133,7 @@ def test_the_app_is_started_with_the_users_name_ports_and_terminal():
     assert argv[0] == "workbench-app" and len(argv) == 2
     assert AppSettings.from_json(json.loads(argv[1])) == settings
     env = spec.env({"SSH_CONNECTION": "x", "PATH": "/bin", "TEXTUAL_DEBUG": "1"})
-    assert env["TEXTUAL_DRIVER"] == "workbench.tui.driver:SessionDriver"
+    assert env["TEXTUAL_DRIVER"] == "workbench.tui.serving.terminal_driver:ServedTerminalDriver"
     assert (env["COLUMNS"], env["ROWS"], env["TERM"]) == ("100", "30", "xterm")
     assert "SSH_CONNECTION" not in env and "TEXTUAL_DEBUG" not in env and env["PATH"] == "/bin"
     hint = forward_hint("ann", "lab.example", 2222, 41000, 41001)

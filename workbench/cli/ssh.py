@@ -21,11 +21,11 @@ from .common import db_option, record_quota_options
 #: the app every SSH session runs, given the session's settings as JSON (see
 #: :mod:`workbench.cli.served`): this Python's ``-m workbench.cli.served``, or forked from the
 #: fork server as :func:`workbench.cli.served.main` with the app's modules imported beforehand
-#: and its first screen's common work done once (:func:`workbench.tui.warmup.prepare`)
+#: and its first screen's common work done once (:func:`workbench.tui.app.warm_up`)
 WORKBENCH_APP = AppEntry(
     command=(sys.executable, "-m", "workbench.cli.served"),
     main="workbench.cli.served:main",
-    preload=("workbench.tui.app", "workbench.tui.warmup:prepare"),
+    preload=("workbench.tui.app:warm_up",),
 )
 
 

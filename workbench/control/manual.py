@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from workbench.sim.commands import Command, MoveAtPower, Stop, TurnByDegrees, WheelPowers
 
-KEYS = ("w", "a", "s", "d", "space")
+DRIVE_KEYS = ("w", "a", "s", "d", "space")
 KEY_NAMES = {
     "w": "forward",
     "a": "left",
@@ -56,7 +56,7 @@ def key_legend(profile: str) -> list[tuple[str, str]]:
         "erobotic": {"w": "one block", "s": "one block back", "a": "turn 90 left",
                      "d": "turn 90 right", "space": "stop"},
     }[profile]  # fmt: skip
-    return [(k, f"{KEY_NAMES[k]} ({detail[k]})") for k in KEYS]
+    return [(k, f"{KEY_NAMES[k]} ({detail[k]})") for k in DRIVE_KEYS]
 
 
 def key_command(profile: str, key: str) -> Command | None:

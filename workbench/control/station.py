@@ -14,7 +14,7 @@ from typing import Any
 from workbench.files.workspace import LOCAL, FileAccess
 from workbench.sim.clock import Pacer
 from workbench.sim.commands import Command, Stop, motion_of
-from workbench.sim.driver import KEYS, Driver
+from workbench.sim.driver import BY_KEYS, Driver
 from workbench.sim.maze import Maze
 from workbench.sim.metrics import Metrics
 from workbench.sim.noise import NoiseSettings
@@ -190,7 +190,7 @@ class LabStation:
     #: (see :attr:`at_rest`) brings the clock up to now first
     on_activity: Callable[[], None] | None = None
     _run_open: bool = False
-    _run_driver: Driver = KEYS
+    _run_driver: Driver = BY_KEYS
     _run_source: str | None = None
     _viple_now: VipleConnection | None = None
     _odometry_seen: tuple[float, float] = (0.0, 0.0)
@@ -218,7 +218,7 @@ class LabStation:
         # the VIPLE endpoints serving it and the pacer keep the one reference
         self.session = Session(self.maze, self.profile, self.sensors, self.noise, self.seed)
         self.pacer = Pacer(self.session)
-        self.session.driver = KEYS
+        self.session.driver = BY_KEYS
         self.session.on_command = self._commanded
         self.session.before_command = self._activity
 
@@ -367,12 +367,12 @@ class LabStation:
             return False
         self._go_on_after_exit()
         self.stop("stopped")
-        if self._run_open and self._run_driver != KEYS:
+        if self._run_open and self._run_driver != BY_KEYS:
             self._close_run("stopped")  # the keys take the robot from a VIPLE program
         if not self._run_open and not self.session.reached_exit:
-            self._open_run(KEYS)  # a run starts at the robot's last reset
+            self._open_run(BY_KEYS)  # a run starts at the robot's last reset
         self.keys_used.add(key)
-        self.session.command(cmd, driver=KEYS)
+        self.session.command(cmd, driver=BY_KEYS)
         if exact_move(self.profile, key):
             profile = get_profile(self.profile)
             self.session.command_after(self.session.world.cell / profile.move_speed, Stop())
@@ -519,7 +519,7 @@ class LabStation:
         if self.driving is None:
             return
         self.session.command(Stop())
-        self.session.detach(KEYS)
+        self.session.detach(BY_KEYS)
         self.driving = None
         if self._run_open:
             self._close_run(ended)
@@ -532,7 +532,7 @@ class LabStation:
             self._close_run("reset")
         self.stop("reset")
         self.session.reset()
-        self.session.driver = KEYS
+        self.session.driver = BY_KEYS
 
     def load_maze(self, maze: Maze) -> None:
         """Put a (new or edited) maze on the station; the robot starts over on it."""
@@ -542,7 +542,7 @@ class LabStation:
         self.stop("maze changed")
         self.maze = maze
         self.session.load_maze(maze, self.profile, self.sensors, self.noise, self.seed)
-        self.session.driver = KEYS
+        self.session.driver = BY_KEYS
 
     # -- runs ----------------------------------------------------------------------------
     def _open_run(self, driver: Driver) -> None:

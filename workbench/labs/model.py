@@ -19,6 +19,7 @@ import yaml
 from workbench.control.algorithms import list_algorithms
 from workbench.control.fsmdef import FsmDefinition
 from workbench.control.fsmfile import FsmFileError, load_fsm
+from workbench.control.manual import DRIVE_KEYS
 from workbench.files.bounded import LAB_LIMITS, BoundedFileError, compose_yaml, read_text
 from workbench.files.yamlread import FileProblem, NodeReader, Skip, problem_list
 from workbench.sim.maze import Maze, MazeError
@@ -32,7 +33,6 @@ OBJECTIVE_KINDS = ("keys", "sensors", "viple", "exit", "maze-edited", "compare",
 CONTROLLER_KINDS = ("keys", "algorithm", "starter", "viple")
 #: what an ``exit`` objective may require of the driver
 DRIVER_KINDS = ("viple", "program", "fsm", "algorithm", "any")
-DRIVE_KEYS = ("w", "a", "s", "d", "space")
 VIPLE_ROLES = ("tcp", "ws")
 
 

@@ -30,7 +30,7 @@ FIELDS = {
     "driver": ("student", "partner", "lab", "exercise", "driver", "updated_at"),
 }
 #: which values make the write's key (a newer write of the same key replaces an older one)
-KEYS = {
+KEY_FIELDS = {
     "progress": ("student", "lab", "exercise"),
     "place": ("student",),
     "driver": ("student", "partner", "lab", "exercise"),
@@ -48,7 +48,7 @@ class PendingWrite:
     @property
     def key(self) -> tuple[str, ...]:
         named = dict(zip(FIELDS[self.kind], self.values, strict=True))
-        return (self.kind, *(named[k] for k in KEYS[self.kind]))
+        return (self.kind, *(named[k] for k in KEY_FIELDS[self.kind]))
 
 
 def pending_path(data_dir: str | os.PathLike, student: str) -> Path:

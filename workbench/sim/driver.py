@@ -85,5 +85,5 @@ class Driver:
         return cls(obj["kind"], **fields)
 
 
-KEYS = Driver("keys")
+BY_KEYS = Driver("keys")
 NOBODY = Driver("nobody")

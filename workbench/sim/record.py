@@ -22,7 +22,7 @@ import pymunk
 import workbench
 
 from .commands import MotorPower, MoveAtPower, Stop, TurnByDegrees, WheelPowers
-from .driver import KEYS, NOBODY, Driver
+from .driver import BY_KEYS, NOBODY, Driver
 
 FORMAT = "workbench-run/1"
 FLUSH_EVERY = 20
@@ -291,7 +291,7 @@ def recorded_driver(header: dict[str, Any]) -> Driver:
         return Driver.viple()
     text = header.get("algorithm")
     if not isinstance(text, str) or not text or text == "keys":
-        return KEYS
+        return BY_KEYS
     if text == "nobody":
         return NOBODY
     if text == "VIPLE" or text.startswith("VIPLE "):

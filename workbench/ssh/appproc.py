@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from workbench.control.recording import RecordQuota
-from workbench.tui import packets
+from workbench.tui.serving import packets
 from workbench.tui.settings import AppSettings
 
 if TYPE_CHECKING:
@@ -30,7 +30,7 @@ if TYPE_CHECKING:
 log = logging.getLogger("workbench.ssh")
 
 #: Textual's web driver, with an input thread that sleeps while no key comes
-DRIVER = "workbench.tui.driver:SessionDriver"
+DRIVER = "workbench.tui.serving.terminal_driver:ServedTerminalDriver"
 #: what the terminal is set back to when an app ends (the web driver leaves it to the server)
 RESTORE_TERMINAL = (
     b"\x1b[?1000l\x1b[?1003l\x1b[?1015l\x1b[?1006l"  # mouse reporting off

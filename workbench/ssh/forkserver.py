@@ -9,7 +9,7 @@ Two halves live here:
   ``module:function``, handed down by whoever starts the lab server), it imports the modules it
   is given, the :data:`PRELOAD` list and every module of the workbench packages the app uses;
   then it calls each ``module:function`` among the modules given (work every app would do the
-  same way, done once here: the app's is :func:`workbench.tui.warmup.prepare`), freezes it all
+  same way, done once here: the app's is :func:`workbench.tui.app.warm_up`), freezes it all
   out of the garbage collector's reach (so the pages stay shared with the children) and waits
   on a Unix socket.
   Each request carries the app's settings (a JSON object) and environment and two file
@@ -54,7 +54,7 @@ from pathlib import Path
 log = logging.getLogger("workbench.ssh")
 
 #: modules the app imports, loaded once in the fork server
-PRELOAD = ("textual.drivers.web_driver", "workbench.tui.driver")
+PRELOAD = ("textual.drivers.web_driver", "workbench.tui.serving.terminal_driver")
 #: packages whose every module is loaded too (the app imports many of them only when used)
 PRELOAD_PACKAGES = (
     "workbench.sim",

@@ -17,6 +17,7 @@ import os
 import threading
 from collections.abc import Callable
 from dataclasses import replace
+from functools import partial
 from pathlib import Path
 from time import perf_counter
 from typing import ClassVar
@@ -24,7 +25,6 @@ from typing import ClassVar
 from textual import events
 from textual.binding import Binding, BindingType
 from textual.screen import ModalScreen, Screen
-from textual.widgets import Tooltip
 
 from workbench.control.station import LabStation
 from workbench.files.bundled import default_maze_path
@@ -42,12 +42,9 @@ from workbench.viple.hosting import Endpoints
 from workbench.viple.tcp_server import TcpConfig
 from workbench.viple.ws_client import WsConfig
 
-from . import warmup
-from .clock import LoopClock
 from .commands import WorkbenchCommands
 from .dialogs.help import HelpScreen
 from .dialogs.too_small import TooSmallScreen
-from .driver import SessionDriver
 from .host import (
     MazeChanged,
     OpenScreen,
@@ -60,13 +57,17 @@ from .host import (
     StationChanged,
     TakesAllKeys,
 )
-from .keys import bindings
-from .quick_keys import QuickKeys
+from .keys import APP_KEY_IDS, bindings
 from .screens.arrival import ArrivalScreen
 from .screens.editor import EditorScreen
 from .screens.labs import LabsScreen
 from .screens.main import MainScreen
 from .screens.runs import RunsScreen
+from .serving import warmup
+from .serving.internals import end_with_error, handled_size
+from .serving.loop_clock import LoopClock
+from .serving.quick_keys import QuickKeys, as_key_press
+from .serving.terminal_driver import serves
 from .settings import AppSettings
 
 #: the smallest terminal the layout is made for (columns, rows)
@@ -99,7 +100,7 @@ class WorkbenchApp(ScreenHost[None]):
     TITLE = "VIPLE Maze Lab Workbench"
     COMMANDS = ScreenHost.COMMANDS | {WorkbenchCommands}
     BINDINGS: ClassVar[list[BindingType]] = [
-        *bindings("app.quit", "app.help", "app.commands"),
+        *bindings(*APP_KEY_IDS),
         *FOCUS_BINDINGS,
     ]
 
@@ -199,11 +200,13 @@ class WorkbenchApp(ScreenHost[None]):
         self.mark_ascii()
         self._show_maze_title()
         self._last_tick = perf_counter()
-        self._clock = LoopClock(self._tick, 1.0 / self.settings.tick_hz, self._handle_exception)
+        self._clock = LoopClock(
+            self._tick, 1.0 / self.settings.tick_hz, partial(end_with_error, self)
+        )
         self.station.on_activity = self.wake
         if self.settings.connect_hint:
             self.say(self.hint_line())
-        if isinstance(self._driver, SessionDriver):
+        if serves(self):
             # a served session's process holds this one app for the whole class: what start-up
             # built lives as long as it, so the garbage collector's full passes (some 70 ms
             # each while a student drives) leave it alone from the first screen on
@@ -321,7 +324,8 @@ class WorkbenchApp(ScreenHost[None]):
 
     def take_typed_key(self, key: str) -> bool:
         """Run a typed key's action at once when the screen has it as a quick action
-        (``workbench/tui/quick_keys.py``); False: the key goes the usual way, as a key event."""
+        (``workbench/tui/serving/quick_keys.py``); False: the key goes the usual way, as a key
+        event."""
         stack = self.screen_stack  # (empty while the app starts or ends)
         screen = stack[-1] if stack else None
         if not isinstance(screen, QuickKeys):
@@ -330,17 +334,11 @@ class WorkbenchApp(ScreenHost[None]):
         action = screen.quick_action(key)
         if action is None:
             return False
-        # what Textual does at the app for any key press
-        if not self.app_focus:
-            self.app_focus = True
-        if self.focused is not None and any(
-            isinstance(child, Tooltip) and child.display for child in screen.children
-        ):  # (looked for here: Textual's own lookup words an error when there is none)
-            screen._clear_tooltip()
+        as_key_press(self, screen)
         try:
             action()
         except Exception as error:  # as an action's error in a key event: shown, the app ends
-            self._handle_exception(error)
+            end_with_error(self, error)
             return True
         self._input_taken()
         return True
@@ -373,7 +371,7 @@ class WorkbenchApp(ScreenHost[None]):
 
     # -- size --------------------------------------------------------------------------------
     def on_resize(self, event: events.Resize) -> None:
-        known = self._size  # None until Textual has handled the app's first resize
+        known = handled_size(self)  # None until Textual has handled the app's first resize
         if known is not None and not self._sized:
             self._sized = True
             if event.size == known:
@@ -688,3 +686,20 @@ def _login_name() -> str:
         return getpass.getuser()
     except (KeyError, OSError):
         return "student"
+
+
+def warm_up() -> None:
+    """Run once in the lab server's fork server, before it forks the sessions' apps: the app a
+    served student gets, run to its first screen (:func:`workbench.tui.serving.warmup.prepare`)."""
+    warmup.prepare(
+        lambda folder: make_app(
+            AppSettings(
+                student="warmup",
+                ask_names=True,
+                student_fixed=True,
+                data_dir=Path(folder),
+                workspace=Path(folder),
+                connect_hint="VIPLE: warming up",
+            )
+        )
+    )

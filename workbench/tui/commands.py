@@ -1,5 +1,5 @@
 """The command palette: the keys of the screen it was opened on (and the app's) as commands,
-named and explained by the one key table, :data:`~workbench.tui.keys.KEYS`."""
+named and explained by the one key table, :data:`~workbench.tui.keys.KEY_TABLE`."""
 
 from __future__ import annotations
 
@@ -10,7 +10,8 @@ from textual.binding import Binding
 from textual.command import DiscoveryHit, Hit, Hits, Provider
 from textual.dom import DOMNode
 
-from .keys import KEYS
+from .keys import KEY_TABLE
+from .serving.internals import bindings_of
 
 
 def key_display(node: DOMNode, binding: Binding) -> str:
@@ -23,8 +24,8 @@ def key_display(node: DOMNode, binding: Binding) -> str:
 def bindings_with_ids(node: DOMNode) -> Iterator[Binding]:
     """The node's bindings that have an id, once each, in declared order."""
     seen: set[str] = set()
-    for _key, binding in node._bindings:
-        if binding.id and binding.id not in seen and binding.id in KEYS:
+    for _key, binding in bindings_of(node):
+        if binding.id and binding.id not in seen and binding.id in KEY_TABLE:
             seen.add(binding.id)
             yield binding
 
@@ -33,7 +34,7 @@ class WorkbenchCommands(Provider):
     """The key bindings of the current screen and of the app as command palette commands."""
 
     def _commands(self) -> list[tuple[str, str, Callable[[], Awaitable[object]]]]:
-        out = []
+        out: list[tuple[str, str, Callable[[], Awaitable[object]]]] = []
         seen: set[str] = set()
         for node in (self.screen, self.app):
             for binding in bindings_with_ids(node):
@@ -41,7 +42,7 @@ class WorkbenchCommands(Provider):
                 if binding.id in seen or binding.id == "app.commands":
                     continue
                 seen.add(binding.id)
-                info = KEYS[binding.id]
+                info = KEY_TABLE[binding.id]
                 title = f"{info.group}: {info.title}"
                 help_text = f"key {key_display(node, binding)}: {info.explanation}"
                 out.append((title, help_text, partial(self.app.run_action, binding.action, node)))

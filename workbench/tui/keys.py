@@ -1,13 +1,16 @@
 """What every key does, in one table: the screens' bindings, the help screen, the command
-palette and the footer are all made from :data:`KEYS`.
+palette, the footer and the key legends beside the editor's and the replay's maze are all made
+from :data:`KEY_TABLE`.
 
 Each entry has an id (``group.what``); a screen lists the ids it answers with
-:func:`bindings`. The drive keys' effect in each profile's key program (the legend beside the
-maze) comes from ``control/manual.py``, which the drive entries point to.
+:func:`bindings` (the screens the help explains take theirs from the lists here, which the help
+reads). The drive keys' effect in each profile's key program (the legend beside the main
+screen's maze) comes from ``control/manual.py``, which the drive entries point to.
 """
 
 from __future__ import annotations
 
+import string
 from dataclasses import dataclass
 
 from textual.binding import Binding
@@ -38,7 +41,7 @@ class Key:
     display: str | None = None
 
 
-KEYS: dict[str, Key] = {
+KEY_TABLE: dict[str, Key] = {
     "app.quit": Key(
         "ctrl+q",
         "quit",
@@ -509,7 +512,7 @@ def bindings(*ids: str) -> list[Binding]:
     """The bindings of the keys ``ids``, in that order (a screen's ``BINDINGS``)."""
     made = []
     for key_id in ids:
-        key = KEYS[key_id]
+        key = KEY_TABLE[key_id]
         each = key.keys.split(",") if "{key}" in key.action else [key.keys]
         for name in each:
             made.append(
@@ -524,3 +527,161 @@ def bindings(*ids: str) -> list[Binding]:
                 )
             )
     return made
+
+
+#: the keys of the app itself, on every screen
+APP_KEY_IDS = ("app.quit", "app.help", "app.commands")
+#: the main screen's keys, in the footer's order
+MAIN_KEY_IDS = (
+    "drive.forward",
+    "drive.left",
+    "drive.backward",
+    "drive.right",
+    "drive.stop",
+    "sim.pause",
+    "sim.step",
+    "sim.speed",
+    "sim.reset",
+    "panel.sensors",
+    "panel.algorithm",
+    "algorithm.run",
+    "algorithm.fix",
+    "view.unicode",
+    "view.trail",
+    "maze.load",
+    "screen.editor",
+    "screen.runs",
+    "screen.labs",
+    "viple.ws",
+    "program.keys",
+    "program.all_keys",
+    "program.keys_back",
+)
+#: the maze editor's keys
+EDITOR_KEY_IDS = (
+    "editor.up",
+    "editor.down",
+    "editor.left",
+    "editor.right",
+    "editor.wall",
+    "editor.start",
+    "editor.exit",
+    "editor.undo",
+    "editor.redo",
+    "editor.new",
+    "editor.generate",
+    "editor.save",
+    "editor.save_as",
+    "editor.next_problem",
+    "editor.unicode",
+    "editor.leave",
+)
+#: the runs screen's keys
+RUNS_KEY_IDS = ("runs.replay", "runs.open", "runs.unicode", "runs.leave")
+#: the replay screen's keys
+REPLAY_KEY_IDS = (
+    "replay.step",
+    "replay.back",
+    "replay.step10",
+    "replay.back10",
+    "replay.play",
+    "replay.faster",
+    "replay.slower",
+    "replay.first",
+    "replay.last",
+    "replay.unicode",
+    "replay.leave",
+)
+#: the help's sections of screen keys: heading, and the keys in the order explained
+HELP_SECTIONS: tuple[tuple[str, tuple[str, ...]], ...] = (
+    ("Workbench", MAIN_KEY_IDS + APP_KEY_IDS),
+    ("Maze editor (e)", EDITOR_KEY_IDS),
+    ("Runs (R)", RUNS_KEY_IDS),
+    ("Replay (enter on a run)", REPLAY_KEY_IDS),
+)
+
+#: letters and digits a running VIPLE program gets besides the drive keys and the arrows: the
+#: ones the main screen has no key of its own for
+PROGRAM_KEYS = frozenset(
+    set(string.ascii_lowercase + string.digits)
+    - {name for key_id in MAIN_KEY_IDS for name in KEY_TABLE[key_id].keys.split(",")}
+)
+
+#: how a key is written in a legend, where Textual's name is long
+LEGEND_NAMES = {"escape": "esc", "pageup": "pgup", "pagedown": "pgdn"}
+
+
+@dataclass(frozen=True)
+class LegendEntry:
+    """Keys of the table as a screen's legend shows them: ``keys what``."""
+
+    #: the table's keys it stands for
+    ids: tuple[str, ...]
+    #: how they are written (default: each one's display or short name, joined by ``/``)
+    keys: str = ""
+    #: what they do (default: the first one's title)
+    what: str = ""
+
+    def __post_init__(self) -> None:
+        unknown = [key_id for key_id in self.ids if key_id not in KEY_TABLE]
+        if not self.ids or unknown:
+            raise KeyError(f"a legend entry names keys not in the table: {unknown or 'none'}")
+
+    def text(self) -> str:
+        entries = [KEY_TABLE[key_id] for key_id in self.ids]
+        keys = self.keys or "/".join(
+            entry.display or LEGEND_NAMES.get(entry.keys, entry.keys) for entry in entries
+        )
+        return f"{keys} {self.what or entries[0].title}"
+
+
+#: a key legend: rows of entries
+Legend = tuple[tuple[LegendEntry, ...], ...]
+
+
+def legend_text(rows: Legend) -> str:
+    """A key legend as shown: each row's entries two spaces apart, one row a line."""
+    return "\n".join("  ".join(entry.text() for entry in row) for row in rows)
+
+
+#: the legend beside the maze editor's maze
+EDITOR_LEGEND: Legend = (
+    (
+        LegendEntry(("editor.up", "editor.down", "editor.left", "editor.right"), "arrows", "move"),
+        LegendEntry(("editor.wall",), "space/click"),
+    ),
+    (
+        LegendEntry(("editor.start",), what="start (again: turn)"),
+        LegendEntry(("editor.exit",)),
+    ),
+    (
+        LegendEntry(("editor.undo",)),
+        LegendEntry(("editor.redo",)),
+        LegendEntry(("editor.next_problem",), what="problem"),
+    ),
+    (
+        LegendEntry(("editor.new",)),
+        LegendEntry(("editor.generate",)),
+        LegendEntry(("editor.unicode",)),
+    ),
+    (
+        LegendEntry(("editor.save",)),
+        LegendEntry(("editor.save_as",)),
+        LegendEntry(("editor.leave",)),
+    ),
+)
+#: the legend beside the replay's maze
+REPLAY_LEGEND: Legend = (
+    (
+        LegendEntry(("replay.back", "replay.step"), what="step"),
+        LegendEntry(("replay.back10", "replay.step10"), what="10"),
+    ),
+    (
+        LegendEntry(("replay.play",)),
+        LegendEntry(("replay.faster", "replay.slower"), what="speed"),
+    ),
+    (
+        LegendEntry(("replay.first", "replay.last"), what="first/last"),
+        LegendEntry(("replay.leave",)),
+    ),
+)

@@ -11,11 +11,12 @@ from __future__ import annotations
 
 from typing import ClassVar
 
-from textual._context import active_app
 from textual.command import CommandPalette, SearchIcon
 from textual.dom import DOMNode
 from textual.scrollbar import ScrollBar, ScrollBarRender
 from textual.widgets import Markdown, Static
+
+from .serving.internals import current_app
 
 #: typographic characters of prose (lab texts, algorithm descriptions) and their ASCII spelling
 PROSE = str.maketrans(
@@ -47,11 +48,8 @@ PROSE = str.maketrans(
 
 def ascii_mode() -> bool:
     """Whether the app drawing now is in ASCII mode."""
-    try:
-        app = active_app.get()
-    except LookupError:
-        return False
-    return app.has_class("-ascii")
+    app = current_app()
+    return app is not None and app.has_class("-ascii")
 
 
 def prose(text: str, unicode: bool) -> str:

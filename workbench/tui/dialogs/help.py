@@ -16,7 +16,7 @@ from textual.widgets import Static
 
 from workbench.control.manual import key_legend
 
-from ..keys import KEYS, bindings
+from ..keys import HELP_SECTIONS, KEY_TABLE, bindings
 
 
 def _table() -> Table:
@@ -30,7 +30,7 @@ def help_text(
     screens: list[tuple[str, list[Binding]]], profile: str, key_name: Callable[[Binding], str]
 ) -> Group:
     """Every key: the profile's drive keys, then each screen's keys grouped as
-    :data:`~workbench.tui.keys.KEYS` says."""
+    :data:`~workbench.tui.keys.KEY_TABLE` says."""
     sections: list[tuple[str, Table]] = []
     drive = _table()
     for key, text in key_legend(profile):
@@ -43,7 +43,7 @@ def help_text(
             if not binding.id or (screen, binding.id) in shown:
                 continue  # the keys of one command (the arrows) are explained once
             shown.add((screen, binding.id))
-            info = KEYS[binding.id]
+            info = KEY_TABLE[binding.id]
             if info.group == "Drive":
                 continue
             if info.group not in tables:
@@ -87,7 +87,7 @@ class HelpScreen(ModalScreen[None]):
     }
     """
 
-    BINDINGS: ClassVar[list[BindingType]] = bindings("help.close")
+    BINDINGS: ClassVar[list[BindingType]] = [*bindings("help.close")]
 
     def __init__(self, profile: str, connect_hint: str = "") -> None:
         super().__init__()
@@ -96,23 +96,12 @@ class HelpScreen(ModalScreen[None]):
         self.connect_hint = connect_hint
 
     def compose(self) -> ComposeResult:
-        from ..screens.editor import EditorScreen
-        from ..screens.main import MainScreen
-        from ..screens.replay import ReplayScreen
-        from ..screens.runs import RunsScreen
-
         app = self.app
         dialog = Vertical(id="help-dialog")
         dialog.border_title = "Help: keys of the workbench"
         dialog.border_subtitle = "escape closes, arrows scroll"
         with dialog, VerticalScroll(id="help-scroll"):
-            screens = [
-                ("Workbench", [*MainScreen.BINDINGS, *app.BINDINGS]),
-                ("Maze editor (e)", EditorScreen.BINDINGS),
-                ("Runs (R)", RunsScreen.BINDINGS),
-                ("Replay (enter on a run)", ReplayScreen.BINDINGS),
-            ]
-            keys = [(name, [b for b in found if isinstance(b, Binding)]) for name, found in screens]
+            keys = [(heading, bindings(*ids)) for heading, ids in HELP_SECTIONS]
             hint = self.connect_hint
             if hint:
                 yield Static(

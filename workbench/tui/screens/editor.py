@@ -29,21 +29,12 @@ from ..dialogs.path import PathDialog
 from ..dialogs.size import SizeDialog
 from ..dialogs.unsaved import Choice, UnsavedDialog
 from ..host import FollowsUnicode, Say, ToggleUnicode
-from ..keys import bindings
+from ..keys import EDITOR_KEY_IDS, EDITOR_LEGEND, bindings, legend_text
 from ..widgets.maze_view import MazeView
 
 SAVE_HELP = (
     "The file is written atomically: a crash leaves the old file or the new one, never half. "
     "A .maz name writes a micromouse binary maze; any other name the workbench text format."
-)
-
-
-KEYS = (
-    "arrows move  space/click wall\n"
-    "s start (again: turn)  x exit\n"
-    "^z undo  ^y redo  p problem\n"
-    "n new  g generate  u unicode\n"
-    "^s save  a save as  esc back"
 )
 
 
@@ -117,26 +108,7 @@ class EditorScreen(FollowsUnicode, Screen[Maze | None]):
     }
     """
 
-    BINDINGS: ClassVar[list[BindingType]] = [
-        *bindings(
-            "editor.up",
-            "editor.down",
-            "editor.left",
-            "editor.right",
-            "editor.wall",
-            "editor.start",
-            "editor.exit",
-            "editor.undo",
-            "editor.redo",
-            "editor.new",
-            "editor.generate",
-            "editor.save",
-            "editor.save_as",
-            "editor.next_problem",
-            "editor.unicode",
-            "editor.leave",
-        )
-    ]
+    BINDINGS: ClassVar[list[BindingType]] = [*bindings(*EDITOR_KEY_IDS)]
 
     def __init__(
         self,
@@ -174,7 +146,7 @@ class EditorScreen(FollowsUnicode, Screen[Maze | None]):
                 yield Static(id="editor-problems-title", markup=False)
                 yield OptionList(id="editor-problems", markup=False)
                 yield Static(id="editor-status", markup=False)
-                yield Static(KEYS, id="editor-keys", markup=False)
+                yield Static(legend_text(EDITOR_LEGEND), id="editor-keys", markup=False)
         yield Footer()
 
     def on_mount(self) -> None:

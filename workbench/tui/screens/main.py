@@ -27,7 +27,6 @@ from workbench.sim.mazeio import load_maze
 from workbench.sim.sensors import SensorConfigError
 from workbench.sim.session import Snapshot
 
-from ..compositor import LiveCompositor
 from ..host import (
     FollowsUnicode,
     MazeChanged,
@@ -39,10 +38,11 @@ from ..host import (
     TakesAllKeys,
     ToggleUnicode,
 )
-from ..keys import bindings
-from ..prompt_frames import PromptFrames
-from ..quick_keys import QuickKeys
+from ..keys import MAIN_KEY_IDS, PROGRAM_KEYS, bindings
 from ..record_words import record_words
+from ..serving.compositor import use_live_compositor
+from ..serving.prompt_frames import PromptFrames
+from ..serving.quick_keys import QuickKeys
 from ..widgets.algorithm_state import AlgorithmState
 from ..widgets.key_bar import KeyBar
 from ..widgets.key_legend import KeyLegend
@@ -75,35 +75,7 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
     # the keys pressed again and again while driving are priority bindings: the screen takes
     # them before the focused widget (the transition log, which has no use for them) would, so
     # a key press runs its action at once instead of bubbling up through the side panel
-    BINDINGS: ClassVar[list[BindingType]] = [
-        *bindings(
-            "drive.forward",
-            "drive.left",
-            "drive.backward",
-            "drive.right",
-            "drive.stop",
-            "sim.pause",
-            "sim.step",
-            "sim.speed",
-            "sim.reset",
-            "panel.sensors",
-            "panel.algorithm",
-            "algorithm.run",
-            "algorithm.fix",
-            "view.unicode",
-            "view.trail",
-            "maze.load",
-            "screen.editor",
-            "screen.runs",
-            "screen.labs",
-            "viple.ws",
-            "program.keys",
-            "program.all_keys",
-            "program.keys_back",
-        )
-    ]
-    #: keys a running VIPLE program may have besides the drive keys and the arrows
-    PROGRAM_KEYS = frozenset("bchijkqyz0123456789")
+    BINDINGS: ClassVar[list[BindingType]] = [*bindings(*MAIN_KEY_IDS)]
 
     #: the last snapshot drawn (a plain attribute: set on every tick, it never repaints)
     snapshot: Snapshot | None = None
@@ -122,7 +94,7 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
         #: the file of the maze on the station (where the maze dialog starts)
         self.maze_path = maze_path
         # the maze and the panels change a few cells at a time, many times a second
-        self._compositor = LiveCompositor()
+        use_live_compositor(self)
         self.station = station
         self._ready = False
         self._unicode = unicode
@@ -318,7 +290,7 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
                 self.station.type_to_program(name)
                 self.refresh_views()
             return
-        if key in self.PROGRAM_KEYS:
+        if key in PROGRAM_KEYS:
             event.stop()
             event.prevent_default()
             self.station.key(key)

@@ -27,7 +27,7 @@ from workbench.sim.maze import Maze
 from workbench.sim.replay import Replay, load_replay, replay_maze
 
 from ..host import FollowsUnicode, ToggleUnicode
-from ..keys import bindings
+from ..keys import REPLAY_KEY_IDS, REPLAY_LEGEND, bindings, legend_text
 from ..widgets.maze_view import MazeView
 from ..widgets.text import count
 
@@ -35,7 +35,6 @@ from ..widgets.text import count
 PLAY_HZ = 20
 #: transition log lines shown before the screen has its size
 LOG_LINES = 8
-KEYS = "left/right step  pgup/pgdn 10\nspace play/pause  +/- speed\nhome/end first/last  esc back"
 
 
 def _number(value: object) -> str:
@@ -112,21 +111,7 @@ class ReplayScreen(FollowsUnicode, Screen[None]):
     }
     """
 
-    BINDINGS: ClassVar[list[BindingType]] = [
-        *bindings(
-            "replay.step",
-            "replay.back",
-            "replay.step10",
-            "replay.back10",
-            "replay.play",
-            "replay.faster",
-            "replay.slower",
-            "replay.first",
-            "replay.last",
-            "replay.unicode",
-            "replay.leave",
-        )
-    ]
+    BINDINGS: ClassVar[list[BindingType]] = [*bindings(*REPLAY_KEY_IDS)]
 
     def __init__(
         self,
@@ -170,7 +155,7 @@ class ReplayScreen(FollowsUnicode, Screen[None]):
             with Vertical(id="replay-side"):
                 yield Static(id="replay-tick", markup=False)
                 yield Static(id="replay-log", markup=False)
-                yield Static(KEYS, id="replay-keys", markup=False)
+                yield Static(legend_text(REPLAY_LEGEND), id="replay-keys", markup=False)
         yield Footer()
 
     def on_mount(self) -> None:

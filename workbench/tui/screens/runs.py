@@ -24,7 +24,7 @@ from workbench.sim.session import Snapshot
 
 from ..dialogs.path import PathDialog
 from ..host import FollowsUnicode, ShowsSnapshot, ToggleUnicode
-from ..keys import bindings
+from ..keys import RUNS_KEY_IDS, bindings
 from ..widgets.text import count
 from .replay import ReplayScreen
 
@@ -114,9 +114,7 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
     }
     """
 
-    BINDINGS: ClassVar[list[BindingType]] = [
-        *bindings("runs.replay", "runs.open", "runs.unicode", "runs.leave")
-    ]
+    BINDINGS: ClassVar[list[BindingType]] = [*bindings(*RUNS_KEY_IDS)]
 
     def __init__(
         self,

@@ -16,6 +16,8 @@ from textual.binding import Binding
 from textual.message import Message
 from textual.widgets import Input
 
+from ..serving.internals import KeyFirstInput
+
 #: every key Input binds, and the action it runs
 _EDITING = {
     key.strip(): binding.action
@@ -25,7 +27,7 @@ _EDITING = {
 }
 
 
-class Field(Input):
+class Field(KeyFirstInput):
     """``Input`` with typed-ahead editing keys kept in order and a steady cursor.
 
     With a ``max_length``, text typed or pasted past it is cut to fit (Textual's ``Input``
@@ -60,11 +62,11 @@ class Field(Input):
                 return
         super().replace(text, start, end)
 
-    async def _on_key(self, event: events.Key) -> None:
+    async def take_key(self, event: events.Key) -> bool:
         action = _EDITING.get(event.key)
         if action is None:
-            await super()._on_key(event)
-            return
+            return False
         event.stop()
         event.prevent_default()
         await self.run_action(action)
+        return True

@@ -11,7 +11,8 @@ from __future__ import annotations
 
 from textual.app import ComposeResult
 from textual.widgets import Footer
-from textual.widgets._footer import FooterKey
+
+from ..serving.internals import FooterKey
 
 
 class KeyBar(Footer):

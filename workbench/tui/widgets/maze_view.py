@@ -561,7 +561,7 @@ class MazeView(ScrollView, can_focus=False):
         """The sensors' readings as last shown, one line per port (None with no sensor)."""
         if self._tooltip_stale and self._last_show is not None:
             self._update_tooltip(self._last_show[0])
-        return self._tooltip
+        return ScrollView.tooltip.fget(self)  # type: ignore[attr-defined]
 
     @tooltip.setter
     def tooltip(self, tooltip: VisualType | None) -> None:
@@ -627,36 +627,36 @@ class MazeView(ScrollView, can_focus=False):
         if (new_x, new_y) != (scroll_x, scroll_y):
             self.scroll_to(new_x, new_y, animate=False)
 
-    def _detach(self) -> None:
+    def _stop_following(self) -> None:
         if self.allow_vertical_scroll or self.allow_horizontal_scroll:
             self._detached = True
 
     def on_mouse_scroll_down(self, event: events.MouseScrollDown) -> None:
-        self._detach()
+        self._stop_following()
 
     def on_mouse_scroll_up(self, event: events.MouseScrollUp) -> None:
-        self._detach()
+        self._stop_following()
 
     def on_mouse_scroll_left(self, event: events.MouseScrollLeft) -> None:
-        self._detach()
+        self._stop_following()
 
     def on_mouse_scroll_right(self, event: events.MouseScrollRight) -> None:
-        self._detach()
+        self._stop_following()
 
     def on_scroll_to(self, message: ScrollTo) -> None:
-        self._detach()
+        self._stop_following()
 
     def on_scroll_up(self, message: ScrollUp) -> None:
-        self._detach()
+        self._stop_following()
 
     def on_scroll_down(self, message: ScrollDown) -> None:
-        self._detach()
+        self._stop_following()
 
     def on_scroll_left(self, message: ScrollLeft) -> None:
-        self._detach()
+        self._stop_following()
 
     def on_scroll_right(self, message: ScrollRight) -> None:
-        self._detach()
+        self._stop_following()
 
     def on_resize(self, event: events.Resize) -> None:
         self._follow_robot()

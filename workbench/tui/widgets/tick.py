@@ -7,13 +7,13 @@ reads as ticked on a plain or monochrome terminal.
 from __future__ import annotations
 
 from textual.content import Content
-from textual.widgets import Checkbox
+
+from ..serving.internals import DrawnCheckbox
 
 
-class Tick(Checkbox):
+class Tick(DrawnCheckbox):
     """``Checkbox`` drawn as ``[X]`` when ticked and ``[ ]`` when not."""
 
-    @property
-    def _button(self) -> Content:
+    def box(self) -> Content:
         style = self.get_visual_style("toggle--label")
         return Content.assemble(("[", style), ("X" if self.value else " ", style), ("]", style))

@@ -2,11 +2,11 @@
 event loop instead of in a thread.
 
 The lab server runs each session's app with Textual's web driver (packets over a pipe, see
-``workbench/tui/packets.py``). That driver reads them in a thread of its own that wakes ten times
-a second, key or no key (to look for a lone Escape whose sequence never finished), and hands
+``packets.py`` beside this module). That driver reads them in a thread of its own that wakes ten
+times a second, key or no key (to look for a lone Escape whose sequence never finished), and hands
 each key to the app's loop wrapped in a coroutine, a task and a pair of futures. With twenty
 keys a second from a student driving, that thread and the hand-over were a fifth of what the app
-cost. :class:`SessionDriver` reads the same packets the same way, on the event loop when the
+cost. :class:`ServedTerminalDriver` reads the same packets the same way, on the event loop when the
 pipe has data: nothing runs while no key comes, except a timer at the key parser's own time
 limit while it waits for the rest of an escape sequence, and a key goes straight into the
 app's message queue, in the order typed.
@@ -15,9 +15,8 @@ Typed characters (printable ASCII, outside an escape sequence and a bracketed pa
 their keys without going through Textual's key parser, which logs a description of every key it
 makes whether or not logging is on; the keys are the ones the parser makes for them
 (:func:`plain_keys`). An app that can (:class:`TakesTypedKeys`) is offered each of them first,
-and runs the action of a driving key at once, without a key event
-(``workbench/tui/quick_keys.py``); once a key goes the usual way, the rest of that text follows
-it, so keys stay in the order typed.
+and runs the action of a driving key at once, without a key event (``quick_keys.py``); once a
+key goes the usual way, the rest of that text follows it, so keys stay in the order typed.
 
 A synchronized update (the terminal's begin-update, the frame and end-update: three writes when
 the student's terminal supports them) leaves the app as one packet, so the server reads and
@@ -32,12 +31,13 @@ import os
 import sys
 from codecs import getincrementaldecoder
 from functools import lru_cache
-from typing import Protocol, runtime_checkable
+from typing import Any, Protocol, runtime_checkable
 
 from textual import events, log, messages
 from textual._ansi_sequences import SYNC_END, SYNC_START
 from textual._time import get_time
 from textual._xterm_parser import XTermParser
+from textual.app import App
 from textual.drivers.web_driver import WebDriver, _ExitInput
 
 from .packets import DATA, PacketReader
@@ -78,7 +78,7 @@ def parser_wait(parser: XTermParser) -> float | None:
 @runtime_checkable
 class TakesTypedKeys(Protocol):
     """An app that may run a typed key's action at once, without a key event
-    (``workbench/tui/quick_keys.py``)."""
+    (``workbench/tui/serving/quick_keys.py``)."""
 
     def take_typed_key(self, key: str) -> bool:
         """Run what ``key`` does now and say so, or say no: it then comes as a key event."""
@@ -91,9 +91,13 @@ class LoopInput:
     Stands in for the web driver's input thread (``start``) and its reader (``close``).
     """
 
-    def __init__(self, driver: SessionDriver, fileno: int | None = None) -> None:
+    def __init__(self, driver: ServedTerminalDriver, fileno: int | None = None) -> None:
         self._driver = driver
-        self.fileno = sys.__stdin__.fileno() if fileno is None else fileno
+        if fileno is None:
+            if sys.__stdin__ is None:
+                raise RuntimeError("a served app reads the server's packets on its standard input")
+            fileno = sys.__stdin__.fileno()
+        self.fileno = fileno
         self._parser = XTermParser(debug=driver._debug)
         self._decode = getincrementaldecoder("utf-8")().decode
         self._packets = PacketReader(marked=False)
@@ -202,7 +206,7 @@ class LoopInput:
             self._escape = self._loop.call_later(wait, self._tick)
 
 
-class SessionDriver(WebDriver):
+class ServedTerminalDriver(WebDriver):
     """Textual's web driver reading its input on the app's event loop (see the module)."""
 
     def __init__(self, *args: object, **kwargs: object) -> None:
@@ -235,3 +239,8 @@ class SessionDriver(WebDriver):
             self._frame = None
             data = "".join(frame)
         super().write(data)
+
+
+def serves(app: App[Any]) -> bool:
+    """Whether ``app`` runs in a served session (with :class:`ServedTerminalDriver`)."""
+    return isinstance(app._driver, ServedTerminalDriver)

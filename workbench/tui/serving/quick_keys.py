@@ -20,7 +20,7 @@ station and draw):
     screen and the app) has nothing queued: a key taken at once never overtakes one typed
     before it that is still on its way.
 
-The served app's driver (``workbench/tui/driver.py``) offers each typed key to the app first
+The served app's terminal driver (``terminal_driver.py``) offers each typed key to the app first
 (``WorkbenchApp.take_typed_key``), which runs the action with what Textual does for any key
 press at the app (the app focused, a tooltip cleared) and what the workbench does (the clock
 woken and nudged).
@@ -30,11 +30,14 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from functools import partial
-from typing import ClassVar
+from typing import Any, ClassVar
 
 from textual.actions import parse
+from textual.app import App
 from textual.binding import BindingsMap
 from textual.dom import DOMNode
+from textual.screen import Screen
+from textual.widgets import Tooltip
 
 from .binding_chain import CachedBindingChain
 
@@ -80,3 +83,14 @@ class QuickKeys(CachedBindingChain):
                     quick = node is self and not namespace and name in self.QUICK_ACTIONS
                     table[key] = (name, params) if quick else None
         return table
+
+
+def as_key_press(app: App[Any], screen: Screen[Any]) -> None:
+    """What Textual does at the app for any key press, done for a key taken at once: the app
+    focused, and a tooltip shown on ``screen`` cleared."""
+    if not app.app_focus:
+        app.app_focus = True
+    if app.focused is not None and any(
+        isinstance(child, Tooltip) and child.display for child in screen.children
+    ):  # (looked for here: Textual's own lookup words an error when there is none)
+        screen._clear_tooltip()

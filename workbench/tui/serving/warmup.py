@@ -1,8 +1,9 @@
 """Work every served app does the same way at start, done once in the fork server.
 
 Each SSH session's app is forked from the lab server's fork server (``workbench/ssh/
-forkserver.py``), which calls :func:`prepare` before it forks. :func:`prepare` runs the app
-once, headless, to the screen a student sees first (the names dialog) and past it to the main
+forkserver.py``), which calls the app's ``warm_up`` (``workbench/tui/app.py``) before it forks.
+That hands :func:`prepare` the app a served student gets, and :func:`prepare` runs it once,
+headless, to the screen a student sees first (the names dialog) and past it to the main
 screen, and keeps what Textual parsed of the stylesheets on the way: every app parses the same
 CSS (the app's file and the widgets' defaults) into the same rules, about a fifth of its CPU to
 the first screen. The run also fills the caches of the libraries beneath (Rich's cell widths,
@@ -16,9 +17,13 @@ from __future__ import annotations
 
 import asyncio
 import tempfile
-from pathlib import Path
+from collections.abc import Callable
+from typing import Any
 
+from textual.app import App
 from textual.css.stylesheet import Stylesheet
+
+from .terminal_driver import plain_keys
 
 #: the rules parsed ahead: Textual's parse cache key -> rule sets, and the variables used
 _parsed: dict[tuple, list] = {}
@@ -27,13 +32,10 @@ _variables: dict[str, str] = {}
 PARSE_CACHE = 256
 
 
-def prepare() -> None:
-    """Run the app headless to its first screen and keep the parsed stylesheets (and the
-    session driver's table of typed keys)."""
-    from .app import make_app
-    from .driver import plain_keys
-    from .settings import AppSettings
-
+def prepare(make_app: Callable[[str], App[Any]]) -> None:
+    """Run the app ``make_app(folder)`` makes (``folder``: an empty temporary folder for its
+    data and files) headless to its first screen and keep the parsed stylesheets (and the
+    served terminal driver's table of typed keys)."""
     plain_keys()
 
     async def first_screen() -> None:
@@ -45,16 +47,7 @@ def prepare() -> None:
             keep(app.stylesheet)  # (Textual starts its parse cache afresh on the way)
 
     with tempfile.TemporaryDirectory(prefix="workbench-warmup-") as folder:
-        app = make_app(
-            AppSettings(
-                student="warmup",
-                ask_names=True,
-                student_fixed=True,
-                data_dir=Path(folder),
-                workspace=Path(folder),
-                connect_hint="VIPLE: warming up",
-            )
-        )
+        app = make_app(folder)
         # more sources than Textual's parse cache holds by default (64): none may drop out
         app.stylesheet._parse_cache.maxsize = PARSE_CACHE
         _parsed.clear()

@@ -1,8 +1,9 @@
 """Textual's web-driver packets, the protocol between the server and an app process.
 
-The app (run with Textual's web driver, ``workbench.tui.driver.SessionDriver``) writes the line
-``__GANGLION__`` on its standard output, then packets: one type byte (``D`` terminal output,
-``M`` JSON meta data, ``P`` binary-encoded data), a 4-byte big-endian length and the payload.
+The app (run with Textual's web driver, :class:`.terminal_driver.ServedTerminalDriver`) writes
+the line ``__GANGLION__`` on its standard output, then packets: one type byte (``D`` terminal
+output, ``M`` JSON meta data, ``P`` binary-encoded data), a 4-byte big-endian length and the
+payload.
 The server writes packets of the same form to the app's standard input: ``D`` with the raw
 bytes the user typed, ``M`` with ``{"type": "resize", ...}`` or ``{"type": "quit"}``.
 """

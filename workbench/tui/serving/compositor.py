@@ -27,10 +27,12 @@ checks, frame by frame, that its partial updates leave the screen exactly as a f
 from __future__ import annotations
 
 from collections.abc import Iterable
+from typing import Any
 
 from rich.console import Console, ConsoleOptions, RenderResult
 from textual._compositor import ChopsUpdate, Compositor, CompositorUpdate
 from textual.geometry import Region
+from textual.screen import Screen
 from textual.strip import Strip
 from textual.widget import Widget
 
@@ -52,7 +54,8 @@ class GroupedUpdate(CompositorUpdate):
 class LiveCompositor(Compositor):
     """Textual's compositor with cheaper partial updates (see the module's description)."""
 
-    def render_partial_update(self) -> ChopsUpdate | GroupedUpdate | None:
+    # (a GroupedUpdate is a CompositorUpdate, all Textual needs of it; its annotation is narrower)
+    def render_partial_update(self) -> ChopsUpdate | GroupedUpdate | None:  # type: ignore[override]
         screen = self.size.region
         regions = [r for r in (d.intersection(screen) for d in self._dirty_regions) if r]
         self._dirty_regions.clear()
@@ -109,3 +112,8 @@ class LiveCompositor(Compositor):
                 and crop_bottom <= y + height
             ):
                 return  # the crop is all this widget's: nothing behind it shows there
+
+
+def use_live_compositor(screen: Screen[Any]) -> None:
+    """Have ``screen`` (not yet shown) drawn by a :class:`LiveCompositor`."""
+    screen._compositor = LiveCompositor()

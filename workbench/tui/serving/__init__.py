@@ -1,0 +1,22 @@
+"""What makes a served app cheap, and every use of Textual's private parts.
+
+A lab server runs one app process per student, and a student driving sends some twenty keys a
+second; the modules here cut what each key, tick and frame costs the server (measured with
+``bench/tui_cpu.py``, see ``docs/ssh.md``):
+
+  * ``terminal_driver``: Textual's web driver reading the session's input on the event loop;
+    ``packets``: the web driver's packet protocol, shared with the SSH server;
+  * ``quick_keys`` and ``binding_chain``: a driving key runs its action without a key event,
+    and a screen's binding chain is built only when it changed;
+  * ``prompt_frames`` and ``compositor``: a change is drawn in the wake that made it, rendering
+    only the widgets it shows;
+  * ``loop_clock``: the simulation's tick as one timer handle, ticking early when a key wakes
+    the app anyway;
+  * ``warmup``: the stylesheets parsed once in the fork server for every app forked after it.
+
+These reach into Textual beyond its public interface, and so does ``internals``, the few
+private parts the rest of the TUI needs (each behind a name that says what it gives). Nothing
+outside this package touches Textual's private modules or attributes, and
+``tests/unit/test_textual_internals.py`` checks that each part relied on here is still there,
+with the shape relied on, in the Textual installed.
+"""

@@ -1,0 +1,74 @@
+"""The private parts of Textual the rest of the TUI needs, each behind a name saying what it
+gives, so that they are all in this package (see its description) and checked in one place
+(``tests/unit/test_textual_internals.py``)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from textual import events
+from textual._context import active_app
+from textual.app import App
+from textual.binding import BindingsMap
+from textual.content import Content
+from textual.dom import DOMNode
+from textual.geometry import Size
+from textual.widgets import Checkbox, Input
+from textual.widgets._footer import FooterKey
+
+__all__ = [
+    "DrawnCheckbox",
+    "FooterKey",
+    "KeyFirstInput",
+    "bindings_of",
+    "current_app",
+    "end_with_error",
+    "handled_size",
+]
+
+
+def current_app() -> App[Any] | None:
+    """The app whose code runs now (None outside any app)."""
+    try:
+        return active_app.get()
+    except LookupError:
+        return None
+
+
+def bindings_of(node: DOMNode) -> BindingsMap:
+    """The node's own key bindings, as Textual merged them from its class and its bases."""
+    return node._bindings
+
+
+def end_with_error(app: App[Any], error: Exception) -> None:
+    """End the app with ``error`` shown, as Textual does for an error in the app's own code."""
+    app._handle_exception(error)
+
+
+def handled_size(app: App[Any]) -> Size | None:
+    """The terminal size the app has handled a resize to (None before the first)."""
+    return app._size
+
+
+class KeyFirstInput(Input):
+    """Textual's ``Input``, which asks :meth:`take_key` first about each key that reaches it."""
+
+    async def take_key(self, event: events.Key) -> bool:
+        """Handle ``event`` here and say so, or say no: the input then handles it as usual."""
+        return False
+
+    async def _on_key(self, event: events.Key) -> None:
+        if not await self.take_key(event):
+            await super()._on_key(event)
+
+
+class DrawnCheckbox(Checkbox):
+    """Textual's ``Checkbox`` with its box drawn by :meth:`box`."""
+
+    def box(self) -> Content:
+        """The box as drawn before the label (Textual's own, unless a subclass says)."""
+        return super()._button
+
+    @property
+    def _button(self) -> Content:
+        return self.box()
