@@ -459,6 +459,12 @@ class LabStation:
         self.overrides = {}
         return definition
 
+    def clear_algorithm(self) -> None:
+        """No algorithm chosen (the keys drive), and no parameters of one kept."""
+        self.stop_algorithm("stopped")
+        self.algorithm = None
+        self.overrides = {}
+
     def set_params(self, items: Sequence[str]) -> dict[str, float]:
         """``NAME=VALUE`` edits, all checked before any is kept; returns the values in force."""
         if self.algorithm is None:
