@@ -17,7 +17,7 @@ from textual.app import ComposeResult
 from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical
 from textual.screen import Screen
-from textual.widgets import Footer, OptionList, Static
+from textual.widgets import OptionList, Static
 from textual.widgets.option_list import Option
 
 from workbench.control.station import LabStation
@@ -30,6 +30,7 @@ from ..dialogs.size import SizeDialog
 from ..dialogs.unsaved import Choice, UnsavedDialog
 from ..host import FollowsUnicode, Say, ToggleUnicode
 from ..keys import bindings
+from ..widgets.key_bar import KeyBar
 from ..widgets.maze_view import MazeView
 
 SAVE_HELP = (
@@ -175,7 +176,7 @@ class EditorScreen(FollowsUnicode, Screen[Maze | None]):
                 yield OptionList(id="editor-problems", markup=False)
                 yield Static(id="editor-status", markup=False)
                 yield Static(KEYS, id="editor-keys", markup=False)
-        yield Footer()
+        yield KeyBar()
 
     def on_mount(self) -> None:
         self._refresh()
