@@ -28,7 +28,7 @@ from ..dialogs.generate import GenerateDialog
 from ..dialogs.path import PathDialog
 from ..dialogs.size import SizeDialog
 from ..dialogs.unsaved import Choice, UnsavedDialog
-from ..host import FollowsUnicode, Say, ToggleUnicode
+from ..host import FollowsUnicode, MazeChanged, Say, ToggleUnicode
 from ..keys import bindings
 from ..widgets.key_bar import KeyBar
 from ..widgets.maze_view import MazeView
@@ -438,9 +438,16 @@ class EditorScreen(FollowsUnicode, Screen[Maze | None]):
             self._leave(discard=False)
 
     def _leave(self, discard: bool) -> None:
-        maze, note = self.editor.handover(discard)
+        editor = self.editor
+        kept = editor.saved if discard else editor.maze
+        maze, note = editor.handover(discard)
         if maze is not None:
             self.station.load_maze(maze)
+        on_robot = maze is not None or kept == editor.opened
+        if editor.path is not None and kept == editor.saved and on_robot:
+            # the maze the robot is on is this file: the editor opens it there next time
+            self.post_message(MazeChanged(editor.path))
+        if maze is not None:
             self.post_message(Say(f"the robot is on the edited maze {maze.name}"))
         elif note:
             self.post_message(Say(note))
