@@ -114,6 +114,9 @@ class ProgramChoice:
     needs: Callable[[Sequence[SensorSpec]], str | None]
     #: a few lines on what the program is and what it answers (keys, sensors)
     summary: tuple[str, ...] = ()
+    #: the robot's sensors changed to the ones the program reads (its ports and kinds), and
+    #: what cannot be fitted (None when all can)
+    fit: Callable[[Sequence[SensorSpec]], tuple[list[SensorSpec], str | None]] | None = None
 
 
 @dataclass
