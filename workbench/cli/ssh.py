@@ -5,14 +5,22 @@ from __future__ import annotations
 import argparse
 import asyncio
 import getpass
+import logging
 import math
 import os
 import signal
 import sys
 from pathlib import Path
 
-from workbench.labs.database import ENV_DB
-from workbench.labs.store import Store, StoreError, StoreUnavailable, resolve_data_dir, resolve_db
+from workbench.labs.database import ENV_DB, redact
+from workbench.labs.store import (
+    DB_NAME,
+    Store,
+    StoreError,
+    StoreUnavailable,
+    resolve_data_dir,
+    resolve_db,
+)
 from workbench.ssh.appproc import AppEntry
 
 from .common import db_option, record_quota_options
@@ -294,10 +302,19 @@ def cmd_serve(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
     print(f"workbench serve-ssh: logging to {log_path}", file=sys.stderr)
+    logging.getLogger("workbench.ssh").info("course store: %s", store_words(data_dir, db))
     try:
         return asyncio.run(_serve(server))
     except OSError as exc:
         return fail("serve-ssh", f"cannot listen on port {args.port}: {exc.strerror or exc}")
+
+
+def store_words(data_dir: Path, db: str | None) -> str:
+    """Which store the sessions keep students' work in: the course database's URL without its
+    password, or the SQLite file in the data folder."""
+    if db:
+        return f"the course database {redact(db)}"
+    return f"SQLite in the data folder, {data_dir / DB_NAME}"
 
 
 def record_quota_argv(args: argparse.Namespace) -> tuple[str, ...]:
