@@ -270,3 +270,33 @@ def test_all_keys_end_when_the_program_stops(tmp_path):
         assert "keys_back" not in active_actions(app) and "pause" in active_actions(app)
 
     run(app, body)
+
+
+def test_after_loading_a_program_f_fits_the_sensors_its_diagram_reads(tmp_path):
+    from workbench.sim.sensors import SensorSpec
+
+    app = make_app(maze_file(tmp_path), paused=True, noise="off")
+    path = drive_by_wire(tmp_path)
+
+    async def body(pilot: Pilot) -> None:
+        station = app.station
+        station.apply_sensors([SensorSpec("touch", 1, "right")])  # port 1 is not a distance
+        await pilot.press("g")
+        await pilot.pause()
+        field = app.screen.query_one("#alg-path", Input)
+        field.focus()
+        field.value = path
+        await pilot.press("enter")  # loads the program; the path is done with
+        await pilot.pause()
+        assert not field.has_focus
+        await pilot.press("f")
+        await pilot.pause()
+        assert field.value == path  # f acted on the dialog, not on the path
+        assert [str(s) for s in station.sensors] == ["distance:1:right"]
+        assert station.program.needs(station.sensors) is None
+        await pilot.press("f")  # nothing more to fit: it says so
+        await pilot.pause()
+        said = str(app.screen.query_one("#alg-error", Static).render())
+        assert said == "the robot has the sensors wire.viple reads already"
+
+    run(app, body)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from textual import events
 from textual.app import App, ComposeResult
 
@@ -29,7 +31,7 @@ SMALL = Maze(
 )
 SMALL_ASCII = [
     "##################",
-    "##>             ##",
+    "##S>            ##",
     "##  ####  ####  ##",
     "##              ##",
     "##############E ##",
@@ -217,7 +219,7 @@ async def test_unicode_mode_draws_outlines():
         await pilot.pause()
         assert maze_lines(view) == [
             "┌───────────────┐ ",
-            "│ ▶             │ ",
+            "│ S▸            │ ",
             "│   ╶─╴   ╶─╴   │ ",
             "│               │ ",
             "└───────────╴ E ╵ ",
@@ -384,12 +386,12 @@ async def test_set_maze_repaints_only_the_edited_rows():
         edited = SMALL.with_start(5, 1, "down").with_exit(7, 4, present=False)
         view.set_maze(edited)
         await pilot.pause()
-        assert maze_lines(view)[1] == "##        v     ##"
+        assert maze_lines(view)[1] == "##        Sv    ##"
         assert maze_lines(view)[4] == "##############  ##"
         bigger = Maze(rows=("#####", "#...#", "#####"), start=(1, 1))
         view.set_maze(bigger)
         await pilot.pause()
-        assert maze_lines(view) == ["##########", "##>     ##", "##########"]
+        assert maze_lines(view) == ["##########", "##S>    ##", "##########"]
         assert view.virtual_size.width == 10
 
 
@@ -483,3 +485,19 @@ async def test_tiny_view_does_not_break():
             await pilot.pause()
         view.set_cursor((3, 3))
         await pilot.pause()
+
+
+@sync
+async def test_the_start_is_marked_apart_from_the_robot_and_the_trail_goes_when_it_starts_over():
+    app = Host(SMALL)
+    async with app.run_test(size=(40, 10)) as pilot:
+        view = app.query_one(MazeView)
+        view.show(snap(1, 1), 1.0)  # on the start block: only the robot is drawn there
+        for x in (2, 3, 4):
+            view.show(replace(snap(x, 1), time=x), 1.0)
+        await pilot.pause()
+        assert maze_lines(view)[1] == "##S>. . >       ##"  # the start is S>, the robot >
+        view.show(snap(1, 1), 1.0)  # time back at 0: a reset or a new maze
+        view.show(replace(snap(2, 1), time=1.0), 1.0)
+        await pilot.pause()
+        assert maze_lines(view)[1] == "##S>>           ##"  # no dots left from before

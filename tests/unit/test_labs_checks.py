@@ -377,3 +377,30 @@ def test_a_viple_exercise_passes_with_the_students_program_run_here():
     digest = hashlib.sha256(Path("programs/right-wall.viple").read_bytes()).hexdigest()
     assert evidence["program_sha256"] == digest
     assert check(for_fsm, ex, b)[0] is False  # a VIPLE program is not an FSM file
+
+
+def test_set_up_starts_afresh_speed_algorithm_and_parameters():
+    b = LabStation.open(EROBOTIC.maze, "erobotic", noise="off")
+    b.select_algorithm("one-distance-first")
+    b.set_params(["right_blocked=50"])
+    b.pacer.set_speed(None)  # "max"
+    changes = apply_setup(b, exercise(profile="web").setup)  # a keys exercise
+    assert b.pacer.speed == 1.0 and b.algorithm is None and b.overrides == {}
+    assert changes.speed == (None, 1.0)
+    assert changes.algorithm == ("one-distance-first", None)
+
+    setup = exercise(profile="web", controller="algorithm one-distance-first").setup
+    apply_setup(b, setup)
+    b.set_params(["right_blocked=50"])
+    changes = apply_setup(b, setup)
+    web = LabStation.open(EROBOTIC.maze, "web", noise="off")
+    web.select_algorithm("one-distance-first")
+    assert b.params() == web.params()  # the web profile's own values, not the edited ones
+    assert changes.params_reset and changes.algorithm is None and changes.speed is None
+
+
+def test_set_up_with_nothing_to_change_reports_nothing():
+    ex = exercise(controller="algorithm right-wall")
+    b = station_for(ex)
+    changes = apply_setup(b, ex.setup)
+    assert changes == type(changes)()

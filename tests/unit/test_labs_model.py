@@ -220,3 +220,18 @@ def test_hash_answer_refuses_a_missing_step_or_a_huge_band():
 
 def test_the_same_answer_hashes_differently_under_another_salt():
     assert hash_answer("a", salt="1")["sha256"] != hash_answer("a", salt="2")["sha256"]
+
+
+def test_a_set_up_speed_is_read_and_a_wrong_one_is_named(tmp_path):
+    lab = Path("labs/unity-simulator.yaml").read_text()
+    shutil.copytree("labs/starters", tmp_path / "labs" / "starters")
+    shutil.copytree("mazes", tmp_path / "mazes")
+    fast = lab.replace("      controller: keys\n", "      controller: keys\n      speed: max\n", 1)
+    path = tmp_path / "labs" / "unity-simulator.yaml"
+    path.write_text(fast)
+    assert load_lab(path).exercises[0].setup.speed is None
+    assert load_lab("labs/unity-simulator.yaml").exercises[0].setup.speed == 1.0
+    path.write_text(fast.replace("speed: max", "speed: 3"))
+    with pytest.raises(LabFileError) as err:
+        load_lab(path)
+    assert "setup: unknown speed '3' (hint: use one of 1, 2, 4, 10, max)" in str(err.value)

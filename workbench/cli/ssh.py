@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import asyncio
 import getpass
+import logging
 import math
 import os
 import signal
@@ -12,8 +13,15 @@ import sys
 from pathlib import Path
 
 from workbench.control.recording import RecordQuota
-from workbench.labs.database import ENV_DB
-from workbench.labs.store import Store, StoreError, StoreUnavailable, resolve_data_dir, resolve_db
+from workbench.labs.database import ENV_DB, redact
+from workbench.labs.store import (
+    DB_NAME,
+    Store,
+    StoreError,
+    StoreUnavailable,
+    resolve_data_dir,
+    resolve_db,
+)
 from workbench.ssh.appproc import AppEntry
 
 from .common import db_option, record_quota_options
@@ -353,6 +361,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
     print(f"workbench serve-ssh: logging to {log_path}", file=sys.stderr)
+    logging.getLogger("workbench.ssh").info("course store: %s", store_words(data_dir, db))
     try:
         return asyncio.run(_serve(server))
     except OSError as exc:
@@ -368,6 +377,14 @@ def parse_terminal(text: str) -> tuple[int, int]:
     if size[0] < 80 or size[1] < 24:
         raise ValueError("the app needs at least 80x24")
     return size
+
+
+def store_words(data_dir: Path, db: str | None) -> str:
+    """Which store the sessions keep students' work in: the course database's URL without its
+    password, or the SQLite file in the data folder."""
+    if db:
+        return f"the course database {redact(db)}"
+    return f"SQLite in the data folder, {data_dir / DB_NAME}"
 
 
 def _prepare_course_store(data_dir: Path, db: str) -> str:

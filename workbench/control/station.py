@@ -107,6 +107,9 @@ class ProgramChoice:
     needs: Callable[[Sequence[SensorSpec]], str | None]
     #: a few lines on what the program is and what it answers (keys, sensors)
     summary: tuple[str, ...] = ()
+    #: the robot's sensors changed to the ones the program reads (its ports and kinds), and
+    #: what cannot be fitted (None when all can)
+    fit: Callable[[Sequence[SensorSpec]], tuple[list[SensorSpec], str | None]] | None = None
 
 
 @dataclass
@@ -448,6 +451,12 @@ class LabStation:
         self.program = None
         self.overrides = {}
         return definition
+
+    def clear_algorithm(self) -> None:
+        """No algorithm chosen (the keys drive), and no parameters of one kept."""
+        self.stop_algorithm("stopped")
+        self.algorithm = None
+        self.overrides = {}
 
     def set_params(self, items: Sequence[str]) -> dict[str, float]:
         """``NAME=VALUE`` edits, all checked before any is kept; returns the values in force."""

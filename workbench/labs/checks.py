@@ -133,9 +133,29 @@ def keep_passed(saved: ExerciseProgress | None, live: ExerciseProgress) -> Exerc
 
 
 # -- set-up --------------------------------------------------------------------------------
-def apply_setup(station: LabStation, setup: Setup) -> None:
-    """The exercise's one-key set-up: profile, maze, sensors and the controller to use, with
-    the maze and starter as they were when the lab was loaded."""
+@dataclass(frozen=True)
+class SetupChanges:
+    """What a set-up changed on the station besides its profile, maze and sensors: each a
+    ``(before, after)`` pair, or None when it stayed as it was."""
+
+    speed: tuple[float | None, float | None] | None = None
+    #: the algorithm's name (None: no algorithm; the keys drive)
+    algorithm: tuple[str | None, str | None] | None = None
+    #: parameters the student had changed, back at the algorithm's values for the profile
+    params_reset: bool = False
+    #: the VIPLE program file that was chosen to drive (no longer chosen)
+    program_dropped: str | None = None
+
+
+def apply_setup(station: LabStation, setup: Setup) -> SetupChanges:
+    """The exercise's one-key set-up: profile, maze, sensors, speed and the controller to use
+    (the maze and starter as they were when the lab was loaded), and nothing kept from before:
+    an exercise without an algorithm has none, and the parameters are the algorithm's own
+    values for the profile. Returns what changed beyond the profile, maze and sensors."""
+    speed_before = station.pacer.speed
+    algorithm_before = station.algorithm.name if station.algorithm is not None else None
+    params_before = bool(station.overrides)
+    program_before = station.program.name if station.program is not None else None
     station.profile = setup.profile
     station.load_maze(setup.maze.maze)
     station.apply_sensors(setup.sensors or get_profile(setup.profile).sensors)
@@ -144,7 +164,20 @@ def apply_setup(station: LabStation, setup: Setup) -> None:
         station.use_algorithm(controller.starter)
     elif controller.kind == "algorithm":
         station.select_algorithm(controller.value)
+    else:
+        station.clear_algorithm()
+    station.program = None
+    station.pacer.set_speed(setup.speed)
+    station.pause(False)
     station.start_exercise()
+    algorithm_after = station.algorithm.name if station.algorithm is not None else None
+    same_algorithm = algorithm_before == algorithm_after
+    return SetupChanges(
+        speed=None if speed_before == setup.speed else (speed_before, setup.speed),
+        algorithm=None if same_algorithm else (algorithm_before, algorithm_after),
+        params_reset=params_before and algorithm_after is not None and same_algorithm,
+        program_dropped=program_before,
+    )
 
 
 # -- evidence ------------------------------------------------------------------------------

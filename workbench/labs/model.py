@@ -31,6 +31,8 @@ from workbench.sim.sensors import SensorConfigError, SensorSpec, check_ports
 LABS_DIR = Path(__file__).resolve().parents[2] / "labs"
 OBJECTIVE_KINDS = ("keys", "sensors", "viple", "exit", "maze-edited", "compare", "questions")
 CONTROLLER_KINDS = ("keys", "algorithm", "starter", "viple")
+#: the speeds a set-up may ask for (the app's speed key steps through the same)
+SETUP_SPEEDS: dict[str, float | None] = {"1": 1.0, "2": 2.0, "4": 4.0, "10": 10.0, "max": None}
 #: what an ``exit`` objective may require of the driver
 DRIVER_KINDS = ("viple", "program", "fsm", "algorithm", "any")
 VIPLE_ROLES = ("tcp", "ws")
@@ -174,6 +176,8 @@ class Setup:
     maze: LabMaze
     sensors: tuple[SensorSpec, ...]
     controller: Controller
+    #: the simulation speed the exercise runs at (None: as fast as it goes)
+    speed: float | None = 1.0
 
 
 @dataclass(frozen=True)
@@ -359,12 +363,15 @@ def _exercise(r: _Reader, node: yaml.Node) -> Exercise:
 
 
 def _setup(r: _Reader, node: yaml.Node, where: str) -> Setup:
-    keys = r.mapping(node, f"{where}: setup", ("profile", "maze", "controller"), ("sensors",))
-    profile = r.choice(keys["profile"], f"{where}: setup", tuple(PROFILES), "profile")
-    sensors = r.sensors(keys["sensors"], f"{where}: setup") if "sensors" in keys else ()
-    return Setup(
-        profile, r.maze(keys["maze"], f"{where}: setup"), sensors, _controller(r, keys, where)
-    )
+    here = f"{where}: setup"
+    keys = r.mapping(node, here, ("profile", "maze", "controller"), ("sensors", "speed"))
+    profile = r.choice(keys["profile"], here, tuple(PROFILES), "profile")
+    sensors = r.sensors(keys["sensors"], here) if "sensors" in keys else ()
+    speed: float | None = 1.0
+    if "speed" in keys:
+        speed = SETUP_SPEEDS[r.choice(keys["speed"], here, SETUP_SPEEDS, "speed")]
+    maze = r.maze(keys["maze"], here)
+    return Setup(profile, maze, sensors, _controller(r, keys, where), speed)
 
 
 def _controller(r: _Reader, keys: dict[str, yaml.Node], where: str) -> Controller:

@@ -13,11 +13,11 @@ from collections.abc import Sequence
 from dataclasses import replace
 
 from workbench.control.station import LabStation, ProgramChoice
-from workbench.sim.sensors import SensorSpec
+from workbench.sim.sensors import MOUNTS, SensorSpec
 
 from . import kinds as K
 from .compiled import Compiled
-from .pilot import check_sensors, load_compiled, program_driving
+from .pilot import SENSOR_NEEDS, check_sensors, load_compiled, program_driving
 from .problems import ProgramError
 
 #: the file endings the app takes for a VIPLE program (VIPLE 4.x, and 3.x XML)
@@ -70,7 +70,36 @@ def program_choice(compiled: Compiled, shown: str) -> ProgramChoice:
         make=lambda: program_driving(compiled, shown),
         needs=needs,
         summary=tuple(describe_choice(compiled)),
+        fit=lambda sensors: fit_sensors(compiled, sensors),
     )
+
+
+def fit_sensors(
+    compiled: Compiled, sensors: Sequence[SensorSpec]
+) -> tuple[list[SensorSpec], str | None]:
+    """``sensors`` with a sensor of the kind the program reads at each port it reads (a
+    sensor already there keeps its mount; a new one takes a free mount), and what cannot be
+    fitted: a diagram reading more ports than a robot has mounts."""
+    by_port = {s.port: s for s in sensors}
+    cannot = []
+    for kind, port in sorted(set(compiled.sensors.values()), key=lambda kp: kp[1]):
+        if kind == K.RAW_SENSOR:
+            continue  # it reads whatever the robot has
+        have = by_port.get(port)
+        wanted = SENSOR_NEEDS[kind]
+        if have is not None and have.kind in wanted:
+            continue
+        used = {s.mount for p, s in by_port.items() if p != port}
+        free = [m for m in MOUNTS if m not in used]
+        mount = have.mount if have is not None and have.mount in free else (free or [None])[0]
+        if mount is None:
+            cannot.append(f"port {port} ({wanted[0]}): every mount has a sensor already")
+            continue
+        by_port[port] = SensorSpec(wanted[0], port, mount)
+    if any(kind == K.RAW_SENSOR for kind, _ in compiled.sensors.values()) and not by_port:
+        cannot.append("it reads the robot's raw report: give the robot a sensor with o")
+    fitted = [by_port[p] for p in sorted(by_port)]
+    return fitted, "; ".join(cannot) or None
 
 
 def describe_choice(compiled: Compiled) -> list[str]:

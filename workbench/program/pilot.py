@@ -26,7 +26,11 @@ from .loader import load_program
 from .problems import Problem, ProgramError
 
 #: which simulated sensor kinds answer each VIPLE sensor activity
-_NEEDS = {K.DISTANCE: ("distance",), K.TOUCH: ("touch",), K.OTHER_SENSOR: ("distance", "touch")}
+SENSOR_NEEDS = {
+    K.DISTANCE: ("distance",),
+    K.TOUCH: ("touch",),
+    K.OTHER_SENSOR: ("distance", "touch"),
+}
 
 
 def load_compiled(path: str, kinds: str | None = None) -> Compiled:
@@ -59,7 +63,7 @@ def check_sensors(compiled: Compiled, sensors: list[SensorSpec]) -> list[Problem
                 )
             continue
         spec = by_port.get(port)
-        wanted = _NEEDS[kind]
+        wanted = SENSOR_NEEDS[kind]
         if spec is None or spec.kind not in wanted:
             have = f"the robot has {spec} there" if spec else "the robot has no sensor there"
             problems.append(

@@ -81,6 +81,13 @@ class Pacer:
         """Whether getting out ends the run: the maze has exits."""
         return bool(self.session.maze.exits)
 
+    def set_speed(self, speed: float | None) -> None:
+        """Run at ``speed`` (one of :data:`SPEEDS`) from now on."""
+        if speed not in SPEEDS:
+            raise ValueError(f"speed {speed} is not one of {SPEEDS}")
+        self.speed = speed
+        self._debt = 0.0
+
     def next_speed(self) -> float | None:
         i = SPEEDS.index(self.speed) if self.speed in SPEEDS else 0
         self.speed = SPEEDS[(i + 1) % len(SPEEDS)]

@@ -39,6 +39,8 @@ class Key:
     priority: bool = False
     #: how the key is written on screen, when not Textual's own way
     display: str | None = None
+    #: the footer's priority where not every key fits: lower ranks stay longest
+    rank: int = 2
 
 
 KEY_TABLE: dict[str, Key] = {
@@ -50,6 +52,7 @@ KEY_TABLE: dict[str, Key] = {
         "quit",
         "Quit the workbench (ctrl+c does not quit).",
         priority=True,
+        rank=1,
     ),
     "app.help": Key(
         "question_mark",
@@ -59,6 +62,7 @@ KEY_TABLE: dict[str, Key] = {
         "help",
         "This help: every key and what it does.",
         display="?",
+        rank=0,
     ),
     "app.commands": Key(
         "ctrl+p",
@@ -137,6 +141,7 @@ KEY_TABLE: dict[str, Key] = {
         "single step",
         "Pause, then advance one control tick (1/20 s of simulated time).",
         priority=True,
+        rank=4,
     ),
     "sim.speed": Key(
         "plus,equals_sign",
@@ -146,6 +151,7 @@ KEY_TABLE: dict[str, Key] = {
         "speed",
         "Cycle the speed: 1x, 2x, 4x, 10x, max (as fast as the machine allows).",
         display="+",
+        rank=3,
     ),
     "sim.reset": Key(
         "r",
@@ -163,6 +169,7 @@ KEY_TABLE: dict[str, Key] = {
         "Set-up",
         "sensor ports",
         "Open the sensor port panel: kinds, port numbers, mounts, presets, live readings.",
+        rank=3,
     ),
     "panel.algorithm": Key(
         "g",
@@ -252,7 +259,7 @@ KEY_TABLE: dict[str, Key] = {
         "Set-up",
         "load a maze",
         "Put a maze file on the bench (the robot starts over on it, same profile).",
-        show=False,
+        rank=1,
     ),
     "screen.editor": Key(
         "e",
@@ -261,7 +268,7 @@ KEY_TABLE: dict[str, Key] = {
         "Screens",
         "maze editor",
         "Edit the maze: walls, start, exits, new, generate, validate, save.",
-        show=False,
+        rank=1,
     ),
     "screen.runs": Key(
         "R",
@@ -270,7 +277,7 @@ KEY_TABLE: dict[str, Key] = {
         "Screens",
         "runs",
         "Compare the last runs side by side; replay a recorded run.",
-        show=False,
+        rank=1,
     ),
     "screen.labs": Key(
         "l",
@@ -279,7 +286,7 @@ KEY_TABLE: dict[str, Key] = {
         "Screens",
         "labs",
         "The lab exercises: instructions, set-up, live objectives, questions, sign-off.",
-        show=False,
+        rank=1,
     ),
     "viple.ws": Key(
         "v",
@@ -408,6 +415,7 @@ KEY_TABLE: dict[str, Key] = {
         "Maze editor",
         "back",
         "Leave the editor; a changed valid maze goes to the robot.",
+        rank=1,
     ),
     "runs.replay": Key(
         "enter", "replay", "Replay", "Runs", "replay", "Replay the selected run from its record."
@@ -423,7 +431,7 @@ KEY_TABLE: dict[str, Key] = {
     "runs.unicode": Key(
         "u", "unicode", "Unicode", "Runs", "unicode", "Plain ASCII or Unicode marks.", show=False
     ),
-    "runs.leave": Key("escape", "leave", "Back", "Runs", "back", "Back to the workbench."),
+    "runs.leave": Key("escape", "leave", "Back", "Runs", "back", "Back to the workbench.", rank=1),
     "replay.step": Key("right", "step(1)", "Step", "Replay", "step", "Forward one control tick."),
     "replay.back": Key("left", "step(-1)", "Back", "Replay", "back", "Back one control tick."),
     "replay.step10": Key(
@@ -457,7 +465,7 @@ KEY_TABLE: dict[str, Key] = {
         "Draw the maze in plain ASCII or with Unicode lines.",
         show=False,
     ),
-    "replay.leave": Key("escape", "leave", "Back", "Replay", "back", "Back to the runs."),
+    "replay.leave": Key("escape", "leave", "Back", "Replay", "back", "Back to the runs.", rank=1),
     "labs.close": Key(
         "escape",
         "close",

@@ -23,10 +23,11 @@ from textual.widgets.option_list import Option
 from workbench.control.algorithms import ALGORITHM_DIR, list_algorithms
 from workbench.control.fsm import FsmError, resolve_params
 from workbench.control.fsmfile import FsmFileError
-from workbench.control.station import LabStation
+from workbench.control.station import LabStation, ProgramChoice
 from workbench.files.workspace import OutsideWorkspace
 from workbench.program.choice import choose_program, is_program_path
 from workbench.program.problems import ProgramError
+from workbench.sim.sensors import SensorConfigError
 from workbench.sim.session import Snapshot
 
 from ..host import Say, ShowsSnapshot, StationChanged
@@ -362,7 +363,9 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
         if not text:
             self._error("type the path of a YAML FSM file or a VIPLE program first")
             return
-        await self.choose(text)
+        if await self.choose(text):
+            # the path is done with: the dialog's keys (f fits the sensors) act on the dialog
+            self.query_one("#alg-start", Button).focus()
 
     @on(ParamEditor.Edited)
     def _param_edited(self, event: ParamEditor.Edited) -> None:
@@ -421,13 +424,39 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
 
     def action_fix_sensors(self) -> None:
         station = self.station
-        if station.algorithm is None or station.missing_sensors() is None:
+        program = station.program
+        if program is not None:
+            self._fit_program(program)
+            return
+        if station.algorithm is None:
+            self._error("choose an algorithm or load a program first: f fits its sensors")
+            return
+        if station.missing_sensors() is None:
+            self._error(f"the robot has the sensors {station.algorithm.name} reads already")
             return
         station.apply_algorithm_preset()
         ports = ", ".join(str(s) for s in station.sensors)
         self._error("")
         self.post_message(Say(f"sensors set for {station.algorithm.name}: {ports}"))
         self._show_missing()
+        self._refresh_all()
+
+    def _fit_program(self, program: ProgramChoice) -> None:
+        """Give the robot the sensors the program's diagram reads, or say what cannot be."""
+        station = self.station
+        if program.needs(station.sensors) is None:
+            self._error(f"the robot has the sensors {program.name} reads already")
+            return
+        assert program.fit is not None
+        fitted, cannot = program.fit(station.sensors)
+        try:
+            station.apply_sensors(fitted)
+        except SensorConfigError as exc:
+            self._error(f"cannot fit the sensors {program.name} reads: {exc}")
+            return
+        ports = ", ".join(str(s) for s in station.sensors)
+        self._error(f"cannot fit all it reads: {cannot}" if cannot else "")
+        self.post_message(Say(f"sensors set for {program.name}: {ports}"))
         self._refresh_all()
 
     async def action_defaults(self) -> None:

@@ -17,7 +17,7 @@ from textual.app import ComposeResult
 from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical
 from textual.screen import Screen
-from textual.widgets import Footer, OptionList, Static
+from textual.widgets import OptionList, Static
 from textual.widgets.option_list import Option
 
 from workbench.control.station import LabStation
@@ -28,8 +28,9 @@ from ..dialogs.generate import GenerateDialog
 from ..dialogs.path import PathDialog
 from ..dialogs.size import SizeDialog
 from ..dialogs.unsaved import Choice, UnsavedDialog
-from ..host import FollowsUnicode, Say, ToggleUnicode
+from ..host import FollowsUnicode, MazeChanged, Say, ToggleUnicode
 from ..keys import EDITOR_KEY_IDS, EDITOR_LEGEND, bindings, legend_text
+from ..widgets.key_bar import KeyBar
 from ..widgets.maze_view import MazeView
 
 SAVE_HELP = (
@@ -147,7 +148,7 @@ class EditorScreen(FollowsUnicode, Screen[Maze | None]):
                 yield OptionList(id="editor-problems", markup=False)
                 yield Static(id="editor-status", markup=False)
                 yield Static(legend_text(EDITOR_LEGEND), id="editor-keys", markup=False)
-        yield Footer()
+        yield KeyBar()
 
     def on_mount(self) -> None:
         self._refresh()
@@ -409,9 +410,16 @@ class EditorScreen(FollowsUnicode, Screen[Maze | None]):
             self._leave(discard=False)
 
     def _leave(self, discard: bool) -> None:
-        maze, note = self.editor.handover(discard)
+        editor = self.editor
+        kept = editor.saved if discard else editor.maze
+        maze, note = editor.handover(discard)
         if maze is not None:
             self.station.load_maze(maze)
+        on_robot = maze is not None or kept == editor.opened
+        if editor.path is not None and kept == editor.saved and on_robot:
+            # the maze the robot is on is this file: the editor opens it there next time
+            self.post_message(MazeChanged(editor.path))
+        if maze is not None:
             self.post_message(Say(f"the robot is on the edited maze {maze.name}"))
         elif note:
             self.post_message(Say(note))

@@ -28,11 +28,12 @@ from workbench.control.station import LabStation
 from workbench.labs.checks import (
     MAX_ANSWER,
     ExerciseProgress,
+    SetupChanges,
     apply_setup,
     evaluate,
     keep_passed,
 )
-from workbench.labs.model import Exercise, Lab, LabFileError, load_labs
+from workbench.labs.model import Exercise, Lab, LabFileError, Setup, load_labs
 from workbench.labs.store import Store, StoreUnavailable
 from workbench.sim.session import Snapshot
 
@@ -62,6 +63,28 @@ PASS, FAIL, OPEN, SIGNED = UNICODE_MARKS
 UNREACHABLE = "the course database cannot be reached"
 #: seconds between tries to write what the course database did not get
 RETRY_SECONDS = 2.0
+
+
+def speed_words(speed: float | None) -> str:
+    return "max" if speed is None else f"{speed:g}x"
+
+
+def setup_words(changes: SetupChanges, setup: Setup) -> list[str]:
+    """What a set-up changed besides the profile, maze and sensors, in the message line's
+    words."""
+    said = []
+    if changes.speed is not None:
+        speed, speed_was = changes.speed[1], changes.speed[0]
+        said.append(f"speed {speed_words(speed)} (was {speed_words(speed_was)})")
+    if changes.algorithm is not None:
+        name, name_was = changes.algorithm[1], changes.algorithm[0]
+        said.append(f"algorithm {name or 'none'} (was {name_was or 'none'})")
+    if changes.params_reset:
+        whose = "the starter's" if setup.controller.starter is not None else "its own"
+        said.append(f"parameters back to {whose} for {setup.profile}")
+    if changes.program_dropped:
+        said.append(f"program {changes.program_dropped} no longer chosen")
+    return said
 
 
 class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
@@ -113,7 +136,8 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         color: $text-muted;
     }
     LabsScreen #labs-message {
-        height: 1;
+        height: auto;
+        max-height: 4;
         padding: 0 1;
         color: $text-warning;
     }
@@ -494,12 +518,13 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             return
         exercise = self.selected[1]
         try:
-            apply_setup(self.station, exercise.setup)
+            changes = apply_setup(self.station, exercise.setup)
         except Exception as exc:
             self.say(f"cannot set up {exercise.title}: {exc}")
             return
         setup = exercise.setup
-        self.say(f"set up: {setup.profile}, {setup.maze.path.name}, {setup.controller}")
+        done = f"set up: {setup.profile}, {setup.maze.path.name}, {setup.controller}"
+        self.say("; ".join([done, *setup_words(changes, setup)]))
         self.post_message(SetUpDone(setup))
         self.show_snapshot(self.station.snapshot())
 

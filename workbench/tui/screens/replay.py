@@ -20,7 +20,7 @@ from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical
 from textual.screen import Screen
 from textual.timer import Timer
-from textual.widgets import Footer, Static
+from textual.widgets import Static
 
 from workbench.files.workspace import LOCAL, FileAccess
 from workbench.sim.maze import Maze
@@ -28,6 +28,7 @@ from workbench.sim.replay import Replay, load_replay, replay_maze
 
 from ..host import FollowsUnicode, ToggleUnicode
 from ..keys import REPLAY_KEY_IDS, REPLAY_LEGEND, bindings, legend_text
+from ..widgets.key_bar import KeyBar
 from ..widgets.maze_view import MazeView
 from ..widgets.text import count
 
@@ -156,7 +157,7 @@ class ReplayScreen(FollowsUnicode, Screen[None]):
                 yield Static(id="replay-tick", markup=False)
                 yield Static(id="replay-log", markup=False)
                 yield Static(legend_text(REPLAY_LEGEND), id="replay-keys", markup=False)
-        yield Footer()
+        yield KeyBar()
 
     def on_mount(self) -> None:
         self._draw()

@@ -14,7 +14,7 @@ from textual import on
 from textual.app import ComposeResult
 from textual.binding import BindingType
 from textual.screen import Screen
-from textual.widgets import DataTable, Footer, Static
+from textual.widgets import DataTable, Static
 
 from workbench.control.station import LabStation, RunEntry
 from workbench.files.workspace import OutsideWorkspace
@@ -25,6 +25,7 @@ from workbench.sim.session import Snapshot
 from ..dialogs.path import PathDialog
 from ..host import FollowsUnicode, ShowsSnapshot, ToggleUnicode
 from ..keys import RUNS_KEY_IDS, bindings
+from ..widgets.key_bar import KeyBar
 from ..widgets.text import count
 from .replay import ReplayScreen
 
@@ -139,7 +140,7 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         yield DataTable(id="runs-table", cursor_type="row", zebra_stripes=True)
         yield Static(id="runs-detail", markup=False)
         yield Static(id="runs-status", markup=False)
-        yield Footer()
+        yield KeyBar()
 
     def on_mount(self) -> None:
         self.refresh_runs()

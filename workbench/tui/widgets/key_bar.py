@@ -1,5 +1,11 @@
-"""The compact key bar at the foot of the main and labs screens: Textual's footer, with each
-key made compact before it is first styled.
+"""The compact key bar at the foot of every screen: Textual's footer, showing the keys that
+fit on one row, with each key made compact before it is first styled.
+
+Where not every key fits, the keys of the lowest rank (``rank`` in ``tui/keys.py``) stay and
+the others give way, in the screen's order: at 80 columns the main screen still shows the
+labs, the editor, the runs, the maze and the help. The bar never draws one key over another,
+and the command palette's key (which Textual docks at the right, over the others) is left to
+the message line and the help.
 
 Textual's footer styles every key as it mounts it and then again, for each key, when the key
 takes the footer's ``compact`` setting and with it the ``-compact`` class: a third of the CPU
@@ -9,20 +15,73 @@ carry the class from the start, so the second styling finds nothing to change.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
+from textual import events
 from textual.app import ComposeResult
 from textual.widgets import Footer
 
+from ..keys import KEYS
 from ..serving.internals import FooterKey
+
+#: the rank of a key that is not in the workbench's table (Textual's own)
+DEFAULT_RANK = 2
+
+
+def key_width(key: FooterKey) -> int:
+    """The columns a compact key takes: its key, a space, its label and the gap after it."""
+    label = len(key.description) + 1 if key.description else 0
+    return len(key.key_display) + label + 1
+
+
+def fitting(widths: Sequence[int], ranks: Sequence[int], width: int) -> list[int]:
+    """The indexes of the keys shown in ``width`` columns, in their order: the lowest ranks
+    first (and within a rank the earlier keys), each while it still fits."""
+    room = width + 1  # the last key needs no gap after it
+    chosen: list[int] = []
+    for i in sorted(range(len(widths)), key=lambda i: (ranks[i], i)):
+        if widths[i] <= room:
+            chosen.append(i)
+            room -= widths[i]
+    return sorted(chosen)
 
 
 class KeyBar(Footer):
-    """A compact footer of the screen's keys (without the command palette's key)."""
+    """A compact footer of the screen's keys that fit (without the command palette's key)."""
 
     def __init__(self, *, id: str | None = None, classes: str | None = None) -> None:
         super().__init__(id=id, classes=classes, compact=True, show_command_palette=False)
+        #: the keys shown, as (key, action) pairs, and the width they were chosen for
+        self._shown: tuple[tuple[str, str], ...] = ()
+
+    def _width(self) -> int:
+        return self.size.width or self.app.size.width
+
+    def _ranks(self) -> dict[str, int]:
+        """Each action's rank, from the workbench's key table."""
+        ranks = {}
+        for _node, binding, _enabled, _tooltip in self.screen.active_bindings.values():
+            key = KEYS.get(binding.id or "")
+            ranks[binding.action] = key.rank if key is not None else DEFAULT_RANK
+        return ranks
+
+    def _choose(self, keys: list[FooterKey]) -> list[FooterKey]:
+        ranks = self._ranks()
+        order = [ranks.get(k.action, DEFAULT_RANK) for k in keys]
+        shown = fitting([key_width(k) for k in keys], order, self._width())
+        return [keys[i] for i in shown]
 
     def compose(self) -> ComposeResult:
-        for widget in super().compose():
-            if isinstance(widget, FooterKey):
-                widget.set_class(True, "-compact", update=False)
+        keys = [w for w in super().compose() if isinstance(w, FooterKey)]
+        chosen = self._choose(keys)
+        self._shown = tuple((k.key, k.action) for k in chosen)
+        for widget in chosen:
+            widget.set_class(True, "-compact", update=False)
             yield widget
+
+    def on_resize(self, event: events.Resize) -> None:
+        if not self._bindings_ready:
+            return
+        keys = [w for w in super().compose() if isinstance(w, FooterKey)]
+        if tuple((k.key, k.action) for k in self._choose(keys)) != self._shown:
+            self.call_after_refresh(self.recompose)

@@ -61,6 +61,9 @@ ROBOT_ASCII = (
 #: ray glyphs by direction modulo 180 degrees in steps of 45: -, \, |, /
 RAY_ASCII = (": ", ": ", ": ", ": ")
 RAY_UNICODE = ("┄┄", "⋱ ", "┆ ", "⋰ ")
+#: the start block: an S and the start heading, apart from the robot's own arrow
+START_ASCII = {"up": "S^", "right": "S>", "down": "Sv", "left": "S<"}
+START_UNICODE = {"up": "S▴", "right": "S▸", "down": "S▾", "left": "S◂"}
 TRAIL_ASCII = ". "
 TRAIL_UNICODE = "· "
 #: unit steps for 0, 90, 180, 270 degrees (right, down, left, up on the screen)
@@ -165,6 +168,8 @@ class MazeView(ScrollView, can_focus=False):
         #: what the robot and its sensors were last drawn from (a show with the same is skipped)
         self._shown: tuple[object, ...] | None = None
         self._trail: set[Cell] = set()
+        #: the simulated time last shown: time going back means the robot started over
+        self._last_time: float | None = None
         self._sprites: dict[Cell, Token] = {}
         self._sprite_rows: dict[int, dict[int, Token]] = {}
         self._base_rows: list[list[Token] | None] = [None] * maze.height
@@ -260,6 +265,9 @@ class MazeView(ScrollView, can_focus=False):
         if shown == self._shown:
             return False  # the robot and its sensors are drawn as they are now
         self._shown = shown
+        if self._last_time is not None and snapshot.time < self._last_time:
+            self._forget_trail()  # the robot started over: a reset, a new maze, a new run
+        self._last_time = snapshot.time
         maze = self._maze
         pose = snapshot.pose
         bx = min(max(math.floor(pose.x / cell_size), 0), max(maze.width - 1, 0))
@@ -313,6 +321,11 @@ class MazeView(ScrollView, can_focus=False):
             return
         self._show_trail = trail
         self._apply(self._spans(self._trail))
+
+    def _forget_trail(self) -> None:
+        gone, self._trail = self._trail, set()
+        if self._show_trail:
+            self._apply(self._spans(gone))
 
     def clear_trail(self) -> None:
         """Forget the blocks driven so far (the robot's own block is kept)."""
@@ -386,6 +399,7 @@ class MazeView(ScrollView, can_focus=False):
         for x in range(maze.width):
             text = block_text(maze, x, y, unicode)
             if (x, y) == start:
+                text = (START_UNICODE if unicode else START_ASCII)[maze.heading]
                 kind = "start"
             elif (x, y) in exits:
                 kind = "exit"
