@@ -275,7 +275,7 @@ def test_all_keys_end_when_the_program_stops(tmp_path):
 def test_after_loading_a_program_f_fits_the_sensors_its_diagram_reads(tmp_path):
     from workbench.sim.sensors import SensorSpec
 
-    app = make_app(maze_file(tmp_path), paused=True, noise="off")
+    app = make_app(AppSettings(maze_file(tmp_path), paused=True, noise="off"))
     path = drive_by_wire(tmp_path)
 
     async def body(pilot: Pilot) -> None:

@@ -7,13 +7,14 @@ from textual.widgets import Input
 
 from workbench.tui.app import make_app
 from workbench.tui.screens.editor import EditorScreen
+from workbench.tui.settings import AppSettings
 
 from .support import run, screen_lines
 
 
 def test_the_title_follows_saving_leaving_and_coming_back(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    app = make_app(paused=True, student="ana")
+    app = make_app(AppSettings(paused=True, student="ana"))
 
     async def body(pilot: Pilot) -> None:
         await pilot.press("e")

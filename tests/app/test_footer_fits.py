@@ -13,6 +13,7 @@ from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
 from workbench.tui.screens.replay import ReplayScreen
 from workbench.tui.screens.runs import RunsScreen
+from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.key_bar import KeyBar
 
 from .support import run, screen_lines
@@ -42,15 +43,15 @@ def bar_keys(pilot: Pilot) -> list[str]:
 
 @pytest.mark.parametrize("width", [80, 100, 132])
 def test_every_screens_key_bar_fits_whole(tmp_path, width):
-    app = make_app(paused=True, student="ana", record_dir=str(tmp_path / "runs"))
+    app = make_app(AppSettings(paused=True, student="ana", record_dir=tmp_path / "runs"))
 
     async def body(pilot: Pilot) -> None:
         station = app.station
         station.select_algorithm("right-wall")
         station.apply_algorithm_preset()
-        station.start_algorithm()
+        station.start()
         station.step(60)
-        station.stop_algorithm()  # one recorded run, for the replay
+        station.stop()  # one recorded run, for the replay
         assert isinstance(app.screen, MainScreen)
         shown = bar_keys(pilot)
         assert all(key in shown for key in NEWCOMER), shown
@@ -73,7 +74,7 @@ def test_every_screens_key_bar_fits_whole(tmp_path, width):
 
 
 def test_the_bar_follows_the_terminals_width(tmp_path):
-    app = make_app(paused=True, student="ana")
+    app = make_app(AppSettings(paused=True, student="ana"))
 
     async def body(pilot: Pilot) -> None:
         wide = bar_keys(pilot)

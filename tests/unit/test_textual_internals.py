@@ -234,6 +234,12 @@ def test_a_new_app_has_the_state_the_serving_code_reads():
     assert isinstance(DOMNode()._bindings, BindingsMap)
 
 
+def test_a_footer_says_when_it_has_read_its_bindings_where_the_key_bar_looks():
+    from textual.widgets import Footer
+
+    assert Footer()._bindings_ready is False
+
+
 def test_a_stylesheet_keeps_its_parse_cache_and_variables_where_the_warm_up_looks():
     stylesheet = Stylesheet(variables={"primary": "#004578"})
     assert isinstance(stylesheet._parse_cache, LRUCache)

@@ -454,7 +454,7 @@ class LabStation:
 
     def clear_algorithm(self) -> None:
         """No algorithm chosen (the keys drive), and no parameters of one kept."""
-        self.stop_algorithm("stopped")
+        self.stop("stopped")
         self.algorithm = None
         self.overrides = {}
 

@@ -13,7 +13,7 @@ from textual.binding import BindingsMap
 from textual.content import Content
 from textual.dom import DOMNode
 from textual.geometry import Size
-from textual.widgets import Checkbox, Input
+from textual.widgets import Checkbox, Footer, Input
 from textual.widgets._footer import FooterKey
 
 __all__ = [
@@ -23,6 +23,7 @@ __all__ = [
     "bindings_of",
     "current_app",
     "end_with_error",
+    "footer_ready",
     "handled_size",
 ]
 
@@ -43,6 +44,11 @@ def bindings_of(node: DOMNode) -> BindingsMap:
 def end_with_error(app: App[Any], error: Exception) -> None:
     """End the app with ``error`` shown, as Textual does for an error in the app's own code."""
     app._handle_exception(error)
+
+
+def footer_ready(footer: Footer) -> bool:
+    """Whether the footer has read its screen's bindings (its keys can be composed)."""
+    return bool(footer._bindings_ready)
 
 
 def handled_size(app: App[Any]) -> Size | None:

@@ -21,8 +21,8 @@ from textual import events
 from textual.app import ComposeResult
 from textual.widgets import Footer
 
-from ..keys import KEYS
-from ..serving.internals import FooterKey
+from ..keys import KEY_TABLE
+from ..serving.internals import FooterKey, footer_ready
 
 #: the rank of a key that is not in the workbench's table (Textual's own)
 DEFAULT_RANK = 2
@@ -61,7 +61,7 @@ class KeyBar(Footer):
         """Each action's rank, from the workbench's key table."""
         ranks = {}
         for _node, binding, _enabled, _tooltip in self.screen.active_bindings.values():
-            key = KEYS.get(binding.id or "")
+            key = KEY_TABLE.get(binding.id or "")
             ranks[binding.action] = key.rank if key is not None else DEFAULT_RANK
         return ranks
 
@@ -80,7 +80,7 @@ class KeyBar(Footer):
             yield widget
 
     def on_resize(self, event: events.Resize) -> None:
-        if not self._bindings_ready:
+        if not footer_ready(self):
             return
         keys = [w for w in super().compose() if isinstance(w, FooterKey)]
         if tuple((k.key, k.action) for k in self._choose(keys)) != self._shown:
