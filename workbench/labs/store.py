@@ -46,7 +46,7 @@ from .database import (
 from .migrations import RECORD_COLUMNS, SIGNOFF_LOCK, check_version, latest, migrate
 from .names import name_key
 from .pending import FIELDS, PendingWrite, load_pending, save_pending
-from .signlog import GENESIS, entry_hash, parse_metrics, signed_payload
+from .signlog import GENESIS, entry_hash, next_place, parse_metrics, signed_payload
 
 __all__ = [
     "LogMissing",
@@ -392,13 +392,14 @@ class Store:
         with self._write() as tx:
             if postgres:
                 tx.execute("SELECT pg_advisory_xact_lock(?)", (SIGNOFF_LOCK,))
-            # rows whose seq is not a number were tampered with: verify names them, and the
-            # log goes on after the last numbered record
+            # rows whose seq is not a number were tampered with, and so is a row numbered
+            # far beyond the log: verify names them, and the log goes on after the run of
+            # consecutive numbers it grew by (signlog.next_place)
             numbered = "seq IS NOT NULL" if postgres else "typeof(seq) = 'integer'"
-            last = tx.execute(
-                f"SELECT seq, entry_hash FROM signoffs WHERE {numbered} ORDER BY seq DESC LIMIT 1"
-            ).fetchone()
-            seq, prev = (int(last[0]) + 1, str(last[1] or "")) if last else (1, GENESIS)
+            rows = tx.execute(
+                f"SELECT seq, entry_hash FROM signoffs WHERE {numbered} ORDER BY seq"
+            ).fetchall()
+            seq, prev = next_place([(int(s), str(h or "")) for s, h in rows])
             if seq >= MAX_SEQ:
                 raise StoreError(
                     f"{self.where}: the sign-off log claims {seq - 1} records, more than it "
