@@ -11,11 +11,13 @@ went away, is :class:`StoreUnavailable`, which the store answers by keeping writ
 from __future__ import annotations
 
 import os
+import socket
 import sqlite3
+import threading
 import time
 from abc import ABC, abstractmethod
-from collections.abc import Iterator
-from contextlib import contextmanager
+from collections.abc import Callable, Iterator
+from contextlib import AbstractContextManager, contextmanager, suppress
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -38,6 +40,16 @@ LINK_DEFAULTS: dict[str, object] = {
     "keepalives_interval": 10,
     "keepalives_count": 3,
 }
+#: how long one statement may take in the course database: the server gives up a statement
+#: (``statement_timeout``) or a wait for a lock (``lock_timeout``) after this many seconds, and
+#: this side gives up a call the server does not answer at all (stopped, or its machine hung
+#: while its network still acknowledges) a little later by dropping the connection. Either way
+#: the call fails as :class:`StoreUnavailable`: writes are kept pending, nobody waits longer.
+ENV_DB_TIMEOUT = "WORKBENCH_DB_TIMEOUT"
+DB_TIMEOUT_S = 5.0
+DB_TIMEOUT_RANGE = (0.5, 600.0)
+#: seconds this side waits beyond the server's own timeout before it drops the connection
+CLIENT_GRACE_S = 2.0
 MAX_URL = 2048
 POSTGRES_SCHEMES = ("postgresql://", "postgres://")
 
@@ -73,6 +85,25 @@ def resolve_db(option: str | None = None) -> str | None:
     return value
 
 
+def db_timeout() -> float:
+    """Seconds a course database statement may take: ``$WORKBENCH_DB_TIMEOUT``, else
+    :data:`DB_TIMEOUT_S`. A value that is not a number in range is refused, naming it."""
+    text = os.environ.get(ENV_DB_TIMEOUT, "").strip()
+    if not text:
+        return DB_TIMEOUT_S
+    low, high = DB_TIMEOUT_RANGE
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not low <= value <= high:
+        raise StoreError(
+            f"${ENV_DB_TIMEOUT}: {text[:40]!r} is not a number of seconds from {low:g} to "
+            f"{high:g} (the default is {DB_TIMEOUT_S:g})"
+        )
+    return value
+
+
 def redact(url: str) -> str:
     """A database URL fit for messages and logs: the password replaced by ``***``."""
     scheme, sep, rest = url.partition("://")
@@ -89,16 +120,75 @@ def redact(url: str) -> str:
 
 @dataclass
 class Tx:
-    """A transaction's cursor: ``execute`` takes SQL with ``?`` placeholders."""
+    """A transaction's cursor: ``execute`` takes SQL with ``?`` placeholders. ``deadline``
+    (PostgreSQL) is the watch each statement runs under."""
 
     cursor: Any
     postgres: bool
+    deadline: Callable[[], AbstractContextManager[None]] | None = None
 
     def execute(self, sql: str, params: tuple[Any, ...] | list[Any] = ()) -> Any:
         if self.postgres:
             sql = sql.replace("?", "%s")
-        self.cursor.execute(sql, tuple(params))
+        if self.deadline is None:
+            self.cursor.execute(sql, tuple(params))
+        else:
+            with self.deadline():
+                self.cursor.execute(sql, tuple(params))
         return self.cursor
+
+
+class Watchdog:
+    """One thread that drops a connection whose statement is still unanswered at its deadline
+    (a server that is stopped, or whose machine hangs while its network still acknowledges,
+    never fires its own timeout). Shutting the socket makes the waiting call fail at once."""
+
+    def __init__(self, seconds: float):
+        self.seconds = seconds
+        self._cond = threading.Condition()
+        self._due: float | None = None
+        self._conn: Any = None
+        self._thread: threading.Thread | None = None
+        #: the connection last dropped (the call on it failed for that reason)
+        self.dropped: Any = None
+
+    @contextmanager
+    def watch(self, conn: Any) -> Iterator[None]:
+        with self._cond:
+            if self._thread is None:
+                self._thread = threading.Thread(
+                    target=self._run, name="course-db-deadline", daemon=True
+                )
+                self._thread.start()
+            self._due, self._conn = time.monotonic() + self.seconds, conn
+            self._cond.notify()
+        try:
+            yield
+        finally:
+            with self._cond:
+                self._due = self._conn = None
+
+    def _run(self) -> None:
+        with self._cond:
+            while True:
+                if self._due is None:
+                    self._cond.wait()
+                    continue
+                left = self._due - time.monotonic()
+                if left > 0:
+                    self._cond.wait(left)
+                    continue
+                self.dropped, conn = self._conn, self._conn
+                self._due = self._conn = None
+                _shut(conn)
+
+
+def _shut(conn: Any) -> None:
+    try:
+        with socket.socket(fileno=os.dup(conn.pgconn.socket)) as sock:
+            sock.shutdown(socket.SHUT_RDWR)
+    except Exception:  # closed meanwhile: its call is over anyway
+        return
 
 
 class Backend(ABC):
@@ -195,16 +285,21 @@ class SqliteBackend(Backend):
 class PostgresBackend(Backend):
     """A PostgreSQL database. The connection is made again after the server went away; while
     it cannot be, every call raises :class:`StoreUnavailable` at once (one new attempt per
-    :data:`RETRY_AFTER_S` at most, so a writer never waits on a dead server)."""
+    :data:`RETRY_AFTER_S` at most, so a writer never waits on a dead server). Every call has a
+    deadline (:func:`db_timeout`): the server's ``statement_timeout`` and ``lock_timeout``, and
+    on this side a :class:`Watchdog` that drops the connection of a statement still
+    unanswered after them."""
 
     kind = "postgresql"
 
-    def __init__(self, url: str, *, read_only: bool = False):
+    def __init__(self, url: str, *, read_only: bool = False, timeout: float | None = None):
         self.url = url
         self.where = redact(url)
         self.read_only = read_only
+        self.timeout = db_timeout() if timeout is None else timeout
         self.conn: Any = None
         self._next_try = 0.0
+        self.watchdog = Watchdog(self.timeout + CLIENT_GRACE_S)
 
     def connection(self) -> Any:
         import psycopg
@@ -219,11 +314,12 @@ class PostgresBackend(Backend):
         now = time.monotonic()
         if now < self._next_try:
             raise StoreUnavailable(f"{self.where}: the database cannot be reached (retrying)")
+        given = conninfo_to_dict(self.url)
         try:
             conn = psycopg.connect(
                 self.url,
                 autocommit=True,
-                **{**LINK_DEFAULTS, **conninfo_to_dict(self.url)},  # the URL's own settings win
+                **{**LINK_DEFAULTS, **given},  # the URL's own settings win
             )
         except psycopg.OperationalError as exc:
             self._next_try = now + RETRY_AFTER_S
@@ -232,17 +328,45 @@ class PostgresBackend(Backend):
             ) from None
         except psycopg.Error as exc:  # a malformed URL, an unknown option
             raise StoreError(f"{self.where}: cannot connect: {_first_line(exc)}") from None
-        if self.read_only:
-            conn.execute("SET SESSION CHARACTERISTICS AS TRANSACTION READ ONLY")
+        try:
+            with self.watchdog.watch(conn):
+                options = str(given.get("options", ""))
+                for name in ("statement_timeout", "lock_timeout"):
+                    if name not in options:  # set in the URL (options=-c ...): that wins
+                        conn.execute(
+                            "SELECT set_config(%s, %s, false)",
+                            (name, f"{round(self.timeout * 1000)}ms"),
+                        )
+                if self.read_only:
+                    conn.execute("SET SESSION CHARACTERISTICS AS TRANSACTION READ ONLY")
+        except psycopg.Error as exc:
+            conn.close()
+            self._next_try = now + RETRY_AFTER_S
+            raise self._failed(exc, "connect") from None
         self.conn = conn
         return conn
 
     def _failed(self, exc: Exception, doing: str) -> StoreError:
         """The error to raise for a failed statement: unavailable when the connection was
-        lost with it (the server stopped or restarted), else a plain one."""
+        lost with it (the server stopped or restarted, or did not answer in time) or the
+        server gave it up at its timeout, else a plain one."""
         import psycopg
 
         conn = self.conn
+        seconds = f"{self.timeout:g} s"
+        if isinstance(exc, psycopg.errors.QueryCanceled | psycopg.errors.LockNotAvailable):
+            self._next_try = time.monotonic() + RETRY_AFTER_S
+            return StoreUnavailable(
+                f"{self.where}: the database did not answer within {seconds} (busy or locked): "
+                f"{_first_line(exc)}"
+            )
+        if self.watchdog.dropped is not None and self.watchdog.dropped in (conn, None):
+            self.watchdog.dropped = None
+            self._next_try = time.monotonic() + RETRY_AFTER_S
+            return StoreUnavailable(
+                f"{self.where}: the database did not answer within {seconds}; the connection "
+                "was dropped"
+            )
         if conn is None or conn.closed or conn.broken or isinstance(exc, psycopg.InterfaceError):
             self._next_try = time.monotonic() + RETRY_AFTER_S
             return StoreUnavailable(f"{self.where}: the database went away: {_first_line(exc)}")
@@ -254,8 +378,16 @@ class PostgresBackend(Backend):
 
         conn = self.connection()
         try:
-            with conn.transaction(), conn.cursor() as cur:
-                yield Tx(cur, postgres=True)
+            with conn.cursor() as cur:
+                tx = Tx(cur, postgres=True, deadline=lambda: self.watchdog.watch(conn))
+                tx.execute("BEGIN")
+                try:
+                    yield tx
+                except BaseException:
+                    with suppress(psycopg.Error):
+                        tx.execute("ROLLBACK")
+                    raise
+                tx.execute("COMMIT")
         except psycopg.Error as exc:
             raise self._failed(exc, "write") from None
 
@@ -265,7 +397,8 @@ class PostgresBackend(Backend):
         conn = self.connection()
         try:
             with conn.cursor() as cur:
-                return Tx(cur, postgres=True).execute(sql, params).fetchall()
+                tx = Tx(cur, postgres=True, deadline=lambda: self.watchdog.watch(conn))
+                return tx.execute(sql, params).fetchall()
         except psycopg.Error as exc:
             raise self._failed(exc, "read") from None
 

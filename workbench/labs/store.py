@@ -24,6 +24,7 @@ import sqlite3
 import threading
 import urllib.request
 from collections.abc import Callable, Iterator
+from concurrent.futures import Future, ThreadPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from datetime import UTC, datetime
@@ -205,6 +206,11 @@ class Store:
         self._pending_student = ""
         #: why the pending writes could not be kept in their file ("" when they could)
         self.pending_file_problem = ""
+        #: with :meth:`write_in_background`: the one thread that writes, and the flush it has
+        #: waiting (not started yet), which a new write joins
+        self._writer: ThreadPoolExecutor | None = None
+        self._queued: Future[bool] | None = None
+        self._on_trouble: Callable[[StoreError], None] | None = None
 
     @classmethod
     def open(
@@ -282,8 +288,67 @@ class Store:
         return len(self._pending)
 
     def close(self) -> None:
+        """Close the connection; writing in the background, without waiting for a write on
+        its way (the writing thread closes it once that write is done or given up)."""
+        writer = self._writer
+        if writer is None:
+            with self._io:
+                self.backend.close()
+            return
+        with self._lock:
+            if self._queued is not None:
+                self._queued.cancel()
+                self._queued = None
+            writer.submit(self._close_backend)
+            writer.shutdown(wait=False)
+
+    def _close_backend(self) -> None:
         with self._io:
             self.backend.close()
+
+    def write_in_background(self, on_trouble: Callable[[StoreError], None]) -> None:
+        """From now on a save never waits for the database: it is kept pending and written
+        by a thread of the store's own, one flush at a time (:meth:`flush_soon`). When a
+        write in that thread fails, ``on_trouble`` is called there with the error: a
+        :class:`StoreUnavailable` when the database is away or did not answer in time (the
+        write stays pending), another :class:`StoreError` when it was refused."""
+        with self._lock:
+            self._on_trouble = on_trouble
+            if self._writer is None:
+                self._writer = ThreadPoolExecutor(1, thread_name_prefix="store-writer")
+
+    @property
+    def in_background(self) -> bool:
+        return self._writer is not None
+
+    def flush_soon(self) -> Future[bool]:
+        """A :meth:`flush` in the store's writing thread (see :meth:`write_in_background`);
+        a flush already waiting there is shared. Its result is that of :meth:`flush`."""
+        with self._lock:
+            if self._writer is None:
+                raise RuntimeError("the store does not write in the background")
+            if self._queued is None:
+                self._queued = self._writer.submit(self._flush_in_writer)
+            return self._queued
+
+    def _flush_in_writer(self) -> bool:
+        with self._lock:
+            self._queued = None  # writes kept from now on go with the next flush
+        try:
+            done = self.flush()
+        except StoreError as exc:
+            self._tell(exc)
+            raise
+        if not done:
+            self._tell(StoreUnavailable(f"{self.where}: the database cannot be reached"))
+        return done
+
+    def _tell(self, exc: StoreError) -> None:
+        if self._on_trouble is not None:
+            try:
+                self._on_trouble(exc)
+            except Exception:  # whoever listens is gone (the app ending): the writes are kept
+                return
 
     def __enter__(self) -> Store:
         return self
@@ -306,13 +371,17 @@ class Store:
 
     def _keep(self, write: PendingWrite) -> bool:
         """Write one upsert, or keep it pending while the database is away; the newest write
-        of a key replaces an older pending one. True when it (and all pending) was written."""
+        of a key replaces an older pending one. True when it (and all pending) was written,
+        or, writing in the background, when it is on its way (the database was answering)."""
         with self._lock:
             self._pending.pop(write.key, None)
             self._pending[write.key] = (write, False)
             if self.offline:
                 self._persist()
                 return False  # no new try here: flush() does it, off the caller's thread
+            if self._writer is not None:
+                self.flush_soon()
+                return True
         return self.flush()
 
     def flush(self) -> bool:
@@ -346,6 +415,12 @@ class Store:
                     del self._pending[key]
             self._persist()
             return not self._pending
+
+    def keep_pending_now(self) -> None:
+        """Write what is pending to its file now (an app ending while a write may still be
+        on its way keeps it for the next app)."""
+        with self._lock:
+            self._persist()
 
     def keep_pending_in(self, path: Path, student: str) -> list[str]:
         """Keep ``student``'s pending writes in the file ``path`` from now on, and take up the
