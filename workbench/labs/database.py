@@ -58,6 +58,11 @@ class StoreError(Exception):
     """The database cannot be opened, read or written; the message names it."""
 
 
+class StoreDiskError(StoreError):
+    """The disk under the database failed (full, over quota, an input/output error): the
+    database is not known to be damaged, and a backup must not be put over it."""
+
+
 class LogMissing(StoreError):
     """There is no sign-off log to read: no database, or no sign-off table in it."""
 
@@ -215,6 +220,42 @@ class Backend(ABC):
         return self.kind == "postgresql"
 
 
+#: what to do with a database file that is not one (or is damaged): only then a backup helps
+NOT_A_DATABASE = "move it aside to start a new one, or restore it from a backup"
+
+
+def sqlite_failure(where: str | os.PathLike, exc: sqlite3.Error, doing: str) -> StoreError:
+    """The error for a failed SQLite call, named for what it is. A full disk and other
+    input/output errors say so and what to do, and never advise restoring a backup: the
+    database is intact, and an older copy would roll back the sign-off log. Only a file that
+    is not a database, or a damaged one, is called unreadable."""
+    text = str(exc)
+    code = getattr(exc, "sqlite_errorcode", None)
+    primary = code & 0xFF if isinstance(code, int) else None
+    if primary == sqlite3.SQLITE_FULL or "disk is full" in text:
+        return StoreDiskError(
+            f"{where}: cannot {doing}: the disk is full (or the account's disk quota is used "
+            "up); free some space and try again. The database is not damaged: do not restore "
+            "a backup over it"
+        )
+    if primary == sqlite3.SQLITE_IOERR or "disk I/O error" in text:
+        return StoreDiskError(
+            f"{where}: cannot {doing}: an input/output error on the disk ({text}); check the "
+            "disk and its free space and try again. This is no sign of a damaged database: "
+            "do not restore a backup over it"
+        )
+    if primary in (sqlite3.SQLITE_NOTADB, sqlite3.SQLITE_CORRUPT) or (
+        "file is not a database" in text or "malformed" in text
+    ):
+        return StoreError(f"{where}: not a readable workbench database ({text}); {NOT_A_DATABASE}")
+    if primary == sqlite3.SQLITE_CANTOPEN:
+        return StoreError(
+            f"{where}: cannot open the database file ({text}): check that its folder can be "
+            "written (SQLite keeps companion files beside it) and has free space"
+        )
+    return StoreError(f"{where}: cannot {doing}: {text}")
+
+
 class SqliteBackend(Backend):
     """The SQLite file in WAL mode; each write is one ``BEGIN IMMEDIATE`` transaction, so two
     processes writing at once queue (for up to ten seconds) rather than fail."""
@@ -231,7 +272,7 @@ class SqliteBackend(Backend):
         try:
             conn = sqlite3.connect(path, timeout=BUSY_TIMEOUT_MS / 1000, isolation_level=None)
         except sqlite3.Error as exc:
-            raise StoreError(f"{path}: cannot open the database: {exc}") from None
+            raise sqlite_failure(path, exc, "open the database") from None
         backend = cls(path, conn)
         try:
             conn.execute(f"PRAGMA busy_timeout = {BUSY_TIMEOUT_MS}")
@@ -241,10 +282,7 @@ class SqliteBackend(Backend):
             conn.execute("PRAGMA synchronous = FULL")
         except sqlite3.DatabaseError as exc:
             conn.close()
-            raise StoreError(
-                f"{path}: not a readable workbench database ({exc}); move it aside to start a "
-                "new one, or restore it from a backup"
-            ) from None
+            raise sqlite_failure(path, exc, "open the database") from None
         except StoreError:
             conn.close()
             raise
@@ -256,12 +294,12 @@ class SqliteBackend(Backend):
         try:
             cur.execute("BEGIN IMMEDIATE")
         except sqlite3.OperationalError as exc:
-            raise StoreError(f"{self.where}: cannot write: {exc}") from None
+            raise sqlite_failure(self.where, exc, "write") from None
         try:
             yield Tx(cur, postgres=False)
         except sqlite3.Error as exc:
             self.conn.rollback()
-            raise StoreError(f"{self.where}: cannot write: {exc}") from None
+            raise sqlite_failure(self.where, exc, "write") from None
         except BaseException:
             self.conn.rollback()
             raise
@@ -270,13 +308,13 @@ class SqliteBackend(Backend):
                 cur.execute("COMMIT")
             except sqlite3.Error as exc:
                 self.conn.rollback()
-                raise StoreError(f"{self.where}: cannot write: {exc}") from None
+                raise sqlite_failure(self.where, exc, "write") from None
 
     def read(self, sql: str, params: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
         try:
             return self.conn.execute(sql, params).fetchall()
         except sqlite3.DatabaseError as exc:
-            raise StoreError(f"{self.where}: cannot read: {exc}") from None
+            raise sqlite_failure(self.where, exc, "read") from None
 
     def close(self) -> None:
         self.conn.close()

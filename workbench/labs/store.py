@@ -39,10 +39,12 @@ from .database import (
     LogMissing,
     PostgresBackend,
     SqliteBackend,
+    StoreDiskError,
     StoreError,
     StoreUnavailable,
     Tx,
     resolve_db,
+    sqlite_failure,
 )
 from .migrations import RECORD_COLUMNS, SIGNOFF_LOCK, check_version, latest, migrate
 from .names import name_key
@@ -52,6 +54,7 @@ from .signlog import GENESIS, entry_hash, next_place, parse_metrics, signed_payl
 __all__ = [
     "LogMissing",
     "Store",
+    "StoreDiskError",
     "StoreError",
     "StoreUnavailable",
     "StoredSignoff",
@@ -251,14 +254,8 @@ class Store:
         store = cls(folder, SqliteBackend.open(path))
         try:
             store._ensure_schema()
-        except StoreError as exc:
+        except StoreError:
             store.close()
-            text = str(exc)
-            if "file is not a database" in text or "malformed" in text:
-                raise StoreError(
-                    f"{path}: not a readable workbench database ({text.split(': ')[-1]}); "
-                    "move it aside to start a new one, or restore it from a backup"
-                ) from None
             raise
         return store
 
@@ -750,7 +747,7 @@ def read_signoffs(data_dir: str | os.PathLike, db: str | None = None) -> list[St
     try:
         conn = sqlite3.connect(uri, uri=True, timeout=BUSY_TIMEOUT_MS / 1000)
     except sqlite3.Error as exc:
-        raise StoreError(f"{path}: cannot open the database: {exc}") from None
+        raise sqlite_failure(path, exc, "open the database") from None
 
     def read(sql: str, params: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
         return conn.execute(sql, params).fetchall()
@@ -758,9 +755,7 @@ def read_signoffs(data_dir: str | os.PathLike, db: str | None = None) -> list[St
     try:
         return _read_log(read, "sqlite", str(path))
     except sqlite3.DatabaseError as exc:
-        raise StoreError(
-            f"{path}: not a readable workbench database ({exc}); restore it from a backup"
-        ) from None
+        raise sqlite_failure(path, exc, "read the sign-off log") from None
     finally:
         conn.close()
 
