@@ -13,6 +13,8 @@ import json
 import os
 from pathlib import Path
 
+from workbench.files.private import private_dir, write_private
+
 from .names import NameProblem, check_pair
 
 FILE_NAME = "last-pair.json"
@@ -37,8 +39,8 @@ def read_last_pair(data_dir: str | os.PathLike) -> tuple[str, str] | None:
 def save_last_pair(data_dir: str | os.PathLike, student: str, partner: str = "") -> None:
     """Remember the pair at this workbench (written whole, then moved into place)."""
     folder = Path(data_dir)
-    folder.mkdir(parents=True, exist_ok=True)
+    private_dir(folder)
     path = folder / FILE_NAME
     part = path.with_suffix(".json.part")
-    part.write_text(json.dumps({"student": student, "partner": partner}), encoding="utf-8")
+    write_private(part, json.dumps({"student": student, "partner": partner}).encode("utf-8"))
     os.replace(part, path)

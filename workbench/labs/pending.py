@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from workbench.files.bounded import Limits, read_text
+from workbench.files.private import private_dir, write_private
 
 #: the values of each kind of write, in the order of its statement
 FIELDS = {
@@ -62,14 +63,14 @@ def save_pending(path: Path, student: str, writes: list[PendingWrite]) -> None:
         with contextlib.suppress(FileNotFoundError):
             path.unlink()
         return
-    path.parent.mkdir(parents=True, exist_ok=True)
+    private_dir(path.parent)
     data = {
         "format": FORMAT,
         "student": student,
         "writes": [{"kind": w.kind, "values": list(w.values)} for w in writes],
     }
     new = path.with_name(f".{path.name}.{os.getpid()}.new")
-    new.write_text(json.dumps(data, ensure_ascii=False, indent=1), encoding="utf-8")
+    write_private(new, json.dumps(data, ensure_ascii=False, indent=1).encode("utf-8"))
     os.replace(new, path)
 
 

@@ -18,7 +18,9 @@ checking and exporting.
 
 from __future__ import annotations
 
+import contextlib
 import json
+import logging
 import os
 import sqlite3
 import threading
@@ -32,6 +34,8 @@ from pathlib import Path
 from typing import Any
 
 import platformdirs
+
+from workbench.files.private import PRIVATE_FILE, private_dir, tighten
 
 from .database import (
     BUSY_TIMEOUT_MS,
@@ -62,6 +66,8 @@ __all__ = [
     "resolve_data_dir",
     "resolve_db",
 ]
+
+log = logging.getLogger(__name__)
 
 APP_NAME = "viple-workbench"
 DB_NAME = "workbench.sqlite3"
@@ -214,6 +220,8 @@ class Store:
         self._writer: ThreadPoolExecutor | None = None
         self._queued: Future[bool] | None = None
         self._on_trouble: Callable[[StoreError], None] | None = None
+        #: what opening the store changed (a data folder open to others made private)
+        self.notices: list[str] = []
 
     @classmethod
     def open(
@@ -247,16 +255,26 @@ class Store:
                 f"{path}: no workbench database here (nothing was signed off or saved with "
                 "this data folder; see --data-dir)"
             )
+        notices: list[str] = []
         try:
-            folder.mkdir(parents=True, exist_ok=True)
+            notices.append(private_dir(folder))
+            if not path.exists():
+                _create_database(path)
+            refuse_empty(path)
+            for name in (DB_NAME, f"{DB_NAME}-wal", f"{DB_NAME}-shm"):
+                notices.append(tighten(folder / name))
         except OSError as exc:
-            raise StoreError(f"{folder}: cannot create the data folder: {exc.strerror}") from None
+            raise StoreError(f"{exc.filename or folder}: cannot set up the data folder: "
+                             f"{exc.strerror}") from None  # fmt: skip
         store = cls(folder, SqliteBackend.open(path))
         try:
             store._ensure_schema()
         except StoreError:
             store.close()
             raise
+        store.notices = [n for n in notices if n]
+        for notice in store.notices:
+            log.warning("%s", notice)
         return store
 
     def _ensure_schema(self) -> None:
@@ -700,6 +718,47 @@ class Store:
             )
 
 
+def _create_database(path: Path) -> None:
+    """Make a new, empty workbench database at ``path``, private to the account: built under
+    another name and then linked into place, so that no other process ever finds an empty file
+    there (an empty file at ``path`` is refused: see :func:`refuse_empty`). When another
+    process made one first, theirs is kept."""
+    part = path.with_name(f".{path.name}.{os.getpid()}.{threading.get_ident()}.new")
+    try:
+        os.close(os.open(part, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, PRIVATE_FILE))
+        os.chmod(part, PRIVATE_FILE)
+        backend = SqliteBackend.open(part)
+        try:
+            migrate(backend)
+        finally:
+            backend.close()
+        try:
+            os.link(part, path)
+        except FileExistsError:
+            pass  # made by another process meanwhile
+        except OSError:  # a file system without hard links
+            if not path.exists():
+                os.replace(part, path)
+    finally:
+        for leftover in (part, Path(f"{part}-wal"), Path(f"{part}-shm")):
+            with contextlib.suppress(FileNotFoundError):
+                leftover.unlink()
+
+
+def refuse_empty(path: Path) -> None:
+    """Refuse a database file of 0 bytes: it is not a workbench database (the workbench never
+    leaves one), and opening it would silently start a new, empty store in its place."""
+    try:
+        size = path.stat().st_size
+    except FileNotFoundError:
+        return
+    if size == 0 and path.is_file():
+        raise StoreError(
+            f"{path}: an empty file (0 bytes), not a workbench database; if the store was "
+            f"lost, restore it from a backup, or move the file aside to start a new one"
+        )
+
+
 def _signoff_from_row(row: tuple[Any, ...], names: tuple[str, ...]) -> StoredSignoff:
     data = dict(zip(names, row, strict=True))
     for name in names:
@@ -743,6 +802,7 @@ def read_signoffs(data_dir: str | os.PathLike, db: str | None = None) -> list[St
             f"{path}: no workbench database here (nothing was signed off with this data "
             "folder, or the file was deleted; see --data-dir)"
         )
+    refuse_empty(path)
     uri = "file:" + urllib.request.pathname2url(str(path.resolve())) + "?mode=ro"
     try:
         conn = sqlite3.connect(uri, uri=True, timeout=BUSY_TIMEOUT_MS / 1000)
