@@ -156,11 +156,13 @@ class Watchdog:
         self._thread: threading.Thread | None = None
         #: the connection last dropped (the call on it failed for that reason)
         self.dropped: Any = None
+        self._stopped = False
 
     @contextmanager
     def watch(self, conn: Any) -> Iterator[None]:
         with self._cond:
             if self._thread is None:
+                self._stopped = False
                 self._thread = threading.Thread(
                     target=self._run, name="course-db-deadline", daemon=True
                 )
@@ -173,9 +175,16 @@ class Watchdog:
             with self._cond:
                 self._due = self._conn = None
 
+    def stop(self) -> None:
+        """End the thread (the backend is closed)."""
+        with self._cond:
+            self._stopped = True
+            self._thread = None
+            self._cond.notify()
+
     def _run(self) -> None:
         with self._cond:
-            while True:
+            while not self._stopped:
                 if self._due is None:
                     self._cond.wait()
                     continue
@@ -441,6 +450,7 @@ class PostgresBackend(Backend):
             raise self._failed(exc, "read") from None
 
     def close(self) -> None:
+        self.watchdog.stop()
         if self.conn is not None:
             self.conn.close()
             self.conn = None
