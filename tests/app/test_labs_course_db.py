@@ -7,6 +7,7 @@ import asyncio
 import threading
 import time
 
+import pytest
 from textual.pilot import Pilot
 from textual.widgets import Input
 
@@ -167,3 +168,85 @@ def test_retries_run_beside_the_app_one_at_a_time(tmp_path, pg_server, pg_url, m
 
     run(app, body)
     assert most == 1
+
+
+class Hang:
+    """A course database that stops answering, in one of two ways, and its release: the whole
+    server stopped (SIGSTOP) or the progress table locked by another connection. It is let go
+    at the latest after ``limit`` seconds, so that an app frozen by it cannot hang the tests."""
+
+    def __init__(self, how: str, server, url: str, limit: float = 40.0):
+        self.how, self.server, self.url = how, server, url
+        self._pids: list[int] = []
+        self._locker = None
+        self._released = threading.Lock()
+        self._timer = threading.Timer(limit, self.release)
+
+    def start(self) -> None:
+        if self.how == "stopped":
+            self._pids = self.server.freeze()
+        else:
+            import psycopg
+
+            self._locker = psycopg.connect(self.url)
+            self._locker.execute("LOCK TABLE progress IN ACCESS EXCLUSIVE MODE")
+        self._timer.start()
+
+    def release(self) -> None:
+        with self._released:
+            self._timer.cancel()
+            if self._pids:
+                self.server.thaw(self._pids)
+                self._pids = []
+            if self._locker is not None:
+                self._locker.rollback()
+                self._locker.close()
+                self._locker = None
+
+
+@pytest.mark.parametrize("how", ["stopped", "locked"])
+def test_a_database_that_hangs_never_freezes_the_app_and_the_work_waits_for_it(
+    tmp_path, pg_server, pg_url, monkeypatch, how
+):
+    monkeypatch.setenv("WORKBENCH_DB_TIMEOUT", "2")  # given up after 2 s (stopped: 2 s more)
+    app = lab_app(tmp_path / "data", db=pg_url)
+    hang = Hang(how, pg_server, pg_url)
+
+    async def body(pilot: Pilot) -> None:
+        screen = await open_exercise(pilot, DRIVE)
+        store = app.store
+        hang.start()
+        try:
+            screen.query_one("#q-tcp-port", Input).value = "1350"  # saving the answer begins
+            await pilot.pause()
+            # while the save waits for the database, keys are handled and the screen drawn
+            await pilot.press("escape", "p")
+            assert isinstance(app.screen, MainScreen) and not app.station.paused
+            frames = app.frames
+            await pilot.press("w")
+            while app.frames == frames:
+                await asyncio.sleep(0.01)
+            assert store.pending  # the answer is still on its way
+            await pilot.press("p", "l")
+            assert app.screen is screen
+            message = ""
+            deadline = time.monotonic() + 15  # the database is given up on within seconds
+            while "saved as soon as it is back" not in message and time.monotonic() < deadline:
+                await asyncio.sleep(0.05)
+                message = text(screen, "#labs-message")
+            assert message.startswith("the course database cannot be reached: your progress")
+            assert "kept here" in message and "saved as soon as it is back" in message
+            assert store.pending
+        finally:
+            hang.release()
+        back = "the course database is back: your progress is saved"
+        deadline = time.monotonic() + 20
+        while text(screen, "#labs-message") != back and time.monotonic() < deadline:
+            await asyncio.sleep(0.1)
+        assert text(screen, "#labs-message") == back
+        assert not store.pending
+
+    run(app, body)
+    with Store.open(tmp_path / "elsewhere", db=pg_url) as store:
+        saved = store.progress("ana")[("unity-simulator", "drive-by-wire")]
+    assert saved["answers"] == {"tcp-port": "1350"}

@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import csv
 import io
+import resource
+import signal
 import sqlite3
+import subprocess
 import sys
 from pathlib import Path
 
@@ -172,3 +175,49 @@ def test_a_data_folder_without_a_database_is_reported_not_created(tmp_path, caps
     assert main(["signoff", "list", "--data-dir", str(missing)]) == 2
     assert "no workbench database here" in capsys.readouterr().err
     assert not missing.exists()
+
+
+def _no_room_to_write() -> None:
+    """A full disk for this process: no file may grow (SQLite's companion files need to)."""
+    signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+    resource.setrlimit(resource.RLIMIT_FSIZE, (0, resource.RLIM_INFINITY))
+
+
+def test_a_disk_that_fails_is_named_and_never_calls_an_intact_store_unreadable(data_dir):
+    sign(data_dir, "ana", "connect")
+    before = (data_dir / DB_NAME).read_bytes()
+    for command in (["store", "info"], ["signoff", "verify"], ["signoff", "list"]):
+        done = subprocess.run(
+            [sys.executable, "-m", "workbench", *command, "--data-dir", str(data_dir)],
+            capture_output=True, text=True, timeout=60, preexec_fn=_no_room_to_write,
+        )  # fmt: skip
+        assert done.returncode != 0, command
+        assert "an input/output error on the disk" in done.stderr, (command, done.stderr)
+        assert "check the disk and its free space" in done.stderr
+        assert "restore" not in done.stderr.replace("do not restore", "")
+        assert "not a readable" not in done.stderr
+        if command[1] == "verify":
+            assert "the records were NOT checked" in done.stderr
+    assert (data_dir / DB_NAME).read_bytes() == before
+    assert main(["signoff", "verify", "--data-dir", str(data_dir)]) == 0  # space again: fine
+
+
+def test_a_full_disk_is_named_as_such(data_dir, monkeypatch, capsys):
+    def full(*args, **kwargs):
+        error = sqlite3.OperationalError("database or disk is full")
+        error.sqlite_errorcode = sqlite3.SQLITE_FULL
+        raise error
+
+    class NoRoom:
+        execute = staticmethod(full)
+
+        def close(self) -> None:
+            pass
+
+    monkeypatch.setattr(sqlite3, "connect", lambda *a, **k: NoRoom())
+    assert main(["signoff", "verify", "--data-dir", str(data_dir)]) == 1
+    assert main(["store", "info", "--data-dir", str(data_dir)]) != 0
+    err = capsys.readouterr().err
+    assert err.count("the disk is full (or the account's disk quota is used up)") == 2, err
+    assert "not a readable" not in err and "or restore it from a backup" not in err
+    assert "the records were NOT checked" in err

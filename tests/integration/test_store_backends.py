@@ -24,7 +24,7 @@ from workbench.labs.signoff_errors import (
     WrongPassphrase,
 )
 from workbench.labs.signoff_record import Evidence, RecordFields
-from workbench.labs.store import LogMissing, Store, StoreError, read_signoffs
+from workbench.labs.store import LogMissing, Store, StoreError, StoreUnavailable, read_signoffs
 from workbench.labs.verify import verify_log
 
 FAST = KdfParams(n=2**10, r=8, p=1)
@@ -362,4 +362,52 @@ def test_a_store_opened_while_the_server_is_down_catches_up_when_it_is_back(
     with Store.open(tmp_path, db=pg_url) as fresh:
         assert fresh.progress("alice") == {("lab", "ex1"): {"i": 1}}
         assert fresh.place("alice") == ("lab", "ex1")
+    store.close()
+
+
+@pytest.mark.parametrize("how", ["stopped", "locked"])
+def test_every_call_to_a_database_that_hangs_is_given_up_and_the_write_kept(
+    pg_server, pg_url, tmp_path, monkeypatch, how
+):
+    """A server stopped (SIGSTOP: its kernel still acknowledges, so no TCP timeout fires) or
+    a table locked by another connection: a save is kept pending, a read and a sign-off fail
+    as "unavailable", each within the deadline, and the kept save is written afterwards."""
+    import psycopg
+
+    monkeypatch.setenv("WORKBENCH_DB_TIMEOUT", "1")  # server side 1 s; this side 1 s more
+    store = Store.open(tmp_path, db=pg_url)
+    create_instructor(tmp_path, "Dr Chen", PASS, kdf=FAST, store=store)
+    store.save_progress("ana", "lab", "ex", {"n": 1})
+    pids: list[int] = []
+    locker = None
+    if how == "stopped":
+        pids = pg_server.freeze()
+    else:
+        locker = psycopg.connect(pg_url)
+        for table in ("progress", "signoffs"):
+            locker.execute(f"LOCK TABLE {table} IN ACCESS EXCLUSIVE MODE")
+    safety = threading.Timer(30, pg_server.thaw, (pids,))  # old code must not hang the tests
+    safety.start()
+    try:
+        for call in (
+            lambda: store.save_progress("ana", "lab", "ex", {"n": 2}),
+            lambda: store.progress("ana"),
+            lambda: sign_off(store, "Dr Chen", PASS, fields()),
+        ):
+            began = time.monotonic()
+            try:
+                assert call() is False  # the save: kept pending
+            except StoreUnavailable as exc:
+                assert "did not answer within 1 s" in str(exc) or "cannot be reached" in str(exc)
+            assert time.monotonic() - began < 8
+        assert store.pending == 1
+    finally:
+        safety.cancel()
+        pg_server.thaw(pids)
+        if locker is not None:
+            locker.close()
+    deadline = time.monotonic() + 20
+    while not store.flush() and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert store.progress("ana")[("lab", "ex")] == {"n": 2}
     store.close()

@@ -2,6 +2,7 @@
 
 import os
 import stat
+from dataclasses import replace
 
 import pytest
 
@@ -15,6 +16,7 @@ from workbench.sim.editing import (
     parse_seed,
     parse_size,
 )
+from workbench.sim.maze import MazeError
 from workbench.sim.mazefile import parse_maze
 from workbench.sim.mazeio import load_maze
 
@@ -270,3 +272,35 @@ def test_a_write_error_comes_back_as_a_message(tmp_path, monkeypatch):
     with pytest.raises(EditorError, match="Permission denied; the maze is still here"):
         ed.save(tmp_path / "m.txt")
     assert ed.dirty and ed.path is None and ed.maze.is_wall(2, 1)
+
+
+BIDI = ["\u202a", "\u202b", "\u202c", "\u202d", "\u202e", "\u2066", "\u2067", "\u2068",
+        "\u2069", "\u200e", "\u200f", "\u061c"]  # fmt: skip
+
+
+@pytest.mark.parametrize("control", BIDI)
+def test_a_maze_name_with_a_bidi_control_is_refused_where_it_is_written(control):
+    text = f"---\nname: Evil{control}txt.exe\n---\n#####\n#S..#\n#..E#\n#####\n"
+    with pytest.raises(MazeError) as caught:
+        parse_maze(text, source="evil.txt")
+    problem = caught.value.problems[0]
+    assert problem.message == (
+        f"the maze's name has a bidi control character (U+{ord(control):04X} at position 5), "
+        "which shows text in another order than it is written"
+    )
+    assert (problem.source, problem.line) == ("evil.txt", 2)
+
+
+def test_the_editor_refuses_to_save_a_maze_named_with_a_bidi_override(tmp_path):
+    named = MazeEditor(replace(ROOM, name="Room\u202etxt.exe"))
+    with pytest.raises(EditorError) as caught:
+        named.save(tmp_path / "room.txt")
+    assert str(caught.value) == (
+        f"cannot save as {tmp_path / 'room.txt'}: the maze's name has a bidi control character "
+        "(U+202E at position 5), which shows text in another order than it is written (type "
+        "it again without it)"
+    )
+    assert list(tmp_path.iterdir()) == []  # nothing written
+    # a file name with one is refused as a path (control characters are never in one)
+    with pytest.raises(EditorError, match="control characters"):
+        MazeEditor(ROOM).save(tmp_path / "maze\u202etxt.exe")

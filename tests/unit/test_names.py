@@ -74,3 +74,13 @@ def test_any_text_is_a_clean_name_or_a_reason(text):
         assert not any(unicodedata.category(c) in ("Cc", "Cf", "Co", "Cn") for c in name)
         assert len(scripts_of(name) - {"LATIN", "HAN", "HIRAGANA", "KATAKANA", "HANGUL",
                                        "BOPOMOFO"}) <= 1  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    "control",
+    ["\u202a", "\u202b", "\u202c", "\u202d", "\u202e", "\u2066", "\u2067", "\u2068", "\u2069",
+     "\u200e", "\u200f", "\u061c"],
+)  # fmt: skip
+def test_every_bidi_control_is_refused_in_a_name(control):
+    with pytest.raises(NameProblem, match=rf"U\+{ord(control):04X} at position 4"):
+        check_pair(f"ana{control}nim")

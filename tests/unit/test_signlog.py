@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 from workbench.labs.instructors import Instructor
 from workbench.labs.roster import RosterEntry
-from workbench.labs.signlog import EMPTY_HEAD, GENESIS, Head, LogError, entry_hash
+from workbench.labs.signlog import EMPTY_HEAD, GENESIS, Head, LogError, entry_hash, next_place
 from workbench.labs.signoff_record import Evidence, SignoffRecord
 from workbench.labs.store import StoredSignoff
 from workbench.labs.verify import verify_log
@@ -269,3 +269,13 @@ def test_whatever_the_rows_hold_checking_gives_a_verdict(rows):
     log = verify_log(rows, ROSTER, kept=HEAD)
     assert len(log.verdicts) == len(rows)
     assert not log.ok  # none of these is the kept log
+
+
+def test_the_next_place_follows_the_run_of_numbers_the_log_grew_by():
+    h = ["sha256:" + c * 64 for c in "abcd"]
+    assert next_place([]) == (1, GENESIS)
+    assert next_place([(1, h[0]), (2, h[1])]) == (3, h[1])
+    # a planted far-off number, or one below 1, is stepped over
+    assert next_place([(-5, h[3]), (1, h[0]), (2, h[1]), (999999999999999999, h[2])]) == (3, h[1])
+    # records deleted from the start: the run starts at the first one left
+    assert next_place([(4, h[0]), (5, h[1])]) == (6, h[1])

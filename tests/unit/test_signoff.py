@@ -35,7 +35,14 @@ from workbench.labs.signoff_record import (
     record_digest,
     record_from_stored,
 )
-from workbench.labs.store import DB_NAME, Store, StoreError, read_signoffs, resolve_data_dir
+from workbench.labs.store import (
+    DB_NAME,
+    SIGNOFF_COLUMNS,
+    Store,
+    StoreError,
+    read_signoffs,
+    resolve_data_dir,
+)
 from workbench.labs.verify import verify_all, verify_log
 
 FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only; defaults are untouched
@@ -579,8 +586,25 @@ def test_signing_after_a_tampered_sequence_number_goes_on_or_says_why(store, dat
     with sqlite3.connect(store.path) as conn:
         conn.execute("UPDATE signoffs SET seq = ? WHERE id = 3", (2**62,))
     conn.close()
-    with pytest.raises(StoreError, match="more than it can hold"):
+    _, record = sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+    assert record.seq == 2  # the far-off number is stepped over, not followed
+
+
+def test_a_planted_row_with_a_huge_sequence_number_is_stepped_over_and_named(store, data_dir):
+    for _ in range(3):
         sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+    with sqlite3.connect(store.path) as conn:  # a copy of record 3, planted far beyond the log
+        columns = ", ".join(c for c in SIGNOFF_COLUMNS if c not in ("id", "seq"))
+        conn.execute(
+            f"INSERT INTO signoffs ({columns}, seq) SELECT {columns}, 999999999999999999 "
+            "FROM signoffs WHERE seq = 3"
+        )
+    conn.close()
+    signed = [sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())[1] for _ in range(2)]
+    assert [r.seq for r in signed] == [4, 5]
+    log = verify_log(read_signoffs(data_dir), roster(data_dir))
+    assert [v.row.seq for v in log.verdicts if not v.ok] == [999999999999999999]
+    assert any("before sequence 999999999999999999" in b for b in log.breaks), log.breaks
 
 
 def test_a_note_longer_than_the_cap_is_refused_and_nothing_is_signed(store, run_record):

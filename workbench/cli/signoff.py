@@ -21,6 +21,7 @@ from workbench.labs.roster import load_roster, roster_path, trusted_roster_path
 from workbench.labs.signlog import Head, LogError
 from workbench.labs.signoff_errors import SignoffError, UntrustedRoster
 from workbench.labs.store import (
+    StoreDiskError,
     StoredSignoff,
     StoreError,
     read_signoffs,
@@ -131,6 +132,8 @@ def _checked_log(args: argparse.Namespace) -> tuple[Path, LogVerdict]:
         local = {}  # only used to explain a signature by another key
     try:
         rows = read_signoffs(data_dir, db)
+    except StoreDiskError as exc:  # the disk failed, not the log: it is not known to be bad
+        raise _Refused(f"{exc}\nthe records were NOT checked", 1) from None
     except StoreError as exc:  # LogMissing too: no log where one should be
         raise _Refused(f"{exc}\nthe log does NOT verify", 1) from None
     return path, verify_log(rows, roster, kept, local)

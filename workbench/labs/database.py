@@ -11,11 +11,13 @@ went away, is :class:`StoreUnavailable`, which the store answers by keeping writ
 from __future__ import annotations
 
 import os
+import socket
 import sqlite3
+import threading
 import time
 from abc import ABC, abstractmethod
-from collections.abc import Iterator
-from contextlib import contextmanager
+from collections.abc import Callable, Iterator
+from contextlib import AbstractContextManager, contextmanager, suppress
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -38,12 +40,27 @@ LINK_DEFAULTS: dict[str, object] = {
     "keepalives_interval": 10,
     "keepalives_count": 3,
 }
+#: how long one statement may take in the course database: the server gives up a statement
+#: (``statement_timeout``) or a wait for a lock (``lock_timeout``) after this many seconds, and
+#: this side gives up a call the server does not answer at all (stopped, or its machine hung
+#: while its network still acknowledges) a little later by dropping the connection. Either way
+#: the call fails as :class:`StoreUnavailable`: writes are kept pending, nobody waits longer.
+ENV_DB_TIMEOUT = "WORKBENCH_DB_TIMEOUT"
+DB_TIMEOUT_S = 5.0
+DB_TIMEOUT_RANGE = (0.5, 600.0)
+#: seconds this side waits beyond the server's own timeout before it drops the connection
+CLIENT_GRACE_S = 2.0
 MAX_URL = 2048
 POSTGRES_SCHEMES = ("postgresql://", "postgres://")
 
 
 class StoreError(Exception):
     """The database cannot be opened, read or written; the message names it."""
+
+
+class StoreDiskError(StoreError):
+    """The disk under the database failed (full, over quota, an input/output error): the
+    database is not known to be damaged, and a backup must not be put over it."""
 
 
 class LogMissing(StoreError):
@@ -73,6 +90,25 @@ def resolve_db(option: str | None = None) -> str | None:
     return value
 
 
+def db_timeout() -> float:
+    """Seconds a course database statement may take: ``$WORKBENCH_DB_TIMEOUT``, else
+    :data:`DB_TIMEOUT_S`. A value that is not a number in range is refused, naming it."""
+    text = os.environ.get(ENV_DB_TIMEOUT, "").strip()
+    if not text:
+        return DB_TIMEOUT_S
+    low, high = DB_TIMEOUT_RANGE
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not low <= value <= high:
+        raise StoreError(
+            f"${ENV_DB_TIMEOUT}: {text[:40]!r} is not a number of seconds from {low:g} to "
+            f"{high:g} (the default is {DB_TIMEOUT_S:g})"
+        )
+    return value
+
+
 def redact(url: str) -> str:
     """A database URL fit for messages and logs: the password replaced by ``***``."""
     scheme, sep, rest = url.partition("://")
@@ -89,16 +125,84 @@ def redact(url: str) -> str:
 
 @dataclass
 class Tx:
-    """A transaction's cursor: ``execute`` takes SQL with ``?`` placeholders."""
+    """A transaction's cursor: ``execute`` takes SQL with ``?`` placeholders. ``deadline``
+    (PostgreSQL) is the watch each statement runs under."""
 
     cursor: Any
     postgres: bool
+    deadline: Callable[[], AbstractContextManager[None]] | None = None
 
     def execute(self, sql: str, params: tuple[Any, ...] | list[Any] = ()) -> Any:
         if self.postgres:
             sql = sql.replace("?", "%s")
-        self.cursor.execute(sql, tuple(params))
+        if self.deadline is None:
+            self.cursor.execute(sql, tuple(params))
+        else:
+            with self.deadline():
+                self.cursor.execute(sql, tuple(params))
         return self.cursor
+
+
+class Watchdog:
+    """One thread that drops a connection whose statement is still unanswered at its deadline
+    (a server that is stopped, or whose machine hangs while its network still acknowledges,
+    never fires its own timeout). Shutting the socket makes the waiting call fail at once."""
+
+    def __init__(self, seconds: float):
+        self.seconds = seconds
+        self._cond = threading.Condition()
+        self._due: float | None = None
+        self._conn: Any = None
+        self._thread: threading.Thread | None = None
+        #: the connection last dropped (the call on it failed for that reason)
+        self.dropped: Any = None
+        self._stopped = False
+
+    @contextmanager
+    def watch(self, conn: Any) -> Iterator[None]:
+        with self._cond:
+            if self._thread is None:
+                self._stopped = False
+                self._thread = threading.Thread(
+                    target=self._run, name="course-db-deadline", daemon=True
+                )
+                self._thread.start()
+            self._due, self._conn = time.monotonic() + self.seconds, conn
+            self._cond.notify()
+        try:
+            yield
+        finally:
+            with self._cond:
+                self._due = self._conn = None
+
+    def stop(self) -> None:
+        """End the thread (the backend is closed)."""
+        with self._cond:
+            self._stopped = True
+            self._thread = None
+            self._cond.notify()
+
+    def _run(self) -> None:
+        with self._cond:
+            while not self._stopped:
+                if self._due is None:
+                    self._cond.wait()
+                    continue
+                left = self._due - time.monotonic()
+                if left > 0:
+                    self._cond.wait(left)
+                    continue
+                self.dropped, conn = self._conn, self._conn
+                self._due = self._conn = None
+                _shut(conn)
+
+
+def _shut(conn: Any) -> None:
+    try:
+        with socket.socket(fileno=os.dup(conn.pgconn.socket)) as sock:
+            sock.shutdown(socket.SHUT_RDWR)
+    except Exception:  # closed meanwhile: its call is over anyway
+        return
 
 
 class Backend(ABC):
@@ -125,6 +229,42 @@ class Backend(ABC):
         return self.kind == "postgresql"
 
 
+#: what to do with a database file that is not one (or is damaged): only then a backup helps
+NOT_A_DATABASE = "move it aside to start a new one, or restore it from a backup"
+
+
+def sqlite_failure(where: str | os.PathLike, exc: sqlite3.Error, doing: str) -> StoreError:
+    """The error for a failed SQLite call, named for what it is. A full disk and other
+    input/output errors say so and what to do, and never advise restoring a backup: the
+    database is intact, and an older copy would roll back the sign-off log. Only a file that
+    is not a database, or a damaged one, is called unreadable."""
+    text = str(exc)
+    code = getattr(exc, "sqlite_errorcode", None)
+    primary = code & 0xFF if isinstance(code, int) else None
+    if primary == sqlite3.SQLITE_FULL or "disk is full" in text:
+        return StoreDiskError(
+            f"{where}: cannot {doing}: the disk is full (or the account's disk quota is used "
+            "up); free some space and try again. The database is not damaged: do not restore "
+            "a backup over it"
+        )
+    if primary == sqlite3.SQLITE_IOERR or "disk I/O error" in text:
+        return StoreDiskError(
+            f"{where}: cannot {doing}: an input/output error on the disk ({text}); check the "
+            "disk and its free space and try again. This is no sign of a damaged database: "
+            "do not restore a backup over it"
+        )
+    if primary in (sqlite3.SQLITE_NOTADB, sqlite3.SQLITE_CORRUPT) or (
+        "file is not a database" in text or "malformed" in text
+    ):
+        return StoreError(f"{where}: not a readable workbench database ({text}); {NOT_A_DATABASE}")
+    if primary == sqlite3.SQLITE_CANTOPEN:
+        return StoreError(
+            f"{where}: cannot open the database file ({text}): check that its folder can be "
+            "written (SQLite keeps companion files beside it) and has free space"
+        )
+    return StoreError(f"{where}: cannot {doing}: {text}")
+
+
 class SqliteBackend(Backend):
     """The SQLite file in WAL mode; each write is one ``BEGIN IMMEDIATE`` transaction, so two
     processes writing at once queue (for up to ten seconds) rather than fail."""
@@ -141,7 +281,7 @@ class SqliteBackend(Backend):
         try:
             conn = sqlite3.connect(path, timeout=BUSY_TIMEOUT_MS / 1000, isolation_level=None)
         except sqlite3.Error as exc:
-            raise StoreError(f"{path}: cannot open the database: {exc}") from None
+            raise sqlite_failure(path, exc, "open the database") from None
         backend = cls(path, conn)
         try:
             conn.execute(f"PRAGMA busy_timeout = {BUSY_TIMEOUT_MS}")
@@ -151,10 +291,7 @@ class SqliteBackend(Backend):
             conn.execute("PRAGMA synchronous = FULL")
         except sqlite3.DatabaseError as exc:
             conn.close()
-            raise StoreError(
-                f"{path}: not a readable workbench database ({exc}); move it aside to start a "
-                "new one, or restore it from a backup"
-            ) from None
+            raise sqlite_failure(path, exc, "open the database") from None
         except StoreError:
             conn.close()
             raise
@@ -166,12 +303,12 @@ class SqliteBackend(Backend):
         try:
             cur.execute("BEGIN IMMEDIATE")
         except sqlite3.OperationalError as exc:
-            raise StoreError(f"{self.where}: cannot write: {exc}") from None
+            raise sqlite_failure(self.where, exc, "write") from None
         try:
             yield Tx(cur, postgres=False)
         except sqlite3.Error as exc:
             self.conn.rollback()
-            raise StoreError(f"{self.where}: cannot write: {exc}") from None
+            raise sqlite_failure(self.where, exc, "write") from None
         except BaseException:
             self.conn.rollback()
             raise
@@ -180,13 +317,13 @@ class SqliteBackend(Backend):
                 cur.execute("COMMIT")
             except sqlite3.Error as exc:
                 self.conn.rollback()
-                raise StoreError(f"{self.where}: cannot write: {exc}") from None
+                raise sqlite_failure(self.where, exc, "write") from None
 
     def read(self, sql: str, params: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
         try:
             return self.conn.execute(sql, params).fetchall()
         except sqlite3.DatabaseError as exc:
-            raise StoreError(f"{self.where}: cannot read: {exc}") from None
+            raise sqlite_failure(self.where, exc, "read") from None
 
     def close(self) -> None:
         self.conn.close()
@@ -195,16 +332,21 @@ class SqliteBackend(Backend):
 class PostgresBackend(Backend):
     """A PostgreSQL database. The connection is made again after the server went away; while
     it cannot be, every call raises :class:`StoreUnavailable` at once (one new attempt per
-    :data:`RETRY_AFTER_S` at most, so a writer never waits on a dead server)."""
+    :data:`RETRY_AFTER_S` at most, so a writer never waits on a dead server). Every call has a
+    deadline (:func:`db_timeout`): the server's ``statement_timeout`` and ``lock_timeout``, and
+    on this side a :class:`Watchdog` that drops the connection of a statement still
+    unanswered after them."""
 
     kind = "postgresql"
 
-    def __init__(self, url: str, *, read_only: bool = False):
+    def __init__(self, url: str, *, read_only: bool = False, timeout: float | None = None):
         self.url = url
         self.where = redact(url)
         self.read_only = read_only
+        self.timeout = db_timeout() if timeout is None else timeout
         self.conn: Any = None
         self._next_try = 0.0
+        self.watchdog = Watchdog(self.timeout + CLIENT_GRACE_S)
 
     def connection(self) -> Any:
         import psycopg
@@ -219,11 +361,12 @@ class PostgresBackend(Backend):
         now = time.monotonic()
         if now < self._next_try:
             raise StoreUnavailable(f"{self.where}: the database cannot be reached (retrying)")
+        given = conninfo_to_dict(self.url)
         try:
             conn = psycopg.connect(
                 self.url,
                 autocommit=True,
-                **{**LINK_DEFAULTS, **conninfo_to_dict(self.url)},  # the URL's own settings win
+                **{**LINK_DEFAULTS, **given},  # the URL's own settings win
             )
         except psycopg.OperationalError as exc:
             self._next_try = now + RETRY_AFTER_S
@@ -232,17 +375,45 @@ class PostgresBackend(Backend):
             ) from None
         except psycopg.Error as exc:  # a malformed URL, an unknown option
             raise StoreError(f"{self.where}: cannot connect: {_first_line(exc)}") from None
-        if self.read_only:
-            conn.execute("SET SESSION CHARACTERISTICS AS TRANSACTION READ ONLY")
+        try:
+            with self.watchdog.watch(conn):
+                options = str(given.get("options", ""))
+                for name in ("statement_timeout", "lock_timeout"):
+                    if name not in options:  # set in the URL (options=-c ...): that wins
+                        conn.execute(
+                            "SELECT set_config(%s, %s, false)",
+                            (name, f"{round(self.timeout * 1000)}ms"),
+                        )
+                if self.read_only:
+                    conn.execute("SET SESSION CHARACTERISTICS AS TRANSACTION READ ONLY")
+        except psycopg.Error as exc:
+            conn.close()
+            self._next_try = now + RETRY_AFTER_S
+            raise self._failed(exc, "connect") from None
         self.conn = conn
         return conn
 
     def _failed(self, exc: Exception, doing: str) -> StoreError:
         """The error to raise for a failed statement: unavailable when the connection was
-        lost with it (the server stopped or restarted), else a plain one."""
+        lost with it (the server stopped or restarted, or did not answer in time) or the
+        server gave it up at its timeout, else a plain one."""
         import psycopg
 
         conn = self.conn
+        seconds = f"{self.timeout:g} s"
+        if isinstance(exc, psycopg.errors.QueryCanceled | psycopg.errors.LockNotAvailable):
+            self._next_try = time.monotonic() + RETRY_AFTER_S
+            return StoreUnavailable(
+                f"{self.where}: the database did not answer within {seconds} (busy or locked): "
+                f"{_first_line(exc)}"
+            )
+        if self.watchdog.dropped is not None and self.watchdog.dropped in (conn, None):
+            self.watchdog.dropped = None
+            self._next_try = time.monotonic() + RETRY_AFTER_S
+            return StoreUnavailable(
+                f"{self.where}: the database did not answer within {seconds}; the connection "
+                "was dropped"
+            )
         if conn is None or conn.closed or conn.broken or isinstance(exc, psycopg.InterfaceError):
             self._next_try = time.monotonic() + RETRY_AFTER_S
             return StoreUnavailable(f"{self.where}: the database went away: {_first_line(exc)}")
@@ -254,8 +425,16 @@ class PostgresBackend(Backend):
 
         conn = self.connection()
         try:
-            with conn.transaction(), conn.cursor() as cur:
-                yield Tx(cur, postgres=True)
+            with conn.cursor() as cur:
+                tx = Tx(cur, postgres=True, deadline=lambda: self.watchdog.watch(conn))
+                tx.execute("BEGIN")
+                try:
+                    yield tx
+                except BaseException:
+                    with suppress(psycopg.Error):
+                        tx.execute("ROLLBACK")
+                    raise
+                tx.execute("COMMIT")
         except psycopg.Error as exc:
             raise self._failed(exc, "write") from None
 
@@ -265,11 +444,13 @@ class PostgresBackend(Backend):
         conn = self.connection()
         try:
             with conn.cursor() as cur:
-                return Tx(cur, postgres=True).execute(sql, params).fetchall()
+                tx = Tx(cur, postgres=True, deadline=lambda: self.watchdog.watch(conn))
+                return tx.execute(sql, params).fetchall()
         except psycopg.Error as exc:
             raise self._failed(exc, "read") from None
 
     def close(self) -> None:
+        self.watchdog.stop()
         if self.conn is not None:
             self.conn.close()
             self.conn = None

@@ -14,6 +14,7 @@ import os
 from pathlib import Path
 
 from workbench.files.atomic import write_text_atomic
+from workbench.files.private import PRIVATE_FILE, private_dir
 
 from .names import NameProblem, check_pair
 
@@ -39,6 +40,8 @@ def read_last_pair(data_dir: str | os.PathLike) -> tuple[str, str] | None:
 def save_last_pair(data_dir: str | os.PathLike, student: str, partner: str = "") -> None:
     """Remember the pair at this workbench (written whole, then moved into place)."""
     folder = Path(data_dir)
-    folder.mkdir(parents=True, exist_ok=True)
+    private_dir(folder)
     path = folder / FILE_NAME
-    write_text_atomic(path, json.dumps({"student": student, "partner": partner}))
+    write_text_atomic(
+        path, json.dumps({"student": student, "partner": partner}), mode=PRIVATE_FILE
+    )

@@ -22,6 +22,7 @@ from typing import Any
 
 from workbench.files.atomic import write_text_atomic
 from workbench.files.bounded import Limits, read_text
+from workbench.files.private import PRIVATE_FILE, private_dir
 
 #: the values of each kind of write, in the order of its statement
 FIELDS = {
@@ -63,13 +64,13 @@ def save_pending(path: Path, student: str, writes: list[PendingWrite]) -> None:
         with contextlib.suppress(FileNotFoundError):
             path.unlink()
         return
-    path.parent.mkdir(parents=True, exist_ok=True)
+    private_dir(path.parent)
     data = {
         "format": FORMAT,
         "student": student,
         "writes": [{"kind": w.kind, "values": list(w.values)} for w in writes],
     }
-    write_text_atomic(path, json.dumps(data, ensure_ascii=False, indent=1))
+    write_text_atomic(path, json.dumps(data, ensure_ascii=False, indent=1), mode=PRIVATE_FILE)
 
 
 def load_pending(path: Path, student: str) -> tuple[list[PendingWrite], list[str]]:

@@ -136,6 +136,24 @@ class Head:
 EMPTY_HEAD = Head(0, GENESIS)
 
 
+def next_place(numbered: Sequence[tuple[int, str]]) -> tuple[int, str]:
+    """Where the next record goes (its sequence number and ``prev``), given the stored
+    ``(seq, entry hash)`` of every numbered record in the order of their sequence numbers:
+    after the run of consecutive numbers that starts with the lowest one from 1 (the log as it
+    grew), so a record planted with a far-off number (``999999999999999999``, or one below 1)
+    is stepped over rather than followed; verify names it. The place is free, as the run stops
+    before the first number not taken."""
+    numbered = [(seq, stored) for seq, stored in numbered if seq >= 1]
+    if not numbered:
+        return 1, GENESIS
+    last_seq, last_hash = numbered[0]
+    for seq, stored in numbered[1:]:
+        if seq != last_seq + 1:
+            break
+        last_seq, last_hash = seq, stored
+    return last_seq + 1, last_hash
+
+
 @dataclass(frozen=True)
 class Entry:
     """What the chain check needs of one stored record."""

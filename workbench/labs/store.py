@@ -18,12 +18,15 @@ checking and exporting.
 
 from __future__ import annotations
 
+import contextlib
 import json
+import logging
 import os
 import sqlite3
 import threading
 import urllib.request
 from collections.abc import Callable, Iterator
+from concurrent.futures import Future, ThreadPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from datetime import UTC, datetime
@@ -32,25 +35,30 @@ from typing import Any
 
 import platformdirs
 
+from workbench.files.private import PRIVATE_FILE, private_dir, tighten
+
 from .database import (
     BUSY_TIMEOUT_MS,
     Backend,
     LogMissing,
     PostgresBackend,
     SqliteBackend,
+    StoreDiskError,
     StoreError,
     StoreUnavailable,
     Tx,
     resolve_db,
+    sqlite_failure,
 )
 from .migrations import RECORD_COLUMNS, SIGNOFF_LOCK, check_version, latest, migrate
 from .names import name_key
 from .pending import FIELDS, PendingWrite, load_pending, save_pending
-from .signlog import GENESIS, entry_hash, parse_metrics, signed_payload
+from .signlog import GENESIS, entry_hash, next_place, parse_metrics, signed_payload
 
 __all__ = [
     "LogMissing",
     "Store",
+    "StoreDiskError",
     "StoreError",
     "StoreUnavailable",
     "StoredSignoff",
@@ -58,6 +66,8 @@ __all__ = [
     "resolve_data_dir",
     "resolve_db",
 ]
+
+log = logging.getLogger(__name__)
 
 APP_NAME = "viple-workbench"
 DB_NAME = "workbench.sqlite3"
@@ -205,6 +215,13 @@ class Store:
         self._pending_student = ""
         #: why the pending writes could not be kept in their file ("" when they could)
         self.pending_file_problem = ""
+        #: with :meth:`write_in_background`: the one thread that writes, and the flush it has
+        #: waiting (not started yet), which a new write joins
+        self._writer: ThreadPoolExecutor | None = None
+        self._queued: Future[bool] | None = None
+        self._on_trouble: Callable[[StoreError], None] | None = None
+        #: what opening the store changed (a data folder open to others made private)
+        self.notices: list[str] = []
 
     @classmethod
     def open(
@@ -238,22 +255,26 @@ class Store:
                 f"{path}: no workbench database here (nothing was signed off or saved with "
                 "this data folder; see --data-dir)"
             )
+        notices: list[str] = []
         try:
-            folder.mkdir(parents=True, exist_ok=True)
+            notices.append(private_dir(folder))
+            if not path.exists():
+                _create_database(path)
+            refuse_empty(path)
+            for name in (DB_NAME, f"{DB_NAME}-wal", f"{DB_NAME}-shm"):
+                notices.append(tighten(folder / name))
         except OSError as exc:
-            raise StoreError(f"{folder}: cannot create the data folder: {exc.strerror}") from None
+            raise StoreError(f"{exc.filename or folder}: cannot set up the data folder: "
+                             f"{exc.strerror}") from None  # fmt: skip
         store = cls(folder, SqliteBackend.open(path))
         try:
             store._ensure_schema()
-        except StoreError as exc:
+        except StoreError:
             store.close()
-            text = str(exc)
-            if "file is not a database" in text or "malformed" in text:
-                raise StoreError(
-                    f"{path}: not a readable workbench database ({text.split(': ')[-1]}); "
-                    "move it aside to start a new one, or restore it from a backup"
-                ) from None
             raise
+        store.notices = [n for n in notices if n]
+        for notice in store.notices:
+            log.warning("%s", notice)
         return store
 
     def _ensure_schema(self) -> None:
@@ -282,8 +303,67 @@ class Store:
         return len(self._pending)
 
     def close(self) -> None:
+        """Close the connection; writing in the background, without waiting for a write on
+        its way (the writing thread closes it once that write is done or given up)."""
+        writer = self._writer
+        if writer is None:
+            with self._io:
+                self.backend.close()
+            return
+        with self._lock:
+            if self._queued is not None:
+                self._queued.cancel()
+                self._queued = None
+            writer.submit(self._close_backend)
+            writer.shutdown(wait=False)
+
+    def _close_backend(self) -> None:
         with self._io:
             self.backend.close()
+
+    def write_in_background(self, on_trouble: Callable[[StoreError], None]) -> None:
+        """From now on a save never waits for the database: it is kept pending and written
+        by a thread of the store's own, one flush at a time (:meth:`flush_soon`). When a
+        write in that thread fails, ``on_trouble`` is called there with the error: a
+        :class:`StoreUnavailable` when the database is away or did not answer in time (the
+        write stays pending), another :class:`StoreError` when it was refused."""
+        with self._lock:
+            self._on_trouble = on_trouble
+            if self._writer is None:
+                self._writer = ThreadPoolExecutor(1, thread_name_prefix="store-writer")
+
+    @property
+    def in_background(self) -> bool:
+        return self._writer is not None
+
+    def flush_soon(self) -> Future[bool]:
+        """A :meth:`flush` in the store's writing thread (see :meth:`write_in_background`);
+        a flush already waiting there is shared. Its result is that of :meth:`flush`."""
+        with self._lock:
+            if self._writer is None:
+                raise RuntimeError("the store does not write in the background")
+            if self._queued is None:
+                self._queued = self._writer.submit(self._flush_in_writer)
+            return self._queued
+
+    def _flush_in_writer(self) -> bool:
+        with self._lock:
+            self._queued = None  # writes kept from now on go with the next flush
+        try:
+            done = self.flush()
+        except StoreError as exc:
+            self._tell(exc)
+            raise
+        if not done:
+            self._tell(StoreUnavailable(f"{self.where}: the database cannot be reached"))
+        return done
+
+    def _tell(self, exc: StoreError) -> None:
+        if self._on_trouble is not None:
+            try:
+                self._on_trouble(exc)
+            except Exception:  # whoever listens is gone (the app ending): the writes are kept
+                return
 
     def __enter__(self) -> Store:
         return self
@@ -306,13 +386,17 @@ class Store:
 
     def _keep(self, write: PendingWrite) -> bool:
         """Write one upsert, or keep it pending while the database is away; the newest write
-        of a key replaces an older pending one. True when it (and all pending) was written."""
+        of a key replaces an older pending one. True when it (and all pending) was written,
+        or, writing in the background, when it is on its way (the database was answering)."""
         with self._lock:
             self._pending.pop(write.key, None)
             self._pending[write.key] = (write, False)
             if self.offline:
                 self._persist()
                 return False  # no new try here: flush() does it, off the caller's thread
+            if self._writer is not None:
+                self.flush_soon()
+                return True
         return self.flush()
 
     def flush(self) -> bool:
@@ -346,6 +430,12 @@ class Store:
                     del self._pending[key]
             self._persist()
             return not self._pending
+
+    def keep_pending_now(self) -> None:
+        """Write what is pending to its file now (an app ending while a write may still be
+        on its way keeps it for the next app)."""
+        with self._lock:
+            self._persist()
 
     def keep_pending_in(self, path: Path, student: str) -> list[str]:
         """Keep ``student``'s pending writes in the file ``path`` from now on, and take up the
@@ -392,13 +482,14 @@ class Store:
         with self._write() as tx:
             if postgres:
                 tx.execute("SELECT pg_advisory_xact_lock(?)", (SIGNOFF_LOCK,))
-            # rows whose seq is not a number were tampered with: verify names them, and the
-            # log goes on after the last numbered record
+            # rows whose seq is not a number were tampered with, and so is a row numbered
+            # far beyond the log: verify names them, and the log goes on after the run of
+            # consecutive numbers it grew by (signlog.next_place)
             numbered = "seq IS NOT NULL" if postgres else "typeof(seq) = 'integer'"
-            last = tx.execute(
-                f"SELECT seq, entry_hash FROM signoffs WHERE {numbered} ORDER BY seq DESC LIMIT 1"
-            ).fetchone()
-            seq, prev = (int(last[0]) + 1, str(last[1] or "")) if last else (1, GENESIS)
+            rows = tx.execute(
+                f"SELECT seq, entry_hash FROM signoffs WHERE {numbered} ORDER BY seq"
+            ).fetchall()
+            seq, prev = next_place([(int(s), str(h or "")) for s, h in rows])
             if seq >= MAX_SEQ:
                 raise StoreError(
                     f"{self.where}: the sign-off log claims {seq - 1} records, more than it "
@@ -627,6 +718,47 @@ class Store:
             )
 
 
+def _create_database(path: Path) -> None:
+    """Make a new, empty workbench database at ``path``, private to the account: built under
+    another name and then linked into place, so that no other process ever finds an empty file
+    there (an empty file at ``path`` is refused: see :func:`refuse_empty`). When another
+    process made one first, theirs is kept."""
+    part = path.with_name(f".{path.name}.{os.getpid()}.{threading.get_ident()}.new")
+    try:
+        os.close(os.open(part, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, PRIVATE_FILE))
+        os.chmod(part, PRIVATE_FILE)
+        backend = SqliteBackend.open(part)
+        try:
+            migrate(backend)
+        finally:
+            backend.close()
+        try:
+            os.link(part, path)
+        except FileExistsError:
+            pass  # made by another process meanwhile
+        except OSError:  # a file system without hard links
+            if not path.exists():
+                os.replace(part, path)
+    finally:
+        for leftover in (part, Path(f"{part}-wal"), Path(f"{part}-shm")):
+            with contextlib.suppress(FileNotFoundError):
+                leftover.unlink()
+
+
+def refuse_empty(path: Path) -> None:
+    """Refuse a database file of 0 bytes: it is not a workbench database (the workbench never
+    leaves one), and opening it would silently start a new, empty store in its place."""
+    try:
+        size = path.stat().st_size
+    except FileNotFoundError:
+        return
+    if size == 0 and path.is_file():
+        raise StoreError(
+            f"{path}: an empty file (0 bytes), not a workbench database; if the store was "
+            f"lost, restore it from a backup, or move the file aside to start a new one"
+        )
+
+
 def _signoff_from_row(row: tuple[Any, ...], names: tuple[str, ...]) -> StoredSignoff:
     data = dict(zip(names, row, strict=True))
     for name in names:
@@ -670,11 +802,12 @@ def read_signoffs(data_dir: str | os.PathLike, db: str | None = None) -> list[St
             f"{path}: no workbench database here (nothing was signed off with this data "
             "folder, or the file was deleted; see --data-dir)"
         )
+    refuse_empty(path)
     uri = "file:" + urllib.request.pathname2url(str(path.resolve())) + "?mode=ro"
     try:
         conn = sqlite3.connect(uri, uri=True, timeout=BUSY_TIMEOUT_MS / 1000)
     except sqlite3.Error as exc:
-        raise StoreError(f"{path}: cannot open the database: {exc}") from None
+        raise sqlite_failure(path, exc, "open the database") from None
 
     def read(sql: str, params: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
         return conn.execute(sql, params).fetchall()
@@ -682,9 +815,7 @@ def read_signoffs(data_dir: str | os.PathLike, db: str | None = None) -> list[St
     try:
         return _read_log(read, "sqlite", str(path))
     except sqlite3.DatabaseError as exc:
-        raise StoreError(
-            f"{path}: not a readable workbench database ({exc}); restore it from a backup"
-        ) from None
+        raise sqlite_failure(path, exc, "read the sign-off log") from None
     finally:
         conn.close()
 

@@ -19,6 +19,7 @@ import os
 import yaml
 
 from workbench.files.atomic import write_text_atomic
+from workbench.files.bidi import bidi_problem
 from workbench.files.bounded import MAZE_LIMITS, BoundedFileError, check_text, load_yaml
 
 from .maze import FLOOR, MAX_SIZE, PROFILES, WALL, Maze, MazeError, Problem
@@ -126,6 +127,11 @@ def _front_matter(lines: list[str], source: str) -> tuple[dict, int, list[Proble
     for key in ("name", "description"):
         if key in meta and not isinstance(meta[key], str):
             meta[key] = str(meta[key])
+        problem = bidi_problem(str(meta.get(key) or ""), f"the maze's {key}")
+        if problem:
+            problems.append(
+                Problem(problem, "type it again without it", source, key_lines.get(key, 2), 1)
+            )
     return meta, end + 1, problems
 
 
@@ -270,5 +276,23 @@ def format_maze(maze: Maze, front_matter: bool = True) -> str:
     return "\n".join(out) + "\n"
 
 
+def check_names(path: str | os.PathLike, maze: Maze) -> None:
+    """:class:`MazeError` when the maze's name or description, or the file name it is to be
+    saved under, holds a bidi control (see :mod:`workbench.files.bidi`)."""
+    checks = (
+        (maze.name, "the maze's name"),
+        (maze.description, "the maze's description"),
+        (os.path.basename(os.fspath(path)), "the file name"),
+    )
+    problems = [
+        Problem(problem, "type it again without it", str(path))
+        for text, what in checks
+        if (problem := bidi_problem(text, what))
+    ]
+    if problems:
+        raise MazeError(problems)
+
+
 def write_maze(path: str | os.PathLike, maze: Maze) -> None:
+    check_names(path, maze)
     write_text_atomic(path, format_maze(maze))

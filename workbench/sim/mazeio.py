@@ -20,7 +20,7 @@ from workbench.files.bounded import (
 
 from .maz import format_maz, parse_maz
 from .maze import Maze, MazeError, Problem
-from .mazefile import format_maze, parse_maze
+from .mazefile import check_names, format_maze, parse_maze
 from .micromouse import format_micromouse, parse_micromouse, parse_mms_map, parse_mms_num
 from .wallmaze import to_blocks
 
@@ -113,6 +113,7 @@ def save_maze(path: str | os.PathLike, maze: Maze, fmt: str = "workbench") -> No
     """Write ``maze`` atomically; MazeError when the format cannot hold it."""
     if fmt not in WRITE_FORMATS:
         raise _unknown(fmt, WRITE_FORMATS, str(path))
+    check_names(path, maze)
     if fmt == "maz":
         write_bytes_atomic(path, format_maz(maze))
     elif fmt == "micromouse":

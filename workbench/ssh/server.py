@@ -8,6 +8,7 @@ import asyncio
 import contextlib
 import itertools
 import logging
+import os
 import socket
 import sys
 import time
@@ -18,6 +19,7 @@ from pathlib import Path
 import asyncssh
 
 from workbench.control.recording import RecordQuota
+from workbench.files.private import private_dir, tighten_tree
 from workbench.files.workspace import workspace_folder
 
 from .appproc import RESTORE_TERMINAL, AppEntry, AppProcess, AppSpec, app_env, forward_hint
@@ -104,8 +106,12 @@ def shown(name: str) -> str:
 
 
 def setup_logging(data_dir: Path, stream: bool = True) -> Path:
-    """Log the server's events to ``<data-dir>/ssh.log`` (and stderr); returns the log's path."""
-    data_dir.mkdir(parents=True, exist_ok=True)
+    """Log the server's events to ``<data-dir>/ssh.log`` (and stderr); returns the log's path.
+    The data folder and everything in it are made private to the server's account first, and
+    so is all the server and its apps make from now on (a umask of 077): they hold students'
+    progress and login addresses."""
+    os.umask(0o077)
+    changed = [n for n in (private_dir(data_dir), *tighten_tree(data_dir)) if n]
     path = data_dir / "ssh.log"
     formatter = logging.Formatter("%(asctime)s %(levelname)s %(message)s")
     handlers: list[logging.Handler] = [logging.FileHandler(path, encoding="utf-8")]
@@ -116,6 +122,14 @@ def setup_logging(data_dir: Path, stream: bool = True) -> Path:
         log.addHandler(handler)
     log.setLevel(logging.INFO)
     logging.getLogger("asyncssh").setLevel(logging.WARNING)
+    if changed:
+        log.warning(
+            "made private to this account: %d file(s) and folder(s) of %s were open to other "
+            "accounts, e.g. %s",
+            len(changed),
+            data_dir,
+            changed[0],
+        )
     return path
 
 

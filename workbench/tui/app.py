@@ -33,7 +33,7 @@ from workbench.labs.lastpair import read_last_pair, save_last_pair
 from workbench.labs.model import Setup
 from workbench.labs.names import NameProblem, check_pair
 from workbench.labs.pending import pending_path
-from workbench.labs.store import Store, resolve_data_dir
+from workbench.labs.store import Store, StoreError, resolve_data_dir
 from workbench.sim.maze import Maze, MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.noise import NOISE_LEVELS
@@ -60,7 +60,7 @@ from .host import (
 from .keys import APP_KEY_IDS, bindings
 from .screens.arrival import ArrivalScreen
 from .screens.editor import EditorScreen
-from .screens.labs import LabsScreen
+from .screens.labs import LabsScreen, StoreTrouble
 from .screens.main import MainScreen
 from .screens.runs import RunsScreen
 from .serving import warmup
@@ -74,6 +74,9 @@ from .settings import AppSettings
 MIN_SIZE = (80, 24)
 #: seconds between tries to write what the course database did not get
 STORE_RETRY_SECONDS = 2.0
+#: how long quitting waits for the course database to take what is pending (it is in the
+#: pending file already, for the next app, if it does not)
+STORE_LAST_TRY_SECONDS = 2.0
 #: how often the clock ticks while the station is at rest (paused, or the robot standing with
 #: nobody driving it): time passes as before, in larger steps, and nothing else needs drawing
 REST_HZ = 0.5
@@ -505,7 +508,15 @@ class WorkbenchApp(ScreenHost[None]):
             # what waits for the database is kept in a file too: it outlives this app
             for problem in store.keep_pending_in(self._pending_file(), self.student):
                 self.log.warning(problem)
+            # and a save never waits for it: a database that hangs must not freeze the screen
+            store.write_in_background(self._store_trouble)
         self.store = store
+
+    def _store_trouble(self, error: StoreError) -> None:
+        """A save failed in the store's thread: the labs screen says so (from that thread)."""
+        labs = self._labs
+        if labs is not None:
+            labs.post_message(StoreTrouble(error))
 
     def _pending_file(self) -> Path:
         return pending_path(resolve_data_dir(self.settings.data_dir), self.student)
@@ -520,7 +531,10 @@ class WorkbenchApp(ScreenHost[None]):
             return
         while store.pending:
             try:
-                done = await asyncio.to_thread(store.flush)
+                if store.in_background:
+                    done = await asyncio.wrap_future(store.flush_soon())
+                else:
+                    done = await asyncio.to_thread(store.flush)
             except Exception as exc:  # written by no retry: say why, keep working
                 self._say(f"changes kept from before were not saved: {exc}")
                 return
@@ -585,10 +599,18 @@ class WorkbenchApp(ScreenHost[None]):
         if self.store is not None:
             # a last try for what the database did not get yet (never shown as saved); while
             # it is away the pending writes are in their file already, for the next app
-            if not self.store.offline:
+            store = self.store
+            if store.in_background:
+                store.keep_pending_now()  # a write on its way when the database hangs
+                if not store.offline:
+                    with contextlib.suppress(Exception):
+                        await asyncio.wait_for(
+                            asyncio.wrap_future(store.flush_soon()), STORE_LAST_TRY_SECONDS
+                        )
+            elif not store.offline:
                 with contextlib.suppress(Exception):
-                    self.store.flush()
-            self.store.close()
+                    store.flush()
+            store.close()
         if self.endpoints is not None:
             await self.endpoints.close()
         self.exit()

@@ -19,6 +19,7 @@ from textual import on
 from textual.app import ComposeResult
 from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical, VerticalScroll
+from textual.message import Message
 from textual.screen import Screen
 from textual.timer import Timer
 from textual.widgets import Input, Markdown, OptionList, Static
@@ -34,7 +35,7 @@ from workbench.labs.checks import (
     keep_passed,
 )
 from workbench.labs.model import Exercise, Lab, LabFileError, Setup, load_labs
-from workbench.labs.store import Store, StoreUnavailable
+from workbench.labs.store import Store, StoreError, StoreUnavailable
 from workbench.sim.session import Snapshot
 
 from ..host import FollowsUnicode, SetUpDone, ShowsSnapshot
@@ -85,6 +86,14 @@ def setup_words(changes: SetupChanges, setup: Setup) -> list[str]:
     if changes.program_dropped:
         said.append(f"program {changes.program_dropped} no longer chosen")
     return said
+
+
+class StoreTrouble(Message):
+    """A save the store wrote in its own thread failed (posted from that thread)."""
+
+    def __init__(self, error: StoreError) -> None:
+        super().__init__()
+        self.error = error
 
 
 class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
@@ -258,6 +267,13 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         if self._retry_timer is None and self._ready:
             self._retry_timer = self.set_interval(RETRY_SECONDS, self._retry_store)
 
+    @on(StoreTrouble)
+    def _store_trouble(self, message: StoreTrouble) -> None:
+        if isinstance(message.error, StoreUnavailable):
+            self._wait_for_store()
+        else:
+            self.say(f"progress not saved: {message.error}")
+
     async def _retry_store(self) -> None:
         """One try to write what is kept here, in a thread: a database that does not answer
         makes the try wait for its connection timeout, and the screen must not wait with it.
@@ -267,7 +283,10 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             return
         self._retrying = True
         try:
-            done = await asyncio.to_thread(store.flush)
+            if store.in_background:  # the store's own thread: one write at a time
+                done = await asyncio.wrap_future(store.flush_soon())
+            else:
+                done = await asyncio.to_thread(store.flush)
             if done and self._reload_when_back:
                 # raises while the database is still away
                 await asyncio.to_thread(store.progress, self.student)
