@@ -266,11 +266,13 @@ async def serve(the_plan: ServePlan, stop: asyncio.Event | None = None) -> int:
         _off_signals(loop, installed)
         return 2
     session.recorder = recorder
+    config = the_plan.tcp or the_plan.ws
+    assert config is not None, "a plan has TCP, a WebSocket URL or both (_endpoint_configs)"
     session.record_header(
         driver="VIPLE",
         driven_by=Driver.viple().as_json(),
         endpoints=[_endpoint_json(status) for status in endpoints.statuses()],
-        report_ms=(the_plan.tcp or the_plan.ws).report_ms,
+        report_ms=config.report_ms,
         **the_plan.fields,
     )
     _log_setup(session)
@@ -384,7 +386,7 @@ def _finish_record(session: Session, statuses: list[LinkStatus]) -> None:
 
 
 def _on_signals(loop: asyncio.AbstractEventLoop, callback) -> list[int]:
-    installed = []
+    installed: list[int] = []
     for sig in (signal.SIGINT, signal.SIGTERM):
         with contextlib.suppress(NotImplementedError, RuntimeError, ValueError):
             loop.add_signal_handler(sig, callback)

@@ -98,12 +98,12 @@ def cmd_viple_client(args: argparse.Namespace) -> int:
     def log(text: str) -> None:
         print(text, file=progress, flush=True)
 
-    def on_step(step: Step, state: str) -> None:
+    def on_step(step: Step, state: str | None) -> None:
         log(describe_step(step, state))
 
     sensors = ", ".join(str(s) for s in setup.sensors)
     log(
-        f"{setup.definition.name} ({setup.profile.name} profile, wheels on ports "
+        f"{setup.name} ({setup.profile.name} profile, wheels on ports "
         f"{setup.profile.left_port}/{setup.profile.right_port}; sensors {sensors})"
     )
     result = asyncio.run(run_client(setup, log, on_step))
@@ -116,7 +116,7 @@ def cmd_viple_client(args: argparse.Namespace) -> int:
     return result.exit_code
 
 
-def describe_step(step: Step, state: str) -> str:
+def describe_step(step: Step, state: str | None) -> str:
     text = f"{step.t:8.2f} s  "
     tr = step.transition
     if tr is None:

@@ -297,13 +297,13 @@ class FsmController:
         ev = lambda text: self._expr(text, names).evaluate  # noqa: E731
         if isinstance(action, WheelsAction):
             lf, rf = ev(action.left), ev(action.right)
-            return ("cmd", lambda env: WheelPowers(lf(env), rf(env)), "wheels")
+            return ("cmd", lambda env: WheelPowers(float(lf(env)), float(rf(env))), "wheels")
         if isinstance(action, MotorAction):
             wheel, pf = action.wheel, ev(action.power)
-            return ("cmd", lambda env: MotorPower(wheel, pf(env)), "motor")
+            return ("cmd", lambda env: MotorPower(wheel, float(pf(env))), "motor")
         if isinstance(action, MoveAction):
             mf = ev(action.power)
-            return ("cmd", lambda env: MoveAtPower(mf(env)), "move")
+            return ("cmd", lambda env: MoveAtPower(float(mf(env))), "move")
         if isinstance(action, TurnAction):
             tf = ev(action.degrees)
             return ("cmd", lambda env: TurnByDegrees(float(tf(env))), "turn")

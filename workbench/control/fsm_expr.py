@@ -15,6 +15,7 @@ import operator
 import warnings
 from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass
+from typing import cast
 
 from workbench.files.bounded import digits_problem
 
@@ -147,11 +148,8 @@ def compile_expr(
         kind, payload = compiler.node(tree.body)
     except (RecursionError, MemoryError):
         raise ExprError("the expression is too complex to read", text, None, _SIMPLER) from None
-    if kind == "const":
-        value = payload
-        return Expr(text, frozenset(compiler.read), lambda env: value, True)
     fn = _as_fn(kind, payload)
-    return Expr(text, frozenset(compiler.read), fn, False)
+    return Expr(text, frozenset(compiler.read), fn, kind == "const")
 
 
 def _prescan(text: str, lead: int) -> None:
@@ -283,12 +281,14 @@ _Node = tuple[str, object]
 
 
 def _as_fn(kind: str, payload: object) -> Fn:
+    # the kind says what the payload is: a Value, a name (str) or an Fn
     if kind == "const":
-        return lambda env: payload
+        value = cast(Value, payload)
+        return lambda env: value
     if kind == "name":
-        key = payload
+        key = cast(str, payload)
         return lambda env: env[key]
-    return payload  # type: ignore[return-value]
+    return cast(Fn, payload)
 
 
 class _Compiler:
@@ -313,7 +313,7 @@ class _Compiler:
         line = getattr(node, "lineno", 1)
         if after is not None and getattr(after, "end_lineno", 0) == 1:
             body = self.text[self.lead :]
-            col = after.end_col_offset or 0
+            col = getattr(after, "end_col_offset", None) or 0
             while col < len(body) and body[col] in " \t()":
                 col += 1
             line = 1
@@ -359,7 +359,9 @@ class _Compiler:
         if type(node.op) in _REFUSED_OPS:
             symbol, hint = _REFUSED_OPS[type(node.op)]
             raise self.fail(node, f"the operator {symbol} is not allowed", hint)
-        op = {ast.USub: operator.neg, ast.UAdd: operator.pos, ast.Not: operator.not_}[type(node.op)]
+        unary: dict[type[ast.unaryop], Callable[..., Value]]
+        unary = {ast.USub: operator.neg, ast.UAdd: operator.pos, ast.Not: operator.not_}
+        op = unary[type(node.op)]
         kind, payload = self.node(node.operand)
         if kind == "const":
             return ("const", self.fold(node, op, payload))
@@ -391,7 +393,7 @@ class _Compiler:
         return ("fn", _any_of(fns))
 
     def _Compare(self, node: ast.Compare) -> _Node:
-        ops = []
+        ops: list[Callable[[Value, Value], bool]] = []
         for i, op in enumerate(node.ops):
             if type(op) not in _CMPOPS:
                 symbol, hint = _REFUSED_OPS.get(type(op), ("?", ""))
@@ -457,12 +459,16 @@ class _Compiler:
 def _binary(op: Callable[[Value, Value], Value], left: _Node, right: _Node) -> Fn:
     lk, lp = left
     rk, rp = right
+    # as in _as_fn, a "name" payload is a str and a "const" payload a Value
     if lk == "name" and rk == "const":
-        return lambda env: op(env[lp], rp)
+        lname, rvalue = cast(str, lp), cast(Value, rp)
+        return lambda env: op(env[lname], rvalue)
     if lk == "const" and rk == "name":
-        return lambda env: op(lp, env[rp])
+        lvalue, rname = cast(Value, lp), cast(str, rp)
+        return lambda env: op(lvalue, env[rname])
     if lk == "name" and rk == "name":
-        return lambda env: op(env[lp], env[rp])
+        lname, rname = cast(str, lp), cast(str, rp)
+        return lambda env: op(env[lname], env[rname])
     lf, rf = _as_fn(lk, lp), _as_fn(rk, rp)
     return lambda env: op(lf(env), rf(env))
 

@@ -196,7 +196,8 @@ class Transition:
     source: str
     target: str
     guard_text: str
-    values: Mapping[str, Value]
+    #: None for a name the guard did not get to read ("a or b" with a true)
+    values: Mapping[str, Value | None]
 
 
 # ----------------------------------------------------------------------------- checking
@@ -293,11 +294,11 @@ def _check_sensors(defn: FsmDefinition, add: Callable) -> None:
                 isinstance(port, bool) or not isinstance(port, int) or port not in PORT_RANGE
             ):
                 bad.setdefault(port, []).append(profile)
-        for port, profiles in bad.items():
+        for wrong, profiles in bad.items():
             add(
                 Problem(
                     (*path, "port", profiles[0]),
-                    f"port {port!r} ({', '.join(profiles)}) is not a whole number from "
+                    f"port {wrong!r} ({', '.join(profiles)}) is not a whole number from "
                     f"{PORT_RANGE.start} to {PORT_RANGE.stop - 1}",
                 )
             )

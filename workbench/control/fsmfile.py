@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import difflib
 import math
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 
 import yaml
@@ -218,7 +218,7 @@ class _Reader:
         if not isinstance(node, MappingNode):
             self.report(node, f"{what} must be a mapping of 'key: value' lines", path=path)
             return []
-        out = []
+        out: list[tuple[str, Node, Node]] = []
         seen: dict[str, Node] = {}
         for key_node, value_node in node.value:
             if not isinstance(key_node, ScalarNode):
@@ -264,7 +264,7 @@ class _Reader:
             value = float(self.constructor.construct_object(node))
             if math.isfinite(value):
                 return value
-        shown = node.value if isinstance(node, ScalarNode) else "a " + node.id
+        shown = node.value if isinstance(node, ScalarNode) else "a " + _kind(node)
         self.report(node, f"{what} must be a number, not {shown!r}", path=path)
         return None
 
@@ -286,7 +286,10 @@ class _Reader:
                 return "0"
             return node.value
         self.report(
-            node, f"{what} must be one expression, not a {node.id}", "e.g. front < 50", path=path
+            node,
+            f"{what} must be one expression, not a {_kind(node)}",
+            "e.g. front < 50",
+            path=path,
         )
         return "0"
 
@@ -537,7 +540,9 @@ class _Reader:
         if kind == "set":
             return SetAction(self.assignments(value, here))
         text = self.expr(value, here, f"{kind}'s value")
-        return {"move": MoveAction, "turn": TurnAction, "timer": TimerAction}[kind](text)
+        makers: dict[str, Callable[[str], Action]]
+        makers = {"move": MoveAction, "turn": TurnAction, "timer": TimerAction}
+        return makers[kind](text)
 
     def transition(self, node: Node, path: tuple) -> TransitionDef | None:
         self.nodes[path] = node
@@ -570,6 +575,12 @@ class _Reader:
                 node, "set: has no assignments", "e.g. set: {RightDistance: front}", path=path
             )
         return tuple(out)
+
+
+def _kind(node: Node) -> str:
+    """"scalar", "sequence" or "mapping": every node PyYAML composes is one of the three."""
+    assert isinstance(node, ScalarNode | SequenceNode | MappingNode)
+    return node.id
 
 
 def _key_hint(key: str, keys: tuple[str, ...]) -> str:

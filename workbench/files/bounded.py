@@ -20,7 +20,7 @@ import re
 import stat
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TypeVar
+from typing import Protocol, TypeVar
 
 import yaml
 from yaml.constructor import SafeConstructor
@@ -265,6 +265,13 @@ def finite_problem(value: float) -> str | None:
 # -- YAML -------------------------------------------------------------------------------------
 
 
+class _Mark(Protocol):
+    """A place in the text, as both PyYAML's Python and C parsers mark it (0-based)."""
+
+    line: int
+    column: int
+
+
 class _BoundedLoader(yaml.SafeLoader):
     """A safe loader that counts nesting, aliases and values while it composes."""
 
@@ -279,12 +286,12 @@ class _BoundedLoader(yaml.SafeLoader):
         #: anchor -> number of values under it, so an alias counts as a copy
         self.sizes: dict[str, int] = {}
 
-    def refuse(self, mark: yaml.Mark | None, message: str, hint: str) -> BoundedFileError:
+    def refuse(self, mark: _Mark | None, message: str, hint: str) -> BoundedFileError:
         line = mark.line + self.first_line if mark is not None else None
         column = mark.column + 1 if mark is not None else None
         return BoundedFileError(self.source, message, hint, line, column)
 
-    def compose_node(self, parent: Node | None, index: object) -> Node:
+    def compose_node(self, parent: Node | None, index: object) -> Node | None:
         event = self.peek_event()
         kind = self.limits.kind
         if isinstance(event, AliasEvent):
@@ -303,7 +310,8 @@ class _BoundedLoader(yaml.SafeLoader):
                     "a value cannot contain itself: write it out",
                 )
             self.count(event.start_mark, self.sizes.get(anchor, 1))
-            return super().compose_node(parent, index)
+            # PyYAML passes a mapping value's key node as its index; the stub says int
+            return super().compose_node(parent, index)  # type: ignore[arg-type]
         if self.depth >= self.limits.max_depth:
             raise self.refuse(
                 event.start_mark,
@@ -314,12 +322,12 @@ class _BoundedLoader(yaml.SafeLoader):
         self.count(event.start_mark, 1)
         self.depth += 1
         try:
-            node = super().compose_node(parent, index)
+            node = super().compose_node(parent, index)  # type: ignore[arg-type]  # as above
         finally:
             self.depth -= 1
-        anchor = getattr(event, "anchor", None)
-        if anchor is not None:
-            self.sizes[str(anchor)] = self.nodes - before
+        named = getattr(event, "anchor", None)
+        if named is not None:
+            self.sizes[str(named)] = self.nodes - before
         if isinstance(node, ScalarNode) and node.tag in (_INT_TAG, _FLOAT_TAG):
             reason = digits_problem(node.value)
             if reason is None and node.tag == _FLOAT_TAG:
@@ -328,7 +336,7 @@ class _BoundedLoader(yaml.SafeLoader):
                 raise self.refuse(node.start_mark, reason, "write a plain finite number")
         return node
 
-    def count(self, mark: yaml.Mark, nodes: int) -> None:
+    def count(self, mark: _Mark | None, nodes: int) -> None:
         self.nodes += nodes
         if self.nodes > self.limits.max_nodes:
             raise self.refuse(

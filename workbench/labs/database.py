@@ -31,7 +31,7 @@ RETRY_AFTER_S = 1.0
 #: connect timeout, a database host lost without a word (its network gone, the machine off) is
 #: noticed within seconds, not after the system's TCP retries (about 15 minutes): a write not
 #: acknowledged for 10 s fails, and an idle connection is probed by keepalives
-LINK_DEFAULTS: dict[str, object] = {
+LINK_DEFAULTS: dict[str, Any] = {
     "connect_timeout": CONNECT_TIMEOUT_S,
     "application_name": "viple-workbench",
     "tcp_user_timeout": 10_000,

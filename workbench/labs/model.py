@@ -444,6 +444,8 @@ def _objective(r: _Reader, node: yaml.Node, where: str) -> Objective:
             if head not in DRIVER_KINDS or (head == "algorithm") != bool(name):
                 r.fail(keys["driver"], here, f"unknown driver {d!r}",
                        "use viple, program, fsm, algorithm NAME or any")  # fmt: skip
+        # the optional keys of "exit" are Objective's limits: max_time, max_turn_degrees, ...
+        limits: dict[str, Any]
         limits = {k: r.number(keys[k], f"{here}: {k}") for k in optional if k in keys}
         if "max_collisions" in limits:
             limits["max_collisions"] = int(limits["max_collisions"])

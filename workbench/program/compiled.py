@@ -117,15 +117,15 @@ def compile_program(program: Program) -> Compiled:
         if kind == K.KEY_PRESS:
             keys = []
             for text in act.values:
-                name = KEY_NAMES.get(int(text)) if text.strip().isdigit() else None
-                if name is None:
+                key = KEY_NAMES.get(int(text)) if text.strip().isdigit() else None
+                if key is None:
                     problem(
                         act,
                         f"key number {text.strip()[:10]!r} is not a key the workbench knows",
                         "choose a letter, digit, arrow or space in VIPLE",
                     )
                 else:
-                    keys.append(name)
+                    keys.append(key)
             if not act.values:
                 problem(act, "the Key Press Event has no key", "choose one in its settings")
             out.key_sets[act.id] = frozenset(keys)

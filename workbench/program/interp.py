@@ -299,11 +299,12 @@ class ProgramController:
                 self._parked.append(flow)
                 continue
             done = 0
+            ended = False
             try:
                 while done < SLICE:
                     done += 1
                     if not self._step(flow):
-                        flow = None
+                        ended = True
                         break
                 else:
                     ready.append(flow)
@@ -311,7 +312,7 @@ class ProgramController:
                 heappush(self._sleeping, (self.now + sleep.seconds, flow.number, flow))
             except _Park:
                 self._parked.append(flow)
-            if flow is not None:
+            if not ended:
                 flow.steps += done
             total += done
         self.steps += total

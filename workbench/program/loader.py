@@ -55,7 +55,7 @@ class _BoundedBuilder(TreeBuilder):
         self.depth = 0
         self.count = 0
 
-    def start(self, tag, attrs):  # type: ignore[no-untyped-def]
+    def start(self, tag: str, attrs: dict[str, str], /) -> Element:
         self.depth += 1
         self.count += 1
         if self.depth > MAX_DEPTH:
@@ -70,7 +70,7 @@ class _BoundedBuilder(TreeBuilder):
             )
         return super().start(tag, attrs)
 
-    def end(self, tag):  # type: ignore[no-untyped-def]
+    def end(self, tag: str, /) -> Element:
         self.depth -= 1
         return super().end(tag)
 
@@ -382,9 +382,10 @@ class _Builder:
             self.id_lists(axml, "AlternateNextActivities", "ActivityID", panel, act),
             self.id_lists(axml, "AlternateOutgoingLines", "GraphEdgeID", panel, act),
         ]
-        if any(x is None for x in lists):
+        present = [x for x in lists if x is not None]
+        if len(present) < len(lists):
             return None
-        nxt, out, prev, inc, alt_next, alt_out = lists  # type: ignore[misc]
+        nxt, out, prev, inc, alt_next, alt_out = present
         if alt_next.get(0) or alt_out.get(0):
             nxt[ELSE] = alt_next.get(0, [])
             out[ELSE] = alt_out.get(0, [])
@@ -456,7 +457,7 @@ class _Builder:
                 got = outputs.get(raw.activity.id, {}).get(pin)
                 if got:
                     rank = {t: i for i, t in enumerate(targets)}
-                    got.sort(key=lambda k, rank=rank: rank.get(k.target, 0))
+                    got.sort(key=lambda k: rank.get(k.target, 0))
         program.outputs = {
             a: {p: tuple(ls) for p, ls in pins.items()} for a, pins in outputs.items()
         }

@@ -134,7 +134,7 @@ class _Tok:
 
 
 def tokenize(text: str) -> list[_Tok]:
-    out = []
+    out: list[_Tok] = []
     pos = 0
     while pos < len(text):
         m = _TOKEN.match(text, pos)

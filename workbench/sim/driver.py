@@ -67,7 +67,7 @@ class Driver:
 
     def as_json(self) -> dict[str, str]:
         """The driver as a run record's header holds it (only the fields that are set)."""
-        out = {"kind": self.kind}
+        out: dict[str, str] = {"kind": self.kind}
         for key in ("name", "role", "peer", "digest"):
             value = getattr(self, key)
             if value:

@@ -27,6 +27,7 @@ from __future__ import annotations
 import math
 import random
 from dataclasses import dataclass, fields, replace
+from typing import Any
 
 from .profiles import NOISE_LEVELS, Profile
 
@@ -103,7 +104,9 @@ def noise_settings(level: str, profile: Profile, **overrides: float) -> NoiseSet
         raise ValueError(
             f"unknown noise setting {', '.join(unknown)}: use {', '.join(sorted(names))}"
         )
-    return replace(settings, **overrides) if overrides else settings
+    # the names were checked above, so no override can reach the str-typed "level"
+    changes: dict[str, Any] = dict(overrides)
+    return replace(settings, **changes) if changes else settings
 
 
 def motor_gains(settings: NoiseSettings, rng: random.Random) -> tuple[float, float]:

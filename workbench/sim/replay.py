@@ -15,7 +15,7 @@ import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeGuard
 
 from workbench.files.workspace import LOCAL, FileAccess, OutsideWorkspace
 
@@ -50,7 +50,7 @@ class Frame:
         return int(self.pose.x // cell), int(self.pose.y // cell)
 
 
-def _number(value: Any) -> bool:
+def _number(value: Any) -> TypeGuard[float]:
     return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
 
 

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 import random
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -181,7 +182,7 @@ class World:
         self,
         maze: Maze,
         profile: Profile | str,
-        sensors: list[SensorSpec] | tuple[SensorSpec, ...] | None = None,
+        sensors: Sequence[SensorSpec] | None = None,
         noise: NoiseSettings | str | None = None,
         seed: int = 0,
         dt: float = 1 / 60,
@@ -206,8 +207,8 @@ class World:
         self.seed = seed
         self.dt = float(dt)
         # a maze's own block size counts when it was written for this profile
-        own_cell = maze.cell is not None and maze.profile in (None, profile.name)
-        self.cell = float(maze.cell) if own_cell else profile.cell
+        own_cell = maze.cell if maze.profile in (None, profile.name) else None
+        self.cell = float(own_cell) if own_cell is not None else profile.cell
         if 2 * profile.robot_radius >= self.cell:
             raise WorldError(
                 f"the {profile.name} robot ({2 * profile.robot_radius:g} {profile.unit} wide) "
@@ -244,7 +245,7 @@ class World:
         self.reset()
 
     # -- configuration -------------------------------------------------------------------
-    def set_sensors(self, specs: list[SensorSpec] | tuple[SensorSpec, ...]) -> None:
+    def set_sensors(self, specs: Sequence[SensorSpec]) -> None:
         """Replace the sensor configuration (effective at the next read)."""
         specs = list(specs)
         for spec in specs:

@@ -139,6 +139,7 @@ class LabServer:
     def __init__(self, config: ServerConfig) -> None:
         self.config = config
         # a users file that cannot be read stops the server here, before it listens
+        assert config.users_file is not None and config.host_key is not None  # __post_init__
         self.users = UsersFile(config.users_file)
         self.host_key = load_or_create_host_key(config.host_key)
         self.pool = PortPool(*config.port_range)
@@ -369,9 +370,10 @@ class LabConnection(asyncssh.SSHServer):
             return
         server.gate.opened(self.peer)
         self.counted = True
-        # agent and X11 forwarding are off; these make their refusals show in the log
+        # agent and X11 forwarding are off; these make their refusals show in the log (asyncssh
+        # has no hook for that, so its methods are replaced; the X11 one refuses whatever it gets)
         conn.create_agent_listener = self._refuse_agent  # type: ignore[method-assign]
-        conn.attach_x11_listener = self._refuse_x11  # type: ignore[method-assign]
+        conn.attach_x11_listener = self._refuse_x11  # type: ignore[method-assign, assignment]
 
     def _turn_away(self, key: str, why: str, message: str) -> None:
         """Close the connection at once with ``message`` for the client; log ``why`` (the

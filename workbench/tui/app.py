@@ -194,7 +194,8 @@ class WorkbenchApp(ScreenHost[None]):
         self._last_said = text  # for the main screen when it comes after the names
         super().say(text)
 
-    async def on_mount(self) -> None:
+    # Textual runs each class's on_mount in turn (the host's too): a handler, not an override
+    async def on_mount(self) -> None:  # type: ignore[override]
         tcp, ws = self._viple_configs
         if not self.settings.ws_at_start:
             ws = None  # later: a WebSocket exercise's set-up or the v key starts it

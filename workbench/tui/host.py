@@ -192,5 +192,6 @@ class ScreenHost(App[ReturnType]):
         """The command palette; in ASCII mode without its emoji search icon."""
         if self.unicode:
             super().action_command_palette()
-        elif self.use_command_palette and not PlainCommandPalette.is_open(self):
+        # is_open asks for an App[object], which no App[ReturnType] is (App is invariant)
+        elif self.use_command_palette and not PlainCommandPalette.is_open(self):  # type: ignore[arg-type]
             self.push_screen(PlainCommandPalette())

@@ -72,7 +72,7 @@ class WorkbenchScrollBarRender(ScrollBarRender):
     blocks), so it is plain spaces on any terminal."""
 
     @classmethod
-    def render_bar(cls, *args, **kwargs):  # type: ignore[override]
+    def render_bar(cls, *args, **kwargs):
         if ascii_mode():
             return _BlankBars.render_bar(*args, **kwargs)
         return super().render_bar(*args, **kwargs)

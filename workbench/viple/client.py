@@ -142,8 +142,10 @@ def _endpoint(role: str, option: str, text: str, scheme: str) -> Endpoint:
 class Brain(Protocol):
     """What drives from the VIPLE side: an FSM (:class:`RemoteFsm`) or a VIPLE program."""
 
-    readings: Mapping[Any, float] | None
     transitions: int
+
+    @property
+    def readings(self) -> Mapping[Any, float] | None: ...
 
     @property
     def state(self) -> str | None: ...
@@ -301,8 +303,11 @@ class RemoteFsm:
         """Follow the turn in progress: a Turn by Degree starts the wait for its end, any
         other command abandons it (as on the robot)."""
         for cmd in commands:
-            is_turn = isinstance(cmd, TurnByDegrees)
-            self.turn_due = t + turn_wait(cmd.degrees, self.setup.profile) if is_turn else None
+            self.turn_due = (
+                t + turn_wait(cmd.degrees, self.setup.profile)
+                if isinstance(cmd, TurnByDegrees)
+                else None
+            )
         due = self.turn_due if commands and isinstance(commands[-1], TurnByDegrees) else None
         return Step(t, commands, fired, due, started)
 
@@ -449,7 +454,7 @@ class VipleClient:
         self,
         setup: ClientSetup,
         log: Callable[[str], None] = print,
-        on_step: Callable[[Step, str], None] | None = None,
+        on_step: Callable[[Step, str | None], None] | None = None,
     ) -> None:
         self.setup = setup
         self.log = log
@@ -698,7 +703,7 @@ class _Abort(Exception):
 async def run_client(
     setup: ClientSetup,
     log: Callable[[str], None] = print,
-    on_step: Callable[[Step, str], None] | None = None,
+    on_step: Callable[[Step, str | None], None] | None = None,
     attach: Callable[[VipleClient], Callable[[], None]] | None = None,
 ) -> ClientResult:
     """Run the client until the run ends; SIGINT and SIGTERM end it cleanly.

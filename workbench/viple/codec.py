@@ -215,7 +215,12 @@ def _object_of(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
     if len(obj) == len(pairs):
         return obj
     seen: set[str] = set()
-    repeated = next(key for key, _ in pairs if key in seen or seen.add(key))
+    repeated = ""
+    for key, _ in pairs:
+        if key in seen:
+            repeated = key
+            break
+        seen.add(key)
     flagged = _RepeatedKeys(obj)
     flagged.repeated = repeated
     return flagged

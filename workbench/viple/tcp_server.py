@@ -242,7 +242,11 @@ class TcpServer:
         outbox = _Outbox(writer)
         pusher = asyncio.create_task(link.push_reports(outbox, self.config.report_ms / 1000))
         # an idle driver is cut off at once: nothing it has not read is worth sending
-        pusher.add_done_callback(lambda task: task.cancelled() or writer.transport.abort())
+        def cut_off(task: asyncio.Task[str]) -> None:
+            if not task.cancelled():
+                writer.transport.abort()
+
+        pusher.add_done_callback(cut_off)
         splitter = LineSplitter(self.config.max_line_bytes)
         try:
             while True:
@@ -328,7 +332,7 @@ def _unavailable(err: OSError) -> bool:
 def _reason(err: BaseException) -> str:
     if isinstance(err, OSError) and (err.errno or err.strerror):
         # asyncio wraps bind errors in a long message; the errno says it plainly
-        plain = not isinstance(err, socket.gaierror) and isinstance(err.errno, int)
-        text = os.strerror(err.errno) if plain and err.errno > 0 else str(err.strerror)
+        code = None if isinstance(err, socket.gaierror) else err.errno
+        text = os.strerror(code) if isinstance(code, int) and code > 0 else str(err.strerror)
         return text[:1].lower() + text[1:]
     return str(err) or type(err).__name__

@@ -200,7 +200,11 @@ class WsClient:
         outbox = _Outbox(ws)
         pusher = asyncio.create_task(link.push_reports(outbox, self.config.report_ms / 1000))
         # an idle driver is cut off at once: nothing it has not read is worth sending
-        pusher.add_done_callback(lambda task: task.cancelled() or ws.transport.abort())
+        def cut_off(task: asyncio.Task[str]) -> None:
+            if not task.cancelled():
+                ws.transport.abort()
+
+        pusher.add_done_callback(cut_off)
         reason = "workbench stopping"
         try:
             while True:

@@ -71,7 +71,7 @@ class Dialog(ModalScreen[ResultType]):
     }
     """
 
-    BINDINGS: ClassVar[list[BindingType]] = bindings("dialog.cancel")
+    BINDINGS: ClassVar[list[BindingType]] = [*bindings("dialog.cancel")]
 
     def show_error(self, text: str) -> None:
         """Show why the input cannot be used (empty text hides the line)."""

@@ -82,7 +82,7 @@ class SensorPortsModal(ShowsSnapshot, ModalScreen[None]):
     }
     """
 
-    BINDINGS: ClassVar[list[BindingType]] = bindings("dialog.close", "sensors.add")
+    BINDINGS: ClassVar[list[BindingType]] = [*bindings("dialog.close", "sensors.add")]
 
     def __init__(self, station: LabStation) -> None:
         super().__init__()

@@ -91,7 +91,7 @@ class SignoffModal(ModalScreen[str | None]):
     }
     """
 
-    BINDINGS: ClassVar[list[BindingType]] = bindings("dialog.close")
+    BINDINGS: ClassVar[list[BindingType]] = [*bindings("dialog.close")]
 
     def __init__(
         self,

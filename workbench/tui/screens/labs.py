@@ -152,7 +152,7 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
     }
     """
 
-    BINDINGS: ClassVar[list[BindingType]] = bindings("labs.close", "labs.setup", "labs.signoff")
+    BINDINGS: ClassVar[list[BindingType]] = [*bindings("labs.close", "labs.setup", "labs.signoff")]
 
     def __init__(
         self,

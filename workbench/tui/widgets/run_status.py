@@ -47,6 +47,7 @@ class RunStatus(TextLines):
             f"turn{'' if m.turns == 1 else 's'}"
         )
         hits = f"collisions {m.collisions}"
+        contact: tuple[str, ...]
         if m.touches:
             # bumps a touch sensor was meant to feel: a line of their own, beside the collisions
             contact = (turning, f"{hits}{sep}touches {m.touches}")
