@@ -91,8 +91,11 @@ def fit_sensors(
             continue
         used = {s.mount for p, s in by_port.items() if p != port}
         free = [m for m in MOUNTS if m not in used]
-        mount = have.mount if have is not None and have.mount in free else (free or [None])[0]
-        if mount is None:
+        if have is not None and have.mount in free:
+            mount = have.mount
+        elif free:
+            mount = free[0]
+        else:
             cannot.append(f"port {port} ({wanted[0]}): every mount has a sensor already")
             continue
         by_port[port] = SensorSpec(wanted[0], port, mount)
