@@ -20,23 +20,33 @@ DEADLINE = 20.0
 
 
 async def until(
-    check: Callable[[], T], what: str = "the condition", timeout: float = DEADLINE
+    check: Callable[[], T],
+    what: str = "the condition",
+    timeout: float = DEADLINE,
+    every: float = 0.005,
 ) -> T:
-    """Wait on the running loop until ``check()`` is true; its value."""
+    """Wait on the running loop until ``check()`` is true, asking every ``every`` seconds;
+    its value."""
     loop = asyncio.get_running_loop()
     deadline = loop.time() + timeout
     while not (value := check()):
         if loop.time() >= deadline:
             raise AssertionError(f"{what}: not so after {timeout:g} s")
-        await asyncio.sleep(0.005)
+        await asyncio.sleep(every)
     return value
 
 
-def wait_until(check: Callable[[], T], what: str = "the condition", timeout: float = DEADLINE) -> T:
-    """Wait in this thread (no loop) until ``check()`` is true; its value."""
+def wait_until(
+    check: Callable[[], T],
+    what: str = "the condition",
+    timeout: float = DEADLINE,
+    every: float = 0.005,
+) -> T:
+    """Wait in this thread (no loop) until ``check()`` is true, asking every ``every``
+    seconds; its value."""
     deadline = time.monotonic() + timeout
     while not (value := check()):
         if time.monotonic() >= deadline:
             raise AssertionError(f"{what}: not so after {timeout:g} s")
-        time.sleep(0.005)
+        time.sleep(every)
     return value
