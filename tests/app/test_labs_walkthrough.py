@@ -27,7 +27,9 @@ from textual.pilot import Pilot
 from textual.widgets import Input, Markdown, OptionList, Select, Static
 from websockets.asyncio.server import serve
 
-from tests.integration.test_labs_completable import DRIVE, SOLUTIONS, answer, free_port
+from tests.integration.test_labs_completable import DRIVE, SOLUTIONS, answer
+from tests.sessions import free_port
+from tests.waiting import DEADLINE, until
 from workbench.cli import main
 from workbench.control.algorithms import list_algorithms
 from workbench.control.headless import RunSpec
@@ -430,22 +432,16 @@ async def viple_over_websocket(w: Walkthrough, screen: LabsScreen, lab: Lab, ex:
     async with serve(program, "127.0.0.1", port) as server:
         assert w.app.endpoints is None or w.app.endpoints.ws is None
         await w.press("a")
-        await asyncio.wait_for(arrived.get(), 5)  # the app connected and sent a report
+        await asyncio.wait_for(arrived.get(), DEADLINE)  # the app connected and sent a report
         client = w.app.endpoints.ws
         assert client is not None
-        for _ in range(300):
-            if client.status.messages_in >= 1:
-                break
-            await asyncio.sleep(0.01)
+        await until(lambda: client.status.messages_in >= 1, "the program's command taken")
         assert client.status.invalid == 0, client.status.last_rejection
         w.station.step(30)  # the program's move, simulated
         await w.pilot.pause()
         assert w.station.viple and w.station.viple[-1].drove
         server.close()  # the students stop their program
-    for _ in range(300):
-        if not str(w.station.session.driver).startswith("VIPLE"):
-            break
-        await asyncio.sleep(0.01)
+    await until(lambda: not str(w.station.session.driver).startswith("VIPLE"), "VIPLE gone")
     w.station.step(1)
     await w.open(lab, ex)
 
