@@ -9,6 +9,8 @@ Where no server can start, the tests that need one are skipped with the reason.
 from __future__ import annotations
 
 import itertools
+import os
+from pathlib import Path
 
 import pytest
 
@@ -61,3 +63,10 @@ def _own_folders(tmp_path_factory, monkeypatch):
         monkeypatch.setenv(name, str(folder))
     # a course database named by the environment would be the user's, not the test's
     monkeypatch.delenv("WORKBENCH_DB", raising=False)
+
+
+@pytest.fixture
+def config_dir(_own_folders) -> Path:
+    """The test's own configuration folder (``$WORKBENCH_CONFIG``), where ``instructor add``
+    keeps the instructor's trusted roster."""
+    return Path(os.environ["WORKBENCH_CONFIG"])
