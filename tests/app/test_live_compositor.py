@@ -122,6 +122,7 @@ def test_partial_updates_match_a_full_render_while_the_robot_drives(size):
 
         def moved_on(drawn: int):
             return lambda: checker.updates >= drawn + 3 or app._resting
+
         await pilot.press("w")
         for keys in ("", "d", "", "u", "a", "t", "", "p", "n", "p", "a", "u", "", "d"):
             for key in keys:
