@@ -45,7 +45,7 @@ async def test_a_dropped_connection_ends_the_app_frees_its_ports_and_progress_su
         term.conn.abort()  # no goodbye: the laptop's lid closed
         await until(lambda: gone(pid), "the app process gone")
         await until(lambda: all(port_is_free(p) for p in ports), "the ports free")
-        assert not host.server.sessions
+        await until(lambda: not host.server.sessions, "the session ended")
         assert not (set(ports) & host.server.pool.in_use)
 
         again = await host.terminal("ann", size=(100, 30))
