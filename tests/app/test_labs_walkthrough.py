@@ -363,9 +363,10 @@ class Walkthrough:
 
     # -- reading the terminal ----------------------------------------------------------------
     async def objectives_readable(self, screen: LabsScreen) -> None:
-        """Scroll the exercise pane with the keys, from the top down past the objectives, and
-        read the terminal at each position: every objective's line (mark, text and reason)
-        must be seen whole in one view, words unbroken, in plain ASCII."""
+        """Scroll the exercise pane with the keys, from the top down past the objectives (or
+        until every objective has been read), and read the terminal at each position: every
+        objective's line (mark, text and reason) must be seen whole in one view, words
+        unbroken, in plain ASCII."""
         assert screen.progress is not None
         marks = screen.marks
         wanted = {
@@ -379,15 +380,16 @@ class Walkthrough:
         pane.scroll_home(animate=False)
         await self.pilot.pause()
         views = []
+        unseen = set(wanted)
         for _ in range(objectives_height + 1):
             lines = screen_lines(self.app)
             assert all(line.isascii() for line in lines), "\n".join(lines)
             views.append(" ".join(" ".join(line[PANE:].split()) for line in lines[:-2]))
-            if pane.scroll_y >= min(objectives_height, pane.max_scroll_y):
-                break
+            unseen = {text for text in unseen if text not in views[-1]}
+            if not unseen or pane.scroll_y >= min(objectives_height, pane.max_scroll_y):
+                break  # every line read whole, or scrolled past the objectives
             await self.press("down")
-        unseen = [text for text in wanted if not any(text in view for view in views)]
-        assert unseen == [], (unseen, views)
+        assert not unseen, (unseen, views)
         screen.query_one("#labs-list").focus()
         await self.pilot.pause()
 
