@@ -9,6 +9,8 @@ Where no server can start, the tests that need one are skipped with the reason.
 from __future__ import annotations
 
 import itertools
+import os
+from pathlib import Path
 
 import pytest
 
@@ -72,3 +74,10 @@ def disk(monkeypatch: pytest.MonkeyPatch) -> FakeDisk:
     fake = FakeDisk()
     monkeypatch.setattr(workbench.sim.record, "open", fake.open, raising=False)
     return fake
+
+
+@pytest.fixture
+def config_dir(_own_folders) -> Path:
+    """The test's own configuration folder (``$WORKBENCH_CONFIG``), where ``instructor add``
+    keeps the instructor's trusted roster."""
+    return Path(os.environ["WORKBENCH_CONFIG"])

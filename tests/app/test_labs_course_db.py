@@ -3,14 +3,13 @@ keeps working while the database restarts."""
 
 from __future__ import annotations
 
-import asyncio
 import threading
-import time
 
 import pytest
 from textual.pilot import Pilot
 from textual.widgets import Input
 
+from tests.waiting import until
 from workbench.labs.pending import pending_path
 from workbench.labs.store import Store
 from workbench.tui.screens.labs import LabsScreen
@@ -65,9 +64,7 @@ def test_the_database_going_away_is_shown_and_the_work_is_saved_when_it_is_back(
             await pilot.pause()
         finally:
             pg_server.start()
-        deadline = time.monotonic() + 15
-        while app.store.pending and time.monotonic() < deadline:
-            await asyncio.sleep(0.2)
+        await until(lambda: not app.store.pending, "the progress saved", every=0.2)
         await pilot.pause()
         assert text(screen, "#labs-message") == (
             "the course database is back: your progress is saved"
@@ -103,9 +100,7 @@ def test_changes_kept_while_the_database_is_down_outlive_the_app_and_are_saved_b
     second = lab_app(data, db=pg_url)  # the next start, the database back
 
     async def resume(pilot: Pilot) -> None:
-        deadline = time.monotonic() + 15
-        while kept.is_file() and time.monotonic() < deadline:
-            await asyncio.sleep(0.2)
+        await until(lambda: not kept.is_file(), "the kept changes saved", every=0.2)
         await pilot.pause()
         assert said(second).startswith("saving resumed")
         assert "saving resumed" in str(second.screen.query_one("#message").render())
@@ -145,26 +140,19 @@ def test_retries_run_beside_the_app_one_at_a_time(tmp_path, pg_server, pg_url, m
         try:
             screen.query_one("#q-tcp-port", Input).value = "77"
             await pilot.pause()
-            for _ in range(1000):
-                if running:
-                    break
-                await asyncio.sleep(0.01)
+            await until(lambda: running, "a retry under way")
             assert running == 1  # a retry is under way now, waiting for the database
             frames = app.frames
             assert isinstance(app.screen, LabsScreen) and app.station.paused
             await pilot.press("escape", "p")  # back on the main screen, running
-            await pilot.pause(0.5)
             # the keys were not held up by the try: they took effect while it still waits
-            assert isinstance(app.screen, MainScreen) and not app.station.paused
+            await until(lambda: isinstance(app.screen, MainScreen) and not app.station.paused)
+            await until(lambda: app.frames > frames, "a frame drawn")  # the screen kept drawing
             assert running == 1
-            assert app.frames > frames  # and the screen kept being drawn
         finally:
             pg_server.start()
             back.set()
-        deadline = time.monotonic() + 15
-        while store.pending and time.monotonic() < deadline:
-            await asyncio.sleep(0.2)
-        assert not store.pending
+        await until(lambda: not store.pending, "the progress saved", every=0.2)
 
     run(app, body)
     assert most == 1

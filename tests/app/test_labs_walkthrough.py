@@ -28,7 +28,9 @@ from textual.widgets import Input, Markdown, OptionList, Select, Static
 from websockets.asyncio.server import serve
 
 from tests.app.labs_support import signing_over
-from tests.integration.test_labs_completable import DRIVE, SOLUTIONS, answer, free_port
+from tests.integration.test_labs_completable import DRIVE, SOLUTIONS, answer
+from tests.sessions import free_port
+from tests.waiting import DEADLINE, until
 from workbench.cli import main
 from workbench.control.algorithms import list_algorithms
 from workbench.control.headless import AlgorithmPilot, RunSpec
@@ -367,9 +369,10 @@ class Walkthrough:
 
     # -- reading the terminal ----------------------------------------------------------------
     async def objectives_readable(self, screen: LabsScreen) -> None:
-        """Scroll the exercise pane with the keys, from the top down past the objectives, and
-        read the terminal at each position: every objective's line (mark, text and reason)
-        must be seen whole in one view, words unbroken, in plain ASCII."""
+        """Scroll the exercise pane with the keys, from the top down past the objectives (or
+        until every objective has been read), and read the terminal at each position: every
+        objective's line (mark, text and reason) must be seen whole in one view, words
+        unbroken, in plain ASCII."""
         assert screen.progress is not None
         marks = screen.marks
         wanted = {
@@ -383,15 +386,16 @@ class Walkthrough:
         pane.scroll_home(animate=False)
         await self.pilot.pause()
         views = []
+        unseen = set(wanted)
         for _ in range(objectives_height + 1):
             lines = screen_lines(self.app)
             assert all(line.isascii() for line in lines), "\n".join(lines)
             views.append(" ".join(" ".join(line[PANE:].split()) for line in lines[:-2]))
-            if pane.scroll_y >= min(objectives_height, pane.max_scroll_y):
-                break
+            unseen = {text for text in unseen if text not in views[-1]}
+            if not unseen or pane.scroll_y >= min(objectives_height, pane.max_scroll_y):
+                break  # every line read whole, or scrolled past the objectives
             await self.press("down")
-        unseen = [text for text in wanted if not any(text in view for view in views)]
-        assert unseen == [], (unseen, views)
+        assert not unseen, (unseen, views)
         screen.query_one("#labs-list").focus()
         await self.pilot.pause()
 
@@ -437,22 +441,16 @@ async def viple_over_websocket(w: Walkthrough, screen: LabsScreen, lab: Lab, ex:
     async with serve(program, "127.0.0.1", port) as server:
         assert w.app.endpoints is None or w.app.endpoints.ws is None
         await w.press("a")
-        await asyncio.wait_for(arrived.get(), 5)  # the app connected and sent a report
+        await asyncio.wait_for(arrived.get(), DEADLINE)  # the app connected and sent a report
         client = w.app.endpoints.ws
         assert client is not None
-        for _ in range(300):
-            if client.status.messages_in >= 1:
-                break
-            await asyncio.sleep(0.01)
+        await until(lambda: client.status.messages_in >= 1, "the program's command taken")
         assert client.status.invalid == 0, client.status.last_rejection
         w.station.step(30)  # the program's move, simulated
         await w.pilot.pause()
         assert w.station.viple and w.station.viple[-1].drove
         server.close()  # the students stop their program
-    for _ in range(300):
-        if not str(w.station.session.driver).startswith("VIPLE"):
-            break
-        await asyncio.sleep(0.01)
+    await until(lambda: not str(w.station.session.driver).startswith("VIPLE"), "VIPLE gone")
     w.station.step(1)
     await w.open(lab, ex)
 

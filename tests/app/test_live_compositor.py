@@ -10,8 +10,6 @@ redraw of a snapshot that did not change refreshes nothing at all.
 
 from __future__ import annotations
 
-import asyncio
-
 import pytest
 from rich.cells import cell_len
 from rich.segment import ControlType, Segment
@@ -20,6 +18,7 @@ from textual.pilot import Pilot
 from textual.strip import Strip
 
 from tests.app.support import run
+from tests.waiting import until
 from workbench.tui.app import WorkbenchApp, make_app
 from workbench.tui.screens.main import MainScreen
 from workbench.tui.serving.compositor import GroupedUpdate, LiveCompositor
@@ -121,18 +120,23 @@ def test_partial_updates_match_a_full_render_while_the_robot_drives(size):
         screen = app.screen
         assert isinstance(screen, MainScreen)
         checker = Checker(app, screen)
+
+        def moved_on(drawn: int):
+            return lambda: checker.updates >= drawn + 3 or app._resting
+
         await pilot.press("w")
         for keys in ("", "d", "", "u", "a", "t", "", "p", "n", "p", "a", "u", "", "d"):
             for key in keys:
                 await pilot.press(key)
-            await asyncio.sleep(0.25)
+            # the robot drives on for a few frames (later on a busy machine), unless the app
+            # is at rest (paused, or nothing moves): then there is nothing new to draw
+            await until(moved_on(checker.updates), "three more updates, or the app at rest")
         await pilot.pause()
         assert checker.mismatches == []
         if not app.station.pacer.paused:
             await pilot.press("p")  # still: every change reaches the screen
-        await asyncio.sleep(0.3)
-        await pilot.pause()
-        assert checker.settled() == []
+        await until(lambda: checker.settled() == [], "the still screen drawn whole")
+        assert checker.mismatches == []
         assert checker.updates >= 20
         assert checker.grouped >= 1  # the maze and a panel changed in the same frame
 

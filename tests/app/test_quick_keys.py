@@ -13,6 +13,7 @@ from textual.pilot import Pilot
 from textual.widgets import Tooltip
 
 from tests.app.support import run
+from tests.waiting import until
 from workbench.tui.app import WorkbenchApp, make_app
 from workbench.tui.dialogs.help import HelpScreen
 from workbench.tui.screens.main import MainScreen
@@ -146,9 +147,11 @@ def test_a_quick_key_clears_a_tooltip_as_a_key_event_does(tmp_path):
         async with app.run_test(size=(80, 24), tooltips=True) as pilot:
             screen = app.screen
             await pilot.hover("#maze", offset=(3, 2))
-            await pilot.pause(1.0)
-            tips = [c for c in screen.children if isinstance(c, Tooltip)]
-            assert tips and tips[0].display  # the maze view's tooltip, where the mouse rests
+            # the maze view's tooltip, shown where the mouse rests after Textual's delay
+            tips = await until(
+                lambda: [c for c in screen.children if isinstance(c, Tooltip) and c.display],
+                "the maze view's tooltip",
+            )
             assert app.take_typed_key("d")
             await pilot.pause()
             assert not tips[0].display

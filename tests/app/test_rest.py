@@ -13,6 +13,7 @@ from textual.pilot import Pilot
 from textual.screen import ModalScreen
 
 from tests.app.support import run
+from tests.waiting import until
 from workbench.tui.app import REST_HZ, make_app
 from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.run_status import RunStatus
@@ -35,14 +36,15 @@ def test_an_idle_app_draws_about_once_a_second_and_its_clock_still_runs(tmp_path
     app = make_app(AppSettings(maze(tmp_path), noise="off"))
 
     async def body(pilot: Pilot) -> None:
-        await pilot.pause(0.3)
-        assert app._resting  # nothing moves: the clock ticks at REST_HZ
-        frames, t0 = app.frames, app.station.session.world.time
-        await pilot.pause(2.5)
-        drawn = app.frames - frames
-        assert 1 <= drawn <= 2.5 * REST_HZ + 1  # at 20 Hz it would be 50
-        t1 = app.station.session.world.time
-        assert t1 - t0 == pytest.approx(2.5, abs=1.1 / REST_HZ)  # simulated time goes on
+        await until(lambda: app._resting, "the app at rest")  # nothing moves: REST_HZ ticks
+        loop = asyncio.get_running_loop()
+        frames, t0, start = app.frames, app.station.session.world.time, loop.time()
+        await until(lambda: app.frames >= frames + 2, "two frames at rest")
+        t1, elapsed = app.station.session.world.time, loop.time() - start
+        # a rest period between them at least (at 20 Hz two frames would take 0.1 s)
+        assert elapsed >= 0.9 / REST_HZ
+        # simulated time goes on, in real time (t0 is the time of the tick before ``start``)
+        assert 0 < t1 - t0 <= elapsed + 1 / REST_HZ
         assert shown_time(app) == pytest.approx(t1, abs=0.051)
 
     run(app, body)
@@ -76,14 +78,13 @@ def test_paused_the_app_rests_and_p_wakes_it(tmp_path):
     app = make_app(AppSettings(maze(tmp_path), paused=True))
 
     async def body(pilot: Pilot) -> None:
-        await pilot.pause(0.2)
-        assert app._resting
+        await until(lambda: app._resting, "the app at rest")
         await pilot.press("w")  # motors on, but paused: nothing moves, still at rest
-        await pilot.pause(0.2)
+        await pilot.pause()
         assert app._resting
         await pilot.press("p")
-        await pilot.pause(0.2)
-        assert not app._resting and "running" in str(app.screen.query_one(RunStatus).lines[1])
+        await until(lambda: not app._resting, "the app awake")
+        await until(lambda: "running" in str(app.screen.query_one(RunStatus).lines[1]))
 
     run(app, body)
 

@@ -5,12 +5,13 @@ scripted VIPLE program over the real endpoints. Wrong set-ups show the expected 
 from __future__ import annotations
 
 import asyncio
-import socket
 from decimal import Decimal
 
 import pytest
 from websockets.asyncio.server import serve
 
+from tests.sessions import free_port
+from tests.waiting import DEADLINE, until
 from workbench.control.station import LabStation
 from workbench.labs.checks import ExerciseProgress, apply_setup, evaluate
 from workbench.labs.model import Exercise, LabMaze, Objective, Question, load_labs
@@ -77,27 +78,13 @@ def reach_exit(station: LabStation, ex: Exercise, obj: Objective) -> None:
         run_on(station, obj.maze, name)
 
 
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
-
-
-async def until(predicate, timeout: float = 3.0) -> None:
-    loop = asyncio.get_running_loop()
-    end = loop.time() + timeout
-    while not predicate():
-        assert loop.time() < end, "timed out"
-        await asyncio.sleep(0.01)
-
-
 async def drive_over_tcp(station: LabStation) -> None:
     """A scripted VIPLE program in the Unity-simulator role: connect, move, leave."""
     async with TcpServer(station.session, TcpConfig(port=0)) as server:
         reader, writer = await asyncio.open_connection("127.0.0.1", server.port)
         writer.write(MOVE.encode() + b"\r\n")
         await writer.drain()
-        await asyncio.wait_for(reader.readline(), 3)
+        await asyncio.wait_for(reader.readline(), DEADLINE)
         station.step(30)
         writer.close()
         await until(lambda: server.status.peer is None)
@@ -118,7 +105,7 @@ async def drive_over_ws(station: LabStation) -> None:
         client = WsClient(station.session, WsConfig(url=f"ws://127.0.0.1:{port}/"))
         await client.start()
         try:
-            await asyncio.wait_for(arrived.get(), 3)
+            await asyncio.wait_for(arrived.get(), DEADLINE)
             await until(lambda: client.status.messages_in >= 1)
             assert client.status.invalid == 0, client.status.last_rejection
             station.step(30)

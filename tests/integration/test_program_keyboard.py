@@ -19,6 +19,7 @@ import pytest
 from tests.integration.test_program_connect import CORRIDOR
 from tests.integration.test_viple_client import free_port
 from tests.program.builder import ProgramBuilder
+from tests.waiting import wait_until
 from workbench.program.keys import RELEASE_GAP
 
 ROBOT = "Robot/IoT Controller 0"
@@ -130,8 +131,8 @@ def test_typed_keys_drive_the_served_robot_and_ctrl_c_stops_it(tmp_path, served)
     client = connect(program, terminal)
     try:
         terminal.read_until("connected to")
-        time.sleep(0.3)
-        assert termios.tcgetattr(terminal.slave) != before  # raw while it drives
+        # raw while it drives
+        wait_until(lambda: termios.tcgetattr(terminal.slave) != before, "the terminal raw")
         terminal.type(b"w")
         terminal.read_until("key w")
         terminal.read_until("print: going")

@@ -15,6 +15,8 @@ from pathlib import Path
 import pytest
 from websockets.asyncio.server import serve as ws_serve
 
+from tests.sessions import free_port
+from tests.waiting import DEADLINE, until
 from workbench.cli import build_parser, main
 from workbench.cli.serve import plan, serve
 from workbench.sim.driver import Driver
@@ -23,12 +25,6 @@ from workbench.viple.codec import parse_report
 
 MOVE = b'{"servos":[{"isTurn":false,"servoId":-1,"servoSpeed":1}]}\r\n'
 ROOT = Path(__file__).resolve().parents[2]
-
-
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
 
 
 def connect(port: int, timeout: float = 10.0) -> socket.socket:
@@ -110,17 +106,24 @@ def test_serve_in_process_with_the_websocket_role_runs_in_real_time(tmp_path):
         async for message in ws:
             reports.append(message)
 
-    async def scenario():
+    async def scenario() -> tuple[int, float]:
         stop = asyncio.Event()
+        loop = asyncio.get_running_loop()
         async with ws_serve(viple, "127.0.0.1", port):
+            start = loop.time()
             running = asyncio.create_task(serve(the_plan, stop))
-            await asyncio.sleep(1.0)
+            await until(lambda: session.world.pose.y - y0 >= 0.5, "the robot half a unit on")
             stop.set()
-            return await asyncio.wait_for(running, 5)
+            code = await asyncio.wait_for(running, DEADLINE)
+            return code, loop.time() - start
 
-    assert asyncio.run(scenario()) == 0
-    # about a second of real time at 1 unit/s (the start waits for the connection)
-    assert 0.5 < session.world.pose.y - y0 < 1.2
+    t0 = session.world.time
+    code, wall = asyncio.run(scenario())
+    assert code == 0
+    # the simulation never runs ahead of real time, and it moved at 1 unit/s of it
+    simulated = session.world.time - t0
+    assert simulated <= wall
+    assert 0.5 <= session.world.pose.y - y0 <= simulated + 0.02
     assert str(session.driver) == "nobody"
     assert reports and all(sorted(parse_report(r)) == [4, 6] for r in reports)
     summary = json.loads(record.read_text().splitlines()[-1])

@@ -9,34 +9,15 @@ import signal
 import sqlite3
 import subprocess
 import sys
-from pathlib import Path
 
 import pytest
 
 from workbench.cli import main
 from workbench.labs.instructors import create_instructor, unlock_instructor
 from workbench.labs.roster import load_roster, roster_path
-from workbench.labs.store import DB_NAME, Store
+from workbench.labs.store import DB_NAME
 
 from .signoff_support import FAST, PASS, add_instructor, sign
-
-
-@pytest.fixture(autouse=True)
-def config_dir(tmp_path, monkeypatch) -> Path:
-    """The instructor's configuration folder, where their trusted roster is kept."""
-    d = tmp_path / "config"
-    monkeypatch.setenv("WORKBENCH_CONFIG", str(d))
-    return d
-
-
-@pytest.fixture
-def data_dir(tmp_path, monkeypatch, config_dir) -> Path:
-    d = tmp_path / "data"
-    d.mkdir()
-    create_instructor(d, "Dr Chen", PASS, kdf=FAST, trusted=config_dir / "roster.json")
-    Store.open(d).close()
-    monkeypatch.delenv("WORKBENCH_DATA", raising=False)
-    return d
 
 
 def test_instructor_add_with_the_default_kdf_and_list(tmp_path, monkeypatch, capsys, config_dir):

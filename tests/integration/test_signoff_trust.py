@@ -21,23 +21,7 @@ from workbench.labs.signlog import GENESIS, entry_hash
 from workbench.labs.signoff_record import record_from_stored
 from workbench.labs.store import DB_NAME, Store, read_signoffs
 
-from .signoff_support import FAST, PASS, add_instructor, sign, sql
-
-
-@pytest.fixture(autouse=True)
-def config_dir(tmp_path, monkeypatch) -> Path:
-    d = tmp_path / "config"
-    monkeypatch.setenv("WORKBENCH_CONFIG", str(d))
-    monkeypatch.delenv("WORKBENCH_DATA", raising=False)
-    return d
-
-
-@pytest.fixture
-def data_dir(tmp_path, config_dir) -> Path:
-    d = tmp_path / "data"
-    create_instructor(d, "Dr Chen", PASS, kdf=FAST, trusted=config_dir / "roster.json")
-    Store.open(d).close()
-    return d
+from .signoff_support import FAST, add_instructor, sign, sql
 
 
 @pytest.fixture

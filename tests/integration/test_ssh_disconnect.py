@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import asyncio
 import os
-import time
 
 from tests.app.support import sync
+from tests.waiting import until
 from workbench.ssh.ports import port_is_free
 
 from .ssh_support import Account, lab_host, open_exercise
@@ -22,14 +22,6 @@ def gone(pid: int) -> bool:
     except ProcessLookupError:
         return True
     return False
-
-
-async def eventually(check, what: str, timeout: float = 5.0) -> float:
-    start = time.monotonic()
-    while not check():
-        assert time.monotonic() - start < timeout, f"{what}: not after {timeout} s"
-        await asyncio.sleep(0.05)
-    return time.monotonic() - start
 
 
 @sync
@@ -51,9 +43,9 @@ async def test_a_dropped_connection_ends_the_app_frees_its_ports_and_progress_su
         pid, ports = session.app.pid, session.ports
         assert not any(port_is_free(p) for p in ports[:1])  # the app listens on its TCP port
         term.conn.abort()  # no goodbye: the laptop's lid closed
-        await eventually(lambda: gone(pid), "the app process gone")
-        await eventually(lambda: all(port_is_free(p) for p in ports), "the ports free")
-        assert not host.server.sessions
+        await until(lambda: gone(pid), "the app process gone")
+        await until(lambda: all(port_is_free(p) for p in ports), "the ports free")
+        await until(lambda: not host.server.sessions, "the session ended")
         assert not (set(ports) & host.server.pool.in_use)
 
         again = await host.terminal("ann", size=(100, 30))

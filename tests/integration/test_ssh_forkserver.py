@@ -9,12 +9,12 @@ import contextlib
 import logging
 import os
 import signal
-import time
 from pathlib import Path
 
 import pytest
 
 from tests.app.support import sync
+from tests.waiting import until
 from workbench.cli.ssh import WORKBENCH_APP
 from workbench.ssh import forkserver as forkserver_module
 from workbench.ssh.appproc import app_env
@@ -33,13 +33,6 @@ def gone(pid: int) -> bool:
     except ProcessLookupError:
         return True
     return False
-
-
-async def eventually(check, what: str, timeout: float = 10.0) -> None:
-    start = time.monotonic()
-    while not check():
-        assert time.monotonic() - start < timeout, f"{what}: not after {timeout} s"
-        await asyncio.sleep(0.05)
 
 
 @sync
@@ -92,7 +85,7 @@ async def test_an_app_whose_server_is_gone_ends(tmp_path):
         app = await server.spawn(settings, app_env(), tmp_path / "app.log")
         assert await asyncio.wait_for(app.stdout.readexactly(13), 20) == b"__GANGLION__\n"
         app.stdin.close()  # the server's end of the app's input and output
-        await eventually(lambda: gone(app.pid) or app.returncode is not None, "app ended", 20)
+        await until(lambda: gone(app.pid) or app.returncode is not None, "app ended")
     finally:
         with contextlib.suppress(ProcessLookupError):
             os.killpg(app.pid, signal.SIGKILL)
@@ -121,8 +114,8 @@ async def test_two_forked_sessions_at_once_resize_and_end_with_ctrl_q(tmp_path, 
         ann.send("\x11")  # ctrl+q
         assert await ann.exit_status() == 0
         await ben.close()  # a disconnect: ben's app is stopped and reaped
-        await eventually(lambda: all(gone(pid) for pid in pids.values()), "both apps gone")
-        await eventually(lambda: not host.server.sessions, "no sessions left")
+        await until(lambda: all(gone(pid) for pid in pids.values()), "both apps gone")
+        await until(lambda: not host.server.sessions, "no sessions left")
         await ann.close()
 
 
@@ -155,7 +148,7 @@ async def test_sessions_go_on_when_the_fork_server_is_lost(tmp_path, caplog):
         first = host.server.live("ann")[0].app
         assert first.forked
         os.kill(host.server.forkserver.pid, signal.SIGKILL)
-        await eventually(lambda: not host.server.forkserver.running, "the fork server lost")
+        await until(lambda: not host.server.forkserver.running, "the fork server lost")
 
         ben = await host.terminal("ben")  # the next session starts the old way
         await ben.start_app()

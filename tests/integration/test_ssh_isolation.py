@@ -16,9 +16,22 @@ from tests.app.support import sync
 from workbench.files.workspace import BUNDLED
 from workbench.labs.store import Store
 
-from .ssh_support import PASSWORD, Account, lab_host, moved
+from .ssh_support import PASSWORD, Account, distance, lab_host, moved
 
 MOVE = b'{"servos":[{"isTurn":false,"servoId":-1,"servoSpeed":1}]}\r\n'
+
+
+def units(text: str) -> float:
+    """The run panel's distance in units (0 when not on the screen)."""
+    shown = distance(text)
+    return float(shown.split()[0]) if shown else 0.0
+
+
+def app_time(text: str) -> float:
+    """The simulated time the run panel shows ("running at 1x | t 2.3 s")."""
+    found = re.search(r"\bt (\d+\.\d) s\b", text)
+    assert found, text
+    return float(found.group(1))
 
 
 async def tcp_port_shown(term) -> int:
@@ -46,7 +59,7 @@ async def test_each_student_sees_only_their_robot_and_forwards_only_to_their_own
         ann.send("w")
         await ann.wait_until(moved, "ann's robot moving")
         ben.send(" ")  # a key for ben too, so both apps are equally awake
-        await asyncio.sleep(0.5)
+        await ann.wait_until(lambda t: units(t) >= 0.5, "ann's robot half a unit on")
         assert "distance 0.00 unit" in ben.text()
 
         # a second connection of A's, like `ssh -N -L ...` on the student's computer
@@ -86,8 +99,10 @@ async def test_each_student_sees_only_their_robot_and_forwards_only_to_their_own
         local = await asyncio.start_server(viple_ws, "127.0.0.1", 0)
         local_port = local.sockets[0].getsockname()[1]
         await tunnel.forward_remote_port("localhost", ws_a, "127.0.0.1", local_port)
-        await asyncio.sleep(1.5)
-        assert not arrived.is_set()  # no attempts (and no errors in ssh -N) until asked
+        # a second of the app's own clock: no attempts (and no errors in ssh -N) until asked
+        then = app_time(ann.text())
+        await ann.wait_until(lambda t: app_time(t) >= then + 1.0, "a second on ann's clock")
+        assert not arrived.is_set()
         ann.send("v")  # connect over WebSocket
         await asyncio.wait_for(arrived.wait(), 15)
 

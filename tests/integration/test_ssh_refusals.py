@@ -10,6 +10,7 @@ import asyncssh
 import pytest
 
 from tests.app.support import sync
+from tests.waiting import until
 from workbench.ssh.limits import SessionLimits
 
 from .ssh_support import Account, lab_host
@@ -62,9 +63,14 @@ async def test_an_idle_session_is_closed_with_a_message(tmp_path):
     limits = SessionLimits(idle_timeout=2.0)
     async with lab_host(tmp_path, [Account("ann")], limits=limits) as host:
         term = await host.terminal("ann")
-        await term.start_app()
-        pid = host.server.live("ann")[0].app.pid
-        await term.wait_for("No input for 2 s: the session was closed.", timeout=15)
+        # the session's app, taken as soon as it is started: on a busy machine the session can
+        # be idle for 2 s before the app has drawn its first screen
+        app = await until(
+            lambda: next((s.app for s in host.server.sessions.values() if s.app), None),
+            "the session's app",
+        )
+        pid = await until(lambda: app.pid, "the app's process")
+        await term.wait_for("No input for 2 s: the session was closed.", timeout=30)
         assert await term.exit_status() == 1
         assert b"Your lab progress is saved; log in again to go on." in term.raw
         with pytest.raises(ProcessLookupError):

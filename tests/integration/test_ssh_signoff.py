@@ -3,7 +3,6 @@ signed with the instructor's key and names the SSH student."""
 
 from __future__ import annotations
 
-import asyncio
 import subprocess
 import sys
 
@@ -11,17 +10,21 @@ from tests.app.support import sync
 from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.store import Store
 
-from .ssh_support import Account, lab_host, open_exercise
+from .ssh_support import Account, Terminal, lab_host, open_exercise
 
 PASSPHRASE = "correct horse battery"
 FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
 
 
-def override_ticked(text: str) -> bool:
-    """The sign-off dialog's override box shows its tick (what the instructor looks for before
-    going on)."""
-    lines = [line for line in text.splitlines() if "Override" in line]
-    return any("X" in line.partition("Override")[0] for line in lines)
+def click(term: Terminal, text: str, after: int = 1) -> None:
+    """Click the left button ``after`` cells into the first place ``text`` is shown."""
+    for y, line in enumerate(term.screen.display):
+        x = line.find(text)
+        if x >= 0:
+            at = f"{x + after + 1};{y + 1}"  # the terminal counts from 1
+            term.send(f"\x1b[<0;{at}M\x1b[<0;{at}m")  # press and release (SGR mouse)
+            return
+    raise AssertionError(f"{text!r} not on the screen:\n{term.text()}")
 
 
 @sync
@@ -37,13 +40,14 @@ async def test_an_instructor_signs_off_an_exercise_from_the_students_session(tmp
         await term.wait_for("Sign off unity-simulator/drive-by-wire", "an override is needed")
         term.send(PASSPHRASE)  # the passphrase field has the focus (one instructor)
         await term.wait_for("•" * len(PASSPHRASE))
-        term.send("\t")
-        await asyncio.sleep(0.2)  # a person's pace between keys: focus moves first
+        # the mouse, not Tab: where a click lands does not depend on how soon the app has
+        # moved the focus, however busy the machine
+        click(term, "Note ", after=len("Note         "))
         term.send("checked at the station")
         await term.wait_for("at the station")
-        term.send("\t ")  # to the override, and tick it
-        await term.wait_until(override_ticked, "the override box ticked")
-        term.send("\x1b[Z\r")  # back to the note, and sign
+        click(term, "[ ] Override")
+        await term.wait_for("[X] Override")
+        click(term, "Sign off    Cancel")
         await term.wait_for("Signed off by ito (override).")
         await term.close()
 

@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pytest
 
+from tests.waiting import wait_until
 from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.roster import RosterEntry, offered_roster
 from workbench.labs.signing import sign_off
@@ -190,27 +191,30 @@ def test_two_threads_write_at_the_same_time(where):
 
 
 SIGNER = """
-import sys, time
+import os, sys, time
 from workbench.labs.signing import sign_off
 from workbench.labs.signoff_record import RecordFields
 from workbench.labs.store import Store
-data_dir, db, who, start = sys.argv[1], sys.argv[2] or None, sys.argv[3], float(sys.argv[4])
+data_dir, db, who, ready = sys.argv[1], sys.argv[2] or None, sys.argv[3], sys.argv[4]
 fields = RecordFields(student=who, lab="lab", exercise="ex", objectives_passed=True)
 with Store.open(data_dir, db=db) as store:
-    time.sleep(max(0.0, start - time.time()))
+    open(os.path.join(ready, who), "w").close()  # ready; both begin once both are
+    while len(os.listdir(ready)) < 2:
+        time.sleep(0.001)
     for i in range(10):
         sign_off(store, "Dr Chen", "correct horse battery", fields)
 """
 
 
-def test_two_processes_signing_at_once_make_one_log(where):
+def test_two_processes_signing_at_once_make_one_log(where, tmp_path):
     """Two servers' apps sign off at the same moment: one log, no number taken twice."""
     where.add_instructor()
-    start = str(time.time() + 1.5)  # both begin together, once started
+    ready = tmp_path / "ready"  # each signer says it is ready here, and waits for the other
+    ready.mkdir()
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     args = [str(where.data_dir), where.db or ""]
     procs = [
-        subprocess.Popen([sys.executable, "-c", SIGNER, *args, who, start], env=env)
+        subprocess.Popen([sys.executable, "-c", SIGNER, *args, who, str(ready)], env=env)
         for who in ("alice", "bob")
     ]
     assert [p.wait(timeout=120) for p in procs] == [0, 0]
@@ -309,12 +313,11 @@ def test_the_database_stopped_and_restarted_under_a_writer_loses_nothing(
     thread = threading.Thread(target=writer)
     thread.start()
     try:
-        while sum(outcome.values()) < 20:
-            time.sleep(0.01)
+        wait_until(lambda: sum(outcome.values()) >= 20, "twenty saves in the database")
         pg_server.stop()
         down_from = len(outcome)
-        while len(outcome) < down_from + 50:  # saves made while the server is down
-            time.sleep(0.01)
+        # saves made while the server is down
+        wait_until(lambda: len(outcome) >= down_from + 50, "fifty saves with the server down")
         assert not any(outcome[i] for i in range(down_from + 5, len(outcome)))  # pending
         assert store.pending > 0 and not store.available
         with pytest.raises(StoreError, match=r"cannot be reached|went away"):
@@ -324,12 +327,9 @@ def test_the_database_stopped_and_restarted_under_a_writer_loses_nothing(
     # what a front end does now and then, in a thread of its own: flush, while the student
     # keeps saving; once the database answers, saves reach it again at once
     back_from = len(outcome)
-    deadline = time.monotonic() + 20
-    while not store.flush() and time.monotonic() < deadline:
-        time.sleep(0.05)
+    wait_until(store.flush, "the pending saves written", every=0.05)
     flushed_at = len(outcome)
-    while len(outcome) < flushed_at + 20:
-        time.sleep(0.01)
+    wait_until(lambda: len(outcome) >= flushed_at + 20, "twenty saves after the flush")
     stop.set()
     thread.join()
     assert outcome[len(outcome) - 1] and len(outcome) > back_from
@@ -357,8 +357,9 @@ def test_a_store_opened_while_the_server_is_down_catches_up_when_it_is_back(
             Store.open(tmp_path, db=pg_url)  # without offline_ok it says so at once
     finally:
         pg_server.start()
-    time.sleep(1.1)  # past the pause between tries
-    assert store.flush() is True
+    wait_until(
+        store.flush, "the pending saves written", every=0.05
+    )  # once past the pause between tries
     with Store.open(tmp_path, db=pg_url) as fresh:
         assert fresh.progress("alice") == {("lab", "ex1"): {"i": 1}}
         assert fresh.place("alice") == ("lab", "ex1")

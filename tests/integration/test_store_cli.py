@@ -22,15 +22,6 @@ from workbench.labs.store import Store
 from .signoff_support import FAST, PASS, sign
 
 
-@pytest.fixture(autouse=True)
-def config_dir(tmp_path, monkeypatch) -> Path:
-    d = tmp_path / "config"
-    monkeypatch.setenv("WORKBENCH_CONFIG", str(d))
-    monkeypatch.delenv("WORKBENCH_DB", raising=False)
-    monkeypatch.delenv("WORKBENCH_DATA", raising=False)
-    return d
-
-
 @pytest.fixture
 def section(tmp_path, config_dir) -> Path:
     """A lab machine's data folder after a week of labs: an instructor, three sign-offs, a

@@ -11,15 +11,16 @@ import pytest
 from websockets.asyncio.server import ServerConnection, serve
 from websockets.exceptions import ConnectionClosed
 
-from workbench.sim.mazefile import parse_maze
+from tests.sessions import CORRIDOR, free_port, pushes_keep_their_interval, session_for, steps
+from tests.waiting import until
 from workbench.sim.sensors import SensorSpec
 from workbench.sim.session import Session
+from workbench.viple import ws_client
 from workbench.viple.codec import parse_report
 from workbench.viple.link import Seat
 from workbench.viple.tcp_server import TcpConfig, TcpServer
 from workbench.viple.ws_client import RETRY_SECONDS, WsClient, WsConfig, check_ws_url
 
-CORRIDOR = parse_maze("##########\n#S.......#\n##########\n", source="corridor.txt")
 MOVE = '{"servos":[{"isTurn":false,"servoId":-1,"servoSpeed":1}]}'
 STOP = '{"servos":[{"isTurn":false,"servoId":-1,"servoSpeed":"0"}]}'
 DRIVE = (
@@ -27,12 +28,6 @@ DRIVE = (
     '{"isTurn":false,"servoId":5,"servoSpeed":0.5}]}'
 )
 RETRY = 0.1
-
-
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
 
 
 class FakeViple:
@@ -78,39 +73,36 @@ class FakeViple:
             self.messages.get_nowait()
 
 
-async def until(predicate, timeout: float = 2.0) -> None:
-    loop = asyncio.get_running_loop()
-    deadline = loop.time() + timeout
-    while not predicate():
-        assert loop.time() < deadline, "timed out"
-        await asyncio.sleep(0.005)
-
-
-def session_for(profile: str = "unity") -> Session:
-    return Session(CORRIDOR, profile, noise="off")
-
-
 def client_for(session: Session, url: str, **config) -> WsClient:
     return WsClient(session, WsConfig(url=url, retry_seconds=RETRY, **config))
 
 
-def steps(session: Session, n: int) -> None:
-    for _ in range(n):
-        session.step()
+def attempts(monkeypatch) -> list[str]:
+    """The URLs the client has tried to connect to so far, one entry per attempt."""
+    tried: list[str] = []
+    connect = ws_client.connect
+
+    def counted(url: str, **options):
+        tried.append(url)
+        return connect(url, **options)
+
+    monkeypatch.setattr(ws_client, "connect", counted)
+    return tried
 
 
 def messages(caplog, text: str) -> list[str]:
     return [r.getMessage() for r in caplog.records if text in r.getMessage()]
 
 
-def test_started_before_viple_it_retries_quietly_until_viple_appears(caplog):
+def test_started_before_viple_it_retries_quietly_until_viple_appears(caplog, monkeypatch):
     caplog.set_level(logging.INFO, logger="workbench.viple")
+    tried = attempts(monkeypatch)
 
     async def scenario():
         viple = FakeViple(free_port())
         session = session_for()
         async with client_for(session, viple.url) as client:
-            await asyncio.sleep(5 * RETRY)  # several failed attempts
+            await until(lambda: len(tried) >= 5, "five attempts")  # each one failed
             assert not client.status.connected
             await viple.start()
             await viple.connected()
@@ -149,31 +141,29 @@ def test_commands_in_frames_move_the_robot_and_each_is_answered():
     asyncio.run(scenario())
 
 
-def test_reports_arrive_at_the_configured_rate():
+def test_reports_arrive_at_the_configured_interval_and_never_early():
     async def scenario():
         viple = await FakeViple(free_port()).start()
+        loop = asyncio.get_running_loop()
+        start = loop.time()
         async with client_for(session_for(), viple.url, report_ms=100):
             await viple.connected()
-            await viple.report()
-            loop = asyncio.get_running_loop()
-            start = loop.time()
-            count = 0
-            while loop.time() - start < 0.6:
-                await viple.report()
-                count += 1
-            assert 4 <= count <= 8
+            await pushes_keep_their_interval(
+                lambda: viple.report(timeout=20), loop.time, start, 0.1, count=6
+            )
         await viple.stop()
 
     asyncio.run(scenario())
 
 
-def test_viple_restarting_stops_the_robot_and_the_client_reconnects(caplog):
+def test_viple_restarting_stops_the_robot_and_the_client_reconnects(caplog, monkeypatch):
     caplog.set_level(logging.INFO, logger="workbench.viple")
+    tried = attempts(monkeypatch)
 
     async def scenario():
         port = free_port()
         viple = await FakeViple(port).start()
-        session = session_for("web")
+        session = session_for(profile="web")
         async with client_for(session, viple.url) as client:
             robot = await viple.connected()
             await robot.send(DRIVE)
@@ -184,7 +174,8 @@ def test_viple_restarting_stops_the_robot_and_the_client_reconnects(caplog):
             x = session.world.pose.x
             steps(session, 30)
             assert session.world.pose.x == pytest.approx(x)  # motors stopped
-            await asyncio.sleep(4 * RETRY)  # VIPLE is down for a while
+            down = len(tried)
+            await until(lambda: len(tried) >= down + 3, "three attempts")  # VIPLE is down
 
             viple = await FakeViple(port).start()
             robot = await viple.connected()
@@ -234,8 +225,14 @@ async def _closed(ws: ServerConnection) -> bool:
     return True
 
 
-def test_the_ws_role_waits_while_a_tcp_program_drives_the_same_robot(caplog):
+def test_the_ws_role_waits_while_a_tcp_program_drives_the_same_robot(caplog, monkeypatch):
     caplog.set_level(logging.INFO, logger="workbench.viple")
+    tried = attempts(monkeypatch)
+    looks: list[bool] = []  # each time the client looked at the seat: whether it was taken
+    seat_taken = WsClient._seat_taken
+    monkeypatch.setattr(
+        WsClient, "_seat_taken", lambda self: looks.append(seat_taken(self)) or looks[-1]
+    )
 
     async def scenario():
         viple = await FakeViple(free_port()).start()
@@ -246,8 +243,9 @@ def test_the_ws_role_waits_while_a_tcp_program_drives_the_same_robot(caplog):
             await reader.readline()
             config = WsConfig(url=viple.url, retry_seconds=RETRY)
             async with WsClient(session, config, seat) as client:
-                await asyncio.sleep(3 * RETRY)
-                assert not viple.arrived.is_set()
+                # the seat is taken at every look, and the client never tries to connect
+                await until(lambda: looks.count(True) >= 3, "three looks at the seat")
+                assert tried == [] and not viple.arrived.is_set()
                 writer.close()
                 await viple.connected()
                 await until(lambda: client.status.connected)

@@ -387,16 +387,14 @@ def test_every_missing_sensor_is_listed():
 # -- speed ----------------------------------------------------------------------------------
 
 
-def test_a_tick_without_a_transition_costs_microseconds():
+def test_ticks_without_a_transition_stay_in_the_state_and_command_nothing_new():
+    # what such a tick costs (target: under 50 µs): bench/fsm_tick.py
     ctl = FsmController(load_algorithm("self-adjusting-wall"), {}, "web")
     ctl.start(0)
     readings = {"front": 300.0, "right": 25.0}
     none = frozenset()
     ctl.tick(DT, readings, none)
-    n = 20_000
-    begin = time.perf_counter()
-    for i in range(n):
-        ctl.tick(i * DT, readings, none)
-    per_tick = (time.perf_counter() - begin) / n
     assert ctl.state == "Forward"
-    assert per_tick < 50e-6, f"{per_tick * 1e6:.1f} µs per tick"
+    for i in range(2, 2_000):
+        assert ctl.tick(i * DT, readings, none) == [], i
+    assert ctl.state == "Forward"

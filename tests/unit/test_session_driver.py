@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 from textual import events, messages
 from textual.drivers import web_driver
 
+from tests.waiting import until
 from workbench.tui.serving import packets
 from workbench.tui.serving.terminal_driver import (
     SYNC_END,
@@ -82,10 +83,8 @@ async def reading_driver() -> AsyncIterator[tuple[PostBox, ServedTerminalDriver,
         os.close(w)
 
 
-async def settle(box: PostBox, count: int, timeout: float = 5.0) -> None:
-    deadline = time.monotonic() + timeout
-    while len(box.messages) < count and time.monotonic() < deadline:
-        await asyncio.sleep(0.01)
+async def settle(box: PostBox, count: int) -> None:
+    await until(lambda: len(box.messages) >= count, f"{count} messages to the app")
 
 
 def test_keys_arrive_in_order_on_the_apps_thread_and_no_thread_reads():
@@ -128,10 +127,7 @@ def test_meta_packets_reach_the_app_and_the_end_of_input_ends_it():
         assert isinstance(leave, messages.ExitApp)
         os.close(w)
         reading = driver._input_reader
-        deadline = time.monotonic() + 5
-        while reading.reading and time.monotonic() < deadline:  # type: ignore[attr-defined]
-            await asyncio.sleep(0.01)
-        assert not reading.reading  # type: ignore[attr-defined]
+        await until(lambda: not reading.reading, "the reading stopped")  # type: ignore[attr-defined]
         # with the server gone (its end of the pipe closed) the app ends, saving as it ends
         assert isinstance(box.messages[-1], messages.ExitApp) and len(box.messages) == 3
 

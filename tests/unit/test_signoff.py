@@ -9,7 +9,6 @@ import sqlite3
 import subprocess
 import sys
 import threading
-import time
 from dataclasses import replace
 from datetime import UTC, datetime, timedelta
 from pathlib import Path
@@ -544,25 +543,28 @@ def test_a_sequence_number_is_taken_once(store):
 
 
 SIGNER = """
-import sys, time
+import os, sys, time
 from datetime import UTC, datetime
 from workbench.labs.signing import sign_off
 from workbench.labs.signoff_record import RecordFields
 from workbench.labs.store import Store
-data_dir, who, start = sys.argv[1], sys.argv[2], float(sys.argv[3])
+data_dir, who, ready = sys.argv[1], sys.argv[2], sys.argv[3]
 fields = RecordFields(student=who, lab="lab", exercise="ex", objectives_passed=True)
 with Store.open(data_dir) as store:
-    time.sleep(max(0.0, start - time.time()))
+    open(os.path.join(ready, who), "w").close()  # ready; both begin once both are
+    while len(os.listdir(ready)) < 2:
+        time.sleep(0.001)
     for i in range(12):
         sign_off(store, "Dr Chen", "correct horse battery", fields)
 """
 
 
-def test_two_processes_signing_at_once_never_fork_the_chain(store, data_dir):
-    start = str(time.time() + 1.5)  # both begin at the same moment, once started
+def test_two_processes_signing_at_once_never_fork_the_chain(store, data_dir, tmp_path):
+    ready = tmp_path / "ready"  # each signer says it is ready here, and waits for the other
+    ready.mkdir()
     env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[2])}
     procs = [
-        subprocess.Popen([sys.executable, "-c", SIGNER, str(data_dir), who, start], env=env)
+        subprocess.Popen([sys.executable, "-c", SIGNER, str(data_dir), who, str(ready)], env=env)
         for who in ("alice", "bob")
     ]
     assert [p.wait(timeout=120) for p in procs] == [0, 0]

@@ -1,0 +1,22 @@
+"""Fixtures of the sign-off and store command tests."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from workbench.labs.instructors import create_instructor
+from workbench.labs.store import Store
+
+from .signoff_support import FAST, PASS
+
+
+@pytest.fixture
+def data_dir(tmp_path, config_dir) -> Path:
+    """A lab machine's data folder: instructor Dr Chen, trusted in the test's own roster, and
+    the database with nothing signed yet."""
+    d = tmp_path / "data"
+    create_instructor(d, "Dr Chen", PASS, kdf=FAST, trusted=config_dir / "roster.json")
+    Store.open(d).close()
+    return d
