@@ -212,26 +212,24 @@ def test_a_database_that_hangs_never_freezes_the_app_and_the_work_waits_for_it(
             assert isinstance(app.screen, MainScreen) and not app.station.paused
             frames = app.frames
             await pilot.press("w")
-            while app.frames == frames:
-                await asyncio.sleep(0.01)
+            await until(lambda: app.frames != frames, "a frame drawn after the key")
             assert store.pending  # the answer is still on its way
             await pilot.press("p", "l")
             assert app.screen is screen
-            message = ""
-            deadline = time.monotonic() + 15  # the database is given up on within seconds
-            while "saved as soon as it is back" not in message and time.monotonic() < deadline:
-                await asyncio.sleep(0.05)
+
+            def kept() -> str:
                 message = text(screen, "#labs-message")
+                return message if "saved as soon as it is back" in message else ""
+
+            # the database is given up on within seconds
+            message = await until(kept, "the message that the work is kept")
             assert message.startswith("the course database cannot be reached: your progress")
             assert "kept here" in message and "saved as soon as it is back" in message
             assert store.pending
         finally:
             hang.release()
         back = "the course database is back: your progress is saved"
-        deadline = time.monotonic() + 20
-        while text(screen, "#labs-message") != back and time.monotonic() < deadline:
-            await asyncio.sleep(0.1)
-        assert text(screen, "#labs-message") == back
+        await until(lambda: text(screen, "#labs-message") == back, "the message that it is back")
         assert not store.pending
 
     run(app, body)
