@@ -126,3 +126,10 @@ def test_it_never_calls_eval(monkeypatch):
     monkeypatch.setattr(builtins, "eval", forbidden)
     monkeypatch.setattr(builtins, "exec", forbidden)
     assert compile_expr("a * 2 > 3", names={"a"})({"a": 2}) is True
+
+
+@pytest.mark.parametrize("text", ["\x00", "front < 20\x00", "x\x00 + 1"])
+def test_a_nul_character_is_refused_with_its_column_on_every_python_311(text):
+    with pytest.raises(ExprError, match="NUL character") as refused:
+        compile_expr(text)
+    assert refused.value.column == text.index("\x00") + 1

@@ -162,6 +162,10 @@ def _prescan(text: str, lead: int) -> None:
             MAX_LENGTH + 1,
             _SIMPLER,
         )
+    nul = text.find("\x00")
+    if nul >= 0:
+        # Python's parser refuses it too, with another error on some 3.11 releases
+        raise ExprError("a NUL character (code 0)", text, nul + 1, "delete it and type the text")
     pending = [0]  # unary operators not yet closed, per open bracket
     operand_before = False
     i = lead
