@@ -3,8 +3,8 @@
 The lab server (``workbench/ssh/appproc.py``) hands a session's app its settings as one JSON
 object (:meth:`workbench.tui.settings.AppSettings.to_json`), the workbench for a student and
 the instructor's console (:mod:`workbench.tui.console_app`) for an instructor: to :func:`main`
-in a process forked from the fork server, or as the one argument of ``python -m workbench.cli.served`` when
-it starts the app as a new process. The course database's URL is never among them: the app
+in a process forked from the fork server, or as the one argument of
+``python -m workbench.cli.served`` when it starts the app as a new process. The course database's URL is never among them: the app
 finds it in its environment (``$WORKBENCH_DB``), as the command line does without ``--db``.
 """
 
