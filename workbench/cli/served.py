@@ -4,8 +4,9 @@ The lab server (``workbench/ssh/appproc.py``) hands a session's app its settings
 object (:meth:`workbench.tui.settings.AppSettings.to_json`), the workbench for a student and
 the instructor's console (:mod:`workbench.tui.console_app`) for an instructor: to :func:`main`
 in a process forked from the fork server, or as the one argument of
-``python -m workbench.cli.served`` when it starts the app as a new process. The course database's URL is never among them: the app
-finds it in its environment (``$WORKBENCH_DB``), as the command line does without ``--db``.
+``python -m workbench.cli.served`` when it starts the app as a new process. The course
+database's URL is never among them: the app finds it in its environment (``$WORKBENCH_DB``),
+as the command line does without ``--db``.
 """
 
 from __future__ import annotations
