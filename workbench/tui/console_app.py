@@ -9,11 +9,14 @@ passphrase typed here.
 
 from __future__ import annotations
 
-from textual.binding import Binding
+from typing import ClassVar
+
+from textual.binding import BindingType
 
 from workbench.labs.model import Lab, LabFileError, load_labs
 from workbench.labs.store import Store, StoreError
 
+from .app import FOCUS_BINDINGS
 from .host import ScreenHost
 from .keys import APP_KEY_IDS, bindings
 from .screens.console import ConsoleScreen
@@ -24,7 +27,10 @@ class ConsoleApp(ScreenHost[None]):
     """The class, its sign-off queue, and signing off from here."""
 
     TITLE = "VIPLE Maze Lab Workbench: instructor's console"
-    BINDINGS: list[Binding] = [b for b in bindings(*APP_KEY_IDS) if b.action == "quit"]  # noqa: RUF012
+    BINDINGS: ClassVar[list[BindingType]] = [
+        *(b for b in bindings(*APP_KEY_IDS) if b.action == "quit"),
+        *FOCUS_BINDINGS,
+    ]
 
     def __init__(
         self, store: Store, labs: list[Lab], *, instructor: str = "", unicode: bool = False

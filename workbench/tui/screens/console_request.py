@@ -80,9 +80,13 @@ def evidence_words(evidence: object) -> str:
     if "run" in evidence:
         return f"run {evidence.get('run')} by {evidence.get('driver', '?')}"
     parts = []
-    for key, value in sorted(evidence.items())[:3]:
+    for key, value in sorted(evidence.items()):
+        if value in (None, "", [], {}):
+            continue
         text = ", ".join(map(str, value)) if isinstance(value, list) else str(value)
-        parts.append(f"{key} {text[:30]}")
+        parts.append(f"{key.replace('_', ' ')} {text[:30]}")
+        if len(parts) == 3:
+            break
     return "; ".join(parts)
 
 

@@ -590,6 +590,7 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             title = f"{self.selected[0].title}: {self.selected[1].title}"
             title += f" ({self.marks.signed} signed off {by})"
             self.query_one("#labs-title", Static).update(prose(title, self.unicode))
+            self.say(f"signed off {by}")
 
     def action_sign_off(self) -> None:
         if self.selected is None:
