@@ -178,7 +178,8 @@ class ConsoleScreen(FollowsUnicode, Screen[None]):
             queue.highlighted = ids.index(chosen) if chosen in ids else 0
         waiting = len(view.queue)
         self.query_one("#console-queue-title", Static).update(
-            f"Sign-off queue: {waiting} waiting" + ("" if waiting else " (nobody has asked)")
+            f"Sign-off queue: {waiting} waiting"
+            + ("; enter opens the highlighted request" if waiting else " (nobody has asked)")
         )
         listing = self.query_one("#console-class", OptionList)
         top = listing.scroll_offset.y
@@ -187,9 +188,10 @@ class ConsoleScreen(FollowsUnicode, Screen[None]):
             [Option(row_text(r, self.unicode), id=f"s:{r.student}") for r in view.rows]
         )
         listing.scroll_to(y=top, animate=False)
+        passed, failed = ("✓", "✗") if self.unicode else ("X", ".")
         self.query_one("#console-class-title", Static).update(
-            f"Class: {len(view.rows)} at work"
-            + (f" (console of {self.instructor})" if self.instructor else "")
+            f"Class: {len(view.rows)} at work; objectives {passed} passed, {failed} not yet"
+            + (f"; console of {self.instructor}" if self.instructor else "")
         )
 
     def action_open_entry(self) -> None:
