@@ -32,7 +32,7 @@ def main(settings: object) -> int:
     from workbench.tui.app import AppSetupError, make_app
     from workbench.tui.console_app import make_console
 
-    app: App[object]
+    app: App[None]
     try:
         given = replace(AppSettings.from_json(settings), db=resolve_db(None))
         # an instructor's session is the console: the class, the queue, signing with their

@@ -201,6 +201,8 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self._retry_timer: Timer | None = None
         self._retrying = False
         self._reload_when_back = False
+        #: a sign-off seen while another screen was over this one
+        self._signed_later: SignoffStatus.Signed | None = None
         self.unicode = False
         self._load_saved()
 
@@ -407,6 +409,9 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
 
     def on_screen_resume(self) -> None:
         self.show_snapshot(self.station.snapshot())
+        later, self._signed_later = self._signed_later, None
+        if later is not None:
+            self._signed_elsewhere(later)
 
     def _refresh_list(self) -> None:
         listing = self.query_one("#labs-list", OptionList)
@@ -579,10 +584,14 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
 
     @on(SignoffStatus.Signed)
     def _signed_elsewhere(self, event: SignoffStatus.Signed) -> None:
-        """A sign-off made at an instructor's console: the title and the list show it."""
+        """A sign-off made at an instructor's console: the title and the list show it (once
+        this screen is shown again, when a dialog or another screen is over it)."""
+        if self.app.screen is not self:
+            self._signed_later = event
+            return
         key = (event.lab, event.exercise)
         by = _by(event.instructor, event.signed_at)
-        if self._signed.get(key) == by:
+        if key in self._signed:  # known here already (read at the start, or signed here)
             return
         self._signed[key] = by
         self._refresh_list()

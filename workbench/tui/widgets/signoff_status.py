@@ -171,6 +171,8 @@ class SignoffStatus(Static):
         self.post_message(asked)  # thread-safe
 
     def _read(self, store: Store, target: Target) -> Seen:
+        if store.offline:  # the saving side is waiting for the database: no reads meanwhile
+            return Seen(target, None, None, "the course database cannot be reached")
         try:
             state = store.queue_state(target.student, target.lab, target.exercise)
             rows = [
