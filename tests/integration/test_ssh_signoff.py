@@ -1,55 +1,119 @@
-"""An instructor signs off a student's exercise at the student's SSH session: the record is
-signed with the instructor's key and names the SSH student."""
+"""An instructor signs off a served student's exercise from their own SSH session (OpenSSH's
+``ssh -tt``, as an instructor logs in): the student asks with the ready key, the request shows on
+the instructor's console, the passphrase is typed only there, and the student's screen shows
+the sign-off. The student's own session never offers a signing dialog."""
 
 from __future__ import annotations
 
+import asyncio
+import os
+import shutil
 import subprocess
 import sys
+import time
+from pathlib import Path
+
+import pexpect
+import pyte
+import pytest
 
 from tests.app.support import sync
 from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.store import Store
 
-from .ssh_support import Account, Terminal, lab_host, open_exercise
+from .ssh_support import Account, lab_host, open_exercise
 
 PASSPHRASE = "correct horse battery"
 FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
+SIZE = (24, 80)
 
 
-def click(term: Terminal, text: str, after: int = 1) -> None:
-    """Click the left button ``after`` cells into the first place ``text`` is shown."""
-    for y, line in enumerate(term.screen.display):
-        x = line.find(text)
-        if x >= 0:
-            at = f"{x + after + 1};{y + 1}"  # the terminal counts from 1
-            term.send(f"\x1b[<0;{at}M\x1b[<0;{at}m")  # press and release (SGR mouse)
-            return
-    raise AssertionError(f"{text!r} not on the screen:\n{term.text()}")
+class OpenSshTerminal:
+    """OpenSSH's client on a pty (``ssh -tt``), its output fed into an emulated 80x24 screen.
+    Its calls block, so a test running the lab server on its event loop calls them in a
+    thread (:meth:`wait_for` is async)."""
+
+    def __init__(self, user: str, port: int, key: Path) -> None:
+        self.screen = pyte.Screen(SIZE[1], SIZE[0])
+        self.stream = pyte.ByteStream(self.screen)
+        argv = [
+            "-tt", "-F", "/dev/null", "-i", str(key), "-p", str(port),
+            "-o", "StrictHostKeyChecking=no", "-o", "UserKnownHostsFile=/dev/null",
+            "-o", "BatchMode=yes", f"{user}@127.0.0.1",
+        ]  # fmt: skip
+        env = {k: v for k, v in os.environ.items() if not k.startswith(("TEXTUAL", "SSH_"))}
+        env.update(TERM="xterm-256color", LANG="C.UTF-8")
+        self.child = pexpect.spawn("ssh", argv, env=env, dimensions=SIZE)
+
+    def text(self) -> str:
+        return "\n".join(self.screen.display)
+
+    def _wait(self, needles: tuple[str, ...], timeout: float) -> str:
+        end = time.monotonic() + timeout
+        while time.monotonic() < end:
+            try:
+                self.stream.feed(self.child.read_nonblocking(65536, timeout=0.05))
+            except pexpect.TIMEOUT:
+                pass
+            except pexpect.EOF:
+                break
+            if all(n in self.text() for n in needles):
+                return self.text()
+        missing = [n for n in needles if n not in self.text()]
+        raise AssertionError(f"{missing} not on the screen after {timeout} s:\n{self.text()}")
+
+    async def wait_for(self, *needles: str, timeout: float = 30.0) -> str:
+        return await asyncio.to_thread(self._wait, needles, timeout)
+
+    def send(self, keys: str) -> None:
+        self.child.send(keys)
+
+    def close(self) -> None:
+        self.child.terminate(force=True)
 
 
+@pytest.mark.skipif(shutil.which("ssh") is None, reason="no OpenSSH client (openssh-client)")
 @sync
-async def test_an_instructor_signs_off_an_exercise_from_the_students_session(tmp_path):
+async def test_the_instructor_signs_from_their_own_session_and_the_student_sees_it(tmp_path):
     accounts = [Account("ann"), Account("ito", role="instructor")]
     async with lab_host(tmp_path, accounts) as host:
         kept = tmp_path / "instructor" / "roster.json"  # the instructor's own copy
         create_instructor(host.data_dir, "ito", PASSPHRASE, kdf=FAST, trusted=kept)
-        term = await host.terminal("ann", size=(100, 30))
-        await term.start_app()
-        await open_exercise(term, "Unity simulator: Drive by wire")
-        term.send("i")
-        await term.wait_for("Sign off unity-simulator/drive-by-wire", "an override is needed")
-        term.send(PASSPHRASE)  # the passphrase field has the focus (one instructor)
-        await term.wait_for("•" * len(PASSPHRASE))
-        # the mouse, not Tab: where a click lands does not depend on how soon the app has
-        # moved the focus, however busy the machine
-        click(term, "Note ", after=len("Note         "))
-        term.send("checked at the station")
-        await term.wait_for("at the station")
-        click(term, "[ ] Override")
-        await term.wait_for("[X] Override")
-        click(term, "Sign off    Cancel")
-        await term.wait_for("Signed off by ito (override).")
-        await term.close()
+        student = await host.terminal("ann")
+        await student.start_app()
+        await open_exercise(student, "Unity simulator: Drive by wire")
+        # no signing dialog in the student's session: i says where sign-off is given
+        student.send("i")
+        screen = await student.wait_for("instructor's console")
+        assert "Passphrase" not in screen
+        student.send("r")
+        await student.wait_for("1st in the queue")
+
+        key = tmp_path / "id_ito"
+        key.write_bytes(host.accounts["ito"].key.export_private_key())
+        key.chmod(0o600)
+        instructor = OpenSshTerminal("ito", host.port, key)
+        try:
+            await instructor.wait_for("Sign-off queue: 1 waiting", "1. ann")
+            instructor.send("\r")
+            await instructor.wait_for("ann ask for sign-off", "objectives pass")
+            instructor.send(PASSPHRASE)  # typed in the instructor's own terminal
+            await instructor.wait_for("•" * len(PASSPHRASE))
+            instructor.send("\t")
+            await asyncio.sleep(0.2)  # a person's pace between keys: focus moves first
+            instructor.send("checked at the console")
+            await instructor.wait_for("at the console")
+            instructor.send("\t")
+            await asyncio.sleep(0.2)  # a person's pace between keys: focus moves first
+            instructor.send(" ")  # the override, ticked
+            await instructor.wait_for("[X] Override")
+            instructor.send("\x13")  # ctrl+s signs
+            await instructor.wait_for("signed off ann unity-simulator/drive-by-wire as ito")
+            # the student's screen shows it without a key pressed
+            await student.wait_for("[*] Drive by wire", "signed off by ito on", timeout=5)
+        finally:
+            instructor.close()
+        await student.close()
 
     command = ["signoff", "verify", "--data-dir", str(host.data_dir), "--roster", str(kept)]
     verify = subprocess.run(
@@ -62,6 +126,7 @@ async def test_an_instructor_signs_off_an_exercise_from_the_students_session(tmp
     assert "all 1 record(s) verify" in verify.stdout
     with Store.open(host.data_dir, create=False) as store:
         (record,) = store.signoffs()
+        assert store.signoff_queue() == []
     assert (record.instructor, record.student) == ("ito", "ann")
     assert (record.lab, record.exercise) == ("unity-simulator", "drive-by-wire")
-    assert record.override and record.note == "checked at the station"
+    assert record.override and record.note == "checked at the console"

@@ -108,6 +108,7 @@ def test_schema_steps_are_numbered_and_recorded_once(where):
     expected = [(1, "tables"), (2, "sign-off chain")]
     if where.db:
         expected.append((3, "instructors' roster"))
+    expected.append((4, "sign-off queue"))
     assert steps == expected and version == expected[-1][0]
 
 

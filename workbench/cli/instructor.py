@@ -53,6 +53,20 @@ def register(sub: argparse._SubParsersAction) -> None:
     db_option(ls)
     ls.set_defaults(func=cmd_list)
 
+    console = inner.add_parser(
+        "console",
+        help="the instructor's console: the class live, the sign-off queue, signing off",
+        description="Show every student's exercise and objectives live from the course store, "
+        "and the requests for sign-off; open one to sign it off with your key (your "
+        "passphrase is typed here) or decline it with a note the student sees.",
+    )
+    console.add_argument(
+        "--unicode", action="store_true", help="draw with Unicode marks (default: plain ASCII)"
+    )
+    data_dir_option(console)
+    db_option(console)
+    console.set_defaults(func=cmd_console)
+
 
 def _trusted_option(parser: argparse.ArgumentParser, what: str) -> None:
     parser.add_argument(
@@ -128,6 +142,25 @@ def cmd_add(args: argparse.Namespace) -> int:
         print(f"the private key is encrypted in the course database {where}")
     else:
         print(f"the private key is encrypted in {key_path(data_dir, name)}")
+    return 0
+
+
+def cmd_console(args: argparse.Namespace) -> int:
+    from workbench.labs.model import LabFileError
+    from workbench.tui.console_app import make_console
+    from workbench.tui.settings import AppSettings
+
+    try:
+        settings = AppSettings(
+            data_dir=resolve_data_dir(args.data_dir),
+            db=resolve_db(getattr(args, "db", None)),
+            unicode=args.unicode,
+            role="instructor",
+        )
+        app = make_console(settings)
+    except (StoreError, LabFileError) as exc:
+        return fail(str(exc))
+    app.run()
     return 0
 
 

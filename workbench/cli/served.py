@@ -1,10 +1,12 @@
 """The app of one SSH session, started from the settings the lab server made for it.
 
 The lab server (``workbench/ssh/appproc.py``) hands a session's app its settings as one JSON
-object (:meth:`workbench.tui.settings.AppSettings.to_json`): to :func:`main` in a process
-forked from the fork server, or as the one argument of ``python -m workbench.cli.served`` when
-it starts the app as a new process. The course database's URL is never among them: the app
-finds it in its environment (``$WORKBENCH_DB``), as the command line does without ``--db``.
+object (:meth:`workbench.tui.settings.AppSettings.to_json`), the workbench for a student and
+the instructor's console (:mod:`workbench.tui.console_app`) for an instructor: to :func:`main`
+in a process forked from the fork server, or as the one argument of
+``python -m workbench.cli.served`` when it starts the app as a new process. The course
+database's URL is never among them: the app finds it in its environment (``$WORKBENCH_DB``),
+as the command line does without ``--db``.
 """
 
 from __future__ import annotations
@@ -12,22 +14,31 @@ from __future__ import annotations
 import json
 import sys
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
 from workbench.labs.store import StoreError, resolve_db
 from workbench.tui.settings import AppSettings, SettingsError
 
 from .common import error
 
+if TYPE_CHECKING:
+    from textual.app import App
+
 
 def main(settings: object) -> int:
     """Run the app with ``settings`` (a JSON object); exit status 2 when they are not the
     app's or the app cannot start with them (the reason on standard error)."""
+    from workbench.labs.model import LabFileError
     from workbench.tui.app import AppSetupError, make_app
+    from workbench.tui.console_app import make_console
 
+    app: App[None]
     try:
-        given = AppSettings.from_json(settings)
-        app = make_app(replace(given, db=resolve_db(None)))
-    except (SettingsError, StoreError, AppSetupError) as exc:
+        given = replace(AppSettings.from_json(settings), db=resolve_db(None))
+        # an instructor's session is the console: the class, the queue, signing with their
+        # own key typed in their own terminal
+        app = make_console(given) if given.role == "instructor" else make_app(given)
+    except (SettingsError, StoreError, AppSetupError, LabFileError) as exc:
         error(str(exc))
         return 2
     app.run()

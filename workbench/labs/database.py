@@ -279,7 +279,14 @@ class SqliteBackend(Backend):
     @classmethod
     def open(cls, path: Path) -> SqliteBackend:
         try:
-            conn = sqlite3.connect(path, timeout=BUSY_TIMEOUT_MS / 1000, isolation_level=None)
+            # the store holds its lock around every use, so threads may share the connection
+            # (a screen reads the store in a thread of its own)
+            conn = sqlite3.connect(
+                path,
+                timeout=BUSY_TIMEOUT_MS / 1000,
+                isolation_level=None,
+                check_same_thread=False,
+            )
         except sqlite3.Error as exc:
             raise sqlite_failure(path, exc, "open the database") from None
         backend = cls(path, conn)

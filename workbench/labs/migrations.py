@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from datetime import UTC, datetime
 from typing import Any
 
+from . import queue
 from .database import Backend, StoreError, Tx
 from .signlog import GENESIS, entry_hash, parse_metrics, signed_payload
 
@@ -173,11 +174,16 @@ def _roster(tx: Tx, kind: str) -> None:
     tx.execute(ROSTER)
 
 
+def _queue(tx: Tx, kind: str) -> None:
+    _statements(tx, kind, queue.TABLE)
+
+
 STEPS = (
     Step(1, "tables", _tables),
     Step(2, "sign-off chain", _chain),
     # a SQLite store keeps the roster and the keys as files in the data folder
     Step(3, "instructors' roster", _roster, kinds=("postgresql",)),
+    Step(4, "sign-off queue", _queue),
 )
 
 

@@ -37,6 +37,7 @@ import platformdirs
 
 from workbench.files.private import PRIVATE_FILE, private_dir, tighten
 
+from . import queue
 from .database import (
     BUSY_TIMEOUT_MS,
     Backend,
@@ -53,6 +54,7 @@ from .database import (
 from .migrations import RECORD_COLUMNS, SIGNOFF_LOCK, check_version, latest, migrate
 from .names import name_key
 from .pending import FIELDS, PendingWrite, load_pending, save_pending
+from .queue import QueueEntry, QueueState
 from .signlog import GENESIS, entry_hash, next_place, parse_metrics, signed_payload
 
 __all__ = [
@@ -627,6 +629,59 @@ class Store:
             (student, partner),
         )
         return {(lab, exercise): driver for lab, exercise, driver in rows}
+
+    # the sign-off queue (see queue.py)
+
+    def request_signoff(
+        self,
+        student: str,
+        partner: str,
+        driver: str,
+        lab: str,
+        exercise: str,
+        now: datetime | None = None,
+    ) -> QueueState:
+        """Ask for an instructor's sign-off of ``lab``/``exercise``; returns where the request
+        stands (its place in the queue). Needs the database: :class:`StoreUnavailable` while
+        it is away."""
+        with self._write() as tx:
+            queue.request(tx, student, partner, driver, lab, exercise, now or _now())
+        return self.queue_state(student, lab, exercise)
+
+    def withdraw_request(
+        self, student: str, lab: str, exercise: str, now: datetime | None = None
+    ) -> bool:
+        """Take back a waiting request; False when none waited."""
+        with self._write() as tx:
+            return queue.withdraw(tx, student, lab, exercise, now or _now())
+
+    def signoff_queue(self) -> list[QueueEntry]:
+        """The requests that wait for an instructor, first asked first."""
+        return queue.waiting(self._read)
+
+    def queue_state(self, student: str, lab: str, exercise: str) -> QueueState:
+        """Where ``student``'s request for ``lab``/``exercise`` stands."""
+        return queue.state_of(self._read, student, lab, exercise)
+
+    def decline_request(
+        self, entry_id: int, instructor: str, note: str, now: datetime | None = None
+    ) -> QueueEntry:
+        """Decline a waiting request with a note the student sees; refused when it no longer
+        waits or the note is empty."""
+        with self._write() as tx:
+            return queue.decide(tx, entry_id, queue.DECLINED, instructor, note, now or _now())
+
+    def mark_signed(
+        self, entry_id: int, instructor: str, now: datetime | None = None
+    ) -> QueueEntry:
+        """Close a waiting request once its exercise is signed off."""
+        with self._write() as tx:
+            return queue.decide(tx, entry_id, queue.SIGNED, instructor, "", now or _now())
+
+    def places(self) -> dict[str, tuple[str, str]]:
+        """The (lab, exercise) every student who has opened one had open last."""
+        rows = self._read("SELECT student, lab, exercise FROM places ORDER BY student")
+        return {str(s): (str(lab), str(ex)) for s, lab, ex in rows}
 
     # passphrase lockout
 

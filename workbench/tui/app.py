@@ -473,6 +473,9 @@ class WorkbenchApp(ScreenHost[None]):
                 self.student,
                 self.partner,
                 store_problem=self.store_problem,
+                # a served student's terminal is theirs: an instructor never types a
+                # passphrase there (they sign at their own console)
+                signs_here=not self.station.files.confined,
             )
             self.install_screen(self._labs, name="labs")
         self.push_screen("labs")

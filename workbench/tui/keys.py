@@ -488,7 +488,52 @@ KEY_TABLE: dict[str, Key] = {
         "Sign off",
         "Labs",
         "instructor sign-off",
-        "The instructor signs the exercise off with their passphrase; then change driver.",
+        "At a workbench of your own, the instructor signs the exercise off here with their "
+        "passphrase, then you change driver; in a lab server session, press r instead.",
+    ),
+    "labs.ready": Key(
+        "r",
+        "ready",
+        "Ready",
+        "Labs",
+        "ready for sign-off",
+        "Ask an instructor to sign the exercise off: it joins the sign-off queue, and the "
+        "screen shows your place, a decline's note or the sign-off.",
+    ),
+    "console.open": Key(
+        "enter",
+        "open_entry",
+        "Open",
+        "Console",
+        "open the request",
+        "Open the chosen request: the objectives, their evidence, the run and the sign-off.",
+    ),
+    "console.replay": Key(
+        "p",
+        "replay",
+        "Replay",
+        "Console",
+        "replay the evidence run",
+        "Replay the run the objectives rest on, in the maze view.",
+    ),
+    "console.sign": Key(
+        "ctrl+s",
+        "sign",
+        "Sign",
+        "Console",
+        "sign off",
+        "Sign the exercise off with your key (your passphrase is typed here, in your own "
+        "session).",
+        priority=True,
+    ),
+    "console.decline": Key(
+        "ctrl+d",
+        "decline",
+        "Decline",
+        "Console",
+        "decline",
+        "Decline the request; the note says what to do and the student sees it.",
+        priority=True,
     ),
     "dialog.close": Key("escape", "close", "Close", "Dialog", "close", "Close this dialog."),
     "sensors.add": Key(

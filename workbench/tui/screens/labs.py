@@ -4,7 +4,10 @@ On the left, every lab and its exercises (✓ once an exercise's objectives pass
 instructor has signed it off; ``[X]`` and ``[*]`` in ASCII mode); on the right, the chosen
 exercise: its instructions, its objectives with ✓/✗ (``[X]``/``[ ]``) and a one-line reason
 that follow the station as the student works, and its questions. ``a`` puts
-the exercise's set-up on the station, ``i`` opens the instructor's sign-off. Progress is saved
+the exercise's set-up on the station, ``r`` asks for sign-off (the exercise joins the store's
+sign-off queue, which the instructor's console shows; the screen follows the request), and
+``i`` opens the instructor's sign-off at this station where signing here is allowed (not in a
+served student's session, whose terminal is the student's). Progress is saved
 in the store as soon as an exercise is opened and each time an objective or an answer
 changes; an objective that passed once stays passed, with its evidence, after a restart.
 """
@@ -43,6 +46,7 @@ from ..keys import bindings
 from ..plain import follow_app, prose
 from ..widgets.field import Field
 from ..widgets.key_bar import KeyBar
+from ..widgets.signoff_status import SignoffStatus
 
 
 class Marks(NamedTuple):
@@ -152,7 +156,9 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
     }
     """
 
-    BINDINGS: ClassVar[list[BindingType]] = [*bindings("labs.close", "labs.setup", "labs.signoff")]
+    BINDINGS: ClassVar[list[BindingType]] = [
+        *bindings("labs.close", "labs.setup", "labs.ready", "labs.signoff")
+    ]
 
     def __init__(
         self,
@@ -162,8 +168,12 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         partner: str = "",
         labs: list[Lab] | None = None,
         store_problem: str = "",
+        signs_here: bool = True,
     ) -> None:
+        """``signs_here``: an instructor may sign off at this station (``i``); False in a
+        served student's session, where only the ready key asks for sign-off."""
         super().__init__()
+        self.signs_here = signs_here
         self.station = station
         self.store = store
         self.student = student
@@ -191,6 +201,8 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self._retry_timer: Timer | None = None
         self._retrying = False
         self._reload_when_back = False
+        #: a sign-off seen while another screen was over this one
+        self._signed_later: SignoffStatus.Signed | None = None
         self.unicode = False
         self._load_saved()
 
@@ -325,6 +337,7 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
                     yield Static("", id="labs-objectives", markup=False)
                     yield Markdown("", id="labs-instructions")
                     yield Vertical(id="labs-questions")
+        yield SignoffStatus(self.store, id="labs-signoff")
         yield Static("", id="labs-message", markup=False)
         yield KeyBar()
 
@@ -396,6 +409,9 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
 
     def on_screen_resume(self) -> None:
         self.show_snapshot(self.station.snapshot())
+        later, self._signed_later = self._signed_later, None
+        if later is not None:
+            self._signed_elsewhere(later)
 
     def _refresh_list(self) -> None:
         listing = self.query_one("#labs-list", OptionList)
@@ -425,6 +441,9 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             except Exception as exc:
                 self.say(f"cannot save where you are: {exc}")
         self.driver = self._drivers.get((lab.id, exercise.id), self.driver)
+        self.query_one(SignoffStatus).follow(
+            self.student, self.partner, self.driver, lab.id, exercise.id
+        )
         self.progress = None
         signed = self._signed.get((lab.id, exercise.id))
         title = f"{lab.title}: {exercise.title}"
@@ -547,9 +566,50 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self.post_message(SetUpDone(setup))
         self.show_snapshot(self.station.snapshot())
 
+    def action_ready(self) -> None:
+        if self.selected is None:
+            self.say("choose an exercise first")
+            return
+        if self.store is None:
+            self.say(self._store_problem or "no data folder: sign-off is not available")
+            return
+        self.query_one(SignoffStatus).ask()
+
+    @on(SignoffStatus.Asked)
+    def _asked(self, event: SignoffStatus.Asked) -> None:
+        if event.problem:
+            self.say(event.problem)
+        elif event.state is not None and event.state.place is not None:
+            self.say(f"asked for sign-off: you are number {event.state.place} in the queue")
+
+    @on(SignoffStatus.Signed)
+    def _signed_elsewhere(self, event: SignoffStatus.Signed) -> None:
+        """A sign-off made at an instructor's console: the title and the list show it (once
+        this screen is shown again, when a dialog or another screen is over it)."""
+        if self.app.screen is not self:
+            self._signed_later = event
+            return
+        key = (event.lab, event.exercise)
+        by = _by(event.instructor, event.signed_at)
+        if key in self._signed:  # known here already (read at the start, or signed here)
+            return
+        self._signed[key] = by
+        self._refresh_list()
+        if self.selected is not None and (self.selected[0].id, self.selected[1].id) == key:
+            title = f"{self.selected[0].title}: {self.selected[1].title}"
+            title += f" ({self.marks.signed} signed off {by})"
+            self.query_one("#labs-title", Static).update(prose(title, self.unicode))
+            self.say(f"signed off {by}")
+
     def action_sign_off(self) -> None:
         if self.selected is None:
             self.say("choose an exercise first")
+            return
+        if not self.signs_here:
+            self.say(
+                "sign-off is given at the instructor's console, not here: press r to ask "
+                "for it (your place in the queue shows below)"
+            )
             return
         if self.store is None:
             self.say(self._store_problem or "no data folder: sign-off is not available")

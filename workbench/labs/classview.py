@@ -1,0 +1,141 @@
+"""The class as the instructor's console shows it: every student, the exercise they have open,
+its objectives and who waits for sign-off, read from the store.
+
+:func:`read_class` reads it all in one go (the console calls it about once a second, in a
+thread); :func:`read_request` reads what one request rests on: the exercise's saved progress,
+the objectives' evidence and the run they rest on, and the sign-off fields an instructor signs.
+Nothing here imports Textual.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from .checks import ExerciseProgress
+from .model import Lab
+from .queue import QueueEntry
+from .signoff_record import Evidence, RecordFields
+from .store import Store
+
+
+@dataclass(frozen=True)
+class StudentRow:
+    """One student (or pair) of the class."""
+
+    student: str
+    #: the partner of the student's last request ("" when alone or not known)
+    partner: str
+    lab: str
+    exercise: str
+    #: the exercise's title ("" when the lab files no longer have it)
+    title: str
+    #: each objective's text and whether it passes (empty: nothing saved yet)
+    objectives: tuple[tuple[str, bool], ...]
+    #: the place of the open exercise's request in the queue (None: not waiting)
+    waiting: int | None
+    #: the open exercise has been signed off
+    signed: bool
+    #: the saved progress could not be read (why)
+    problem: str = ""
+
+
+@dataclass(frozen=True)
+class ClassView:
+    rows: tuple[StudentRow, ...]
+    queue: tuple[QueueEntry, ...]
+
+
+def titles(labs: list[Lab]) -> dict[tuple[str, str], str]:
+    return {(lab.id, ex.id): ex.title for lab in labs for ex in lab.exercises}
+
+
+def read_class(store: Store, labs: list[Lab]) -> ClassView:
+    """The class as the store has it now."""
+    names = titles(labs)
+    queue = store.signoff_queue()
+    places = store.places()
+    records = store.signoffs()
+    signed = {(r.student, r.lab, r.exercise) for r in records}
+    signed |= {(r.partner, r.lab, r.exercise) for r in records if r.partner}
+    waiting = {(e.student, e.lab, e.exercise): n for n, e in enumerate(queue, 1)}
+    partners = {e.student: e.partner for e in queue}
+    rows = []
+    for student, (lab, exercise) in sorted(places.items(), key=lambda p: p[0].casefold()):
+        objectives: tuple[tuple[str, bool], ...] = ()
+        problem = ""
+        saved = store.progress(student, lab).get((lab, exercise))
+        if saved is not None:
+            try:
+                progress = ExerciseProgress.from_dict(saved)
+                objectives = tuple((o.text, o.passed) for o in progress.objectives)
+            except ValueError as exc:
+                problem = str(exc)
+        rows.append(
+            StudentRow(
+                student=student,
+                partner=partners.get(student, ""),
+                lab=lab,
+                exercise=exercise,
+                title=names.get((lab, exercise), ""),
+                objectives=objectives,
+                waiting=waiting.get((student, lab, exercise)),
+                signed=(student, lab, exercise) in signed,
+                problem=problem,
+            )
+        )
+    return ClassView(tuple(rows), tuple(queue))
+
+
+@dataclass(frozen=True)
+class Request:
+    """What one request for sign-off rests on, for the instructor to judge and sign."""
+
+    entry: QueueEntry
+    title: str
+    #: the exercise's saved progress (None: nothing saved, or unreadable: see ``problem``)
+    progress: ExerciseProgress | None
+    #: the run the objectives rest on: its record file and figures (None: no run)
+    run: dict[str, Any] | None
+    problem: str = ""
+
+    @property
+    def passed(self) -> bool:
+        return self.progress is not None and self.progress.passed
+
+    def fields(self) -> RecordFields:
+        """The sign-off's fields: the pair and driver of the request, the saved evidence."""
+        progress = self.progress
+        if progress is None:
+            raise ValueError(f"{self.entry.pair} has no saved progress in this exercise")
+        return RecordFields(
+            student=self.entry.student,
+            lab=self.entry.lab,
+            exercise=self.entry.exercise,
+            driver=self.entry.driver or self.entry.student,
+            partner=self.entry.partner,
+            evidence=Evidence.of_progress(progress),
+            objectives_passed=progress.passed,
+        )
+
+
+def evidence_run(progress: ExerciseProgress) -> dict[str, Any] | None:
+    """The evidence of the first passing objective that rests on a run (its number, driver,
+    maze, figures and record), else None."""
+    for o in progress.objectives:
+        if o.passed and isinstance(o.evidence, dict) and "metrics" in o.evidence:
+            return dict(o.evidence)
+    return None
+
+
+def read_request(store: Store, entry: QueueEntry, labs: list[Lab]) -> Request:
+    """The saved progress of ``entry``'s exercise and the run its objectives rest on."""
+    title = titles(labs).get((entry.lab, entry.exercise), entry.exercise)
+    saved = store.progress(entry.student, entry.lab).get((entry.lab, entry.exercise))
+    if saved is None:
+        return Request(entry, title, None, None, "nothing saved for this exercise yet")
+    try:
+        progress = ExerciseProgress.from_dict(saved)
+    except ValueError as exc:
+        return Request(entry, title, None, None, str(exc))
+    return Request(entry, title, progress, evidence_run(progress))

@@ -1,0 +1,376 @@
+"""One request for sign-off, opened at the instructor's console: judge it, then sign or decline.
+
+The screen shows the pair, the driver and the exercise, every objective with its reason and its
+evidence, and the figures of the run the objectives rest on (``p`` replays that run in the
+maze view). The instructor chooses their name, types their passphrase (here, in their own
+session: the student's terminal never sees it) and signs (ctrl+s), or writes a note and
+declines (ctrl+d), which the student reads on their labs screen. Reading the request, unlocking
+the key (scrypt) and writing the record all run in threads; the screen keeps answering.
+It returns what was done, in words for the console's message line (None: closed).
+"""
+
+from __future__ import annotations
+
+import asyncio
+from typing import Any, ClassVar
+
+from textual import on
+from textual.app import ComposeResult
+from textual.binding import BindingType
+from textual.containers import Horizontal, Vertical, VerticalScroll
+from textual.screen import Screen
+from textual.widgets import Button, Checkbox, Input, Label, Select, Static
+
+from workbench.labs.classview import Request, read_request
+from workbench.labs.model import Lab
+from workbench.labs.queue import QueueEntry
+from workbench.labs.roster import offered_roster
+from workbench.labs.signing import MAX_NOTE, prepare_signoff
+from workbench.labs.signoff_errors import SignoffError
+from workbench.labs.store import Store, StoreError
+from workbench.sim.record import RecordError
+from workbench.sim.replay import load_replay
+
+from ..keys import bindings
+from ..plain import follow_app
+from ..widgets.field import Field
+from ..widgets.key_bar import KeyBar
+from ..widgets.tick import Tick
+
+#: the run figures shown, in this order, with their units
+FIGURES = (
+    ("exit_time", "time to the exit", "s"),
+    ("distance", "distance", "m"),
+    ("collisions", "collisions", ""),
+    ("turns", "turns", ""),
+)
+
+
+def figure_lines(run: dict[str, Any]) -> list[str]:
+    """The evidence run in a few lines: which run, who drove, the maze, its figures."""
+    lines = [
+        f"run {run.get('run', '?')} by {run.get('driver', '?')} on {run.get('maze', '?')} "
+        f"({run.get('profile', '?')}), ended: {run.get('ended', '?')}"
+    ]
+    metrics = run.get("metrics")
+    if isinstance(metrics, dict):
+        known = [k for k, *_ in FIGURES]
+        shown = [
+            f"{label} {_number(metrics[k])}{(' ' + unit) if unit else ''}"
+            for k, label, unit in FIGURES
+            if k in metrics
+        ]
+        shown += [f"{k} {_number(v)}" for k, v in sorted(metrics.items()) if k not in known]
+        lines.append("; ".join(shown))
+    record = run.get("record")
+    lines.append(f"record: {record}" if record else "the run was not recorded (no replay)")
+    return lines
+
+
+def _number(value: object) -> str:
+    if isinstance(value, float):
+        return f"{value:.2f}"
+    return str(value)
+
+
+def evidence_words(evidence: object) -> str:
+    """An objective's evidence in one short line."""
+    if not isinstance(evidence, dict) or not evidence:
+        return ""
+    if "run" in evidence:
+        return f"run {evidence.get('run')} by {evidence.get('driver', '?')}"
+    parts = []
+    for key, value in sorted(evidence.items()):
+        if value in (None, "", [], {}):
+            continue
+        text = ", ".join(map(str, value)) if isinstance(value, list) else str(value)
+        parts.append(f"{key.replace('_', ' ')} {text[:30]}")
+        if len(parts) == 3:
+            break
+    return "; ".join(parts)
+
+
+class RequestScreen(Screen[str | None]):
+    """Judge one request; sign it off or decline it."""
+
+    DEFAULT_CSS = """
+    RequestScreen #request-title {
+        height: auto;
+        text-style: bold;
+        color: $text-primary;
+        padding: 0 1;
+    }
+    RequestScreen #request-scroll {
+        height: 1fr;
+        padding: 0 1;
+    }
+    RequestScreen #request-objectives, RequestScreen #request-run {
+        height: auto;
+    }
+    RequestScreen #request-run {
+        color: $text-muted;
+    }
+    RequestScreen .field-row {
+        height: 1;
+        padding: 0 1;
+    }
+    RequestScreen .field-row Label {
+        width: 12;
+    }
+    RequestScreen .field-row Input, RequestScreen .field-row Select {
+        width: 1fr;
+    }
+    RequestScreen #request-override {
+        padding: 0 1;
+    }
+    RequestScreen .button-row {
+        height: 1;
+        padding: 0 1;
+    }
+    RequestScreen .button-row Button {
+        margin-right: 2;
+        min-width: 0;
+        width: auto;
+    }
+    RequestScreen #request-status {
+        height: auto;
+        max-height: 2;
+        padding: 0 1;
+        color: $text-warning;
+    }
+    """
+
+    BINDINGS: ClassVar[list[BindingType]] = [
+        *bindings("dialog.close", "console.sign", "console.decline", "console.replay")
+    ]
+
+    def __init__(self, store: Store, entry: QueueEntry, labs: list[Lab]) -> None:
+        super().__init__()
+        self.store = store
+        self.entry = entry
+        self.labs = labs
+        self.request: Request | None = None
+        #: a sign-off or decline under way (one at a time)
+        self.busy = False
+        self.done = ""
+        try:
+            self.roster = sorted(offered_roster(store))
+            self.roster_problem = "" if self.roster else "the roster has no instructors yet"
+        except (SignoffError, StoreError) as exc:
+            self.roster = []
+            self.roster_problem = str(exc)
+        if self.roster_problem:
+            self.roster_problem += ": add one with 'workbench instructor add NAME'"
+
+    def compose(self) -> ComposeResult:
+        e = self.entry
+        yield Static(
+            f"{e.pair} ask for sign-off of {e.lab}/{e.exercise}; driver {e.driver or e.student}",
+            id="request-title",
+            markup=False,
+        )
+        with VerticalScroll(id="request-scroll"):
+            yield Static("reading the saved progress...", id="request-objectives", markup=False)
+            yield Static("", id="request-run", markup=False)
+        with Vertical(id="request-form"):
+            with Horizontal(classes="field-row"):
+                yield Label("Instructor")
+                yield Select(
+                    [(name, name) for name in self.roster],
+                    prompt="choose",
+                    value=self.roster[0] if len(self.roster) == 1 else Select.NULL,
+                    id="request-instructor",
+                    compact=True,
+                )
+            with Horizontal(classes="field-row"):
+                yield Label("Passphrase")
+                yield Field(password=True, id="request-passphrase", compact=True)
+            with Horizontal(classes="field-row"):
+                yield Label("Note")
+                yield Field(
+                    placeholder="optional to sign; needed to decline or override",
+                    id="request-note",
+                    compact=True,
+                    max_length=MAX_NOTE,
+                )
+            yield Tick(
+                "Override: sign although objectives have not passed",
+                value=False,
+                id="request-override",
+                compact=True,
+            )
+            with Horizontal(classes="button-row"):
+                yield Button("Sign off", id="request-sign", variant="primary", compact=True)
+                yield Button("Decline", id="request-decline", compact=True)
+                yield Button("Replay run", id="request-replay", compact=True)
+        yield Static(self.roster_problem, id="request-status", markup=False)
+        yield KeyBar()
+
+    def on_mount(self) -> None:
+        follow_app(self)
+        field = "#request-passphrase" if len(self.roster) <= 1 else "#request-instructor"
+        self.query_one(field).focus()
+        self.run_worker(self._load(), group="request", exit_on_error=False)
+
+    async def _load(self) -> None:
+        try:
+            request = await asyncio.to_thread(read_request, self.store, self.entry, self.labs)
+        except StoreError as exc:
+            self._say(f"cannot read the saved progress: {exc}")
+            return
+        self.request = request
+        self._show(request)
+
+    def _show(self, request: Request) -> None:
+        unicode = getattr(self.app, "unicode", False)
+        passed, failed = ("✓", "✗") if unicode else ("[X]", "[ ]")
+        lines = [f"{request.title}"]
+        if request.progress is None:
+            lines.append(request.problem)
+        else:
+            for o in request.progress.objectives:
+                lines.append(f"{passed if o.passed else failed} {o.text}: {o.reason}")
+                said = evidence_words(o.evidence)
+                if said:
+                    lines.append(f"    evidence: {said}")
+            count = sum(o.passed for o in request.progress.objectives)
+            total = len(request.progress.objectives)
+            lines.append(
+                "all objectives pass"
+                if request.passed
+                else f"{count} of {total} objectives pass: signing needs an override and a note"
+            )
+        self.query_one("#request-objectives", Static).update("\n".join(lines))
+        run = request.run
+        self.query_one("#request-run", Static).update(
+            "\n".join(figure_lines(run)) if run else "no run among the evidence"
+        )
+
+    def _say(self, message: str) -> None:
+        self.query_one("#request-status", Static).update(message)
+
+    @on(Field.Capped, "#request-note")
+    def _note_too_long(self, event: Field.Capped) -> None:
+        self._say(f"a note is at most {event.limit} characters: the rest was not kept")
+
+    # -- signing ---------------------------------------------------------------------------
+    @on(Input.Submitted, "#request-passphrase")
+    @on(Button.Pressed, "#request-sign")
+    def action_sign(self) -> None:
+        if self.busy or self.done:
+            return
+        if not self.roster:
+            self._say(self.roster_problem)
+            return
+        request = self.request
+        if request is None or request.progress is None:
+            self._say(request.problem if request else "the saved progress is still being read")
+            return
+        instructor = self.query_one("#request-instructor", Select).value
+        if instructor is Select.NULL or not isinstance(instructor, str):
+            self._say("choose the instructor")
+            return
+        passphrase = self.query_one("#request-passphrase", Input)
+        note = self.query_one("#request-note", Input).value
+        override = self.query_one("#request-override", Checkbox).value
+        self.busy = True
+        self._say(f"unlocking the key of {instructor}...")
+        secret, passphrase.value = passphrase.value, ""
+        self.run_worker(
+            self._sign(request, instructor, secret, note, override),
+            group="request",
+            exit_on_error=False,
+        )
+
+    async def _sign(
+        self, request: Request, instructor: str, passphrase: str, note: str, override: bool
+    ) -> None:
+        """Check, unlock (scrypt) and sign, each in a thread; then close the request."""
+        store, entry = self.store, self.entry
+        try:
+            pending = await asyncio.to_thread(
+                prepare_signoff, store, instructor, request.fields(), override, note
+            )
+            signer = await asyncio.to_thread(pending.unlock, passphrase)
+            await asyncio.to_thread(pending.complete, signer)
+        except SignoffError as exc:
+            self._say(str(exc))
+            return
+        except Exception as exc:
+            self._say(f"not signed: {exc}")
+            return
+        finally:
+            self.busy = False
+        record = pending.record
+        problems = []
+        try:
+            await asyncio.to_thread(store.mark_signed, entry.id, instructor)
+        except StoreError as exc:
+            problems.append(f"the request stays in the queue: {exc}")
+        try:
+            await asyncio.to_thread(
+                store.set_driver, entry.student, entry.partner, entry.lab, entry.exercise,
+                record.driver,
+            )  # fmt: skip
+        except StoreError as exc:
+            problems.append(f"the driver was not recorded: {exc}")
+        self.done = (
+            f"signed off {entry.pair} {entry.lab}/{entry.exercise} as {instructor}"
+            f"{' (override)' if record.override else ''}"
+        )
+        self._say("; ".join([self.done, *problems]) + "; escape goes back to the class")
+
+    @on(Input.Submitted, "#request-note")
+    @on(Button.Pressed, "#request-decline")
+    def action_decline(self) -> None:
+        if self.busy or self.done:
+            return
+        note = self.query_one("#request-note", Input).value.strip()
+        if not note:
+            self._say("write a note first: it tells the student what to do before asking again")
+            self.query_one("#request-note").focus()
+            return
+        instructor = self.query_one("#request-instructor", Select).value
+        who = instructor if isinstance(instructor, str) else (self.app.title or "instructor")
+        self.busy = True
+        self.run_worker(self._decline(str(who), note), group="request", exit_on_error=False)
+
+    async def _decline(self, instructor: str, note: str) -> None:
+        try:
+            await asyncio.to_thread(self.store.decline_request, self.entry.id, instructor, note)
+        except StoreError as exc:
+            self._say(f"not declined: {exc}")
+            return
+        finally:
+            self.busy = False
+        e = self.entry
+        self.done = f"declined {e.pair} {e.lab}/{e.exercise}: {note}"
+        self.dismiss(self.done)
+
+    # -- replay ----------------------------------------------------------------------------
+    @on(Button.Pressed, "#request-replay")
+    def action_replay(self) -> None:
+        request = self.request
+        run = request.run if request is not None else None
+        record = run.get("record") if run else None
+        if not record:
+            self._say("no recorded run among the evidence: nothing to replay")
+            return
+        self.run_worker(self._replay(str(record)), group="request", exit_on_error=False)
+
+    async def _replay(self, path: str) -> None:
+        from .replay import ReplayScreen
+
+        try:
+            replay = await asyncio.to_thread(load_replay, path)
+        except (OSError, RecordError) as exc:
+            self._say(f"cannot replay the run: {exc}")
+            return
+        unicode = getattr(self.app, "unicode", False)
+        self.app.push_screen(ReplayScreen(path, replay, unicode=unicode))
+
+    def action_close(self) -> None:
+        if self.busy:
+            self._say("wait: the sign-off is under way")
+            return
+        self.dismiss(self.done or None)
