@@ -12,7 +12,7 @@ from workbench.tui.screens.labs import UNREACHABLE, LabsScreen
 from workbench.tui.screens.main import MainScreen
 from workbench.tui.settings import AppSettings
 
-from .labs_support import lab_app
+from .labs_support import lab_app, open_exercise
 from .support import run, screen_lines
 
 #: what an algorithm that fails in a file kept deep in a student's folders may say
@@ -59,5 +59,22 @@ def test_the_course_database_message_is_drawn_whole(tmp_path):
             "soon as it is back$",
             said,
         ), said
+
+    run(app, body)
+
+
+def test_a_set_up_names_its_starter_by_the_file_alone(tmp_path):
+    app = lab_app(tmp_path / "data")
+
+    async def body(pilot: Pilot) -> None:
+        screen = await open_exercise(pilot, "web-simulator/local-best-main")
+        await pilot.press("a")
+        await pilot.pause()
+        said = drawn(pilot, 2)
+        assert said == (
+            "set up: web, web.txt, starter web-two-distance.yaml; "
+            "algorithm starter-web-two-distance (was none)"
+        ), said
+        assert screen is app.screen
 
     run(app, body)
