@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import json
 
+import pytest
 from textual.screen import Screen
 from textual.widgets import DataTable, Input, Static
 
-from tests.app.support import sync
+from tests.app.support import screen_lines, sync
 from workbench.control.station import LabStation
 from workbench.sim.mazefile import parse_maze
 from workbench.sim.mazeio import load_maze
@@ -65,7 +66,7 @@ def table_rows(table: DataTable) -> list[list[str]]:
 async def test_the_table_shows_each_run_with_its_measures(tmp_path):
     station = two_runs(tmp_path)
     app = Host(RunsScreen(station, unicode=False))
-    async with app.run_test(size=SIZE) as pilot:
+    async with app.run_test(size=(132, 24)) as pilot:
         await pilot.pause()
         table = app.screen.query_one(DataTable)
         assert [str(c.label) for c in table.columns.values()] == [
@@ -80,23 +81,9 @@ async def test_the_table_shows_each_run_with_its_measures(tmp_path):
             "Eff",
             "Ended",
             "Rec",
-            "Maze",
         ]
         assert table_rows(table) == [
-            [
-                "1",
-                "right-wall",
-                "yes",
-                "11.6",
-                "9.52",
-                "180",
-                "2",
-                "0/0",
-                "1.00",
-                "exit",
-                "yes",
-                "Bend",
-            ],
+            ["1", "right-wall", "yes", "11.6", "9.52", "180", "2", "0/0", "1.00", "exit", "yes"],
             [
                 "2",
                 "two-distance-local-best",
@@ -109,10 +96,74 @@ async def test_the_table_shows_each_run_with_its_measures(tmp_path):
                 "0.98",
                 "exit",
                 "yes",
-                "Bend",
             ],
         ]
-        assert text(app.screen.query_one("#runs-title")).startswith("Runs on this bench: 2")
+        assert text(app.screen.query_one("#runs-title")) == "Runs on Bend (erobotic): 2"
+
+
+def runs_on_two_mazes(tmp_path) -> LabStation:
+    """Two runs on Bend, then one on the web maze: the station is left on the web maze."""
+    station = two_runs(tmp_path)
+    station.load_maze(load_maze("mazes/web.txt"))
+    return run_algorithms(station, "two-distance-local-best")
+
+
+def check_no_column_is_cut(app: Host) -> list[str]:
+    """Every heading and cell of the table drawn whole inside the screen; the headings."""
+    table = app.screen.query_one(DataTable)
+    assert table.virtual_size.width <= table.scrollable_content_region.width
+    lines = screen_lines(app)
+    headings = [str(c.label) for c in table.columns.values()]
+    header = next(line for line in lines if line.lstrip().startswith("#  Driver"))
+    assert header.split() == " ".join(headings).split()
+    for row in table_rows(table):
+        assert any(line.split() == " ".join(row).split() for line in lines), row
+    return headings
+
+
+@pytest.mark.parametrize("width", [80, 100, 132])
+@sync
+async def test_no_column_is_cut_and_the_rest_is_on_the_detail_line(tmp_path, width):
+    station = runs_on_two_mazes(tmp_path)
+    screen = RunsScreen(station, unicode=False)
+    app = Host(screen)
+    async with app.run_test(size=(width, 24)) as pilot:
+        await pilot.pause()
+        # the station's maze only: the one run on the web maze
+        title = text(screen.query_one("#runs-title"))
+        assert (
+            title == "Runs on Web Simulator lab maze (erobotic): 1, 2 on other mazes (a shows all)"
+        )
+        headings = check_no_column_is_cut(app)
+        assert headings[:3] == ["#", "Driver", "Out"] and "Maze" not in headings
+        assert [row[1] for row in table_rows(screen.query_one(DataTable))] == [
+            "two-distance-local-best"
+        ]
+        detail = text(screen.query_one("#runs-detail"))
+        eff = f"Eff {station.runs[2].metrics.efficiency:.2f}"
+        assert detail.startswith(
+            "run 3: algorithm two-distance-local-best on Web Simulator lab maze (erobotic"
+        )
+        assert (eff in detail) == ("Eff" not in headings)
+        assert ("Turn deg" in detail) == ("Turn deg" not in headings)
+
+        await pilot.press("a")
+        await pilot.pause()
+        assert text(screen.query_one("#runs-title")).startswith("Runs on every maze: 3")
+        headings = check_no_column_is_cut(app)
+        assert headings[:4] == ["#", "Driver", "Maze", "Profile"]
+        rows = table_rows(screen.query_one(DataTable))
+        assert [(row[0], row[2], row[3]) for row in rows] == [
+            ("1", "Bend", "erobotic"),
+            ("2", "Bend", "erobotic"),
+            ("3", "Web Simulator lab maze", "erobotic"),
+        ]
+        if width == 132:
+            assert "Ended" in headings and "Rec" in headings
+
+        await pilot.press("a")
+        await pilot.pause()
+        assert screen.query_one(DataTable).row_count == 1
 
 
 @sync

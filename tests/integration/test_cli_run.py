@@ -2,6 +2,7 @@
 
 import csv
 import json
+from pathlib import Path
 
 import pytest
 
@@ -125,3 +126,38 @@ def test_eval_bad_algorithm_exits_2(capsys):
     code = main(["eval", "--maze", "mazes/web.txt", "--algorithm", "nope", "--jobs", "1"])
     assert code == 2
     assert "nope on mazes/web.txt" in capsys.readouterr().err
+
+
+def test_eval_fits_80_columns_and_wide_keeps_one_line_per_entrant(tmp_path, capsys):
+    # two programs of one name: each is named by its whole (long) path
+    source = Path("programs/right-wall.viple").read_text(encoding="utf-8")
+    paths = []
+    for group in ("one", "two"):
+        folder = tmp_path / f"submissions of the Tuesday afternoon group {group}" / "final"
+        folder.mkdir(parents=True)
+        (folder / "right-wall.viple").write_text(source, encoding="utf-8")
+        paths.append(str(folder / "right-wall.viple"))
+    args = ["eval", "--maze", "mazes/web.txt", "--profile", "web", "--seeds", "1", "--jobs", "2",
+            "--algorithm", "right-wall", "two-distance-local-best",
+            "--program", *paths]  # fmt: skip
+    assert main(args) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines and all(len(line) <= 80 for line in lines), max(lines, key=len)
+    assert lines[1].split() == ["#", "entrant", "out", "turn", "deg", "blocks", "time", "s",
+                                "hits", "touches"]  # fmt: skip
+    text = "\n".join(lines)
+    assert "two-distance-local-best" in text
+    # a name too long for its column stands whole above its figures
+    names, name = [], ""
+    for line in lines[2:]:
+        if line.strip().startswith("1/1"):
+            names.append(name)
+        elif line[2:3].isdigit():
+            name = line[4:]
+        else:
+            name += line[4:]
+    assert sorted(names) == sorted(paths)
+    assert main([*args, "--wide"]) == 0
+    wide = capsys.readouterr().out.splitlines()
+    assert any(line.split()[-2:] == ["collisions", "touches"] for line in wide)
+    assert sum(path in line for line in wide for path in paths) == 2

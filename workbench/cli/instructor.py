@@ -4,10 +4,17 @@ from __future__ import annotations
 
 import argparse
 import getpass
+import shlex
 import sys
 from pathlib import Path
 
-from workbench.labs.instructors import MIN_PASSPHRASE, check_passphrase, create_instructor, key_path
+from workbench.labs.instructors import (
+    MIN_PASSPHRASE,
+    check_passphrase,
+    copy_instructor,
+    create_instructor,
+    key_path,
+)
 from workbench.labs.roster import (
     ROSTER_NAME,
     check_name,
@@ -43,6 +50,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="read the passphrase from the first line of standard input (for scripts)",
     )
     _trusted_option(add, "add the public key to this roster file too")
+    add.add_argument(
+        "--key-from",
+        metavar="DIR",
+        help="for an instructor already in your trusted roster: the data folder holding their "
+        "key, copied to this data folder after the passphrase opens it (default: "
+        "$WORKBENCH_DATA, else the user data folder)",
+    )
     data_dir_option(add)
     db_option(add)
     add.set_defaults(func=cmd_add)
@@ -100,6 +114,55 @@ def read_new_passphrase(from_stdin: bool) -> str:
     return first
 
 
+def read_passphrase(from_stdin: bool, name: str) -> str:
+    """The passphrase of an existing key, asked once."""
+    if from_stdin:
+        line = sys.stdin.readline()
+        return line[:-1] if line.endswith("\n") else line
+    if not sys.stdin.isatty():
+        raise SignoffError("no terminal to ask for the passphrase: use --passphrase-stdin")
+    return getpass.getpass(f"{name}'s passphrase: ")
+
+
+def _quoted(text: str | Path) -> str:
+    return shlex.quote(str(text))
+
+
+def _add_existing(
+    args: argparse.Namespace, name: str, data_dir: Path, trusted: Path, store: Store | None
+) -> int:
+    """Add an instructor of the trusted roster to another data folder with the same key, or
+    say the command that does."""
+    entry = load_roster(trusted)[name]
+    source = Path(args.key_from).expanduser() if args.key_from else resolve_data_dir(None)
+    target = store.where if store is not None else str(data_dir)
+    command = (
+        f"workbench instructor add {_quoted(name)} --data-dir {_quoted(data_dir)} "
+        + (f"--roster {_quoted(trusted)} " if args.roster else "")
+        + "--key-from DIR"
+    )
+    if not key_path(source, name).is_file() or source.resolve() == data_dir.resolve():
+        return fail(
+            f"{name} is already in your trusted roster {trusted} (key {entry.fingerprint()}), "
+            f"and {source} holds no key for {name}. To add that same key to {target}, name "
+            f"the data folder that holds it: {command}"
+        )
+    print(
+        f"{name} is already in your trusted roster (key {entry.fingerprint()}): adding that key "
+        f"from {source} to {target}",
+        file=sys.stderr,
+    )
+    passphrase = read_passphrase(args.passphrase_stdin, name)
+    copy_instructor(source, data_dir, name, passphrase, trusted, store=store)
+    print(f"added {name} (key {entry.fingerprint()}) to {target}, the same key as in {source}")
+    if store is not None:
+        print(f"the private key is encrypted in the course database {target}")
+    else:
+        print(f"the private key is encrypted in {key_path(data_dir, name)}")
+    print(f"your trusted roster {trusted} is unchanged: 'workbench signoff verify' checks with it")
+    return 0
+
+
 def _course_store(args: argparse.Namespace, data_dir: Path) -> Store | None:
     """The course's PostgreSQL store when ``--db``/``$WORKBENCH_DB`` names one, else None
     (the roster and keys stay in the data folder's files)."""
@@ -126,7 +189,7 @@ def cmd_add(args: argparse.Namespace) -> int:
                 "elsewhere (--roster FILE or $WORKBENCH_CONFIG)"
             )
         if name in load_roster(trusted):
-            raise SignoffError(f"{name} is already in your trusted roster {trusted}")
+            return _add_existing(args, name, data_dir, trusted, store)
         passphrase = read_new_passphrase(args.passphrase_stdin)
         entry = create_instructor(data_dir, name, passphrase, trusted=trusted, store=store)
     except (SignoffError, EOFError) as exc:

@@ -8,7 +8,13 @@ import os
 import sys
 from collections.abc import Callable
 
-from workbench.control.evaluate import EvalError, evaluate, format_table, write_csv
+from workbench.control.evaluate import (
+    EvalError,
+    evaluate,
+    format_narrow,
+    format_table,
+    write_csv,
+)
 from workbench.control.headless import AlgorithmPilot, RunResult, RunSetupError, RunSpec, run
 from workbench.program.pilot import program_entrant
 from workbench.sim.noise import NOISE_LEVELS
@@ -70,6 +76,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     e.add_argument("--max-time", type=float, help="simulated seconds per run")
     e.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="parallel processes")
     e.add_argument("--csv", metavar="FILE", help="also write the matrix as CSV")
+    e.add_argument(
+        "--wide", action="store_true", help="the table in one wide line per entrant (110 columns)"
+    )
     e.add_argument("--json", action="store_true", help="one JSON object")
     e.set_defaults(func=cmd_eval)
 
@@ -187,5 +196,5 @@ def cmd_eval(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(result.as_dict(), sort_keys=False))
     else:
-        print(format_table(result))
+        print(format_table(result) if args.wide else format_narrow(result))
     return 0

@@ -200,8 +200,64 @@ class _progress_bar:
         self._progress.stop()
 
 
+#: the narrow table's measures: heading, the cell of an entrant
+_NARROW: tuple[tuple[str, Callable[[Cell], str]], ...] = (
+    ("out", lambda c: f"{c.reached}/{c.runs}"),
+    ("turn deg", lambda c: _pm(c, "turn_degrees", 0)),
+    ("blocks", lambda c: _pm(c, "distance_cells", 1)),
+    ("time s", lambda c: f"{c.mean['sim_time']:.1f}"),
+    ("hits", lambda c: f"{c.mean['collisions']:.1f}"),
+    ("touches", lambda c: f"{c.mean['touches']:.1f}"),
+)
+NARROW_WIDTH = 80
+
+
+def format_narrow(result: EvalResult, width: int = NARROW_WIDTH) -> str:
+    """Per maze: each entrant's means (± spread over the seeds), best first, in lines of at
+    most ``width`` columns: the measures' columns are as wide as their figures, and a name
+    longer than the room left stands on a line of its own above its figures."""
+    lines = []
+    cells = result.cells
+    sep = "  "
+    widths = [max(len(h), *(len(cell(c)) for c in cells)) for h, cell in _NARROW]
+    rank_width = len(str(len(result.algorithms))) + 1
+    figures = sum(widths) + len(sep) * len(widths)
+    room = max(width - 2 - rank_width - figures, len("entrant"))
+    name_width = min(max(len("entrant"), *(len(c.algorithm) for c in cells)), room)
+
+    def row(rank: str, name: str, values: list[str]) -> str:
+        shown = "".join(f"{sep}{v:>{w}}" for v, w in zip(values, widths, strict=True))
+        return f"  {rank:<{rank_width}}{name:<{name_width}}{shown}".rstrip()
+
+    seeds = f"{result.seeds} seed{'s' if result.seeds > 1 else ''}"
+    for maze in result.mazes:
+        lines.extend(wrap_line(f"{maze}  ({seeds}; mean ± spread, best first)", width))
+        lines.append(row("#", "entrant", [h for h, _ in _NARROW]))
+        for rank, c in enumerate(result.ranking(maze), start=1):
+            values = [cell(c) for _, cell in _NARROW]
+            if len(c.algorithm) > name_width:
+                name = f"  {rank:<{rank_width}}{c.algorithm}"
+                lines.extend(wrap_line(name, width, indent=2 + rank_width))
+                lines.append(row("", "", values))
+            else:
+                lines.append(row(str(rank), c.algorithm, values))
+        lines.append("")
+    return "\n".join(lines).rstrip()
+
+
+def wrap_line(text: str, width: int, indent: int = 0) -> list[str]:
+    """``text`` in lines of at most ``width`` characters, the lines after the first indented
+    by ``indent`` spaces (a long path is cut where the line ends)."""
+    lines = [text[:width]]
+    rest, room = text[width:], width - indent
+    while rest:
+        lines.append(" " * indent + rest[:room])
+        rest = rest[room:]
+    return lines
+
+
 def format_table(result: EvalResult) -> str:
-    """Per maze: each algorithm's means (± spread), best first."""
+    """Per maze: each algorithm's means (± spread), best first, in wide lines (``--wide``)."""
     lines = []
     for maze in result.mazes:
         lines.append(f"{maze}  ({result.seeds} seed{'s' if result.seeds > 1 else ''})")

@@ -155,23 +155,79 @@ def create_instructor(
         "encrypted_private_key": to_b64(sealed),
     }
     entry = RosterEntry(name, public, utc_iso(now or datetime.now(UTC)))
-    if database is not None:
-        try:
-            database.add_instructor(name, public, entry.added, json.dumps(data, indent=2) + "\n")
-        except StoreError as exc:
-            raise SignoffError(str(exc)) from None
-    else:
-        target.parent.mkdir(parents=True, exist_ok=True)
-        fd = os.open(target, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(json.dumps(data, indent=2) + "\n")
-            fh.flush()
-            os.fsync(fh.fileno())
-        roster[name] = entry
-        save_roster(roster_file, roster)
+    _keep(data_dir, database, entry, json.dumps(data, indent=2) + "\n", roster)
     if trusted is not None:
         kept[name] = entry
         save_roster(trusted, kept)
+    return entry
+
+
+def _keep(
+    data_dir: Path,
+    database: Store | None,
+    entry: RosterEntry,
+    key_text: str,
+    roster: dict[str, RosterEntry],
+) -> None:
+    """Keep an instructor's sealed key and roster entry: in the course ``database``, else as
+    the data folder's key file (never over another) and ``roster`` saved with the entry."""
+    if database is not None:
+        try:
+            database.add_instructor(entry.name, entry.public_key, entry.added, key_text)
+        except StoreError as exc:
+            raise SignoffError(str(exc)) from None
+        return
+    target = key_path(data_dir, entry.name)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    fd = os.open(target, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+    with os.fdopen(fd, "w", encoding="utf-8") as fh:
+        fh.write(key_text)
+        fh.flush()
+        os.fsync(fh.fileno())
+    roster[entry.name] = entry
+    save_roster(roster_path(data_dir), roster)
+
+
+def copy_instructor(
+    source_dir: Path,
+    data_dir: Path,
+    name: str,
+    passphrase: str,
+    trusted: Path,
+    store: Store | None = None,
+) -> RosterEntry:
+    """Add an instructor already in the ``trusted`` roster to another data folder (or the
+    course database of a PostgreSQL ``store``) with the same key: the sealed key of
+    ``source_dir`` is copied as it is, once the passphrase opens it and it is the key the
+    trusted roster holds, and the trusted entry joins that folder's roster."""
+    name = check_name(name)
+    entry = load_roster(trusted).get(name)
+    if entry is None:
+        raise SignoffError(f"{name} is not in your trusted roster {trusted}")
+    database = store if store is not None and store.keeps_roster else None
+    roster_file = roster_path(data_dir)
+    roster = offered_roster(database) if database is not None else load_roster(roster_file)
+    if name in roster:
+        where = database.where if database is not None else roster_file
+        raise SignoffError(f"{name} is already in the roster {where}")
+    source = key_path(source_dir, name)
+    try:
+        text = source.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise UnknownInstructor(f"no key for instructor {name} in {source.parent}") from None
+    except OSError as exc:
+        raise SignoffError(f"{source}: cannot read the key: {exc.strerror}") from None
+    sealed = parse_key(text, name, source)
+    if sealed.public_key != entry.public_key:
+        raise SignoffError(
+            f"{source} holds another key for {name} than your trusted roster {trusted} "
+            f"({entry.fingerprint()}): it is not copied"
+        )
+    if sealed.unlock(passphrase).public_key_b64() != entry.public_key:
+        raise SignoffError(f"{source}: the key does not match its public key; it is not copied")
+    if database is None and key_path(data_dir, name).exists():
+        raise SignoffError(f"{key_path(data_dir, name)}: a key for {name} already exists")
+    _keep(data_dir, database, entry, text, roster)
     return entry
 
 
@@ -210,7 +266,6 @@ def read_key(data_dir: Path, name: str, store: Store | None = None) -> SealedKey
                 raise FileNotFoundError(path)
         else:
             text = Path(path).read_text(encoding="utf-8")
-        data = json.loads(text)
     except FileNotFoundError:
         where = store.where if store is not None and store.keeps_roster else Path(path).parent
         raise UnknownInstructor(
@@ -220,6 +275,14 @@ def read_key(data_dir: Path, name: str, store: Store | None = None) -> SealedKey
         raise SignoffError(str(exc)) from None
     except OSError as exc:
         raise SignoffError(f"{path}: cannot read the key: {exc.strerror}") from None
+    return parse_key(text, name, path)
+
+
+def parse_key(text: str, name: str, path: Path | str) -> SealedKey:
+    """The sealed key of ``name`` written in ``text`` (read from ``path``);
+    :class:`SignoffError` naming the place when it is not that key file."""
+    try:
+        data = json.loads(text)
     except json.JSONDecodeError:
         raise SignoffError(f"{path}: the key file is not JSON") from None
     try:

@@ -167,7 +167,10 @@ class Controller:
     starter: FsmDefinition | None = field(default=None, compare=False)
 
     def __str__(self) -> str:
-        return f"{self.kind} {self.value}".strip()
+        """The controller in words: a starter by its file's name (where the lab's files are
+        kept is no concern of a student's)."""
+        value = Path(self.value).name if self.kind == "starter" else self.value
+        return f"{self.kind} {value}".strip()
 
 
 @dataclass(frozen=True)

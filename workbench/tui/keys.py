@@ -428,6 +428,14 @@ KEY_TABLE: dict[str, Key] = {
         "open record",
         "Replay any run record (.jsonl) by its path.",
     ),
+    "runs.scope": Key(
+        "a",
+        "scope",
+        "This/all mazes",
+        "Runs",
+        "this maze or all",
+        "Show the runs on this maze and profile, or the runs on every maze by maze and profile.",
+    ),
     "runs.unicode": Key(
         "u", "unicode", "Unicode", "Runs", "unicode", "Plain ASCII or Unicode marks.", show=False
     ),
@@ -630,7 +638,7 @@ EDITOR_KEY_IDS = (
     "editor.leave",
 )
 #: the runs screen's keys
-RUNS_KEY_IDS = ("runs.replay", "runs.open", "runs.unicode", "runs.leave")
+RUNS_KEY_IDS = ("runs.replay", "runs.open", "runs.scope", "runs.unicode", "runs.leave")
 #: the replay screen's keys
 REPLAY_KEY_IDS = (
     "replay.step",

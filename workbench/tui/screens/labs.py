@@ -456,15 +456,17 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         box.remove_children()
         answers = self.answers.get((lab.id, exercise.id), {})
         for q in exercise.questions:
+            # the field's hint is one short word; the choices stand whole above it
+            choices = f" (one of: {', '.join(q.choices)})" if q.choices else ""
             field = Field(
                 answers.get(q.id, ""),
-                placeholder=" / ".join(q.choices) if q.choices else q.unit or "answer",
+                placeholder=q.unit or "answer",
                 id=f"q-{q.id}",
                 max_length=MAX_ANSWER,
             )
             box.mount(
                 Vertical(
-                    Static(prose(q.text, unicode), markup=False, classes="question-text"),
+                    Static(prose(q.text + choices, unicode), markup=False, classes="question-text"),
                     field,
                     Static(
                         self._answer_reason(exercise, q.id),

@@ -1,13 +1,14 @@
 """The runs screen: the station's last runs side by side, and the way into their replays.
 
 Each row is one run with the course's measures, so students can answer "which algorithm is
-better on this maze". Enter (or a click) on a run with a record opens its replay; ``o`` opens
-any run record (JSONL) by path.
+better on this maze": it shows the runs on the station's maze and profile, and ``a`` shows the
+runs on every maze, grouped by maze and profile. The table keeps the columns that fit the
+width; the line under it says the chosen run whole. Enter (or a click) on a run with a record
+opens its replay; ``o`` opens any run record (JSONL) by path.
 """
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import ClassVar
 
 from textual import on
@@ -26,61 +27,23 @@ from ..dialogs.path import PathDialog
 from ..host import FollowsUnicode, ShowsSnapshot, ToggleUnicode
 from ..keys import RUNS_KEY_IDS, bindings
 from ..widgets.key_bar import KeyBar
-from ..widgets.text import count
 from .replay import ReplayScreen
-
-#: column key, heading (ASCII), heading (Unicode)
-COLUMNS: tuple[tuple[str, str, str], ...] = (
-    ("number", "#", "#"),
-    ("driver", "Driver", "Driver"),
-    ("reached", "Out", "Out"),
-    ("time", "Time s", "Time s"),
-    ("distance", "Blocks", "Blocks"),
-    ("turning", "Turn deg", "Turn °"),
-    ("turns", "Turns", "Turns"),
-    ("contacts", "Hit/Tch", "Hit/Tch"),
-    ("efficiency", "Eff", "Eff"),
-    ("ended", "Ended", "Ended"),
-    ("record", "Rec", "Rec"),
-    ("maze", "Maze", "Maze"),
+from .runs_table import (
+    ALL_MAZES,
+    COLUMNS,
+    SCOPES,
+    THIS_MAZE,
+    RunColumn,
+    fit_columns,
+    heading,
+    run_detail,
+    runs_in_scope,
 )
+
 OPEN_HELP = (
     "A run record is a .jsonl file written by 'workbench run --record FILE' or by the app "
     "when it records runs."
 )
-
-
-def run_cells(run: RunEntry, unicode: bool) -> tuple[str, ...]:
-    """The table cells of a run, in :data:`COLUMNS` order."""
-    m = run.metrics
-    time = m.exit_time if m.reached_exit and m.exit_time is not None else m.sim_time
-    yes, no = ("✓", "✗") if unicode else ("yes", "no")
-    return (
-        str(run.number),
-        run.driver.short,
-        yes if m.reached_exit else no,
-        f"{time:.1f}",
-        f"{m.distance_cells:.2f}",
-        f"{m.turn_degrees:.0f}",
-        str(m.turns),
-        f"{m.collisions}/{m.touches}",
-        f"{m.efficiency:.2f}" if m.efficiency is not None else "-",
-        run.ended,
-        yes if run.record else "-",
-        run.maze or "-",
-    )
-
-
-def run_detail(run: RunEntry) -> str:
-    """The chosen run in words, whole: who drove, on which maze and profile, its collisions
-    and touches, its record (the table's last columns do not fit 80 columns)."""
-    m = run.metrics
-    record = f"record {Path(run.record).name}" if run.record else "not recorded"
-    return (
-        f"run {run.number}: {run.driver} on {run.maze or '-'} ({run.profile}, seed {run.seed}), "
-        f"ended by {run.ended}; {count(m.collisions, 'collision')}, "
-        f"{count(m.touches, 'touch', 'touches')}; {record}"
-    )
 
 
 class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
@@ -88,7 +51,7 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
 
     DEFAULT_CSS = """
     RunsScreen #runs-title {
-        height: 1;
+        height: auto;
         padding: 0 1;
         background: $boost;
         text-style: bold;
@@ -129,8 +92,12 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         super().__init__(name=name, id=id, classes=classes)
         self.station = station
         self._unicode = unicode
-        self._shown: tuple[tuple[str, ...], ...] | None = None
+        self._shown: tuple[object, ...] | None = None
         self._shown_count = -1
+        #: which runs the table shows: :data:`THIS_MAZE` or :data:`ALL_MAZES`
+        self.scope = THIS_MAZE
+        self._runs: list[RunEntry] = []
+        self._columns: tuple[RunColumn, ...] = COLUMNS
         #: the last message shown under the table (what happened, or why not)
         self.status = ""
 
@@ -146,6 +113,9 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self.refresh_runs()
 
     def on_screen_resume(self) -> None:
+        self.refresh_runs()
+
+    def on_resize(self) -> None:
         self.refresh_runs()
 
     # -- public ------------------------------------------------------------------------------
@@ -165,41 +135,67 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             self.refresh_runs()
 
     def refresh_runs(self) -> None:
-        """Show the station's runs (newest last); repaints only when they changed."""
-        runs = self.station.runs
-        self._shown_count = len(runs)
-        rows = tuple(run_cells(run, self.unicode) for run in runs)
+        """Show the runs in scope (in the order they ran, or grouped by maze and profile) with
+        the columns that fit; repaints only when they changed."""
+        station = self.station
+        self._shown_count = len(station.runs)
+        runs = runs_in_scope(station.runs, self.scope, station.maze.digest(), station.profile)
         table = self.query_one(DataTable)
-        self.query_one("#runs-title", Static).update(
-            f"Runs on this bench: {len(runs)}  [maze now: {self.station.maze.name or '-'}]"
-        )
-        if runs:
-            help_text = (
-                "Compare runs on one maze; Hit/Tch = collisions/touch-sensor bumps. "
-                "Enter replays a recorded run; o opens a record file."
-            )
-        else:
-            help_text = (
-                "No runs yet: drive with the keys or start an algorithm, then come back. "
-                "o opens a record file."
-            )
-        self.query_one("#runs-help", Static).update(help_text)
-        if rows == self._shown:
+        scrollbar = table.styles.scrollbar_size_vertical
+        width = (self.size.width or self.app.size.width) - scrollbar
+        columns = fit_columns(runs, self.unicode, width, self.scope, table.cell_padding)
+        self.query_one("#runs-title", Static).update(self._title(len(runs)))
+        self.query_one("#runs-help", Static).update(self._help(runs))
+        rows = tuple(tuple(c.cell(run, self.unicode) for c in columns) for run in runs)
+        shown = (self.scope, self.unicode, tuple(c.key for c in columns), rows)
+        if shown == self._shown:
             return
-        self._shown = rows
+        self._shown = shown
+        self._runs = runs
+        self._columns = columns
         row = table.cursor_row
         table.clear(columns=True)
-        for key, ascii_label, unicode_label in COLUMNS:
-            table.add_column(unicode_label if self.unicode else ascii_label, key=key)
+        for column in columns:
+            table.add_column(heading(column, self.unicode), key=column.key)
         for run, cells in zip(runs, rows, strict=True):
             table.add_row(*cells, key=str(run.number))
         if runs:
             table.move_cursor(row=min(max(row, 0), len(runs) - 1))
         self._show_detail()
 
+    def _title(self, shown: int) -> str:
+        station = self.station
+        total = len(station.runs)
+        if self.scope == ALL_MAZES:
+            return f"Runs on every maze: {total}, by maze and profile  (a: this maze only)"
+        where = f"{station.maze.name or '-'} ({station.profile})"
+        others = total - shown
+        more = f", {others} on other mazes (a shows all)" if others else ""
+        return f"Runs on {where}: {shown}{more}"
+
+    def _help(self, runs: list[RunEntry]) -> str:
+        if runs:
+            return (
+                "Hit/Tch = collisions/touch-sensor bumps. "
+                "Enter replays a recorded run; o opens a record file."
+            )
+        if self.station.runs:
+            return "No runs on this maze yet: a shows the runs on other mazes."
+        return (
+            "No runs yet: drive with the keys or start an algorithm, then come back. "
+            "o opens a record file."
+        )
+
+    def action_scope(self) -> None:
+        """Show the runs on this maze only, or on every maze."""
+        self.scope = SCOPES[(SCOPES.index(self.scope) + 1) % len(SCOPES)]
+        self.refresh_runs()
+
     def _show_detail(self) -> None:
         run = self._selected()
-        self.query_one("#runs-detail", Static).update(run_detail(run) if run else "")
+        hidden = [c for c in COLUMNS if c not in self._columns]
+        text = run_detail(run, hidden, self.unicode) if run else ""
+        self.query_one("#runs-detail", Static).update(text)
 
     @on(DataTable.RowHighlighted, "#runs-table")
     def _row_highlighted(self, event: DataTable.RowHighlighted) -> None:
@@ -216,10 +212,10 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
     # -- replay ------------------------------------------------------------------------------
     def _selected(self) -> RunEntry | None:
         table = self.query_one(DataTable)
-        if not self.station.runs or table.row_count == 0:
+        if not self._runs or table.row_count == 0:
             return None
         key = table.coordinate_to_cell_key(table.cursor_coordinate).row_key.value
-        return next((r for r in self.station.runs if str(r.number) == key), None)
+        return next((r for r in self._runs if str(r.number) == key), None)
 
     def action_replay(self) -> None:
         run = self._selected()

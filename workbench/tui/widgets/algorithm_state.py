@@ -14,7 +14,7 @@ from workbench.control.fsm import FsmController
 from workbench.control.station import LabStation
 from workbench.sim.profiles import get_profile
 
-from .text import arrow, number, set_border_title
+from .text import arrow, named_title, number, set_border_title
 from .transition_log import TransitionLog, values_text
 
 
@@ -86,7 +86,7 @@ class AlgorithmState(Vertical):
             log.show(None, (), unit, unicode)
             log.display = False
             return
-        set_border_title(self, f"Algorithm {definition.name}")
+        set_border_title(self, named_title(self, "Algorithm", definition.name))
         names = tuple(s.name for s in definition.states)
         if controller is None:
             missing = station.missing_sensors()

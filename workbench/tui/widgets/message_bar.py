@@ -12,7 +12,7 @@ class MessageBar(Static):
     DEFAULT_CSS = """
     MessageBar {
         height: auto;
-        max-height: 3;
+        max-height: 8;
         padding: 0 1;
         background: $boost;
         color: $text-muted;

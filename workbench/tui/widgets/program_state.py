@@ -13,7 +13,7 @@ from workbench.control.station import LabStation
 from workbench.program.interp import ProgramController
 from workbench.program.viple_expr import show
 
-from .text import set_border_title
+from .text import named_title, set_border_title
 
 #: how many flows and events the panel lists (the rest are counted)
 SHOWN_FLOWS = 3
@@ -86,7 +86,7 @@ class ProgramState(Vertical):
         """Follow the station's program; ``all_keys``: every key goes to it (ctrl+k)."""
         choice = station.program
         run = station.driving.controller if station.driving is not None else None
-        set_border_title(self, f"Program {choice.name}" if choice else "Program")
+        set_border_title(self, named_title(self, "Program", choice.name) if choice else "Program")
         if not isinstance(run, ProgramController):
             self.summary = "not running: x starts it, g changes it." if choice else ""
             self.flows = self.variables = self.events = ""

@@ -52,6 +52,14 @@ def speed(value: float | None) -> str:
     return "max" if value is None else f"{value:g}x"
 
 
+def named_title(widget: Widget, word: str, name: str) -> str:
+    """A panel's border title ``word name`` ("Algorithm right-wall"), or the name alone where
+    the panel is too narrow for both: the name is never the part cut."""
+    title = f"{word} {name}"
+    room = widget.size.width - 2  # the border's corners
+    return name if 0 < room < len(title) else title
+
+
 def set_border_title(widget: Widget, title: str) -> None:
     """Set a panel's border title; setting it at all repaints the whole panel, so only on change."""
     if widget.border_title != title:

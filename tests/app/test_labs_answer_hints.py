@@ -1,0 +1,44 @@
+"""The answer fields of every lab at 80×24: each hint drawn whole, the choices above the field."""
+
+from __future__ import annotations
+
+from rich.cells import cell_len
+from textual.pilot import Pilot
+from textual.widgets import Input, OptionList, Static
+
+from workbench.labs.model import load_labs
+from workbench.tui.screens.labs import LabsScreen
+
+from .labs_support import lab_app
+from .support import run
+
+
+def test_no_answer_hint_is_cut_and_the_choices_stand_whole(tmp_path):
+    app = lab_app(tmp_path / "data")
+    asked = [
+        (f"{lab.id}/{exercise.id}", exercise)
+        for lab in load_labs()
+        for exercise in lab.exercises
+        if exercise.questions
+    ]
+    assert any(q.choices for _, exercise in asked for q in exercise.questions)
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.press("l")
+        await pilot.pause()
+        screen = app.screen
+        assert isinstance(screen, LabsScreen)
+        listing = screen.query_one("#labs-list", OptionList)
+        for option_id, exercise in asked:
+            listing.highlighted = listing.get_option_index(option_id)
+            await pilot.pause()
+            for q in exercise.questions:
+                field = screen.query_one(f"#q-{q.id}", Input)
+                hint = str(field.placeholder)
+                assert 0 < cell_len(hint) <= field.content_region.width, (option_id, hint)
+                question = str(screen.query_one(f"#q-{q.id}").parent.query_one(
+                    ".question-text", Static).render())  # fmt: skip
+                for choice in q.choices:
+                    assert choice in question, (option_id, choice)
+
+    run(app, body)
