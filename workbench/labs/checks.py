@@ -294,7 +294,7 @@ def check_keys(obj: Objective, station: LabStation, attempt: Attempt) -> Check:
         "people": sorted({u.person for u in uses if u.key in obj.keys} - {""}),
     }
     if not missing:
-        return Check(True, f"used {', '.join(obj.keys)} on {attempt.profile}", evidence)
+        return Check(True, f"used {', '.join(obj.keys)}", evidence)
     mine = [c for c in station.viple if c.attempt == attempt.id]
     if obj.role:
         wanted = [KEY_NAMES[k] for k in obj.keys]
@@ -308,7 +308,7 @@ def check_keys(obj: Objective, station: LabStation, attempt: Attempt) -> Check:
         if motions:
             lacking = [m for m in wanted if m not in motions]
             return Check(False, f"VIPLE has not asked for {', '.join(lacking)} yet", {})
-    return Check(False, f"not used yet on {attempt.profile}: {', '.join(missing)}", {})
+    return Check(False, f"not used yet: {', '.join(missing)}", {})
 
 
 def check_sensors(obj: Objective, station: LabStation, attempt: Attempt) -> Check:
