@@ -405,7 +405,8 @@ def test_set_up_starts_afresh_speed_algorithm_and_parameters():
     b.select_algorithm("one-distance-first")
     b.set_params(["right_blocked=50"])
     b.pacer.set_speed(None)  # "max"
-    changes = apply_setup(b, exercise(profile="web").setup, lab="lab", exercise="ex")  # a keys exercise
+    keys_exercise = exercise(profile="web")
+    changes = apply_setup(b, keys_exercise.setup, lab="lab", exercise="ex")
     assert b.pacer.speed == 1.0 and b.algorithm is None and b.overrides == {}
     assert changes.speed == (None, 1.0)
     assert changes.algorithm == ("one-distance-first", None)
