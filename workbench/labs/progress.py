@@ -22,7 +22,6 @@ from typing import Any, Literal
 from workbench.control.station import LabStation
 
 from .checks import (
-    ATTEMPT,
     ExerciseProgress,
     ObjectiveState,
     SetupChanges,
@@ -216,7 +215,6 @@ def evidence_words(state: ObjectiveState) -> str:
         return ""
     if state.kind == "questions":
         return f"{ev.get('correct', 0)} of {ev.get('of', 0)} right"
-    attempt = str(ev.get(ATTEMPT, ""))[:6]
     by = f" by {ev['person']}" if ev.get("person") else ""
     if "run" in ev:
         words = f"run {ev['run']}{by} ({ev.get('driver', '')})"
@@ -240,4 +238,4 @@ def evidence_words(state: ObjectiveState) -> str:
         words = f"sensors {', '.join(ev['sensors'])}{by}"
     else:
         words = ""
-    return f"{words} (attempt {attempt})" if attempt else words
+    return words
