@@ -24,6 +24,19 @@ def text(screen, selector: str) -> str:
     return str(screen.query_one(selector, Static).render())
 
 
+def objective_lines(screen) -> list[str]:
+    """The objectives' lines of the labs screen (mark, text and reason), without the lines of
+    evidence under the passed ones."""
+    lines = text(screen, "#labs-objectives").splitlines()
+    return [line for line in lines if line and not line.startswith(" ")]
+
+
+def evidence_lines(screen) -> list[str]:
+    """The lines under the passed objectives that say what each pass rests on."""
+    lines = text(screen, "#labs-objectives").splitlines()
+    return [line.strip() for line in lines if line.startswith(" ")]
+
+
 async def open_exercise(pilot: Pilot, option_id: str = DRIVE) -> LabsScreen:
     """``l``, then the exercise ``option_id`` ("lab/exercise") highlighted in the list."""
     await pilot.press("l")

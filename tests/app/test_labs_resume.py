@@ -13,7 +13,7 @@ from workbench.tui.screens.main import MainScreen
 from workbench.tui.settings import AppSettings
 from workbench.viple.tcp_server import TcpConfig
 
-from .labs_support import DRIVE, lab_app, open_exercise, text
+from .labs_support import DRIVE, lab_app, objective_lines, open_exercise, text
 from .support import run, run_panel, said
 
 CONNECT = "web-simulator/connect"
@@ -48,7 +48,7 @@ def test_what_passed_before_a_restart_is_still_passed_after_it(tmp_path):
 
     async def resume(pilot: Pilot) -> None:
         screen = await open_exercise(pilot, DRIVE)
-        lines = text(screen, "#labs-objectives").splitlines()
+        lines = objective_lines(screen)
         kept = "[X] drove with w, a, s, d and space: passed earlier: used w, a, s, d, space"
         assert lines[0] == kept
         assert lines[1].startswith("[ ] edited the maze")

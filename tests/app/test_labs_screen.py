@@ -19,7 +19,7 @@ from workbench.tui.dialogs.signoff import SignoffModal
 from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
 
-from .labs_support import DRIVE, lab_app, open_exercise, signing_over, text
+from .labs_support import DRIVE, lab_app, objective_lines, open_exercise, signing_over, text
 from .support import run
 
 FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
@@ -35,7 +35,7 @@ async def complete_drive_by_wire(pilot: Pilot, screen: LabsScreen) -> None:
     maze = station.maze
     inner = next((x, y) for y in range(1, maze.height - 1) for x in range(1, maze.width - 1)
                  if maze.is_wall(x, y))  # fmt: skip
-    station.load_maze(maze.with_block(*inner, wall=False))  # what the editor puts on the station
+    station.put_edited_maze(maze.with_block(*inner, wall=False), maze)  # the editor's report
     await pilot.press("l")
     await pilot.pause()
     screen.query_one("#q-tcp-port", Input).value = "1350"
@@ -74,7 +74,7 @@ def test_set_up_then_driving_flips_the_keys_objective_and_saves_progress(tmp_pat
         assert progress["objectives"][0]["passed"] is True  # saved while the labs were closed
         await pilot.press("l")
         await pilot.pause()
-        lines = text(screen, "#labs-objectives").splitlines()
+        lines = objective_lines(screen)
         assert lines[0].startswith("[X] drove with w, a, s, d and space")
         assert lines[1].startswith("[ ] edited the maze")
 

@@ -27,7 +27,7 @@ from textual.pilot import Pilot
 from textual.widgets import Input, Markdown, OptionList, Select, Static
 from websockets.asyncio.server import serve
 
-from tests.app.labs_support import signing_over
+from tests.app.labs_support import objective_lines, signing_over
 from tests.integration.test_labs_completable import DRIVE, SOLUTIONS, answer
 from tests.sessions import free_port
 from tests.waiting import DEADLINE, until
@@ -423,7 +423,7 @@ class Walkthrough:
 
 
 def objectives(screen: LabsScreen) -> list[str]:
-    return str(screen.query_one("#labs-objectives", Static).render()).splitlines()
+    return objective_lines(screen)
 
 
 async def viple_over_websocket(w: Walkthrough, screen: LabsScreen, lab: Lab, ex: Exercise) -> None:

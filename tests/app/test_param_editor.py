@@ -21,7 +21,7 @@ def test_fill_in_parameters_are_marked_with_their_hint_and_full_range(tmp_path):
     app = make_app(AppSettings(paused=True, noise="off", data_dir=tmp_path / "data"))
 
     async def body(pilot: Pilot) -> None:
-        apply_setup(app.station, EXERCISE.setup)
+        apply_setup(app.station, EXERCISE.setup, lab="unity-simulator", exercise=EXERCISE.id)
         app.set_up_done(EXERCISE.setup)
         await pilot.press("g")
         await pilot.pause()

@@ -37,9 +37,14 @@ SOLUTIONS = {
 }  # fmt: skip
 
 
+def lab_of(ex: Exercise) -> str:
+    return next(lab.id for lab in LABS.values() if any(e is ex for e in lab.exercises))
+
+
 def fresh_station(ex: Exercise) -> LabStation:
+    """A station with ``ex`` set up (its attempt begun)."""
     station = LabStation.open(ex.setup.maze.maze, ex.setup.profile, noise="off")
-    apply_setup(station, ex.setup)
+    apply_setup(station, ex.setup, lab=lab_of(ex), exercise=ex.id)
     return station
 
 
@@ -141,7 +146,9 @@ def complete(station: LabStation, ex: Exercise) -> dict[str, str]:
             for maze in obj.mazes:
                 for name in obj.algorithms:
                     run_on(station, maze, name)
-    apply_setup(station, ex.setup)  # back to the exercise's maze and sensors
+    # back to the exercise's maze and sensors, in the same attempt
+    station.load_maze(ex.setup.maze.maze)
+    station.apply_sensors(ex.setup.sensors or station.sensors)
     for obj in ex.objectives:
         if obj.kind == "sensors":
             station.apply_sensors(obj.sensors)
@@ -155,7 +162,7 @@ def complete(station: LabStation, ex: Exercise) -> dict[str, str]:
         maze = station.maze
         inner = next((x, y) for y in range(1, maze.height - 1) for x in range(1, maze.width - 1)
                      if maze.is_wall(x, y))  # fmt: skip
-        station.load_maze(maze.with_block(*inner, wall=False))
+        station.put_edited_maze(maze.with_block(*inner, wall=False), maze)
     return {q.id: answer(q) for q in ex.questions}
 
 

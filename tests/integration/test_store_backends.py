@@ -109,7 +109,48 @@ def test_schema_steps_are_numbered_and_recorded_once(where):
     if where.db:
         expected.append((3, "instructors' roster"))
     expected.append((4, "sign-off queue"))
+    expected.append((5, "progress evidence"))
     assert steps == expected and version == expected[-1][0]
+
+
+def old_progress(evidence: dict) -> dict:
+    """An exercise's progress as workbenches before step 4 saved it: a pass of each kind."""
+    return {
+        "lab": "unity-simulator", "exercise": "drive-by-wire", "passed": True,
+        "answers": {"tcp-port": "1350"},
+        "objectives": [
+            {"kind": "keys", "text": "drove", "passed": True, "reason": "used w",
+             "evidence": evidence},
+            {"kind": "maze-edited", "text": "edited", "passed": True,
+             "reason": "the maze was edited and is valid", "evidence": {"maze_digest": "ab"}},
+            {"kind": "questions", "text": "answered", "passed": True,
+             "reason": "all 1 answered correctly", "evidence": {"correct": 1, "of": 1}},
+        ],
+    }  # fmt: skip
+
+
+def test_passes_saved_without_their_work_need_redoing_after_the_upgrade(where):
+    with where.open() as s:
+        s.save_progress("ana", "unity-simulator", "drive-by-wire", old_progress({}))
+        kept = old_progress({"attempt": "5eed", "keys_used": ["w"]})
+        s.save_progress("ben", "unity-simulator", "drive-by-wire", kept)
+    # as a store before step 4 was: the step not applied, the older schema version
+    with where.open() as store, store.backend.write() as tx:
+        tx.execute("DELETE FROM schema_migrations WHERE version = 4")
+        before = "3" if where.db else "2"
+        tx.execute("UPDATE meta SET value = ? WHERE key = 'schema_version'", (before,))
+    with where.open() as s:
+        assert (4, "progress evidence") in s.migrations()
+        ana = s.progress("ana")[("unity-simulator", "drive-by-wire")]
+        ben = s.progress("ben")[("unity-simulator", "drive-by-wire")]
+    keys, edited, answered = ana["objectives"]
+    assert (keys["passed"], keys["redo"], keys["reason"].startswith("needs redoing")) == (
+        False, True, True)  # fmt: skip
+    assert (edited["passed"], edited["redo"]) == (False, True)
+    assert answered["passed"] is True and "redo" not in answered  # the answers are kept
+    assert ana["passed"] is False and ana["answers"] == {"tcp-port": "1350"}
+    # a pass with the evidence of its work is left as it was
+    assert ben["objectives"][0] == kept["objectives"][0]
 
 
 def test_a_store_written_by_a_newer_workbench_is_refused(where):

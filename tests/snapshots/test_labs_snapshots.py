@@ -7,6 +7,7 @@ on every run.
 
 from __future__ import annotations
 
+from datetime import UTC, datetime
 from pathlib import Path
 
 import pytest
@@ -64,7 +65,18 @@ def test_signoff_dialog(snap_compare, tmp_path):
     assert snap_compare(lab_app(tmp_path / "data"), terminal_size=SIZE, run_before=before)
 
 
-def test_driver_change_prompt_after_an_override(snap_compare, tmp_path):
+class SigningTime(datetime):
+    """The clock of the sign-off, at one fixed moment: the labs screen behind the dialog shows
+    the sign-off's time as soon as it is saved."""
+
+    @classmethod
+    def now(cls, tz=None):  # type: ignore[override]
+        return datetime(2026, 3, 2, 10, 0, tzinfo=UTC)
+
+
+def test_driver_change_prompt_after_an_override(snap_compare, tmp_path, monkeypatch):
+    monkeypatch.setattr("workbench.labs.signing.datetime", SigningTime)
+
     async def before(pilot: Pilot) -> None:
         await open_drive_by_wire(pilot)
         await pilot.press("i")

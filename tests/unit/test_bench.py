@@ -276,7 +276,7 @@ def test_a_viple_program_that_takes_the_robot_from_an_algorithm_ends_its_run():
     assert b.runs[-1].source.endswith("right-wall.yaml")
 
 
-def test_starting_an_exercise_forgets_keys_and_viple_seen_before_but_not_the_one_driving():
+def test_an_attempt_keeps_apart_keys_and_viple_seen_before_but_not_the_one_driving():
     from workbench.viple.link import Link
 
     b = station(CORRIDOR, profile="unity")
@@ -290,12 +290,14 @@ def test_starting_an_exercise_forgets_keys_and_viple_seen_before_but_not_the_one
     link = Link(b.session, "tcp")
     link.connect("127.0.0.1:50400")
     b.step(1)
-    b.start_exercise()
+    attempt = b.begin_attempt("lab", "ex")
     assert b.keys_used == set()
-    assert [(c.role, c.peer, c.drove) for c in b.viple] == [("tcp", "127.0.0.1:50400", False)]
+    mine = [c for c in b.viple if c.attempt == attempt.id]
+    assert [(c.role, c.peer, c.drove) for c in mine] == [("tcp", "127.0.0.1:50400", False)]
     link.apply(MOVE)
     b.step(60)
-    assert b.viple[0].drove and b.viple[0].distance > 0.5  # the driving after the start counts
+    assert mine[0].drove and mine[0].distance > 0.5  # the driving after the start counts
+    assert {u.key for u in b.key_uses if u.attempt == ""} == {"w", "a"}  # kept, apart
 
 
 def test_after_a_run_ends_at_the_exit_the_next_drive_key_drives():

@@ -10,6 +10,7 @@ from workbench.control.station import LabStation
 from workbench.labs.checks import (
     ExerciseProgress,
     apply_setup,
+    attempt_of,
     check_objective,
     evaluate,
     keep_passed,
@@ -43,13 +44,17 @@ def exercise(*objectives, questions=(), maze=EROBOTIC, profile="unity", controll
 
 def station_for(ex):
     b = LabStation.open(ex.setup.maze.maze, ex.setup.profile, noise="off")
-    apply_setup(b, ex.setup)
+    apply_setup(b, ex.setup, lab="lab", exercise=ex.id)
     return b
 
 
 def check(obj, ex, b, answers=None):
-    result = check_objective(obj, ex, b, answers)
+    result = check_objective(obj, ex, b, answers, attempt_of(b, "lab", ex))
     return result.passed, result.reason
+
+
+def evidence_of(obj, ex, b):
+    return check_objective(obj, ex, b, None, attempt_of(b, "lab", ex)).evidence
 
 
 def run_to_exit(b, limit_s=400):
@@ -82,8 +87,9 @@ def test_sensors_objective_lists_what_is_missing_and_what_is_extra():
     assert check(obj, ex, b) == (False, "missing touch:2:front; not wanted distance:2:front")
     b.apply_sensors(want)
     assert check(obj, ex, b) == (True, "sensors are distance:1:right, touch:2:front")
-    result = check_objective(obj, ex, b)
-    assert result.evidence == {"sensors": ["distance:1:right", "touch:2:front"]}
+    evidence = evidence_of(obj, ex, b)
+    assert evidence == {"attempt": b.attempt.id, "person": "",
+                        "sensors": ["distance:1:right", "touch:2:front"]}  # fmt: skip
 
 
 def test_viple_objective_needs_the_role_and_real_driving():
@@ -112,7 +118,7 @@ def test_viple_objective_needs_the_role_and_real_driving():
     b.step(30)
     passed, reason = check(obj, ex, b)
     assert (passed, reason) == (True, "VIPLE tcp program at 127.0.0.1:50000 drove the robot")
-    assert check_objective(obj, ex, b).evidence["distance"] > 0
+    assert evidence_of(obj, ex, b)["distance"] > 0
 
 
 def test_exit_objective_wants_the_right_kind_of_driver_on_the_right_maze():
@@ -133,7 +139,7 @@ def test_exit_objective_wants_the_right_kind_of_driver_on_the_right_maze():
     assert passed and reason.startswith(
         f"run {run.number} (algorithm starter-unity-wall-following)"
     )
-    evidence = check_objective(obj, ex, b).evidence
+    evidence = evidence_of(obj, ex, b)
     assert evidence["run"] == run.number and evidence["metrics"]["reached_exit"] is True
     assert evidence["maze_digest"] == EROBOTIC.maze.digest()
 
@@ -165,10 +171,10 @@ def test_exit_objective_with_a_record_keeps_its_digest(tmp_path):
     obj = Objective("exit", "out", maze=RANK, drivers=("any",))
     ex = exercise(obj, maze=RANK)
     b = LabStation.open(RANK.maze, "unity", noise="off", record_dir=str(tmp_path))
-    apply_setup(b, ex.setup)
+    apply_setup(b, ex.setup, lab="lab", exercise=ex.id)
     b.select_algorithm("right-wall")
     run_to_exit(b)
-    evidence = check_objective(obj, ex, b).evidence
+    evidence = evidence_of(obj, ex, b)
     assert evidence["record"].endswith("run-001.jsonl") and len(evidence["record_sha256"]) == 64
 
 
@@ -178,16 +184,24 @@ def test_maze_edited_objective_wants_a_change_and_a_valid_maze():
     b = station_for(ex)
     assert check(obj, ex, b) == (
         False,
-        "the maze is still 'eRobotic lab maze' as set up: add or remove a block",
+        "the maze has not been edited yet: open the editor (e), add or remove a block",
     )
     maze = b.maze
-    b.load_maze(maze.with_block(0, 0, wall=False))  # a hole in the outer wall
-    passed, reason = check(obj, ex, b)
-    assert not passed and reason.startswith("the edited maze has 1 problem(s):")
+    b.load_maze(RANK.maze)  # loading another maze is not editing
+    assert not check(obj, ex, b)[0]
+    b.load_maze(maze)
+    b.put_edited_maze(maze.with_block(0, 0, wall=False), maze)  # a hole in the outer wall
+    assert check(obj, ex, b) == (
+        False,
+        "the edited maze has problems: fix them in the editor (e)",
+    )
     inner = next((x, y) for y in range(1, maze.height - 1) for x in range(1, maze.width - 1)
                  if maze.is_wall(x, y))  # fmt: skip
-    b.load_maze(maze.with_block(*inner, wall=False))
-    assert check(obj, ex, b) == (True, "the maze was edited and is valid")
+    edited = maze.with_block(*inner, wall=False)
+    b.put_edited_maze(edited, maze)
+    assert check(obj, ex, b) == (True, f"edit 2 left a valid maze, {edited.name!r}")
+    evidence = evidence_of(obj, ex, b)
+    assert evidence["edit"] == 2 and evidence["maze_digest"] == edited.digest()
 
 
 def test_compare_objective_names_the_missing_runs():
@@ -208,7 +222,7 @@ def test_compare_objective_names_the_missing_runs():
     b.select_algorithm("two-distance-local-best")
     run_to_exit(b)
     assert check(obj, ex, b) == (True, "2 runs to compare")
-    table = check_objective(obj, ex, b).evidence["runs"]
+    table = evidence_of(obj, ex, b)["runs"]
     assert [r["algorithm"] for r in table] == ["right-wall", "two-distance-local-best"]
 
 
@@ -249,7 +263,7 @@ def test_apply_setup_puts_profile_maze_sensors_and_controller_on_the_station():
         maze=RANK, profile="web", controller="starter labs/starters/web-two-distance.yaml"
     )
     b = LabStation.open(EROBOTIC.maze, "unity", noise="off")
-    apply_setup(b, ex.setup)
+    apply_setup(b, ex.setup, lab="lab", exercise=ex.id)
     assert (b.profile, b.maze.name) == ("web", "Ranking - right wall wins")
     assert [str(s) for s in b.sensors] == RIGHT_WALL
     assert b.algorithm.name == "starter-web-two-distance"
@@ -272,12 +286,17 @@ def test_runs_on_another_profile_do_not_count():
     b = LabStation.open(RANK.maze, "unity", noise="off")
     b.select_algorithm("right-wall")
     run_to_exit(b)
+    apply_setup(b, ex.setup, lab="lab", exercise=ex.id)
+    b.profile = "unity"  # the profile changed after the set-up
+    b.load_maze(RANK.maze)
+    b.select_algorithm("right-wall")
+    run_to_exit(b)
     assert check(obj, ex, b) == (
         False,
         "no run by algorithm right-wall has reached the exit of 'Ranking - right wall wins' "
         "(web) yet",
     )
-    apply_setup(b, ex.setup)
+    apply_setup(b, ex.setup, lab="lab", exercise=ex.id)
     b.select_algorithm("right-wall")
     run_to_exit(b)
     assert check(obj, ex, b)[0]
@@ -299,7 +318,8 @@ def test_objectives_that_passed_before_stay_passed_with_their_evidence():
     progress = keep_passed(saved, evaluate("lab", ex, again, {"q": "b"}))
     drove, sensed, answered = progress.objectives
     assert (drove.passed, drove.reason) == (True, "passed earlier: used w, a")
-    assert drove.evidence == {"keys_used": ["a", "w"]}
+    assert drove.evidence == {"attempt": first.attempt.id, "keys_used": ["a", "w"],
+                              "people": [], "profile": "unity"}  # fmt: skip
     assert not sensed.passed  # it never passed
     assert not answered.passed  # answers are judged as they stand now
     assert keep_passed(progress, progress).objectives[0].reason == "passed earlier: used w, a"
@@ -321,7 +341,7 @@ def test_the_set_up_starts_the_exercise_afresh():
     b = station_for(ex)
     b.key("w")
     assert check(obj, ex, b)[0]
-    apply_setup(b, ex.setup)
+    apply_setup(b, ex.setup, lab="lab", exercise=ex.id)
     assert check(obj, ex, b) == (False, "not used yet: w")
 
 
@@ -344,8 +364,9 @@ def test_keys_objective_with_a_role_accepts_a_viple_program_making_the_five_moti
         True,
         "VIPLE tcp program asked for forward, left, backward, right, stop",
     )
-    evidence = check_objective(obj, ex, b).evidence
-    assert evidence == {"role": "tcp", "peer": "127.0.0.1:50500",
+    evidence = evidence_of(obj, ex, b)
+    assert evidence == {"attempt": b.attempt.id, "role": "tcp", "peer": "127.0.0.1:50500",
+                        "person": "",
                         "motions": ["backward", "forward", "left", "right", "stop"]}  # fmt: skip
     other = Objective("keys", "drove", keys=("w",), role="ws")
     assert check(other, exercise(other), b) == (False, "not used yet: w")  # tcp is not ws
@@ -373,7 +394,7 @@ def test_a_viple_exercise_passes_with_the_students_program_run_here():
     assert run.ended == "exit" and str(run.driver) == "VIPLE program right-wall.viple"
     passed, reason = check(for_viple, ex, b)
     assert passed and reason.startswith(f"run {run.number} (VIPLE program right-wall.viple)")
-    evidence = check_objective(for_viple, ex, b).evidence
+    evidence = evidence_of(for_viple, ex, b)
     digest = hashlib.sha256(Path("programs/right-wall.viple").read_bytes()).hexdigest()
     assert evidence["program_sha256"] == digest
     assert check(for_fsm, ex, b)[0] is False  # a VIPLE program is not an FSM file
@@ -384,15 +405,16 @@ def test_set_up_starts_afresh_speed_algorithm_and_parameters():
     b.select_algorithm("one-distance-first")
     b.set_params(["right_blocked=50"])
     b.pacer.set_speed(None)  # "max"
-    changes = apply_setup(b, exercise(profile="web").setup)  # a keys exercise
+    keys_exercise = exercise(profile="web")
+    changes = apply_setup(b, keys_exercise.setup, lab="lab", exercise="ex")
     assert b.pacer.speed == 1.0 and b.algorithm is None and b.overrides == {}
     assert changes.speed == (None, 1.0)
     assert changes.algorithm == ("one-distance-first", None)
 
     setup = exercise(profile="web", controller="algorithm one-distance-first").setup
-    apply_setup(b, setup)
+    apply_setup(b, setup, lab="lab", exercise="ex")
     b.set_params(["right_blocked=50"])
-    changes = apply_setup(b, setup)
+    changes = apply_setup(b, setup, lab="lab", exercise="ex")
     web = LabStation.open(EROBOTIC.maze, "web", noise="off")
     web.select_algorithm("one-distance-first")
     assert b.params() == web.params()  # the web profile's own values, not the edited ones
@@ -402,5 +424,5 @@ def test_set_up_starts_afresh_speed_algorithm_and_parameters():
 def test_set_up_with_nothing_to_change_reports_nothing():
     ex = exercise(controller="algorithm right-wall")
     b = station_for(ex)
-    changes = apply_setup(b, ex.setup)
+    changes = apply_setup(b, ex.setup, lab="lab", exercise=ex.id)
     assert changes == type(changes)()

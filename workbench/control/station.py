@@ -7,6 +7,7 @@ only renders and routes input. A station owns a :class:`Session` and its :class:
 from __future__ import annotations
 
 import os
+import secrets
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -72,6 +73,49 @@ class RunEntry:
     source: str | None = None
     #: the layout digest of the maze the run was on (see ``Maze.digest``)
     maze_digest: str = ""
+    #: the id of the lab exercise's attempt that was under way when the run began ("" none)
+    attempt: str = ""
+    #: who of the pair was at the station when the run began ("" nobody named)
+    person: str = ""
+
+
+@dataclass(frozen=True)
+class Attempt:
+    """One go at a lab exercise, begun by its set-up: the work done on the station while it
+    is the current attempt (runs, edits, keys, VIPLE programs) is that exercise's work."""
+
+    #: unique on the station (and beyond: random), kept with the work and its evidence
+    id: str
+    lab: str
+    exercise: str
+    #: the exercise's profile, and who of the pair was at the station, at the set-up
+    profile: str
+    person: str = ""
+
+
+@dataclass(frozen=True)
+class MazeEdit:
+    """A maze edited in the editor and put on the station (loading a maze is not an edit)."""
+
+    number: int
+    #: the maze as edited (its name and layout digest), and the one the editor opened
+    maze: str
+    maze_digest: str
+    opened_digest: str
+    #: the maze has no problems (see ``Maze.validate``)
+    valid: bool
+    attempt: str = ""
+    person: str = ""
+
+
+@dataclass(frozen=True)
+class KeyUse:
+    """A drive key pressed on the station: in which attempt, on which profile, by whom."""
+
+    key: str
+    attempt: str
+    profile: str
+    person: str = ""
 
 
 #: the kinds of :class:`Notice`
@@ -123,6 +167,11 @@ class VipleConnection:
     turn_degrees: float = 0.0
     #: the motions its commands asked for, named as the drive keys' (forward, left, ...)
     motions: set[str] = field(default_factory=set)
+    #: the attempt under way, the profile and who of the pair was at the station when it
+    #: took the robot (or when that attempt began)
+    attempt: str = ""
+    profile: str = ""
+    person: str = ""
 
     @property
     def drove(self) -> bool:
@@ -178,7 +227,15 @@ class LabStation:
     algorithm: FsmDefinition | None = None
     overrides: dict[str, float] = field(default_factory=dict)
     runs: list[RunEntry] = field(default_factory=list)
-    keys_used: set[str] = field(default_factory=set)
+    #: every drive key pressed, with its attempt, profile and person (once each)
+    key_uses: set[KeyUse] = field(default_factory=set)
+    #: every maze edited in the editor and put on the station, oldest first
+    edits: list[MazeEdit] = field(default_factory=list)
+    #: the lab exercise attempt under way (None: no exercise set up), and every one begun
+    attempt: Attempt | None = None
+    attempts: list[Attempt] = field(default_factory=list)
+    #: who of the pair is at the station now (the work done is recorded as theirs)
+    person: str = ""
     #: the last thing the station did on its own that the person at it should hear of
     notice: Notice | None = None
     #: every VIPLE program seen driving this station, oldest first
@@ -195,6 +252,8 @@ class LabStation:
     _run_open: bool = False
     _run_driver: Driver = BY_KEYS
     _run_source: str | None = None
+    _run_attempt: str = ""
+    _run_person: str = ""
     _viple_now: VipleConnection | None = None
     _odometry_seen: tuple[float, float] = (0.0, 0.0)
     _recorder: Recorder | None = None
@@ -299,7 +358,7 @@ class LabStation:
         role, peer = driver.role, driver.peer
         now = self._viple_now
         if now is None or (now.role, now.peer) != (role, peer):  # another program took over
-            now = self._viple_now = VipleConnection(role, peer)
+            now = self._viple_now = self._connection(role, peer)
             self.viple.append(now)
         now.distance += seen[0] - last[0]
         now.turn_degrees += seen[1] - last[1]
@@ -312,14 +371,33 @@ class LabStation:
         if not self._run_open and not self.session.reached_exit:
             self._open_run(driver)
 
-    def start_exercise(self) -> None:
-        """Forget the drive keys and VIPLE programs seen so far (a lab exercise starts afresh);
-        a VIPLE program driving right now counts from here on."""
-        self.keys_used.clear()
-        self.viple.clear()
+    def _connection(self, role: str, peer: str) -> VipleConnection:
+        attempt = self.attempt.id if self.attempt is not None else ""
+        return VipleConnection(
+            role, peer, attempt=attempt, profile=self.profile, person=self.person
+        )
+
+    @property
+    def attempt_id(self) -> str:
+        return self.attempt.id if self.attempt is not None else ""
+
+    def begin_attempt(self, lab: str, exercise: str) -> Attempt:
+        """A lab exercise starts afresh (its set-up): the work done from now on is this
+        attempt's; a VIPLE program driving right now counts from here on."""
+        attempt = Attempt(secrets.token_hex(8), lab, exercise, self.profile, self.person)
+        self.attempt = attempt
+        self.attempts.append(attempt)
         if self._viple_now is not None:
-            self._viple_now = VipleConnection(self._viple_now.role, self._viple_now.peer)
+            self._viple_now = self._connection(self._viple_now.role, self._viple_now.peer)
             self.viple.append(self._viple_now)
+        return attempt
+
+    @property
+    def keys_used(self) -> set[str]:
+        """The drive keys pressed in the attempt under way (since the station opened when no
+        exercise was set up), on any profile."""
+        attempt = self.attempt_id
+        return {use.key for use in self.key_uses if use.attempt == attempt}
 
     def _commanded(self, cmd: Command, driver: Driver) -> None:
         """A VIPLE program's command: remember the motion it asked for (its drive keys)."""
@@ -374,7 +452,7 @@ class LabStation:
             self._close_run("stopped")  # the keys take the robot from a VIPLE program
         if not self._run_open and not self.session.reached_exit:
             self._open_run(BY_KEYS)  # a run starts at the robot's last reset
-        self.keys_used.add(key)
+        self.key_uses.add(KeyUse(key, self.attempt_id, self.profile, self.person))
         self.session.command(cmd, driver=BY_KEYS)
         if exact_move(self.profile, key):
             profile = get_profile(self.profile)
@@ -543,6 +621,22 @@ class LabStation:
         self.session.reset()
         self.session.driver = BY_KEYS
 
+    def put_edited_maze(self, maze: Maze, opened: Maze) -> MazeEdit:
+        """Put a maze edited in the editor on the station (``opened``: the maze the editor
+        began with), and keep the edit with the attempt under way."""
+        edit = MazeEdit(
+            number=len(self.edits) + 1,
+            maze=maze.name,
+            maze_digest=maze.digest(),
+            opened_digest=opened.digest(),
+            valid=not maze.validate(),
+            attempt=self.attempt_id,
+            person=self.person,
+        )
+        self.edits.append(edit)
+        self.load_maze(maze)
+        return edit
+
     def load_maze(self, maze: Maze) -> None:
         """Put a (new or edited) maze on the station; the robot starts over on it."""
         self._go_on_after_exit()
@@ -558,6 +652,8 @@ class LabStation:
         self._run_open = True
         self._run_driver = driver
         self._run_source = self.driving.source if self.driving is not None else None
+        self._run_attempt = self.attempt_id
+        self._run_person = self.person
         self._record_stop_told = False
         if self.record_dir:
             recorder, trouble = open_record(
@@ -573,7 +669,8 @@ class LabStation:
             self._recorder = recorder
             self._record_path = str(recorder.path)
             self.session.recorder = recorder
-            self.session.record_header(**record_fields(driver, self.driving))
+            person = {"person": self.person} if self.person else {}
+            self.session.record_header(**record_fields(driver, self.driving), **person)
 
     def _tell_record_stopped(self, recorder: Recorder) -> None:
         assert recorder.stopped is not None
@@ -605,6 +702,8 @@ class LabStation:
             record=self._record_path,
             source=self._run_source,
             maze_digest=self.maze.digest(),
+            attempt=self._run_attempt,
+            person=self._run_person,
         )
         self.runs.append(entry)
         recorder = self._recorder
@@ -623,4 +722,3 @@ class LabStation:
         """End the session: an open run is kept (with its record) as stopped."""
         if self._run_open:
             self._close_run("stopped")
-

@@ -2,6 +2,12 @@
 
 Each objective gives a :class:`Check`: passed or not, a one-line reason the app shows next to
 ✓ or ✗, and the evidence a sign-off keeps (the run, its metrics and its record's digest).
+
+An objective looks only at the exercise's own work: what was done on the station during the
+exercise's latest attempt (begun by its set-up, :func:`apply_setup`). Runs, edits, drive keys
+and VIPLE programs carry the id of the attempt under way when they happened; work of another
+exercise, or from before the set-up, meets nothing. Every pass names its attempt in its
+evidence (:data:`ATTEMPT`).
 """
 
 from __future__ import annotations
@@ -15,10 +21,11 @@ from typing import Any
 
 from workbench.control.algorithms import ALGORITHM_DIR
 from workbench.control.manual import KEY_NAMES
-from workbench.control.station import LabStation, RunEntry
+from workbench.control.station import Attempt, LabStation, RunEntry
 from workbench.sim.profiles import get_profile
 from workbench.sim.record import file_sha256
 
+from .migrations import REDO_REASON
 from .model import Exercise, LabMaze, Objective, Setup
 
 ROLE_NAMES = {"tcp": "TCP (the Unity simulator's role)", "ws": "WebSocket (the Web Simulator's)"}
@@ -38,6 +45,27 @@ class ObjectiveState:
     passed: bool
     reason: str
     evidence: dict[str, Any] = field(default_factory=dict)
+    #: it passed in a workbench that did not keep the work's evidence: it must be done again
+    redo: bool = False
+
+
+#: the evidence key naming the attempt whose work an objective passed on
+ATTEMPT = "attempt"
+#: the reason shown for a pass kept without its evidence
+REDO = REDO_REASON
+
+
+def proven(state: ObjectiveState) -> bool:
+    """Whether a passed objective rests on evidence of its exercise's own work (the
+    questions rest on the answers kept with the exercise)."""
+    return state.kind == "questions" or bool(state.evidence.get(ATTEMPT))
+
+
+def unproven_to_redo(state: ObjectiveState) -> ObjectiveState:
+    """A pass saved without the evidence of its work, as one that needs redoing."""
+    if state.passed and not proven(state):
+        return ObjectiveState(state.kind, state.text, False, REDO, {}, redo=True)
+    return state
 
 
 #: the longest answer kept, in characters (an answer is a number or a choice: a few words),
@@ -83,8 +111,13 @@ class ExerciseProgress:
         return all(o.passed for o in self.objectives)
 
     def to_json(self) -> str:
+        return json.dumps(self.as_dict(), sort_keys=True)
+
+    def as_dict(self) -> dict[str, Any]:
+        """The progress as saved: every objective's state and evidence, the answers, and
+        whether all objectives pass."""
         data = {k: v for k, v in asdict(self).items() if k != "cut"}
-        return json.dumps({**data, "passed": self.passed}, sort_keys=True)
+        return json.loads(json.dumps({**data, "passed": self.passed}))
 
     @classmethod
     def from_json(cls, text: str) -> ExerciseProgress:
@@ -94,7 +127,7 @@ class ExerciseProgress:
     def from_dict(cls, data: Mapping[str, Any]) -> ExerciseProgress:
         """Progress as saved (:meth:`to_json`); ValueError when it is not in that shape."""
         try:
-            objectives = [ObjectiveState(**o) for o in data["objectives"]]
+            objectives = [unproven_to_redo(ObjectiveState(**o)) for o in data["objectives"]]
             answers = dict(data.get("answers") or {})
             return cls(str(data["lab"]), str(data["exercise"]), objectives, answers)
         except (KeyError, TypeError, ValueError) as exc:
@@ -114,18 +147,22 @@ def keep_passed(saved: ExerciseProgress | None, live: ExerciseProgress) -> Exerc
     """``live`` with every objective that passed in ``saved`` still passed, with its evidence.
 
     What was checked once is not lost: after a restart (or a new robot, a new maze) the station
-    no longer shows the run that passed, but the saved progress does. Objectives are matched
-    by kind and text, so a changed lab file does not carry over a different objective. The
-    questions follow the answers as they stand (those are saved and shown again).
+    no longer shows the run that passed, but the saved progress does. Only a pass that rests
+    on the evidence of its exercise's own work is kept; one saved without it stays "needs
+    redoing" until the work is done again. Objectives are matched by kind and text, so a
+    changed lab file does not carry over a different objective. The questions follow the
+    answers as they stand (those are saved and shown again).
     """
     if saved is None:
         return live
-    earlier = {(o.kind, o.text): o for o in saved.objectives if o.passed and o.kind != "questions"}
+    earlier = {(o.kind, o.text): o for o in saved.objectives if o.kind != "questions"}
     objectives = []
     for o in live.objectives:
         before = earlier.get((o.kind, o.text))
-        if o.passed or before is None:
+        if o.passed or before is None or not (before.passed or before.redo):
             objectives.append(o)
+        elif before.redo or not proven(before):
+            objectives.append(ObjectiveState(o.kind, o.text, False, REDO, {}, redo=True))
         else:
             reason = before.reason if before.reason.startswith(KEPT) else KEPT + before.reason
             objectives.append(ObjectiveState(o.kind, o.text, True, reason, before.evidence))
@@ -147,11 +184,13 @@ class SetupChanges:
     program_dropped: str | None = None
 
 
-def apply_setup(station: LabStation, setup: Setup) -> SetupChanges:
-    """The exercise's one-key set-up: profile, maze, sensors, speed and the controller to use
-    (the maze and starter as they were when the lab was loaded), and nothing kept from before:
-    an exercise without an algorithm has none, and the parameters are the algorithm's own
-    values for the profile. Returns what changed beyond the profile, maze and sensors."""
+def apply_setup(station: LabStation, setup: Setup, *, lab: str, exercise: str) -> SetupChanges:
+    """The one-key set-up of exercise ``exercise`` of ``lab``: profile, maze, sensors, speed
+    and the controller to use (the maze and starter as they were when the lab was loaded),
+    and nothing kept from before: an exercise without an algorithm has none, and the
+    parameters are the algorithm's own values for the profile. It begins the exercise's
+    attempt: only the work done from here on counts for it. Returns what changed beyond the
+    profile, maze and sensors."""
     speed_before = station.pacer.speed
     algorithm_before = station.algorithm.name if station.algorithm is not None else None
     params_before = bool(station.overrides)
@@ -169,7 +208,7 @@ def apply_setup(station: LabStation, setup: Setup) -> SetupChanges:
     station.program = None
     station.pacer.set_speed(setup.speed)
     station.pause(False)
-    station.start_exercise()
+    station.begin_attempt(lab, exercise)
     algorithm_after = station.algorithm.name if station.algorithm is not None else None
     same_algorithm = algorithm_before == algorithm_after
     return SetupChanges(
@@ -194,8 +233,10 @@ def record_digest(path: str | None) -> str | None:
 def run_evidence(run: RunEntry) -> dict[str, Any]:
     program = {"program_sha256": run.driver.digest} if run.driver.digest else {}
     return {
+        ATTEMPT: run.attempt,
         "run": run.number,
         "driver": str(run.driver),
+        "person": run.person,
         **program,
         "maze": run.maze,
         "maze_digest": run.maze_digest,
@@ -222,32 +263,61 @@ def driver_kinds(run: RunEntry) -> set[str]:
     return kinds
 
 
+# -- the exercise's own work ---------------------------------------------------------------
+NOT_SET_UP = "not set up yet: press a to set this exercise up, then do the work"
+
+
+def attempt_of(station: LabStation, lab: str, exercise: Exercise) -> Attempt | None:
+    """The latest attempt of the exercise on the station (None: it was never set up here)."""
+    for attempt in reversed(station.attempts):
+        if (attempt.lab, attempt.exercise) == (lab, exercise.id):
+            return attempt
+    return None
+
+
+def _runs(station: LabStation, attempt: Attempt) -> list[RunEntry]:
+    return [r for r in station.runs if r.attempt == attempt.id]
+
+
 # -- the objective kinds -------------------------------------------------------------------
-def check_keys(obj: Objective, station: LabStation) -> Check:
-    """The drive keys pressed on the station, or (with ``role``) the same motions asked for by a
-    VIPLE program over that role: its own key bindings turned into commands."""
-    missing = [k for k in obj.keys if k not in station.keys_used]
-    evidence: dict[str, Any] = {"keys_used": sorted(station.keys_used)}
+def check_keys(obj: Objective, station: LabStation, attempt: Attempt) -> Check:
+    """The drive keys pressed on the exercise's profile during its attempt, or (with ``role``)
+    the same motions asked for by a VIPLE program over that role during the attempt: its own
+    key bindings turned into commands."""
+    uses = [u for u in station.key_uses if u.attempt == attempt.id and u.profile == attempt.profile]
+    pressed = {u.key for u in uses}
+    missing = [k for k in obj.keys if k not in pressed]
+    evidence: dict[str, Any] = {
+        ATTEMPT: attempt.id,
+        "profile": attempt.profile,
+        "keys_used": sorted(pressed),
+        "people": sorted({u.person for u in uses if u.key in obj.keys} - {""}),
+    }
     if not missing:
         return Check(True, f"used {', '.join(obj.keys)}", evidence)
+    mine = [c for c in station.viple if c.attempt == attempt.id]
     if obj.role:
         wanted = [KEY_NAMES[k] for k in obj.keys]
-        for c in reversed([c for c in station.viple if c.role == obj.role]):
+        for c in reversed([c for c in mine if c.role == obj.role]):
             if all(m in c.motions for m in wanted):
-                evidence = {"role": c.role, "peer": c.peer, "motions": sorted(c.motions)}
+                evidence = {ATTEMPT: attempt.id, "role": c.role, "peer": c.peer,
+                            "motions": sorted(c.motions), "person": c.person}  # fmt: skip
                 reason = f"VIPLE {c.role} program asked for {', '.join(wanted)}"
                 return Check(True, reason, evidence)
-        motions = set().union(*(c.motions for c in station.viple if c.role == obj.role))
+        motions = set().union(*(c.motions for c in mine if c.role == obj.role))
         if motions:
             lacking = [m for m in wanted if m not in motions]
-            return Check(False, f"VIPLE has not asked for {', '.join(lacking)} yet", evidence)
-    return Check(False, f"not used yet: {', '.join(missing)}", evidence)
+            return Check(False, f"VIPLE has not asked for {', '.join(lacking)} yet", {})
+    return Check(False, f"not used yet: {', '.join(missing)}", {})
 
 
-def check_sensors(obj: Objective, station: LabStation) -> Check:
+def check_sensors(obj: Objective, station: LabStation, attempt: Attempt) -> Check:
+    """The robot's sensors while the exercise's attempt is the one under way."""
+    if station.attempt != attempt:
+        return Check(False, "another exercise is set up now: press a to set this one up again")
     have = {str(s) for s in station.sensors}
     want = {str(s) for s in obj.sensors}
-    evidence = {"sensors": sorted(have)}
+    evidence = {ATTEMPT: attempt.id, "sensors": sorted(have), "person": station.person}
     if have == want:
         return Check(True, f"sensors are {', '.join(sorted(want)) or 'none'}", evidence)
     parts = []
@@ -255,20 +325,22 @@ def check_sensors(obj: Objective, station: LabStation) -> Check:
         parts.append(f"missing {', '.join(sorted(want - have))}")
     if have - want:
         parts.append(f"not wanted {', '.join(sorted(have - want))}")
-    return Check(False, "; ".join(parts), evidence)
+    return Check(False, "; ".join(parts), {})
 
 
-def check_viple(obj: Objective, station: LabStation) -> Check:
-    mine = [c for c in station.viple if c.role == obj.role]
+def check_viple(obj: Objective, station: LabStation, attempt: Attempt) -> Check:
+    seen = [c for c in station.viple if c.attempt == attempt.id]
+    mine = [c for c in seen if c.role == obj.role]
     drove = [c for c in mine if c.drove]
     if drove:
         c = drove[-1]
-        evidence = {"role": c.role, "peer": c.peer, "distance": round(c.distance, 4),
+        evidence = {ATTEMPT: attempt.id, "role": c.role, "peer": c.peer, "person": c.person,
+                    "distance": round(c.distance, 4),
                     "turn_degrees": round(c.turn_degrees, 4)}  # fmt: skip
         return Check(True, f"VIPLE {c.role} program at {c.peer} drove the robot", evidence)
     if mine:
         return Check(False, f"VIPLE {obj.role} program connected but has not moved the robot")
-    others = sorted({c.role for c in station.viple})
+    others = sorted({c.role for c in seen})
     if others:
         return Check(
             False,
@@ -291,35 +363,39 @@ def _limits(obj: Objective, run: RunEntry) -> str | None:
     return None
 
 
-def _exits(station: LabStation, maze: LabMaze, profile: str) -> list[RunEntry]:
-    """Runs that reached the exit of exactly the lab's ``maze`` (same layout) on ``profile``."""
+def _exits(station: LabStation, attempt: Attempt, maze: LabMaze, profile: str) -> list[RunEntry]:
+    """Runs of the attempt that reached the exit of exactly the lab's ``maze`` (same layout)
+    on ``profile``."""
     return [
         r
-        for r in station.runs
+        for r in _runs(station, attempt)
         if r.ended == "exit" and r.maze_digest == maze.digest and r.profile == profile
     ]
 
 
-def _not_the_lab_maze(station: LabStation, maze: LabMaze, profile: str) -> RunEntry | None:
-    """The last run that got out of a maze of the same name as the lab's but not its layout."""
+def _not_the_lab_maze(
+    station: LabStation, attempt: Attempt, maze: LabMaze, profile: str
+) -> RunEntry | None:
+    """The attempt's last run that got out of a maze of the same name as the lab's but not its
+    layout."""
     others = [
         r
-        for r in station.runs
+        for r in _runs(station, attempt)
         if r.ended == "exit" and r.maze == maze.name and r.profile == profile
         and r.maze_digest != maze.digest
     ]  # fmt: skip
     return others[-1] if others else None
 
 
-def check_exit(obj: Objective, exercise: Exercise, station: LabStation) -> Check:
+def check_exit(obj: Objective, exercise: Exercise, station: LabStation, attempt: Attempt) -> Check:
     assert obj.maze is not None
     maze = obj.maze
     profile = exercise.setup.profile
     wanted = set(obj.drivers)
-    runs = [r for r in _exits(station, maze, profile) if driver_kinds(r) & wanted]
+    runs = [r for r in _exits(station, attempt, maze, profile) if driver_kinds(r) & wanted]
     drivers = " or ".join(obj.drivers)
     if not runs:
-        other = _not_the_lab_maze(station, maze, profile)
+        other = _not_the_lab_maze(station, attempt, maze, profile)
         if other is not None:
             return Check(
                 False,
@@ -341,28 +417,39 @@ def check_exit(obj: Objective, exercise: Exercise, station: LabStation) -> Check
     return Check(False, f"run {last.number} ({last.driver}) {_limits(obj, last)}", {})
 
 
-def check_maze_edited(exercise: Exercise, station: LabStation) -> Check:
+def check_maze_edited(exercise: Exercise, station: LabStation, attempt: Attempt) -> Check:
+    """An edit made in the editor during the attempt that left a valid maze other than the
+    set-up maze (loading a maze is not editing)."""
     original = exercise.setup.maze.maze
-    evidence = {"maze_digest": station.maze.digest(), "original_digest": original.digest()}
-    if station.maze.same_layout(original):
-        return Check(False, f"the maze is still {original.name!r} as set up: add or remove a block")
-    problems = station.maze.validate()
-    if problems:
-        first = problems[0]
-        return Check(
-            False, f"the edited maze has {len(problems)} problem(s): {first.message}", evidence
-        )
-    return Check(True, "the maze was edited and is valid", evidence)
+    edits = [
+        e for e in station.edits if e.attempt == attempt.id and e.maze_digest != e.opened_digest
+    ]
+    changed = [e for e in edits if e.maze_digest != original.digest()]
+    good = [e for e in changed if e.valid]
+    if good:
+        e = good[-1]
+        evidence = {ATTEMPT: attempt.id, "edit": e.number, "maze": e.maze, "person": e.person,
+                    "maze_digest": e.maze_digest, "original_digest": original.digest()}  # fmt: skip
+        return Check(True, f"edit {e.number} left a valid maze, {e.maze!r}", evidence)
+    if changed:
+        return Check(False, "the edited maze has problems: fix them in the editor (e)")
+    if edits:
+        return Check(False, f"the edits left {original.name!r} as set up: add or remove a block")
+    return Check(
+        False, "the maze has not been edited yet: open the editor (e), add or remove a block"
+    )
 
 
-def check_compare(obj: Objective, exercise: Exercise, station: LabStation) -> Check:
+def check_compare(
+    obj: Objective, exercise: Exercise, station: LabStation, attempt: Attempt
+) -> Check:
     table: list[dict[str, Any]] = []
     missing = []
     for maze in obj.mazes:
         for name in obj.algorithms:
             runs = [
                 r
-                for r in _exits(station, maze, exercise.setup.profile)
+                for r in _exits(station, attempt, maze, exercise.setup.profile)
                 if f"algorithm {name}" in driver_kinds(r)
             ]
             if runs:
@@ -372,7 +459,7 @@ def check_compare(obj: Objective, exercise: Exercise, station: LabStation) -> Ch
     if missing:
         more = f" (+{len(missing) - 1} more)" if len(missing) > 1 else ""
         return Check(False, f"no run to the exit yet: {missing[0]}{more}", {"runs": table})
-    return Check(True, f"{len(table)} runs to compare", {"runs": table})
+    return Check(True, f"{len(table)} runs to compare", {ATTEMPT: attempt.id, "runs": table})
 
 
 def check_questions(exercise: Exercise, answers: Mapping[str, str]) -> Check:
@@ -394,26 +481,34 @@ def check_objective(
     exercise: Exercise,
     station: LabStation,
     answers: Mapping[str, str] | None = None,
+    attempt: Attempt | None = None,
 ) -> Check:
-    by_kind: dict[str, Callable[[], Check]] = {
-        "keys": lambda: check_keys(obj, station),
-        "sensors": lambda: check_sensors(obj, station),
-        "viple": lambda: check_viple(obj, station),
-        "exit": lambda: check_exit(obj, exercise, station),
-        "maze-edited": lambda: check_maze_edited(exercise, station),
-        "compare": lambda: check_compare(obj, exercise, station),
-        "questions": lambda: check_questions(exercise, answers or {}),
+    """``obj`` checked against the work of ``attempt`` (the exercise's latest attempt on the
+    station), and the answers given in the exercise."""
+    if obj.kind == "questions":
+        return check_questions(exercise, answers or {})
+    if attempt is None:
+        return Check(False, NOT_SET_UP)
+    by_kind: dict[str, Callable[[Attempt], Check]] = {
+        "keys": lambda a: check_keys(obj, station, a),
+        "sensors": lambda a: check_sensors(obj, station, a),
+        "viple": lambda a: check_viple(obj, station, a),
+        "exit": lambda a: check_exit(obj, exercise, station, a),
+        "maze-edited": lambda a: check_maze_edited(exercise, station, a),
+        "compare": lambda a: check_compare(obj, exercise, station, a),
     }
-    return by_kind[obj.kind]()
+    return by_kind[obj.kind](attempt)
 
 
 def evaluate(
     lab_id: str, exercise: Exercise, station: LabStation, answers: Mapping[str, str] | None = None
 ) -> ExerciseProgress:
-    """Every objective of ``exercise`` checked against the station now."""
+    """Every objective of ``exercise`` checked against its own work on the station now: the
+    work of its latest attempt, and its answers."""
+    attempt = attempt_of(station, lab_id, exercise)
     states = []
     for obj in exercise.objectives:
-        check = check_objective(obj, exercise, station, answers)
+        check = check_objective(obj, exercise, station, answers, attempt)
         states.append(
             ObjectiveState(obj.kind, obj.text, check.passed, check.reason, check.evidence)
         )

@@ -14,6 +14,7 @@ from typing import Any
 
 from .checks import ExerciseProgress
 from .model import Lab
+from .progress import signoff_driver
 from .queue import QueueEntry
 from .signoff_record import Evidence, RecordFields
 from .store import Store
@@ -104,16 +105,19 @@ class Request:
         return self.progress is not None and self.progress.passed
 
     def fields(self) -> RecordFields:
-        """The sign-off's fields: the pair and driver of the request, the saved evidence."""
+        """The sign-off's fields: the pair of the request, the saved evidence, and as driver
+        the person whose work the evidence rests on (else the request's driver)."""
         progress = self.progress
         if progress is None:
             raise ValueError(f"{self.entry.pair} has no saved progress in this exercise")
+        entry = self.entry
+        people = {name for name in (entry.student, entry.partner) if name}
         return RecordFields(
-            student=self.entry.student,
-            lab=self.entry.lab,
-            exercise=self.entry.exercise,
-            driver=self.entry.driver or self.entry.student,
-            partner=self.entry.partner,
+            student=entry.student,
+            lab=entry.lab,
+            exercise=entry.exercise,
+            driver=signoff_driver(progress, people) or entry.driver or entry.student,
+            partner=entry.partner,
             evidence=Evidence.of_progress(progress),
             objectives_passed=progress.passed,
         )

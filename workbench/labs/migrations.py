@@ -7,12 +7,18 @@ The same steps serve both databases: where their SQL differs (an identity column
 type) a step names both spellings. ``meta.schema_version`` keeps the number of the last step,
 as workbenches before this table read it.
 
+Step 4 marks the objectives that passed in workbenches that did not keep the evidence of the
+work (which attempt at the exercise, which run, edit or keys): such a pass is saved again as
+"needs redoing" (``redo``), neither kept as passed nor dropped. The app reads any progress
+still in the old shape the same way (:func:`workbench.labs.checks.unproven_to_redo`).
+
 Databases made before the table existed (SQLite, schema 1 or 2) are recognised by their
 ``meta.schema_version``: the steps up to it are recorded as applied, the rest are run.
 """
 
 from __future__ import annotations
 
+import json
 from collections.abc import Callable
 from dataclasses import dataclass
 from datetime import UTC, datetime
@@ -178,12 +184,52 @@ def _queue(tx: Tx, kind: str) -> None:
     _statements(tx, kind, queue.TABLE)
 
 
+#: the reason saved with a pass that needs redoing (as the app words it)
+REDO_REASON = "needs redoing: passed before the workbench kept the work it rests on; do it again"
+
+
+def redo_unproven(progress: dict[str, Any]) -> bool:
+    """Mark, in one exercise's saved progress, every passed objective without the evidence of
+    its work (an ``attempt`` in its evidence) as needing to be redone; the questions rest on
+    the saved answers and stay as they are. True when anything changed."""
+    objectives = progress.get("objectives")
+    if not isinstance(objectives, list):
+        return False
+    changed = False
+    for o in objectives:
+        if not isinstance(o, dict) or o.get("passed") is not True or o.get("kind") == "questions":
+            continue
+        evidence = o.get("evidence")
+        if isinstance(evidence, dict) and evidence.get("attempt"):
+            continue
+        o.update(passed=False, redo=True, reason=REDO_REASON, evidence={})
+        changed = True
+    if changed:
+        progress["passed"] = False
+    return changed
+
+
+def _progress_evidence(tx: Tx, kind: str) -> None:
+    rows = tx.execute("SELECT student, lab, exercise, progress FROM progress").fetchall()
+    for student, lab, exercise, text in rows:
+        try:
+            progress = json.loads(text)
+        except (TypeError, ValueError):
+            continue  # the app names such a row as unreadable; it is not rewritten here
+        if isinstance(progress, dict) and redo_unproven(progress):
+            tx.execute(
+                "UPDATE progress SET progress = ? WHERE student = ? AND lab = ? AND exercise = ?",
+                (json.dumps(progress, sort_keys=True), student, lab, exercise),
+            )
+
+
 STEPS = (
     Step(1, "tables", _tables),
     Step(2, "sign-off chain", _chain),
     # a SQLite store keeps the roster and the keys as files in the data folder
     Step(3, "instructors' roster", _roster, kinds=("postgresql",)),
     Step(4, "sign-off queue", _queue),
+    Step(5, "progress evidence", _progress_evidence),
 )
 
 
@@ -227,8 +273,7 @@ def tables(tx: Tx, kind: str) -> set[str]:
         rows = tx.execute("SELECT name FROM sqlite_master WHERE type = 'table'").fetchall()
     else:
         rows = tx.execute(
-            "SELECT table_name FROM information_schema.tables "
-            "WHERE table_schema = current_schema()"
+            "SELECT table_name FROM information_schema.tables WHERE table_schema = current_schema()"
         ).fetchall()
     return {r[0] for r in rows}
 
@@ -297,4 +342,3 @@ def migrate(backend: Backend, now: datetime | None = None) -> list[int]:
             (str(latest(kind)),),
         )
     return ran
-

@@ -9,6 +9,7 @@ drives next and records it; it returns that driver (None when closed without sig
 from __future__ import annotations
 
 import asyncio
+from collections.abc import Callable
 from typing import ClassVar
 
 from textual import on
@@ -23,7 +24,7 @@ from workbench.labs.checks import ExerciseProgress
 from workbench.labs.roster import offered_roster
 from workbench.labs.signing import MAX_NOTE, PendingSignoff, prepare_signoff
 from workbench.labs.signoff_errors import SignoffError
-from workbench.labs.signoff_record import Evidence, RecordFields
+from workbench.labs.signoff_record import Evidence, RecordFields, SignoffRecord
 from workbench.labs.store import Store, StoreError
 
 from ..keys import bindings
@@ -101,10 +102,14 @@ class SignoffModal(ModalScreen[str | None]):
         partner: str = "",
         driver: str = "",
         already: str = "",
+        on_signed: Callable[[SignoffRecord], None] | None = None,
     ) -> None:
-        """``already`` says who signed the exercise off before, and when (empty when nobody
-        has): the dialog is then a re-sign-off, which adds a second record."""
+        """``driver``: the person whose work the sign-off rests on. ``already`` says who
+        signed the exercise off before, and when (empty when nobody has): the dialog is then
+        a re-sign-off, which adds a second record. ``on_signed`` is told of the record the
+        moment it is saved (before the dialog asks who drives next)."""
         super().__init__()
+        self.on_signed = on_signed
         self.already = already
         self.store = store
         self.progress = progress
@@ -249,14 +254,16 @@ class SignoffModal(ModalScreen[str | None]):
         the failure here, where the store is used."""
         try:
             signer = await asyncio.to_thread(pending.unlock, passphrase)
-            pending.complete(signer)
+            _, record = pending.complete(signer)
         except SignoffError as exc:
             self.query_one("#signoff-passphrase", Input).value = ""
             self._say(str(exc))
         except Exception as exc:
             self._say(f"not signed: {exc}")
         else:
-            self._signed(pending.record.instructor, pending.record.override)
+            self._signed(record.instructor, record.override)
+            if self.on_signed is not None:
+                self.on_signed(record)
         finally:
             self.signing = None
         if self.close_asked:

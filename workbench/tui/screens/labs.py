@@ -3,19 +3,20 @@
 On the left, every lab and its exercises (✓ once an exercise's objectives pass, ★ once an
 instructor has signed it off; ``[X]`` and ``[*]`` in ASCII mode); on the right, the chosen
 exercise: its instructions, its objectives with ✓/✗ (``[X]``/``[ ]``) and a one-line reason
-that follow the station as the student works, and its questions. ``a`` puts
-the exercise's set-up on the station, ``r`` asks for sign-off (the exercise joins the store's
-sign-off queue, which the instructor's console shows; the screen follows the request), and
-``i`` opens the instructor's sign-off at this station where signing here is allowed (not in a
-served student's session, whose terminal is the student's). Progress is saved
-in the store as soon as an exercise is opened and each time an objective or an answer
-changes; an objective that passed once stays passed, with its evidence, after a restart.
+that follow the station as the student works, and its questions; under a passed objective,
+the work it rests on. ``a`` puts the exercise's set-up on the station, ``r`` asks for sign-off
+(the exercise joins the store's sign-off queue, which the instructor's console shows; the
+screen follows the request), and ``i`` opens the instructor's sign-off at this station where
+signing here is allowed (not in a served student's session, whose terminal is the student's).
+What the student has done is held by :class:`LabProgress` (in the core): the screen draws it
+and routes the student's input to it. Progress is saved in the store as soon as an exercise is
+opened and each time an objective or an answer changes; an objective that passed once stays
+passed, with its evidence, after a restart.
 """
 
 from __future__ import annotations
 
 import asyncio
-import json
 from typing import ClassVar, NamedTuple
 
 from textual import on
@@ -29,15 +30,10 @@ from textual.widgets import Input, Markdown, OptionList, Static
 from textual.widgets.option_list import Option
 
 from workbench.control.station import LabStation
-from workbench.labs.checks import (
-    MAX_ANSWER,
-    ExerciseProgress,
-    SetupChanges,
-    apply_setup,
-    evaluate,
-    keep_passed,
-)
+from workbench.labs.checks import MAX_ANSWER, ExerciseProgress, SetupChanges
 from workbench.labs.model import Exercise, Lab, LabFileError, Setup, load_labs
+from workbench.labs.progress import LabProgress, SignedOff, evidence_words, read_saved
+from workbench.labs.signoff_record import SignoffRecord
 from workbench.labs.store import Store, StoreError, StoreUnavailable
 from workbench.sim.session import Snapshot
 
@@ -178,7 +174,8 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self.store = store
         self.student = student
         self.partner = partner
-        self.driver = student
+        #: what the student (or pair) has done in the labs
+        self.lab_progress = LabProgress(student, partner)
         self._problem = ""
         if labs is None:
             try:
@@ -190,14 +187,7 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self._store_problem = store_problem
         self._ready = False
         self.selected: tuple[Lab, Exercise] | None = None
-        self.answers: dict[tuple[str, str], dict[str, str]] = {}
         self.progress: ExerciseProgress | None = None
-        #: the progress last saved (or read back) for each exercise
-        self._saved: dict[tuple[str, str], ExerciseProgress] = {}
-        self._done: set[tuple[str, str]] = set()
-        #: (lab, exercise) -> "by INSTRUCTOR on DATE" of its last sign-off
-        self._signed: dict[tuple[str, str], str] = {}
-        self._drivers: dict[tuple[str, str], str] = {}
         self._retry_timer: Timer | None = None
         self._retrying = False
         self._reload_when_back = False
@@ -206,14 +196,17 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self.unicode = False
         self._load_saved()
 
+    @property
+    def driver(self) -> str:
+        """Who of the pair drives now, as far as the workbench knows."""
+        return self.lab_progress.driver
+
     # -- store ---------------------------------------------------------------------------
     def _load_saved(self) -> None:
         if self.store is None:
             return
         try:
-            saved = self.store.progress(self.student)
-            signed = self.store.signoffs(student=self.student)
-            self._drivers = self.store.drivers(self.student, self.partner)
+            loaded = read_saved(self.store, self.student, self.partner)
         except StoreUnavailable:
             self._store_problem = (
                 f"{UNREACHABLE}: saved progress is not shown yet; what you do now is kept "
@@ -224,18 +217,8 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         except Exception as exc:  # a damaged database must not stop the lab
             self._store_problem = f"cannot read saved progress: {exc}"
             return
-        damaged, cut = [], []
-        for key, data in saved.items():
-            try:
-                progress = ExerciseProgress.from_dict(data)
-            except ValueError:
-                damaged.append("/".join(key))
-                continue
-            cut += [f"{'/'.join(key)} {question}" for question in progress.cut]
-            self._saved[key] = progress
-            if progress.passed:
-                self._done.add(key)
-            self.answers[key] = dict(progress.answers)
+        self.lab_progress.take(loaded)
+        damaged, cut = loaded.damaged, loaded.cut
         if damaged:
             self._store_problem = f"saved progress unreadable (starts afresh): {', '.join(damaged)}"
         elif cut:
@@ -243,21 +226,10 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
                 f"saved answers longer than {MAX_ANSWER} characters were cut to their first "
                 f"{MAX_ANSWER}: {', '.join(cut[:3])}{' ...' if len(cut) > 3 else ''}"
             )
-        self._signed = {
-            (row.lab, row.exercise): _by(row.instructor, row.signed_at) for row in signed
-        }
 
     def _save(self, progress: ExerciseProgress) -> None:
-        key = (progress.lab, progress.exercise)
-        self._saved[key] = progress
-        if progress.passed:
-            self._done.add(key)
-        if self.store is None:
-            return
         try:
-            saved = self.store.save_progress(
-                self.student, progress.lab, progress.exercise, _json(progress)
-            )
+            saved = self.lab_progress.save(self.store, progress)
         except Exception as exc:
             self.say(f"progress not saved: {exc}")
             return
@@ -353,14 +325,9 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
                 Option(prose(lab.title, self.unicode), id=f"lab:{lab.id}", disabled=True)
             )
             for ex in lab.exercises:
-                key = (lab.id, ex.id)
-                mark = (
-                    marks.signed
-                    if key in self._signed
-                    else marks.passed
-                    if key in self._done
-                    else marks.open
-                )
+                mark = {"signed": marks.signed, "passed": marks.passed, "open": marks.open}[
+                    self.lab_progress.mark((lab.id, ex.id))
+                ]
                 title = prose(ex.title, self.unicode)
                 options.append(Option(f"{mark} {title}", id=f"{lab.id}/{ex.id}"))
         return options
@@ -440,21 +407,17 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
                     self._wait_for_store()
             except Exception as exc:
                 self.say(f"cannot save where you are: {exc}")
-        self.driver = self._drivers.get((lab.id, exercise.id), self.driver)
+        driver = self.lab_progress.open((lab.id, exercise.id))
         self.query_one(SignoffStatus).follow(
-            self.student, self.partner, self.driver, lab.id, exercise.id
+            self.student, self.partner, driver, lab.id, exercise.id
         )
         self.progress = None
-        signed = self._signed.get((lab.id, exercise.id))
-        title = f"{lab.title}: {exercise.title}"
-        if signed:
-            title += f" ({self.marks.signed} signed off {signed})"
+        self._show_title()
         unicode = self.unicode
-        self.query_one("#labs-title", Static).update(prose(title, unicode))
         self.query_one("#labs-instructions", Markdown).update(prose(exercise.instructions, unicode))
         box = self.query_one("#labs-questions", Vertical)
         box.remove_children()
-        answers = self.answers.get((lab.id, exercise.id), {})
+        answers = self.lab_progress.answers.get((lab.id, exercise.id), {})
         for q in exercise.questions:
             # the field's hint is one short word; the choices stand whole above it
             choices = f" (one of: {', '.join(q.choices)})" if q.choices else ""
@@ -478,9 +441,20 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             )
         self.show_snapshot(self.station.snapshot())
 
+    def _show_title(self) -> None:
+        """The chosen exercise's title, and by whom and when it was signed off."""
+        if self.selected is None:
+            return
+        lab, exercise = self.selected
+        signed = self.lab_progress.signed.get((lab.id, exercise.id))
+        title = f"{lab.title}: {exercise.title}"
+        if signed:
+            title += f" ({self.marks.signed} signed off {signed.words()})"
+        self.query_one("#labs-title", Static).update(prose(title, self.unicode))
+
     def _answer_reason(self, exercise: Exercise, question_id: str) -> str:
         lab = self.selected[0] if self.selected else None
-        answers = self.answers.get((lab.id, exercise.id), {}) if lab else {}
+        answers = self.lab_progress.answers.get((lab.id, exercise.id), {}) if lab else {}
         text = answers.get(question_id, "").strip()
         if not text:
             return "not answered yet"
@@ -497,7 +471,7 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             return
         lab, exercise = self.selected
         question_id = field_id[2:]
-        self.answers.setdefault((lab.id, exercise.id), {})[question_id] = event.value
+        self.lab_progress.answer((lab.id, exercise.id), question_id, event.value)
         box = event.input.parent
         if box is not None:
             box.query_one(".question-reason", Static).update(
@@ -518,13 +492,11 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             return None
         lab, exercise = self.selected
         key = (lab.id, exercise.id)
-        saved = self._saved.get(key)
-        live = evaluate(lab.id, exercise, self.station, self.answers.get(key, {}))
-        progress = keep_passed(saved, live)
-        if saved is None or _changed(saved, progress):
-            was_done = key in self._done
+        progress = self.lab_progress.check(lab.id, exercise, self.station)
+        if self.lab_progress.changed(progress):
+            mark = self.lab_progress.mark(key)
             self._save(progress)
-            if self._ready and (key in self._done) != was_done:
+            if self._ready and self.lab_progress.mark(key) != mark:
                 self._refresh_list()
         self.progress = progress
         return progress
@@ -536,10 +508,12 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         if progress is None:
             return
         marks = self.marks
-        lines = [
-            f"{marks.passed if o.passed else marks.failed} {o.text}: {o.reason}"
-            for o in progress.objectives
-        ]
+        lines = []
+        for o in progress.objectives:
+            lines.append(f"{marks.passed if o.passed else marks.failed} {o.text}: {o.reason}")
+            evidence = evidence_words(o)
+            if evidence:
+                lines.append(f"  {evidence}")
         self.query_one("#labs-objectives", Static).update(prose("\n".join(lines), self.unicode))
 
     def say(self, message: str) -> None:
@@ -556,9 +530,9 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         if self.selected is None:
             self.say("choose an exercise first")
             return
-        exercise = self.selected[1]
+        lab, exercise = self.selected
         try:
-            changes = apply_setup(self.station, exercise.setup)
+            changes = self.lab_progress.set_up(self.station, lab, exercise)
         except Exception as exc:
             self.say(f"cannot set up {exercise.title}: {exc}")
             return
@@ -592,16 +566,14 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             self._signed_later = event
             return
         key = (event.lab, event.exercise)
-        by = _by(event.instructor, event.signed_at)
-        if key in self._signed:  # known here already (read at the start, or signed here)
+        if key in self.lab_progress.signed:  # known here already (read at the start, or here)
             return
-        self._signed[key] = by
+        signed = SignedOff(event.instructor, event.signed_at)
+        self.lab_progress.signed[key] = signed
         self._refresh_list()
         if self.selected is not None and (self.selected[0].id, self.selected[1].id) == key:
-            title = f"{self.selected[0].title}: {self.selected[1].title}"
-            title += f" ({self.marks.signed} signed off {by})"
-            self.query_one("#labs-title", Static).update(prose(title, self.unicode))
-            self.say(f"signed off {by}")
+            self._show_title()
+            self.say(f"signed off {signed.words()}")
 
     def action_sign_off(self) -> None:
         if self.selected is None:
@@ -620,52 +592,38 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
 
         progress = self.track()
         assert progress is not None
+        already = self.lab_progress.signed.get((progress.lab, progress.exercise))
         self.app.push_screen(
             SignoffModal(
                 self.store,
                 progress,
                 self.student,
                 self.partner,
-                self.driver,
-                already=self._signed.get((progress.lab, progress.exercise), ""),
+                self.lab_progress.signoff_driver(progress),
+                already=already.words() if already is not None else "",
+                on_signed=self._record_saved,
             ),
             self._signed_off,
         )
+
+    def _record_saved(self, record: SignoffRecord) -> None:
+        """A sign-off was saved: the exercise's title and its mark in the list say so now."""
+        key = (record.lab, record.exercise)
+        self.lab_progress.signed_off(key, record.instructor, record.signed_at, record.driver)
+        self._refresh_list()
+        self._show_title()
 
     def _signed_off(self, driver: str | None) -> None:
         if driver is None or self.selected is None:
             return
         lab, exercise = self.selected
-        self._signed[(lab.id, exercise.id)] = "just now"
-        self._drivers[(lab.id, exercise.id)] = self.driver
-        self.driver = driver
-        following = list(lab.exercises)[list(lab.exercises).index(exercise) + 1 :]
-        if following:
-            self._drivers[(lab.id, following[0].id)] = driver
-        if following and self.store is not None:
+        following = self.lab_progress.next_driver(lab, exercise, driver)
+        self.station.person = driver
+        if following is not None and self.store is not None:
             try:
-                self.store.set_driver(self.student, self.partner, lab.id, following[0].id, driver)
+                self.store.set_driver(self.student, self.partner, *following, driver)
             except Exception as exc:
                 self.say(f"signed off; the next driver was not recorded: {exc}")
                 return
         self._refresh_list()
         self.say(f"signed off; {driver} drives next")
-
-
-def _by(instructor: str, signed_at: str) -> str:
-    """``by Dr Chen on 2026-03-02 10:00``: who signed an exercise off, and when (UTC)."""
-    when = signed_at.replace("T", " ").rstrip("Z")[:16]
-    return f"by {instructor} on {when} UTC" if when else f"by {instructor}"
-
-
-def _changed(before: ExerciseProgress, now: ExerciseProgress) -> bool:
-    """Worth a save: an objective passed or failed, or an answer changed."""
-
-    def states(p: ExerciseProgress) -> list[tuple[str, bool]]:
-        return [(o.text, o.passed) for o in p.objectives]
-
-    return states(before) != states(now) or before.answers != now.answers
-
-
-def _json(progress: ExerciseProgress) -> dict:
-    return json.loads(progress.to_json())

@@ -1,0 +1,241 @@
+"""Where one student (or pair) stands in the labs: each exercise's progress as saved and as
+checked live, the answers given, the sign-offs, and who drives.
+
+The labs screen (and any other front end, and the tests) keeps a :class:`LabProgress` and
+asks it everything: reading what the store saved (:func:`read_saved`, which touches nothing
+but the store, so it may run in a thread, then :meth:`LabProgress.take`), setting an
+exercise up (:meth:`LabProgress.set_up`), checking it against the station and saving what
+changed (:meth:`LabProgress.check`, :meth:`LabProgress.save`), and what a sign-off changes.
+
+An objective passes only on its exercise's own work (:mod:`.checks`), and its pass keeps the
+evidence: :func:`evidence_words` says it in one line, and :func:`signoff_driver` names the
+person whose work the sign-off rests on.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+from workbench.control.station import LabStation
+
+from .checks import (
+    ExerciseProgress,
+    ObjectiveState,
+    SetupChanges,
+    apply_setup,
+    evaluate,
+    keep_passed,
+)
+from .model import Exercise, Lab
+from .store import Store
+
+#: (lab id, exercise id)
+ExerciseKey = tuple[str, str]
+#: how an exercise stands in the list: signed off, its objectives all pass, or neither
+Mark = Literal["signed", "passed", "open"]
+
+
+@dataclass(frozen=True)
+class SignedOff:
+    """The last sign-off of an exercise: by whom and when (UTC ISO 8601)."""
+
+    instructor: str
+    signed_at: str
+
+    def words(self) -> str:
+        """``by Dr Chen on 2026-03-02 10:00 UTC``."""
+        when = self.signed_at.replace("T", " ").rstrip("Z")[:16]
+        return f"by {self.instructor} on {when} UTC" if when else f"by {self.instructor}"
+
+
+@dataclass
+class SavedProgress:
+    """What the store holds for a student (or pair), as read in one go."""
+
+    progress: dict[ExerciseKey, ExerciseProgress] = field(default_factory=dict)
+    signed: dict[ExerciseKey, SignedOff] = field(default_factory=dict)
+    drivers: dict[ExerciseKey, str] = field(default_factory=dict)
+    #: exercises ("lab/exercise") whose saved progress could not be read (they start afresh)
+    damaged: list[str] = field(default_factory=list)
+    #: answers ("lab/exercise question") longer than is kept, cut as they were read
+    cut: list[str] = field(default_factory=list)
+
+
+def read_saved(store: Store, student: str, partner: str = "") -> SavedProgress:
+    """The saved progress, sign-offs and drivers of ``student`` (with ``partner``). Passes
+    saved without the evidence of their work read as "needs redoing". Raises what the store
+    raises (:class:`~.store.StoreUnavailable` while a course database is away)."""
+    rows = store.progress(student)
+    signoffs = store.signoffs(student=student)
+    drivers = store.drivers(student, partner)
+    out = SavedProgress(drivers=drivers)
+    for key, data in rows.items():
+        try:
+            progress = ExerciseProgress.from_dict(data)
+        except ValueError:
+            out.damaged.append("/".join(key))
+            continue
+        out.cut += [f"{'/'.join(key)} {question}" for question in progress.cut]
+        out.progress[key] = progress
+    out.signed = {(r.lab, r.exercise): SignedOff(r.instructor, r.signed_at) for r in signoffs}
+    return out
+
+
+@dataclass
+class LabProgress:
+    """One student's (or pair's) progress through the labs, in one app."""
+
+    student: str
+    partner: str = ""
+    #: the progress last saved (or read back) for each exercise
+    saved: dict[ExerciseKey, ExerciseProgress] = field(default_factory=dict)
+    answers: dict[ExerciseKey, dict[str, str]] = field(default_factory=dict)
+    signed: dict[ExerciseKey, SignedOff] = field(default_factory=dict)
+    #: who drove (or drives) each exercise, as recorded
+    drivers: dict[ExerciseKey, str] = field(default_factory=dict)
+    #: who of the pair drives now, as far as the workbench knows
+    driver: str = ""
+
+    def __post_init__(self) -> None:
+        self.driver = self.driver or self.student
+
+    # -- what the store holds --------------------------------------------------------------
+    def take(self, loaded: SavedProgress) -> None:
+        """Take what :func:`read_saved` read (on the thread that uses this progress)."""
+        for key, progress in loaded.progress.items():
+            self.saved[key] = progress
+            self.answers[key] = dict(progress.answers)
+        self.signed.update(loaded.signed)
+        self.drivers.update(loaded.drivers)
+
+    def mark(self, key: ExerciseKey) -> Mark:
+        if key in self.signed:
+            return "signed"
+        saved = self.saved.get(key)
+        return "passed" if saved is not None and saved.passed else "open"
+
+    # -- doing an exercise -----------------------------------------------------------------
+    def open(self, key: ExerciseKey) -> str:
+        """The exercise ``key`` is chosen: its recorded driver (else whoever drove last)
+        drives it. Returns that driver."""
+        self.driver = self.drivers.get(key, self.driver)
+        return self.driver
+
+    def set_up(self, station: LabStation, lab: Lab, exercise: Exercise) -> SetupChanges:
+        """The exercise's one-key set-up, which begins its attempt; the exercise's driver is
+        at the station from now on (the work is recorded as theirs)."""
+        station.person = self.open((lab.id, exercise.id))
+        return apply_setup(station, exercise.setup, lab=lab.id, exercise=exercise.id)
+
+    def answer(self, key: ExerciseKey, question: str, text: str) -> None:
+        self.answers.setdefault(key, {})[question] = text
+
+    def check(self, lab_id: str, exercise: Exercise, station: LabStation) -> ExerciseProgress:
+        """The exercise checked against its own work on the station now, with every pass
+        saved before kept (and every pass saved without evidence still needing redoing)."""
+        key = (lab_id, exercise.id)
+        live = evaluate(lab_id, exercise, station, self.answers.get(key, {}))
+        return keep_passed(self.saved.get(key), live)
+
+    def changed(self, progress: ExerciseProgress) -> bool:
+        """Worth a save: never saved, an objective passed or failed (or came to need redoing),
+        or an answer changed."""
+        saved = self.saved.get((progress.lab, progress.exercise))
+        if saved is None:
+            return True
+
+        def states(p: ExerciseProgress) -> list[tuple[str, bool, bool]]:
+            return [(o.text, o.passed, o.redo) for o in p.objectives]
+
+        return states(saved) != states(progress) or saved.answers != progress.answers
+
+    def save(self, store: Store | None, progress: ExerciseProgress) -> bool:
+        """Keep ``progress`` as the exercise's, and write it to ``store``: True when written
+        (or on its way), False when kept pending. Raises what the store raises."""
+        self.saved[(progress.lab, progress.exercise)] = progress
+        if store is None:
+            return True
+        return store.save_progress(
+            self.student, progress.lab, progress.exercise, progress.as_dict()
+        )
+
+    # -- sign-off --------------------------------------------------------------------------
+    def signoff_driver(self, progress: ExerciseProgress) -> str:
+        """Who the sign-off of ``progress`` names as the driver (:func:`signoff_driver`)."""
+        people = {self.student, self.partner} - {""}
+        return signoff_driver(progress, people) or self.driver
+
+    def signed_off(self, key: ExerciseKey, instructor: str, signed_at: str, driver: str) -> None:
+        """A sign-off of ``key`` was saved, naming ``driver``."""
+        self.signed[key] = SignedOff(instructor, signed_at)
+        self.drivers[key] = driver
+
+    def next_driver(self, lab: Lab, exercise: Exercise, driver: str) -> ExerciseKey | None:
+        """``driver`` was chosen to drive next: they drive now, and the exercise after
+        ``exercise`` is theirs. Returns that exercise (None after the lab's last) for the
+        caller to record (:meth:`Store.set_driver`)."""
+        self.driver = driver
+        ids = [ex.id for ex in lab.exercises]
+        place = ids.index(exercise.id) + 1
+        if place >= len(ids):
+            return None
+        following = (lab.id, ids[place])
+        self.drivers[following] = driver
+        return following
+
+
+def signoff_driver(progress: ExerciseProgress, people: set[str]) -> str:
+    """The person whose work the sign-off rests on: the one who was at the station for the
+    evidence run (the run :class:`~.signoff_record.Evidence` keeps), else for the first other
+    passed objective's work; "" when the evidence names nobody of ``people``."""
+    passed = [o for o in progress.objectives if o.passed]
+    runs = [o.evidence for o in passed if o.evidence.get("record") and o.evidence.get("run")]
+    runs += [o.evidence for o in passed if o.evidence.get("run")]
+    for ev in runs:
+        if ev.get("person") in people:
+            return str(ev["person"])
+    for o in passed:
+        ev = o.evidence
+        named = [ev.get("person"), *(ev.get("people") or [])]
+        named += [r.get("person") for r in ev.get("runs") or [] if isinstance(r, Mapping)]
+        for person in named:
+            if person in people:
+                return str(person)
+    return ""
+
+
+def evidence_words(state: ObjectiveState) -> str:
+    """What a pass rests on, in one short line ("" for none): the run (its driver, who was at
+    the station, its record and digest), the edit, the keys or the VIPLE program."""
+    ev: Mapping[str, Any] = state.evidence
+    if not state.passed or not ev:
+        return ""
+    if state.kind == "questions":
+        return f"{ev.get('correct', 0)} of {ev.get('of', 0)} right"
+    by = f" by {ev['person']}" if ev.get("person") else ""
+    if "run" in ev:
+        words = f"run {ev['run']}{by} ({ev.get('driver', '')})"
+        if ev.get("record"):
+            sha = ev.get("record_sha256") or "unreadable"
+            words += f", record {Path(str(ev['record'])).name} sha256 {str(sha)[:12]}"
+    elif "edit" in ev:
+        words = f"edit {ev['edit']}{by}: {ev.get('maze', '')} {str(ev.get('maze_digest'))[:12]}"
+    elif "runs" in ev:
+        runs = ", ".join(f"{r.get('algorithm')} run {r.get('run')}" for r in ev["runs"])
+        words = f"runs {runs}"
+    elif "motions" in ev:
+        words = f"VIPLE {ev.get('role')} at {ev.get('peer')}{by}: {', '.join(ev['motions'])}"
+    elif "keys_used" in ev:
+        people = ", ".join(ev.get("people") or [])
+        words = f"keys {' '.join(ev['keys_used'])} on {ev.get('profile')}"
+        words += f" by {people}" if people else ""
+    elif "role" in ev:
+        words = f"VIPLE {ev['role']} at {ev.get('peer')}{by} drove {ev.get('distance')}"
+    elif "sensors" in ev:
+        words = f"sensors {', '.join(ev['sensors'])}{by}"
+    else:
+        words = ""
+    return words
