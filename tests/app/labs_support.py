@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import asyncio
 from pathlib import Path
 
 from textual.pilot import Pilot
@@ -24,12 +25,20 @@ def text(screen, selector: str) -> str:
     return str(screen.query_one(selector, Static).render())
 
 
-async def open_exercise(pilot: Pilot, option_id: str = DRIVE) -> LabsScreen:
-    """``l``, then the exercise ``option_id`` ("lab/exercise") highlighted in the list."""
+async def open_labs(pilot: Pilot) -> LabsScreen:
+    """``l``, and the labs screen once it has shown the saved progress (read in a thread)."""
     await pilot.press("l")
     await pilot.pause()
     screen = pilot.app.screen
     assert isinstance(screen, LabsScreen)
+    await asyncio.wait_for(screen.loaded.wait(), 30)
+    await pilot.pause()
+    return screen
+
+
+async def open_exercise(pilot: Pilot, option_id: str = DRIVE) -> LabsScreen:
+    """``l``, then the exercise ``option_id`` ("lab/exercise") highlighted in the list."""
+    screen = await open_labs(pilot)
     listing = screen.query_one("#labs-list", OptionList)
     listing.highlighted = listing.get_option_index(option_id)
     await pilot.pause()

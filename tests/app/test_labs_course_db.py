@@ -9,15 +9,20 @@ import time
 
 import pytest
 from textual.pilot import Pilot
-from textual.widgets import Input
+from textual.widgets import Checkbox, Input
 
+from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.pending import pending_path
 from workbench.labs.store import Store
-from workbench.tui.screens.labs import LabsScreen
+from workbench.tui.dialogs.signoff import SignoffModal
+from workbench.tui.screens.labs import LOADING, UNREACHABLE, LabsScreen
 from workbench.tui.screens.main import MainScreen
 
-from .labs_support import DRIVE, lab_app, open_exercise, text
+from .labs_support import DRIVE, lab_app, open_exercise, signing_over, text
 from .support import run, said
+
+FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
+PASS = "correct horse battery"
 
 
 def test_a_student_resumes_on_another_server_where_they_left_off(tmp_path, pg_url):
@@ -250,3 +255,109 @@ def test_a_database_that_hangs_never_freezes_the_app_and_the_work_waits_for_it(
     with Store.open(tmp_path / "elsewhere", db=pg_url) as store:
         saved = store.progress("ana")[("unity-simulator", "drive-by-wire")]
     assert saved["answers"] == {"tcp-port": "1350"}
+
+
+def test_the_labs_open_at_once_on_a_database_that_hangs_and_fill_in_once_it_answers(
+    tmp_path, pg_server, pg_url, monkeypatch
+):
+    """The course database stopped (SIGSTOP) when the student opens the labs: the screen is
+    there at once, saying it loads their progress, and keys work meanwhile; then it says the
+    database is away, and once it answers the saved progress is shown where they left off."""
+    first = lab_app(tmp_path / "server-one", db=pg_url)
+
+    async def answer(pilot: Pilot) -> None:
+        screen = await open_exercise(pilot, DRIVE)
+        screen.query_one("#q-tcp-port", Input).value = "1350"
+        await pilot.pause()
+
+    run(first, answer)
+    monkeypatch.setenv("WORKBENCH_DB_TIMEOUT", "2")
+    app = lab_app(tmp_path / "server-two", db=pg_url)
+    hang = Hang("stopped", pg_server, pg_url)
+
+    async def body(pilot: Pilot) -> None:
+        hang.start()
+        try:
+            await pilot.press("l")
+            screen = app.screen
+            assert isinstance(screen, LabsScreen)  # open while the database says nothing
+            assert text(screen, "#labs-message") == LOADING
+            assert not screen.loaded.is_set()
+            await pilot.press("escape", "p")  # keys are handled while the progress is read
+            assert isinstance(app.screen, MainScreen) and not app.station.paused
+            await pilot.press("p", "l")
+            assert app.screen is screen
+            await asyncio.wait_for(screen.loaded.wait(), 40)
+            await pilot.pause()
+            assert text(screen, "#labs-message").startswith(
+                f"{UNREACHABLE}: saved progress is not shown yet"
+            )
+        finally:
+            hang.release()
+        back = "the course database is back: your progress is saved"
+        deadline = time.monotonic() + 20
+        while text(screen, "#labs-message") != back and time.monotonic() < deadline:
+            await asyncio.sleep(0.1)
+        await pilot.pause()
+        assert text(screen, "#labs-message") == back
+        assert text(screen, "#labs-title") == "Unity simulator: Drive by wire"  # where they were
+        assert screen.query_one("#q-tcp-port", Input).value == "1350"
+
+    run(app, body)
+
+
+def statement_waits_for_a_lock(url: str) -> bool:
+    import psycopg
+
+    with psycopg.connect(url, autocommit=True) as conn:
+        row = conn.execute(
+            "SELECT count(*) FROM pg_stat_activity WHERE wait_event_type = 'Lock'"
+        ).fetchone()
+    return bool(row and row[0])
+
+
+def test_signing_off_behind_a_save_stuck_on_the_database_keeps_the_app_answering(
+    tmp_path, pg_server, pg_url, monkeypatch
+):
+    """A save of progress stuck on a locked table holds the store; a sign-off started then
+    waits for it in a thread: the dialog takes keys meanwhile, and signs once it is free."""
+    monkeypatch.setenv("WORKBENCH_DB_TIMEOUT", "20")
+    data = tmp_path / "data"
+    with Store.open(data, db=pg_url) as store:
+        create_instructor(data, "Dr Chen", PASS, kdf=FAST, store=store)
+    app = lab_app(data, db=pg_url)
+    hang = Hang("locked", pg_server, pg_url)
+
+    async def body(pilot: Pilot) -> None:
+        await open_exercise(pilot, DRIVE)
+        await pilot.press("i")
+        modal = app.screen
+        assert isinstance(modal, SignoffModal)
+        await asyncio.wait_for(modal.roster_read.wait(), 20)  # read in a thread
+        await pilot.pause()
+        modal.query_one("#signoff-passphrase", Input).value = PASS
+        modal.query_one("#signoff-override", Checkbox).value = True
+        note = modal.query_one("#signoff-note", Input)
+        note.value = "checked at the station"
+        store = app.store
+        saved = store.progress("ana")[("unity-simulator", "drive-by-wire")]
+        hang.start()
+        try:
+            # the labs screen's save of the exercise, on its way in the store's thread
+            store.save_progress("ana", "unity-simulator", "drive-by-wire", saved)
+            for _ in range(200):
+                if await asyncio.to_thread(statement_waits_for_a_lock, pg_url):
+                    break
+                await asyncio.sleep(0.05)
+            note.focus()
+            await pilot.press("enter")  # sign: the store is held by the stuck save
+            await pilot.press("end", "!")
+            await pilot.pause()
+            assert modal.signing is not None and not modal.signed  # still waiting ...
+            assert note.value == "checked at the station!"  # ... and the key was taken
+        finally:
+            hang.release()
+        await signing_over(pilot, modal)
+        assert "Signed off by Dr Chen (override)." in text(modal, "#signoff-done")
+
+    run(app, body)

@@ -13,7 +13,7 @@ import pytest
 from textual.pilot import Pilot
 from textual.widgets import Checkbox, Input, OptionList
 
-from tests.app.labs_support import signing_over
+from tests.app.labs_support import open_labs, signing_over
 from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.model import load_labs
 from workbench.tui.app import WorkbenchApp, make_app
@@ -36,8 +36,7 @@ def still(pilot: Pilot) -> None:
 
 
 async def open_drive_by_wire(pilot: Pilot) -> None:
-    await pilot.press("l")
-    await pilot.pause()
+    await open_labs(pilot)
     listing = pilot.app.screen.query_one("#labs-list", OptionList)
     listing.highlighted = listing.get_option_index("unity-simulator/drive-by-wire")
     await pilot.pause()

@@ -279,7 +279,14 @@ class SqliteBackend(Backend):
     @classmethod
     def open(cls, path: Path) -> SqliteBackend:
         try:
-            conn = sqlite3.connect(path, timeout=BUSY_TIMEOUT_MS / 1000, isolation_level=None)
+            # used from more than one thread (opened in one, saved to from another), one
+            # at a time: the store holds a lock of its own around every use
+            conn = sqlite3.connect(
+                path,
+                timeout=BUSY_TIMEOUT_MS / 1000,
+                isolation_level=None,
+                check_same_thread=False,
+            )
         except sqlite3.Error as exc:
             raise sqlite_failure(path, exc, "open the database") from None
         backend = cls(path, conn)

@@ -33,6 +33,7 @@ from workbench.labs.lastpair import read_last_pair, save_last_pair
 from workbench.labs.model import Setup
 from workbench.labs.names import NameProblem, check_pair
 from workbench.labs.pending import pending_path
+from workbench.labs.saved import SavedProgress, read_saved
 from workbench.labs.store import Store, StoreError, resolve_data_dir
 from workbench.sim.maze import Maze, MazeError
 from workbench.sim.mazeio import load_maze
@@ -464,30 +465,49 @@ class WorkbenchApp(ScreenHost[None]):
 
     def _open_labs(self) -> None:
         if self._labs is None:
-            self._open_store()
-            self._match_stored_names()
-            self._labs = LabsScreen(
-                self.station,
-                self.store,
-                self.student,
-                self.partner,
-                store_problem=self.store_problem,
-            )
+            self._labs = LabsScreen(self.station, None, self.student, self.partner)
             self.install_screen(self._labs, name="labs")
+            self.run_worker(self._load_labs(self._labs), group="labs-store")
         self.push_screen("labs")
 
-    def _match_stored_names(self) -> None:
-        """Spell the pair as the store does, so "alice doe" resumes Alice Doe's progress (not
-        for a served student, whose login name is the only one that is theirs)."""
-        if self.store is None or self.station.files.confined:
-            return
+    async def _load_labs(self, labs: LabsScreen) -> None:
+        """Open the store and read the pair's saved progress in a thread (a course database
+        may take up to its deadline to answer, or not answer), then show it on the labs
+        screen, which is open meanwhile."""
+        before = (labs.student, labs.partner)
         try:
-            student = self.store.spelling(self.student)
-            partner = self.store.spelling(self.partner) if self.partner else ""
-        except Exception:  # the store may be away; the names stay as typed
+            names, saved = await asyncio.to_thread(self._read_labs, *before)
+        except Exception as exc:  # the labs go on without what was saved
+            labs.progress_loaded(self.store, f"cannot read saved progress: {exc}", None)
             return
-        if (student, partner) != (self.student, self.partner):
-            self._set_names(student, partner)
+        if names != before:
+            self._set_names(*names)
+            labs.student, labs.partner = names
+            if labs.driver == before[0]:
+                labs.driver = names[0]
+        labs.progress_loaded(self.store, self.store_problem, saved)
+
+    def _read_labs(
+        self, student: str, partner: str
+    ) -> tuple[tuple[str, str], SavedProgress | None]:
+        """In a thread: the store opened, the pair's names as the store spells them, and what
+        it holds for them."""
+        self._open_store()
+        store = self.store
+        if store is None:
+            return (student, partner), None
+        names = self._stored_names(store, student, partner)
+        return names, read_saved(store, *names)
+
+    def _stored_names(self, store: Store, student: str, partner: str) -> tuple[str, str]:
+        """The pair as the store spells it, so "alice doe" resumes Alice Doe's progress (not
+        for a served student, whose login name is the only one that is theirs)."""
+        if self.station.files.confined:
+            return student, partner
+        try:
+            return store.spelling(student), store.spelling(partner) if partner else ""
+        except Exception:  # the store may be away; the names stay as typed
+            return student, partner
 
     def _open_store(self) -> None:
         with self._store_lock:  # the labs (here) or the saving of kept changes (a thread)

@@ -35,6 +35,7 @@ from workbench.labs.checks import (
     keep_passed,
 )
 from workbench.labs.model import Exercise, Lab, LabFileError, Setup, load_labs
+from workbench.labs.saved import SavedProgress, read_saved
 from workbench.labs.store import Store, StoreError, StoreUnavailable
 from workbench.sim.session import Snapshot
 
@@ -62,6 +63,8 @@ PASS, FAIL, OPEN, SIGNED = UNICODE_MARKS
 
 
 UNREACHABLE = "the course database cannot be reached"
+#: shown while the saved progress is read (in a thread: the database may take its time)
+LOADING = "loading your progress…"
 #: seconds between tries to write what the course database did not get
 RETRY_SECONDS = 2.0
 
@@ -192,48 +195,64 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self._retrying = False
         self._reload_when_back = False
         self.unicode = False
-        self._load_saved()
+        #: the saved progress is being read (see :meth:`progress_loaded`); set once it is in
+        self._loading = True
+        self.loaded = asyncio.Event()
+        self._place_saved: tuple[str, str] | None = None
+        self._first_highlight: int | None = None
+        self._message = ""
 
     # -- store ---------------------------------------------------------------------------
-    def _load_saved(self) -> None:
-        if self.store is None:
-            return
-        try:
-            saved = self.store.progress(self.student)
-            signed = self.store.signoffs(student=self.student)
-            self._drivers = self.store.drivers(self.student, self.partner)
-        except StoreUnavailable:
+    def progress_loaded(
+        self, store: Store | None, store_problem: str, saved: SavedProgress | None
+    ) -> None:
+        """The store and what it holds for the pair, read in a thread after the screen
+        opened: shown now. Answers typed meanwhile win over saved ones."""
+        self.store = store
+        self._store_problem = store_problem
+        if saved is not None:
+            self._apply_saved(saved)
+        self._loading = False
+        if self._ready:
+            if saved is not None and (saved.progress or saved.signed):
+                self._refresh_list()  # marks of exercises passed or signed off
+            listing = self.query_one("#labs-list", OptionList)
+            place = self._place()
+            shown = self.selected
+            unmoved = listing.highlighted == self._first_highlight
+            if place is not None and unmoved and listing.highlighted != self._index(place):
+                self._highlight(place)  # the student has not moved yet: back where they were
+            elif shown is not None and saved and (shown[0].id, shown[1].id) in saved.progress:
+                self.selected = None  # shown again, with its saved answers
+                self._show_exercise(*shown)
+            self._show_loaded()
+        self.loaded.set()
+
+    def _apply_saved(self, saved: SavedProgress) -> None:
+        if saved.unreachable:
             self._store_problem = (
                 f"{UNREACHABLE}: saved progress is not shown yet; what you do now is kept "
                 "and saved when it is back"
             )
             self._reload_when_back = True
             return
-        except Exception as exc:  # a damaged database must not stop the lab
-            self._store_problem = f"cannot read saved progress: {exc}"
-            return
-        damaged, cut = [], []
-        for key, data in saved.items():
-            try:
-                progress = ExerciseProgress.from_dict(data)
-            except ValueError:
-                damaged.append("/".join(key))
-                continue
-            cut += [f"{'/'.join(key)} {question}" for question in progress.cut]
+        self._store_problem = self._store_problem or saved.problem
+        self._drivers = saved.drivers
+        for key, progress in saved.progress.items():
             self._saved[key] = progress
             if progress.passed:
                 self._done.add(key)
-            self.answers[key] = dict(progress.answers)
-        if damaged:
-            self._store_problem = f"saved progress unreadable (starts afresh): {', '.join(damaged)}"
-        elif cut:
-            self._store_problem = (
-                f"saved answers longer than {MAX_ANSWER} characters were cut to their first "
-                f"{MAX_ANSWER}: {', '.join(cut[:3])}{' ...' if len(cut) > 3 else ''}"
-            )
-        self._signed = {
-            (row.lab, row.exercise): _by(row.instructor, row.signed_at) for row in signed
-        }
+            self.answers[key] = {**progress.answers, **self.answers.get(key, {})}
+        self._signed = {key: _by(*signed) for key, signed in saved.signed.items()}
+        self._place_saved = saved.place
+
+    def _show_loaded(self) -> None:
+        waiting = self._reload_when_back or (self.store is not None and self.store.pending)
+        if waiting and self._retry_timer is None:
+            self._retry_timer = self.set_interval(RETRY_SECONDS, self._retry_store)
+        problem = self._problem or self._store_problem
+        if problem or self._message == LOADING:
+            self.say(problem)
 
     def _save(self, progress: ExerciseProgress) -> None:
         key = (progress.lab, progress.exercise)
@@ -288,9 +307,10 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             else:
                 done = await asyncio.to_thread(store.flush)
             if done and self._reload_when_back:
-                # raises while the database is still away
-                await asyncio.to_thread(store.progress, self.student)
-                self._load_saved_again()
+                saved = await asyncio.to_thread(read_saved, store, self.student, self.partner)
+                if saved.unreachable:
+                    return
+                self._load_saved_again(saved)
         except StoreUnavailable:
             return
         except Exception as exc:
@@ -305,14 +325,11 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             self._retry_timer = None
         self.say("the course database is back: your progress is saved")
 
-    def _load_saved_again(self) -> None:
-        """Read the saved progress the database could not give at the start (what this
+    def _load_saved_again(self, saved: SavedProgress) -> None:
+        """Show the saved progress the database could not give at the start (what this
         session changed meanwhile was written first, so it reads back as it is here)."""
-        assert self.store is not None
         self._reload_when_back = False
-        self._store_problem = ""
-        self._load_saved()
-        self._refresh_list()
+        self.progress_loaded(self.store, "", saved)
 
     # -- layout --------------------------------------------------------------------------
     def compose(self) -> ComposeResult:
@@ -367,27 +384,30 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         follow_app(self)
         self._ready = True
         self._refresh_list()
-        if self._reload_when_back or (self.store is not None and self.store.pending):
-            self._retry_timer = self.set_interval(RETRY_SECONDS, self._retry_store)
-        problem = self._problem or self._store_problem
-        if problem:
-            self.say(problem)
+        if self._loading:
+            self.say(self._problem or LOADING)
+        else:
+            self._show_loaded()
+        self._first_highlight = self._highlight(self._place())
+        self.query_one("#labs-list", OptionList).focus()
+
+    def _highlight(self, place: str | None) -> int | None:
+        """Highlight the option ``place`` (None: the first exercise); its index."""
+        index = self._index(place)
+        if index is not None:
+            self.query_one("#labs-list", OptionList).highlighted = index
+        return index
+
+    def _index(self, place: str | None) -> int | None:
         listing = self.query_one("#labs-list", OptionList)
-        place = self._place()
         for index, option in enumerate(listing.options):
             if not option.disabled and (place is None or option.id == place):
-                listing.highlighted = index
-                break
-        listing.focus()
+                return index
+        return None
 
     def _place(self) -> str | None:
         """The option of the exercise the student had open last (None: the first)."""
-        if self.store is None:
-            return None
-        try:
-            place = self.store.place(self.student)
-        except Exception:  # where the student was is a convenience, never a reason to fail
-            return None
+        place = self._place_saved
         if place is None:
             return None
         option = "/".join(place)
@@ -522,6 +542,7 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self.query_one("#labs-objectives", Static).update(prose("\n".join(lines), self.unicode))
 
     def say(self, message: str) -> None:
+        self._message = message
         if self._ready:
             self.query_one("#labs-message", Static).update(message)
         else:
@@ -552,7 +573,8 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             self.say("choose an exercise first")
             return
         if self.store is None:
-            self.say(self._store_problem or "no data folder: sign-off is not available")
+            problem = LOADING if self._loading else self._store_problem
+            self.say(problem or "no data folder: sign-off is not available")
             return
         from ..dialogs.signoff import SignoffModal
 
