@@ -56,3 +56,21 @@ async def test_a_flood_of_error_output_neither_stalls_the_app_nor_passes_the_log
     text = current.read_text()
     assert text.endswith(f"flood line {LINES - 1:06d} " + "x" * 80 + "\n" + LAST + "\n")
     assert sum(p.stat().st_size for p in logs.iterdir()) <= 1_000_000
+
+
+@sync
+async def test_an_app_log_that_cannot_be_written_leaves_its_last_lines_in_the_servers_log(
+    tmp_path, caplog
+):
+    caplog.set_level(logging.INFO, logger="workbench.ssh")
+    logs = tmp_path / "data" / "logs"
+    logs.mkdir(parents=True)
+    (logs / "ann").write_text("a file where ann's logs folder should be")
+    async with lab_host(tmp_path, [Account("ann")], app=FLOOD) as host:
+        term = await pty_session(host, "ann", (80, 24), (80, 24))
+        assert await term.exit_status(timeout=60) == 0  # the app was not held up either
+        await term.close()
+    (report,) = [r.getMessage() for r in caplog.records if "'s app log " in r.getMessage()]
+    assert "could not be written (File exists)" in report
+    assert f"{LINES + 1} lines of the app's error output not written" in report
+    assert report.endswith(f"flood line {LINES - 1:06d} " + "x" * 80 + "\n  " + LAST)
