@@ -23,8 +23,9 @@ from workbench.labs.store import (
     resolve_db,
 )
 from workbench.ssh.appproc import AppEntry
+from workbench.ssh.limits import SessionLimits
 
-from .common import db_option, record_quota_options
+from .common import db_option, record_quota_options, size
 
 #: the app every SSH session runs, given the session's settings as JSON (see
 #: :mod:`workbench.cli.served`): this Python's ``-m workbench.cli.served``, or forked from the
@@ -81,6 +82,16 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--app-memory", type=int, default=512, metavar="MIB",
         help="memory each session's app may use, in MiB; an app past it is ended with a "
         "message (default 512; 0: no cap)",
+    )  # fmt: skip
+    serve.add_argument(
+        "--app-log-size", type=size, default=SessionLimits.app_log, metavar="SIZE",
+        help="the largest one session's error log grows; a full one is kept as .log.1 and a "
+        "new one begun (e.g. 1M; 0: no limit; default 1 MB)",
+    )  # fmt: skip
+    serve.add_argument(
+        "--user-logs-quota", type=size, default=SessionLimits.user_logs, metavar="SIZE",
+        help="the most one user's error logs (<data-dir>/logs/USER) may take; the oldest are "
+        "removed at a session's start (0: no limit; default 20 MB)",
     )  # fmt: skip
     serve.add_argument(
         "--login-timeout", type=float, default=30,
@@ -247,7 +258,6 @@ def cmd_list_users(args: argparse.Namespace) -> int:
 # -- the server -------------------------------------------------------------------------------
 def cmd_serve(args: argparse.Namespace) -> int:
     from workbench.ssh.hostkey import HostKeyError
-    from workbench.ssh.limits import SessionLimits
     from workbench.ssh.logins import LoginPolicy
     from workbench.ssh.ports import parse_range
     from workbench.ssh.server import LabServer, ServerConfig, setup_logging
@@ -341,6 +351,8 @@ def cmd_serve(args: argparse.Namespace) -> int:
             max_columns=columns,
             max_rows=rows,
             app_memory=args.app_memory,
+            app_log=args.app_log_size or 0,
+            user_logs=args.user_logs_quota or 0,
         ),
         logins=logins,
         fork_server=not args.no_fork_server,

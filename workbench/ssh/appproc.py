@@ -24,6 +24,8 @@ from workbench.control.recording import RecordQuota
 from workbench.tui.serving import packets
 from workbench.tui.settings import AppSettings
 
+from .applog import AppLog, ErrorPipe, read_errors
+
 if TYPE_CHECKING:
     from .forkserver import ForkedApp, ForkServer
 
@@ -41,8 +43,6 @@ RESTORE_TERMINAL = (
 READ_SIZE = 65536
 #: how an app that ran out of memory says so on its error output (Python, the C library)
 OUT_OF_MEMORY = (b"MemoryError", b"Cannot allocate memory", b"std::bad_alloc")
-#: how much of the end of an app's error output is searched for them
-LOG_TAIL = 256 * 1024
 
 
 @dataclass(frozen=True)
@@ -149,18 +149,21 @@ class AppProcess:
         forkserver: ForkServer | None = None,
         settings: dict[str, object] | None = None,
         memory: int = 0,
+        log_size: int = 0,
     ) -> None:
         """``argv`` starts the app as a new process; with a running ``forkserver`` the app is
         forked from it with ``settings`` (a JSON object) instead (``argv`` stays the way if
-        that fails). The app may have ``memory`` bytes (0: no cap)."""
+        that fails). The app may have ``memory`` bytes (0: no cap). Its error output goes to
+        ``log_path``, of at most ``log_size`` bytes rotated once (0: no cap)."""
         self.argv = argv
         self.env = env
         self.log_path = log_path
+        self.errors = AppLog(log_path, log_size)
+        self._error_pipe: ErrorPipe | None = None
         self.on_output = on_output
         self.forkserver = forkserver
         self.settings = settings
         self.memory = memory
-        self._log_start = 0
         self.forked = False
         self.process: asyncio.subprocess.Process | ForkedApp | None = None
         self.said_exit = False  # the app announced its end itself
@@ -178,38 +181,51 @@ class AppProcess:
         return self.process.returncode if self.process else None
 
     async def start(self) -> None:
-        self.log_path.parent.mkdir(parents=True, exist_ok=True)
-        with contextlib.suppress(OSError):
-            self._log_start = self.log_path.stat().st_size
+        # the app writes its error output into a pipe the server reads as it comes
+        errors_r, errors_w = os.pipe2(os.O_CLOEXEC)
+        try:
+            self._error_pipe = await read_errors(self.errors, errors_r)
+        except BaseException:
+            os.close(errors_w)
+            raise
+        try:
+            await self._spawn(errors_w)
+        except BaseException:
+            self._error_pipe.close()
+            self.errors.close()
+            raise
+        finally:
+            os.close(errors_w)  # the app holds its own copy
+        for packet in self._pending:
+            self._write(packet)
+        self._pending.clear()
+        self._reader = asyncio.create_task(self._read(), name=f"app-output-{self.pid}")
+
+    async def _spawn(self, errors: int) -> None:
         forkserver = self.forkserver
         if forkserver is not None and forkserver.running and self.settings is not None:
             from .forkserver import ForkServerError
 
             try:
                 self.process = await forkserver.spawn(
-                    self.settings, self.env, self.log_path, memory=self.memory
+                    self.settings, self.env, errors, memory=self.memory
                 )
                 self.forked = True
             except ForkServerError as exc:
                 log.warning("app not forked (%s): starting it as a new process", exc)
         if self.process is None:
-            with open(self.log_path, "ab") as errors:
-                self.process = await asyncio.create_subprocess_exec(
-                    *self.argv,
-                    stdin=asyncio.subprocess.PIPE,
-                    stdout=asyncio.subprocess.PIPE,
-                    stderr=errors,
-                    env=self.env,
-                    start_new_session=True,
-                )
+            self.process = await asyncio.create_subprocess_exec(
+                *self.argv,
+                stdin=asyncio.subprocess.PIPE,
+                stdout=asyncio.subprocess.PIPE,
+                stderr=errors,
+                env=self.env,
+                start_new_session=True,
+            )
             from .forkserver import APP_NICENESS, limit_memory, lower_priority
 
             lower_priority(APP_NICENESS, self.process.pid)  # as a forked app runs
             limit_memory(self.memory, self.process.pid)
-        for packet in self._pending:
-            self._write(packet)
-        self._pending.clear()
-        self._reader = asyncio.create_task(self._read(), name=f"app-output-{self.pid}")
 
     # -- input -------------------------------------------------------------------------------
     def _write(self, packet: bytes) -> None:
@@ -283,23 +299,27 @@ class AppProcess:
             await self._reader
         code = await self.process.wait()
         self._close_input()
+        await self._end_errors()
         if not getattr(self.process, "status_known", True) and self.said_exit:
             code = 0  # its fork server was lost, but the app said it ended by itself
         return code
+
+    async def _end_errors(self, grace: float = 1.0) -> None:
+        """Read the app's last error output and close its log. What the app started may
+        still hold the pipe: it is read for ``grace`` seconds more, then closed."""
+        pipe = self._error_pipe
+        if pipe is not None:
+            with contextlib.suppress(TimeoutError):
+                await asyncio.wait_for(asyncio.shield(pipe.done), grace)
+            pipe.close()
+        self.errors.close()
 
     def ran_out_of_memory(self) -> bool:
         """Whether the app, ended with an error, says on its error output that memory ran out
         (under its cap, an allocation past it fails)."""
         if self.memory <= 0 or not self.returncode:
             return False
-        try:
-            with open(self.log_path, "rb") as errors:
-                size = errors.seek(0, os.SEEK_END)
-                errors.seek(max(self._log_start, size - LOG_TAIL))
-                tail = errors.read(LOG_TAIL)
-        except OSError:
-            return False
-        return any(sign in tail for sign in OUT_OF_MEMORY)
+        return any(sign in self.errors.tail for sign in OUT_OF_MEMORY)
 
     def _close_input(self) -> None:
         process = self.process
@@ -338,4 +358,5 @@ class AppProcess:
         if self._reader is not None:
             with contextlib.suppress(Exception):
                 await asyncio.wait_for(self._reader, grace)
+        await self._end_errors()
         return code

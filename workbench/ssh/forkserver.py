@@ -14,7 +14,8 @@ Two halves live here:
   on a Unix socket.
   Each request carries the app's settings (a JSON object) and environment and two file
   descriptors (SCM_RIGHTS):
-  the socket that becomes the app's standard input and output, and its error log. It forks; the
+  the socket that becomes the app's standard input and output, and its error output (the
+  pipe the lab server reads into the session's log, :mod:`.applog`). It forks; the
   child starts a new session (its own process group), puts the descriptors on 0, 1 and 2, sets
   the environment and runs the entry point with the app's settings, ending with the
   interpreter's ordinary exit. An app runs :data:`APP_NICENESS` steps below the lab server, so
@@ -484,12 +485,13 @@ class ForkServer:
         self,
         settings: dict,
         env: dict[str, str],
-        log_path: Path,
+        errors: Path | int,
         cwd: str | None = None,
         memory: int = 0,
     ) -> ForkedApp:
-        """A new app with these settings (a JSON object) and environment, its errors appended
-        to ``log_path``, under a cap of ``memory`` bytes (0: none)."""
+        """A new app with these settings (a JSON object) and environment, its error output
+        written to the descriptor ``errors`` (a pipe's end, say) or appended to the file of
+        that path, under a cap of ``memory`` bytes (0: none)."""
         if not self._running or self._sock is None:
             raise ForkServerError("the fork server is not running")
         loop = asyncio.get_running_loop()
@@ -497,8 +499,10 @@ class ForkServer:
         request = json.dumps(fields).encode()
         ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_STREAM)
         try:
-            with open(log_path, "ab") as errors:
-                socket.send_fds(self._sock, [request], [theirs.fileno(), errors.fileno()])
+            with contextlib.ExitStack() as opened:
+                if not isinstance(errors, int):
+                    errors = opened.enter_context(open(errors, "ab")).fileno()
+                socket.send_fds(self._sock, [request], [theirs.fileno(), errors])
         except OSError as exc:
             ours.close()
             raise ForkServerError(f"the request was not sent: {exc}") from exc

@@ -1,6 +1,6 @@
 """The server's limits on what one user may spend: sessions per user and in all, the idle
-timeout, connections per user, the terminal's size and how often it may change, and each
-app's memory."""
+timeout, connections per user, the terminal's size and how often it may change, each
+app's memory and the room its error log takes."""
 
 from __future__ import annotations
 
@@ -21,6 +21,10 @@ class SessionLimits:
     resize_every: float = 0.1
     #: each app's memory, in MiB (0: no cap)
     app_memory: int = 512
+    #: bytes of one session's error log, rotated once (so twice this on disk), and of all
+    #: of one user's logs, the oldest removed at a session's start (0: no limit)
+    app_log: int = 1_000_000
+    user_logs: int = 20_000_000
 
     def refusal(self, user_sessions: int, all_sessions: int) -> str | None:
         """The message for a user who would open one more session, or None when it may."""

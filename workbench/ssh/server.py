@@ -18,10 +18,11 @@ from pathlib import Path
 
 import asyncssh
 
-from workbench.control.recording import RecordQuota
+from workbench.control.recording import RecordQuota, shown_size
 from workbench.files.private import private_dir, tighten_tree
 from workbench.files.workspace import workspace_folder
 
+from .applog import make_room
 from .appproc import RESTORE_TERMINAL, AppEntry, AppProcess, AppSpec, app_env, forward_hint
 from .forkserver import ForkServer, ForkServerError
 from .forwarding import local_forward_refusal, remote_forward_refusal
@@ -198,9 +199,11 @@ class LabServer:
         raised = f" (raised from {files_before})" if files_before != self.file_limit else ""
         log.info(
             "limits: %d connections per user; terminals at most %dx%d; app memory %s; "
-            "%d open files%s",
+            "app logs %s each, %s per user; %d open files%s",
             limits.connections_per_user, limits.max_columns, limits.max_rows,
             describe_memory(limits.app_memory) if limits.app_memory else "not capped",
+            shown_size(limits.app_log) if limits.app_log else "not capped",
+            shown_size(limits.user_logs) if limits.user_logs else "not capped",
             self.file_limit, raised,
         )  # fmt: skip
 
@@ -628,6 +631,7 @@ class LabSession(asyncssh.SSHServerSession):
         self._ending: asyncio.Task[None] | None = None
         self._runner: asyncio.Task[None] | None = None
         self._closed = False
+        self._log_reported = False
         #: the size the app was last given, when, and the pass-on of a newer one, if waiting
         self._app_size = self.size
         self._resized_at = 0.0
@@ -757,6 +761,7 @@ class LabSession(asyncssh.SSHServerSession):
             config.record_quota,
         )
         log_path = config.data_dir / "logs" / user / f"{stamp}-{self.id}.log"
+        self._make_log_room(log_path)
         self.app = AppProcess(
             self.spec.argv(config.app_command or config.app.command),
             self.spec.env(),
@@ -765,6 +770,7 @@ class LabSession(asyncssh.SSHServerSession):
             forkserver=server.forkserver,
             settings=self.spec.settings().to_json(),
             memory=config.limits.app_memory * 1024 * 1024,
+            log_size=config.limits.app_log,
         )
         try:
             await self.app.start()
@@ -800,6 +806,22 @@ class LabSession(asyncssh.SSHServerSession):
                 message = limits.memory_message()
             await self._finish(message, code)
 
+    def _make_log_room(self, log_path: Path) -> None:
+        """Remove the user's oldest logs until their folder has room for this session's."""
+        limits, server = self.server.config.limits, self.server
+        writing = {
+            path
+            for s in server.sessions.values()
+            if s.app is not None
+            for path in (s.app.errors.path, s.app.errors.rotated)
+        }
+        removed, freed = make_room(log_path.parent, limits.user_logs, 2 * limits.app_log, writing)
+        if removed:
+            log.info(
+                "session %d: removed %s's %d oldest app logs (%s) to keep their logs within %s",
+                self.id, self.user.name, removed, shown_size(freed), shown_size(limits.user_logs),
+            )  # fmt: skip
+
     def _output(self, data: bytes) -> None:
         if self.chan is not None and not self._closed:
             self.chan.write(data)
@@ -821,6 +843,14 @@ class LabSession(asyncssh.SSHServerSession):
 
     async def _finish(self, message: str, status: int) -> None:
         server = self.server
+        if self.app is not None and not self._log_reported:
+            self._log_reported = True
+            lines = self.app.errors.report()
+            if lines:
+                log.warning(
+                    "session %d: %s's app log %s",
+                    self.id, self.user.name, "\n  ".join(lines),
+                )  # fmt: skip
         if server.sessions.pop(self.id, None) is not None and self.app is not None:
             log.info(
                 "session %d: %s ended (exit %s) after %.0f s",

@@ -22,7 +22,7 @@ from textual.worker import Worker
 
 from workbench.labs.checks import ExerciseProgress
 from workbench.labs.roster import offered_roster
-from workbench.labs.signing import MAX_NOTE, PendingSignoff, prepare_signoff
+from workbench.labs.signing import MAX_NOTE, prepare_signoff
 from workbench.labs.signoff_errors import SignoffError
 from workbench.labs.signoff_record import Evidence, RecordFields, SignoffRecord
 from workbench.labs.store import Store, StoreError
@@ -31,6 +31,20 @@ from ..keys import bindings
 from ..plain import follow_app
 from ..widgets.field import Field
 from ..widgets.tick import Tick
+
+READING_ROSTER = "reading the roster of instructors..."
+
+
+def read_roster(store: Store) -> tuple[list[str], str]:
+    """The instructors one may sign as, and the problem to show when there are none."""
+    try:
+        roster = sorted(offered_roster(store))
+        problem = "" if roster else "the roster has no instructors yet"
+    except (SignoffError, StoreError) as exc:
+        roster, problem = [], str(exc)
+    if problem:
+        problem += ": add one with 'workbench instructor add NAME'"
+    return roster, problem
 
 
 class SignoffModal(ModalScreen[str | None]):
@@ -121,14 +135,13 @@ class SignoffModal(ModalScreen[str | None]):
         self.signing: Worker[None] | None = None
         #: escape was pressed while a sign-off was under way
         self.close_asked = False
-        try:
-            self.roster = sorted(offered_roster(store))
-            self.roster_problem = "" if self.roster else "the roster has no instructors yet"
-        except (SignoffError, StoreError) as exc:
-            self.roster = []
-            self.roster_problem = str(exc)
-        if self.roster_problem:
-            self.roster_problem += ": add one with 'workbench instructor add NAME'"
+        self.roster: list[str] = []
+        self.roster_problem = ""
+        #: set once the roster is read: at once from the data folder's files, in a thread
+        #: from a course database (which may take its time, or not answer)
+        self.roster_read = asyncio.Event()
+        if not store.keeps_roster:
+            self._take_roster(*read_roster(store))
 
     def compose(self) -> ComposeResult:
         progress = self.progress
@@ -197,9 +210,29 @@ class SignoffModal(ModalScreen[str | None]):
     def on_mount(self) -> None:
         follow_app(self)
         self.query_one("#signoff-next").display = False
+        if self.roster_read.is_set():
+            self._focus_first()
+        else:
+            self._say(READING_ROSTER)
+            self.run_worker(self._read_roster_later(), group="signoff-roster")
+
+    def _focus_first(self) -> None:
         if self.roster:
             field = "#signoff-passphrase" if len(self.roster) == 1 else "#signoff-instructor"
             self.query_one(field).focus()
+
+    def _take_roster(self, roster: list[str], problem: str) -> None:
+        self.roster, self.roster_problem = roster, problem
+        self.roster_read.set()
+
+    async def _read_roster_later(self) -> None:
+        self._take_roster(*await asyncio.to_thread(read_roster, self.store))
+        select = self.query_one("#signoff-instructor", Select)
+        select.set_options([(name, name) for name in self.roster])
+        if len(self.roster) == 1:
+            select.value = self.roster[0]
+        self._say(self.roster_problem)
+        self._focus_first()
 
     # -- signing ---------------------------------------------------------------------------
     def _say(self, message: str) -> None:
@@ -214,6 +247,9 @@ class SignoffModal(ModalScreen[str | None]):
     @on(Button.Pressed, "#signoff-sign")
     def _sign(self) -> None:
         if self.signed or self.signing is not None:
+            return
+        if not self.roster_read.is_set():
+            self._say(READING_ROSTER)
             return
         if not self.roster:
             self._say(self.roster_problem)
@@ -235,26 +271,29 @@ class SignoffModal(ModalScreen[str | None]):
             evidence=Evidence.of_progress(progress),
             objectives_passed=progress.passed,
         )
-        try:
-            pending = prepare_signoff(self.store, instructor, fields, override, note)
-        except SignoffError as exc:
-            passphrase.value = ""
-            self._say(str(exc))
-            return
-        except Exception as exc:
-            self._say(f"not signed: {exc}")
-            return
-        self._say(f"unlocking the key of {instructor}...")
+        self._say(f"checking {instructor}'s key...")
         self.signing = self.run_worker(
-            self._unlock_and_sign(pending, passphrase.value), group="signoff", exit_on_error=False
+            self._sign_off(instructor, fields, override, note, passphrase.value),
+            group="signoff",
+            exit_on_error=False,
         )
 
-    async def _unlock_and_sign(self, pending: PendingSignoff, passphrase: str) -> None:
-        """Unlock the key in a thread (scrypt: the app keeps answering), then sign or count
-        the failure here, where the store is used."""
+    async def _sign_off(
+        self, instructor: str, fields: RecordFields, override: bool, note: str, passphrase: str
+    ) -> None:
+        """Check, unlock the key (scrypt) and sign, each in a thread: the store may wait for
+        its database (a save on its way, a database that does not answer) and the app keeps
+        answering meanwhile."""
+        store = self.store
         try:
+            pending = await asyncio.to_thread(
+                prepare_signoff, store, instructor, fields, override, note
+            )
+            self._say(f"unlocking the key of {instructor}...")
             signer = await asyncio.to_thread(pending.unlock, passphrase)
-            _, record = pending.complete(signer)
+            if signer is not None:
+                self._say(f"signing as {instructor}...")
+            _, record = await asyncio.to_thread(pending.complete, signer)
         except SignoffError as exc:
             self.query_one("#signoff-passphrase", Input).value = ""
             self._say(str(exc))
@@ -264,23 +303,27 @@ class SignoffModal(ModalScreen[str | None]):
             self._signed(record.instructor, record.override)
             if self.on_signed is not None:
                 self.on_signed(record)
+            await self._record_driver()
         finally:
             self.signing = None
         if self.close_asked:
             self.action_close()
 
-    def _signed(self, instructor: str, override: bool) -> None:
-        self.signed = True
+    async def _record_driver(self) -> None:
         progress = self.progress
         try:
-            self.store.set_driver(
-                self.student, self.partner, progress.lab, progress.exercise, self.driver
-            )
+            await asyncio.to_thread(
+                self.store.set_driver,
+                self.student, self.partner, progress.lab, progress.exercise, self.driver,
+            )  # fmt: skip
         except Exception as exc:
             self._say(f"signed, but the driver was not recorded: {exc}")
         else:
             if not self.roster_problem:
                 self._say("")
+
+    def _signed(self, instructor: str, override: bool) -> None:
+        self.signed = True
         self.query_one("#signoff-form").display = False
         self.query_one("#signoff-state").display = False
         self.query_one("#signoff-done", Static).update(
