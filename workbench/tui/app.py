@@ -64,6 +64,7 @@ from .screens.labs import LabsScreen, StoreTrouble
 from .screens.main import MainScreen
 from .screens.runs import RunsScreen
 from .serving import warmup
+from .serving.delivered_keys import DeliveredKeys
 from .serving.internals import end_with_error, handled_size
 from .serving.loop_clock import LoopClock
 from .serving.quick_keys import QuickKeys, as_key_press
@@ -85,7 +86,8 @@ ROLES = ("student", "instructor")
 
 #: tab and shift+tab move the focus before the next key is delivered: over SSH a typist's tab
 #: and the characters after it arrive together, and the characters belong in the new field
-#: (the help's Dialogs section explains them)
+#: (the help's Dialogs section explains them); a key typed just before them still acts where
+#: it was typed (DeliveredKeys: a space ticks the box it was typed at)
 FOCUS_BINDINGS = (
     Binding("tab", "focus_next", show=False, priority=True),
     Binding("shift+tab", "focus_previous", show=False, priority=True),
@@ -96,7 +98,7 @@ class AppSetupError(ValueError):
     """The app cannot start with these settings; the message says what to change."""
 
 
-class WorkbenchApp(ScreenHost[None]):
+class WorkbenchApp(DeliveredKeys, ScreenHost[None]):
     """VIPLE Maze Lab Workbench."""
 
     CSS_PATH = "app.tcss"

@@ -1,0 +1,104 @@
+"""Keys that arrive together (over SSH a burst comes in one packet) each do what they do alone:
+none is lost when the next one moves the focus."""
+
+from __future__ import annotations
+
+from textual import events
+from textual.pilot import Pilot
+from textual.widgets import Button, Checkbox, Input
+
+from workbench.labs.instructors import KdfParams, create_instructor
+from workbench.tui.app import make_app
+from workbench.tui.dialogs.signoff import SignoffModal
+from workbench.tui.dialogs.size import SizeDialog
+from workbench.tui.settings import AppSettings
+
+from .labs_support import lab_app, open_exercise
+from .support import run
+
+FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
+
+
+async def burst(pilot: Pilot, *keys: tuple[str, str | None]) -> None:
+    """Post ``keys`` to the app in one go, as a packet's keys come, then let them settle."""
+    for key, char in keys:
+        pilot.app.post_message(events.Key(key, char))
+    for _ in range(3):
+        await pilot.pause()
+
+
+def test_space_then_shift_tab_ticks_the_override_and_moves_back(tmp_path):
+    data = tmp_path / "data"
+    create_instructor(data, "Dr Chen", "correct horse battery", kdf=FAST)
+    app = lab_app(data)
+
+    async def body(pilot: Pilot) -> None:
+        await open_exercise(pilot)
+        await pilot.press("i")
+        await pilot.pause()
+        modal = app.screen
+        assert isinstance(modal, SignoffModal)
+        box = modal.query_one("#signoff-override", Checkbox)
+        box.focus()
+        await pilot.pause()
+        await burst(pilot, ("space", " "), ("shift+tab", None))
+        assert box.value is True
+        assert modal.focused is modal.query_one("#signoff-note", Input)
+
+    run(app, body)
+
+
+def test_shift_tab_then_space_ticks_the_box_the_focus_moved_to(tmp_path):
+    data = tmp_path / "data"
+    create_instructor(data, "Dr Chen", "correct horse battery", kdf=FAST)
+    app = lab_app(data)
+
+    async def body(pilot: Pilot) -> None:
+        await open_exercise(pilot)
+        await pilot.press("i")
+        await pilot.pause()
+        modal = app.screen
+        sign = modal.query_one("#signoff-sign", Button)
+        sign.focus()
+        await pilot.pause()
+        await burst(pilot, ("shift+tab", None), ("space", " "))
+        box = modal.query_one("#signoff-override", Checkbox)
+        assert box.value is True and modal.focused is box
+
+    run(app, body)
+
+
+def test_enter_on_a_button_then_tab_presses_that_button(tmp_path):
+    app = make_app(AppSettings(paused=True, student="ana", data_dir=tmp_path))
+    answers: list[tuple[int, int] | None] = []
+
+    async def body(pilot: Pilot) -> None:
+        app.push_screen(SizeDialog(10, 12), answers.append)
+        await pilot.pause()
+        app.screen.query_one("#ok", Button).focus()
+        await pilot.pause()
+        # enter on Create, tab on to Cancel: Create was pressed, Cancel was not
+        await burst(pilot, ("enter", "\r"), ("tab", "\t"))
+        assert answers == [(10, 12)]
+
+    run(app, body)
+
+
+def test_a_key_on_its_own_acts_once(tmp_path):
+    data = tmp_path / "data"
+    create_instructor(data, "Dr Chen", "correct horse battery", kdf=FAST)
+    app = lab_app(data)
+
+    async def body(pilot: Pilot) -> None:
+        await open_exercise(pilot)
+        await pilot.press("i")
+        await pilot.pause()
+        box = app.screen.query_one("#signoff-override", Checkbox)
+        box.focus()
+        await pilot.pause()
+        await burst(pilot, ("space", " "))
+        assert box.value is True  # toggled once (twice would leave it unticked)
+        await burst(pilot, ("space", " "), ("space", " "), ("space", " "))
+        assert box.value is False
+
+    run(app, body)
