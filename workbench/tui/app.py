@@ -98,8 +98,10 @@ class AppSetupError(ValueError):
     """The app cannot start with these settings; the message says what to change."""
 
 
-class WorkbenchApp(DeliveredKeys, ScreenHost[None]):
+class WorkbenchApp(ScreenHost[None], DeliveredKeys):
     """VIPLE Maze Lab Workbench."""
+
+    # (ScreenHost first: Textual gathers an app's default CSS along its first bases)
 
     CSS_PATH = "app.tcss"
     TITLE = "VIPLE Maze Lab Workbench"
