@@ -126,9 +126,7 @@ def test_every_choice_is_shown_whole_at_80x24(tmp_path):
         choices = screen.query_one(f"#q-{QUESTION}", Choices)
         choices.scroll_visible(animate=False)
         await pilot.pause()
-        shown = " ".join(
-            " ".join(str(choice.render()).split()) for choice in choices.query(Choice)
-        )
+        shown = " ".join(" ".join(str(choice.render()).split()) for choice in choices.query(Choice))
         for choice in rules_question().choices:
             assert choice in shown
         for choice in choices.query(Choice):
