@@ -146,8 +146,8 @@ MODULE_NAMES = {
     "textual._xterm_parser": {"XTermParser": type},
     "textual._compositor": {"ChopsUpdate": type, "Compositor": type, "CompositorUpdate": type},
     "textual._context": {"active_app": "contextvar"},
-    "textual._dispatch_key": {"dispatch_key": "callable"},
     "textual.widgets._footer": {"FooterKey": type},
+    "textual.widgets._toggle_button": {"ToggleButton": type},
     "textual.drivers.web_driver": {"_ExitInput": type},
 }
 
@@ -165,7 +165,6 @@ METHODS = {
     ("textual.drivers.web_driver", "WebDriver", "_on_meta"): ["self", "packet_type", "payload"],
     ("textual.drivers.web_driver", "WebDriver", "write"): ["self", "data"],
     ("textual.app", "App", "_handle_exception"): ["self", "error"],
-    ("textual.app", "App", "_on_key"): ["self", "event"],
     ("textual.screen", "Screen", "_clear_tooltip"): ["self"],
     ("textual.screen", "Screen", "_on_idle"): ["self", "event"],
     ("textual.screen", "Screen", "_on_timer_update"): ["self"],
@@ -203,7 +202,6 @@ def test_the_private_properties_replaced_are_still_properties():
     from textual.widgets._toggle_button import ToggleButton
 
     assert isinstance(inspect.getattr_static(Screen, "_binding_chain"), property)
-    assert isinstance(inspect.getattr_static(Screen, "_modal_binding_chain"), property)
     button = inspect.getattr_static(ToggleButton, "_button")
     assert isinstance(button, property)
     assert inspect.signature(button.fget).return_annotation in (Content, "Content")
