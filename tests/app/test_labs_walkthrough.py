@@ -52,6 +52,7 @@ from workbench.tui.screens.editor import EditorScreen
 from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
 from workbench.tui.settings import AppSettings
+from workbench.tui.widgets.choices import Choices
 from workbench.tui.widgets.param_editor import ParamEditor
 from workbench.tui.widgets.sensor_row_editor import SensorRowEditor
 from workbench.tui.widgets.text import degrees, number
@@ -342,7 +343,11 @@ class Walkthrough:
     async def answer_questions(self, ex: Exercise) -> None:
         screen = await self.labs()
         for q in ex.questions:
-            screen.query_one(f"#q-{q.id}", Input).value = answer(q)
+            if q.choices:  # picked: the set takes the focus, the keys move to the choice
+                screen.query_one(f"#q-{q.id}", Choices).focus()
+                await self.press(*["down"] * q.choices.index(answer(q)), "enter")
+            else:
+                screen.query_one(f"#q-{q.id}", Input).value = answer(q)
         await self.pilot.pause()
         reasons = [str(s.render()) for s in screen.query(".question-reason").results(Static)]
         assert reasons == ["[X] correct"] * len(ex.questions), reasons

@@ -128,3 +128,27 @@ def test_every_lab_exercise_at_80x24(snap_compare, tmp_path, option_id):
 
     app = lab_app(tmp_path / "data", instructor=False)
     assert snap_compare(app, terminal_size=SIZE, run_before=before)
+
+
+def test_multiple_choice_question_at_80x24(snap_compare, tmp_path):
+    """A multiple-choice question moved to with the keys, its second choice picked: every
+    choice whole (the long one wrapped under its text), the picked one marked (*)."""
+
+    async def before(pilot: Pilot) -> None:
+        await pilot.press("l")
+        await pilot.pause()
+        screen = pilot.app.screen
+        listing = screen.query_one("#labs-list", OptionList)
+        listing.highlighted = listing.get_option_index("maze-algorithms/erobotic-rules")
+        await pilot.pause()
+        choices = screen.query_one("#q-why-no-states")
+        choices.focus()
+        await pilot.pause()
+        await pilot.press("down", "enter")
+        screen.query_one("#labs-scroll").scroll_end(animate=False)
+        await pilot.pause()
+        still(pilot)
+        await pilot.pause()
+
+    app = lab_app(tmp_path / "data", instructor=False)
+    assert snap_compare(app, terminal_size=SIZE, run_before=before)

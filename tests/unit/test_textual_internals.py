@@ -147,6 +147,7 @@ MODULE_NAMES = {
     "textual._compositor": {"ChopsUpdate": type, "Compositor": type, "CompositorUpdate": type},
     "textual._context": {"active_app": "contextvar"},
     "textual.widgets._footer": {"FooterKey": type},
+    "textual.widgets._toggle_button": {"ToggleButton": type},
     "textual.drivers.web_driver": {"_ExitInput": type},
 }
 

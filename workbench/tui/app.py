@@ -66,6 +66,7 @@ from .screens.runs import RunsScreen
 from .serving import warmup
 from .serving.internals import end_with_error, handled_size
 from .serving.loop_clock import LoopClock
+from .serving.ordered_keys import OrderedKeys
 from .serving.quick_keys import QuickKeys, as_key_press
 from .serving.terminal_driver import serves
 from .settings import AppSettings
@@ -85,7 +86,8 @@ ROLES = ("student", "instructor")
 
 #: tab and shift+tab move the focus before the next key is delivered: over SSH a typist's tab
 #: and the characters after it arrive together, and the characters belong in the new field
-#: (the help's Dialogs section explains them)
+#: (the help's Dialogs section explains them); a key typed just before them has gone its way
+#: first (OrderedKeys: a space ticks the box it was typed at)
 FOCUS_BINDINGS = (
     Binding("tab", "focus_next", show=False, priority=True),
     Binding("shift+tab", "focus_previous", show=False, priority=True),
@@ -96,8 +98,10 @@ class AppSetupError(ValueError):
     """The app cannot start with these settings; the message says what to change."""
 
 
-class WorkbenchApp(ScreenHost[None]):
+class WorkbenchApp(ScreenHost[None], OrderedKeys):
     """VIPLE Maze Lab Workbench."""
+
+    # (ScreenHost first: Textual gathers an app's default CSS along its first bases)
 
     CSS_PATH = "app.tcss"
     TITLE = "VIPLE Maze Lab Workbench"
@@ -332,7 +336,7 @@ class WorkbenchApp(ScreenHost[None]):
         event."""
         stack = self.screen_stack  # (empty while the app starts or ends)
         screen = stack[-1] if stack else None
-        if not isinstance(screen, QuickKeys):
+        if not isinstance(screen, QuickKeys) or self.keys_on_their_way:
             return False
         self._input_comes()  # the time owed at rest first, as for a key event
         action = screen.quick_action(key)

@@ -3,15 +3,17 @@
 On the left, every lab and its exercises (✓ once an exercise's objectives pass, ★ once an
 instructor has signed it off; ``[X]`` and ``[*]`` in ASCII mode); on the right, the chosen
 exercise: its instructions, its objectives with ✓/✗ (``[X]``/``[ ]``) and a one-line reason
-that follow the station as the student works, and its questions; under a passed objective,
-the work it rests on. ``a`` puts the exercise's set-up on the station, ``r`` asks for sign-off
-(the exercise joins the store's sign-off queue, which the instructor's console shows; the
-screen follows the request), and ``i`` opens the instructor's sign-off at this station where
-signing here is allowed (not in a served student's session, whose terminal is the student's).
-What the student has done is held by :class:`LabProgress` (in the core): the screen draws it
-and routes the student's input to it. Progress is saved in the store as soon as an exercise is
-opened and each time an objective or an answer changes; an objective that passed once stays
-passed, with its evidence, after a restart.
+that follow the station as the student works, and its questions (a multiple-choice one's
+choices picked with the arrows and enter or a click, any other typed in its field); under a
+passed objective, the work it rests on. The list has the focus whenever the screen comes up,
+so its keys never land in an answer: ``a`` puts the exercise's set-up on the station, ``r``
+asks for sign-off (the exercise joins the store's sign-off queue, which the instructor's
+console shows; the screen follows the request), and ``i`` opens the instructor's sign-off at
+this station where signing here is allowed (not in a served student's session, whose terminal
+is the student's). What the student has done is held by :class:`LabProgress` (in the core):
+the screen draws it and routes the student's input to it. Progress is saved in the store as
+soon as an exercise is opened and each time an objective or an answer changes; an objective
+that passed once stays passed, with its evidence, after a restart.
 """
 
 from __future__ import annotations
@@ -26,12 +28,13 @@ from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.message import Message
 from textual.screen import Screen
 from textual.timer import Timer
-from textual.widgets import Input, Markdown, OptionList, Static
+from textual.widget import Widget
+from textual.widgets import Input, Markdown, OptionList, RadioSet, Static
 from textual.widgets.option_list import Option
 
 from workbench.control.station import LabStation
 from workbench.labs.checks import MAX_ANSWER, ExerciseProgress, SetupChanges
-from workbench.labs.model import Exercise, Lab, LabFileError, Setup, load_labs
+from workbench.labs.model import Exercise, Lab, LabFileError, Question, Setup, load_labs
 from workbench.labs.progress import LabProgress, SignedOff, evidence_words, read_saved
 from workbench.labs.signoff_record import SignoffRecord
 from workbench.labs.store import Store, StoreError, StoreUnavailable
@@ -40,6 +43,7 @@ from workbench.sim.session import Snapshot
 from ..host import FollowsUnicode, SetUpDone, ShowsSnapshot
 from ..keys import bindings
 from ..plain import follow_app, prose
+from ..widgets.choices import Choices
 from ..widgets.field import Field
 from ..widgets.key_bar import KeyBar
 from ..widgets.signoff_status import SignoffStatus
@@ -375,6 +379,9 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         return option if option in known else None
 
     def on_screen_resume(self) -> None:
+        # back on the list, whatever had the focus before: the screen's keys (a, i) never
+        # land in an answer; an answer takes keys only once the student moves to it
+        self.query_one("#labs-list", OptionList).focus()
         self.show_snapshot(self.station.snapshot())
         later, self._signed_later = self._signed_later, None
         if later is not None:
@@ -390,7 +397,17 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
     # -- choosing ------------------------------------------------------------------------
     @on(OptionList.OptionHighlighted, "#labs-list")
     def _chosen(self, event: OptionList.OptionHighlighted) -> None:
-        option_id = event.option.id or ""
+        self._show_option(event.option.id or "")
+
+    def _catch_up(self) -> None:
+        """Show the exercise the list has highlighted now: a key typed right after the one
+        that moved the highlight acts on the exercise it moved to, though the list's message
+        saying so is still on its way."""
+        option = self.query_one("#labs-list", OptionList).highlighted_option
+        if option is not None:
+            self._show_option(option.id or "")
+
+    def _show_option(self, option_id: str) -> None:
         if "/" not in option_id:
             return
         lab_id, ex_id = option_id.split("/", 1)
@@ -416,21 +433,16 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         unicode = self.unicode
         self.query_one("#labs-instructions", Markdown).update(prose(exercise.instructions, unicode))
         box = self.query_one("#labs-questions", Vertical)
+        listing = self.query_one("#labs-list", OptionList)
+        if self.focused is not None and box in self.focused.ancestors:
+            listing.focus()  # not onto whatever follows the answer that goes
         box.remove_children()
         answers = self.lab_progress.answers.get((lab.id, exercise.id), {})
         for q in exercise.questions:
-            # the field's hint is one short word; the choices stand whole above it
-            choices = f" (one of: {', '.join(q.choices)})" if q.choices else ""
-            field = Field(
-                answers.get(q.id, ""),
-                placeholder=q.unit or "answer",
-                id=f"q-{q.id}",
-                max_length=MAX_ANSWER,
-            )
             box.mount(
                 Vertical(
-                    Static(prose(q.text + choices, unicode), markup=False, classes="question-text"),
-                    field,
+                    Static(prose(q.text, unicode), markup=False, classes="question-text"),
+                    self._answer_widget(q, answers.get(q.id, "")),
                     Static(
                         self._answer_reason(exercise, q.id),
                         classes="question-reason",
@@ -439,6 +451,8 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
                     classes="question",
                 )
             )
+        # the exercise opens at the top of its text, its objectives in view
+        self.query_one("#labs-scroll", VerticalScroll).scroll_home(animate=False)
         self.show_snapshot(self.station.snapshot())
 
     def _show_title(self) -> None:
@@ -451,6 +465,20 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         if signed:
             title += f" ({self.marks.signed} signed off {signed.words()})"
         self.query_one("#labs-title", Static).update(prose(title, self.unicode))
+
+    def _answer_widget(self, q: Question, answer: str) -> Field | Choices:
+        """A multiple-choice question's choices to pick from, any other question's field
+        (neither selects what it holds when it takes the focus: a key typed there adds to it)."""
+        if q.choices:
+            labels = [prose(choice, self.unicode) for choice in q.choices]
+            return Choices(q.choices, labels, answer, id=f"q-{q.id}")
+        return Field(
+            answer,
+            placeholder=q.unit or "answer",
+            id=f"q-{q.id}",
+            max_length=MAX_ANSWER,
+            select_on_focus=False,
+        )
 
     def _answer_reason(self, exercise: Exercise, question_id: str) -> str:
         lab = self.selected[0] if self.selected else None
@@ -465,14 +493,22 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
 
     @on(Input.Submitted)
     @on(Input.Changed)
-    def _answered(self, event: Input.Changed | Input.Submitted) -> None:
-        field_id = event.input.id or ""
+    def _typed(self, event: Input.Changed | Input.Submitted) -> None:
+        self._answered(event.input, event.value)
+
+    @on(RadioSet.Changed)
+    def _picked(self, event: RadioSet.Changed) -> None:
+        if isinstance(event.radio_set, Choices):
+            self._answered(event.radio_set, event.radio_set.answer)
+
+    def _answered(self, widget: Widget, answer: str) -> None:
+        field_id = widget.id or ""
         if not field_id.startswith("q-") or self.selected is None:
             return
         lab, exercise = self.selected
         question_id = field_id[2:]
-        self.lab_progress.answer((lab.id, exercise.id), question_id, event.value)
-        box = event.input.parent
+        self.lab_progress.answer((lab.id, exercise.id), question_id, answer)
+        box = widget.parent
         if box is not None:
             box.query_one(".question-reason", Static).update(
                 self._answer_reason(exercise, question_id)
@@ -527,6 +563,7 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self.app.pop_screen()
 
     def action_apply_setup(self) -> None:
+        self._catch_up()
         if self.selected is None:
             self.say("choose an exercise first")
             return
@@ -576,6 +613,7 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             self.say(f"signed off {signed.words()}")
 
     def action_sign_off(self) -> None:
+        self._catch_up()
         if self.selected is None:
             self.say("choose an exercise first")
             return

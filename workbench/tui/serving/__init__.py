@@ -14,6 +14,9 @@ second; the modules here cut what each key, tick and frame costs the server (mea
     the app anyway;
   * ``warmup``: the stylesheets parsed once in the fork server for every app forked after it.
 
+``ordered_keys`` makes keys typed together act as they would one by one: a key is handed on
+only once the key before it has gone its whole way, bindings and all.
+
 These reach into Textual beyond its public interface, and so does ``internals``, the few
 private parts the rest of the TUI needs (each behind a name that says what it gives). Nothing
 outside this package touches Textual's private modules or attributes, and

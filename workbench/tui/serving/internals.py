@@ -13,11 +13,13 @@ from textual.binding import BindingsMap
 from textual.content import Content
 from textual.dom import DOMNode
 from textual.geometry import Size
-from textual.widgets import Checkbox, Footer, Input
+from textual.widgets import Checkbox, Footer, Input, RadioButton
 from textual.widgets._footer import FooterKey
+from textual.widgets._toggle_button import ToggleButton
 
 __all__ = [
     "DrawnCheckbox",
+    "DrawnRadioButton",
     "FooterKey",
     "KeyFirstInput",
     "bindings_of",
@@ -68,8 +70,9 @@ class KeyFirstInput(Input):
             await super()._on_key(event)
 
 
-class DrawnCheckbox(Checkbox):
-    """Textual's ``Checkbox`` with its box drawn by :meth:`box`."""
+class DrawnToggle(ToggleButton):
+    """Textual's toggle button (a check box, a radio button) with its box drawn by
+    :meth:`box`."""
 
     def box(self) -> Content:
         """The box as drawn before the label (Textual's own, unless a subclass says)."""
@@ -78,3 +81,11 @@ class DrawnCheckbox(Checkbox):
     @property
     def _button(self) -> Content:
         return self.box()
+
+
+class DrawnCheckbox(Checkbox, DrawnToggle):
+    """Textual's ``Checkbox`` with its box drawn by :meth:`box`."""
+
+
+class DrawnRadioButton(RadioButton, DrawnToggle):
+    """Textual's ``RadioButton`` with its box drawn by :meth:`box`."""
