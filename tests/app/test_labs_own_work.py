@@ -13,6 +13,7 @@ from workbench.labs.store import Store
 from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.dialogs.signoff import SignoffModal
 from workbench.tui.screens.labs import LabsScreen
+from workbench.tui.widgets.choices import Choices
 
 from .labs_support import (
     DRIVE,
@@ -102,7 +103,11 @@ def test_the_sign_off_names_who_did_the_work_and_shows_the_moment_it_is_saved(tm
                 break
         assert station.runs[-1].ended == "exit" and station.runs[-1].person == "ana"
         for q in ex.questions:
-            screen.query_one(f"#q-{q.id}", Input).value = answer(q)
+            if q.choices:  # picked from its choices, as a student does
+                screen.query_one(f"#q-{q.id}", Choices).focus()
+                await pilot.press(*["down"] * q.choices.index(answer(q)), "enter")
+            else:
+                screen.query_one(f"#q-{q.id}", Input).value = answer(q)
         await pilot.pause()
         assert screen.progress is not None and screen.progress.passed
         assert evidence_lines(screen)[0].startswith("run 1 by ana (algorithm right-wall)")
