@@ -52,3 +52,17 @@ def test_set_up_again_puts_the_starters_parameters_back(tmp_path):
         )
 
     run(app, body)
+
+
+def test_the_set_up_message_names_the_algorithm_once(tmp_path):
+    app = lab_app(tmp_path / "data")
+
+    async def body(pilot: Pilot) -> None:
+        screen = await open_exercise(pilot, "maze-algorithms/erobotic-rules")
+        await pilot.press("a")
+        await pilot.pause()
+        message = text(screen, "#labs-message")
+        assert message.count("right-wall") == 1, message
+        assert "algorithm right-wall (was none)" in message
+
+    run(app, body)

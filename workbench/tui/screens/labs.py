@@ -574,7 +574,10 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             self.say(f"cannot set up {exercise.title}: {exc}")
             return
         setup = exercise.setup
-        done = f"set up: {setup.profile}, {setup.maze.path.name}, {setup.controller}"
+        done = f"set up: {setup.profile}, {setup.maze.path.name}"
+        controller = str(setup.controller)
+        if changes.algorithm is None or controller != f"algorithm {changes.algorithm[1]}":
+            done += f", {controller}"  # (else the algorithm is named with what it replaced)
         self.say("; ".join([done, *setup_words(changes, setup)]))
         self.post_message(SetUpDone(setup))
         self.show_snapshot(self.station.snapshot())
