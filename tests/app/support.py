@@ -70,3 +70,9 @@ def screen_lines(app: App) -> list[str]:
         app.screen._compositor.render_update(full=True, screen_stack=app._background_screens)
     )
     return console.export_text().splitlines()
+
+
+async def endpoints_started(app) -> None:
+    """Wait until the app's VIPLE endpoints have started: the workers that start them are done
+    (not every worker: a screen may keep one reading the store for as long as it is open)."""
+    await app.workers.wait_for_complete([w for w in app.workers if w.group == "endpoints"])

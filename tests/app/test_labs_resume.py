@@ -14,7 +14,7 @@ from workbench.tui.settings import AppSettings
 from workbench.viple.tcp_server import TcpConfig
 
 from .labs_support import DRIVE, lab_app, objective_lines, open_exercise, text
-from .support import run, run_panel, said
+from .support import endpoints_started, run, run_panel, said
 
 CONNECT = "web-simulator/connect"
 
@@ -166,7 +166,7 @@ def test_the_set_up_of_a_websocket_exercise_starts_the_websocket_client(tmp_path
         assert app.endpoints is None
         screen = await open_exercise(pilot, CONNECT)
         await pilot.press("a")
-        await app.workers.wait_for_complete()
+        await endpoints_started(app)
         await pilot.pause()
         assert app.endpoints is not None and app.endpoints.ws is not None
         assert app.endpoints.ws.config.url == "ws://localhost:8124/"
@@ -270,7 +270,7 @@ def test_a_websocket_url_can_wait_until_asked_and_v_connects(tmp_path):
     async def body(pilot: Pilot) -> None:
         assert app.endpoints is None  # no connection attempts until asked
         await pilot.press("v")
-        await app.workers.wait_for_complete()
+        await endpoints_started(app)
         await pilot.pause()
         assert app.endpoints.ws is not None and app.endpoints.ws.config.url == url
         assert said(app) == (
