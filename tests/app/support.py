@@ -75,4 +75,6 @@ def screen_lines(app: App) -> list[str]:
 async def endpoints_started(app) -> None:
     """Wait until the app's VIPLE endpoints have started: the workers that start them are done
     (not every worker: a screen may keep one reading the store for as long as it is open)."""
-    await app.workers.wait_for_complete([w for w in app.workers if w.group == "endpoints"])
+    starting = [w for w in app.workers if w.group == "endpoints"]
+    if starting:  # (an empty list would make Textual wait for every worker)
+        await app.workers.wait_for_complete(starting)
