@@ -134,13 +134,12 @@ def test_passes_saved_without_their_work_need_redoing_after_the_upgrade(where):
         s.save_progress("ana", "unity-simulator", "drive-by-wire", old_progress({}))
         kept = old_progress({"attempt": "5eed", "keys_used": ["w"]})
         s.save_progress("ben", "unity-simulator", "drive-by-wire", kept)
-    # as a store before step 4 was: the step not applied, the older schema version
+    # as a store before step 5 was: the step not applied, the older schema version
     with where.open() as store, store.backend.write() as tx:
-        tx.execute("DELETE FROM schema_migrations WHERE version = 4")
-        before = "3" if where.db else "2"
-        tx.execute("UPDATE meta SET value = ? WHERE key = 'schema_version'", (before,))
+        tx.execute("DELETE FROM schema_migrations WHERE version = 5")
+        tx.execute("UPDATE meta SET value = ? WHERE key = 'schema_version'", ("4",))
     with where.open() as s:
-        assert (4, "progress evidence") in s.migrations()
+        assert (5, "progress evidence") in s.migrations()
         ana = s.progress("ana")[("unity-simulator", "drive-by-wire")]
         ben = s.progress("ben")[("unity-simulator", "drive-by-wire")]
     keys, edited, answered = ana["objectives"]
