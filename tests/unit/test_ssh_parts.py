@@ -176,7 +176,13 @@ def test_an_app_started_as_a_new_process_runs_below_the_server_as_a_forked_one_d
         assert app.pid is not None and not app.forked
         niceness = os.getpriority(os.PRIO_PROCESS, app.pid)
         group = Path(f"/proc/{app.pid}/autogroup")
-        grouped = group.read_text().split()[-1] if group.exists() else None
+        grouped = None
+        if group.exists():  # the group's nice value is set just after the app starts
+            deadline = asyncio.get_running_loop().time() + 10
+            while (grouped := group.read_text().split()[-1]) != str(APP_NICENESS):
+                if asyncio.get_running_loop().time() > deadline:
+                    break
+                await asyncio.sleep(0.01)
         app.process.stdin.close()
         assert await app.wait() == 0
         return niceness, grouped
