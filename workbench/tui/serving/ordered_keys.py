@@ -51,8 +51,10 @@ class OrderedKeys(App[Any]):
 
     @property
     def keys_on_their_way(self) -> bool:
-        """Whether a key is going its way or waiting for its turn."""
-        return self.key_sent_at is not None or bool(self.keys_waiting)
+        """Whether a key is going its way or waiting for its turn (a key sent longer than
+        :data:`LONGEST_WAIT` ago is not waited for, as :meth:`on_event` does not)."""
+        sent = self.key_sent_at
+        return bool(self.keys_waiting) or (sent is not None and monotonic() - sent < LONGEST_WAIT)
 
     async def on_event(self, event: events.Event) -> None:
         if isinstance(event, events.Key) and not event.is_forwarded:
