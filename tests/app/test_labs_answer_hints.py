@@ -10,6 +10,8 @@ from textual.widgets import Input, OptionList
 from workbench.labs.model import load_labs
 from workbench.tui.screens.labs import LabsScreen
 
+from tests.waiting import until
+
 from .labs_support import lab_app
 from .support import run
 
@@ -37,6 +39,8 @@ def test_no_answer_hint_is_cut(tmp_path):
                 if q.choices:
                     continue
                 field = screen.query_one(f"#q-{q.id}", Input)
+                # the exercise's fields are laid out after they are mounted
+                await until(lambda: field.content_region.width > 0, f"{option_id}'s fields laid out")
                 hint = str(field.placeholder)
                 assert 0 < cell_len(hint) <= field.content_region.width, (option_id, hint)
 

@@ -176,7 +176,8 @@ class Terminal:
 
     async def start_app(self) -> str:
         """Pass the names dialog with Enter; the app's main screen."""
-        await self.wait_for("Who is at this robot?", "Partner", timeout=30)
+        # an app started as a new process imports all of Textual afresh: slow on a busy machine
+        await self.wait_for("Who is at this robot?", "Partner", timeout=90)
         self.send("\r")
         return await self.wait_until(
             lambda t: "Who is at this robot?" not in t and "distance 0.00 unit" in t,
