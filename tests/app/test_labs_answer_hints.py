@@ -7,10 +7,9 @@ from rich.cells import cell_len
 from textual.pilot import Pilot
 from textual.widgets import Input, OptionList
 
+from tests.waiting import until
 from workbench.labs.model import load_labs
 from workbench.tui.screens.labs import LabsScreen
-
-from tests.waiting import until
 
 from .labs_support import lab_app
 from .support import run
@@ -40,7 +39,7 @@ def test_no_answer_hint_is_cut(tmp_path):
                     continue
                 field = screen.query_one(f"#q-{q.id}", Input)
                 # the exercise's fields are laid out after they are mounted
-                await until(lambda: field.content_region.width > 0, f"{option_id}'s fields laid out")
+                await until(lambda f=field: f.content_region.width > 0, f"{option_id} laid out")
                 hint = str(field.placeholder)
                 assert 0 < cell_len(hint) <= field.content_region.width, (option_id, hint)
 

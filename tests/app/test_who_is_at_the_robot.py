@@ -29,9 +29,7 @@ def test_a_name_typed_in_lower_case_resumes_the_saved_progress(tmp_path):
         assert text(screen, "#labs-objectives").startswith("[X] drove with w, a, s, d")
 
     run(first, drive)
-    again = make_app(
-        AppSettings(paused=True, student=" alice doe ", data_dir=data, ask_names=True)
-    )
+    again = make_app(AppSettings(paused=True, student=" alice doe ", data_dir=data, ask_names=True))
 
     async def resume(pilot: Pilot) -> None:
         await pilot.press("enter")  # the names as given
