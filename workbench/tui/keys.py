@@ -418,7 +418,14 @@ KEY_TABLE: dict[str, Key] = {
         rank=1,
     ),
     "runs.replay": Key(
-        "enter", "replay", "Replay", "Runs", "replay", "Replay the selected run from its record."
+        "enter",
+        "replay",
+        "Replay",
+        "Runs",
+        "replay",
+        "Replay the selected run from its record.",
+        priority=True,  # before the table's own enter, which would hide it from the key bar
+        rank=1,
     ),
     "runs.open": Key(
         "o",
