@@ -256,9 +256,9 @@ class _ProgramBrain:
         printed, fired = self.remote.news()
         self.transitions += len(fired)
         for f in fired:
-            self.log(f"{f.time:8.2f} s  {f.what}")
+            self.log(f"{f.time:8.2f} s  {one_line(f.what, 200)}")
         for p in printed:
-            self.log(f"{p.time:8.2f} s  print: {p.text[:200]}")
+            self.log(f"{p.time:8.2f} s  print: {one_line(p.text, 200)}")
         errors = self.remote.controller.errors
         for e in errors[self._errors :]:
             self.log(f"error at {e}")
