@@ -126,7 +126,8 @@ def _activity(program: Program, activity: Activity) -> list[str]:
 
 def describe_program(program: Program) -> list[str]:
     """The lines of ``workbench viple show``."""
-    lines = _wrap("", f"{program.source}: VIPLE {program.version}, digest {program.digest[:16]}")
+    lines = _wrap("", f"{program.source}:", "  ")
+    lines += _wrap("", f"VIPLE {program.version}, digest {program.digest[:16]}", "  ")
     lines.append(
         f"{count(len(program.panels), 'panel')}, "
         f"{count(len(program.activities), 'activity', 'activities')}, "
