@@ -202,7 +202,9 @@ def test_tokens_drop_comments_and_keep_texts_whole():
     ]
 
 
-@settings(max_examples=300, suppress_health_check=[HealthCheck.too_slow], deadline=None)
+@settings(
+    max_examples=300, suppress_health_check=[HealthCheck.too_slow], deadline=None, database=None
+)
 @given(st.text(max_size=3000))
 def test_any_text_gives_the_builtin_or_a_refusal(body):
     try:
@@ -211,7 +213,7 @@ def test_any_text_gives_the_builtin_or_a_refusal(body):
         assert str(exc).startswith("the C# class 'X' is not run: ")
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=300, deadline=None, database=None)
 @given(st.data())
 def test_edits_of_an_accepted_body_never_crash(data):
     body = DATA_CONTRACT
@@ -225,6 +227,33 @@ def test_edits_of_an_accepted_body_never_crash(data):
         assert "is not run" in str(exc)
     else:
         assert result == BUILTIN
+
+
+_FORM_TOKENS = [t.text for t in tokens(DATA_CONTRACT)]
+_OTHER_TOKENS = sorted({*_FORM_TOKENS, "1", "+", "*", '"x"', "ToUpper", "Trim", "name", "int"})
+
+
+@settings(max_examples=300, deadline=None, database=None)
+@given(st.data())
+def test_any_one_token_changed_added_or_removed_is_refused(data):
+    """Exactly the form: a body one token away from it, whatever the token, is refused (the
+    leading using lines may name any namespace, so they are left alone)."""
+    body = list(_FORM_TOKENS)
+    at = data.draw(st.integers(body.index("public"), len(body) - 1))
+    how = data.draw(st.sampled_from(["replace", "insert", "delete"]))
+    if how == "delete":
+        del body[at]
+    else:
+        other = data.draw(st.sampled_from(_OTHER_TOKENS))
+        if how == "replace":
+            if other == body[at]:
+                return
+            body[at] = other
+        else:
+            body.insert(at, other)
+    assert recognise(("Parse", " ".join(_FORM_TOKENS))) == BUILTIN
+    with pytest.raises(CodeRefused):
+        recognise(("Parse", " ".join(body)))
 
 
 @pytest.mark.parametrize(
