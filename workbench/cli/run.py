@@ -17,6 +17,7 @@ from workbench.control.evaluate import (
 )
 from workbench.control.headless import AlgorithmPilot, RunResult, RunSetupError, RunSpec, run
 from workbench.program.pilot import program_entrant
+from workbench.sim.metrics import TURN_MIN_DEGREES
 from workbench.sim.noise import NOISE_LEVELS
 from workbench.sim.profiles import PROFILES
 
@@ -143,7 +144,8 @@ def describe_measures(result: RunResult) -> list[str]:
     return [
         f"  {outcome}",
         f"  distance travelled  {d['distance']:.1f} {unit} ({d['distance_cells']:.1f} blocks)",
-        f"  turning degrees     {d['turn_degrees']:.0f} deg in {d['turns']} turns",
+        f"  turning degrees     {d['turn_degrees']:.0f} deg in all; "
+        f"{d['turns']} turn{'' if d['turns'] == 1 else 's'} of {TURN_MIN_DEGREES:.0f} deg or more",
         f"  collisions          {d['collisions']}",
         f"  touches             {d['touches']} (a touch sensor's bumper meeting a wall gently)",
         f"  efficiency          {eff} (shortest path / distance travelled)",

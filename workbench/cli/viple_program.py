@@ -9,12 +9,12 @@ import os
 import sys
 
 from workbench.control.headless import RunResult, RunSetupError, RunSpec, run
-from workbench.program.interp import ProgramController
+from workbench.program.interp import MAX_ERRORS, MAX_FIRED, Printed, ProgramController
 from workbench.program.keys import KeyScriptError, parse_key_script, typed_events
 from workbench.program.pilot import ProgramPilot, load_compiled
 from workbench.program.problems import ProgramError
 from workbench.program.remote import RemoteProgram, robot_settings, wheel_ports
-from workbench.program.show import describe_program
+from workbench.program.show import count, describe_program, one_line
 from workbench.sim.profiles import get_profile
 from workbench.viple.client import (
     ClientSetup,
@@ -102,11 +102,10 @@ def cmd_check(args: argparse.Namespace) -> int:
             continue
         program = compiled.program
         counts = ", ".join(
-            _many(len(things), word)
-            for things, word in (
-                (program.activities, "activity"),
-                (program.panels, "panel"),
-                (program.links, "link"),
+            (
+                count(len(program.activities), "activity", "activities"),
+                count(len(program.panels), "panel"),
+                count(len(program.links), "link"),
             )
         )
         print(f"{path}: ok (VIPLE {program.version}, {counts})")
@@ -156,33 +155,59 @@ def cmd_run(args: argparse.Namespace) -> int:
     return report(result, args.json, describe_program_run)
 
 
+#: how many printed lines a run's summary shows from the start and from the end
+FIRST_PRINTED = 5
+LAST_PRINTED = 10
+#: how many events and errors it lists
+LISTED = 10
+
+
 def describe_program_run(result: RunResult) -> str:
     program = result.driving.controller
     assert isinstance(program, ProgramController)
     lines = [run_head(result, result.driving.driver.name), *describe_measures(result)]
-    printed = program.printed
-    shown = printed[-10:]
-    if printed:
-        more = len(printed) + program.printed_dropped - len(shown)
-        lines.append(
-            f"  printed {len(printed) + program.printed_dropped} lines"
-            + (f"; the last {len(shown)}:" if more else ":")
-        )
-        lines += [f"    {p.time:7.2f} s  {p.text[:60]}" for p in shown]
-    if program.fired:
-        lines.append(f"  events: {len(program.fired)}")
-        lines += [f"    {f.time:7.2f} s  {f.what}" for f in program.fired[:10]]
-    if program.errors:
-        lines.append(f"  errors: {len(program.errors)}")
-        lines += [f"    {e}" for e in program.errors[:10]]
+    lines += printed_summary(program)
+    lines += _listed(
+        "events",
+        [f"{f.time:7.2f} s  {one_line(f.what, 64)}" for f in program.fired],
+        MAX_FIRED,
+    )
+    lines += _listed("errors", [one_line(str(e), 1000) for e in program.errors], MAX_ERRORS)
     return "\n".join(lines)
 
 
-def _many(count: int, word: str) -> str:
-    """``1 panel``, ``5 panels``, ``32 activities``."""
-    if count == 1:
-        return f"1 {word}"
-    return f"{count} {word[:-1]}ies" if word.endswith("y") else f"{count} {word}s"
+def _printed_line(p: Printed) -> str:
+    return f"    {p.time:7.2f} s  {one_line(p.text, 63)}"
+
+
+def printed_summary(program: ProgramController) -> list[str]:
+    """What Print Line printed: every line, or the first and the last few with what lies
+    between them said in numbers and simulated times."""
+    total = program.printed_total
+    if not total:
+        return []
+    if total <= FIRST_PRINTED + LAST_PRINTED:
+        return [f"  printed {count(total, 'line')}:", *map(_printed_line, program.printed)]
+    recent = list(program.recent)
+    first, last = program.printed[:FIRST_PRINTED], recent[-LAST_PRINTED:]
+    hidden = total - FIRST_PRINTED - LAST_PRINTED
+    since, until = program.printed[FIRST_PRINTED].time, recent[-LAST_PRINTED - 1].time
+    return [
+        f"  printed {total:,} lines; the first {FIRST_PRINTED} and the last {LAST_PRINTED}:",
+        *map(_printed_line, first),
+        f"    ... {count(hidden, 'line')} not shown (lines {FIRST_PRINTED + 1:,} to "
+        f"{total - LAST_PRINTED:,}, printed from {since:.2f} s to {until:.2f} s)",
+        *map(_printed_line, last),
+    ]
+
+
+def _listed(what: str, items: list[str], kept: int) -> list[str]:
+    """``events: 3`` and the items, or the first LISTED of them, saying which."""
+    if not items:
+        return []
+    n = f"{len(items):,}" if len(items) < kept else f"{kept:,} or more (no more are kept)"
+    head = f"  {what}: {n}" + (f"; the first {LISTED}:" if len(items) > LISTED else ":")
+    return [head, *(f"    {item}" for item in items[:LISTED])]
 
 
 # -- driving a robot over the protocol ---------------------------------------------------------
@@ -231,9 +256,9 @@ class _ProgramBrain:
         printed, fired = self.remote.news()
         self.transitions += len(fired)
         for f in fired:
-            self.log(f"{f.time:8.2f} s  {f.what}")
+            self.log(f"{f.time:8.2f} s  {one_line(f.what, 200)}")
         for p in printed:
-            self.log(f"{p.time:8.2f} s  print: {p.text[:200]}")
+            self.log(f"{p.time:8.2f} s  print: {one_line(p.text, 200)}")
         errors = self.remote.controller.errors
         for e in errors[self._errors :]:
             self.log(f"error at {e}")

@@ -133,7 +133,11 @@ def compile_program(program: Program) -> Compiled:
             try:
                 recognise(act.values)
             except CodeRefused as exc:
-                problem(act, str(exc), "replace it with Calculate activities")
+                problem(
+                    act,
+                    str(exc),
+                    "write it as a form docs/viple-programs.md lists, or use Calculate activities",
+                )
         if kind in (K.TOUCH, K.DISTANCE, K.OTHER_SENSOR):
             port = act.value(1).strip()
             if not port.lstrip("-").isdigit() or not 0 <= int(port) < 100:
