@@ -175,6 +175,19 @@ def save_roster(path: Path, roster: dict[str, RosterEntry]) -> None:
     write_text_atomic(path, json.dumps(data, indent=2, ensure_ascii=False) + "\n")
 
 
+def roster_names(store: Store) -> tuple[list[str], str]:
+    """The names one may sign as, sorted, and the problem to show when there are none (it
+    says how to add one). Reads a course database: call it off the event loop."""
+    try:
+        names = sorted(offered_roster(store))
+        problem = "" if names else "the roster has no instructors yet"
+    except (SignoffError, StoreError) as exc:
+        names, problem = [], str(exc)
+    if problem:
+        problem += ": add one with 'workbench instructor add NAME'"
+    return names, problem
+
+
 def offered_roster(store: Store) -> dict[str, RosterEntry]:
     """The instructors the app offers to sign with: the database's roster (PostgreSQL) or
     the data folder's ``roster.json`` (SQLite). Neither is trusted for checking."""

@@ -17,34 +17,20 @@ from textual.app import ComposeResult
 from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical
 from textual.screen import ModalScreen
-from textual.widgets import Button, Checkbox, Input, Label, Select, Static
+from textual.widgets import Button, Input, Label, Static
 from textual.worker import Worker
 
 from workbench.labs.checks import ExerciseProgress
-from workbench.labs.roster import offered_roster
-from workbench.labs.signing import MAX_NOTE, prepare_signoff
+from workbench.labs.roster import roster_names
+from workbench.labs.signing import prepare_signoff
 from workbench.labs.signoff_errors import SignoffError
 from workbench.labs.signoff_record import Evidence, RecordFields, SignoffRecord
-from workbench.labs.store import Store, StoreError
+from workbench.labs.store import Store
 
 from ..keys import bindings
 from ..plain import follow_app
 from ..widgets.field import Field
-from ..widgets.tick import Tick
-
-READING_ROSTER = "reading the roster of instructors..."
-
-
-def read_roster(store: Store) -> tuple[list[str], str]:
-    """The instructors one may sign as, and the problem to show when there are none."""
-    try:
-        roster = sorted(offered_roster(store))
-        problem = "" if roster else "the roster has no instructors yet"
-    except (SignoffError, StoreError) as exc:
-        roster, problem = [], str(exc)
-    if problem:
-        problem += ": add one with 'workbench instructor add NAME'"
-    return roster, problem
+from ..widgets.signoff_form import READING_ROSTER, SignoffForm
 
 
 class SignoffModal(ModalScreen[str | None]):
@@ -64,21 +50,8 @@ class SignoffModal(ModalScreen[str | None]):
         background: $surface;
         padding: 0 1;
     }
-    SignoffModal #signoff-form, SignoffModal #signoff-next {
+    SignoffModal #signoff-sign-off, SignoffModal #signoff-next {
         height: auto;
-    }
-    SignoffModal .field-row {
-        height: 1;
-        margin-top: 1;
-    }
-    SignoffModal .field-row Label {
-        width: 13;
-    }
-    SignoffModal #signoff-override {
-        margin-top: 1;
-    }
-    SignoffModal .field-row Input, SignoffModal .field-row Select {
-        width: 1fr;
     }
     SignoffModal #signoff-state {
         height: auto;
@@ -141,7 +114,7 @@ class SignoffModal(ModalScreen[str | None]):
         #: from a course database (which may take its time, or not answer)
         self.roster_read = asyncio.Event()
         if not store.keeps_roster:
-            self._take_roster(*read_roster(store))
+            self._take_roster(*roster_names(store))
 
     def compose(self) -> ComposeResult:
         progress = self.progress
@@ -165,32 +138,12 @@ class SignoffModal(ModalScreen[str | None]):
                     markup=False,
                 )
             yield Static(f"{who}, driver {self.driver}; {state}", id="signoff-state", markup=False)
-            with Vertical(id="signoff-form"):
-                with Horizontal(classes="field-row"):
-                    yield Label("Instructor")
-                    yield Select(
-                        [(name, name) for name in self.roster],
-                        prompt="choose",
-                        value=self.roster[0] if len(self.roster) == 1 else Select.NULL,
-                        id="signoff-instructor",
-                        compact=True,
-                    )
-                with Horizontal(classes="field-row"):
-                    yield Label("Passphrase")
-                    yield Field(password=True, id="signoff-passphrase", compact=True)
-                with Horizontal(classes="field-row"):
-                    yield Label("Note")
-                    yield Field(
-                        placeholder="optional; required with an override",
-                        id="signoff-note",
-                        compact=True,
-                        max_length=MAX_NOTE,
-                    )
-                yield Tick(
-                    "Override: sign off although objectives have not passed",
-                    value=False,
-                    id="signoff-override",
-                    compact=True,
+            with Vertical(id="signoff-sign-off"):
+                yield SignoffForm(
+                    "signoff",
+                    self.roster,
+                    note_hint="optional; required with an override",
+                    override_label="Override: sign off although objectives have not passed",
                 )
                 with Horizontal(classes="button-row"):
                     yield Static(classes="spacer")
@@ -218,19 +171,15 @@ class SignoffModal(ModalScreen[str | None]):
 
     def _focus_first(self) -> None:
         if self.roster:
-            field = "#signoff-passphrase" if len(self.roster) == 1 else "#signoff-instructor"
-            self.query_one(field).focus()
+            self.query_one(SignoffForm).focus_first()
 
     def _take_roster(self, roster: list[str], problem: str) -> None:
         self.roster, self.roster_problem = roster, problem
         self.roster_read.set()
 
     async def _read_roster_later(self) -> None:
-        self._take_roster(*await asyncio.to_thread(read_roster, self.store))
-        select = self.query_one("#signoff-instructor", Select)
-        select.set_options([(name, name) for name in self.roster])
-        if len(self.roster) == 1:
-            select.value = self.roster[0]
+        self._take_roster(*await asyncio.to_thread(roster_names, self.store))
+        self.query_one(SignoffForm).set_roster(self.roster)
         self._say(self.roster_problem)
         self._focus_first()
 
@@ -254,13 +203,12 @@ class SignoffModal(ModalScreen[str | None]):
         if not self.roster:
             self._say(self.roster_problem)
             return
-        instructor = self.query_one("#signoff-instructor", Select).value
-        if instructor is Select.NULL or not isinstance(instructor, str):
+        form = self.query_one(SignoffForm)
+        entry = form.entry()
+        instructor = entry.instructor
+        if instructor is None:
             self._say("choose the instructor")
             return
-        passphrase = self.query_one("#signoff-passphrase", Input)
-        note = self.query_one("#signoff-note", Input).value
-        override = self.query_one("#signoff-override", Checkbox).value
         progress = self.progress
         fields = RecordFields(
             student=self.student,
@@ -273,7 +221,7 @@ class SignoffModal(ModalScreen[str | None]):
         )
         self._say(f"checking {instructor}'s key...")
         self.signing = self.run_worker(
-            self._sign_off(instructor, fields, override, note, passphrase.value),
+            self._sign_off(instructor, fields, entry.override, entry.note, entry.passphrase),
             group="signoff",
             exit_on_error=False,
         )
@@ -295,7 +243,7 @@ class SignoffModal(ModalScreen[str | None]):
                 self._say(f"signing as {instructor}...")
             _, record = await asyncio.to_thread(pending.complete, signer)
         except SignoffError as exc:
-            self.query_one("#signoff-passphrase", Input).value = ""
+            self.query_one(SignoffForm).take_passphrase()
             self._say(str(exc))
         except Exception as exc:
             self._say(f"not signed: {exc}")
@@ -324,7 +272,7 @@ class SignoffModal(ModalScreen[str | None]):
 
     def _signed(self, instructor: str, override: bool) -> None:
         self.signed = True
-        self.query_one("#signoff-form").display = False
+        self.query_one("#signoff-sign-off").display = False
         self.query_one("#signoff-state").display = False
         self.query_one("#signoff-done", Static).update(
             f"Signed off by {instructor}{' (override)' if override else ''}."

@@ -19,13 +19,13 @@ from textual.app import ComposeResult
 from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.screen import Screen
-from textual.widgets import Button, Checkbox, Input, Label, Select, Static
+from textual.widgets import Button, Input, Static
 
 from workbench.labs.classview import Request, read_request
 from workbench.labs.model import Lab
 from workbench.labs.queue import QueueEntry
-from workbench.labs.roster import offered_roster
-from workbench.labs.signing import MAX_NOTE, prepare_signoff
+from workbench.labs.roster import roster_names
+from workbench.labs.signing import prepare_signoff
 from workbench.labs.signoff_errors import SignoffError
 from workbench.labs.store import Store, StoreError
 from workbench.sim.record import RecordError
@@ -35,7 +35,7 @@ from ..keys import bindings
 from ..plain import follow_app
 from ..widgets.field import Field
 from ..widgets.key_bar import KeyBar
-from ..widgets.tick import Tick
+from ..widgets.signoff_form import READING_ROSTER, SignoffForm
 
 #: the run figures shown, in this order, with their units
 FIGURES = (
@@ -110,22 +110,15 @@ class RequestScreen(Screen[str | None]):
     RequestScreen #request-run {
         color: $text-muted;
     }
-    RequestScreen .field-row {
-        height: 1;
+    RequestScreen #request-sign-off {
+        height: auto;
         padding: 0 1;
     }
-    RequestScreen .field-row Label {
-        width: 12;
-    }
-    RequestScreen .field-row Input, RequestScreen .field-row Select {
-        width: 1fr;
-    }
-    RequestScreen #request-override {
-        padding: 0 1;
+    RequestScreen #request-sign-off .field-row, RequestScreen #request-sign-off Tick {
+        margin-top: 0;
     }
     RequestScreen .button-row {
         height: 1;
-        padding: 0 1;
     }
     RequestScreen .button-row Button {
         margin-right: 2;
@@ -153,14 +146,9 @@ class RequestScreen(Screen[str | None]):
         #: a sign-off or decline under way (one at a time)
         self.busy = False
         self.done = ""
-        try:
-            self.roster = sorted(offered_roster(store))
-            self.roster_problem = "" if self.roster else "the roster has no instructors yet"
-        except (SignoffError, StoreError) as exc:
-            self.roster = []
-            self.roster_problem = str(exc)
-        if self.roster_problem:
-            self.roster_problem += ": add one with 'workbench instructor add NAME'"
+        #: the instructors one may sign as, read from the store once the screen is up
+        self.roster: list[str] = []
+        self.roster_problem = ""
 
     def compose(self) -> ComposeResult:
         e = self.entry
@@ -172,32 +160,12 @@ class RequestScreen(Screen[str | None]):
         with VerticalScroll(id="request-scroll"):
             yield Static("reading the saved progress...", id="request-objectives", markup=False)
             yield Static("", id="request-run", markup=False)
-        with Vertical(id="request-form"):
-            with Horizontal(classes="field-row"):
-                yield Label("Instructor")
-                yield Select(
-                    [(name, name) for name in self.roster],
-                    prompt="choose",
-                    value=self.roster[0] if len(self.roster) == 1 else Select.NULL,
-                    id="request-instructor",
-                    compact=True,
-                )
-            with Horizontal(classes="field-row"):
-                yield Label("Passphrase")
-                yield Field(password=True, id="request-passphrase", compact=True)
-            with Horizontal(classes="field-row"):
-                yield Label("Note")
-                yield Field(
-                    placeholder="optional to sign; needed to decline or override",
-                    id="request-note",
-                    compact=True,
-                    max_length=MAX_NOTE,
-                )
-            yield Tick(
-                "Override: sign although objectives have not passed",
-                value=False,
-                id="request-override",
-                compact=True,
+        with Vertical(id="request-sign-off"):
+            yield SignoffForm(
+                "request",
+                self.roster,
+                note_hint="optional to sign; needed to decline or override",
+                override_label="Override: sign although objectives have not passed",
             )
             with Horizontal(classes="button-row"):
                 yield Button("Sign off", id="request-sign", variant="primary", compact=True)
@@ -208,11 +176,18 @@ class RequestScreen(Screen[str | None]):
 
     def on_mount(self) -> None:
         follow_app(self)
-        field = "#request-passphrase" if len(self.roster) <= 1 else "#request-instructor"
-        self.query_one(field).focus()
+        self.query_one(SignoffForm).focus_first()
+        self._say(READING_ROSTER)
         self.run_worker(self._load(), group="request", exit_on_error=False)
 
     async def _load(self) -> None:
+        """Read the roster, then the request, each in a thread (a course database may take
+        its time, or not answer)."""
+        self.roster, self.roster_problem = await asyncio.to_thread(roster_names, self.store)
+        form = self.query_one(SignoffForm)
+        form.set_roster(self.roster)
+        form.focus_first()
+        self._say(self.roster_problem)
         try:
             request = await asyncio.to_thread(read_request, self.store, self.entry, self.labs)
         except StoreError as exc:
@@ -260,24 +235,23 @@ class RequestScreen(Screen[str | None]):
         if self.busy or self.done:
             return
         if not self.roster:
-            self._say(self.roster_problem)
+            self._say(self.roster_problem or READING_ROSTER)
             return
         request = self.request
         if request is None or request.progress is None:
             self._say(request.problem if request else "the saved progress is still being read")
             return
-        instructor = self.query_one("#request-instructor", Select).value
-        if instructor is Select.NULL or not isinstance(instructor, str):
+        form = self.query_one(SignoffForm)
+        entry = form.entry()
+        instructor = entry.instructor
+        if instructor is None:
             self._say("choose the instructor")
             return
-        passphrase = self.query_one("#request-passphrase", Input)
-        note = self.query_one("#request-note", Input).value
-        override = self.query_one("#request-override", Checkbox).value
         self.busy = True
         self._say(f"unlocking the key of {instructor}...")
-        secret, passphrase.value = passphrase.value, ""
+        secret = form.take_passphrase()
         self.run_worker(
-            self._sign(request, instructor, secret, note, override),
+            self._sign(request, instructor, secret, entry.note, entry.override),
             group="request",
             exit_on_error=False,
         )
@@ -325,15 +299,16 @@ class RequestScreen(Screen[str | None]):
     def action_decline(self) -> None:
         if self.busy or self.done:
             return
-        note = self.query_one("#request-note", Input).value.strip()
+        form = self.query_one(SignoffForm)
+        entry = form.entry()
+        note = entry.note.strip()
         if not note:
             self._say("write a note first: it tells the student what to do before asking again")
-            self.query_one("#request-note").focus()
+            form.focus_note()
             return
-        instructor = self.query_one("#request-instructor", Select).value
-        who = instructor if isinstance(instructor, str) else (self.app.title or "instructor")
+        who = entry.instructor or self.app.title or "instructor"
         self.busy = True
-        self.run_worker(self._decline(str(who), note), group="request", exit_on_error=False)
+        self.run_worker(self._decline(who, note), group="request", exit_on_error=False)
 
     async def _decline(self, instructor: str, note: str) -> None:
         try:
