@@ -41,6 +41,16 @@ STOP = (
     b'{"servos":[{"isTurn":false,"servoId":3,"servoSpeed":0},'
     b'{"isTurn":false,"servoId":5,"servoSpeed":0}]}\r\n'
 )
+#: the same two commands as Robot Drive wheel powers (erobotic: Move at Power 1 is full power on
+#: both wheels; the spin at the 90 deg/s turn rate is half power, left wheel forward)
+WHEELS_MOVE = (
+    b'{"servos":[{"isTurn":false,"servoId":3,"servoSpeed":1},'
+    b'{"isTurn":false,"servoId":5,"servoSpeed":1}]}\r\n'
+)
+WHEELS_RIGHT90 = (
+    b'{"servos":[{"isTurn":false,"servoId":3,"servoSpeed":0.5},'
+    b'{"isTurn":false,"servoId":5,"servoSpeed":-0.5}]}\r\n'
+)
 
 
 def report(front: float, port: int = 1) -> bytes:
@@ -284,7 +294,7 @@ class ScriptedRobot:
 
 def test_tcp_client_sends_viple_bytes_and_ends_when_the_robot_closes():
     robot = ScriptedRobot([report(172.0), report(49.0), report(60.0)])
-    result = asyncio.run(robot.run())
+    result = asyncio.run(robot.run(unity_simulator=True))
     assert robot.received.startswith(MOVE + RIGHT90)
     assert result.ended == "closed" and result.exit_code == 0
     assert result.reports == 3 and result.commands == 2 and result.final_state == "TurningRight"
@@ -296,7 +306,7 @@ def test_reports_split_across_writes_and_bad_lines_are_handled():
     )
     result = asyncio.run(robot.run())
     assert result.reports == 2 and result.rejected == 1
-    assert robot.received == MOVE + RIGHT90
+    assert robot.received == WHEELS_MOVE + WHEELS_RIGHT90
 
 
 def test_hostile_report_lines_are_only_rejected_and_the_run_goes_on():
@@ -320,7 +330,9 @@ def test_hostile_report_lines_are_only_rejected_and_the_run_goes_on():
     assert result.reports == 1 and result.rejected == 3
     assert any("the simulator says: \\u001b[2Jgone" in x for x in lines)
     assert not any("\x1b" in x for x in lines)
-    assert any('sensors[0].value "\\u001e172" is not a number' in x for x in lines)
+    assert any(
+        'sensors[0].value "\\u001e172" holds a control character (U+001E)' in x for x in lines
+    )
 
 
 def test_a_report_missing_the_fsm_sensor_stops_the_robot_and_exits_1():
@@ -328,7 +340,7 @@ def test_a_report_missing_the_fsm_sensor_stops_the_robot_and_exits_1():
     result = asyncio.run(robot.run())
     assert result.ended == "error" and result.exit_code == 1
     assert "no sensor on port 1 (front)" in result.message
-    assert robot.received == MOVE + STOP
+    assert robot.received == WHEELS_MOVE + STOP
 
 
 def test_duration_ends_the_run_and_stops_the_robot():
@@ -336,7 +348,7 @@ def test_duration_ends_the_run_and_stops_the_robot():
     result = asyncio.run(robot.run(duration=0.5))
     assert result.ended == "duration" and result.exit_code == 0
     assert result.time >= 0.5  # ended by the duration (above), not before it
-    assert robot.received == MOVE + STOP
+    assert robot.received == WHEELS_MOVE + STOP
 
 
 def test_a_refusal_is_shown_and_a_run_without_reports_exits_1():
@@ -374,7 +386,7 @@ def test_websocket_role_serves_one_simulator_and_refuses_a_second(unused_port):
             return first, second, refused
 
     async def go():
-        setup = local_best(listen=url)
+        setup = local_best(listen=url, unity_simulator=True)
         client = asyncio.create_task(run_client(setup, log=lambda text: None))
         frames = await simulator()
         return frames, await client
@@ -466,7 +478,10 @@ def served_run(tmp_path: Path, role: str) -> tuple[dict, dict, str]:
     record = tmp_path / f"served-{role}.jsonl"
     port = free_port()
     serve = ["serve", "--maze", str(maze), "--report-ms", "50", "--record", str(record)]
+    # workbench serve plays the Unity simulator: the client turns by Turn by Degree, as the
+    # in-process run does
     client = ["viple-client", "--algorithm", ALGORITHM, "--profile", "erobotic"]
+    client.append("--unity-simulator")
     procs: list[subprocess.Popen] = []
     try:
         if role == "tcp":
