@@ -530,3 +530,60 @@ def test_viple_client_drives_out_through_serve_like_the_in_process_run(tmp_path,
     assert summary["collisions"] == in_process["collisions"] == 0
     assert "TurningRight -> TurnedRight" in out and "TurnedLeft -> Forward" in out
     assert "summary:" in out and "stopped by SIGINT" in out
+
+
+# ----------------------------------------------------------------------------- a robot's own
+
+
+def test_the_stand_in_client_speaks_wheel_powers_to_a_robot_that_knows_only_its_wheels():
+    """The robot's listener takes only Robot Drive's two wheel entries (it breaks on anything
+    else); right-wall drives it, turns left at a wall and drives on, then Ctrl+C stops it."""
+    from tests.integration.fake_robot import FakeRobot, collapsed, wheel_powers
+
+    def distances(front: float, right: float) -> bytes:
+        entries = [
+            {"name": "distance", "id": 1, "value": front},
+            {"name": "distance", "id": 3, "value": right},
+        ]
+        return (json.dumps({"sensors": entries}) + "\r\n").encode()
+
+    spin = (-0.5, 0.5)  # a left turn at erobotic's 90 deg/s: half power, right wheel forward
+    stop, move = (0.0, 0.0), (1.0, 1.0)
+    proc: list[subprocess.Popen] = []
+
+    def script(robot: FakeRobot) -> bytes | None:
+        if robot.broken is not None:
+            return None  # its listener failed: the robot hears nothing more
+        seen = collapsed(robot.powers())
+        if move not in seen:
+            return distances(200, 60)
+        if spin not in seen:
+            return distances(40, 60)  # a wall ahead, none open on the right: turn left
+        if seen[seen.index(spin) :][:3] == [spin, stop, move] and proc[0].poll() is None:
+            proc[0].send_signal(signal.SIGINT)  # driving on after the turn: the user stops it
+        return distances(200, 60)
+
+    with FakeRobot(script, accepts=lambda message: wheel_powers(message) is not None) as robot:
+        argv = ["viple-client", "--algorithm", "right-wall", "--profile", "erobotic"]
+        proc.append(workbench(*argv, "--connect", robot.url, "--json"))
+        try:
+            out, err = proc[0].communicate(timeout=90)
+        finally:
+            if proc[0].poll() is None:
+                proc[0].kill()
+                proc[0].communicate()
+    assert robot.broken is None, robot.broken
+    assert proc[0].returncode == 130, err
+    result = json.loads(out)
+    assert result["commands"] == len(robot.commands)  # every command reached the robot...
+    # ...as two wheel entries: go, the turn's spin, its end, go again, and the final stop
+    assert collapsed(robot.powers()) == [move, spin, stop, move, stop]
+    assert "commands as wheel powers" in err
+
+
+def test_the_unity_simulator_form_is_offered_in_the_help(capsys):
+    with pytest.raises(SystemExit):
+        main(["viple-client", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "--unity-simulator send the Unity simulator's Robot+ commands" in text
+    assert "Commands go as Robot Drive's two wheel powers" in text
