@@ -22,6 +22,14 @@ Reports do not say when the robot reaches the exit, so the client cannot know: a
 ``duration`` has passed, when the simulator closes the connection, or when the user stops it
 (a signal, or :meth:`VipleClient.stop` from a front end's quit key).
 
+The FSM's commands go as Robot Drive's two wheel powers unless the set-up asks for the Unity
+simulator's Robot+ form (``wheels_only``; see :mod:`workbench.viple.wheel_form`): a turn then
+is a spin that the client stops when its time is up, woken for it as for a tick. A VIPLE
+program's commands go as the program says, as VIPLE sends them.
+
+Reports are read as they came (any JSON scalar as a value); a brain refuses one it cannot read
+(an FSM, text where it needs a number) with a ``CodecError``, and the run goes on.
+
 A brain that answers keys (:class:`TakesKeys`, a VIPLE program) gets the keys a front end hands
 to :meth:`VipleClient.press`, on the client's clock, and ticks at once so the robot answers
 without waiting for the next report.
