@@ -470,18 +470,20 @@ def interrupt(proc: subprocess.Popen) -> tuple[int, str, str]:
     return proc.returncode, out, err
 
 
-def served_run(tmp_path: Path, role: str) -> tuple[dict, dict, str]:
-    """The run through `workbench serve` driven by `workbench viple-client`; its metrics at the
-    exit, the server's summary line and the client's output."""
+def served_run(tmp_path: Path, role: str, unity: bool = True) -> tuple[dict, dict, str]:
+    """The run through `workbench serve` driven by `workbench viple-client` (in the Unity
+    simulator's form, else in wheel powers); its metrics at the exit, the server's summary line
+    and the client's output."""
     maze = tmp_path / "one-corner.txt"
     maze.write_text(ONE_CORNER)
     record = tmp_path / f"served-{role}.jsonl"
     port = free_port()
     serve = ["serve", "--maze", str(maze), "--report-ms", "50", "--record", str(record)]
-    # workbench serve plays the Unity simulator: the client turns by Turn by Degree, as the
+    # workbench serve plays the Unity simulator: the client can turn by Turn by Degree, as the
     # in-process run does
     client = ["viple-client", "--algorithm", ALGORITHM, "--profile", "erobotic"]
-    client.append("--unity-simulator")
+    if unity:
+        client.append("--unity-simulator")
     procs: list[subprocess.Popen] = []
     try:
         if role == "tcp":
@@ -587,3 +589,14 @@ def test_the_unity_simulator_form_is_offered_in_the_help(capsys):
     text = " ".join(capsys.readouterr().out.split())
     assert "--unity-simulator send the Unity simulator's Robot+ commands" in text
     assert "Commands go as Robot Drive's two wheel powers" in text
+
+
+@pytest.mark.long
+def test_viple_client_in_wheel_powers_drives_out_through_serve(tmp_path, in_process):
+    """The same run with every command as wheel powers: each turn is a spin the client stops
+    on its own clock, so it ends within a few degrees of the Turn by Degree's angle."""
+    at_exit, summary, out = served_run(tmp_path, "tcp", unity=False)
+    assert summary["reached_exit"] and at_exit["reached_exit"]
+    assert at_exit["turn_degrees"] == pytest.approx(in_process["turn_degrees"], abs=10.0)
+    assert summary["collisions"] == 0
+    assert "TurningRight -> TurnedRight" in out and "TurnedLeft -> Forward" in out
