@@ -106,9 +106,20 @@ def raw_program(tmp_path) -> str:
     return b.write(tmp_path / "raw.viple")
 
 
-def test_a_raw_sensor_gets_the_report_as_it_arrived(tmp_path, capsys):
-    line = b'{"sensors":[{"id":2,"value":555},{"id":1,"value":777}]}'
-
+@pytest.mark.parametrize(
+    ("line", "shown"),
+    [
+        (
+            b'{"sensors":[{"id":2,"value":555},{"id":1,"value":777}]}',
+            '{"sensors":[{"id":2,"value":555},{"id":1,"value":777}]}',
+        ),
+        (  # JSON blanks inside the report reach the program; the terminal sees them escaped
+            b'{"sensors":\r[{"id":2,"value":555},\t{"id":1,"value":777}]}',
+            '{"sensors":\\r[{"id":2,"value":555},\\t{"id":1,"value":777}]}',
+        ),
+    ],
+)
+def test_a_raw_sensor_gets_the_report_as_it_arrived(tmp_path, capsys, line, shown):
     def script(robot: FakeRobot) -> bytes | None:
         return None if robot.commands else line + b"\r\n"
 
@@ -118,4 +129,5 @@ def test_a_raw_sensor_gets_the_report_as_it_arrived(tmp_path, capsys):
     assert code == 0, captured.err
     assert robot.powers()[0] == (0.555, 0.555)  # the first entry, not port 1's 777
     assert "print: 555" in captured.err
-    assert f"print: {line.decode()}" in captured.err  # entries in their order, as sent
+    assert f"print: {shown}\n" in captured.err  # entries in their order, as sent
+    assert "\r" not in captured.err and "\t" not in captured.err

@@ -233,12 +233,20 @@ class _ProgramBrain:
         for f in fired:
             self.log(f"{f.time:8.2f} s  {f.what}")
         for p in printed:
-            self.log(f"{p.time:8.2f} s  print: {p.text[:200]}")
+            self.log(f"{p.time:8.2f} s  print: {_shown(p.text[:200])}")
         errors = self.remote.controller.errors
         for e in errors[self._errors :]:
             self.log(f"error at {e}")
         self._errors = len(errors)
         return Step(t, list(commands), started=started)
+
+
+def _shown(text: str) -> str:
+    """Printed text as the terminal may show it: control characters (a robot's report may
+    carry a tab or a carriage return between its parts) escaped, never sent raw."""
+    if text.isprintable():
+        return text
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
 def cmd_connect(args: argparse.Namespace) -> int:
