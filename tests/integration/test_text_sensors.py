@@ -118,6 +118,7 @@ def raw_program(tmp_path) -> str:
             '{"sensors":\\r[{"id":2,"value":555},\\t{"id":1,"value":777}]}',
         ),
     ],
+    ids=["plain", "blanks inside"],
 )
 def test_a_raw_sensor_gets_the_report_as_it_arrived(tmp_path, capsys, line, shown):
     def script(robot: FakeRobot) -> bytes | None:

@@ -477,7 +477,7 @@ def test_a_reader_that_needs_a_number_refuses_other_values_by_port(value, messag
         ),
         (
             '{"sensors":[{"id":1,"value":{"ai":"straight"}}]}',
-            'line 9: sensors[0].value is an object; expected a number like 1.5, text like '
+            "line 9: sensors[0].value is an object; expected a number like 1.5, text like "
             '"straight", true, false or null',
         ),
         (
