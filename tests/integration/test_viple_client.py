@@ -41,6 +41,16 @@ STOP = (
     b'{"servos":[{"isTurn":false,"servoId":3,"servoSpeed":0},'
     b'{"isTurn":false,"servoId":5,"servoSpeed":0}]}\r\n'
 )
+#: the same two commands as Robot Drive wheel powers (erobotic: Move at Power 1 is full power on
+#: both wheels; the spin at the 90 deg/s turn rate is half power, left wheel forward)
+WHEELS_MOVE = (
+    b'{"servos":[{"isTurn":false,"servoId":3,"servoSpeed":1},'
+    b'{"isTurn":false,"servoId":5,"servoSpeed":1}]}\r\n'
+)
+WHEELS_RIGHT90 = (
+    b'{"servos":[{"isTurn":false,"servoId":3,"servoSpeed":0.5},'
+    b'{"isTurn":false,"servoId":5,"servoSpeed":-0.5}]}\r\n'
+)
 
 
 def report(front: float, port: int = 1) -> bytes:
@@ -284,7 +294,7 @@ class ScriptedRobot:
 
 def test_tcp_client_sends_viple_bytes_and_ends_when_the_robot_closes():
     robot = ScriptedRobot([report(172.0), report(49.0), report(60.0)])
-    result = asyncio.run(robot.run())
+    result = asyncio.run(robot.run(unity_simulator=True))
     assert robot.received.startswith(MOVE + RIGHT90)
     assert result.ended == "closed" and result.exit_code == 0
     assert result.reports == 3 and result.commands == 2 and result.final_state == "TurningRight"
@@ -296,7 +306,7 @@ def test_reports_split_across_writes_and_bad_lines_are_handled():
     )
     result = asyncio.run(robot.run())
     assert result.reports == 2 and result.rejected == 1
-    assert robot.received == MOVE + RIGHT90
+    assert robot.received == WHEELS_MOVE + WHEELS_RIGHT90
 
 
 def test_hostile_report_lines_are_only_rejected_and_the_run_goes_on():
@@ -320,7 +330,9 @@ def test_hostile_report_lines_are_only_rejected_and_the_run_goes_on():
     assert result.reports == 1 and result.rejected == 3
     assert any("the simulator says: \\u001b[2Jgone" in x for x in lines)
     assert not any("\x1b" in x for x in lines)
-    assert any('sensors[0].value "\\u001e172" is not a number' in x for x in lines)
+    assert any(
+        'sensors[0].value "\\u001e172" holds a control character (U+001E)' in x for x in lines
+    )
 
 
 def test_a_report_missing_the_fsm_sensor_stops_the_robot_and_exits_1():
@@ -328,7 +340,7 @@ def test_a_report_missing_the_fsm_sensor_stops_the_robot_and_exits_1():
     result = asyncio.run(robot.run())
     assert result.ended == "error" and result.exit_code == 1
     assert "no sensor on port 1 (front)" in result.message
-    assert robot.received == MOVE + STOP
+    assert robot.received == WHEELS_MOVE + STOP
 
 
 def test_duration_ends_the_run_and_stops_the_robot():
@@ -336,7 +348,7 @@ def test_duration_ends_the_run_and_stops_the_robot():
     result = asyncio.run(robot.run(duration=0.5))
     assert result.ended == "duration" and result.exit_code == 0
     assert result.time >= 0.5  # ended by the duration (above), not before it
-    assert robot.received == MOVE + STOP
+    assert robot.received == WHEELS_MOVE + STOP
 
 
 def test_a_refusal_is_shown_and_a_run_without_reports_exits_1():
@@ -374,7 +386,7 @@ def test_websocket_role_serves_one_simulator_and_refuses_a_second(unused_port):
             return first, second, refused
 
     async def go():
-        setup = local_best(listen=url)
+        setup = local_best(listen=url, unity_simulator=True)
         client = asyncio.create_task(run_client(setup, log=lambda text: None))
         frames = await simulator()
         return frames, await client
@@ -458,15 +470,20 @@ def interrupt(proc: subprocess.Popen) -> tuple[int, str, str]:
     return proc.returncode, out, err
 
 
-def served_run(tmp_path: Path, role: str) -> tuple[dict, dict, str]:
-    """The run through `workbench serve` driven by `workbench viple-client`; its metrics at the
-    exit, the server's summary line and the client's output."""
+def served_run(tmp_path: Path, role: str, unity: bool = True) -> tuple[dict, dict, str]:
+    """The run through `workbench serve` driven by `workbench viple-client` (in the Unity
+    simulator's form, else in wheel powers); its metrics at the exit, the server's summary line
+    and the client's output."""
     maze = tmp_path / "one-corner.txt"
     maze.write_text(ONE_CORNER)
     record = tmp_path / f"served-{role}.jsonl"
     port = free_port()
     serve = ["serve", "--maze", str(maze), "--report-ms", "50", "--record", str(record)]
+    # workbench serve plays the Unity simulator: the client can turn by Turn by Degree, as the
+    # in-process run does
     client = ["viple-client", "--algorithm", ALGORITHM, "--profile", "erobotic"]
+    if unity:
+        client.append("--unity-simulator")
     procs: list[subprocess.Popen] = []
     try:
         if role == "tcp":
@@ -515,3 +532,71 @@ def test_viple_client_drives_out_through_serve_like_the_in_process_run(tmp_path,
     assert summary["collisions"] == in_process["collisions"] == 0
     assert "TurningRight -> TurnedRight" in out and "TurnedLeft -> Forward" in out
     assert "summary:" in out and "stopped by SIGINT" in out
+
+
+# ----------------------------------------------------------------------------- a robot's own
+
+
+def test_the_stand_in_client_speaks_wheel_powers_to_a_robot_that_knows_only_its_wheels():
+    """The robot's listener takes only Robot Drive's two wheel entries (it breaks on anything
+    else); right-wall drives it, turns left at a wall and drives on, then Ctrl+C stops it."""
+    from tests.integration.fake_robot import FakeRobot, collapsed, wheel_powers
+
+    def distances(front: float, right: float) -> bytes:
+        entries = [
+            {"name": "distance", "id": 1, "value": front},
+            {"name": "distance", "id": 3, "value": right},
+        ]
+        return (json.dumps({"sensors": entries}) + "\r\n").encode()
+
+    spin = (-0.5, 0.5)  # a left turn at erobotic's 90 deg/s: half power, right wheel forward
+    stop, move = (0.0, 0.0), (1.0, 1.0)
+    proc: list[subprocess.Popen] = []
+
+    def script(robot: FakeRobot) -> bytes | None:
+        if robot.broken is not None:
+            return None  # its listener failed: the robot hears nothing more
+        seen = collapsed(robot.powers())
+        if move not in seen:
+            return distances(200, 60)
+        if spin not in seen:
+            return distances(40, 60)  # a wall ahead, none open on the right: turn left
+        if seen[seen.index(spin) :][:3] == [spin, stop, move] and proc[0].poll() is None:
+            proc[0].send_signal(signal.SIGINT)  # driving on after the turn: the user stops it
+        return distances(200, 60)
+
+    with FakeRobot(script, accepts=lambda message: wheel_powers(message) is not None) as robot:
+        argv = ["viple-client", "--algorithm", "right-wall", "--profile", "erobotic"]
+        proc.append(workbench(*argv, "--connect", robot.url, "--json"))
+        try:
+            out, err = proc[0].communicate(timeout=90)
+        finally:
+            if proc[0].poll() is None:
+                proc[0].kill()
+                proc[0].communicate()
+    assert robot.broken is None, robot.broken
+    assert proc[0].returncode == 130, err
+    result = json.loads(out)
+    assert result["commands"] == len(robot.commands)  # every command reached the robot...
+    # ...as two wheel entries: go, the turn's spin, its end, go again, and the final stop
+    assert collapsed(robot.powers()) == [move, spin, stop, move, stop]
+    assert "commands as wheel powers" in err
+
+
+def test_the_unity_simulator_form_is_offered_in_the_help(capsys):
+    with pytest.raises(SystemExit):
+        main(["viple-client", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "--unity-simulator send the Unity simulator's Robot+ commands" in text
+    assert "Commands go as Robot Drive's two wheel powers" in text
+
+
+@pytest.mark.long
+def test_viple_client_in_wheel_powers_drives_out_through_serve(tmp_path, in_process):
+    """The same run with every command as wheel powers: each turn is a spin the client stops
+    on its own clock, so it ends within a few degrees of the Turn by Degree's angle."""
+    at_exit, summary, out = served_run(tmp_path, "tcp", unity=False)
+    assert summary["reached_exit"] and at_exit["reached_exit"]
+    assert at_exit["turn_degrees"] == pytest.approx(in_process["turn_degrees"], abs=10.0)
+    assert summary["collisions"] == 0
+    assert "TurningRight -> TurnedRight" in out and "TurnedLeft -> Forward" in out

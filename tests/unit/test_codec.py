@@ -26,6 +26,7 @@ from workbench.viple.codec import (
     encode_report,
     parse_command,
     parse_report,
+    reading_number,
     split_frame,
 )
 
@@ -412,12 +413,45 @@ def test_a_report_that_cannot_be_sent_is_refused(readings, kinds, message):
         encode_report(readings, kinds)
 
 
-def test_a_report_is_read_back_including_numbers_sent_as_strings():
+def test_a_report_is_read_back_with_its_values_as_sent():
     line = (
         '{"sensors":[{"name":"distance","id":"1","value":"1.5"},'
         '{"name":"touch","id":2,"value":1},{"name":"distance","id":3,"value":1000,"x":0}]}'
     )
-    assert parse_report(line) == {1: 1.5, 2: 1.0, 3: 1000.0}
+    readings = parse_report(line)
+    assert readings == {1: "1.5", 2: 1.0, 3: 1000.0}
+    # a reader that needs a number (an FSM) reads the Unity simulator's "1.5" as 1.5
+    assert [reading_number(value, port) for port, value in readings.items()] == [1.5, 1, 1000]
+
+
+def test_a_robot_reports_text_and_every_other_json_scalar():
+    line = '{"sensors": [{"id": 1, "name": "ai", "value": "straight"}]}'
+    assert parse_report(line) == {1: "straight"}
+    line = '{"sensors":[{"id":4,"value":true},{"id":2,"value":null},{"id":3,"value":"été"}]}'
+    assert parse_report(line) == {4: True, 2: None, 3: "été"}
+
+
+def test_readings_keep_the_order_of_the_report():
+    assert list(parse_report('{"sensors":[{"id":2,"value":555},{"id":1,"value":777}]}')) == [2, 1]
+
+
+@pytest.mark.parametrize(
+    ("value", "message"),
+    [
+        (
+            '"straight"',
+            'the reading of port 1 "straight" is not a number; expected a number, or text '
+            "holding one",
+        ),
+        ("true", "the reading of port 1 is true/false; expected a number, or text holding one"),
+        ("null", "the reading of port 1 is null; expected a number, or text holding one"),
+    ],
+)
+def test_a_reader_that_needs_a_number_refuses_other_values_by_port(value, message):
+    (reading,) = parse_report('{"sensors":[{"id":1,"value":' + value + "}]}").values()
+    with pytest.raises(CodecError) as info:
+        reading_number(reading, 1)
+    assert str(info.value) == message
 
 
 @pytest.mark.parametrize(
@@ -429,17 +463,36 @@ def test_a_report_is_read_back_including_numbers_sent_as_strings():
         ),
         (
             '{"sensors":[{"id":1}]}',
-            "line 9: sensors[0].value is missing; expected a number like 0.5, or a string"
-            " holding one",
+            'line 9: sensors[0].value is missing; expected a number like 1.5, text like "straight",'
+            " true, false or null",
         ),
         (
             '{"sensors":[{"value":1}]}',
             "line 9: sensors[0].id is missing; expected a port number like 1",
         ),
         (
-            '{"sensors":[{"id":1,"value":"far"}]}',
-            'line 9: sensors[0].value "far" is not a number; expected a number like 0.5, or a'
-            " string holding one",
+            '{"sensors":[{"id":1,"value":[1.5]}]}',
+            'line 9: sensors[0].value is a list; expected a number like 1.5, text like "straight",'
+            " true, false or null",
+        ),
+        (
+            '{"sensors":[{"id":1,"value":{"ai":"straight"}}]}',
+            "line 9: sensors[0].value is an object; expected a number like 1.5, text like "
+            '"straight", true, false or null',
+        ),
+        (
+            '{"sensors":[{"id":1,"value":1e400}]}',
+            "line 9: sensors[0].value 1e400 is out of range; expected a finite number",
+        ),
+        (
+            '{"sensors":[{"id":1,"value":"\\u001b[2Jstraight"}]}',
+            'line 9: sensors[0].value "\\u001b[2Jstraight" holds a control character (U+001B) at'
+            " character 1; expected text without control characters",
+        ),
+        (
+            '{"sensors":[{"id":1,"value":"left\\udc00"}]}',
+            'line 9: sensors[0].value "left\\udc00" holds a lone surrogate (U+DC00) at character'
+            " 5; expected text without control characters",
         ),
         (
             '{"sensors":[{"id":1,"value":1},{"id":1,"value":2}]}',
@@ -799,3 +852,74 @@ def test_a_reason_stays_short_however_many_entries_the_line_has():
     message = rejection(line)
     assert message.startswith("servos has 1994 wheel entries (servoId 6, 7, 8, 9, 10, …)")
     assert len(message) < 200
+
+
+# --- sensor values of any JSON type -----------------------------------------------------------
+
+sensor_values = st.one_of(
+    st.none(),
+    st.booleans(),
+    st.integers(),
+    st.integers(min_value=10**308, max_value=10**400),
+    st.floats(),
+    st.text(max_size=12),
+    st.lists(st.integers(), max_size=2),
+    st.dictionaries(st.text(max_size=3), st.integers(), max_size=2),
+)
+
+
+def expected_reading(value):
+    """What a report carrying ``value`` gives: ("ok", reading) or ("refused", the reason's
+    start), worked out apart from the codec."""
+    path = "line 1: sensors[0].value"
+    if isinstance(value, float) and not math.isfinite(value):
+        return "refused", "line 1: not JSON: "
+    if isinstance(value, list):
+        return "refused", f"{path} is a list; expected"
+    if isinstance(value, dict):
+        return "refused", f"{path} is an object; expected"
+    is_int = isinstance(value, int) and not isinstance(value, bool)
+    if is_int and not math.isfinite(float(str(value))):
+        return "refused", f"{path} {str(value)[:39]}"
+    if isinstance(value, str):
+        codes = [ord(c) for c in value]
+        if any(c < 0x20 or 0x7F <= c <= 0x9F or 0xD800 <= c < 0xE000 for c in codes):
+            return "refused", f"{path} "
+        return "ok", value
+    if isinstance(value, bool) or value is None:
+        return "ok", value
+    return "ok", float(value)
+
+
+@FUZZ
+@given(sensor_values, st.integers(0, 99), st.sampled_from(["distance", "ai", "", "touch"]))
+def test_a_sensor_value_of_any_json_type_is_read_as_sent_or_refused_naming_it(value, port, name):
+    line = json.dumps({"sensors": [{"id": port, "name": name, "value": value}]})
+    outcome, expected = expected_reading(value)
+    if outcome == "ok":
+        assert parse_report(line, 1) == {port: expected}
+        return
+    with pytest.raises(CodecError) as info:
+        parse_report(line, 1)
+    assert str(info.value).startswith(expected)
+    if expected.startswith("line 1: sensors[0].value"):
+        assert "expected" in str(info.value)
+
+
+@FUZZ
+@given(st.lists(st.tuples(st.integers(0, 9), sensor_values), max_size=5))
+def test_a_report_of_any_values_gives_readings_in_its_order_or_one_refusal(entries):
+    line = json.dumps({"sensors": [{"id": port, "value": value} for port, value in entries]})
+    try:
+        readings = parse_report(line, 1)
+    except CodecError as err:
+        assert re.match(r"line 1: (not JSON: |sensors\[\d\]\.(value|id) )", str(err)), str(err)
+        return
+    assert list(readings) == [port for port, _ in entries]
+    for port, value in readings.items():
+        try:
+            number = reading_number(value, port)
+        except CodecError as err:
+            assert str(err).startswith(f"the reading of port {port} ")
+        else:
+            assert math.isfinite(number)

@@ -25,8 +25,12 @@ The client plays VIPLE: it sees only the sensor reports and sends only servo com
 the simulator first (workbench serve), or with --listen start this first and point the
 simulator at it (workbench serve --ws-url ws://localhost:8124/). Time is the client's own clock;
 a Turn by Degree counts as done after the profile's turn time plus a margin, as a VIPLE program
-waits for it with a Timer. The reports do not say when the robot is out of the maze: the run
-ends after --duration, when the simulator closes the connection, or with Ctrl+C.
+waits for it with a Timer. Commands go as Robot Drive's two wheel powers (left and right port),
+which a robot's own middleware understands: Move at Power becomes both wheels at its speed,
+Turn by Degree a spin in place at the profile's turn rate, stopped when the angle's time is up.
+--unity-simulator sends the Robot+ form instead (servoId -1), for VIPLE's Unity simulator.
+The reports do not say when the robot is out of the maze: the run ends after --duration, when
+the simulator closes the connection, or with Ctrl+C.
 
 exit codes: 0 the run ended by --duration or by the simulator closing the connection;
 1 no connection, the simulator closed before any report, the reports lack a sensor the FSM
@@ -55,6 +59,14 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="play VIPLE's WebSocket server; the simulator connects (e.g. ws://localhost:8124)",
     )
     p.add_argument("--profile", choices=list(PROFILES), default="unity", help="default unity")
+    p.add_argument(
+        "--unity-simulator",
+        action="store_true",
+        help="send the Unity simulator's Robot+ commands (Move at Power, Turn by Degree: "
+        "servoId -1), which VIPLE's Unity simulator and workbench serve understand; without "
+        "it every command is Robot Drive's two wheel powers on the profile's wheel ports, "
+        "which a robot understands",
+    )
     p.add_argument("--param", action="append", default=[], metavar="NAME=VALUE")
     p.add_argument(
         "--sensor",
@@ -89,6 +101,7 @@ def cmd_viple_client(args: argparse.Namespace) -> int:
             connect=args.connect,
             listen=args.listen,
             duration=args.duration,
+            unity_simulator=args.unity_simulator,
         )
     except ClientSetupError as exc:
         print(f"workbench viple-client: {exc}", file=sys.stderr)
@@ -102,9 +115,10 @@ def cmd_viple_client(args: argparse.Namespace) -> int:
         log(describe_step(step, state))
 
     sensors = ", ".join(str(s) for s in setup.sensors)
+    form = "commands as wheel powers" if setup.wheels_only else "Robot+ for the Unity simulator"
     log(
         f"{setup.name} ({setup.profile.name} profile, wheels on ports "
-        f"{setup.profile.left_port}/{setup.profile.right_port}; sensors {sensors})"
+        f"{setup.profile.left_port}/{setup.profile.right_port}, {form}; sensors {sensors})"
     )
     result = asyncio.run(run_client(setup, log, on_step))
     if args.json:

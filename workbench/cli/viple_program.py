@@ -235,7 +235,7 @@ class _ProgramBrain:
     def start(self, t: float) -> Step:
         return self._step(t, self.remote.start(t), started=True)
 
-    def report(self, t: float, readings) -> Step:
+    def report(self, t: float, readings, text: str) -> Step:
         missing = self.remote.missing_ports(readings)
         if missing and not self._told_missing:
             self._told_missing = True
@@ -244,7 +244,7 @@ class _ProgramBrain:
                 f"{t:8.2f} s  the reports carry no sensor on port(s) "
                 f"{', '.join(map(str, missing))}, which the program reads (they carry {have})"
             )
-        return self._step(t, self.remote.report(t, readings))
+        return self._step(t, self.remote.report(t, readings, text))
 
     def tick(self, t: float) -> Step:
         return self._step(t, self.remote.tick(t))

@@ -27,6 +27,7 @@ from .code import first_sensor_value
 from .compiled import DEFAULTS, Compiled
 from .keys import KeyEvent, TypedKeys
 from .model import ELSE
+from .readings import pressed, sensor_message, touch_problem
 from .viple_expr import ExprError, Scope, Value, show, type_name
 
 SLICE = 50
@@ -172,15 +173,24 @@ class ProgramController:
                 self._spawn(aid, None, main)
         return self._run()
 
-    def tick(self, t: float, readings: dict[str, float], events: frozenset[str]) -> list[Any]:
+    def tick(
+        self,
+        t: float,
+        readings: dict[str, Value],
+        events: frozenset[str],
+        report: str | None = None,
+    ) -> list[Any]:
+        """One control tick; ``readings`` ("port N" -> value) fire the sensor activities, and
+        ``report``, a robot's report as it arrived, is what a raw sensor gets (None: the
+        simulated robot's report is made from the readings)."""
         self.now = t
         while self._sleeping and self._sleeping[0][0] <= t + 1e-9:
             self._ready.append(heappop(self._sleeping)[2])
         self._ready.extend(self._parked)
         self._parked = []
         self._keys(t)
-        if readings:  # a tick between two reports of a remote robot fires no sensor
-            self._sensors({int(name.split()[-1]): v for name, v in readings.items()})
+        if readings or report is not None:  # a tick between two reports fires no sensor
+            self._sensors({int(name.split()[-1]): v for name, v in readings.items()}, report)
         return self._run()
 
     # -- events --------------------------------------------------------------------------
@@ -219,11 +229,11 @@ class ProgramController:
             if wanted and wanted <= self._held and wanted & event.keys:
                 self._fire(act.id, "+".join(sorted(wanted)), f"key {'+'.join(sorted(wanted))}")
 
-    def _sensors(self, readings: dict[int, float]) -> None:
-        raw = None
+    def _sensors(self, readings: dict[int, Value], report: str | None) -> None:
+        raw = report
         for aid, (kind, port) in self.compiled.sensors.items():
             if kind == K.RAW_SENSOR:
-                if raw is None:
+                if raw is None:  # the simulated robot: a report made from its readings
                     raw = json.dumps(
                         {
                             "sensors": [
@@ -236,12 +246,15 @@ class ProgramController:
                 continue
             if port not in readings:
                 continue
-            value = readings[port]
+            value = sensor_message(readings[port])
             if kind == K.TOUCH:
-                pressed = 1 if value else 0
+                down = pressed(value)
+                if down is None:
+                    self._error(aid, touch_problem(port, value))
+                    continue
                 before = self._touch.get(aid, 0)
-                self._touch[aid] = pressed
-                if pressed and not before:
+                self._touch[aid] = int(down)
+                if down and not before:
                     self._fire(aid, 1, f"touch {port}")
                 continue
             self._fire(aid, value)

@@ -23,6 +23,7 @@ from .compiled import Compiled
 from .interp import Fired, Printed, ProgramController
 from .keys import KeyEvent
 from .problems import Problem, ProgramError
+from .viple_expr import Value
 
 #: the program ticks at least this often between reports (the in-process control rate)
 CONTROL_HZ = 20.0
@@ -94,7 +95,7 @@ class RemoteProgram:
 
     def __init__(self, compiled: Compiled, keys: tuple[KeyEvent, ...] = ()) -> None:
         self.controller = ProgramController(compiled, keys)
-        self.readings: dict[int, float] | None = None
+        self.readings: dict[int, Value] | None = None
         self.last_tick = -math.inf
         self._printed = 0
         self._fired = 0
@@ -112,12 +113,13 @@ class RemoteProgram:
         self.last_tick = t
         return self.controller.start(t)
 
-    def report(self, t: float, readings: Mapping[int, float]) -> list[Any]:
-        """A report arrived: the sensor activities fire with it, then the flows run."""
+    def report(self, t: float, readings: Mapping[int, Value], text: str | None = None) -> list[Any]:
+        """A report arrived: the sensor activities fire with its values (any JSON scalar, as
+        sent), a raw sensor with ``text``, the report as it arrived; then the flows run."""
         self.readings = dict(readings)
         self.last_tick = t
         named = {f"port {port}": value for port, value in readings.items()}
-        return self.controller.tick(t, named, frozenset())
+        return self.controller.tick(t, named, frozenset(), text)
 
     def tick(self, t: float) -> list[Any]:
         """No report since the last tick: Timers, keys and waiting flows go on."""
@@ -130,7 +132,7 @@ class RemoteProgram:
     def type_key(self, key: str, t: float) -> None:
         self.controller.type_key(key, t)
 
-    def missing_ports(self, readings: Mapping[int, float]) -> list[int]:
+    def missing_ports(self, readings: Mapping[int, Value]) -> list[int]:
         """The ports the program reads that a report does not carry."""
         return [port for port in self._ports if port not in readings]
 

@@ -22,6 +22,14 @@ Reports do not say when the robot reaches the exit, so the client cannot know: a
 ``duration`` has passed, when the simulator closes the connection, or when the user stops it
 (a signal, or :meth:`VipleClient.stop` from a front end's quit key).
 
+The FSM's commands go as Robot Drive's two wheel powers unless the set-up asks for the Unity
+simulator's Robot+ form (``wheels_only``; see :mod:`workbench.viple.wheel_form`): a turn then
+is a spin that the client stops when its time is up, woken for it as for a tick. A VIPLE
+program's commands go as the program says, as VIPLE sends them.
+
+Reports are read as they came (any JSON scalar as a value); a brain refuses one it cannot read
+(an FSM, text where it needs a number) with a ``CodecError``, and the run goes on.
+
 A brain that answers keys (:class:`TakesKeys`, a VIPLE program) gets the keys a front end hands
 to :meth:`VipleClient.press`, on the client's clock, and ticks at once so the robot answers
 without waiting for the next report.
@@ -60,7 +68,18 @@ from workbench.sim.commands import Command, Stop, TurnByDegrees
 from workbench.sim.profiles import Profile, get_profile
 from workbench.sim.sensors import SensorConfigError, SensorSpec, check_ports
 
-from .codec import FrameError, LineSplitter, WheelPorts, encode_command, parse_report, split_frame
+from .codec import (
+    CodecError,
+    FrameError,
+    LineSplitter,
+    SensorValue,
+    WheelPorts,
+    encode_command,
+    parse_report,
+    reading_number,
+    split_frame,
+)
+from .wheel_form import WheelDrive
 
 DEFAULT_CONNECT = "tcp://localhost:1350"
 DEFAULT_PORTS = {"tcp": 1350, "ws": 8124}
@@ -145,14 +164,17 @@ class Brain(Protocol):
     transitions: int
 
     @property
-    def readings(self) -> Mapping[Any, float] | None: ...
+    def readings(self) -> Mapping[Any, SensorValue] | None: ...
 
     @property
     def state(self) -> str | None: ...
 
     def start(self, t: float) -> Step: ...
 
-    def report(self, t: float, readings: Mapping[int, float]) -> Step: ...
+    def report(self, t: float, readings: Mapping[int, SensorValue], text: str) -> Step:
+        """A report arrived: its readings (port -> value, in its order) and its text as it
+        arrived. A ``CodecError`` refuses the report (a value this brain cannot read)."""
+        ...
 
     def next_tick(self) -> float: ...
 
@@ -179,6 +201,9 @@ class ClientSetup:
     brain: Callable[[], Brain] | None = None
     title: str = ""
     ports: WheelPorts | None = None
+    #: every command goes as Robot Drive's two wheel powers (what a robot's middleware reads);
+    #: False: as VIPLE sends it, the Robot+ services as ``servoId`` -1 (the Unity simulator)
+    wheels_only: bool = False
 
     @property
     def name(self) -> str:
@@ -199,8 +224,13 @@ def prepare(
     connect: str | None = None,
     listen: str | None = None,
     duration: float | None = None,
+    unity_simulator: bool = False,
 ) -> ClientSetup:
-    """Check everything the run needs; bad input is a :class:`ClientSetupError`."""
+    """Check everything the run needs; bad input is a :class:`ClientSetupError`.
+
+    The FSM's commands go as Robot Drive wheel powers, which any robot understands, unless
+    ``unity_simulator`` asks for the Unity simulator's Robot+ form (Move at Power, Turn by
+    Degree)."""
     if duration is not None and not (math.isfinite(duration) and duration > 0):
         raise ClientSetupError(f"--duration must be a positive number of seconds, not {duration}")
     endpoint = parse_endpoint(connect, listen)
@@ -216,7 +246,16 @@ def prepare(
         values = FsmController(definition, overrides, prof.name).params
     except (FsmFileError, FsmError, SensorConfigError, ValueError) as exc:
         raise ClientSetupError(str(exc)) from None
-    return ClientSetup(definition, prof, values, tuple(specs), binding, endpoint, duration)
+    return ClientSetup(
+        definition,
+        prof,
+        values,
+        tuple(specs),
+        binding,
+        endpoint,
+        duration,
+        wheels_only=not unity_simulator,
+    )
 
 
 # ----------------------------------------------------------------------------- the FSM side
@@ -228,8 +267,11 @@ def turn_wait(degrees: float, profile: Profile) -> float:
     return nominal * (1.0 + TURN_MARGIN_FRACTION) + TURN_MARGIN_S
 
 
-def readings_by_name(readings: Mapping[int, float], binding: Mapping[str, int]) -> dict[str, float]:
-    """A report's readings (port -> value) under the FSM's sensor names."""
+def readings_by_name(
+    readings: Mapping[int, SensorValue], binding: Mapping[str, int]
+) -> dict[str, float]:
+    """A report's readings (port -> value) under the FSM's sensor names, as numbers (numeric
+    text converted); a ``CodecError`` for a reading the FSM reads that is not a number."""
     missing = {name: port for name, port in binding.items() if port not in readings}
     if missing:
         wanted = ", ".join(f"port {port} ({name})" for name, port in sorted(missing.items()))
@@ -238,7 +280,7 @@ def readings_by_name(readings: Mapping[int, float], binding: Mapping[str, int]) 
             f"the reports carry no sensor on {wanted}; they carry port(s) {have}: give both "
             "sides the same sensors (--sensor KIND:PORT:MOUNT on workbench serve and here)"
         )
-    return {name: readings[port] for name, port in binding.items()}
+    return {name: reading_number(readings[port], port) for name, port in binding.items()}
 
 
 @dataclass(frozen=True)
@@ -271,8 +313,8 @@ class RemoteFsm:
     def start(self, t: float) -> Step:
         return self._step(t, self.controller.start(t), None, started=True)
 
-    def report(self, t: float, readings: Mapping[int, float]) -> Step:
-        """A sensor report arrived: tick with its readings."""
+    def report(self, t: float, readings: Mapping[int, SensorValue], text: str = "") -> Step:
+        """A sensor report arrived: tick with its readings (the FSM reads numbers only)."""
         self.readings = readings_by_name(readings, self.setup.binding)
         return self.tick(t)
 
@@ -393,7 +435,7 @@ class ClientResult:
     commands: int = 0
     transitions: int = 0
     final_state: str | None = None
-    readings: dict[str, float] = field(default_factory=dict)
+    readings: dict[str, SensorValue] = field(default_factory=dict)
     message: str = ""
 
     def as_dict(self) -> dict[str, Any]:
@@ -409,7 +451,9 @@ class ClientResult:
             "commands": self.commands,
             "transitions": self.transitions,
             "final_state": self.final_state,
-            "readings": {k: round(v, 4) for k, v in self.readings.items()},
+            "readings": {
+                k: round(v, 4) if isinstance(v, float) else v for k, v in self.readings.items()
+            },
             "message": self.message,
         }
 
@@ -464,6 +508,7 @@ class VipleClient:
         self._busy = False
         self._released = asyncio.Event()
         self._t0 = 0.0
+        self._wheel_drive = WheelDrive(setup.profile) if setup.wheels_only else None
 
     def interrupt(self, signum: int = signal.SIGINT) -> None:
         """Stop the run (from a signal handler): stop the robot, close, summarise."""
@@ -595,12 +640,16 @@ class VipleClient:
                 await self._stop_robot(channel)
                 self._end("duration", EXIT_OK, f"--duration {end:g} s has passed")
                 return
-            wake = fsm.next_tick() if end is None else min(fsm.next_tick(), end)
+            wake = min(fsm.next_tick(), self._spin_ends(), math.inf if end is None else end)
             try:
                 async with asyncio.timeout(max(0.0, wake - now)):
                     item = await self.inbox.get()
             except TimeoutError:
-                await self._send(channel, self._shown(fsm.tick(self._now()), fsm))
+                now = self._now()
+                if self._wheel_drive is not None and self._wheel_drive.spin_over(now):
+                    await self._send(channel, [Stop()])
+                if now >= fsm.next_tick():
+                    await self._send(channel, self._shown(fsm.tick(now), fsm))
                 continue
             if isinstance(item, _Received):
                 await self._reports(channel, fsm, item)
@@ -626,12 +675,15 @@ class VipleClient:
             except ValueError as err:
                 self._reject(_refusal(line) or str(err))
                 continue
-            self.result.reports += 1
             try:
-                step = fsm.report(self._now(), readings)
+                step = fsm.report(self._now(), readings, line)
+            except CodecError as err:
+                self._reject(str(err))
+                continue
             except (ClientRunError, FsmRuntimeError) as exc:
                 await self._stop_robot(channel)
                 raise _Abort(str(exc)) from None
+            self.result.reports += 1
             await self._send(channel, self._shown(step, fsm))
 
     async def _pump(self, channel: Channel) -> None:
@@ -643,12 +695,20 @@ class VipleClient:
 
     async def _send(self, channel: Channel, commands: list[Command]) -> None:
         wheels = self.setup.wheels
+        drive = self._wheel_drive
         for cmd in commands:
+            if drive is not None:
+                cmd = drive.powers(self._now(), cmd)
             try:
                 await channel.send(encode_command(cmd, wheels))
             except (OSError, ConnectionClosed):
                 return
             self.result.commands += 1
+
+    def _spin_ends(self) -> float:
+        """When the spin of a turn sent as wheel powers is to stop (inf: none is going)."""
+        drive = self._wheel_drive
+        return math.inf if drive is None or drive.spin_ends is None else drive.spin_ends
 
     async def _stop_robot(self, channel: Channel) -> None:
         await self._send(channel, [Stop()])

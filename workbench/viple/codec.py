@@ -15,6 +15,8 @@ Receiver choices where the protocol leaves room:
 * ``isTurn`` only matters for Robot+ entries, but a malformed ``isTurn`` is rejected anywhere.
 * ``servoId`` and sensor ``id`` may be whole numbers written as numbers or strings ("3", 3.0);
   negative ports other than -1 are rejected.
+* A sensor ``value`` may be any JSON scalar and is read as sent (text stays text); only a
+  reader that needs a number converts numeric text, as VIPLE does with the Unity simulator's.
 
 Every line that is not a message is refused with ``CodecError`` and nothing else: its reason
 says where (the field path, ``servos[0].servoSpeed``), what was wrong and what is expected.
@@ -46,6 +48,8 @@ REPORT_KINDS = ("distance", "touch", "light", "sound", "color", "motorEncoder")
 #: the ``servoId`` of VIPLE's Robot+ services (Move at Power, Turn by Degree)
 ROBOT_PLUS_ID = -1
 DEFAULT_MAX_LINE_BYTES = 65536
+#: a sensor's value as a report carries it: a number, text, true/false or null
+SensorValue = float | str | bool | None
 
 _NUMBER_TEXT = re.compile(r"[+-]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)(?:[eE][+-]?[0-9]+)?")
 _LONGEST_EXACT_INT = 18
@@ -563,8 +567,16 @@ def _reading_json(port: int, kind: str, value: float | int) -> str:
     return f'{{"name":"{kind}","id":{port},"value":{number}}}'
 
 
-def parse_report(line: str, line_no: int | None = None) -> dict[int, float]:
-    """The readings (port -> value) in one sensor report, as a VIPLE-side client reads it."""
+def parse_report(line: str, line_no: int | None = None) -> dict[int, SensorValue]:
+    """The readings (port -> value) in one sensor report, in the report's order, as a
+    VIPLE-side client reads it.
+
+    Values stay as sent: a number (as a float), text, true/false or null. A robot's own
+    middleware may report text (an AI camera's ``"straight"``), and the Unity simulator sent
+    its numbers as text; whoever needs a number converts numeric text (:func:`reading_number`).
+    Refused: a value that is a list or an object, a number too large for a float, text holding
+    a control character or a lone surrogate (nothing that could reach a terminal raw).
+    """
     try:
         items = _object_list(_load(line), "sensors")
         return _readings(items)
@@ -572,8 +584,14 @@ def parse_report(line: str, line_no: int | None = None) -> dict[int, float]:
         raise err.at_line(line_no) from None
 
 
-def _readings(items: Iterable[Any]) -> dict[int, float]:
-    readings: dict[int, float] = {}
+def reading_number(value: SensorValue, port: int) -> float:
+    """A reading as a number, for a reader that needs one (an FSM's guards): a number as it
+    is, numeric text converted; ``CodecError`` naming the port for anything else."""
+    return _number(value, f"the reading of port {port}", "a number, or text holding one")
+
+
+def _readings(items: Iterable[Any]) -> dict[int, SensorValue]:
+    readings: dict[int, SensorValue] = {}
     first: dict[int, int] = {}
     for index, item in enumerate(items):
         path = f"sensors[{index}]"
@@ -589,11 +607,34 @@ def _readings(items: Iterable[Any]) -> dict[int, float]:
     return readings
 
 
-def _reading(entry: dict[str, Any], path: str) -> tuple[int, float]:
-    for key, expected in (("id", "a port number like 1"), ("value", _A_NUMBER)):
+_A_READING = 'a number like 1.5, text like "straight", true, false or null'
+_NOT_TEXT = re.compile("[\x00-\x1f\x7f-\x9f\ud800-\udfff]")
+
+
+def _reading(entry: dict[str, Any], path: str) -> tuple[int, SensorValue]:
+    for key, expected in (("id", "a port number like 1"), ("value", _A_READING)):
         if key not in entry:
             raise CodecError(f"{path}.{key} is missing; expected {expected}")
     port = _port(entry["id"], f"{path}.id", "a port number like 1")
     if port < 0:
         raise CodecError(f"{path}.id {port} is not a port; expected a port number >= 0")
-    return port, _number(entry["value"], f"{path}.value")
+    return port, _sensor_value(entry["value"], f"{path}.value")
+
+
+def _sensor_value(value: Any, path: str) -> SensorValue:
+    if isinstance(value, _OutOfRange):
+        raise CodecError(f"{path} {_show(value)} is out of range; expected a finite number")
+    if isinstance(value, dict | list):
+        raise CodecError(f"{path} is {_kind_of(value)}; expected {_A_READING}")
+    if isinstance(value, str):
+        bad = _NOT_TEXT.search(value)
+        if bad is not None:
+            what = "a lone surrogate" if bad.group() >= "\ud800" else "a control character"
+            raise CodecError(
+                f"{path} {_show(value)} holds {what} (U+{ord(bad.group()):04X}) at character "
+                f"{bad.start() + 1}; expected text without control characters"
+            )
+        return value
+    if isinstance(value, bool) or value is None:
+        return value
+    return float(value)
