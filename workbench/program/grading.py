@@ -73,6 +73,8 @@ class Plan:
     noise_params: tuple[str, ...] = ()
     max_time: float | None = None
     kinds: str | None = None
+    #: what drives each run: made of the program's path, its key script and the kinds map
+    pilot: type[ProgramPilot] = ProgramPilot
 
     @property
     def runs(self) -> list[tuple[str, int]]:
@@ -80,7 +82,7 @@ class Plan:
         return [(maze, seed) for maze in self.mazes for seed in range(self.seeds)]
 
     def specs(self, submission: Submission) -> list[RunSpec]:
-        pilot = ProgramPilot(submission.path, keys=submission.keys, kinds=self.kinds)
+        pilot = self.pilot(submission.path, keys=submission.keys, kinds=self.kinds)
         return [
             RunSpec(
                 maze=maze,
