@@ -12,6 +12,7 @@ not load, crashes, hangs or blows its memory costs its own rows only: the reason
 
 from __future__ import annotations
 
+import faulthandler
 import multiprocessing
 import os
 import resource
@@ -19,7 +20,7 @@ import signal
 import time
 from collections import deque
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from multiprocessing.connection import Connection, wait
 from pathlib import Path
 from typing import Any
@@ -35,8 +36,6 @@ DEFAULT_DEADLINE = 60.0
 DEFAULT_MEMORY = 1024
 #: the longest refusal reason a row keeps (a program's problem can be long)
 MAX_REASON = 300
-#: what the grading processes import before they fork a program's process
-_PRELOAD = ["workbench.program.grading"]
 
 
 @dataclass(frozen=True)
@@ -156,8 +155,9 @@ def grade(
         else:
             pending.append(i)
     running: dict[Connection, _Child] = {}
-    context = multiprocessing.get_context("forkserver")
-    context.set_forkserver_preload(_PRELOAD)
+    # forked: a program's process starts with what this one has loaded, at once (a fresh
+    # interpreter would import the command's main module again for each program)
+    context = multiprocessing.get_context("fork")
     try:
         while pending or running:
             while pending and len(running) < max(1, jobs):
@@ -200,7 +200,7 @@ class _Child:
     """One program's process, as the parent sees it."""
 
     index: int
-    process: Any  # a multiprocessing process of the forkserver context
+    process: Any  # a multiprocessing process of the fork context
     conn: Connection
     deadline: float
     memory: int
@@ -269,20 +269,20 @@ class _Child:
 def _rows(submission: Submission, plan: Plan, outcome: _Outcome) -> list[Row]:
     rows = []
     for i, (maze, seed) in enumerate(plan.runs):
-        head = {
-            "student": submission.student,
-            "file": submission.file,
-            "program_sha256": submission.sha256,
-            "loads": outcome.loads,
-            "maze": Path(maze).name,
-            "seed": seed,
-        }
+        row = Row(
+            submission.student,
+            submission.file,
+            submission.sha256,
+            outcome.loads,
+            Path(maze).name,
+            seed,
+        )
         measures = outcome.measures.get(i)
         if measures is not None:
-            rows.append(Row(**head, **measures))
+            rows.append(replace(row, **measures))
         else:
             reason = outcome.refused.get(i) or outcome.stopped or "the run gave no result"
-            rows.append(Row(**head, refusal=_short(reason)))
+            rows.append(replace(row, refusal=_short(reason)))
     return rows
 
 
@@ -331,7 +331,9 @@ def _child_main(
 
 def _wall(memory: int, deadline: float) -> None:
     """The limits of a program's process: its address space, its processor time (a backstop
-    for the parent's deadline), no core files; its output goes nowhere."""
+    for the parent's deadline), no core files; its output (a crash's report too) goes
+    nowhere."""
+    faulthandler.disable()
     cap = memory << 20
     resource.setrlimit(resource.RLIMIT_AS, (cap, cap))
     seconds = int(deadline) + 5
