@@ -86,7 +86,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         type=int,
         default=DEFAULT_MEMORY,
         metavar="MIB",
-        help=f"address space of one program's process, in MiB (default {DEFAULT_MEMORY})",
+        help="address space one program's process may map beyond the grader's, in MiB "
+        f"(default {DEFAULT_MEMORY})",
     )
     g.add_argument(
         "--out",

@@ -330,19 +330,34 @@ def _child_main(
 
 
 def _wall(memory: int, deadline: float) -> None:
-    """The limits of a program's process: its address space, its processor time (a backstop
-    for the parent's deadline), no core files; its output (a crash's report too) goes
-    nowhere."""
+    """The limits of a program's process: ``memory`` MiB of address space beyond what it
+    was forked with, its processor time (a backstop for the parent's deadline), no core
+    files; its output (a crash's report too) goes nowhere."""
     faulthandler.disable()
-    cap = memory << 20
-    resource.setrlimit(resource.RLIMIT_AS, (cap, cap))
-    seconds = int(deadline) + 5
-    resource.setrlimit(resource.RLIMIT_CPU, (seconds, seconds + 5))
-    resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
+    _lower(resource.RLIMIT_AS, _mapped() + (memory << 20))
+    _lower(resource.RLIMIT_CPU, int(deadline) + 5)
+    _lower(resource.RLIMIT_CORE, 0)
     devnull = os.open(os.devnull, os.O_RDWR)
     for fd in (0, 1, 2):
         os.dup2(devnull, fd)
     os.close(devnull)
+
+
+def _lower(limit: int, value: int) -> None:
+    """Set ``limit`` to ``value``, or keep it where it is already lower."""
+    _, hard = resource.getrlimit(limit)
+    if hard != resource.RLIM_INFINITY:
+        value = min(value, hard)
+    resource.setrlimit(limit, (value, value))
+
+
+def _mapped() -> int:
+    """Bytes of address space this process has mapped (0 where ``/proc`` does not say)."""
+    try:
+        with open("/proc/self/statm") as fh:
+            return int(fh.read().split()[0]) * resource.getpagesize()
+    except (OSError, ValueError, IndexError):
+        return 0
 
 
 def _problems(exc: ProgramError) -> str:
