@@ -46,14 +46,17 @@ def register(sub: argparse._SubParsersAction) -> None:
         "and seed. A program that does not load, crashes, hangs or runs out of memory gets "
         "the reason in its rows; the others are graded as usual.",
     )
-    g.add_argument("folder", metavar="FOLDER")
+    g.add_argument("folder", metavar="FOLDER", help="the folder of the students' programs")
     g.add_argument("--lab", metavar="L", help="a bundled lab's id, or a lab file (.yaml)")
     g.add_argument("--exercise", metavar="E", help="the exercise of --lab to grade")
     g.add_argument(
         "--maze", nargs="+", default=[], metavar="M", help="without --lab: the mazes to grade on"
     )
     g.add_argument(
-        "--seeds", type=int, help="seeds 0..N-1 on each maze (default: the exercise's, else 1)"
+        "--seeds",
+        type=int,
+        metavar="N",
+        help="seeds 0..N-1 on each maze (default: the exercise's, else 1)",
     )
     _simulation_options(g)
     g.add_argument(
@@ -66,14 +69,18 @@ def register(sub: argparse._SubParsersAction) -> None:
     g.add_argument(
         "--max-time",
         type=float,
+        metavar="S",
         help="simulated seconds per run (default: the exercise's, else from the maze's size)",
     )
     key_options(g)
     g.add_argument("--kinds", metavar="MAP.yaml", help="names for unknown activity kinds")
     g.add_argument(
-        "--jobs", type=int, default=os.cpu_count() or 1, help="programs run at once (default: "
-        "the number of processors)",
-    )  # fmt: skip
+        "--jobs",
+        type=int,
+        default=os.cpu_count() or 1,
+        metavar="N",
+        help="programs run at once (default: the number of processors)",
+    )
     g.add_argument(
         "--deadline",
         type=float,
