@@ -118,3 +118,13 @@ def test_the_table_as_csv_and_json(tmp_path):
         "2 programs, 2 runs: 1 load, 1 reached the exit on every run, 1 refused on some run"
     )
     assert lines[1] == "  =cmd.viple: bad"
+
+
+def test_the_runs_a_program_finished_before_its_deadline_keep_their_measures(tmp_path):
+    right_wall(tmp_path / "later.viple")
+    plan = Plan(str(tmp_path), (RANK, WEB), profile="web", pilot=HostilePilot)
+    rows = grade(find_submissions(tmp_path), plan, limits=Limits(deadline=3))
+    first, second = rows
+    assert (first.maze, first.reached_exit, first.refusal) == ("rank-wall-wins.txt", True, "")
+    assert second.maze == "web.txt" and not second.reached_exit
+    assert second.refusal.startswith("stopped after 3 s of wall-clock time")

@@ -15,6 +15,7 @@ from __future__ import annotations
 import faulthandler
 import multiprocessing
 import os
+import pickle
 import resource
 import signal
 import time
@@ -221,21 +222,31 @@ class _Child:
 
     def take(self) -> bool:
         """Read what the process sent; True once it has ended (its pipe closed)."""
+        if self._read():
+            return False
+        self.process.join()
+        self._ended()
+        self.conn.close()
+        return True
+
+    def stop(self, reason: str) -> None:
+        """Kill the process; the runs it finished keep what it sent, the others get
+        ``reason``."""
+        self.process.kill()
+        self.process.join()
+        self._read()
+        self.conn.close()
+        self.outcome.stopped = self.outcome.stopped or reason
+
+    def _read(self) -> bool:
+        """Take every message waiting in the pipe; False once the pipe has closed (a message
+        cut short by a killed process is dropped)."""
         try:
             while self.conn.poll():
                 self._note(self.conn.recv())
-        except (EOFError, OSError):
-            self.process.join()
-            self._ended()
-            self.conn.close()
-            return True
-        return False
-
-    def stop(self, reason: str) -> None:
-        self.process.kill()
-        self.process.join()
-        self.conn.close()
-        self.outcome.stopped = self.outcome.stopped or reason
+        except (EOFError, OSError, pickle.UnpicklingError):
+            return False
+        return True
 
     def _note(self, message: tuple) -> None:
         what = message[0]
