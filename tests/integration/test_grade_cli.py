@@ -4,7 +4,10 @@ them."""
 from __future__ import annotations
 
 import csv
+import io
 import json
+import re
+import sys
 from pathlib import Path
 
 from tests.program.graded_programs import memory_hog, right_wall, runaway
@@ -135,3 +138,25 @@ def test_eval_presses_a_key_script_for_a_program_that_waits_for_one(tmp_path, ca
     (tmp_path / "follower.keys").write_text("a at 1")
     assert main(args) == 2
     assert "follower.keys: key 1 'a'" in capsys.readouterr().err
+
+
+class _Terminal(io.StringIO):
+    def isatty(self) -> bool:
+        return True
+
+
+def test_progress_on_a_terminal_names_each_program_then_the_summary(tmp_path, monkeypatch):
+    folder = tmp_path / "handins"
+    folder.mkdir()
+    right_wall(folder / "ana.viple")
+    (folder / "bo.viple").write_text("not a program")
+    terminal = _Terminal()
+    monkeypatch.setattr(sys, "stderr", terminal)
+    out = tmp_path / "t.csv"
+    assert main(["grade", str(folder), "--maze", WEB, "--profile", "web", "--out", str(out)]) == 0
+    shown = terminal.getvalue()
+    lines = sorted(re.findall(r"graded (\d) of 2: (\w+\.viple)", shown))
+    assert [n for n, _ in lines] == ["1", "2"]
+    assert sorted(name for _, name in lines) == ["ana.viple", "bo.viple"]
+    last = shown.rsplit("\r\x1b[K", 1)[1]  # the progress line is cleared before the summary
+    assert last.startswith("2 programs, 2 runs: 1 load, 1 reached the exit on every run")
