@@ -10,6 +10,7 @@ engine, each in a process of its own, and the bench prints programs per minute. 
 
 from __future__ import annotations
 
+import resource
 import sys
 import tempfile
 import time
@@ -41,21 +42,34 @@ def make_class(folder: Path) -> None:
         (folder / f"student{i:02d}.viple").write_bytes(good[: 200 * (i - 56)])
 
 
+def _cpu() -> float:
+    """Processor seconds of this process and its children that have ended."""
+    own = resource.getrusage(resource.RUSAGE_SELF)
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
+
+
 def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
         make_class(folder)
         submissions = find_submissions(folder)
         plan = Plan(str(folder), MAZES, profile="web")
+        cpu0 = _cpu()
         t0 = time.perf_counter()
         rows = grade(submissions, plan, jobs=JOBS, limits=Limits())
         took = time.perf_counter() - t0
+        cpu = _cpu() - cpu0
     programs = len(submissions)
     out = sum(r.reached_exit for r in rows)
     refused = sum(bool(r.refusal) for r in rows)
     print(f"{programs} programs x {len(MAZES)} mazes = {len(rows)} runs, {JOBS} at a time")
     print(f"  {out} runs reached the exit, {refused} refused")
     print(f"  {took:.1f} s: {programs / took * 60:.0f} programs per minute")
+    print(
+        f"  {cpu:.1f} processor seconds in all (the grader and the programs' processes): "
+        f"{cpu / JOBS:.1f} s on {JOBS} otherwise idle processors"
+    )
     met = took <= TARGET
     print(f"  target: {programs} programs x {len(MAZES)} mazes within {TARGET:g} s: "
           f"{'met' if met else 'NOT met'}")  # fmt: skip
