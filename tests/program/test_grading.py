@@ -23,7 +23,7 @@ RANK = str(MAZES / "rank-wall-wins.txt")
 
 
 def test_a_folder_holds_files_and_subfolders_one_student_each(tmp_path):
-    right_wall(tmp_path / "zoe.viple")
+    right_wall(tmp_path / "zoe.VIPLE")
     (tmp_path / "amy").mkdir()
     right_wall(tmp_path / "amy" / "walls.viple", start_key="a")
     (tmp_path / "amy" / "walls.keys").write_text("a@0.5\nrelease@40\n")
@@ -32,9 +32,9 @@ def test_a_folder_holds_files_and_subfolders_one_student_each(tmp_path):
     right_wall(tmp_path / "two" / "a.viple")
     right_wall(tmp_path / "two" / "b.viple")
     (tmp_path / "empty").mkdir()
-    (tmp_path / "badkeys.viple").write_bytes((tmp_path / "zoe.viple").read_bytes())
+    (tmp_path / "badkeys.viple").write_bytes((tmp_path / "zoe.VIPLE").read_bytes())
     (tmp_path / "badkeys.keys").write_text("w at 3")
-    (tmp_path / "link.viple").symlink_to(tmp_path / "zoe.viple")
+    (tmp_path / "link.viple").symlink_to(tmp_path / "zoe.VIPLE")
     (tmp_path / ".hidden.viple").write_text("<Program/>")
     (tmp_path / "readme.txt").write_text("not a program")
 
@@ -44,6 +44,7 @@ def test_a_folder_holds_files_and_subfolders_one_student_each(tmp_path):
     assert (amy.file, amy.keys, amy.refused) == ("amy/walls.viple", "a@0.5 release@40", "")
     assert len(amy.sha256) == 64
     assert zoe.keys == "d@1" and not zoe.refused  # the common script, having none of its own
+    assert zoe.file == "zoe.VIPLE"
     assert "badkeys.keys: key 1 'w'" in badkeys.refused and "KEY@SECONDS" in badkeys.refused
     assert empty.refused == "the folder holds no .viple program"
     assert link.refused == "a symbolic link: hand in the file"

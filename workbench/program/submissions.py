@@ -2,9 +2,9 @@
 
 Two layouts, mixed freely: a ``*.viple`` file right in the folder is one student's program
 (the student is the file's name without ``.viple``), and a subfolder is one student's (the
-student is the subfolder's name) holding exactly one ``*.viple`` file. Files and folders whose
-names start with a dot, and files of other kinds, are passed over. A program's own key script
-is the file ``NAME.keys`` beside it (:mod:`.keyfiles`).
+student is the subfolder's name) holding exactly one ``*.viple`` file; ``.VIPLE`` counts too.
+Files and folders whose names start with a dot, and files of other kinds, are passed over. A
+program's own key script is the file ``NAME.keys`` beside it (:mod:`.keyfiles`).
 
 The folder is the students' work, so everything in it is taken as hostile: a symbolic link,
 a subfolder with no program or with several, a program too big to read or a bad key script
@@ -54,15 +54,21 @@ def find_submissions(folder: str | os.PathLike, keys: str = "") -> list[Submissi
     for entry in entries:
         if entry.name.startswith("."):
             continue
-        student = shown_name(entry.name.removesuffix(PROGRAM_SUFFIX))
+        program = is_program(entry.name)
+        student = shown_name(entry.name[: -len(PROGRAM_SUFFIX)] if program else entry.name)
         if entry.is_symlink():
-            if entry.name.endswith(PROGRAM_SUFFIX) or _is_dir(entry.path):
+            if program or _is_dir(entry.path):
                 found.append(_refused(student, entry.name, "a symbolic link: hand in the file"))
-        elif entry.is_file() and entry.name.endswith(PROGRAM_SUFFIX):
+        elif entry.is_file() and program:
             found.append(_submission(root, student, entry.name, keys))
         elif entry.is_dir():
             found.append(_from_subfolder(root, entry.name, keys))
     return sorted(found, key=lambda s: (s.student, s.file))
+
+
+def is_program(name: str) -> bool:
+    """A program's file name: ``NAME.viple``, in any case (``NAME.VIPLE`` too)."""
+    return name.lower().endswith(PROGRAM_SUFFIX) and len(name) > len(PROGRAM_SUFFIX)
 
 
 def _is_dir(path: str) -> bool:
@@ -78,9 +84,7 @@ def _from_subfolder(root: Path, name: str, keys: str) -> Submission:
         entries = sorted(os.scandir(root / name), key=lambda e: e.name)
     except OSError as exc:
         return _refused(student, name, f"cannot read the folder: {exc.strerror}")
-    programs = [
-        e.name for e in entries if e.name.endswith(PROGRAM_SUFFIX) and not e.name.startswith(".")
-    ]
+    programs = [e.name for e in entries if is_program(e.name) and not e.name.startswith(".")]
     if not programs:
         return _refused(student, name, f"the folder holds no {PROGRAM_SUFFIX} program")
     if len(programs) > 1:
