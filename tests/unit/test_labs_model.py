@@ -235,3 +235,35 @@ def test_a_set_up_speed_is_read_and_a_wrong_one_is_named(tmp_path):
     with pytest.raises(LabFileError) as err:
         load_lab(path)
     assert "setup: unknown speed '3' (hint: use one of 1, 2, 4, 10, max)" in str(err.value)
+
+
+def test_an_exercise_says_what_its_students_programs_are_graded_on(folder):
+    exit_obj = (
+        "      - kind: exit\n        text: out\n        maze: mazes/other.txt\n"
+        "        driver: viple\n"
+    )
+    shutil.copy(Path("mazes/web.txt"), folder / "mazes" / "other.txt")
+    base = good_text().replace("      - kind: questions\n", exit_obj + "      - kind: questions\n")
+    graded = load_lab(write(folder, base)).exercises[0].graded
+    # by default: the set-up's maze and each exit objective's, seed 0, time from the maze
+    assert [m.path.name for m in graded.mazes] == ["m.txt", "other.txt"]
+    assert (graded.seeds, graded.max_time) == (1, None)
+
+    def with_grading(lines):
+        return write(
+            folder, base.replace("    signoff: required\n", lines + "    signoff: required\n")
+        )
+
+    own = "    grading:\n      mazes: [mazes/other.txt]\n      seeds: 3\n      max_time: 300\n"
+    graded = load_lab(with_grading(own)).exercises[0].graded
+    assert ([m.path.name for m in graded.mazes], graded.seeds, graded.max_time) == (
+        ["other.txt"],
+        3,
+        300.0,
+    )
+    with pytest.raises(LabFileError, match=r":28:\d+: .*grading: seeds must be a whole number"):
+        load_lab(with_grading(own.replace("seeds: 3", "seeds: 2.5")))
+    with pytest.raises(LabFileError, match=r":29:\d+: .*grading: max_time must be above 0"):
+        load_lab(with_grading(own.replace("max_time: 300", "max_time: 0")))
+    with pytest.raises(LabFileError, match=r":27:\d+: .*grading: no file 'mazes/gone.txt'"):
+        load_lab(with_grading(own.replace("mazes/other.txt", "mazes/gone.txt")))

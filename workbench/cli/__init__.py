@@ -14,6 +14,7 @@ from workbench.labs.store import StoreError, resolve_db
 from workbench.tui.settings import AppSettings
 
 from . import algorithms as algorithms_cmd
+from . import grade as grade_cmd
 from . import instructor as instructor_cmd
 from . import labs as labs_cmd
 from . import maze as maze_cmd
@@ -100,6 +101,7 @@ def build_parser() -> argparse.ArgumentParser:
     maze_cmd.register(sub)
     algorithms_cmd.register(sub)
     run_cmd.register(sub)
+    grade_cmd.register(sub)
     viple_program_cmd.register(sub)
     labs_cmd.register(sub)
     serve_cmd.register(sub)

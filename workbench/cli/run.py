@@ -16,6 +16,8 @@ from workbench.control.evaluate import (
     write_csv,
 )
 from workbench.control.headless import AlgorithmPilot, RunResult, RunSetupError, RunSpec, run
+from workbench.program.keyfiles import program_keys, read_key_file
+from workbench.program.keys import KeyScriptError, parse_key_script
 from workbench.program.pilot import program_entrant
 from workbench.sim.metrics import TURN_MIN_DEGREES
 from workbench.sim.noise import NOISE_LEVELS
@@ -71,6 +73,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         metavar="KIND:PORT:MOUNT",
         help="the robot's sensors for the programs (default: the profile's)",
     )
+    key_options(e)
     e.add_argument("--kinds", metavar="MAP.yaml", help="names for unknown activity kinds")
     _simulation_options(e)
     e.add_argument("--seeds", type=int, default=3, help="seeds 0..N-1 (default 3)")
@@ -82,6 +85,27 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     e.add_argument("--json", action="store_true", help="one JSON object")
     e.set_defaults(func=cmd_eval)
+
+
+def key_options(parser: argparse.ArgumentParser) -> None:
+    """``--keys`` and ``--keys-file``: the key script of the programs without their own."""
+    keys = parser.add_mutually_exclusive_group()
+    keys.add_argument(
+        "--keys",
+        default="",
+        metavar="SCRIPT",
+        help='keys pressed in every run of a program, e.g. "a@0.2 release@1" (a program\'s '
+        "own NAME.keys file beside it comes first)",
+    )
+    keys.add_argument("--keys-file", metavar="FILE", help="the same, read from a file")
+
+
+def common_keys(args: argparse.Namespace) -> str:
+    """The key script ``--keys`` or ``--keys-file`` gives (KeyScriptError when it is bad)."""
+    if args.keys_file:
+        return read_key_file(args.keys_file)
+    parse_key_script(args.keys)
+    return str(args.keys)
 
 
 def cmd_run(args: argparse.Namespace) -> int:
@@ -163,6 +187,12 @@ def cmd_eval(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 2
+    try:
+        keys = common_keys(args)
+        scripts = [program_keys(path, keys) for path in args.program]
+    except KeyScriptError as exc:
+        print(f"workbench eval: {exc}", file=sys.stderr)
+        return 2
     bases = [os.path.basename(p) for p in args.program]
     programs = [
         program_entrant(
@@ -174,8 +204,9 @@ def cmd_eval(args: argparse.Namespace) -> int:
             noise=args.noise,
             noise_params=tuple(args.noise_set),
             max_time=args.max_time,
+            keys=script,
         )
-        for path, base in zip(args.program, bases, strict=True)
+        for path, base, script in zip(args.program, bases, scripts, strict=True)
     ]
     try:
         result = evaluate(

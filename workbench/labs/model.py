@@ -201,6 +201,17 @@ class Objective:
 
 
 @dataclass(frozen=True)
+class Grading:
+    """What ``workbench grade`` runs each student's program on for an exercise."""
+
+    mazes: tuple[LabMaze, ...]
+    #: seeds 0..seeds-1 on every maze
+    seeds: int = 1
+    #: simulated seconds per run (None: from the maze's size)
+    max_time: float | None = None
+
+
+@dataclass(frozen=True)
 class Exercise:
     id: str
     title: str
@@ -209,6 +220,21 @@ class Exercise:
     objectives: tuple[Objective, ...]
     questions: tuple[Question, ...] = ()
     signoff: bool = True
+    #: the exercise's ``grading:`` (None: the defaults, see :attr:`graded`)
+    grading: Grading | None = None
+
+    @property
+    def graded(self) -> Grading:
+        """How the exercise is graded: its ``grading:``, else the set-up's maze and every
+        ``exit`` objective's maze, once each, with seed 0."""
+        if self.grading is not None:
+            return self.grading
+        mazes = [self.setup.maze]
+        for objective in self.objectives:
+            if objective.kind == "exit" and objective.maze is not None:
+                mazes.append(objective.maze)
+        unique = {m.path: m for m in mazes}
+        return Grading(tuple(unique.values()))
 
 
 @dataclass(frozen=True)
@@ -329,7 +355,7 @@ def _exercise(r: _Reader, node: yaml.Node) -> Exercise:
         node,
         "exercise",
         ("id", "title", "instructions", "setup", "objectives"),
-        ("questions", "signoff"),
+        ("questions", "signoff", "grading"),
     )
     ex_id = r.text(keys["id"], "exercise")
     where = f"exercise {ex_id!r}"
@@ -362,7 +388,32 @@ def _exercise(r: _Reader, node: yaml.Node) -> Exercise:
         _setup(r, keys["setup"], where),
         objectives,
         questions,
+        grading=_grading(r, keys["grading"], where) if "grading" in keys else None,
     )
+
+
+#: the most seeds an exercise's grading may ask for
+MAX_GRADING_SEEDS = 100
+
+
+def _grading(r: _Reader, node: yaml.Node, where: str) -> Grading:
+    here = f"{where}: grading"
+    keys = r.mapping(node, here, ("mazes",), ("seeds", "max_time"))
+    mazes = tuple(r.maze(n, here) for n in r.items(keys["mazes"], here))
+    seeds = 1
+    if "seeds" in keys:
+        value = r.number(keys["seeds"], f"{here}: seeds", minimum=1)
+        if value != int(value) or value > MAX_GRADING_SEEDS:
+            r.fail(keys["seeds"], here, f"seeds must be a whole number from 1 to "
+                   f"{MAX_GRADING_SEEDS}", "write e.g. 'seeds: 3'")  # fmt: skip
+        seeds = int(value)
+    max_time = None
+    if "max_time" in keys:
+        max_time = r.number(keys["max_time"], f"{here}: max_time")
+        if not 0 < max_time <= 24 * 3600:
+            r.fail(keys["max_time"], here, "max_time must be above 0 and at most a day",
+                   "write simulated seconds, e.g. 'max_time: 300'")  # fmt: skip
+    return Grading(mazes, seeds, max_time)
 
 
 def _setup(r: _Reader, node: yaml.Node, where: str) -> Setup:

@@ -158,13 +158,15 @@ def program_entrant(
     noise: str | None = None,
     noise_params: tuple[str, ...] = (),
     max_time: float | None = None,
+    keys: str = "",
 ) -> Entrant:
-    """A program in ``workbench eval`` (named ``name``, default its path), on each maze and seed."""
+    """A program in ``workbench eval`` (named ``name``, default its path), on each maze and
+    seed, with the key script ``keys`` pressed in every run."""
 
     def spec(maze: str, seed: int) -> RunSpec:
         return RunSpec(
             maze=maze,
-            pilot=ProgramPilot(path, kinds=kinds),
+            pilot=ProgramPilot(path, keys=keys, kinds=kinds),
             profile=profile,
             sensors=sensors,
             seed=seed,
