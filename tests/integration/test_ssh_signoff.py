@@ -100,11 +100,9 @@ async def test_the_instructor_signs_from_their_own_session_and_the_student_sees_
             instructor.send(PASSPHRASE)  # typed in the instructor's own terminal
             await instructor.wait_for("•" * len(PASSPHRASE))
             instructor.send("\t")
-            await asyncio.sleep(0.2)  # a person's pace between keys: focus moves first
             instructor.send("checked at the console")
             await instructor.wait_for("at the console")
             instructor.send("\t")
-            await asyncio.sleep(0.2)  # a person's pace between keys: focus moves first
             instructor.send(" ")  # the override, ticked
             await instructor.wait_for("[X] Override")
             instructor.send("\x13")  # ctrl+s signs

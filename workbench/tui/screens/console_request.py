@@ -186,7 +186,8 @@ class RequestScreen(Screen[str | None]):
         self.roster, self.roster_problem = await asyncio.to_thread(roster_names, self.store)
         form = self.query_one(SignoffForm)
         form.set_roster(self.roster)
-        form.focus_first()
+        if not form.entry().passphrase:  # not while the instructor is typing it
+            form.focus_first()
         self._say(self.roster_problem)
         try:
             request = await asyncio.to_thread(read_request, self.store, self.entry, self.labs)
