@@ -154,8 +154,8 @@ def many_whiles(count: int = 2_000) -> str:
 
 
 def many_attributes(count: int = 340_000) -> str:
-    """One element with ``count`` attributes."""
-    attributes = " ".join(f"a{k}='1'" for k in range(count))
+    """One element with ``count`` attributes, one a line."""
+    attributes = "\n".join(f"a{k}=''" for k in range(count))
     return f'<?xml version="1.0"?>\n<Program {attributes}><Version>4.0</Version></Program>\n'
 
 

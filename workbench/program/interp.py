@@ -579,9 +579,8 @@ class ProgramController:
         self._stop(
             aid,
             f"the program holds values of {held:,} parts written out (at most "
-            f"{self.limits.memory:,}; {where[aid]:,} of them here, in "
-            f"{sum(f.activity == aid for f in flows):,} messages on their way and the ones "
-            "waiting at it): does a loop make messages faster than they are used?",
+            f"{self.limits.memory:,}; {where[aid]:,} of them in messages on their way to this "
+            "activity or waiting at it): does a loop make messages faster than they are used?",
         )
 
     def _all_joins(self) -> list[dict[int, list[deque[Value]]]]:
