@@ -61,10 +61,12 @@ MAX_JOIN_QUEUE = 1_000
 class Limits:
     """What one program may use; past any of them it is stopped with a message."""
 
-    #: activities run in one control tick, all flows together (the rest wait for the next)
-    tick: int = 10_000
-    #: activities run in one simulated second, all flows together
-    second: int = 100_000
+    #: activities run in one control tick, all flows together (the rest wait for the next);
+    #: real programs run at most about 50 in a tick
+    tick: int = 2_500
+    #: activities run in the last simulated second, all flows together (real programs run a
+    #: few hundred): a program may compute in bursts, but not without pause
+    second: int = 50_000
     #: parts of the values the program holds at once, written out (a text counts one part
     #: for each 100 characters): messages on their way, waiting at Joins, in variables
     memory: int = 1_000_000
@@ -192,10 +194,11 @@ class ProgramController:
         self.state: str | None = None
         #: why and where the program was stopped (None while it may run)
         self.stopped: RunError | None = None
-        #: the simulated second being counted, the activities run in it, and where flows
-        #: were at the end of each slice in it (the busiest is named if the budget runs out)
-        self._second = 0
+        #: the activities run at each run of the last simulated second, and their sum
+        self._window: deque[tuple[float, int]] = deque()
         self._second_steps = 0
+        #: where flows were at the end of each slice, and how many activities they had run
+        #: there (the busiest is named if the budget runs out)
         self._hot: dict[int, int] = {}
         #: parts of the messages waiting at Joins
         self._join_parts = 0
@@ -338,9 +341,11 @@ class ProgramController:
         self._ready.append(Flow(next(self._numbers), aid, value, frame, in_pin))
 
     def _run(self) -> list[Any]:
-        second = int(self.now + 1e-9)
-        if second != self._second:
-            self._second, self._second_steps, self._hot = second, 0, {}
+        window = self._window
+        while window and window[0][0] <= self.now - 1.0 + 1e-9:
+            self._second_steps -= window.popleft()[1]
+        if not window:
+            self._hot = {}
         total = 0
         budget = min(self.limits.tick, self.limits.second - self._second_steps)
         ready = self._ready
@@ -370,6 +375,8 @@ class ProgramController:
             total += done
         self.steps += total
         self._second_steps += total
+        if total:
+            window.append((self.now, total))
         if (ready or self._parked) and self._second_steps >= self.limits.second:
             self._over_work()
         elif self._parked or ready or self._join_parts:
