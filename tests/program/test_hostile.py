@@ -231,3 +231,44 @@ def test_hundreds_of_thousands_of_attributes_or_elements_are_refused_before_buil
         f"{tmp_path / 'hostile.viple'}: the file has 399,005 tags; a VIPLE program has at most "
         "150,000 elements (check that this is a VIPLE program file)"
     ]
+
+
+# -- where programs run --------------------------------------------------------------------------
+
+
+@pytest.mark.timeout(60)
+def test_the_station_stops_a_runaway_program_and_says_where(tmp_path):
+    from workbench.control.station import PROGRAM_STOPPED, LabStation
+    from workbench.program.choice import choose_program
+    from workbench.sim.mazefile import parse_maze
+
+    path = tmp_path / "spin.viple"
+    path.write_text(hostile.merge_spin())
+    room = parse_maze("#######\n#.....#\n#..S..#\n#.....#\n#######\n", source="room.txt")
+    station = LabStation.open(room, "unity", noise="off")
+    choose_program(station, str(path))
+    station.start()
+    for _ in range(3 * 60):
+        station.step()
+        if station.notice is not None:
+            break
+    notice = station.notice
+    assert notice is not None and notice.kind == PROGRAM_STOPPED
+    assert "panel Main: activity 3 (Calculate): the program ran 50,000 activities" in notice.detail
+    assert station.driving is None and station.paused
+    assert station.runs[-1].ended == "error"
+
+
+@pytest.mark.timeout(120)
+def test_eval_ranks_hostile_programs_each_on_its_own_row(tmp_path, capsys):
+    paths = []
+    for name in ("merge_spin", "join_doubling", "number_doubling"):
+        path = tmp_path / f"{name}.viple"
+        path.write_text(getattr(hostile, name)())
+        paths.append(str(path))
+    args = ["eval", "--maze", WEB_MAZE, "--program", *paths, "--algorithm", "right-wall"]
+    assert main([*args, "--max-time", "5", "--seeds", "1", "--jobs", "1", "--json"]) == 0
+    cells = {c["algorithm"]: c for c in json.loads(capsys.readouterr().out)["cells"]}
+    assert set(cells) == {"right-wall", "merge_spin.viple", "join_doubling.viple",
+                          "number_doubling.viple"}  # fmt: skip
+    assert all(cell["runs"] == 1 for cell in cells.values())
