@@ -31,6 +31,7 @@ from __future__ import annotations
 import argparse
 import asyncio
 import contextlib
+import re
 import sys
 import tempfile
 import time
@@ -169,34 +170,39 @@ async def storm_terminal(port: int, key, notes: list[str]) -> None:
 async def run_program(port: int, key, name: str, notes: list[str]) -> None:
     """Mallory loads ``~/NAME.viple`` in the algorithm dialog and starts it, then watches."""
     mallory = Student("mallory", key, port, Result(), "127.0.8.9", "asyncssh", Path())
-    async with mallory.terminal() as write:
-        if write is None or not await mallory.wait_for(b"Who is at this robot", 0, 60):
-            notes.append("mallory could not log in")
-            return
-        write(b"\r")
-        if not await mallory.wait_for(b"running", 0, 60):
-            notes.append("mallory saw no main screen")
-            return
-        mark = len(mallory.buffer)
-        write(b"g")
-        if not await mallory.wait_for(b"Built-in", mark, 10):
-            notes.append("no algorithm dialog")
-            return
-        write(b"\t")
-        await asyncio.sleep(0.3)
-        mark = len(mallory.buffer)
-        write(f"~/{name}.viple\r".encode())
-        if not await mallory.wait_for(b"chose the program", mark, 30):
-            notes.append(f"{name} did not load: {bytes(mallory.buffer[-200:])!r}")
-            return
-        await asyncio.sleep(0.3)
-        mark = len(mallory.buffer)
-        started = time.perf_counter()
-        write(b"\r")  # Start
-        if await mallory.wait_for(b"program stopped", mark, 3600):
-            notes.append(f"mallory's screen said the program stopped after "
-                         f"{time.perf_counter() - started:.1f} s")  # fmt: skip
-        await asyncio.Event().wait()
+    stage = "logging in"
+    began = time.perf_counter()
+    try:
+        async with mallory.terminal() as write:
+            if write is None or not await mallory.wait_for(b"Who is at this robot", 0, 60):
+                return
+            write(b"\r")
+            if not await mallory.wait_for(b"running", 0, 60):
+                return
+            stage = "opening the algorithm dialog"
+            mark = len(mallory.buffer)
+            write(b"g")
+            if not await mallory.wait_for(b"Built-in", mark, 10):
+                return
+            write(b"\t")
+            await asyncio.sleep(0.3)
+            stage = "loading the program"
+            mark = len(mallory.buffer)
+            write(f"~/{name}.viple\r".encode())
+            if not await mallory.wait_for(b"stops it", mark, 30):  # the program's summary
+                return
+            await asyncio.sleep(1.0)
+            stage = "running the program"
+            mark = len(mallory.buffer)
+            started = time.perf_counter()
+            write(b"\r")  # Start
+            if await mallory.wait_for(b"stopped at", mark, 3600):
+                stage = f"stopped {time.perf_counter() - started:.1f} s after it started"
+            await asyncio.Event().wait()
+    finally:
+        shown = re.sub(rb"\x1b\[[0-9;?]*[A-Za-z]", b" ", bytes(mallory.buffer[-3000:]))
+        tail = "" if stage.startswith("stopped") else f"; her screen ends {shown[-200:]!r}"
+        notes.append(f"mallory's program: {stage} ({time.perf_counter() - began:.0f} s){tail}")
 
 
 LATE_KEY = asyncssh.generate_private_key("ssh-ed25519")
