@@ -58,7 +58,8 @@ def test_a_join_message_nesting_forever_is_refused_at_the_join(tmp_path):
     error = c.errors[0]
     assert (error.activity, error.label) == (4, "Join")
     assert f"Joins {MAX_MESSAGE_DEPTH + 1} deep (at most {MAX_MESSAGE_DEPTH})" in error.message
-    assert live_flows(c) == 0  # the loop ended there: nothing more is held
+    assert c.stopped == error and c.state == "stopped"
+    assert live_flows(c) == 0  # the program stopped there: nothing more is held
 
 
 @pytest.mark.timeout(60)
@@ -67,6 +68,7 @@ def test_a_join_fed_twice_from_one_merge_and_printed_is_refused_not_written_out(
     run(c, 2.0)
     assert [(e.activity, e.label) for e in c.errors] == [(3, "Join")]
     assert "parts written out (at most 20,000)" in c.errors[0].message
+    assert c.stopped == c.errors[0]
     assert c.printed and max(len(p.text) for p in c.printed) <= 1000
 
 
@@ -97,7 +99,7 @@ def test_doubling_a_global_is_refused_at_the_calculate_and_recorded_without_a_tr
     args = ["viple", "run", str(path), "--maze", WEB_MAZE, "--max-time", "2"]
     assert main([*args, "--record", str(record), "--json"]) == 1
     data = json.loads(capsys.readouterr().out)
-    assert len(data["errors"]) == 1
+    assert len(data["errors"]) == 1 and data["stopped"] == data["errors"][0]
     assert "activity 4 (Calculate): column 9: the number grew past the range of a 64-bit" in (
         data["errors"][0]
     )

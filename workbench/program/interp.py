@@ -36,6 +36,7 @@ from .viple_expr import (
     INT_LIMIT,
     ExprError,
     JoinMessage,
+    LimitError,
     Scope,
     Value,
     join_message,
@@ -350,7 +351,7 @@ class ProgramController:
         budget = min(self.limits.tick, self.limits.second - self._second_steps)
         ready = self._ready
         hot = self._hot
-        while ready and total < budget:
+        while ready and total < budget and self.stopped is None:
             flow = ready.popleft()
             if flow.steps >= FLOW_TICK_STEPS:
                 self._parked.append(flow)
@@ -377,7 +378,9 @@ class ProgramController:
         self._second_steps += total
         if total:
             window.append((self.now, total))
-        if (ready or self._parked) and self._second_steps >= self.limits.second:
+        if self.stopped is not None:
+            pass
+        elif (ready or self._parked) and self._second_steps >= self.limits.second:
             self._over_work()
         elif self._parked or ready or self._join_parts:
             self._check_memory()
@@ -398,6 +401,9 @@ class ProgramController:
         act = self.program.activities[flow.activity]
         try:
             return self._execute(flow, act)
+        except LimitError as exc:
+            self._stop(act.id, str(exc))
+            return False
         except (ExprError, ValueError, TypeError, OverflowError) as exc:
             self._error(act.id, str(exc))
             return False
@@ -661,7 +667,7 @@ def convert(value: Value, vtype: str) -> Value:
             return float(value)
         whole = round(value)
         if not -INT_LIMIT <= whole < INT_LIMIT:
-            raise ValueError("the number is past the range of a 64-bit whole number")
+            raise LimitError("the number is past the range of a 64-bit whole number")
         return whole
     if vtype == "System.Boolean":
         if isinstance(value, str) and value.strip().lower() in ("true", "false"):

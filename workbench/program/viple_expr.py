@@ -55,6 +55,11 @@ class ExprError(ValueError):
         return f"{where}{self.message}" + (f" ({self.hint})" if self.hint else "")
 
 
+class LimitError(ExprError):
+    """A value past the bounds every program keeps to (a number's range, a text's length, a
+    Join message's size): a program that meets one is stopped, not only the flow."""
+
+
 @dataclass
 class Scope:
     """What an expression reads: the message, the globals, the block's parameters, a Join's
@@ -89,20 +94,20 @@ def parts_of(value: Value) -> int:
 
 
 def join_message(parts: dict[str, Value]) -> JoinMessage:
-    """The message a Join sends; ValueError when it would nest too deep or grow too large (a
-    loop that feeds the Join's message back into it)."""
+    """The message a Join sends; :class:`LimitError` when it would nest too deep or grow too
+    large (a loop that feeds the Join's message back into it)."""
     message = JoinMessage(parts)
     message.depth = 1 + max(
         (v.depth for v in parts.values() if isinstance(v, JoinMessage)), default=0
     )
     message.parts = 1 + sum(parts_of(v) for v in parts.values())
     if message.depth > MAX_MESSAGE_DEPTH:
-        raise ValueError(
+        raise LimitError(
             f"its message would hold Joins {message.depth} deep (at most {MAX_MESSAGE_DEPTH}): "
             "does a loop bring the Join's own message back into it?"
         )
     if message.parts > MAX_MESSAGE_PARTS:
-        raise ValueError(
+        raise LimitError(
             f"its message would have {message.parts:,} parts written out (at most "
             f"{MAX_MESSAGE_PARTS:,}): does a loop bring the Join's own message back into it?"
         )
@@ -115,13 +120,13 @@ def bounded(value: Value, col: int | None = None) -> Value:
         return value
     if isinstance(value, int):
         if not -INT_LIMIT <= value < INT_LIMIT:
-            raise ExprError(
+            raise LimitError(
                 "the number grew past the range of a 64-bit whole number",
                 col,
                 "does a loop keep adding or multiplying it?",
             )
     elif isinstance(value, float) and not math.isfinite(value):
-        raise ExprError(
+        raise LimitError(
             "the number grew past the range of a Double",
             col,
             "does a loop keep adding or multiplying it?",
@@ -601,7 +606,7 @@ def _arith(op: str, a: Fn, b: Fn, col: int) -> Fn:
         if op == "&" or (op == "+" and (isinstance(x, str) or isinstance(y, str))):
             text = show(x) + show(y)
             if len(text) > MAX_TEXT:
-                raise ExprError(f"the text grew past {MAX_TEXT:,} characters", col)
+                raise LimitError(f"the text grew past {MAX_TEXT:,} characters", col)
             return text
         if not (_number(x) and _number(y)):
             raise ExprError(f"{op} needs numbers, not {type_name(x)} and {type_name(y)}", col)
