@@ -196,12 +196,14 @@ async def run_program(port: int, key, name: str, notes: list[str]) -> None:
             mark = len(mallory.buffer)
             started = time.perf_counter()
             write(b"\r")  # Start
-            if await mallory.wait_for(b"stopped at", mark, 3600):
-                stage = f"stopped {time.perf_counter() - started:.1f} s after it started"
+            if await mallory.wait_for(b"stopped", mark, 3600):  # the program, or its record
+                line = re.search(rb"(program|recording) stopped[^\x1b]{0,60}", mallory.buffer)
+                said = line.group().decode(errors="replace").strip() if line else "stopped"
+                stage = f"{said!r} {time.perf_counter() - started:.1f} s after it started"
             await asyncio.Event().wait()
     finally:
         shown = re.sub(rb"\x1b\[[0-9;?]*[A-Za-z]", b" ", bytes(mallory.buffer[-3000:]))
-        tail = "" if stage.startswith("stopped") else f"; her screen ends {shown[-200:]!r}"
+        tail = "" if "after it started" in stage else f"; her screen ends {shown[-200:]!r}"
         notes.append(f"mallory's program: {stage} ({time.perf_counter() - began:.0f} s){tail}")
 
 
