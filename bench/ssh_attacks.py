@@ -189,9 +189,9 @@ async def run_program(port: int, key, name: str, notes: list[str]) -> None:
             stage = "loading the program"
             mark = len(mallory.buffer)
             write(f"~/{name}.viple\r".encode())
-            if not await mallory.wait_for(b"stops it", mark, 30):  # the program's summary
+            if not await mallory.wait_for(b"runs it", mark, 30):  # "Start (or x) runs it"
                 return
-            await asyncio.sleep(1.0)
+            await asyncio.sleep(0.5)  # the Start button has the focus
             stage = "running the program"
             mark = len(mallory.buffer)
             started = time.perf_counter()
