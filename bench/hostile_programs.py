@@ -35,7 +35,7 @@ CHECKED = (
 )
 RUN = ("join_nesting", "join_doubling", "number_doubling", "record_flood", "merge_spin")
 #: words in the output that say how the program ended, most telling first
-TELLING = ("STOPPED at", "run record ", "errors:", ": ", "ok (")
+TELLING = ("STOPPED at", "run record ", "too tangled", "errors:", ": ", "ok (")
 
 
 def measure(args: list[str], timeout: float) -> tuple[float, float, str]:

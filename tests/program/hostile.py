@@ -118,7 +118,7 @@ def long_comment(length: int = 190_000) -> str:
     return b.xml()
 
 
-def while_lattice(width: int = 40, rows: int = 40) -> str:
+def while_lattice(width: int = 60, rows: int = 45) -> str:
     """Whiles in a grid, each leading to the two below it, and End Whiles at the bottom:
     every While's body reaches a large share of the others."""
     b = ProgramBuilder()
@@ -138,17 +138,15 @@ def while_lattice(width: int = 40, rows: int = 40) -> str:
 
 
 def many_whiles(count: int = 2_000) -> str:
-    """``count`` While loops one after the other, each with a Calculate in its body."""
+    """``count`` While loops one after the other."""
     b = ProgramBuilder()
     main = b.panel("Main")
     previous = main.add(DATA, "0")
     for _ in range(count):
         loop = main.add(WHILE, "value < 1")
-        body = main.add(CALC, "value + 1")
         end = main.add(END_WHILE)
         b.link(previous, loop)
-        b.link(loop, body)
-        b.link(body, end)
+        b.link(loop, end)
         previous = end
     return b.xml()
 
