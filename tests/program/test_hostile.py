@@ -100,8 +100,9 @@ def test_doubling_a_global_is_refused_at_the_calculate_and_recorded_without_a_tr
     assert main([*args, "--record", str(record), "--json"]) == 1
     data = json.loads(capsys.readouterr().out)
     assert len(data["errors"]) == 1 and data["stopped"] == data["errors"][0]
-    assert "activity 4 (Calculate): column 9: the number grew past the range of a 64-bit" in (
-        data["errors"][0]
+    assert (
+        "activity 4 (Calculate): column 9: the number grew past the range of a 64-bit"
+        in (data["errors"][0])
     )
     kept = read_record(record)
     assert kept.summary is not None
@@ -267,3 +268,22 @@ def test_eval_ranks_hostile_programs_each_on_its_own_row(tmp_path, capsys):
     assert set(cells) == {"right-wall", "merge_spin.viple", "join_doubling.viple",
                           "number_doubling.viple"}  # fmt: skip
     assert all(cell["runs"] == 1 for cell in cells.values())
+
+
+def test_long_names_and_crowded_elements_are_refused(tmp_path):
+    b = ProgramBuilder()
+    main_panel = b.panel("Main")
+    main_panel.add(3, "1", name="n" * 5_000)
+    b.var("v" * 300)
+    found = problems(b.xml(), tmp_path)
+    assert any("activity 1: its Name is 5,000 characters; at most 200" in p for p in found)
+    assert any("a variable's name is 300 characters; at most 200" in p for p in found)
+    crowded = ProgramBuilder()
+    crowded.panel("Main").add(3, "1")
+    text = crowded.xml().replace(
+        "<Version>", "<Version " + " ".join(f"a{k}=''" for k in range(40)) + ">"
+    )
+    assert problems(text, tmp_path) == [
+        f"{tmp_path / 'hostile.viple'}: an element has 40 attributes; a VIPLE program has at most "
+        "16 on one (check that this is a VIPLE program file)"
+    ]
