@@ -16,7 +16,11 @@ dialog and drive at 20 keys a second, probing key-to-screen time every 2 s (``p`
 - ``terminal``: two of mallory's sessions ask for a 65535x65535 terminal and send window
   changes between huge and small sizes without pause (clamped to 500x200, passed on at most
   every 0.1 s, so her apps draw a 500x200 screen ten times a second: as near to pinning a core
-  as a student gets).
+  as a student gets);
+- ``program-NAME``: mallory loads a hostile VIPLE program of ``tests/program/hostile.py``
+  (``merge_spin``, ``join_nesting``, ``join_doubling``, ``number_doubling``, ``record_flood``)
+  from her workspace in her app and starts it; the phase notes when her screen said the program
+  stopped, if it did.
 
 Usage: ``python bench/ssh_attacks.py [--students 4] [--seconds 20] [--only flood]``.
 Figures vary from run to run; the machine is shared by the clients, the server and the apps.
@@ -27,6 +31,7 @@ from __future__ import annotations
 import argparse
 import asyncio
 import contextlib
+import re
 import sys
 import tempfile
 import time
@@ -40,9 +45,12 @@ sys.path.insert(0, str(ROOT))
 
 from ssh_load import Result, Student, free_port, pct, start_server, student_address  # noqa: E402
 
+from tests.program import hostile  # noqa: E402
+from workbench.files.workspace import workspace_folder  # noqa: E402
 from workbench.ssh.users import add_user  # noqa: E402
 
-PHASES = ("none", "connections", "flood", "terminal")
+PROGRAMS = ("merge_spin", "join_nesting", "join_doubling", "number_doubling", "record_flood")
+PHASES = ("none", "connections", "flood", "terminal", *(f"program-{p}" for p in PROGRAMS))
 
 
 async def drive(student: Student, seconds: float, ready: asyncio.Event) -> None:
@@ -159,6 +167,46 @@ async def storm_terminal(port: int, key, notes: list[str]) -> None:
             conn.close()
 
 
+async def run_program(port: int, key, name: str, notes: list[str]) -> None:
+    """Mallory loads ``~/NAME.viple`` in the algorithm dialog and starts it, then watches."""
+    mallory = Student("mallory", key, port, Result(), "127.0.8.9", "asyncssh", Path())
+    stage = "logging in"
+    began = time.perf_counter()
+    try:
+        async with mallory.terminal() as write:
+            if write is None or not await mallory.wait_for(b"Who is at this robot", 0, 60):
+                return
+            write(b"\r")
+            if not await mallory.wait_for(b"running", 0, 60):
+                return
+            stage = "opening the algorithm dialog"
+            mark = len(mallory.buffer)
+            write(b"g")
+            if not await mallory.wait_for(b"Built-in", mark, 10):
+                return
+            write(b"\t")
+            await asyncio.sleep(0.3)
+            stage = "loading the program"
+            mark = len(mallory.buffer)
+            write(f"~/{name}.viple\r".encode())
+            if not await mallory.wait_for(b"runs it", mark, 30):  # "Start (or x) runs it"
+                return
+            await asyncio.sleep(0.5)  # the Start button has the focus
+            stage = "running the program"
+            mark = len(mallory.buffer)
+            started = time.perf_counter()
+            write(b"\r")  # Start
+            if await mallory.wait_for(b"stopped", mark, 3600):  # the program, or its record
+                line = re.search(rb"(program|recording) stopped[^\x1b]{0,60}", mallory.buffer)
+                said = line.group().decode(errors="replace").strip() if line else "stopped"
+                stage = f"{said!r} {time.perf_counter() - started:.1f} s after it started"
+            await asyncio.Event().wait()
+    finally:
+        shown = re.sub(rb"\x1b\[[0-9;?]*[A-Za-z]", b" ", bytes(mallory.buffer[-3000:]))
+        tail = "" if "after it started" in stage else f"; her screen ends {shown[-200:]!r}"
+        notes.append(f"mallory's program: {stage} ({time.perf_counter() - began:.0f} s){tail}")
+
+
 LATE_KEY = asyncssh.generate_private_key("ssh-ed25519")
 
 
@@ -173,6 +221,10 @@ async def phase(name: str, port: int, students: list[Student], keys, seconds: fl
         "flood": lambda: flood(port, notes),
         "terminal": lambda: storm_terminal(port, keys["mallory"], notes),
     }
+    for program in PROGRAMS:
+        attacks[f"program-{program}"] = lambda program=program: run_program(
+            port, keys["mallory"], program, notes
+        )
     readies = [asyncio.Event() for _ in students]
     drivers = [
         asyncio.create_task(drive(s, seconds, r)) for s, r in zip(students, readies, strict=True)
@@ -209,6 +261,10 @@ async def main() -> None:
             keys[name] = asyncssh.generate_private_key("ssh-ed25519")
             add_user(users, name, "student", [keys[name].export_public_key().decode()])
         add_user(users, "late", "student", [LATE_KEY.export_public_key().decode()])
+        workspace = workspace_folder(data, "mallory")
+        workspace.mkdir(parents=True, exist_ok=True)
+        for program in PROGRAMS:
+            (workspace / f"{program}.viple").write_text(getattr(hostile, program)())
         port = free_port()
         server = start_server(data, port, args.students + 4, fork=True)
         try:

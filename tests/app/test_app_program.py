@@ -300,3 +300,40 @@ def test_after_loading_a_program_f_fits_the_sensors_its_diagram_reads(tmp_path):
         assert said == "the robot has the sensors wire.viple reads already"
 
     run(app, body)
+
+
+def test_a_program_is_read_and_checked_beside_the_event_loop(tmp_path, monkeypatch):
+    import asyncio
+    import threading
+
+    import workbench.tui.dialogs.algorithm as dialog_module
+
+    app = make_app(AppSettings(maze_file(tmp_path), paused=True, noise="off"))
+    path = drive_by_wire(tmp_path)
+    release = threading.Event()
+    checking = threading.Event()
+    real_load = dialog_module.load_choice
+
+    def slow_load(station, typed):  # a file that takes long to check
+        checking.set()
+        assert release.wait(30)
+        return real_load(station, typed)
+
+    monkeypatch.setattr(dialog_module, "load_choice", slow_load)
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.press("g")
+        await pilot.pause()
+        dialog = pilot.app.screen
+        assert isinstance(dialog, AlgorithmModal)
+        choosing = asyncio.create_task(dialog.choose(path))
+        while not checking.is_set():
+            await pilot.pause(0.01)
+        await pilot.pause()  # the app answers while the file is checked
+        assert "loading" in str(dialog.query_one("#alg-error", Static).render())
+        assert app.station.program is None
+        release.set()
+        assert await choosing
+        assert app.station.program is not None and app.station.program.name == "wire.viple"
+
+    run(app, body)

@@ -71,6 +71,11 @@ class ProgramBuilder:
 
     # -- writing -------------------------------------------------------------------------
     def xml(self) -> str:
+        self._into: dict[int, list] = {}
+        self._from: dict[int, list] = {}
+        for lk in self.links:
+            self._into.setdefault(lk[3], []).append(lk)
+            self._from.setdefault(lk[1], []).append(lk)
         out = ['<?xml version="1.0" encoding="utf-8"?>', '<Program VIPLE_Type="1">']
         out.append(f"  <Version>{self.version}</Version>")
         for panel in self.panels:
@@ -105,9 +110,10 @@ class ProgramBuilder:
         lines = [f'    <Activity{name} IsFlipped="false">']
         lines.append(f"      <ActivityNameInt>{act.kind}</ActivityNameInt>")
         lines.append(f"      <ActivityID>{act.id}</ActivityID>")
-        incoming = [lk for lk in self.links if lk[3] == act.id]
-        outgoing = [lk for lk in self.links if lk[1] == act.id and lk[2] >= 0]
-        alternate = [lk for lk in self.links if lk[1] == act.id and lk[2] < 0]
+        incoming = self._into.get(act.id, [])
+        leaving = self._from.get(act.id, [])
+        outgoing = [lk for lk in leaving if lk[2] >= 0]
+        alternate = [lk for lk in leaving if lk[2] < 0]
         in_pins = sorted({lk[4] for lk in incoming})
         indexed_in = act.kind == 4
         lines += _groups("PreviousActivities", "ActivityID", incoming, 4, 1, in_pins, indexed_in)

@@ -22,6 +22,7 @@ from workbench.program.pilot import program_entrant
 from workbench.sim.metrics import TURN_MIN_DEGREES
 from workbench.sim.noise import NOISE_LEVELS
 from workbench.sim.profiles import PROFILES
+from workbench.sim.record import stop_words
 
 
 def _simulation_options(parser: argparse.ArgumentParser) -> None:
@@ -174,6 +175,11 @@ def describe_measures(result: RunResult) -> list[str]:
         f"  touches             {d['touches']} (a touch sensor's bumper meeting a wall gently)",
         f"  efficiency          {eff} (shortest path / distance travelled)",
         f"  simulated time      {d['sim_time']:.1f} s",
+        *(
+            [f"  run record          {stop_words(result.record_stop)}"]
+            if result.record_stop is not None
+            else []
+        ),
     ]
 
 

@@ -166,6 +166,8 @@ def describe_program_run(result: RunResult) -> str:
     program = result.driving.controller
     assert isinstance(program, ProgramController)
     lines = [run_head(result, result.driving.driver.name), *describe_measures(result)]
+    if program.stopped is not None:
+        lines.append(f"  STOPPED at {program.stopped}")
     lines += printed_summary(program)
     lines += _listed(
         "events",

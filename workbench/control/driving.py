@@ -39,6 +39,8 @@ class Driving:
     #: a program's Key Press events: a key typed while it drives, at the simulated time
     #: (None: it does not answer keys, as an algorithm)
     type_key: Callable[[str, float], None] | None = None
+    #: why it stopped itself for good (a program past its limits), None while it may run
+    stopped: Callable[[], str | None] | None = None
 
 
 def record_fields(driver: Driver, driving: Driving | None) -> dict[str, Any]:

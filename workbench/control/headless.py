@@ -16,7 +16,7 @@ from workbench.sim.maze import Maze, MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.noise import noise_settings
 from workbench.sim.profiles import Profile, get_profile
-from workbench.sim.record import Recorder
+from workbench.sim.record import Recorder, RecordStop
 from workbench.sim.sensors import SensorSpec, check_ports
 from workbench.sim.session import Session
 
@@ -94,6 +94,8 @@ class RunResult:
     metrics: dict[str, Any]
     cut_by_limit: bool
     max_time: float
+    #: why the run record stopped before the run ended (None: complete, or no record)
+    record_stop: RecordStop | None = None
 
     @property
     def final_state(self) -> str:
@@ -219,4 +221,5 @@ def run(spec: RunSpec) -> RunResult:
         metrics=metrics.as_dict(),
         cut_by_limit=cut,
         max_time=ready.max_time,
+        record_stop=session.recorder.stopped if session.recorder is not None else None,
     )

@@ -20,7 +20,7 @@ from workbench.sim.maze import Maze
 from workbench.sim.metrics import Metrics
 from workbench.sim.noise import NoiseSettings
 from workbench.sim.profiles import get_profile
-from workbench.sim.record import CAPPED, Recorder
+from workbench.sim.record import CAPPED, TOO_FAST, Recorder
 from workbench.sim.sensors import (
     KINDS,
     MOUNTS,
@@ -120,6 +120,8 @@ class KeyUse:
 
 #: the kinds of :class:`Notice`
 ALGORITHM_FAILED = "algorithm failed"
+#: a program stopped itself past its limits (detail: when, where and why)
+PROGRAM_STOPPED = "program stopped"
 OUT = "out"
 RECORDING = "recording"
 
@@ -130,7 +132,7 @@ class Notice:
     words it for the person at the station. A new value each time, so it can be told apart
     from the last one seen."""
 
-    kind: str  # ALGORITHM_FAILED (detail: why), OUT (the run finished at the exit), RECORDING
+    kind: str  # ALGORITHM_FAILED, PROGRAM_STOPPED (detail: why), OUT (at the exit), RECORDING
     detail: str = ""
     #: RECORDING: why the run goes unrecorded, or what was done to record it
     recording: RecordTrouble | None = None
@@ -330,10 +332,16 @@ class LabStation:
 
     def _after_steps(self) -> None:
         self._watch_viple()
+        driving = self.driving
+        why = driving.stopped() if driving is not None and driving.stopped is not None else None
+        if why is not None:
+            self.stop("error")
+            self.pause()
+            self.notice = Notice(PROGRAM_STOPPED, why)
         recorder = self._recorder
         if recorder is not None and recorder.stopped is not None and not self._record_stop_told:
             self._tell_record_stopped(recorder)  # the run goes on unrecorded
-            if recorder.stopped.reason != CAPPED:  # a capped record still takes its summary
+            if recorder.stopped.reason not in (CAPPED, TOO_FAST):  # these still take a summary
                 self._drop_recorder()
         if self._run_open and self.maze.exits and self.session.reached_exit:
             self._close_run("exit")

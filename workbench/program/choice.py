@@ -41,6 +41,14 @@ def choose_program(station: LabStation, path: str) -> ProgramChoice:
     A program with problems raises :class:`ProgramError` naming the file as the student
     typed it; a file outside the workspace raises ``OutsideWorkspace``.
     """
+    choice = load_choice(station, path)
+    station.use_program(choice)
+    return choice
+
+
+def load_choice(station: LabStation, path: str) -> ProgramChoice:
+    """Load the program at ``path`` as :func:`choose_program` does, without choosing it: the
+    part that may take a while (an app does it beside its event loop), changing nothing."""
     files = station.files
     real = files.for_reading(path)
     shown = files.shown(real)
@@ -48,9 +56,7 @@ def choose_program(station: LabStation, path: str) -> ProgramChoice:
         compiled = load_compiled(str(real))
     except ProgramError as exc:
         raise ProgramError([replace(p, source=shown) for p in exc.problems]) from None
-    choice = program_choice(compiled, shown)
-    station.use_program(choice)
-    return choice
+    return program_choice(compiled, shown)
 
 
 def program_choice(compiled: Compiled, shown: str) -> ProgramChoice:

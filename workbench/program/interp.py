@@ -9,6 +9,11 @@ order), then the ready flows run in turn, each for a slice of :data:`SLICE` acti
 that ran :data:`FLOW_TICK_STEPS` activities in one tick, or that loops in a While without
 anything having changed since its last pass, waits for the next tick, so a busy-waiting loop
 never freezes the others. A Timer puts only its own flow to sleep.
+
+A program's work and memory are bounded (:class:`Limits`): the activities run in one control
+tick and in one simulated second, and the parts of the values it holds (messages on their way,
+messages waiting at Joins, variables). A program past a limit is stopped: :attr:`stopped` says
+when, at which activity and why, the robot is told to stop, and nothing of it runs again.
 """
 
 from __future__ import annotations
@@ -20,7 +25,7 @@ from dataclasses import dataclass, field
 from heapq import heappop, heappush
 from typing import Any
 
-from workbench.sim.commands import MotorPower, MoveAtPower, TurnByDegrees, WheelPowers
+from workbench.sim.commands import MotorPower, MoveAtPower, Stop, TurnByDegrees, WheelPowers
 
 from . import kinds as K
 from .code import first_sensor_value
@@ -28,11 +33,21 @@ from .compiled import DEFAULTS, Compiled
 from .keys import KeyEvent, TypedKeys
 from .model import ELSE
 from .readings import pressed, sensor_message, touch_problem
-from .viple_expr import ExprError, Scope, Value, show, type_name
+from .viple_expr import (
+    INT_LIMIT,
+    ExprError,
+    JoinMessage,
+    LimitError,
+    Scope,
+    Value,
+    join_message,
+    parts_of,
+    show,
+    type_name,
+)
 
 SLICE = 50
 FLOW_TICK_STEPS = 5_000
-TICK_STEPS = 50_000
 MAX_FLOWS = 2_000
 MAX_CALL_DEPTH = 64
 MAX_PRINTED = 5_000
@@ -40,6 +55,25 @@ MAX_ERRORS = 100
 MAX_FIRED = 5_000
 #: the newest printed lines a live console keeps (the list of all stops at MAX_PRINTED)
 RECENT_PRINTED = 200
+#: messages waiting at one input of a Join
+MAX_JOIN_QUEUE = 1_000
+
+
+@dataclass(frozen=True)
+class Limits:
+    """What one program may use; past any of them it is stopped with a message."""
+
+    #: activities run in one control tick, all flows together (the rest wait for the next);
+    #: real programs run at most about 50 in a tick
+    tick: int = 2_500
+    #: activities run in the last simulated second, all flows together (real programs run a
+    #: few hundred): a program may compute in bursts, but not without pause
+    second: int = 50_000
+    #: parts of the values the program holds at once, written out (a text counts one part
+    #: for each 100 characters): messages on their way, waiting at Joins, in variables
+    memory: int = 1_000_000
+
+
 #: activities that pass the message straight on when one arrives
 _PASS_ON = frozenset(
     (
@@ -122,10 +156,13 @@ class _Park(Exception):
 class ProgramController:
     """A :class:`workbench.sim.session.Controller` that runs a VIPLE program."""
 
-    def __init__(self, compiled: Compiled, keys: tuple[KeyEvent, ...] = ()) -> None:
+    def __init__(
+        self, compiled: Compiled, keys: tuple[KeyEvent, ...] = (), limits: Limits = Limits()
+    ) -> None:
         self.compiled = compiled
         self.program = compiled.program
         self.key_script = keys
+        self.limits = limits
         self.reset()
 
     # -- the Controller protocol ----------------------------------------------------------
@@ -157,6 +194,16 @@ class ProgramController:
         self.flows_dropped = 0
         self.steps = 0
         self.state: str | None = None
+        #: why and where the program was stopped (None while it may run)
+        self.stopped: RunError | None = None
+        #: the activities run at each run of the last simulated second, and their sum
+        self._window: deque[tuple[float, int]] = deque()
+        self._second_steps = 0
+        #: where flows were at the end of each slice, and how many activities they had run
+        #: there (the busiest is named if the budget runs out)
+        self._hot: dict[int, int] = {}
+        #: parts of the messages waiting at Joins
+        self._join_parts = 0
 
     @property
     def variables(self) -> dict[str, Any]:
@@ -184,6 +231,8 @@ class ProgramController:
         ``report``, a robot's report as it arrived, is what a raw sensor gets (None: the
         simulated robot's report is made from the readings)."""
         self.now = t
+        if self.stopped is not None:
+            return []
         while self._sleeping and self._sleeping[0][0] <= t + 1e-9:
             self._ready.append(heappop(self._sleeping)[2])
         self._ready.extend(self._parked)
@@ -197,6 +246,8 @@ class ProgramController:
     def type_key(self, key: str, t: float) -> None:
         """A key typed on a terminal at ``t`` (it fires at the next tick); the release comes by
         :class:`TypedKeys`'s rule."""
+        if self.stopped is not None:
+            return
         self._pushed += self._typed.press(key.lower(), t)
 
     @property
@@ -304,9 +355,16 @@ class ProgramController:
         self._ready.append(Flow(next(self._numbers), aid, value, frame, in_pin))
 
     def _run(self) -> list[Any]:
+        window = self._window
+        while window and window[0][0] <= self.now - 1.0 + 1e-9:
+            self._second_steps -= window.popleft()[1]
+        if not window:
+            self._hot = {}
         total = 0
+        budget = min(self.limits.tick, self.limits.second - self._second_steps)
         ready = self._ready
-        while ready and total < TICK_STEPS:
+        hot = self._hot
+        while ready and total < budget and self.stopped is None:
             flow = ready.popleft()
             if flow.steps >= FLOW_TICK_STEPS:
                 self._parked.append(flow)
@@ -327,8 +385,20 @@ class ProgramController:
                 self._parked.append(flow)
             if not ended:
                 flow.steps += done
+                hot[flow.activity] = hot.get(flow.activity, 0) + done
             total += done
         self.steps += total
+        self._second_steps += total
+        if total:
+            window.append((self.now, total))
+        if self.stopped is not None:
+            pass
+        elif (ready or self._parked) and self._second_steps >= self.limits.second:
+            self._over_work()
+        elif self._parked or ready or self._join_parts:
+            self._check_memory()
+        if self.stopped is not None:
+            return self._halted()
         for flow in itertools.chain(ready, self._parked):
             flow.steps = 0
         for _, _, flow in self._sleeping:
@@ -344,6 +414,9 @@ class ProgramController:
         act = self.program.activities[flow.activity]
         try:
             return self._execute(flow, act)
+        except LimitError as exc:
+            self._stop(act.id, str(exc))
+            return False
         except (ExprError, ValueError, TypeError, OverflowError) as exc:
             self._error(act.id, str(exc))
             return False
@@ -492,14 +565,81 @@ class ProgramController:
         # panel level share the panel's Join
         joins = flow.frame.joins if flow.frame.block is not None else self._joins
         queues = joins.setdefault(act.id, [deque() for _ in range(count)])
-        if len(queues[flow.in_pin]) >= 1_000:
-            raise ValueError("more than 1,000 messages wait at one Join input")
+        if len(queues[flow.in_pin]) >= MAX_JOIN_QUEUE:
+            raise ValueError(f"more than {MAX_JOIN_QUEUE:,} messages wait at one Join input")
         queues[flow.in_pin].append(flow.value)
+        self._join_parts += parts_of(flow.value)
         if not all(queues):
             return False
         names = [(act.value(i).strip() or f"input{i}").lower() for i in range(count)]
-        message = {name: q.popleft() for name, q in zip(names, queues, strict=True)}
-        return self._go(flow, 0, message)
+        parts = {name: q.popleft() for name, q in zip(names, queues, strict=True)}
+        self._join_parts -= sum(parts_of(v) for v in parts.values())
+        return self._go(flow, 0, join_message(parts))
+
+    # -- limits --------------------------------------------------------------------------
+    def _over_work(self) -> None:
+        aid = max(self._hot, key=self._hot.__getitem__, default=self._ready[0].activity)
+        limit = self.limits.second
+        self._stop(
+            aid,
+            f"the program ran {self._second_steps:,} activities in one simulated second (at "
+            f"most {limit:,}), most of them from here: a loop that never waits? (a Timer in "
+            "the loop lets the robot move)",
+        )
+
+    def _check_memory(self) -> None:
+        flows = list(itertools.chain(self._ready, self._parked, (f for *_, f in self._sleeping)))
+        held = self._join_parts + sum(parts_of(f.value) for f in flows)
+        if held <= self.limits.memory:
+            return
+        held += sum(parts_of(v) for v in self.globals.values())
+        if held <= self.limits.memory:
+            return
+        where: dict[int, int] = {}
+        for flow in flows:
+            where[flow.activity] = where.get(flow.activity, 0) + parts_of(flow.value)
+        for joins in self._all_joins():
+            for aid, queues in joins.items():
+                where[aid] = where.get(aid, 0) + sum(parts_of(v) for q in queues for v in q)
+        aid = max(where, key=where.__getitem__)
+        self._stop(
+            aid,
+            f"the program holds values of {held:,} parts written out (at most "
+            f"{self.limits.memory:,}; {where[aid]:,} of them in messages on their way to this "
+            "activity or waiting at it): does a loop make messages faster than they are used?",
+        )
+
+    def _all_joins(self) -> list[dict[int, list[deque[Value]]]]:
+        frames = {id(f.frame): f.frame for f in self._ready}
+        frames.update({id(f.frame): f.frame for f in self._parked})
+        frames.update({id(f.frame): f.frame for *_, f in self._sleeping})
+        out = [self._joins]
+        for frame in frames.values():
+            at: Frame | None = frame
+            while at is not None:
+                out.append(at.joins)
+                at = at.parent
+        return out
+
+    def _stop(self, aid: int, message: str) -> None:
+        """Stop the program for good at ``aid``: its flows and Joins dropped, the robot told
+        to stop."""
+        act = self.program.activities[aid]
+        self.stopped = RunError(self.now, act.panel, aid, self.program.label(act), message)
+        if len(self.errors) >= MAX_ERRORS:
+            self.errors.pop()
+        self.errors.append(self.stopped)
+
+    def _halted(self) -> list[Any]:
+        self._ready.clear()
+        self._parked = []
+        self._sleeping = []
+        self._joins = {}
+        self._join_parts = 0
+        self._pushed = []
+        self.commands = []
+        self.state = "stopped"
+        return [Stop()]
 
     # -- effects ---------------------------------------------------------------------------
     def _command(self, cmd: Any) -> None:
@@ -536,7 +676,12 @@ def convert(value: Value, vtype: str) -> Value:
                 raise ValueError(f"{value[:30]!r} is not a number for a {vtype[7:]}") from None
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise ValueError(f"{type_name(value)} cannot be stored in a {vtype[7:]}")
-        return round(value) if vtype == "System.Int32" else float(value)
+        if vtype == "System.Double":
+            return float(value)
+        whole = round(value)
+        if not -INT_LIMIT <= whole < INT_LIMIT:
+            raise LimitError("the number is past the range of a 64-bit whole number")
+        return whole
     if vtype == "System.Boolean":
         if isinstance(value, str) and value.strip().lower() in ("true", "false"):
             return value.strip().lower() == "true"
@@ -566,6 +711,6 @@ def _plain(value: Value) -> bool:
 
 
 def _key(value: Value) -> Any:
-    if isinstance(value, dict):
+    if isinstance(value, JoinMessage):
         return tuple(sorted(value.items()))
     return (type(value), value)

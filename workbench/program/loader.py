@@ -31,7 +31,15 @@ from .problems import Problem, ProgramError
 #: sizes: the largest real programs are about 35 KB of XML
 LIMITS = Limits("a VIPLE program", max_bytes=4 << 20, max_lines=400_000, max_line_length=200_000)
 MAX_DEPTH = 12
-MAX_ELEMENTS = 400_000
+#: the largest real programs have about 2,000 elements, one or two attributes on each
+MAX_ELEMENTS = 150_000
+MAX_ATTRIBUTES = 16
+MAX_ALL_ATTRIBUTES = 50_000
+#: the longest Value (a comment, a text, an expression) and the longest name
+MAX_VALUE_LENGTH = 10_000
+MAX_NAME_LENGTH = 200
+#: activities visited while pairing every While with its End While, all loops together
+MAX_LOOP_STEPS = 400_000
 MAX_ACTIVITIES = 5_000
 MAX_VALUES = 200
 MAX_PANELS = 500
@@ -47,6 +55,10 @@ class _Refused(Exception):
         self.hint = hint
 
 
+class _Tangled(Exception):
+    """Pairing the loops took more than :data:`MAX_LOOP_STEPS` steps."""
+
+
 class _BoundedBuilder(TreeBuilder):
     """A tree builder that stops at :data:`MAX_DEPTH` or :data:`MAX_ELEMENTS`."""
 
@@ -58,6 +70,12 @@ class _BoundedBuilder(TreeBuilder):
     def start(self, tag: str, attrs: dict[str, str], /) -> Element:
         self.depth += 1
         self.count += 1
+        if len(attrs) > MAX_ATTRIBUTES:
+            raise _Refused(
+                f"an element has {len(attrs):,} attributes; a VIPLE program has at most "
+                f"{MAX_ATTRIBUTES} on one",
+                "check that this is a VIPLE program file",
+            )
         if self.depth > MAX_DEPTH:
             raise _Refused(
                 f"elements nested more than {MAX_DEPTH} deep; a VIPLE program needs about 6",
@@ -108,7 +126,28 @@ def _gunzip(data: bytes, source: str) -> bytes:
     return out
 
 
+def _count_marks(text: str, source: str) -> None:
+    """Refuse a text with more tags or attributes than the caps allow, before it is parsed
+    (counting characters is quick; building a tree of them is not)."""
+    tags = text.count("<")
+    if tags > 2 * MAX_ELEMENTS + 10:
+        raise BoundedFileError(
+            source,
+            f"the file has {tags:,} tags; a VIPLE program has at most {MAX_ELEMENTS:,} elements",
+            "check that this is a VIPLE program file",
+        )
+    attributes = text.count("='") + text.count('="') + text.count("= ")
+    if attributes > MAX_ALL_ATTRIBUTES:
+        raise BoundedFileError(
+            source,
+            f"the file has about {attributes:,} attributes; a VIPLE program has at most "
+            f"{MAX_ALL_ATTRIBUTES:,}",
+            "check that this is a VIPLE program file",
+        )
+
+
 def parse_xml(text: str, source: str) -> Element:
+    _count_marks(text, source)
     builder = _BoundedBuilder()
     parser = XMLParser(target=builder, forbid_dtd=True)
     try:
@@ -182,6 +221,7 @@ class _Builder:
         self.source = source
         self.kinds = kinds
         self.problems: list[Problem] = []
+        self.loop_steps = 0
 
     def problem(
         self, message: str, hint: str = "", panel: str | None = None, act: Activity | None = None
@@ -233,7 +273,8 @@ class _Builder:
             out[pin] = ids
         return out
 
-    def values(self, elem: Element | None, act_id: int, panel: str) -> tuple[str, ...]:
+    def values(self, elem: Element | None, act_id: int, panel: str) -> tuple[str, ...] | None:
+        """The Values in their Index order; None when one is too long (said as a problem)."""
         if elem is None:
             return ()
         items = elem.findall("Value")
@@ -244,6 +285,14 @@ class _Builder:
             items = items[:MAX_VALUES]
         placed: dict[int, str] = {}
         for position, item in enumerate(items):
+            if len(item.text or "") > MAX_VALUE_LENGTH:
+                self.problem(
+                    f"activity {act_id}: Values[{position}] is {len(item.text or ''):,} "
+                    f"characters long; at most {MAX_VALUE_LENGTH:,}",
+                    "shorten it (a long text can be built by a Calculate)",
+                    panel,
+                )
+                return None
             index_text = item.get("Index")
             index = position
             if index_text is not None:
@@ -267,6 +316,13 @@ class _Builder:
             vtype = (item.findtext("VariableType") or "").strip()
             if not name:
                 self.problem("a variable has no name", "name it in VIPLE's Variables dialog", panel)
+                continue
+            if len(name) > MAX_NAME_LENGTH:
+                self.problem(
+                    f"a variable's name is {len(name):,} characters; at most {MAX_NAME_LENGTH}",
+                    "give it a shorter name",
+                    panel,
+                )
                 continue
             if name.lower() in seen:
                 self.problem(f"the variable {name!r} is declared twice", "remove one", panel)
@@ -305,6 +361,12 @@ class _Builder:
             name = pxml.get("Name") or ""
             if not name:
                 self.problem("a panel has no Name", "save it again from VIPLE")
+                continue
+            if len(name) > MAX_NAME_LENGTH:
+                self.problem(
+                    f"a panel's Name is {len(name):,} characters; at most {MAX_NAME_LENGTH}",
+                    "give the custom activity a shorter name",
+                )
                 continue
             if name in panels:
                 self.problem(f"two panels are named {name!r}", "rename one", name)
@@ -367,13 +429,18 @@ class _Builder:
         if not 0 <= aid <= MAX_ID:
             self.problem(f"activity ID {aid} is out of range", _SAVE_AGAIN, panel)
             return None
-        act = Activity(
-            aid,
-            kind,
-            panel,
-            (axml.get("Name") or "").strip(),
-            self.values(axml.find("Values"), aid, panel),
-        )
+        if len(axml.get("Name") or "") > MAX_NAME_LENGTH:
+            self.problem(
+                f"{owner}: its Name is {len(axml.get('Name') or ''):,} characters; "
+                f"at most {MAX_NAME_LENGTH}",
+                "give it a shorter name",
+                panel,
+            )
+            return None
+        values = self.values(axml.find("Values"), aid, panel)
+        if values is None:
+            return None
+        act = Activity(aid, kind, panel, (axml.get("Name") or "").strip(), values)
         lists = [
             self.id_lists(axml, "NextActivities", "ActivityID", panel, act),
             self.id_lists(axml, "OutgoingLines", "GraphEdgeID", panel, act),
@@ -544,10 +611,20 @@ class _Builder:
     # -- loops ---------------------------------------------------------------------------
     def loops(self, program: Program) -> None:
         acts = program.activities
+        self.loop_steps = 0
         for act in acts.values():
             if act.kind != K.WHILE:
                 continue
-            ends, breaks = self._loop_body(program, act.id)
+            try:
+                ends, breaks = self._loop_body(program, act.id)
+            except _Tangled:
+                self.problem(
+                    f"following the While loops' bodies took more than {MAX_LOOP_STEPS:,} "
+                    "steps: the loops are too tangled to pair each While with its End While",
+                    "give each While a body that leads to its own End While",
+                    act=act,
+                )
+                return
             if len(ends) == 1:
                 end = ends[0]
                 if end in program.loop_start:
@@ -596,6 +673,9 @@ class _Builder:
             if (aid, depth) in seen or depth > MAX_DEPTH * 4 or aid == start:
                 continue
             seen.add((aid, depth))
+            self.loop_steps += 1
+            if self.loop_steps > MAX_LOOP_STEPS:
+                raise _Tangled()
             kind = acts[aid].kind
             if kind == K.END_WHILE:
                 if depth == 0:
@@ -645,10 +725,11 @@ def partner_index(kind: int, mapping: KindMap) -> int | None:
 def resolve_partner(name: str, robots: int) -> int | None:
     """The robot (0-based, in file order) a service's partner name points to: the trailing
     number of the display name ("My Robot 0", "Robot/IoT Controller 1")."""
-    match = re.search(r"(\d+)\s*$", name)
-    if match is None:
+    text = name.rstrip()
+    digits = len(text) - len(text.rstrip("0123456789"))
+    if not digits:
         return 0 if robots == 1 else None
-    index = int(match.group(1)[-6:])
+    index = int(text[-min(digits, 6) :])
     return index if index < robots else None
 
 

@@ -99,6 +99,7 @@ def program_driving(compiled: Compiled, shown: str, keys: Sequence[KeyEvent] = (
         header={"program": name, "program_sha256": digest},
         source=shown,
         type_key=controller.type_key,
+        stopped=lambda: str(controller.stopped) if controller.stopped is not None else None,
     )
 
 
@@ -146,6 +147,7 @@ class ProgramPilot:
                 for f in controller.fired
             ],
             "errors": [str(e) for e in controller.errors],
+            "stopped": str(controller.stopped) if controller.stopped is not None else None,
         }
 
 

@@ -30,6 +30,13 @@ MAX_TOKENS = 400
 MAX_DEPTH = 40
 #: the longest text an expression may build (concatenation)
 MAX_TEXT = 100_000
+#: whole numbers stay within 64 bits, real ones finite (C#'s Int64 and Double)
+INT_LIMIT = 1 << 63
+#: a Join's message: Joins inside Joins at most this deep, and at most this many parts when
+#: written out (a text counts one part for each TEXT_PART characters)
+MAX_MESSAGE_DEPTH = 32
+MAX_MESSAGE_PARTS = 20_000
+TEXT_PART = 100
 
 Value = Any
 
@@ -48,6 +55,11 @@ class ExprError(ValueError):
         return f"{where}{self.message}" + (f" ({self.hint})" if self.hint else "")
 
 
+class LimitError(ExprError):
+    """A value past the bounds every program keeps to (a number's range, a text's length, a
+    Join message's size): a program that meets one is stopped, not only the flow."""
+
+
 @dataclass
 class Scope:
     """What an expression reads: the message, the globals, the block's parameters, a Join's
@@ -60,6 +72,66 @@ class Scope:
 
 
 Fn = Callable[[Scope], Value]
+
+
+class JoinMessage(dict):
+    """A Join's message: its inputs' values by name, with how deep Joins nest in it and how
+    many parts it has written out (a message holding another twice counts it twice)."""
+
+    __slots__ = ("depth", "parts")
+
+    depth: int
+    parts: int
+
+
+def parts_of(value: Value) -> int:
+    """How many parts ``value`` has written out (see :data:`MAX_MESSAGE_PARTS`)."""
+    if isinstance(value, JoinMessage):
+        return value.parts
+    if isinstance(value, str):
+        return 1 + len(value) // TEXT_PART
+    return 1
+
+
+def join_message(parts: dict[str, Value]) -> JoinMessage:
+    """The message a Join sends; :class:`LimitError` when it would nest too deep or grow too
+    large (a loop that feeds the Join's message back into it)."""
+    message = JoinMessage(parts)
+    message.depth = 1 + max(
+        (v.depth for v in parts.values() if isinstance(v, JoinMessage)), default=0
+    )
+    message.parts = 1 + sum(parts_of(v) for v in parts.values())
+    if message.depth > MAX_MESSAGE_DEPTH:
+        raise LimitError(
+            f"its message would hold Joins {message.depth} deep (at most {MAX_MESSAGE_DEPTH}): "
+            "does a loop bring the Join's own message back into it?"
+        )
+    if message.parts > MAX_MESSAGE_PARTS:
+        raise LimitError(
+            f"its message would have {message.parts:,} parts written out (at most "
+            f"{MAX_MESSAGE_PARTS:,}): does a loop bring the Join's own message back into it?"
+        )
+    return message
+
+
+def bounded(value: Value, col: int | None = None) -> Value:
+    """``value`` when it is a number within range (or not a number); else an ExprError."""
+    if isinstance(value, bool):
+        return value
+    if isinstance(value, int):
+        if not -INT_LIMIT <= value < INT_LIMIT:
+            raise LimitError(
+                "the number grew past the range of a 64-bit whole number",
+                col,
+                "does a loop keep adding or multiplying it?",
+            )
+    elif isinstance(value, float) and not math.isfinite(value):
+        raise LimitError(
+            "the number grew past the range of a Double",
+            col,
+            "does a loop keep adding or multiplying it?",
+        )
+    return value
 
 
 @dataclass(frozen=True)
@@ -78,8 +150,40 @@ class Expression:
 # -- values as C# shows them -------------------------------------------------------------------
 
 
-def show(value: Value) -> str:
-    """A value as VIPLE prints it (C# ``ToString``): 1.0 is "1", true is "True"."""
+def show(value: Value, limit: int = MAX_TEXT) -> str:
+    """A value as VIPLE prints it (C# ``ToString``): 1.0 is "1", true is "True". A Join's
+    message is written out without recursion and cut after ``limit`` characters (``...``)."""
+    if not isinstance(value, dict):
+        return _show_one(value)
+    out = ["{"]
+    size = 1
+    stack = [iter(value.items())]
+    first = True
+    while stack:
+        item = next(stack[-1], None)
+        if item is None:
+            stack.pop()
+            out.append("}")
+            size += 1
+            first = False
+            continue
+        key, part = item
+        piece = f"{'' if first else ', '}{key} = "
+        if isinstance(part, dict):
+            piece += "{"
+            stack.append(iter(part.items()))
+            first = True
+        else:
+            piece += _show_one(part)
+            first = False
+        out.append(piece)
+        size += len(piece)
+        if size > limit:
+            return "".join(out)[:limit] + "..."
+    return "".join(out)
+
+
+def _show_one(value: Value) -> str:
     if value is None:
         return ""
     if isinstance(value, bool):
@@ -88,8 +192,6 @@ def show(value: Value) -> str:
         if math.isfinite(value) and value == int(value) and abs(value) < 1e15:
             return str(int(value))
         return repr(value)
-    if isinstance(value, dict):
-        return "{" + ", ".join(f"{k} = {show(v)}" for k, v in value.items()) + "}"
     return str(value)
 
 
@@ -464,7 +566,7 @@ def _negate(a: Fn, col: int) -> Fn:
         v = a(s)
         if not _number(v):
             raise ExprError(f"- needs a number, not {type_name(v)}", col)
-        return -v
+        return bounded(-v, col)
 
     return run
 
@@ -504,25 +606,22 @@ def _arith(op: str, a: Fn, b: Fn, col: int) -> Fn:
         if op == "&" or (op == "+" and (isinstance(x, str) or isinstance(y, str))):
             text = show(x) + show(y)
             if len(text) > MAX_TEXT:
-                raise ExprError(f"the text grew past {MAX_TEXT:,} characters", col)
+                raise LimitError(f"the text grew past {MAX_TEXT:,} characters", col)
             return text
         if not (_number(x) and _number(y)):
             raise ExprError(f"{op} needs numbers, not {type_name(x)} and {type_name(y)}", col)
         if op == "+":
-            return x + y
+            return bounded(x + y, col)
         if op == "-":
-            return x - y
+            return bounded(x - y, col)
         if op == "*":
-            result = x * y
-            if isinstance(result, int) and abs(result) > 1 << 63:
-                raise ExprError("the number grew too large", col)
-            return result
+            return bounded(x * y, col)
         if y == 0:
             raise ExprError("division by zero", col, "check the divisor before dividing")
         if isinstance(x, int) and isinstance(y, int):
             quotient = abs(x) // abs(y) * (1 if (x >= 0) == (y >= 0) else -1)
             return quotient if op == "/" else x - quotient * y
-        return x / y if op == "/" else math.fmod(x, y)
+        return bounded(x / y if op == "/" else math.fmod(x, y), col)
 
     return run
 
@@ -531,9 +630,10 @@ def _call(fn: Callable[..., Value], args: list[Fn], name: str, col: int) -> Fn:
     def run(s: Scope) -> Value:
         values = [arg(s) for arg in args]
         try:
-            return fn(*values)
+            result = fn(*values)
         except (TypeError, ValueError, OverflowError) as exc:
             raise ExprError(f"{name}: {exc}", col) from None
+        return bounded(result, col)
 
     return run
 
@@ -550,8 +650,11 @@ def _round(v: Value, digits: Value = 0) -> float:
 
 def _to_int(v: Value) -> int:
     if isinstance(v, str):
+        text = v.strip()
+        if len(text) > 30:
+            raise ValueError(f"{v[:30]!r}... is not a whole number of at most 30 digits")
         try:
-            return int(v.strip())
+            return int(text)
         except ValueError:
             raise ValueError(f"{v[:30]!r} is not a whole number") from None
     if isinstance(v, bool):

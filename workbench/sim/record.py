@@ -61,32 +61,55 @@ def command_json(cmd: object) -> dict[str, Any]:
 
 #: why a record stopped before its run ended (:attr:`Recorder.stopped`)
 CAPPED = "cap"
+#: it grew faster than :data:`RECORD_RATE` bytes in one simulated second
+TOO_FAST = "rate"
 DISK_FULL = "disk full"
 IO_ERROR = "i/o error"
 #: the errors that mean no room is left (the disk, the user's quota, the largest file allowed)
 NO_ROOM = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG)
 #: room kept under a record's cap for its summary line, written even when the cap was reached
 SUMMARY_ROOM = 4096
+#: the most bytes a record takes for one simulated second of its run (a run record of an
+#: ordinary run takes about 5 kB a second; a program that keeps long texts in its variables
+#: can write megabytes)
+RECORD_RATE = 500_000
+
+
+#: the stops after which the summary line is still written
+_KEEPS_SUMMARY = (CAPPED, TOO_FAST)
 
 
 @dataclass(frozen=True)
 class RecordStop:
     """Why a record stopped taking lines while its run went on."""
 
-    reason: str  # CAPPED, DISK_FULL or IO_ERROR
-    #: the cap in bytes (CAPPED), or the system's words for the error
+    reason: str  # CAPPED, TOO_FAST, DISK_FULL or IO_ERROR
+    #: the cap in bytes (CAPPED), the bytes a second (TOO_FAST), or the system's words for
+    #: the error
     detail: str = ""
     #: simulated time of the last line kept
     t: float = 0.0
 
 
+def stop_words(stop: RecordStop) -> str:
+    """Why a record stopped, in a few words for a command's report."""
+    if stop.reason == CAPPED:
+        why = f"it reached its size limit of {int(stop.detail):,} bytes"
+    elif stop.reason == TOO_FAST:
+        why = f"it grew by more than {int(stop.detail):,} bytes in one simulated second"
+    else:
+        why = f"it could not be written ({stop.detail})"
+    return f"stopped after {stop.t:.1f} s: {why}; the run went on unrecorded"
+
+
 class Recorder:
     """Writes a run record to a file (or any text stream).
 
-    With a ``cap`` (bytes) the record stops taking tick lines before it grows past it, and with
-    ``keep_going`` a write that fails (a full disk, an I/O error) stops the record instead of
-    raising: either way :attr:`stopped` says why, the run goes on, and the file keeps every
-    whole line written before (a capped record still gets its summary).
+    With a ``cap`` (bytes) the record stops taking tick lines before it grows past it; past
+    ``rate`` bytes in one simulated second it stops too; and with ``keep_going`` a write that
+    fails (a full disk, an I/O error) stops the record instead of raising: either way
+    :attr:`stopped` says why, the run goes on, and the file keeps every whole line written
+    before (a record stopped by its cap or rate still gets its summary).
     """
 
     def __init__(
@@ -94,8 +117,13 @@ class Recorder:
         target: str | os.PathLike | IO[str],
         cap: int | None = None,
         keep_going: bool = False,
+        rate: int | None = RECORD_RATE,
     ):
         self.cap = cap
+        self.rate = rate
+        #: the simulated second being counted against :attr:`rate`, and its bytes so far
+        self._second = 0
+        self._second_size = 0
         self.keep_going = keep_going
         self.stopped: RecordStop | None = None
         #: bytes of whole lines handed to the file so far
@@ -117,9 +145,18 @@ class Recorder:
         self._kept = 0
 
     def _write(self, obj: dict[str, Any], summary: bool = False, t: float | None = None) -> None:
-        if self.stopped is not None and not (summary and self.stopped.reason == CAPPED):
+        if self.stopped is not None and not (summary and self.stopped.reason in _KEEPS_SUMMARY):
             return
         data = (json.dumps(obj, separators=(",", ":")) + "\n").encode()
+        if self.rate is not None and t is not None:
+            second = int(t + 1e-9)
+            if second != self._second:
+                self._second, self._second_size = second, 0
+            self._second_size += len(data)
+            if self._second_size > self.rate:
+                self.stopped = RecordStop(TOO_FAST, str(self.rate), self._t)
+                self.flush()
+                return
         if self.cap is not None:
             room = self.cap if summary else self.cap - SUMMARY_ROOM
             if self.size + len(data) > room:
@@ -142,7 +179,7 @@ class Recorder:
         """Hand the lines written so far to the file; a failure stops the record (with
         ``keep_going``) or raises."""
         lines, self._buffer = b"".join(self._buffer), []
-        if self.stopped is not None and self.stopped.reason != CAPPED:
+        if self.stopped is not None and self.stopped.reason not in _KEEPS_SUMMARY:
             return
         try:
             if self._stream is not None:
@@ -205,6 +242,8 @@ class Recorder:
         stop = self.stopped
         if stop is not None and stop.reason == CAPPED:
             extra = {**extra, "record_capped": {"bytes": self.cap, "t": _r(stop.t)}}
+        if stop is not None and stop.reason == TOO_FAST:
+            extra = {**extra, "record_capped": {"bytes_per_second": self.rate, "t": _r(stop.t)}}
         self._write({"type": "summary", **metrics, **extra}, summary=True)
 
     def close(self) -> None:

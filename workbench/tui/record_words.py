@@ -13,7 +13,7 @@ from workbench.control.recording import (
     RecordTrouble,
     shown_size,
 )
-from workbench.sim.record import CAPPED, DISK_FULL
+from workbench.sim.record import CAPPED, DISK_FULL, TOO_FAST
 
 #: the run goes on; what brings recording back
 _NEXT = "the next run (r resets the robot) is recorded again"
@@ -26,6 +26,11 @@ def record_words(trouble: RecordTrouble, shown: Callable[[str | os.PathLike], st
         return (
             f"recording stopped: {where} reached its size limit of "
             f"{shown_size(int(trouble.detail))}; the run goes on unrecorded, {_NEXT}"
+        )
+    if trouble.kind == TOO_FAST:
+        return (
+            f"recording stopped: {where} grew by more than {shown_size(int(trouble.detail))} "
+            f"in one simulated second; the run goes on unrecorded, {_NEXT}"
         )
     if trouble.kind == DISK_FULL:
         return (

@@ -9,6 +9,7 @@ algorithm reads.
 
 from __future__ import annotations
 
+import asyncio
 from pathlib import Path
 from typing import ClassVar
 
@@ -25,7 +26,7 @@ from workbench.control.fsm import FsmError, resolve_params
 from workbench.control.fsmfile import FsmFileError
 from workbench.control.station import LabStation, ProgramChoice
 from workbench.files.workspace import OutsideWorkspace
-from workbench.program.choice import choose_program, is_program_path
+from workbench.program.choice import is_program_path, load_choice
 from workbench.program.problems import ProgramError
 from workbench.sim.sensors import SensorConfigError
 from workbench.sim.session import Snapshot
@@ -335,9 +336,11 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
         return True
 
     async def choose_program(self, path: str) -> bool:
-        """Load a VIPLE program to drive; a bad one's problems are all shown, not raised."""
+        """Load a VIPLE program to drive; a bad one's problems are all shown, not raised. The
+        file is read and checked beside the event loop, so the app answers meanwhile."""
+        self._error(f"loading {path}...")
         try:
-            choice = choose_program(self.station, path)
+            choice = await asyncio.to_thread(load_choice, self.station, path)
         except ProgramError as exc:
             await self._show_problems(path, [str(p) for p in exc.problems])
             self._error("fix these in VIPLE (or the file) and load it again")
@@ -345,6 +348,7 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
         except (OSError, OutsideWorkspace) as exc:
             self._error(str(exc))
             return False
+        self.station.use_program(choice)
         self._error("")
         await self._show_definition()
         self._refresh_all()

@@ -19,7 +19,7 @@ from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical
 
 from workbench.control.fsm import FsmError
-from workbench.control.station import ALGORITHM_FAILED, LabStation, Notice
+from workbench.control.station import ALGORITHM_FAILED, PROGRAM_STOPPED, LabStation, Notice
 from workbench.files.workspace import OutsideWorkspace
 from workbench.program.keys import known_key
 from workbench.sim.maze import MazeError
@@ -432,6 +432,8 @@ def worded(notice: Notice, shown: Callable[[str | os.PathLike], str] = str) -> s
     path as the student sees it)."""
     if notice.kind == ALGORITHM_FAILED:
         return f"algorithm stopped: {notice.detail}"
+    if notice.kind == PROGRAM_STOPPED:
+        return f"program stopped at {notice.detail}"
     if notice.recording is not None:
         return record_words(notice.recording, shown)
     return "the robot is out: run finished (r resets the robot)"
