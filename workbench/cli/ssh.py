@@ -260,7 +260,8 @@ def cmd_serve(args: argparse.Namespace) -> int:
     from workbench.ssh.hostkey import HostKeyError
     from workbench.ssh.logins import LoginPolicy
     from workbench.ssh.ports import parse_range
-    from workbench.ssh.server import LabServer, ServerConfig, setup_logging
+    from workbench.ssh.server import LabServer, ServerConfig
+    from workbench.ssh.serverlog import setup_logging
     from workbench.ssh.users import UsersFileError
 
     if not 0 <= args.port <= 65535:
