@@ -30,9 +30,15 @@ from typing import BinaryIO
 
 from .atomic import PendingFile
 from .names import UPLOADS_FOLDER, Parts, shown_path
+from .sizes import shown_size
 from .workspace import RESERVED
 
-MiB = 1024 * 1024
+#: the largest one file may be, all of a student's files together, and how many
+FILE_CAP = 5_000_000
+QUOTA_BYTES = 50_000_000
+QUOTA_FILES = 2000
+#: how much of a file is copied at a time when an upload starts from it
+_CHUNK = 1 << 20
 
 
 @dataclass(frozen=True)
@@ -40,11 +46,11 @@ class UploadLimits:
     """What one student may keep in their workspace through a file server."""
 
     #: the largest one file may be, in bytes (0: no cap)
-    file_size: int = 5 * MiB
+    file_size: int = FILE_CAP
     #: all of the student's files (run records not counted: they have their own quota)
-    quota_bytes: int = 50 * MiB
-    #: how many files and folders (run records not counted)
-    quota_files: int = 2000
+    quota_bytes: int = QUOTA_BYTES
+    #: how many files and folders (run records not counted); 0 in any of them: no limit
+    quota_files: int = QUOTA_FILES
 
 
 class Refusal(Enum):
@@ -162,7 +168,7 @@ class WorkspaceFiles:
             elif keep:
                 with open(path, "rb") as source:
                     offset = 0
-                    while chunk := source.read(MiB):
+                    while chunk := source.read(_CHUNK):
                         upload.write(offset, chunk)
                         offset += len(chunk)
         except BaseException:
@@ -270,9 +276,10 @@ class WorkspaceFiles:
         ):
             raise WorkspaceError(
                 Refusal.QUOTA,
-                f"{shown_path(parts)}: your files may take at most {_mib(limits.quota_bytes)} "
-                f"on this server and take {_mib(usage.bytes + usage.reserved_bytes)} already: "
-                "remove some files and try again",
+                f"{shown_path(parts)}: your files may take at most "
+                f"{shown_size(limits.quota_bytes)} on this server and take "
+                f"{shown_size(usage.bytes + usage.reserved_bytes)} already: remove some files "
+                "and try again",
             )
         if (
             limits.quota_files
@@ -400,8 +407,8 @@ class Upload:
         if cap and end > cap:
             raise WorkspaceError(
                 Refusal.TOO_BIG,
-                f"{shown_path(self.parts)}: a file may be at most {_mib(cap)} on this server: "
-                "the upload was stopped",
+                f"{shown_path(self.parts)}: a file may be at most {shown_size(cap)} on this "
+                "server: the upload was stopped",
             )
         if end > self.reserved:
             self.files.reserve(end - self.reserved, 0, self.parts)
@@ -442,10 +449,6 @@ class Upload:
 
 def _entry(name: str, info: os.stat_result) -> Entry:
     return Entry(name, stat.S_ISDIR(info.st_mode), info.st_size, info.st_mtime, info.st_atime)
-
-
-def _mib(size: int) -> str:
-    return f"{size / MiB:g} MiB" if size >= MiB else f"{size} bytes"
 
 
 def _refusal(exc: OSError, parts: Parts) -> WorkspaceError:

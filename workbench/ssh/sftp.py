@@ -449,9 +449,8 @@ class _Handler(SFTPServerHandler):
         server = self._server
         if isinstance(server, WorkspaceSFTPServer):
             server.ending = True
-        if self._writer is not None and exc is None:
-            with contextlib.suppress(Exception):
-                self._writer.channel.exit(0)  # before the channel is closed: OpenSSH reads it
+            with contextlib.suppress(Exception):  # before the channel closes: OpenSSH reads it
+                server.channel.exit(0 if exc is None else 1)
         await super()._cleanup(exc)
 
     async def _process_opendir(self, packet: SSHPacket) -> bytes:
@@ -507,8 +506,6 @@ class SFTPChannel:
             await _Handler(self.server, reader, writer, 3).run()
         finally:
             self.service.close(self.user)
-            with contextlib.suppress(Exception):
-                writer.channel.exit(0)
 
 
 class _Stream(SSHServerStreamSession):
