@@ -93,13 +93,20 @@ class SFTPService:
             )
         return files
 
+    def workspace(self, name: str) -> WorkspaceFiles | None:
+        """The files of student ``name`` while they have SFTP channels open."""
+        return self._files.get(name)
+
     def close(self, user: User) -> None:
         left = self.channels.get(user.name, 0) - 1
         if left > 0:
             self.channels[user.name] = left
             return
         self.channels.pop(user.name, None)
-        self._files.pop(user.name, None)  # counted afresh next time: the app writes there too
+        files = self._files.pop(user.name, None)  # counted afresh next time: the app writes too
+        if files is not None:
+            with contextlib.suppress(OSError):
+                files.clear_uploads()
 
     def refusal(self, user: User, most: int) -> str | None:
         """Why ``user`` may not open one more SFTP channel, or None."""
