@@ -63,7 +63,7 @@ async def test_a_student_puts_lists_and_gets_files_and_the_app_opens_an_upload_a
             "programs/prog.viple": PROGRAM,
             "runs/20260101-100000/run-001.jsonl": b'{"a run": "record"}\n',
         }
-        assert not any((space / ".uploading").iterdir())
+        await until(lambda: not (space / ".uploading").exists(), "the uploads folder removed")
         assert "sftp: ann write /programs/prog.viple: 39 bytes: done" in caplog.text
         assert "sftp: ann read /programs/prog.viple: 39 bytes: done" in caplog.text
         assert "sftp: ann write /runs/20260101-100000/run-002.jsonl: 0 bytes: refused" in (
@@ -178,7 +178,7 @@ async def test_thousands_of_tiny_files_stop_at_the_file_count_quota(tmp_path):
         assert "you may keep at most 2000 files and folders on this server" in done.said
         space = host.data_dir / "workspaces" / "ann"
         assert len(files_under(space)) == 1999  # and the folder they are in
-        assert not any((space / ".uploading").iterdir())
+        await until(lambda: not (space / ".uploading").exists(), "the uploads folder removed")
         done = await ssh.sftp("ann", "rm many/f0000.txt", f"put {many}/f0001.txt again.txt")
         assert done.status == 0, done.said
         assert (space / "again.txt").read_bytes() == b"x"

@@ -5,7 +5,8 @@ and the room the student's own files take counted against a quota.
 :class:`WorkspaceFiles` keeps the files in the workspace folder on disk. Every path is given
 as its parts inside the workspace (checked by :mod:`workbench.files.names`), and every change
 is told to ``on_change`` with the path it changed, relative to the workspace (``"a/b.viple"``),
-once it is made: a workspace kept elsewhere as well (the course's database) syncs from there.
+once it is made (in the thread that made it: an upload may be committed in a worker thread): a
+workspace kept elsewhere as well (the course's database) syncs from there.
 
 An upload is written whole or not at all: its bytes go to a hidden file in the workspace's
 ``.uploading`` folder and take the file's name only at :meth:`Upload.commit`; an upload

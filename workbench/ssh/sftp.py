@@ -10,6 +10,7 @@ OpenSSH's ``sftp`` and ``scp`` print), and logs one line per file opened.
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import logging
 import os
@@ -309,7 +310,7 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
     def fsync(self, file_obj: object) -> None:
         self._handle(file_obj)  # an upload is flushed to the disk when it is closed
 
-    def close(self, file_obj: object) -> None:
+    async def close(self, file_obj: object) -> None:
         handle = self._handles.pop(file_obj, None)  # type: ignore[call-overload]
         if handle is None:
             return
@@ -325,8 +326,8 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
             upload.abandon()
             self._log(handle.parts, "write", upload.size, "dropped: the client left mid-way")
             return
-        try:
-            upload.commit()
+        try:  # flushed to the disk away from the loop that serves every student
+            await asyncio.to_thread(upload.commit)
             if handle.times is not None:
                 self.files.set_times(handle.parts, *handle.times)
         except WorkspaceError as exc:
@@ -340,10 +341,10 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
             raise asyncssh.SFTPInvalidHandle("no such open file")
         return handle
 
-    def exit(self) -> None:
+    async def exit(self) -> None:
         for key in list(self._handles):
             self.ending = True
-            self.close(key)
+            await self.close(key)
 
     # -- attributes --------------------------------------------------------------------------
     def _check_attrs(self, attrs: asyncssh.SFTPAttrs, parts: Parts) -> None:
