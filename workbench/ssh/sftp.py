@@ -138,11 +138,6 @@ class _Writing:
 _Open = _Reading | _Writing
 
 
-@dataclass
-class _Said:
-    count: int = 0
-
-
 class WorkspaceSFTPServer(asyncssh.SFTPServer):
     """One SFTP channel's requests, answered from one workspace's files."""
 
@@ -155,9 +150,9 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
         self.peer = peer
         #: set when the client is gone: an upload still open then is dropped, not kept
         self.ending = False
-        self.open_files: set[int] = set()
         self._handles: dict[int, _Open] = {}
-        self._said = _Said()
+        #: refusal lines written to the client's error output so far
+        self._said = 0
 
     # -- paths and refusals ------------------------------------------------------------------
     def _parts(self, raw: bytes, *, say: bool = True) -> Parts:
@@ -172,8 +167,8 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
         self, kind: Callable[[str], asyncssh.SFTPError], message: str
     ) -> asyncssh.SFTPError:
         """The error to answer with; the reason also goes to the client's error output."""
-        if self._said.count < MAX_SAID:
-            self._said.count += 1
+        if self._said < MAX_SAID:
+            self._said += 1
             with contextlib.suppress(Exception):
                 self.channel.write_stderr(f"lab server: {message}\n".encode())
         return kind(message)
