@@ -4,7 +4,6 @@ quota on two connections, and a client gone in the middle of an upload."""
 
 from __future__ import annotations
 
-import asyncio
 import logging
 
 import asyncssh
@@ -94,6 +93,8 @@ async def test_a_client_gone_mid_upload_leaves_no_file_and_the_quota_whole(tmp_p
     caplog.set_level(logging.INFO, logger="workbench.ssh")
     limits = UploadLimits(file_size=3_000_000, quota_bytes=3_000_000)
     async with lab_host(tmp_path, [Account("ann")], fork_server=False, uploads=limits) as host:
+        changed: list[tuple[str, str]] = []
+        host.server.sftp.on_change = lambda user, path: changed.append((user, path))
         stays = await host.connect("ann")
         kept = await stays.start_sftp_client()  # keeps the workspace's count alive
         leaves = await host.connect("ann")
@@ -116,5 +117,5 @@ async def test_a_client_gone_mid_upload_leaves_no_file_and_the_quota_whole(tmp_p
         async with kept.open("whole.viple", "wb") as out:
             await out.write(whole)
         assert files_under(space) == {"whole.viple": whole}
-        await asyncio.sleep(0)
+        assert changed == [("ann", "whole.viple")]  # the dropped upload changed nothing
         stays.close()
