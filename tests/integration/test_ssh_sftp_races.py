@@ -50,6 +50,11 @@ async def test_names_a_client_may_send_are_refused_with_their_reason(tmp_path):
         assert files_under(space) == {}
         assert list(space.iterdir()) == []
         assert await sftp.realpath(b"/a/b/../../..") == b"/"
+        room = await sftp.statvfs("/")  # the quota, not the server's disk
+        assert (room.blocks, room.bavail, room.files, room.favail) == (
+            50_000_000, 50_000_000, 2000, 2000
+        )  # fmt: skip
+        assert "no such file" in await refusal(sftp.statvfs("/etc"))
         conn.close()
 
 

@@ -33,7 +33,14 @@ from asyncssh.sftp import (
 )
 from asyncssh.stream import SSHReader, SSHServerStreamSession, SSHWriter
 
-from workbench.files.names import BadPath, Parts, path_parts, resolved_parts, shown_path
+from workbench.files.names import (
+    MAX_NAME_BYTES,
+    BadPath,
+    Parts,
+    path_parts,
+    resolved_parts,
+    shown_path,
+)
 from workbench.files.workspace import workspace_folder, workspaces_folder
 from workbench.files.workspace_files import (
     Refusal,
@@ -232,6 +239,33 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
         for entry in entries:
             attrs = self._attrs(entry.is_folder, entry.size, entry.mtime, entry.atime)
             yield asyncssh.SFTPName(entry.name.encode(), attrs=attrs)
+
+    def statvfs(self, path: bytes) -> asyncssh.SFTPVFSAttrs:
+        """The room the quota leaves (``df`` in ``sftp``), never the server's disks."""
+        parts = self._parts(path)
+        try:
+            self.files.stat(parts)
+        except WorkspaceError as exc:
+            raise self._refusal(exc) from None
+        limits, usage = self.files.limits, self.files.usage
+        if self.files.read_only or not (limits.quota_bytes and limits.quota_files):
+            raise asyncssh.SFTPOpUnsupported("no quota to show here")
+        used = usage.bytes + usage.reserved_bytes
+        entries = usage.files + usage.reserved_files
+        free = max(0, limits.quota_bytes - used)
+        left = max(0, limits.quota_files - entries)
+        return asyncssh.SFTPVFSAttrs(
+            bsize=1, frsize=1, blocks=limits.quota_bytes, bfree=free, bavail=free,
+            files=limits.quota_files, ffree=left, favail=left, namemax=MAX_NAME_BYTES,
+        )  # fmt: skip
+
+    def fstatvfs(self, file_obj: object) -> asyncssh.SFTPVFSAttrs:
+        return self.statvfs(shown_path(self._handle(file_obj).parts).encode())
+
+    def open56(
+        self, path: bytes, desired_access: int, flags: int, attrs: asyncssh.SFTPAttrs
+    ) -> object:
+        raise asyncssh.SFTPOpUnsupported("this server speaks SFTP version 3")
 
     def readlink(self, path: bytes) -> bytes:
         raise self._refused(asyncssh.SFTPOpUnsupported, "links are not kept on this server")
