@@ -578,7 +578,7 @@ class _Reader:
 
 
 def _kind(node: Node) -> str:
-    """ "scalar", "sequence" or "mapping": every node PyYAML composes is one of the three."""
+    """"scalar", "sequence" or "mapping": every node PyYAML composes is one of the three."""
     assert isinstance(node, ScalarNode | SequenceNode | MappingNode)
     return node.id
 

@@ -42,4 +42,6 @@ def save_last_pair(data_dir: str | os.PathLike, student: str, partner: str = "")
     folder = Path(data_dir)
     private_dir(folder)
     path = folder / FILE_NAME
-    write_text_atomic(path, json.dumps({"student": student, "partner": partner}), mode=PRIVATE_FILE)
+    write_text_atomic(
+        path, json.dumps({"student": student, "partner": partner}), mode=PRIVATE_FILE
+    )

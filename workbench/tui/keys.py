@@ -530,7 +530,8 @@ KEY_TABLE: dict[str, Key] = {
         "Sign",
         "Console",
         "sign off",
-        "Sign the exercise off with your key (your passphrase is typed here, in your own session).",
+        "Sign the exercise off with your key (your passphrase is typed here, in your own "
+        "session).",
         priority=True,
     ),
     "console.decline": Key(

@@ -161,3 +161,4 @@ def _read(name: str, kinds: tuple[type, ...], value: object) -> object:
         return float(value)
     wanted = " or ".join(dict.fromkeys(_WORDS[k] for k in kinds))
     raise SettingsError(f"setting {name!r} must be {wanted}, not {value!r:.60}")
+

@@ -199,7 +199,6 @@ class WsClient:
         configure_socket(ws.transport.get_extra_info("socket"))
         outbox = _Outbox(ws)
         pusher = asyncio.create_task(link.push_reports(outbox, self.config.report_ms / 1000))
-
         # an idle driver is cut off at once: nothing it has not read is worth sending
         def cut_off(task: asyncio.Task[str]) -> None:
             if not task.cancelled():

@@ -19,9 +19,9 @@ Choice = Literal["save", "discard", "cancel"]
 class UnsavedDialog(Dialog[Choice | None]):
     """Dismisses with "save", "discard" or "cancel" (escape cancels too)."""
 
-    BINDINGS: ClassVar[list[BindingType]] = [
-        *bindings("unsaved.save", "unsaved.discard", "unsaved.cancel")
-    ]
+    BINDINGS: ClassVar[list[BindingType]] = [*bindings(
+        "unsaved.save", "unsaved.discard", "unsaved.cancel"
+    )]
 
     def __init__(self, title: str, detail: str = "") -> None:
         super().__init__()
