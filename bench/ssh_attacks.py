@@ -21,6 +21,10 @@ dialog and drive at 20 keys a second, probing key-to-screen time every 2 s (``p`
   (``merge_spin``, ``join_nesting``, ``join_doubling``, ``number_doubling``, ``record_flood``)
   from her workspace in her app and starts it; the phase notes when her screen said the program
   stopped, if it did.
+- ``uploads``: mallory uploads a 4 MB program over and over with OpenSSH's ``sftp`` on three
+  connections at once (put, then rm, so her quota never stops her), as fast as they go; the
+  phase gives the upload throughput the server kept up (from its log's transfer lines) and,
+  before the students start, one 4 MB upload's time with nothing else running.
 
 Usage: ``python bench/ssh_attacks.py [--students 4] [--seconds 20] [--only flood]``.
 Figures vary from run to run; the machine is shared by the clients, the server and the apps.
@@ -31,7 +35,9 @@ from __future__ import annotations
 import argparse
 import asyncio
 import contextlib
+import os
 import re
+import subprocess
 import sys
 import tempfile
 import time
@@ -50,7 +56,15 @@ from workbench.files.workspace import workspace_folder  # noqa: E402
 from workbench.ssh.users import add_user  # noqa: E402
 
 PROGRAMS = ("merge_spin", "join_nesting", "join_doubling", "number_doubling", "record_flood")
-PHASES = ("none", "connections", "flood", "terminal", *(f"program-{p}" for p in PROGRAMS))
+PHASES = (
+    "none",
+    "connections",
+    "flood",
+    "terminal",
+    "uploads",
+    *(f"program-{p}" for p in PROGRAMS),
+)
+UPLOAD = 4_000_000
 
 
 async def drive(student: Student, seconds: float, ready: asyncio.Event) -> None:
@@ -207,10 +221,76 @@ async def run_program(port: int, key, name: str, notes: list[str]) -> None:
         notes.append(f"mallory's program: {stage} ({time.perf_counter() - began:.0f} s){tail}")
 
 
+def sftp_argv(port: int, key_file: Path, batch: Path, address: str) -> list[str]:
+    return [
+        "sftp", "-F", "/dev/null", "-i", str(key_file), "-P", str(port),
+        "-o", "StrictHostKeyChecking=no", "-o", "UserKnownHostsFile=/dev/null",
+        "-o", "BatchMode=yes", "-o", "LogLevel=ERROR", "-o", f"BindAddress={address}",
+        "-b", str(batch), "mallory@127.0.0.1",
+    ]  # fmt: skip
+
+
+def upload_files(folder: Path, streams: int) -> tuple[Path, list[Path]]:
+    """A 4 MB program and, for each stream, a batch putting and removing it 500 times."""
+    big = folder / "big.viple"
+    big.write_bytes(os.urandom(UPLOAD))
+    batches = []
+    for s in range(streams):
+        batch = folder / f"batch-{s}"
+        lines = [f"put {big} u{s}-{i}.viple\nrm u{s}-{i}.viple" for i in range(500)]
+        batch.write_text("\n".join(lines) + "\n")
+        batches.append(batch)
+    one = folder / "batch-one"
+    one.write_text(f"put {big} one.viple\nrm one.viple\n")
+    return one, batches
+
+
+def uploaded(log: Path, since: int) -> int:
+    """Bytes of mallory's uploads done, in the server's log after offset ``since``."""
+    text = log.read_text(errors="replace")[since:]
+    return sum(int(n) for n in re.findall(r"sftp: mallory write /\S+: (\d+) bytes: done", text))
+
+
+async def upload_flood(port: int, folder: Path, data: Path, notes: list[str]) -> None:
+    log = data / "ssh.log"
+    since = len(log.read_text(errors="replace"))
+    started = time.perf_counter()
+    procs = [
+        subprocess.Popen(
+            sftp_argv(port, folder / "mallory.key", folder / f"batch-{s}", f"127.0.8.{s + 5}"),
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+        )
+        for s in range(3)
+    ]
+    try:
+        await asyncio.Event().wait()
+    finally:
+        for proc in procs:
+            proc.terminate()
+            proc.wait()
+        seconds = time.perf_counter() - started
+        done = uploaded(log, since)
+        notes.append(
+            f"mallory uploaded {done / 1e6:.0f} MB in {seconds:.0f} s on 3 connections: "
+            f"{done / 1e6 / seconds:.1f} MB/s"
+        )
+
+
+def upload_alone(port: int, folder: Path) -> float:
+    """Seconds one 4 MB upload (and its rm) takes with nothing else running."""
+    started = time.perf_counter()
+    argv = sftp_argv(port, folder / "mallory.key", folder / "batch-one", "127.0.8.9")
+    subprocess.run(argv, check=True, capture_output=True, timeout=120)
+    return time.perf_counter() - started
+
+
 LATE_KEY = asyncssh.generate_private_key("ssh-ed25519")
 
 
-async def phase(name: str, port: int, students: list[Student], keys, seconds: float):
+async def phase(
+    name: str, port: int, students: list[Student], keys, seconds: float, folder: Path, data: Path
+):
     for student in students:
         student.result = Result()
         student.buffer.clear()
@@ -220,6 +300,7 @@ async def phase(name: str, port: int, students: list[Student], keys, seconds: fl
         "connections": lambda: hog_connections(port, keys["mallory"], notes),
         "flood": lambda: flood(port, notes),
         "terminal": lambda: storm_terminal(port, keys["mallory"], notes),
+        "uploads": lambda: upload_flood(port, folder, data, notes),
     }
     for program in PROGRAMS:
         attacks[f"program-{program}"] = lambda program=program: run_program(
@@ -265,15 +346,21 @@ async def main() -> None:
         workspace.mkdir(parents=True, exist_ok=True)
         for program in PROGRAMS:
             (workspace / f"{program}.viple").write_text(getattr(hostile, program)())
+        keys["mallory"].write_private_key(Path(tmp) / "mallory.key")
+        (Path(tmp) / "mallory.key").chmod(0o600)
+        upload_files(Path(tmp), 3)
         port = free_port()
         server = start_server(data, port, args.students + 4, fork=True)
         try:
+            if "uploads" in (args.only or PHASES):
+                alone = upload_alone(port, Path(tmp))
+                print(f"one 4 MB upload alone (sftp put and rm): {alone:.2f} s")
             students = [
                 Student(name, keys[name], port, Result(), student_address(n), "asyncssh", Path())
                 for n, name in enumerate(names[:-1])
             ]
             for name in args.only or PHASES:
-                await phase(name, port, students, keys, args.seconds)
+                await phase(name, port, students, keys, args.seconds, Path(tmp), data)
         finally:
             server.terminate()
             server.wait(30)

@@ -13,9 +13,9 @@ from workbench.control.recording import (
     QUOTA_FULL,
     RecordQuota,
     folder_usage,
-    parse_size,
 )
 from workbench.control.station import RECORDING, LabStation
+from workbench.files.sizes import parse_size
 from workbench.files.workspace import FileAccess
 from workbench.sim.mazefile import parse_maze
 from workbench.sim.record import CAPPED, DISK_FULL, Recorder, read_record

@@ -24,7 +24,7 @@ def new_runs_dir() -> str:
 
 def size(text: str) -> int | None:
     """A size option's value: bytes, or None for 0 (no limit)."""
-    from workbench.control.recording import parse_size
+    from workbench.files.sizes import parse_size
 
     try:
         value = parse_size(text)
@@ -69,3 +69,41 @@ def db_option(parser: argparse.ArgumentParser, top: bool = False) -> None:
 
 def error(message: str) -> None:
     print(f"workbench: {message}", file=sys.stderr)
+
+
+def upload_options(parser: argparse.ArgumentParser) -> None:
+    """``--upload-cap``, ``--workspace-quota`` and ``--workspace-files``: what a student may
+    keep in their workspace by SFTP and scp."""
+    from workbench.files.sizes import shown_size
+    from workbench.files.workspace_files import FILE_CAP, QUOTA_BYTES, QUOTA_FILES
+
+    parser.add_argument(
+        "--upload-cap",
+        type=size,
+        default=FILE_CAP,
+        metavar="SIZE",
+        help="the largest file a student may upload by SFTP or scp "
+        f"(e.g. 5M; 0: no limit; default {shown_size(FILE_CAP)})",
+    )
+    parser.add_argument(
+        "--workspace-quota",
+        type=size,
+        default=QUOTA_BYTES,
+        metavar="SIZE",
+        help="the most a student's own files in their workspace may take, run records not "
+        f"counted (0: no limit; default {shown_size(QUOTA_BYTES)})",
+    )
+    parser.add_argument(
+        "--workspace-files",
+        type=_count,
+        default=QUOTA_FILES,
+        metavar="N",
+        help="the most files and folders a student may keep in their workspace, run records "
+        f"not counted (0: no limit; default {QUOTA_FILES})",
+    )
+
+
+def _count(text: str) -> int:
+    if not text.strip().isdigit():
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number of files (e.g. 2000)")
+    return int(text)

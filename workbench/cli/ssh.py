@@ -13,6 +13,7 @@ import sys
 from pathlib import Path
 
 from workbench.control.recording import RecordQuota
+from workbench.files.workspace_files import UploadLimits
 from workbench.labs.database import ENV_DB, redact
 from workbench.labs.store import (
     DB_NAME,
@@ -25,7 +26,7 @@ from workbench.labs.store import (
 from workbench.ssh.appproc import AppEntry
 from workbench.ssh.limits import SessionLimits
 
-from .common import db_option, record_quota_options, size
+from .common import db_option, record_quota_options, size, upload_options
 
 #: the app every SSH session runs, given the session's settings as JSON (see
 #: :mod:`workbench.cli.served`): this Python's ``-m workbench.cli.served``, or forked from the
@@ -129,6 +130,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="seconds an account takes no passwords once locked; keys still work (default 900)",
     )  # fmt: skip
     record_quota_options(serve)
+    upload_options(serve)
     serve.add_argument(
         "--no-fork-server", action="store_true",
         help="start each session's app as a new Python process instead of forking it from a "
@@ -260,7 +262,8 @@ def cmd_serve(args: argparse.Namespace) -> int:
     from workbench.ssh.hostkey import HostKeyError
     from workbench.ssh.logins import LoginPolicy
     from workbench.ssh.ports import parse_range
-    from workbench.ssh.server import LabServer, ServerConfig, setup_logging
+    from workbench.ssh.server import LabServer, ServerConfig
+    from workbench.ssh.serverlog import setup_logging
     from workbench.ssh.users import UsersFileError
 
     if not 0 <= args.port <= 65535:
@@ -358,6 +361,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
         fork_server=not args.no_fork_server,
         app=WORKBENCH_APP,
         record_quota=RecordQuota(args.record_cap, args.runs_quota),
+        uploads=UploadLimits(args.upload_cap or 0, args.workspace_quota or 0, args.workspace_files),
     )
     try:
         log_path = setup_logging(data_dir)

@@ -12,10 +12,10 @@ from __future__ import annotations
 
 import logging
 import os
-import re
 from dataclasses import dataclass
 from pathlib import Path
 
+from workbench.files.sizes import shown_size
 from workbench.sim.record import DISK_FULL, NO_ROOM, Recorder, RecordStop
 
 log = logging.getLogger("workbench.record")
@@ -33,27 +33,6 @@ QUOTA_FULL = "quota full"
 TOO_MANY_FILES = "too many files"
 MOVED_ASIDE = "moved aside"
 NO_FOLDER = "no folder"
-
-_SIZE = re.compile(r"(\d+(?:\.\d+)?)\s*([kmg]?)b?", re.IGNORECASE)
-_UNITS = {"": 1, "k": 1_000, "m": 1_000_000, "g": 1_000_000_000}
-
-
-def parse_size(text: str) -> int:
-    """``20M``, ``500k``, ``1.5G`` or a number of bytes; ValueError says what is accepted."""
-    match = _SIZE.fullmatch(text.strip())
-    if match is None:
-        raise ValueError(
-            f"{text!r} is not a size: give bytes or a number with k, M or G (e.g. 20M)"
-        )
-    return int(float(match.group(1)) * _UNITS[match.group(2).lower()])
-
-
-def shown_size(size: int) -> str:
-    """A size as people say it: ``20 MB``, ``500 kB``."""
-    for unit, name in ((1_000_000_000, "GB"), (1_000_000, "MB"), (1_000, "kB")):
-        if size >= unit:
-            return f"{size / unit:.3g} {name}"
-    return f"{size} bytes"
 
 
 @dataclass(frozen=True)

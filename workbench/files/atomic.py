@@ -1,9 +1,10 @@
 """Writing a file whole: a crash or a full disk leaves either the old file or the new one.
 
-The new content goes to a temporary file beside the target, is flushed to the disk, and then
-takes the target's place in one step (``os.replace``). The one way every file the workbench
-writes in place is saved: mazes, rosters, gradebooks, the SSH users file, the last pair and
-the pending store writes.
+The new content goes to a temporary file beside the target (for a file written piece by
+piece, :class:`PendingFile`, in a hidden folder on the same file system), is flushed to the
+disk, and then takes the target's place in one step (``os.replace``). The one way every file
+the workbench writes in place is saved: mazes, rosters, gradebooks, the SSH users file, the
+last pair, the pending store writes and the files students upload to the lab server.
 """
 
 from __future__ import annotations
@@ -46,3 +47,60 @@ def _mode_for(path: Path) -> int:
         umask = os.umask(0)
         os.umask(umask)
         return 0o666 & ~umask
+
+
+class PendingFile:
+    """A file written piece by piece that appears whole or not at all: the pieces go to a
+    temporary file in ``folder`` (a hidden one, on the same file system as the target), and
+    :meth:`commit` flushes it to the disk and puts it in the target's place in one step.
+    :meth:`discard` removes it; nothing of it is ever seen under the target's name."""
+
+    def __init__(self, folder: Path, stem: str = "pending", mode: int = 0o600) -> None:
+        fd, temp = tempfile.mkstemp(prefix=f".{stem}.", suffix=".tmp", dir=folder)
+        os.fchmod(fd, mode)
+        self.fd: int | None = fd
+        self.temp = Path(temp)
+
+    @property
+    def open(self) -> bool:
+        return self.fd is not None
+
+    def write(self, offset: int, data: bytes) -> None:
+        assert self.fd is not None
+        view = memoryview(data)
+        while view:
+            done = os.pwrite(self.fd, view, offset)
+            view, offset = view[done:], offset + done
+
+    def read(self, offset: int, size: int) -> bytes:
+        assert self.fd is not None
+        return os.pread(self.fd, size, offset)
+
+    def truncate(self, size: int) -> None:
+        assert self.fd is not None
+        os.ftruncate(self.fd, size)
+
+    def size(self) -> int:
+        assert self.fd is not None
+        return os.fstat(self.fd).st_size
+
+    def commit(self, target: str | os.PathLike) -> None:
+        """Flush the file and put it at ``target``, replacing what is there."""
+        assert self.fd is not None
+        try:
+            os.fsync(self.fd)
+        finally:
+            os.close(self.fd)
+            self.fd = None
+        try:
+            os.replace(self.temp, target)
+        except BaseException:
+            self.discard()
+            raise
+
+    def discard(self) -> None:
+        if self.fd is not None:
+            os.close(self.fd)
+            self.fd = None
+        with contextlib.suppress(OSError):
+            os.unlink(self.temp)

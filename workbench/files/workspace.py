@@ -162,7 +162,12 @@ def workspace_folder(data_dir: str | os.PathLike, user: str) -> Path:
     """``<data-dir>/workspaces/<user>``: a served student's own folder."""
     if not _FOLDER_NAME.fullmatch(user) or user in {".", ".."}:
         raise ValueError(f"{user!r} cannot name a workspace folder")
-    return Path(data_dir) / "workspaces" / user
+    return workspaces_folder(data_dir) / user
+
+
+def workspaces_folder(data_dir: str | os.PathLike) -> Path:
+    """``<data-dir>/workspaces``: every served student's folder is in it."""
+    return Path(data_dir) / "workspaces"
 
 
 LOCAL = FileAccess()

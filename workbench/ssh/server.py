@@ -8,9 +8,7 @@ import asyncio
 import contextlib
 import itertools
 import logging
-import os
 import socket
-import sys
 import time
 from collections import Counter
 from dataclasses import dataclass, field
@@ -19,8 +17,8 @@ from pathlib import Path
 import asyncssh
 
 from workbench.control.recording import RecordQuota, shown_size
-from workbench.files.private import private_dir, tighten_tree
 from workbench.files.workspace import workspace_folder
+from workbench.files.workspace_files import UploadLimits
 
 from .applog import make_room
 from .appproc import RESTORE_TERMINAL, AppEntry, AppProcess, AppSpec, app_env, forward_hint
@@ -32,17 +30,14 @@ from .logins import ConnectionGate, LoginGuard, LoginPolicy, QuietLog
 from .openfiles import Handler, near_the_limit, quiet_accept_errors, raise_file_limit
 from .passwords import hash_password, verify_password
 from .ports import PoolExhausted, PortPool
+from .refusals import refusal_message
+from .serverlog import shown
+from .sftp import SFTPChannel, SFTPService
 from .sources import source_of
 from .users import User, UsersFile, users_path
 
 log = logging.getLogger("workbench.ssh")
 
-NOT_A_TERMINAL = (
-    "This lab server runs the workbench only, in a terminal: "
-    "connect with plain 'ssh -p {port} {user}@{host}'."
-)
-NO_COMMANDS = "This lab server runs the workbench only: no commands ({what} refused)."
-NO_FILES = "This lab server runs the workbench only: no file transfer ({what} refused)."
 #: what a client closed before it logs in reads (as the reason of the SSH disconnect)
 TOO_MANY_WAITING = (
     "The lab server has too many connections waiting to log in from your network or in all; "
@@ -93,45 +88,14 @@ class ServerConfig:
     app: AppEntry = field(kw_only=True)
     #: how much room each session's run records may take
     record_quota: RecordQuota = field(default_factory=RecordQuota, kw_only=True)
+    #: what a student may upload by SFTP
+    uploads: UploadLimits = field(default_factory=UploadLimits, kw_only=True)
 
     def __post_init__(self) -> None:
         self.data_dir = Path(self.data_dir)
         self.host_key = Path(self.host_key or host_key_path(self.data_dir))
         self.users_file = Path(self.users_file or users_path(self.data_dir))
         self.public_host = self.public_host or socket.getfqdn()
-
-
-def shown(name: str) -> str:
-    """A login name as the log shows it: at most 64 characters, no control characters."""
-    return "".join(c if c.isprintable() else "?" for c in name[:64])
-
-
-def setup_logging(data_dir: Path, stream: bool = True) -> Path:
-    """Log the server's events to ``<data-dir>/ssh.log`` (and stderr); returns the log's path.
-    The data folder and everything in it are made private to the server's account first, and
-    so is all the server and its apps make from now on (a umask of 077): they hold students'
-    progress and login addresses."""
-    os.umask(0o077)
-    changed = [n for n in (private_dir(data_dir), *tighten_tree(data_dir)) if n]
-    path = data_dir / "ssh.log"
-    formatter = logging.Formatter("%(asctime)s %(levelname)s %(message)s")
-    handlers: list[logging.Handler] = [logging.FileHandler(path, encoding="utf-8")]
-    if stream:
-        handlers.append(logging.StreamHandler(sys.stderr))
-    for handler in handlers:
-        handler.setFormatter(formatter)
-        log.addHandler(handler)
-    log.setLevel(logging.INFO)
-    logging.getLogger("asyncssh").setLevel(logging.WARNING)
-    if changed:
-        log.warning(
-            "made private to this account: %d file(s) and folder(s) of %s were open to other "
-            "accounts, e.g. %s",
-            len(changed),
-            data_dir,
-            changed[0],
-        )
-    return path
 
 
 class LabServer:
@@ -162,6 +126,7 @@ class LabServer:
         self._closing = False
         self._previous_handler: Handler = None
         self.forkserver: ForkServer | None = None
+        self.sftp = SFTPService(config.data_dir, config.uploads)
 
     @property
     def port(self) -> int:
@@ -623,6 +588,7 @@ class LabSession(asyncssh.SSHServerSession):
         self.size = (80, 24)
         self.has_pty = False
         self.request = ""  # shell, or what was refused
+        self.command = ""
         self.spec: AppSpec | None = None
         self.app: AppProcess | None = None
         self.ports: tuple[int, ...] = ()
@@ -636,6 +602,8 @@ class LabSession(asyncssh.SSHServerSession):
         self._app_size = self.size
         self._resized_at = 0.0
         self._resize: asyncio.TimerHandle | None = None
+        #: a file transfer (the ``sftp`` subsystem) runs on this channel instead of the app
+        self.sftp: SFTPChannel | None = None
 
     @property
     def running(self) -> bool:
@@ -670,13 +638,20 @@ class LabSession(asyncssh.SSHServerSession):
 
     def exec_requested(self, command: str) -> bool:
         self.request = f"command {command[:60]!r}"
+        self.command = command[:200]
         return True
 
     def subsystem_requested(self, subsystem: str) -> bool:
         self.request = f"subsystem {subsystem[:30]!r}"
+        if subsystem == "sftp" and self.chan is not None:
+            self.sftp = SFTPChannel(self.server.sftp, self.user, self.connection.peer)
+            self.sftp.connection_made(self.chan)
         return True
 
     def session_started(self) -> None:
+        if self.sftp is not None and self.chan is not None:
+            self.sftp.start(self.chan, self.server.config.limits.connections_per_user)
+            return
         if self.request != "shell" or not self.has_pty:
             self._refuse_request()
             return
@@ -695,14 +670,9 @@ class LabSession(asyncssh.SSHServerSession):
 
     def _refuse_request(self) -> None:
         config = self.server.config
-        if self.request.startswith("subsystem"):
-            message = NO_FILES.format(what=self.request)
-        elif self.request.startswith("command"):
-            message = NO_COMMANDS.format(what=self.request)
-        else:
-            message = NOT_A_TERMINAL.format(
-                port=config.port, user=self.user.name, host=config.public_host
-            )
+        message = refusal_message(
+            self.request, self.command, self.server.port, self.user.name, config.public_host
+        )
         log.warning(
             "%s refused: %s from %s",
             self.request or "session without terminal",
@@ -880,6 +850,9 @@ class LabSession(asyncssh.SSHServerSession):
 
     # -- the client --------------------------------------------------------------------------
     def data_received(self, data: bytes, datatype: asyncssh.DataType) -> None:
+        if self.sftp is not None:
+            self.sftp.stream.data_received(data, datatype)
+            return
         self.last_input = time.monotonic()
         if self.app is not None:
             self.app.send_keys(data)
@@ -907,6 +880,8 @@ class LabSession(asyncssh.SSHServerSession):
         self.app.resize(*self.size)
 
     def eof_received(self) -> bool:
+        if self.sftp is not None:
+            return self.sftp.stream.eof_received()
         self._client_gone("end of input")
         return False
 
@@ -914,14 +889,20 @@ class LabSession(asyncssh.SSHServerSession):
         return False
 
     def pause_writing(self) -> None:
+        if self.sftp is not None:
+            self.sftp.stream.pause_writing()
         if self.app is not None:
             self.app.pause_output()
 
     def resume_writing(self) -> None:
+        if self.sftp is not None:
+            self.sftp.stream.resume_writing()
         if self.app is not None:
             self.app.resume_output()
 
     def connection_lost(self, exc: Exception | None) -> None:
+        if self.sftp is not None:
+            self.sftp.stream.connection_lost(exc)
         self._closed = True
         self._client_gone(str(exc) if exc else "disconnected")
 

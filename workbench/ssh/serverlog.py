@@ -1,0 +1,46 @@
+"""The lab server's log: ``<data-dir>/ssh.log`` (and standard error), and how names a client
+chose are shown in it."""
+
+from __future__ import annotations
+
+import logging
+import os
+import sys
+from pathlib import Path
+
+from workbench.files.private import private_dir, tighten_tree
+
+log = logging.getLogger("workbench.ssh")
+
+
+def shown(name: str) -> str:
+    """A login name as the log shows it: at most 64 characters, no control characters."""
+    return "".join(c if c.isprintable() else "?" for c in name[:64])
+
+
+def setup_logging(data_dir: Path, stream: bool = True) -> Path:
+    """Log the server's events to ``<data-dir>/ssh.log`` (and stderr); returns the log's path.
+    The data folder and everything in it are made private to the server's account first, and
+    so is all the server and its apps make from now on (a umask of 077): they hold students'
+    progress and login addresses."""
+    os.umask(0o077)
+    changed = [n for n in (private_dir(data_dir), *tighten_tree(data_dir)) if n]
+    path = data_dir / "ssh.log"
+    formatter = logging.Formatter("%(asctime)s %(levelname)s %(message)s")
+    handlers: list[logging.Handler] = [logging.FileHandler(path, encoding="utf-8")]
+    if stream:
+        handlers.append(logging.StreamHandler(sys.stderr))
+    for handler in handlers:
+        handler.setFormatter(formatter)
+        log.addHandler(handler)
+    log.setLevel(logging.INFO)
+    logging.getLogger("asyncssh").setLevel(logging.WARNING)
+    if changed:
+        log.warning(
+            "made private to this account: %d file(s) and folder(s) of %s were open to other "
+            "accounts, e.g. %s",
+            len(changed),
+            data_dir,
+            changed[0],
+        )
+    return path
