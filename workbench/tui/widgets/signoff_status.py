@@ -114,7 +114,7 @@ class SignoffStatus(Static):
         #: the last sign-off seen, by (lab, exercise): a newer one is news
         self._known: dict[tuple[str, str], tuple[str, str] | None] = {}
         self.seen: Seen | None = None
-        #: the reading thread runs (once the widget is mounted and has a store)
+        #: the reading thread starts once the widget is mounted and has a store, and only once
         self._mounted_once = False
         self._polling = False
 
