@@ -101,6 +101,12 @@ async def connect(port: int, name: str, key, address: str = "127.0.0.1", **kw):
     )  # fmt: skip
 
 
+async def close_all(conns: list[asyncssh.SSHClientConnection]) -> None:
+    for conn in conns:
+        conn.close()
+    await asyncio.gather(*(conn.wait_closed() for conn in conns))
+
+
 async def hog_connections(port: int, key, notes: list[str]) -> None:
     held, refused = [], 0
     try:
@@ -114,35 +120,52 @@ async def hog_connections(port: int, key, notes: list[str]) -> None:
         open_ = [c for c in held if not c.is_closed()]
         refused += len(held) - len(open_)  # let in, then closed with the reason
         notes.append(f"mallory held {len(open_)} connections; {refused} more refused")
-        for conn in held:
-            conn.close()
+        await close_all(held)
+
+
+async def let_go(reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+    """Close a connection that never logged in, and wait until the server has let go of it:
+    our end of the stream is shut, and the server, seeing that, drops the connection (and
+    its place at the login) and closes its end, which reads here as the end of the stream."""
+    with contextlib.suppress(OSError):
+        if not writer.is_closing():
+            writer.write_eof()
+            while await asyncio.wait_for(reader.read(4096), RELEASE_TIMEOUT):
+                pass
+    writer.close()
+    with contextlib.suppress(OSError):
+        await writer.wait_closed()
 
 
 async def flood(port: int, notes: list[str]) -> None:
+    held: set[tuple[asyncio.StreamReader, asyncio.StreamWriter]] = set()
+
     async def hold(address: str) -> None:
         while True:
             try:
-                reader, writer = await asyncio.open_connection(
-                    "127.0.0.1", port, local_addr=(address, 0)
-                )
+                pair = await asyncio.open_connection("127.0.0.1", port, local_addr=(address, 0))
             except OSError:
                 await asyncio.sleep(0.1)
                 continue
+            held.add(pair)
+            reader, writer = pair
             with contextlib.suppress(OSError):
                 while await reader.read(4096):
                     pass
+            held.discard(pair)
             writer.close()
 
     tasks = [asyncio.create_task(hold(f"127.0.9.{a}")) for a in range(1, 11) for _ in range(10)]
+    started = time.perf_counter()
+    tries = 0
     try:
         await asyncio.sleep(1.0)  # the places are full
         started = time.perf_counter()
-        tries = 0
         while True:
             tries += 1
             try:
                 conn = await connect(port, "late", LATE_KEY, "127.0.10.1")
-                conn.close()
+                await close_all([conn])
                 break
             except (OSError, asyncssh.Error):
                 await asyncio.sleep(0.5)
@@ -151,8 +174,16 @@ async def flood(port: int, notes: list[str]) -> None:
         )
         await asyncio.Event().wait()
     finally:
+        if not notes:
+            notes.append(
+                f"a new student did not get in within {time.perf_counter() - started:.1f} s "
+                f"({tries} tries)"
+            )
         for task in tasks:
             task.cancel()
+        await asyncio.gather(*tasks, return_exceptions=True)
+        # the next phase's logins find the places at the login free again
+        await asyncio.gather(*(let_go(*pair) for pair in held))
 
 
 async def storm_terminal(port: int, key, notes: list[str]) -> None:
@@ -177,8 +208,7 @@ async def storm_terminal(port: int, key, notes: list[str]) -> None:
             await asyncio.sleep(0.01)
     finally:
         notes.append(f"mallory sent {changes} window changes")
-        for conn in conns:
-            conn.close()
+        await close_all(conns)
 
 
 async def run_program(port: int, key, name: str, notes: list[str]) -> None:
@@ -286,6 +316,8 @@ def upload_alone(port: int, folder: Path) -> float:
 
 
 LATE_KEY = asyncssh.generate_private_key("ssh-ed25519")
+#: seconds the server has to let go of a connection the bench closes (it takes milliseconds)
+RELEASE_TIMEOUT = 30.0
 
 
 async def phase(
@@ -310,7 +342,18 @@ async def phase(
     drivers = [
         asyncio.create_task(drive(s, seconds, r)) for s, r in zip(students, readies, strict=True)
     ]
-    await asyncio.wait_for(asyncio.gather(*(r.wait() for r in readies)), 180)
+    # every student drives (or one could not: that is reported, not waited for)
+    waits = [asyncio.create_task(r.wait()) for r in readies]
+    for ready, driver in zip(waits, drivers, strict=True):
+        await asyncio.wait([ready, driver], timeout=180, return_when=asyncio.FIRST_COMPLETED)
+    for wait in waits:
+        wait.cancel()
+    if not all(r.is_set() for r in readies):
+        failures = [f for s in students for f in s.result.failures] or ["no main screen in 180 s"]
+        for driver in drivers:
+            driver.cancel()
+        await asyncio.gather(*drivers, return_exceptions=True)
+        raise SystemExit(f"{name}: not every student got to drive: {failures[:3]}")
     attack = attacks[name]
     task = asyncio.create_task(attack()) if attack else None
     await asyncio.gather(*drivers)

@@ -7,6 +7,7 @@ from pathlib import Path
 from textual.pilot import Pilot
 from textual.widgets import OptionList, Static
 
+from tests.waiting import until
 from workbench.tui.app import WorkbenchApp, make_app
 from workbench.tui.dialogs.signoff import SignoffModal
 from workbench.tui.screens.labs import LabsScreen
@@ -37,12 +38,19 @@ def evidence_lines(screen) -> list[str]:
     return [line.strip() for line in lines if line.startswith(" ")]
 
 
-async def open_exercise(pilot: Pilot, option_id: str = DRIVE) -> LabsScreen:
-    """``l``, then the exercise ``option_id`` ("lab/exercise") highlighted in the list."""
+async def open_labs(pilot: Pilot) -> LabsScreen:
+    """``l``, and the labs screen once it has read the saved work (from a thread)."""
     await pilot.press("l")
-    await pilot.pause()
     screen = pilot.app.screen
     assert isinstance(screen, LabsScreen)
+    await until(lambda: not screen.lab_progress.reading, "the saved work read")
+    await pilot.pause()
+    return screen
+
+
+async def open_exercise(pilot: Pilot, option_id: str = DRIVE) -> LabsScreen:
+    """``l``, then the exercise ``option_id`` ("lab/exercise") highlighted in the list."""
+    screen = await open_labs(pilot)
     listing = screen.query_one("#labs-list", OptionList)
     listing.highlighted = listing.get_option_index(option_id)
     await pilot.pause()

@@ -12,11 +12,10 @@ from workbench.tui.app import make_app
 from workbench.tui.dialogs.algorithm import AlgorithmModal
 from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.screens import labs as labs_screen
-from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
 from workbench.tui.settings import AppSettings
 
-from .labs_support import lab_app, text
+from .labs_support import lab_app, open_labs, text
 from .support import run
 
 MAZES = ["maze-deep-flow.txt", "maze-nul.txt", "maze-1000x1000.txt", "maze-1mb-line.txt"]
@@ -89,10 +88,7 @@ def test_l_with_a_bad_lab_file_shows_the_error_and_keeps_running(
     app = lab_app(tmp_path / "data")
 
     async def body(pilot: Pilot) -> None:
-        await pilot.press("l")
-        await pilot.pause()
-        screen = app.screen
-        assert isinstance(screen, LabsScreen)
+        screen = await open_labs(pilot)
         message = text(screen, "#labs-message")
         assert name in message and SECRET not in message
         await pilot.press("escape")

@@ -11,7 +11,7 @@ from tests.waiting import until
 from workbench.labs.model import load_labs
 from workbench.tui.screens.labs import LabsScreen
 
-from .labs_support import lab_app
+from .labs_support import lab_app, open_labs
 from .support import run
 
 
@@ -26,8 +26,7 @@ def test_no_answer_hint_is_cut(tmp_path):
     assert any(not q.choices for _, exercise in asked for q in exercise.questions)
 
     async def body(pilot: Pilot) -> None:
-        await pilot.press("l")
-        await pilot.pause()
+        await open_labs(pilot)
         screen = app.screen
         assert isinstance(screen, LabsScreen)
         listing = screen.query_one("#labs-list", OptionList)

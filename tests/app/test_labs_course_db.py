@@ -7,7 +7,7 @@ import threading
 
 import pytest
 from textual.pilot import Pilot
-from textual.widgets import Input
+from textual.widgets import Input, OptionList
 
 from tests.waiting import until
 from workbench.labs.pending import pending_path
@@ -15,7 +15,7 @@ from workbench.labs.store import Store
 from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
 
-from .labs_support import DRIVE, lab_app, open_exercise, text
+from .labs_support import DRIVE, lab_app, open_exercise, open_labs, text
 from .support import run, said
 
 
@@ -34,9 +34,7 @@ def test_a_student_resumes_on_another_server_where_they_left_off(tmp_path, pg_ur
     second = lab_app(tmp_path / "server-two", db=pg_url)  # another machine, the same database
 
     async def resume(pilot: Pilot) -> None:
-        await pilot.press("l")
-        await pilot.pause()
-        screen = second.screen
+        screen = await open_labs(pilot)
         assert "Drive by wire" in text(screen, "#labs-title")  # reopened where they were
         assert text(screen, "#labs-objectives").startswith(
             "[X] drove with w, a, s, d and space: passed earlier"
@@ -236,3 +234,64 @@ def test_a_database_that_hangs_never_freezes_the_app_and_the_work_waits_for_it(
     with Store.open(tmp_path / "elsewhere", db=pg_url) as store:
         saved = store.progress("ana")[("unity-simulator", "drive-by-wire")]
     assert saved["answers"] == {"tcp-port": "1350"}
+
+
+@pytest.mark.parametrize("how", ["stopped", "locked"])
+def test_the_labs_open_beside_a_database_that_hangs_and_the_student_goes_on(
+    tmp_path, pg_server, pg_url, monkeypatch, how
+):
+    first = lab_app(tmp_path / "one", db=pg_url)
+
+    async def work(pilot: Pilot) -> None:
+        screen = await open_exercise(pilot, DRIVE)
+        screen.query_one("#q-tcp-port", Input).value = "1350"
+        await pilot.pause()
+
+    run(first, work)  # saved progress the hung database holds
+    # a connection or a statement is given up on after 8 s: long enough that the keys below
+    # are answered while the labs still wait for the database
+    monkeypatch.setenv("WORKBENCH_DB_TIMEOUT", "8")
+    app = lab_app(tmp_path / "two", db=f"{pg_url}?connect_timeout=8")
+    hang = Hang(how, pg_server, pg_url, limit=90)
+
+    async def body(pilot: Pilot) -> None:
+        hang.start()
+        try:
+            await pilot.press("l")  # the store is opened and read while the database hangs
+            screen = app.screen
+            assert isinstance(screen, LabsScreen)
+            await pilot.pause()
+            assert "loading saved work" in text(screen, "#labs-title")
+            # the keys are handled and the screen drawn while the labs wait for the database
+            await pilot.press("escape", "p")
+            assert isinstance(app.screen, MainScreen) and not app.station.paused
+            frames = app.frames
+            await pilot.press("w")
+            await until(lambda: app.frames != frames, "a frame drawn after the key")
+            await pilot.press("p", "l")
+            assert app.screen is screen
+            assert screen.lab_progress.reading  # (the read still waits)
+
+            def away() -> str:
+                message = text(screen, "#labs-message")
+                return message if "saved progress is not shown yet" in message else ""
+
+            # given up on at the deadline: the labs work as with a database that is down
+            message = await until(away, "the message that the database is away", timeout=60)
+            assert message.startswith("the course database cannot be reached")
+            assert not screen.lab_progress.reading
+            listing = screen.query_one("#labs-list", OptionList)
+            listing.highlighted = listing.get_option_index("unity-simulator/wall-following")
+            await until(lambda: "Wall following" in text(screen, "#labs-title"), "an exercise")
+        finally:
+            hang.release()
+        # once it is back, the saved work is read and shown
+        back = "the course database is back: your progress is saved"
+        await until(
+            lambda: text(screen, "#labs-message") == back, "the message that it is back", 60
+        )
+        assert screen.lab_progress.answers[("unity-simulator", "drive-by-wire")] == {
+            "tcp-port": "1350"
+        }
+
+    run(app, body)

@@ -13,7 +13,7 @@ from workbench.tui.screens.main import MainScreen
 from workbench.tui.settings import AppSettings
 from workbench.viple.tcp_server import TcpConfig
 
-from .labs_support import DRIVE, lab_app, objective_lines, open_exercise, text
+from .labs_support import DRIVE, lab_app, objective_lines, open_exercise, open_labs, text
 from .support import endpoints_started, run, run_panel, said
 
 CONNECT = "web-simulator/connect"
@@ -76,8 +76,7 @@ def test_the_names_are_asked_at_start_and_shown_on_the_message_line(tmp_path):
         assert isinstance(app.screen, MainScreen)
         assert (app.student, app.partner) == ("ana", "Ben Ortiz")
         assert text(app.screen, "#message").rstrip().endswith("ana & Ben Ortiz (student)")
-        await pilot.press("l")
-        await pilot.pause()
+        await open_labs(pilot)
         assert app.screen.partner == "Ben Ortiz"
 
     run(app, body)
@@ -251,8 +250,7 @@ def test_the_labs_reopen_at_the_exercise_the_student_had_open(tmp_path):
     again = lab_app(data)
 
     async def resume(pilot: Pilot) -> None:
-        await pilot.press("l")
-        await pilot.pause()
+        await open_labs(pilot)
         screen = again.screen
         assert "Wall following" in text(screen, "#labs-title")
         listing = screen.query_one("#labs-list", OptionList)

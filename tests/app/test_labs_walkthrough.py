@@ -27,7 +27,7 @@ from textual.pilot import Pilot
 from textual.widgets import Input, Markdown, OptionList, Select, Static
 from websockets.asyncio.server import serve
 
-from tests.app.labs_support import objective_lines, signing_over
+from tests.app.labs_support import objective_lines, open_labs, signing_over
 from tests.integration.test_labs_completable import DRIVE, SOLUTIONS, answer
 from tests.sessions import free_port
 from tests.waiting import DEADLINE, until
@@ -95,7 +95,7 @@ class Walkthrough:
     # -- screens ---------------------------------------------------------------------------
     async def labs(self) -> LabsScreen:
         if not isinstance(self.app.screen, LabsScreen):
-            await self.press("l")
+            return await open_labs(self.pilot)
         screen = self.app.screen
         assert isinstance(screen, LabsScreen)
         return screen

@@ -8,11 +8,11 @@ import re
 from textual.pilot import Pilot
 
 from workbench.tui.app import make_app
-from workbench.tui.screens.labs import UNREACHABLE, LabsScreen
+from workbench.tui.screens.labs import UNREACHABLE
 from workbench.tui.screens.main import MainScreen
 from workbench.tui.settings import AppSettings
 
-from .labs_support import lab_app, open_exercise
+from .labs_support import lab_app, open_exercise, open_labs
 from .support import run, screen_lines
 
 #: what an algorithm that fails in a file kept deep in a student's folders may say
@@ -50,9 +50,7 @@ def test_the_course_database_message_is_drawn_whole(tmp_path):
     app = lab_app(tmp_path / "data", db="postgresql://ana@127.0.0.1:1/course")
 
     async def body(pilot: Pilot) -> None:
-        await pilot.press("l")
-        await pilot.pause()
-        assert isinstance(app.screen, LabsScreen)
+        await open_labs(pilot)
         said = drawn(pilot, 4)
         assert re.search(
             f"{UNREACHABLE}: your progress is kept here \\(\\d+ change\\(s\\)\\) and saved as "

@@ -41,7 +41,10 @@ async def test_a_student_moves_between_two_servers_sharing_one_database(
         again = await two.terminal("ann", size=(100, 30))
         await again.start_app()
         again.send("l")
-        screen = await again.wait_for("esc Back", "Sign off")
+        await again.wait_for("esc Back", "Sign off")
+        screen = await again.wait_until(
+            lambda t: "loading saved work" not in t, "the saved work read"
+        )
         assert DRIVE in screen.splitlines()[0]  # reopened at the exercise left on server one
         assert KEYS_DONE in screen
         await again.close()

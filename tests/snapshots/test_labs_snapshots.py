@@ -14,7 +14,7 @@ import pytest
 from textual.pilot import Pilot
 from textual.widgets import Checkbox, Input, OptionList
 
-from tests.app.labs_support import signing_over
+from tests.app.labs_support import open_labs, signing_over
 from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.model import load_labs
 from workbench.tui.app import WorkbenchApp, make_app
@@ -37,8 +37,7 @@ def still(pilot: Pilot) -> None:
 
 
 async def open_drive_by_wire(pilot: Pilot) -> None:
-    await pilot.press("l")
-    await pilot.pause()
+    await open_labs(pilot)
     listing = pilot.app.screen.query_one("#labs-list", OptionList)
     listing.highlighted = listing.get_option_index("unity-simulator/drive-by-wire")
     await pilot.pause()
@@ -118,8 +117,7 @@ def test_every_lab_exercise_at_80x24(snap_compare, tmp_path, option_id):
     """Each exercise as a pair first sees it: chosen in the list, not set up, ASCII marks."""
 
     async def before(pilot: Pilot) -> None:
-        await pilot.press("l")
-        await pilot.pause()
+        await open_labs(pilot)
         listing = pilot.app.screen.query_one("#labs-list", OptionList)
         listing.highlighted = listing.get_option_index(option_id)
         await pilot.pause()
@@ -135,8 +133,7 @@ def test_multiple_choice_question_at_80x24(snap_compare, tmp_path):
     choice whole (the long one wrapped under its text), the picked one marked (*)."""
 
     async def before(pilot: Pilot) -> None:
-        await pilot.press("l")
-        await pilot.pause()
+        await open_labs(pilot)
         screen = pilot.app.screen
         listing = screen.query_one("#labs-list", OptionList)
         listing.highlighted = listing.get_option_index("maze-algorithms/erobotic-rules")

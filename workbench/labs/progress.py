@@ -2,8 +2,9 @@
 checked live, the answers given, the sign-offs, and who drives.
 
 The labs screen (and any other front end, and the tests) keeps a :class:`LabProgress` and
-asks it everything: reading what the store saved (:func:`read_saved`, which touches nothing
-but the store, so it may run in a thread, then :meth:`LabProgress.take`), setting an
+asks it everything: reading what the store saved (:func:`read_work`, which touches nothing
+but the store and waits for it, so a front end runs it off its event loop, then
+:meth:`LabProgress.take_work`; :attr:`LabProgress.reading` until then), setting an
 exercise up (:meth:`LabProgress.set_up`), checking it against the station and saving what
 changed (:meth:`LabProgress.check`, :meth:`LabProgress.save`), and what a sign-off changes.
 
@@ -30,7 +31,7 @@ from .checks import (
     keep_passed,
 )
 from .model import Exercise, Lab
-from .store import Store
+from .store import Store, StoreUnavailable
 
 #: (lab id, exercise id)
 ExerciseKey = tuple[str, str]
@@ -84,6 +85,38 @@ def read_saved(store: Store, student: str, partner: str = "") -> SavedProgress:
     return out
 
 
+@dataclass(frozen=True)
+class SavedWork:
+    """What the labs read from the store as they open (:func:`read_work`): the saved progress
+    and the exercise the student had open last, or why they could not be read."""
+
+    saved: SavedProgress | None = None
+    place: ExerciseKey | None = None
+    #: the course database cannot be reached, or did not answer within its deadline: the
+    #: work goes on as with a database that is down, and is read again once it is back
+    away: bool = False
+    #: why the saved progress could not be read otherwise ("" when it was, or when away)
+    error: str = ""
+
+
+def read_work(store: Store, student: str, partner: str = "") -> SavedWork:
+    """Everything the labs read from the store as they open: :func:`read_saved` and the
+    student's last place. Never raises: a store that is away (or did not answer within its
+    deadline) or damaged is said in the result. It waits for the store, up to the store's
+    deadline, so a front end calls it off its event loop."""
+    try:
+        saved = read_saved(store, student, partner)
+    except StoreUnavailable:
+        return SavedWork(away=True)
+    except Exception as exc:  # a damaged database must not stop the lab
+        return SavedWork(error=str(exc))
+    try:
+        place = store.place(student)
+    except Exception:  # where the student was is a convenience, never a reason to fail
+        place = None
+    return SavedWork(saved, place)
+
+
 @dataclass
 class LabProgress:
     """One student's (or pair's) progress through the labs, in one app."""
@@ -98,6 +131,9 @@ class LabProgress:
     drivers: dict[ExerciseKey, str] = field(default_factory=dict)
     #: who of the pair drives now, as far as the workbench knows
     driver: str = ""
+    #: the saved work is being read (:func:`read_work`): a front end opens no exercise (so
+    #: checks and saves nothing over that work) until :meth:`take_work` has it
+    reading: bool = False
 
     def __post_init__(self) -> None:
         self.driver = self.driver or self.student
@@ -110,6 +146,13 @@ class LabProgress:
             self.answers[key] = dict(progress.answers)
         self.signed.update(loaded.signed)
         self.drivers.update(loaded.drivers)
+
+    def take_work(self, work: SavedWork) -> None:
+        """Take what :func:`read_work` read (on the thread that uses this progress); the
+        reading is over, whether or not the store could give it."""
+        self.reading = False
+        if work.saved is not None:
+            self.take(work.saved)
 
     def mark(self, key: ExerciseKey) -> Mark:
         if key in self.signed:

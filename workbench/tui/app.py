@@ -60,7 +60,7 @@ from .host import (
 from .keys import APP_KEY_IDS, bindings
 from .screens.arrival import ArrivalScreen
 from .screens.editor import EditorScreen
-from .screens.labs import LabsScreen, StoreTrouble
+from .screens.labs import LabsScreen, StoreOpened, StoreTrouble
 from .screens.main import MainScreen
 from .screens.runs import RunsScreen
 from .serving import warmup
@@ -469,33 +469,41 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
 
     def _open_labs(self) -> None:
         if self._labs is None:
-            self._open_store()
-            self._match_stored_names()
             self._labs = LabsScreen(
                 self.station,
-                self.store,
                 self.student,
                 self.partner,
-                store_problem=self.store_problem,
                 # a served student's terminal is theirs: an instructor never types a
                 # passphrase there (they sign at their own console)
                 signs_here=not self.station.files.confined,
             )
             self.install_screen(self._labs, name="labs")
+            # the screen comes up at once; the store is opened and read beside it
+            self.run_worker(self._open_store_for(self._labs), group="store")
         self.push_screen("labs")
 
-    def _match_stored_names(self) -> None:
-        """Spell the pair as the store does, so "alice doe" resumes Alice Doe's progress (not
-        for a served student, whose login name is the only one that is theirs)."""
+    async def _open_store_for(self, labs: LabsScreen) -> None:
+        """Open the store and spell the pair as it does, in a thread (a course database that
+        hangs makes both wait for its deadline), then hand the store to the labs screen."""
+        names = await asyncio.to_thread(self._stored_names)
+        if names != (self.student, self.partner):
+            self._set_names(*names)
+        labs.post_message(StoreOpened(self.store, self.store_problem, *names))
+
+    def _stored_names(self) -> tuple[str, str]:
+        """The store opened, and the pair as it spells them, so "alice doe" resumes Alice
+        Doe's progress (not for a served student, whose login name is the only one that is
+        theirs). Waits for the store: run off the event loop."""
+        self._open_store()
+        names = (self.student, self.partner)
         if self.store is None or self.station.files.confined:
-            return
+            return names
         try:
             student = self.store.spelling(self.student)
             partner = self.store.spelling(self.partner) if self.partner else ""
         except Exception:  # the store may be away; the names stay as typed
-            return
-        if (student, partner) != (self.student, self.partner):
-            self._set_names(student, partner)
+            return names
+        return student, partner
 
     def _open_store(self) -> None:
         with self._store_lock:  # the labs (here) or the saving of kept changes (a thread)

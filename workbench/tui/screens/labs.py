@@ -13,7 +13,9 @@ this station where signing here is allowed (not in a served student's session, w
 is the student's). What the student has done is held by :class:`LabProgress` (in the core):
 the screen draws it and routes the student's input to it. Progress is saved in the store as
 soon as an exercise is opened and each time an objective or an answer changes; an objective
-that passed once stays passed, with its evidence, after a restart.
+that passed once stays passed, with its evidence, after a restart. The saved work is read in
+a thread as the screen comes up (a course database may be slow, or hang until its deadline):
+until it is read the screen says so and opens no exercise, so nothing is saved over it.
 """
 
 from __future__ import annotations
@@ -35,7 +37,13 @@ from textual.widgets.option_list import Option
 from workbench.control.station import LabStation
 from workbench.labs.checks import MAX_ANSWER, ExerciseProgress, SetupChanges
 from workbench.labs.model import Exercise, Lab, LabFileError, Question, Setup, load_labs
-from workbench.labs.progress import LabProgress, SignedOff, evidence_words, read_saved
+from workbench.labs.progress import (
+    LabProgress,
+    SavedWork,
+    SignedOff,
+    evidence_words,
+    read_work,
+)
 from workbench.labs.signoff_record import SignoffRecord
 from workbench.labs.store import Store, StoreError, StoreUnavailable
 from workbench.sim.session import Snapshot
@@ -66,6 +74,8 @@ PASS, FAIL, OPEN, SIGNED = UNICODE_MARKS
 
 
 UNREACHABLE = "the course database cannot be reached"
+#: what the screen shows until the saved work is read
+LOADING = "loading saved work…"
 #: seconds between tries to write what the course database did not get
 RETRY_SECONDS = 2.0
 
@@ -90,6 +100,19 @@ def setup_words(changes: SetupChanges, setup: Setup) -> list[str]:
     if changes.program_dropped:
         said.append(f"program {changes.program_dropped} no longer chosen")
     return said
+
+
+class StoreOpened(Message):
+    """The app opened the store for the labs (in a thread: a course database may hang): the
+    store (None when it could not be opened, ``problem`` says why) and the pair's names as
+    the store spells them. The screen reads the saved work from it next."""
+
+    def __init__(self, store: Store | None, problem: str, student: str, partner: str) -> None:
+        super().__init__()
+        self.store = store
+        self.problem = problem
+        self.student = student
+        self.partner = partner
 
 
 class StoreTrouble(Message):
@@ -163,23 +186,23 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
     def __init__(
         self,
         station: LabStation,
-        store: Store | None,
         student: str,
         partner: str = "",
         labs: list[Lab] | None = None,
-        store_problem: str = "",
         signs_here: bool = True,
     ) -> None:
-        """``signs_here``: an instructor may sign off at this station (``i``); False in a
-        served student's session, where only the ready key asks for sign-off."""
+        """The screen shows the labs at once and the saved work once it is read: the store
+        comes with :class:`StoreOpened`. ``signs_here``: an instructor may sign off at this
+        station (``i``); False in a served student's session, where only the ready key asks
+        for sign-off."""
         super().__init__()
         self.signs_here = signs_here
         self.station = station
-        self.store = store
+        self.store: Store | None = None
         self.student = student
         self.partner = partner
-        #: what the student (or pair) has done in the labs
-        self.lab_progress = LabProgress(student, partner)
+        #: what the student (or pair) has done in the labs (read from the store first)
+        self.lab_progress = LabProgress(student, partner, reading=True)
         self._problem = ""
         if labs is None:
             try:
@@ -188,7 +211,7 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
                 labs = []
                 self._problem = str(exc)
         self.labs = labs
-        self._store_problem = store_problem
+        self._store_problem = ""
         self._ready = False
         self.selected: tuple[Lab, Exercise] | None = None
         self.progress: ExerciseProgress | None = None
@@ -198,7 +221,6 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         #: a sign-off seen while another screen was over this one
         self._signed_later: SignoffStatus.Signed | None = None
         self.unicode = False
-        self._load_saved()
 
     @property
     def driver(self) -> str:
@@ -206,30 +228,66 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         return self.lab_progress.driver
 
     # -- store ---------------------------------------------------------------------------
-    def _load_saved(self) -> None:
+    @on(StoreOpened)
+    def _store_opened(self, message: StoreOpened) -> None:
+        """The store is open (or could not be): read the saved work from it, in a thread."""
+        self.store = message.store
+        self._store_problem = message.problem
+        self.student, self.partner = message.student, message.partner
+        self.lab_progress = LabProgress(self.student, self.partner, reading=True)
         if self.store is None:
+            self._take_work(SavedWork())
             return
-        try:
-            loaded = read_saved(self.store, self.student, self.partner)
-        except StoreUnavailable:
-            self._store_problem = (
+        self.query_one(SignoffStatus).use(self.store)
+        self.run_worker(self._read_work(), group="labs-read", exit_on_error=False)
+
+    async def _read_work(self) -> None:
+        """Read the saved work off the event loop (a course database that hangs makes the
+        read wait for the store's deadline; the app answers keys meanwhile), then show it."""
+        store = self.store
+        assert store is not None
+        work = await asyncio.to_thread(read_work, store, self.student, self.partner)
+        self._take_work(work)
+
+    def _take_work(self, work: SavedWork) -> None:
+        """The saved work was read (or could not be): the list, the exercise the student had
+        open last and what went wrong show it."""
+        self.lab_progress.take_work(work)
+        self._store_problem = self._work_problem(work) or self._store_problem
+        if work.away:
+            self._reload_when_back = True
+            self._wait_for_store()
+        if not self._ready:
+            return
+        self._refresh_list()
+        listing = self.query_one("#labs-list", OptionList)
+        place = self._place(work)
+        if place is not None and listing.highlighted == self._first_option():
+            # the student had not moved yet: the labs reopen where they were
+            listing.highlighted = listing.get_option_index(place)
+        self._catch_up()
+        self._show_title()
+        self.say(self._problem or self._store_problem)
+
+    def _work_problem(self, work: SavedWork) -> str:
+        if work.away:
+            return (
                 f"{UNREACHABLE}: saved progress is not shown yet; what you do now is kept "
                 "and saved when it is back"
             )
-            self._reload_when_back = True
-            return
-        except Exception as exc:  # a damaged database must not stop the lab
-            self._store_problem = f"cannot read saved progress: {exc}"
-            return
-        self.lab_progress.take(loaded)
-        damaged, cut = loaded.damaged, loaded.cut
+        if work.error:
+            return f"cannot read saved progress: {work.error}"
+        if work.saved is None:
+            return ""
+        damaged, cut = work.saved.damaged, work.saved.cut
         if damaged:
-            self._store_problem = f"saved progress unreadable (starts afresh): {', '.join(damaged)}"
-        elif cut:
-            self._store_problem = (
+            return f"saved progress unreadable (starts afresh): {', '.join(damaged)}"
+        if cut:
+            return (
                 f"saved answers longer than {MAX_ANSWER} characters were cut to their first "
                 f"{MAX_ANSWER}: {', '.join(cut[:3])}{' ...' if len(cut) > 3 else ''}"
             )
+        return ""
 
     def _save(self, progress: ExerciseProgress) -> None:
         try:
@@ -276,9 +334,15 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             else:
                 done = await asyncio.to_thread(store.flush)
             if done and self._reload_when_back:
-                # raises while the database is still away
-                await asyncio.to_thread(store.progress, self.student)
-                self._load_saved_again()
+                # what this session changed meanwhile was written first, so it reads back as
+                # it is here
+                work = await asyncio.to_thread(read_work, store, self.student, self.partner)
+                if work.away:
+                    return  # still away: the next try reads again
+                self._reload_when_back = False
+                self.lab_progress.take_work(work)
+                self._store_problem = self._work_problem(work)
+                self._refresh_list()
         except StoreUnavailable:
             return
         except Exception as exc:
@@ -292,15 +356,6 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             self._retry_timer.stop()
             self._retry_timer = None
         self.say("the course database is back: your progress is saved")
-
-    def _load_saved_again(self) -> None:
-        """Read the saved progress the database could not give at the start (what this
-        session changed meanwhile was written first, so it reads back as it is here)."""
-        assert self.store is not None
-        self._reload_when_back = False
-        self._store_problem = ""
-        self._load_saved()
-        self._refresh_list()
 
     # -- layout --------------------------------------------------------------------------
     def compose(self) -> ComposeResult:
@@ -353,28 +408,24 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self._refresh_list()
         if self._reload_when_back or (self.store is not None and self.store.pending):
             self._retry_timer = self.set_interval(RETRY_SECONDS, self._retry_store)
-        problem = self._problem or self._store_problem
-        if problem:
-            self.say(problem)
         listing = self.query_one("#labs-list", OptionList)
-        place = self._place()
-        for index, option in enumerate(listing.options):
-            if not option.disabled and (place is None or option.id == place):
-                listing.highlighted = index
-                break
+        listing.highlighted = self._first_option()
         listing.focus()
+        if self.lab_progress.reading:
+            self._show_title()
+            self.say(self._problem)
+        else:  # read before the screen came up: shown now
+            self._take_work(SavedWork())
 
-    def _place(self) -> str | None:
-        """The option of the exercise the student had open last (None: the first)."""
-        if self.store is None:
+    def _first_option(self) -> int | None:
+        listing = self.query_one("#labs-list", OptionList)
+        return next((i for i, o in enumerate(listing.options) if not o.disabled), None)
+
+    def _place(self, work: SavedWork) -> str | None:
+        """The option of the exercise the student had open last (None: not known)."""
+        if work.place is None:
             return None
-        try:
-            place = self.store.place(self.student)
-        except Exception:  # where the student was is a convenience, never a reason to fail
-            return None
-        if place is None:
-            return None
-        option = "/".join(place)
+        option = "/".join(work.place)
         known = {f"{lab.id}/{ex.id}" for lab in self.labs for ex in lab.exercises}
         return option if option in known else None
 
@@ -388,11 +439,12 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             self._signed_elsewhere(later)
 
     def _refresh_list(self) -> None:
+        # each option's text replaced where it is: the list keeps its highlight and scroll,
+        # and measures the new texts at the width it has now (options cleared and added
+        # again were measured without the scroll bar they bring back)
         listing = self.query_one("#labs-list", OptionList)
-        highlighted = listing.highlighted
-        listing.clear_options()
-        listing.add_options(self._options())
-        listing.highlighted = highlighted
+        for option in self._options():
+            listing.replace_option_prompt(option.id or "", option.prompt)
 
     # -- choosing ------------------------------------------------------------------------
     @on(OptionList.OptionHighlighted, "#labs-list")
@@ -415,8 +467,8 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self._show_exercise(lab, lab.exercise(ex_id))
 
     def _show_exercise(self, lab: Lab, exercise: Exercise) -> None:
-        if self.selected == (lab, exercise):
-            return
+        if self.selected == (lab, exercise) or self.lab_progress.reading:
+            return  # (an exercise opens once the saved work is read: nothing is saved over it)
         self.selected = (lab, exercise)
         if self.store is not None:
             try:
@@ -456,7 +508,11 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self.show_snapshot(self.station.snapshot())
 
     def _show_title(self) -> None:
-        """The chosen exercise's title, and by whom and when it was signed off."""
+        """The chosen exercise's title, and by whom and when it was signed off (while the
+        saved work is read, that it is)."""
+        if self.lab_progress.reading:
+            self.query_one("#labs-title", Static).update(prose(LOADING, self.unicode))
+            return
         if self.selected is None:
             return
         lab, exercise = self.selected
@@ -562,11 +618,21 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
     def action_close(self) -> None:
         self.app.pop_screen()
 
+    def _choose_first(self) -> bool:
+        """Whether an exercise is chosen; else the student is told why not."""
+        if self.selected is not None:
+            return True
+        if self.lab_progress.reading:
+            self.say(prose(f"{LOADING} a moment, please", self.unicode))
+        else:
+            self.say("choose an exercise first")
+        return False
+
     def action_apply_setup(self) -> None:
         self._catch_up()
-        if self.selected is None:
-            self.say("choose an exercise first")
+        if not self._choose_first():
             return
+        assert self.selected is not None
         lab, exercise = self.selected
         try:
             changes = self.lab_progress.set_up(self.station, lab, exercise)
@@ -583,8 +649,7 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self.show_snapshot(self.station.snapshot())
 
     def action_ready(self) -> None:
-        if self.selected is None:
-            self.say("choose an exercise first")
+        if not self._choose_first():
             return
         if self.store is None:
             self.say(self._store_problem or "no data folder: sign-off is not available")
@@ -617,8 +682,7 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
 
     def action_sign_off(self) -> None:
         self._catch_up()
-        if self.selected is None:
-            self.say("choose an exercise first")
+        if not self._choose_first():
             return
         if not self.signs_here:
             self.say(

@@ -114,10 +114,24 @@ class SignoffStatus(Static):
         #: the last sign-off seen, by (lab, exercise): a newer one is news
         self._known: dict[tuple[str, str], tuple[str, str] | None] = {}
         self.seen: Seen | None = None
+        #: the reading thread starts once the widget is mounted and has a store, and only once
+        self._mounted_once = False
+        self._polling = False
 
     def on_mount(self) -> None:
         self.display = False
-        if self.store is not None:
+        self._mounted_once = True
+        self._start()
+
+    def use(self, store: Store) -> None:
+        """Read ``store`` from now on (one opened after the widget was made)."""
+        if self.store is None:
+            self.store = store
+            self._start()
+
+    def _start(self) -> None:
+        if self.store is not None and self._mounted_once and not self._polling:
+            self._polling = True
             self.run_worker(self._poll, thread=True, group="signoff-status", exit_on_error=False)
 
     def on_unmount(self) -> None:
