@@ -3,12 +3,18 @@
 The model is VIPLE's dataflow: a message arrives at an activity, the activity runs once and
 sends one message to every target of the output pin it chose. Each event (a key, a sensor
 report, a start message) and each extra branch of a fan-out is a *flow* of its own. Flows are
-scheduled on the simulation clock, deterministically: at each control tick the timers that
-are due wake first (earliest first), then key events, then sensor reports (activities in file
-order), then the ready flows run in turn, each for a slice of :data:`SLICE` activities. A flow
-that ran :data:`FLOW_TICK_STEPS` activities in one tick, or that loops in a While without
-anything having changed since its last pass, waits for the next tick, so a busy-waiting loop
-never freezes the others. A Timer puts only its own flow to sleep.
+scheduled on the simulation clock, deterministically: at each tick the timers that are due
+wake first (earliest first), then key events, then a sensor report if one is due (activities
+in file order), then the ready flows run in turn, each for a slice of :data:`SLICE`
+activities. A flow that ran :data:`FLOW_TICK_STEPS` activities in one tick, or that loops in a
+While without anything having changed since its last pass, waits for the next tick, so a
+busy-waiting loop never freezes the others. A Timer puts only its own flow to sleep, until its
+own time: :meth:`ProgramController.next_due` says when the next Timer, scripted key or sensor
+report is due, and the session (or the remote runner) ticks the program at exactly that time.
+
+Sensor reports come at the pace VIPLE's simulator sends them (``report_period``, the profile's
+250 ms offline), or, with no period, with every set of readings the caller gives (a real
+robot's own reports).
 """
 
 from __future__ import annotations
@@ -37,6 +43,12 @@ MAX_CALL_DEPTH = 64
 MAX_PRINTED = 5_000
 MAX_ERRORS = 100
 MAX_FIRED = 5_000
+#: the shortest wait a Timer takes, seconds (VIPLE counts whole milliseconds); a Timer of 0 ms
+#: or less only lets the other ready flows go first
+MIN_WAIT = 0.001
+#: times closer than this are the same moment, seconds
+_SAME = 1e-9
+_NEVER = float("inf")
 #: the newest printed lines a live console keeps (the list of all stops at MAX_PRINTED)
 RECENT_PRINTED = 200
 #: activities that pass the message straight on when one arrives
@@ -121,10 +133,20 @@ class _Park(Exception):
 class ProgramController:
     """A :class:`workbench.sim.session.Controller` that runs a VIPLE program."""
 
-    def __init__(self, compiled: Compiled, keys: tuple[KeyEvent, ...] = ()) -> None:
+    def __init__(
+        self,
+        compiled: Compiled,
+        keys: tuple[KeyEvent, ...] = (),
+        report_period: float | None = None,
+    ) -> None:
         self.compiled = compiled
         self.program = compiled.program
         self.key_script = keys
+        #: seconds between two sensor reports (None: every tick that brings readings reports)
+        if report_period is not None and not report_period > 0:
+            raise ValueError(f"the report period must be above 0 s, not {report_period!r}")
+        self.report_period = report_period
+        self._reads = bool(compiled.sensors)
         self.reset()
 
     # -- the Controller protocol ----------------------------------------------------------
@@ -153,6 +175,7 @@ class ProgramController:
         self._typed = TypedKeys()
         self._pushed: list[KeyEvent] = []
         self._touch: dict[int, int] = {}
+        self._next_report = _NEVER
         self.flows_dropped = 0
         self.steps = 0
         self.state: str | None = None
@@ -164,6 +187,8 @@ class ProgramController:
 
     def start(self, t: float) -> list[Any]:
         self.now = t
+        if self.report_period is not None and self._reads:
+            self._next_report = t + self.report_period
         program = self.program
         main = Frame("Main", {})
         for aid in program.panels["Main"].activities:
@@ -174,14 +199,41 @@ class ProgramController:
 
     def tick(self, t: float, readings: dict[str, float], events: frozenset[str]) -> list[Any]:
         self.now = t
-        while self._sleeping and self._sleeping[0][0] <= t + 1e-9:
-            self._ready.append(heappop(self._sleeping)[2])
-        self._ready.extend(self._parked)
-        self._parked = []
+        sleeping = self._sleeping
+        while sleeping and sleeping[0][0] <= t + _SAME:
+            self._ready.append(heappop(sleeping)[2])
+        if self._parked:
+            self._ready.extend(self._parked)
+            self._parked = []
         self._keys(t)
-        if readings:  # a tick between two reports of a remote robot fires no sensor
+        if readings and self._report_due(t):
+            # a tick between two reports (of a remote robot, or of the paced simulator) fires
+            # no sensor
             self._sensors({int(name.split()[-1]): v for name, v in readings.items()})
         return self._run()
+
+    def next_due(self) -> float | None:
+        """When the program next has something to do at a time of its own: a Timer ends, a
+        scripted key is pressed or a sensor report is due (None: nothing is)."""
+        due = self._next_report
+        sleeping = self._sleeping
+        if sleeping and sleeping[0][0] < due:
+            due = sleeping[0][0]
+        script = self.key_script
+        if self._next_key < len(script) and script[self._next_key].time < due:
+            due = script[self._next_key].time
+        return None if due == _NEVER else due
+
+    def _report_due(self, t: float) -> bool:
+        period = self.report_period
+        if period is None:
+            return True
+        if t + _SAME < self._next_report:
+            return False
+        # the next report on the same grid after t (a late tick skips the missed ones)
+        start = self._next_report
+        self._next_report = start + period * (1 + int((t + _SAME - start) // period))
+        return True
 
     # -- events --------------------------------------------------------------------------
     def type_key(self, key: str, t: float) -> None:
@@ -309,7 +361,11 @@ class ProgramController:
                 else:
                     ready.append(flow)
             except _Sleep as sleep:
-                heappush(self._sleeping, (self.now + sleep.seconds, flow.number, flow))
+                if sleep.seconds > 0:
+                    due = self.now + max(sleep.seconds, MIN_WAIT)
+                    heappush(self._sleeping, (due, flow.number, flow))
+                else:
+                    ready.append(flow)
             except _Park:
                 self._parked.append(flow)
             if not ended:

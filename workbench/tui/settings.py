@@ -42,6 +42,9 @@ class AppSettings:
     paused: bool = False
     #: the app's clock ticks this often a second while anything moves
     tick_hz: float = 20.0
+    #: how often a VIPLE program file driving the robot gets its sensor reports, milliseconds
+    #: (None: the profile's simulator period, 250 ms)
+    report_ms: int | None = None
     #: draw with Unicode lines, arrows and marks (False: plain ASCII)
     unicode: bool = False
     #: where each run's record is kept for replay (None: no records)
@@ -161,4 +164,3 @@ def _read(name: str, kinds: tuple[type, ...], value: object) -> object:
         return float(value)
     wanted = " or ".join(dict.fromkeys(_WORDS[k] for k in kinds))
     raise SettingsError(f"setting {name!r} must be {wanted}, not {value!r:.60}")
-
