@@ -175,6 +175,8 @@ class ProgramController:
         self._typed = TypedKeys()
         self._pushed: list[KeyEvent] = []
         self._touch: dict[int, int] = {}
+        #: a reading's name ("port 3") -> its port
+        self._ports: dict[str, int] = {}
         self._next_report = _NEVER
         self.flows_dropped = 0
         self.steps = 0
@@ -209,7 +211,8 @@ class ProgramController:
         if readings and self._report_due(t):
             # a tick between two reports (of a remote robot, or of the paced simulator) fires
             # no sensor
-            self._sensors({int(name.split()[-1]): v for name, v in readings.items()})
+            ports = self._ports
+            self._sensors({ports.get(n) or _port(ports, n): v for n, v in readings.items()})
         return self._run()
 
     def next_due(self) -> float | None:
@@ -343,8 +346,10 @@ class ProgramController:
         self._ready.append(Flow(next(self._numbers), aid, value, frame, in_pin))
 
     def _run(self) -> list[Any]:
-        total = 0
         ready = self._ready
+        if not ready and self.state is not None:
+            return []  # nothing ran, so nothing changed since the last pass
+        total = 0
         while ready and total < TICK_STEPS:
             flow = ready.popleft()
             if flow.steps >= FLOW_TICK_STEPS:
@@ -586,6 +591,12 @@ def convert(value: Value, vtype: str) -> Value:
         if not isinstance(value, bool):
             raise ValueError(f"{type_name(value)} cannot be stored in a Boolean")
     return value
+
+
+def _port(ports: dict[str, int], name: str) -> int:
+    """The port of a reading named ``port N`` (kept in ``ports`` for the next report)."""
+    port = ports[name] = int(name.split()[-1])
+    return port
 
 
 def _truth(value: Value, index: int) -> bool:

@@ -100,6 +100,8 @@ class Session:
         self._events: list[str] = []
         self._commands: list[Any] = []
         self._started = False
+        #: when the controller next has something due (inf: nothing; asked each time it ran)
+        self._due = math.inf
         self._turns = TurnCounter()
         self._last_angle = self.world.angle
         self._last_time = 0.0
@@ -114,10 +116,12 @@ class Session:
         self.binding = dict(binding)
         self.driver = driver
         self._started = False
+        self._due = math.inf
 
     def detach(self, driver: Driver = NOBODY) -> None:
         self.controller = None
         self._next_due = None
+        self._due = math.inf
         self.binding = {}
         self.driver = driver
 
@@ -193,10 +197,9 @@ class Session:
     def step(self) -> tuple[str, ...]:
         """One physics step (and a control tick every ``every`` steps); a controller with
         something due inside the step is woken at that time."""
-        next_due = self._next_due
         early: tuple[str, ...] = ()
-        if next_due is not None and self._started:
-            early = self._wake_within(next_due)
+        if self._due < (self._steps + 1) * self.world.dt - _SAME:
+            early = self._wake_within()
         events = self._world_step()
         if early:
             events = early + events
@@ -210,27 +213,32 @@ class Session:
             self._commands.append(cmd)
         if n % self.every == 0:
             self._control_tick()
-        elif next_due is not None and self._started:
-            due = next_due()
-            if due is not None and due <= self.world.time + _SAME:
-                self._wake(self.world.time)
+        elif self._due <= self.world.time + _SAME:
+            self._wake(self.world.time)
         return events
 
-    def _wake_within(self, next_due: Callable[[], float | None]) -> tuple[str, ...]:
+    def _wake_within(self) -> tuple[str, ...]:
         """Wake the controller at each time it has something due before this step ends,
         moving the world to that time first; the events on the way."""
         world = self.world
         end = (self._steps + 1) * world.dt - _SAME
         events: tuple[str, ...] = ()
         last = -math.inf
-        due = next_due()
-        while due is not None and last < due < end:
+        due = self._due
+        while last < due < end:
             if due > world.time + _SAME:
                 events += world.step_to(due)
             self._wake(max(due, world.time))
             last = due
-            due = next_due()
+            due = self._due
         return events
+
+    def _ask_due(self) -> None:
+        """After the controller ran: when it next has something due."""
+        next_due = self._next_due
+        if next_due is not None:
+            due = next_due()
+            self._due = math.inf if due is None else due
 
     def _wake(self, t: float) -> None:
         """The controller's due work at ``t`` between control ticks: it gets the readings of
@@ -241,6 +249,7 @@ class Session:
         self.readings = readings = world.read_sensors()
         named = {name: readings[port] for name, port in self.binding.items()}
         commands = controller.tick(t, named, _NONE)
+        self._ask_due()
         if commands:
             for cmd in commands:
                 world.apply(cmd)
@@ -263,6 +272,7 @@ class Session:
             else:
                 self._started = True
                 commands = controller.start(t)
+            self._ask_due()
             if commands:
                 for cmd in commands:
                     world.apply(cmd)
