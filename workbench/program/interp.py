@@ -147,6 +147,14 @@ class ProgramController:
             raise ValueError(f"the report period must be above 0 s, not {report_period!r}")
         self.report_period = report_period
         self._reads = bool(compiled.sensors)
+        #: each activity's output pins and their links (Program.targets, without the call)
+        self._outputs = compiled.program.outputs
+        #: a Variable activity's id -> the global it sets (lower case)
+        self._var_keys = {
+            aid: act.value(0).strip().lower()
+            for aid, act in compiled.program.activities.items()
+            if act.kind == K.VARIABLE
+        }
         self.reset()
 
     # -- the Controller protocol ----------------------------------------------------------
@@ -251,6 +259,8 @@ class ProgramController:
 
     def _keys(self, t: float) -> None:
         script = self.key_script
+        if self._next_key >= len(script) and not self._pushed and not self._typed.held:
+            return  # no key is due, typed or waiting for its release
         while self._next_key < len(script) and script[self._next_key].time <= t + 1e-9:
             self._next_key += 1
             self._key_event(script[self._next_key - 1])
@@ -398,7 +408,8 @@ class ProgramController:
 
     def _go(self, flow: Flow, pin: int, value: Value, source: int | None = None) -> bool:
         """Send ``value`` out of ``pin``: the first target continues this flow."""
-        links = self.program.targets(flow.activity if source is None else source, pin)
+        out = self._outputs.get(flow.activity if source is None else source)
+        links = out.get(pin) if out else None
         if not links:
             return False
         for link in links[1:]:
@@ -422,7 +433,7 @@ class ProgramController:
         if kind == K.CALCULATE:
             return self._go(flow, 0, compiled.expr(act.id, 0)(self._scope(flow)))
         if kind == K.VARIABLE:
-            key = act.value(0).strip().lower()
+            key = self._var_keys[act.id]
             stored = convert(value, compiled.globals[key][1])
             self.globals[key] = stored
             self.changes += 1

@@ -7,8 +7,8 @@ activities name the wheel ports the commands go to.
 
 :class:`RemoteProgram` runs the program on the client's own clock: each sensor report fires
 the sensor activities (one report, one firing), and between reports the program ticks at the
-control rate so its keys and waiting flows go on, and at each Timer's own time. The protocol side (sockets, the
-wire) is ``workbench.viple.client``; the command line joins the two.
+control rate so its keys and waiting flows go on, and at each Timer's own time. The protocol
+side (sockets, the wire) is ``workbench.viple.client``; the command line joins the two.
 """
 
 from __future__ import annotations
