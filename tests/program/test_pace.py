@@ -4,18 +4,23 @@ times (between physics steps offline, between control ticks over the protocol)."
 from __future__ import annotations
 
 import itertools
+import json
+from pathlib import Path
 
 import pytest
 
 from tests.program.builder import ProgramBuilder
 from workbench.cli import main
 from workbench.control.headless import RunSpec, prepare, run
+from workbench.control.station import LabStation
+from workbench.program.choice import program_choice
 from workbench.program.compiled import compile_program
 from workbench.program.interp import ProgramController
 from workbench.program.loader import load_program, load_program_text
-from workbench.program.pilot import ProgramPilot
+from workbench.program.pilot import ProgramPilot, load_compiled
 from workbench.program.remote import RemoteProgram
 from workbench.sim.clock import Pacer
+from workbench.sim.mazeio import load_maze
 from workbench.sim.world import WorldError
 
 CORRIDOR = """\
@@ -188,3 +193,35 @@ def test_report_ms_out_of_range_is_refused_naming_the_option(tmp_path, capsys):
     assert exit_.value.code == 2
     err = capsys.readouterr().err
     assert "--report-ms" in err and "use 50 to 1000 ms" in err
+
+
+def reporter(tmp_path) -> str:
+    """Prints every distance report (port 1)."""
+    b = ProgramBuilder()
+    main_ = b.panel("Main")
+    b.robot(main_)
+    main_.chain(main_.add(23, "Robot/IoT Controller 0", "1"), main_.add(28, ""))
+    return b.write(tmp_path / "reporter.viple")
+
+
+def test_the_lab_station_reports_at_the_profile_period_or_its_own(tmp_path):
+    station = LabStation.open(load_maze(maze(tmp_path)), "web", noise="off")
+    station.use_program(program_choice(load_compiled(reporter(tmp_path)), "reporter.viple"))
+    counts = []
+    for report_ms in (None, 100):
+        station.report_ms = report_ms
+        station.start()
+        station.step(120)  # 2 simulated seconds
+        controller = station.driving.controller
+        assert isinstance(controller, ProgramController)
+        counts.append(len(controller.printed))
+    # the program starts at 0.05 s: reports at 0.30, 0.55, ... 1.80, or 0.15, 0.25, ... 1.95
+    assert counts == [7, 19]
+
+
+def test_the_shipped_web_wall_following_program_leaves_the_web_maze(capsys):
+    root = Path(__file__).resolve().parents[2]
+    program = str(root / "programs" / "web-wall-following.viple")
+    assert main(["viple", "run", program, "--maze", str(root / "mazes" / "web.txt"), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["reached_exit"] and not data["errors"]
