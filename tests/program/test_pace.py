@@ -225,3 +225,18 @@ def test_the_shipped_web_wall_following_program_leaves_the_web_maze(capsys):
     assert main(["viple", "run", program, "--maze", str(root / "mazes" / "web.txt"), "--json"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["reached_exit"] and not data["errors"]
+
+
+def test_timers_end_on_whole_milliseconds_and_an_endless_wait_never_wakes(tmp_path):
+    b = ProgramBuilder()
+    main_ = b.panel("Main")
+    for wait in ("0.25", "1e308 * 10", "2.5"):
+        main_.chain(main_.add(2, wait), main_.add(15, ""), main_.add(2, '"after " + value'))
+    c = ProgramController(compile_program(load_program(b.write(tmp_path / "w.viple"))))
+    c.start(0.0)
+    assert c.next_due() == pytest.approx(0.001)  # 0.25 ms waits the shortest wait, 1 ms
+    c.tick(0.001, {}, frozenset())
+    assert c.next_due() == pytest.approx(0.003)  # 2.5 ms ends on the next whole millisecond
+    c.tick(0.003, {}, frozenset())
+    assert c.next_due() is None and not c.errors
+    assert [what for _, _, what in c.running()] == ["sleeping"]

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import itertools
 import json
+import math
 from collections import deque
 from dataclasses import dataclass, field
 from heapq import heappop, heappush
@@ -44,7 +45,8 @@ MAX_PRINTED = 5_000
 MAX_ERRORS = 100
 MAX_FIRED = 5_000
 #: the shortest wait a Timer takes, seconds (VIPLE counts whole milliseconds); a Timer of 0 ms
-#: or less only lets the other ready flows go first
+#: or less only lets the other ready flows go first. Timers end on the clock's whole
+#: milliseconds, so however many flows wait, the program wakes at most 1,000 times a second.
 MIN_WAIT = 0.001
 #: times closer than this are the same moment, seconds
 _SAME = 1e-9
@@ -377,7 +379,7 @@ class ProgramController:
                     ready.append(flow)
             except _Sleep as sleep:
                 if sleep.seconds > 0:
-                    due = self.now + max(sleep.seconds, MIN_WAIT)
+                    due = _whole_ms(self.now + max(sleep.seconds, MIN_WAIT))
                     heappush(self._sleeping, (due, flow.number, flow))
                 else:
                     ready.append(flow)
@@ -602,6 +604,14 @@ def convert(value: Value, vtype: str) -> Value:
         if not isinstance(value, bool):
             raise ValueError(f"{type_name(value)} cannot be stored in a Boolean")
     return value
+
+
+def _whole_ms(t: float) -> float:
+    """``t`` rounded up to the clock's next whole millisecond (``t`` itself when it is one, or
+    when it lies beyond any run: an endless wait stays endless)."""
+    if not t < 1e12:
+        return t
+    return math.ceil(t * 1000.0 - 1e-6) / 1000.0
 
 
 def _port(ports: dict[str, int], name: str) -> int:
