@@ -144,6 +144,11 @@ class TestRealPrograms:
             "a@0.2",
             "--max-time",
             "30",
+            # written for a robot measuring in cm, in this maze the program pins itself
+            # against a wall within 8 s at the simulator's pace of 250 ms; 20 reports a
+            # second let it follow the wall for the whole run
+            "--report-ms",
+            "50",
             "--json",
         ]
         main(args)

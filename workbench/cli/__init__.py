@@ -25,7 +25,14 @@ from . import ssh as ssh_cmd
 from . import store as store_cmd
 from . import viple_client as viple_client_cmd
 from . import viple_program as viple_program_cmd
-from .common import db_option, error, new_runs_dir, record_quota_options, runs_home
+from .common import (
+    db_option,
+    error,
+    new_runs_dir,
+    record_quota_options,
+    report_ms_option,
+    runs_home,
+)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -89,6 +96,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="where lab progress and sign-offs are kept (default: $WORKBENCH_DATA "
         "or the user data folder)",
     )
+    report_ms_option(parser)
     record_quota_options(parser)
     db_option(parser, top=True)
     parser.add_argument(
@@ -163,6 +171,7 @@ def app_settings(args: argparse.Namespace, db: str | None) -> AppSettings:
         profile=args.profile,
         seed=args.seed,
         noise=args.noise,
+        report_ms=args.report_ms,
         unicode=args.unicode,
         tcp_port=args.tcp_port or None,
         ws_url=args.ws_url,

@@ -8,6 +8,8 @@ import sys
 import time
 from pathlib import Path
 
+from workbench.sim.profiles import REPORT_MS_MAX, REPORT_MS_MIN, check_report_ms
+
 
 def runs_home() -> Path:
     """Where the app keeps run records: $XDG_DATA_HOME/viple-workbench/runs."""
@@ -64,6 +66,31 @@ def db_option(parser: argparse.ArgumentParser, top: bool = False) -> None:
         help="keep progress, sign-offs and the roster in this PostgreSQL database "
         "(postgresql://USER@HOST/DBNAME), shared by every lab server of a course (default: "
         "$WORKBENCH_DB, else the SQLite file in the data folder)",
+    )
+
+
+def report_ms(text: str) -> int:
+    """``--report-ms``'s value: whole milliseconds in the allowed range."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"{text[:20]!r} is not a whole number of milliseconds"
+        ) from None
+    try:
+        return check_report_ms(value)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def report_ms_option(parser: argparse.ArgumentParser) -> None:
+    """How often a VIPLE program file gets its sensor reports when it runs here."""
+    parser.add_argument(
+        "--report-ms",
+        type=report_ms,
+        metavar="MS",
+        help="a VIPLE program's sensors are reported every MS milliseconds, as VIPLE's "
+        f"simulator does ({REPORT_MS_MIN}-{REPORT_MS_MAX}; default: the profile's, 250)",
     )
 
 

@@ -24,6 +24,8 @@ from workbench.sim.noise import NOISE_LEVELS
 from workbench.sim.profiles import PROFILES
 from workbench.sim.record import stop_words
 
+from .common import report_ms_option
+
 
 def _simulation_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--profile", choices=list(PROFILES), help="default: the maze's, else unity")
@@ -77,6 +79,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     key_options(e)
     e.add_argument("--kinds", metavar="MAP.yaml", help="names for unknown activity kinds")
     _simulation_options(e)
+    report_ms_option(e)
     e.add_argument("--seeds", type=int, default=3, help="seeds 0..N-1 (default 3)")
     e.add_argument("--max-time", type=float, help="simulated seconds per run")
     e.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="parallel processes")
@@ -211,6 +214,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
             noise_params=tuple(args.noise_set),
             max_time=args.max_time,
             keys=script,
+            report_ms=args.report_ms,
         )
         for path, base, script in zip(args.program, bases, scripts, strict=True)
     ]

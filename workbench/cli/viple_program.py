@@ -25,6 +25,7 @@ from workbench.viple.client import (
 )
 from workbench.viple.codec import WheelPorts
 
+from .common import report_ms_option
 from .keyboard import QUIT_KEYS, attach_keyboard, raw_terminal
 from .run import _simulation_options, describe_measures, report, run_head
 
@@ -65,6 +66,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "gap, as in the app",
     )
     r.add_argument("--kinds", metavar="MAP.yaml", help="names for unknown activity kinds")
+    report_ms_option(r)
     r.add_argument("--seed", type=int, default=0)
     r.add_argument("--max-time", type=float, help="simulated seconds (default: from maze size)")
     r.add_argument("--record", metavar="FILE.jsonl", help="write the run record")
@@ -134,7 +136,13 @@ def cmd_run(args: argparse.Namespace) -> int:
         return 2
     spec = RunSpec(
         maze=args.maze,
-        pilot=ProgramPilot(args.file, keys=args.keys, typed=args.typed, kinds=args.kinds),
+        pilot=ProgramPilot(
+            args.file,
+            keys=args.keys,
+            typed=args.typed,
+            kinds=args.kinds,
+            report_ms=args.report_ms,
+        ),
         profile=args.profile,
         sensors=tuple(args.sensor),
         seed=args.seed,

@@ -147,8 +147,9 @@ class ProgramChoice:
     #: the path it was read from, and sha256 of its bytes
     source: str
     digest: str
-    #: the program driving afresh, from its start
-    make: Callable[[], Driving]
+    #: the program driving afresh, from its start, its sensors reported every so many
+    #: milliseconds
+    make: Callable[[int], Driving]
     #: why the program cannot run with these sensors (None when it can)
     needs: Callable[[Sequence[SensorSpec]], str | None]
     #: a few lines on what the program is and what it answers (keys, sensors)
@@ -244,6 +245,9 @@ class LabStation:
     viple: list[VipleConnection] = field(default_factory=list)
     #: the program file chosen to drive (most recent choice wins over :attr:`algorithm`)
     program: ProgramChoice | None = None
+    #: how often a program file driving gets its sensor reports, milliseconds (None: the
+    #: profile's simulator period)
+    report_ms: int | None = None
     #: what drives the robot now: the chosen algorithm or program, from :meth:`start` until
     #: :meth:`stop` (None while the keys or a VIPLE program over the network drive)
     driving: Driving | None = None
@@ -582,6 +586,11 @@ class LabStation:
         self.stop("stopped")
         self.program = choice
 
+    @property
+    def program_report_ms(self) -> int:
+        """The milliseconds between two sensor reports to a program file driving here."""
+        return self.report_ms if self.report_ms is not None else get_profile(self.profile).report_ms
+
     # -- driving -------------------------------------------------------------------------
     def start(self) -> None:
         """Robot back to the start and the chosen program, else the chosen algorithm, driving
@@ -592,7 +601,7 @@ class LabStation:
             missing = choice.needs(self.sensors)
             if missing:
                 raise ValueError(missing)
-            driving = choice.make()
+            driving = choice.make(self.program_report_ms)
         elif self.algorithm is not None:
             driving = algorithm_driving(self.algorithm, self.overrides, self.profile)
         else:

@@ -73,7 +73,7 @@ def program_choice(compiled: Compiled, shown: str) -> ProgramChoice:
         name=os.path.basename(shown),
         source=shown,
         digest=program.digest,
-        make=lambda: program_driving(compiled, shown),
+        make=lambda report_ms: program_driving(compiled, shown, report_ms),
         needs=needs,
         summary=tuple(describe_choice(compiled)),
         fit=lambda sensors: fit_sensors(compiled, sensors),

@@ -3,12 +3,18 @@
 The model is VIPLE's dataflow: a message arrives at an activity, the activity runs once and
 sends one message to every target of the output pin it chose. Each event (a key, a sensor
 report, a start message) and each extra branch of a fan-out is a *flow* of its own. Flows are
-scheduled on the simulation clock, deterministically: at each control tick the timers that
-are due wake first (earliest first), then key events, then sensor reports (activities in file
-order), then the ready flows run in turn, each for a slice of :data:`SLICE` activities. A flow
-that ran :data:`FLOW_TICK_STEPS` activities in one tick, or that loops in a While without
-anything having changed since its last pass, waits for the next tick, so a busy-waiting loop
-never freezes the others. A Timer puts only its own flow to sleep.
+scheduled on the simulation clock, deterministically: at each tick the timers that are due
+wake first (earliest first), then key events, then a sensor report if one is due (activities
+in file order), then the ready flows run in turn, each for a slice of :data:`SLICE`
+activities. A flow that ran :data:`FLOW_TICK_STEPS` activities in one tick, or that loops in a
+While without anything having changed since its last pass, waits for the next tick, so a
+busy-waiting loop never freezes the others. A Timer puts only its own flow to sleep, until its
+own time: :meth:`ProgramController.next_due` says when the next Timer, scripted key or sensor
+report is due, and the session (or the remote runner) ticks the program at exactly that time.
+
+Sensor reports come at the pace VIPLE's simulator sends them (``report_period``, the profile's
+250 ms offline), or, with no period, with every set of readings the caller gives (a real
+robot's own reports).
 
 A program's work and memory are bounded (:class:`Limits`): the activities run in one control
 tick and in one simulated second, and the parts of the values it holds (messages on their way,
@@ -20,6 +26,7 @@ from __future__ import annotations
 
 import itertools
 import json
+import math
 from collections import deque
 from dataclasses import dataclass, field
 from heapq import heappop, heappush
@@ -53,6 +60,13 @@ MAX_CALL_DEPTH = 64
 MAX_PRINTED = 5_000
 MAX_ERRORS = 100
 MAX_FIRED = 5_000
+#: the shortest wait a Timer takes, seconds (VIPLE counts whole milliseconds); a Timer of 0 ms
+#: or less only lets the other ready flows go first. Timers end on the clock's whole
+#: milliseconds, so however many flows wait, the program wakes at most 1,000 times a second.
+MIN_WAIT = 0.001
+#: times closer than this are the same moment, seconds
+_SAME = 1e-9
+_NEVER = float("inf")
 #: the newest printed lines a live console keeps (the list of all stops at MAX_PRINTED)
 RECENT_PRINTED = 200
 #: messages waiting at one input of a Join
@@ -157,12 +171,29 @@ class ProgramController:
     """A :class:`workbench.sim.session.Controller` that runs a VIPLE program."""
 
     def __init__(
-        self, compiled: Compiled, keys: tuple[KeyEvent, ...] = (), limits: Limits = Limits()
+        self,
+        compiled: Compiled,
+        keys: tuple[KeyEvent, ...] = (),
+        report_period: float | None = None,
+        limits: Limits = Limits(),
     ) -> None:
         self.compiled = compiled
         self.program = compiled.program
         self.key_script = keys
         self.limits = limits
+        #: seconds between two sensor reports (None: every tick that brings readings reports)
+        if report_period is not None and not report_period > 0:
+            raise ValueError(f"the report period must be above 0 s, not {report_period!r}")
+        self.report_period = report_period
+        self._reads = bool(compiled.sensors)
+        #: each activity's output pins and their links (Program.targets, without the call)
+        self._outputs = compiled.program.outputs
+        #: a Variable activity's id -> the global it sets (lower case)
+        self._var_keys = {
+            aid: act.value(0).strip().lower()
+            for aid, act in compiled.program.activities.items()
+            if act.kind == K.VARIABLE
+        }
         self.reset()
 
     # -- the Controller protocol ----------------------------------------------------------
@@ -191,6 +222,9 @@ class ProgramController:
         self._typed = TypedKeys()
         self._pushed: list[KeyEvent] = []
         self._touch: dict[int, int] = {}
+        #: a reading's name ("port 3") -> its port
+        self._ports: dict[str, int] = {}
+        self._next_report = _NEVER
         self.flows_dropped = 0
         self.steps = 0
         self.state: str | None = None
@@ -212,6 +246,8 @@ class ProgramController:
 
     def start(self, t: float) -> list[Any]:
         self.now = t
+        if self.report_period is not None and self._reads:
+            self._next_report = t + self.report_period
         program = self.program
         main = Frame("Main", {})
         for aid in program.panels["Main"].activities:
@@ -233,14 +269,42 @@ class ProgramController:
         self.now = t
         if self.stopped is not None:
             return []
-        while self._sleeping and self._sleeping[0][0] <= t + 1e-9:
-            self._ready.append(heappop(self._sleeping)[2])
-        self._ready.extend(self._parked)
-        self._parked = []
+        sleeping = self._sleeping
+        while sleeping and sleeping[0][0] <= t + _SAME:
+            self._ready.append(heappop(sleeping)[2])
+        if self._parked:
+            self._ready.extend(self._parked)
+            self._parked = []
         self._keys(t)
-        if readings or report is not None:  # a tick between two reports fires no sensor
-            self._sensors({int(name.split()[-1]): v for name, v in readings.items()}, report)
+        if (readings or report is not None) and self._report_due(t):
+            # a tick between two reports (of a remote robot, or of the paced simulator) fires
+            # no sensor
+            ports = self._ports
+            self._sensors({ports.get(n) or _port(ports, n): v for n, v in readings.items()}, report)
         return self._run()
+
+    def next_due(self) -> float | None:
+        """When the program next has something to do at a time of its own: a Timer ends, a
+        scripted key is pressed or a sensor report is due (None: nothing is)."""
+        due = self._next_report
+        sleeping = self._sleeping
+        if sleeping and sleeping[0][0] < due:
+            due = sleeping[0][0]
+        script = self.key_script
+        if self._next_key < len(script) and script[self._next_key].time < due:
+            due = script[self._next_key].time
+        return None if due == _NEVER else due
+
+    def _report_due(self, t: float) -> bool:
+        period = self.report_period
+        if period is None:
+            return True
+        if t + _SAME < self._next_report:
+            return False
+        # the next report on the same grid after t (a late tick skips the missed ones)
+        start = self._next_report
+        self._next_report = start + period * (1 + int((t + _SAME - start) // period))
+        return True
 
     # -- events --------------------------------------------------------------------------
     def type_key(self, key: str, t: float) -> None:
@@ -257,6 +321,8 @@ class ProgramController:
 
     def _keys(self, t: float) -> None:
         script = self.key_script
+        if self._next_key >= len(script) and not self._pushed and not self._typed.held:
+            return  # no key is due, typed or waiting for its release
         while self._next_key < len(script) and script[self._next_key].time <= t + 1e-9:
             self._next_key += 1
             self._key_event(script[self._next_key - 1])
@@ -355,6 +421,9 @@ class ProgramController:
         self._ready.append(Flow(next(self._numbers), aid, value, frame, in_pin))
 
     def _run(self) -> list[Any]:
+        ready = self._ready
+        if not ready and self.state is not None:
+            return []  # nothing ran, so nothing changed since the last pass
         window = self._window
         while window and window[0][0] <= self.now - 1.0 + 1e-9:
             self._second_steps -= window.popleft()[1]
@@ -362,7 +431,6 @@ class ProgramController:
             self._hot = {}
         total = 0
         budget = min(self.limits.tick, self.limits.second - self._second_steps)
-        ready = self._ready
         hot = self._hot
         while ready and total < budget and self.stopped is None:
             flow = ready.popleft()
@@ -380,7 +448,11 @@ class ProgramController:
                 else:
                     ready.append(flow)
             except _Sleep as sleep:
-                heappush(self._sleeping, (self.now + sleep.seconds, flow.number, flow))
+                if sleep.seconds > 0:
+                    due = _whole_ms(self.now + max(sleep.seconds, MIN_WAIT))
+                    heappush(self._sleeping, (due, flow.number, flow))
+                else:
+                    ready.append(flow)
             except _Park:
                 self._parked.append(flow)
             if not ended:
@@ -423,7 +495,8 @@ class ProgramController:
 
     def _go(self, flow: Flow, pin: int, value: Value, source: int | None = None) -> bool:
         """Send ``value`` out of ``pin``: the first target continues this flow."""
-        links = self.program.targets(flow.activity if source is None else source, pin)
+        out = self._outputs.get(flow.activity if source is None else source)
+        links = out.get(pin) if out else None
         if not links:
             return False
         for link in links[1:]:
@@ -447,7 +520,7 @@ class ProgramController:
         if kind == K.CALCULATE:
             return self._go(flow, 0, compiled.expr(act.id, 0)(self._scope(flow)))
         if kind == K.VARIABLE:
-            key = act.value(0).strip().lower()
+            key = self._var_keys[act.id]
             stored = convert(value, compiled.globals[key][1])
             self.globals[key] = stored
             self.changes += 1
@@ -688,6 +761,20 @@ def convert(value: Value, vtype: str) -> Value:
         if not isinstance(value, bool):
             raise ValueError(f"{type_name(value)} cannot be stored in a Boolean")
     return value
+
+
+def _whole_ms(t: float) -> float:
+    """``t`` rounded up to the clock's next whole millisecond (``t`` itself when it is one, or
+    when it lies beyond any run: an endless wait stays endless)."""
+    if not t < 1e12:
+        return t
+    return math.ceil(t * 1000.0 - 1e-6) / 1000.0
+
+
+def _port(ports: dict[str, int], name: str) -> int:
+    """The port of a reading named ``port N`` (kept in ``ports`` for the next report)."""
+    port = ports[name] = int(name.split()[-1])
+    return port
 
 
 def _truth(value: Value, index: int) -> bool:

@@ -14,13 +14,13 @@ from workbench.control.evaluate import Entrant
 from workbench.control.headless import RunResult, RunSetupError, RunSpec
 from workbench.files.bounded import BoundedFileError
 from workbench.sim.driver import Driver
-from workbench.sim.profiles import Profile
+from workbench.sim.profiles import Profile, check_report_ms
 from workbench.sim.sensors import SensorSpec
 
 from . import kinds as K
 from .compiled import Compiled, compile_program
 from .interp import ProgramController
-from .keys import KeyEvent, KeyScriptError, parse_key_script, typed_events
+from .keys import KeyEvent, parse_key_script, typed_events
 from .kinds import load_kind_map
 from .loader import load_program
 from .problems import Problem, ProgramError
@@ -86,10 +86,13 @@ def port_binding(sensors: Sequence[SensorSpec]) -> dict[str, int]:
     return {f"port {s.port}": s.port for s in sensors}
 
 
-def program_driving(compiled: Compiled, shown: str, keys: Sequence[KeyEvent] = ()) -> Driving:
+def program_driving(
+    compiled: Compiled, shown: str, report_ms: int, keys: Sequence[KeyEvent] = ()
+) -> Driving:
     """The program driving, from the start, as the file ``shown`` (its path as the student
-    gave it); ``keys`` are pressed at their simulated times (a headless run's script)."""
-    controller = ProgramController(compiled, tuple(keys))
+    gave it), its sensors reported every ``report_ms`` as VIPLE's simulator does; ``keys`` are
+    pressed at their simulated times (a headless run's script)."""
+    controller = ProgramController(compiled, tuple(keys), report_period=report_ms / 1000.0)
     name = os.path.basename(shown)
     digest = compiled.program.digest
     return Driving(
@@ -113,24 +116,28 @@ class ProgramPilot:
     typed: str = ""
     #: names for unknown activity kinds (a YAML file)
     kinds: str | None = None
+    #: milliseconds between two sensor reports (None: the profile's simulator period)
+    report_ms: int | None = None
 
     def drive(
         self, profile: Profile, sensors: list[SensorSpec] | None
     ) -> tuple[Driving, list[SensorSpec]]:
         compiled = load_compiled(self.program, self.kinds)
         try:
+            report_ms = profile.report_ms if self.report_ms is None else self.report_ms
+            check_report_ms(report_ms)
             keys = parse_key_script(self.keys)
             if self.typed:
                 typed = typed_events(parse_key_script(self.typed), until=float("inf"))
                 keys = tuple(sorted(keys + typed, key=lambda e: e.time))
-        except KeyScriptError as exc:
+        except ValueError as exc:  # the report interval, the key script (KeyScriptError)
             raise RunSetupError(str(exc)) from None
         if sensors is None:
             sensors = list(profile.sensors)
         missing = check_sensors(compiled, sensors)
         if missing:
             raise ProgramError(missing)
-        return program_driving(compiled, self.program, keys), sensors
+        return program_driving(compiled, self.program, report_ms, keys), sensors
 
     def result(self, run: RunResult) -> dict[str, Any]:
         controller = run.driving.controller
@@ -161,14 +168,16 @@ def program_entrant(
     noise_params: tuple[str, ...] = (),
     max_time: float | None = None,
     keys: str = "",
+    report_ms: int | None = None,
 ) -> Entrant:
     """A program in ``workbench eval`` (named ``name``, default its path), on each maze and
-    seed, with the key script ``keys`` pressed in every run."""
+    seed, with the key script ``keys`` pressed in every run and its sensors reported every
+    ``report_ms`` (None: the profile's period)."""
 
     def spec(maze: str, seed: int) -> RunSpec:
         return RunSpec(
             maze=maze,
-            pilot=ProgramPilot(path, keys=keys, kinds=kinds),
+            pilot=ProgramPilot(path, keys=keys, kinds=kinds, report_ms=report_ms),
             profile=profile,
             sensors=sensors,
             seed=seed,

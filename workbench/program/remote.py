@@ -7,8 +7,8 @@ activities name the wheel ports the commands go to.
 
 :class:`RemoteProgram` runs the program on the client's own clock: each sensor report fires
 the sensor activities (one report, one firing), and between reports the program ticks at the
-control rate so its Timers, keys and waiting flows go on. The protocol side (sockets, the
-wire) is ``workbench.viple.client``; the command line joins the two.
+control rate so its keys and waiting flows go on, and at each Timer's own time. The protocol
+side (sockets, the wire) is ``workbench.viple.client``; the command line joins the two.
 """
 
 from __future__ import annotations
@@ -127,7 +127,11 @@ class RemoteProgram:
         return self.controller.tick(t, {}, frozenset())
 
     def next_tick(self) -> float:
-        return self.last_tick + 1.0 / CONTROL_HZ
+        """When to tick next: at the control rate, or sooner when a Timer or a scripted key
+        is due (so a Timer ends at its own time, not at the next control tick)."""
+        tick = self.last_tick + 1.0 / CONTROL_HZ
+        due = self.controller.next_due()
+        return tick if due is None or due > tick else due
 
     def type_key(self, key: str, t: float) -> None:
         self.controller.type_key(key, t)

@@ -38,7 +38,8 @@ erobotic  unit "px". ``c = 120``, ``r = 8``. Centred side reading 60 - 8 = 52: n
 Default sensors: unity distance 1 right + distance 2 front (the Unity simulator's preset);
 web distance 1 right + touch 2 front (the Web Simulator wall-following program); erobotic
 distance 1 front, 2 left, 3 right. Robot Drive wheel ports: left 3, right 5 in every profile
-(the protocol example's servo ids).
+(the protocol example's servo ids). A VIPLE program run offline gets a sensor report every
+``report_ms`` (250 ms in every profile, the pace of the workbench's own VIPLE server).
 """
 
 from __future__ import annotations
@@ -49,6 +50,22 @@ from dataclasses import dataclass
 from .sensors import MOUNTS, SensorSpec, check_ports
 
 NOISE_LEVELS = ("off", "low", "realistic")
+#: the interval between two sensor reports to a VIPLE program: limits and default, milliseconds
+REPORT_MS_MIN = 50
+REPORT_MS_MAX = 1000
+REPORT_MS_DEFAULT = 250
+
+
+def check_report_ms(value: object) -> int:
+    """The report interval in whole milliseconds, or ``ValueError`` naming the allowed range."""
+    if isinstance(value, bool) or not isinstance(value, int):
+        raise ValueError(f"report interval must be a whole number of milliseconds, not {value!r}")
+    if not REPORT_MS_MIN <= value <= REPORT_MS_MAX:
+        raise ValueError(
+            f"report interval {value} ms is out of range: use {REPORT_MS_MIN} to "
+            f"{REPORT_MS_MAX} ms (VIPLE's Unity simulator used about 260)"
+        )
+    return value
 
 
 @dataclass(frozen=True)
@@ -88,6 +105,9 @@ class Profile:
     blocked_below: float
     open_above: float
     description: str = ""
+    #: how often the simulator reports the sensors to a VIPLE program, milliseconds (the
+    #: workbench's VIPLE server reports every 250 ms; offline program runs keep that pace)
+    report_ms: int = REPORT_MS_DEFAULT
 
     def __post_init__(self) -> None:
         positive = (
@@ -115,6 +135,10 @@ class Profile:
                 f"profile {self.name!r}: noise {self.noise!r} is not one of {NOISE_LEVELS}"
             )
         check_ports(self.sensors)
+        try:
+            check_report_ms(self.report_ms)
+        except ValueError as exc:
+            raise ValueError(f"profile {self.name!r}: {exc}") from None
 
     def sensor_offset(self, mount: str) -> float:
         return self.sensor_offsets[MOUNTS.index(mount)]

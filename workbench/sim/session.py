@@ -2,7 +2,9 @@
 
 Physics steps at ``dt``; the controller (an FSM, or nothing while keys or a VIPLE program
 drive) runs at the control rate ``control_hz`` on simulated time, and the run record gets one
-line per control tick. Front ends call :meth:`Session.step` (or :meth:`Session.run`), hand
+line per control tick. A controller that has things due at their own times (a VIPLE program
+file's Timers and sensor reports) is woken at exactly those times as well: the physics step
+they fall in is split there. Front ends call :meth:`Session.step` (or :meth:`Session.run`), hand
 commands to :meth:`Session.command`, and read :meth:`Session.snapshot`.
 """
 
@@ -36,6 +38,14 @@ class Controller(Protocol):
     def start(self, t: float) -> list[Any]: ...
 
     def tick(self, t: float, readings: dict[str, float], events: frozenset[str]) -> list[Any]: ...
+
+
+#: a controller may also say when it next has something to do between control ticks (a VIPLE
+#: program's Timer or sensor report): ``next_due() -> float | None``; the session then wakes it
+#: with :meth:`Controller.tick` at exactly that simulated time, between physics steps if need be
+NEXT_DUE = "next_due"
+#: times closer than this are the same moment, seconds
+_SAME = 1e-9
 
 
 @dataclass(frozen=True)
@@ -74,6 +84,7 @@ class Session:
         self.every = max(1, round(1.0 / (dt * control_hz)))
         self.shortest_blocks = maze.shortest_path_length()
         self.controller: Controller | None = None
+        self._next_due: Callable[[], float | None] | None = None
         self.binding: dict[str, int] = {}
         self.driver = NOBODY
         #: told of every command from outside the controller, with the driver that sent it
@@ -89,6 +100,8 @@ class Session:
         self._events: list[str] = []
         self._commands: list[Any] = []
         self._started = False
+        #: when the controller next has something due (inf: nothing; asked each time it ran)
+        self._due = math.inf
         self._turns = TurnCounter()
         self._last_angle = self.world.angle
         self._last_time = 0.0
@@ -99,12 +112,16 @@ class Session:
     def attach(self, controller: Controller, binding: dict[str, int], driver: Driver) -> None:
         """Let ``controller`` drive; ``binding`` maps its sensor names to ports."""
         self.controller = controller
+        self._next_due = getattr(controller, NEXT_DUE, None)
         self.binding = dict(binding)
         self.driver = driver
         self._started = False
+        self._due = math.inf
 
     def detach(self, driver: Driver = NOBODY) -> None:
         self.controller = None
+        self._next_due = None
+        self._due = math.inf
         self.binding = {}
         self.driver = driver
 
@@ -160,6 +177,7 @@ class Session:
         self.maze = maze
         self.shortest_blocks = maze.shortest_path_length()
         self.controller = None
+        self._next_due = None
         self.binding = {}
         self._reset_run_state()
 
@@ -177,8 +195,14 @@ class Session:
 
     # -- time ----------------------------------------------------------------------------
     def step(self) -> tuple[str, ...]:
-        """One physics step (and a control tick every ``every`` steps)."""
+        """One physics step (and a control tick every ``every`` steps); a controller with
+        something due inside the step is woken at that time."""
+        early: tuple[str, ...] = ()
+        if self._due < (self._steps + 1) * self.world.dt - _SAME:
+            early = self._wake_within()
         events = self._world_step()
+        if early:
+            events = early + events
         if events:
             self._events.extend(events)
         self._steps = n = self._steps + 1
@@ -189,7 +213,47 @@ class Session:
             self._commands.append(cmd)
         if n % self.every == 0:
             self._control_tick()
+        elif self._due <= self.world.time + _SAME:
+            self._wake(self.world.time)
         return events
+
+    def _wake_within(self) -> tuple[str, ...]:
+        """Wake the controller at each time it has something due before this step ends,
+        moving the world to that time first; the events on the way."""
+        world = self.world
+        end = (self._steps + 1) * world.dt - _SAME
+        events: tuple[str, ...] = ()
+        last = -math.inf
+        due = self._due
+        while last < due < end:
+            if due > world.time + _SAME:
+                events += world.step_to(due)
+            self._wake(max(due, world.time))
+            last = due
+            due = self._due
+        return events
+
+    def _ask_due(self) -> None:
+        """After the controller ran: when it next has something due."""
+        next_due = self._next_due
+        if next_due is not None:
+            due = next_due()
+            self._due = math.inf if due is None else due
+
+    def _wake(self, t: float) -> None:
+        """The controller's due work at ``t`` between control ticks: it gets the readings of
+        that moment and its commands apply at once (the record shows them at the next tick)."""
+        controller = self.controller
+        assert controller is not None
+        world = self.world
+        self.readings = readings = world.read_sensors()
+        named = {name: readings[port] for name, port in self.binding.items()}
+        commands = controller.tick(t, named, _NONE)
+        self._ask_due()
+        if commands:
+            for cmd in commands:
+                world.apply(cmd)
+            self._commands.extend(commands)
 
     def _control_tick(self, run_controller: bool = True) -> None:
         world = self.world
@@ -208,6 +272,7 @@ class Session:
             else:
                 self._started = True
                 commands = controller.start(t)
+            self._ask_due()
             if commands:
                 for cmd in commands:
                     world.apply(cmd)

@@ -276,6 +276,8 @@ class World:
         self._gains = motor_gains(self.noise, self._rng)
         self._build_space()
         self._steps = 0
+        #: the part of the current step already done by :meth:`step_to`, seconds
+        self._part = 0.0
         self.time = 0.0
         self._x, self._y, self._angle = self._start
         self._distance = 0.0
@@ -296,6 +298,7 @@ class World:
         self._free_w = 0.0
         self._physics_stale = False
         self._step_angle = self._step_v = math.nan  # the cached step of straight driving
+        self._step_dt = self.dt
         self._step_dx = self._step_dy = 0.0
         self._box = (math.inf, -math.inf, math.inf, -math.inf)
 
@@ -423,14 +426,34 @@ class World:
 
     # -- stepping ------------------------------------------------------------------------
     def step(self) -> tuple[str, ...]:
-        """Advance one ``dt``; the events of this step ("turn_done", "collision", "touch",
-        "exit").
+        """Advance to the end of the current ``dt`` step; the events of this step
+        ("turn_done", "collision", "touch", "exit").
 
         Where no wall is within reach of this step's motion the pose is integrated directly
         (free motion, exactly what the solver would do with nothing to collide with); anywhere
         else, and whenever the robot touches a wall, pymunk steps the world.
         """
-        dt = self.dt
+        part = self._part
+        if part:
+            self._part = 0.0
+            return self._advance(self.dt - part, True)
+        return self._advance(self.dt, True)
+
+    def step_to(self, t: float) -> tuple[str, ...]:
+        """Advance to simulated time ``t`` inside the current step (something is due then,
+        such as a program's Timer); the next :meth:`step` ends the step at its usual time.
+        Its events, as :meth:`step`'s."""
+        h = t - self.time
+        if not 0.0 < h < self.dt - self._part:
+            raise WorldError(
+                f"step_to({t!r}): the time must fall inside the current step, after "
+                f"{self.time:.6f} s and before {(self._steps + 1) * self.dt:.6f} s"
+            )
+        self._part += h
+        return self._advance(h, False)
+
+    def _advance(self, dt: float, whole: bool) -> tuple[str, ...]:
+        """Move the robot on by ``dt`` seconds; ``whole``: that ends the current step."""
         target = self._turn_target
         x0 = self._x
         y0 = self._y
@@ -446,7 +469,8 @@ class World:
                 v = self._v
                 w = self._w
             if v:
-                if a0 != self._step_angle or v != self._step_v:
+                if a0 != self._step_angle or v != self._step_v or dt != self._step_dt:
+                    self._step_dt = dt
                     self._step_angle = a0
                     self._step_v = v
                     self._step_dx = v * math.cos(a0) * dt
@@ -468,11 +492,14 @@ class World:
                 moved = abs(v) * dt
                 turned = abs(w) * dt
         if not free:
-            x, y, a = self._physics_step(target, a0)
+            x, y, a = self._physics_step(target, a0, dt)
             moved = math.hypot(x - x0, y - y0)
             turned = abs(a - a0)
-        self._steps += 1
-        self.time = t = self._steps * dt
+        if whole:
+            self._steps += 1
+            self.time = t = self._steps * self.dt
+        else:
+            self.time = t = self._steps * self.dt + self._part
         self._distance += moved
         self._turned += turned
         self._moved = moved or turned
@@ -488,9 +515,10 @@ class World:
             return _NO_EVENTS  # nothing can have happened: the common step ends here
         return self._events(t, x, y, a, target)
 
-    def _physics_step(self, target: float | None, a0: float) -> tuple[float, float, float]:
-        """One pymunk step; the robot's new x, y and angle."""
-        dt = self.dt
+    def _physics_step(
+        self, target: float | None, a0: float, dt: float
+    ) -> tuple[float, float, float]:
+        """One pymunk step of ``dt``; the robot's new x, y and angle."""
         if self._physics_stale:
             self._sync_body()
         if target is not None:

@@ -37,7 +37,7 @@ from workbench.labs.store import Store, StoreError, resolve_data_dir
 from workbench.sim.maze import Maze, MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.noise import NOISE_LEVELS
-from workbench.sim.profiles import PROFILES
+from workbench.sim.profiles import PROFILES, check_report_ms
 from workbench.viple.hosting import Endpoints
 from workbench.viple.tcp_server import TcpConfig
 from workbench.viple.ws_client import WsConfig
@@ -668,6 +668,11 @@ def make_app(settings: AppSettings) -> WorkbenchApp:
         viple_configs(settings)
     except ValueError as exc:
         raise AppSetupError(str(exc)) from None
+    if settings.report_ms is not None:
+        try:
+            check_report_ms(settings.report_ms)
+        except ValueError as exc:
+            raise AppSetupError(f"a VIPLE program's {exc}") from None
     try:
         maze = load_maze(path)
     except MazeError as exc:
@@ -692,6 +697,7 @@ def make_app(settings: AppSettings) -> WorkbenchApp:
     except ValueError as exc:
         raise AppSetupError(f"cannot set up the robot: {exc}") from None
     station.pause(settings.paused)
+    station.report_ms = settings.report_ms
     # max speed may use at most 60 % of each frame, so keys and drawing stay responsive
     station.pacer.budget = 0.6 / tick_hz
     named = replace(settings, maze_path=path, student=student, partner=partner)

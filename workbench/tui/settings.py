@@ -42,6 +42,9 @@ class AppSettings:
     paused: bool = False
     #: the app's clock ticks this often a second while anything moves
     tick_hz: float = 20.0
+    #: how often a VIPLE program file driving the robot gets its sensor reports, milliseconds
+    #: (None: the profile's simulator period, 250 ms)
+    report_ms: int | None = None
     #: draw with Unicode lines, arrows and marks (False: plain ASCII)
     unicode: bool = False
     #: where each run's record is kept for replay (None: no records)

@@ -33,14 +33,16 @@ from typing import Protocol
 
 from workbench.sim.commands import Stop
 from workbench.sim.driver import NOBODY, Driver
+
+# the report interval's rule, shared with offline program runs (named here for the endpoints)
+from workbench.sim.profiles import REPORT_MS_DEFAULT as REPORT_MS_DEFAULT
+from workbench.sim.profiles import REPORT_MS_MAX as REPORT_MS_MAX
+from workbench.sim.profiles import REPORT_MS_MIN as REPORT_MS_MIN
+from workbench.sim.profiles import check_report_ms as check_report_ms
 from workbench.sim.session import Session
 
 from .codec import REPORT_KINDS, CodecError, WheelPorts, encode_report, parse_command
 
-#: report interval limits and default, milliseconds
-REPORT_MS_MIN = 50
-REPORT_MS_MAX = 1000
-REPORT_MS_DEFAULT = 250
 #: lines (and reads) handled before the loop gets a turn
 BATCH = 64
 #: bytes of reports an endpoint holds for a peer that is slow to read; above it reports drop
@@ -70,18 +72,6 @@ def check_idle_s(value: object) -> float | None:
     if not math.isfinite(value):
         raise ValueError("driver idle time must be finite; use None for no limit")
     return float(value)
-
-
-def check_report_ms(value: object) -> int:
-    """The report interval in whole milliseconds, or ``ValueError`` naming the allowed range."""
-    if isinstance(value, bool) or not isinstance(value, int):
-        raise ValueError(f"report interval must be a whole number of milliseconds, not {value!r}")
-    if not REPORT_MS_MIN <= value <= REPORT_MS_MAX:
-        raise ValueError(
-            f"report interval {value} ms is out of range: use {REPORT_MS_MIN} to "
-            f"{REPORT_MS_MAX} ms (VIPLE's Unity simulator used about 260)"
-        )
-    return value
 
 
 @dataclass(frozen=True)
