@@ -354,7 +354,7 @@ def test_data_dir_comes_from_the_option_then_the_environment(monkeypatch, tmp_pa
 
 def test_store_uses_wal_and_a_schema_version(data_dir):
     with Store.open(data_dir) as s:
-        assert s.schema_version() == 5  # the last step: progress evidence
+        assert s.schema_version() == 6  # the last step: workspace files
     with sqlite3.connect(data_dir / DB_NAME) as conn:
         assert conn.execute("PRAGMA journal_mode").fetchone()[0] == "wal"
 

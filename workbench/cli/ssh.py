@@ -358,6 +358,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
         fork_server=not args.no_fork_server,
         app=WORKBENCH_APP,
         record_quota=RecordQuota(args.record_cap, args.runs_quota),
+        db=db,
     )
     try:
         log_path = setup_logging(data_dir)

@@ -3,7 +3,7 @@
 The new content goes to a temporary file beside the target, is flushed to the disk, and then
 takes the target's place in one step (``os.replace``). The one way every file the workbench
 writes in place is saved: mazes, rosters, gradebooks, the SSH users file, the last pair and
-the pending store writes.
+the pending store writes. Once in place, the file is announced (:func:`.commits.committed`).
 """
 
 from __future__ import annotations
@@ -12,6 +12,8 @@ import contextlib
 import os
 import tempfile
 from pathlib import Path
+
+from .commits import committed
 
 
 def write_text_atomic(path: str | os.PathLike, text: str, mode: int | None = None) -> None:
@@ -36,6 +38,7 @@ def write_bytes_atomic(path: str | os.PathLike, data: bytes, mode: int | None = 
         with contextlib.suppress(OSError):
             os.unlink(temp)
         raise
+    committed(target)
 
 
 def _mode_for(path: Path) -> int:

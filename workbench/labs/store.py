@@ -37,7 +37,7 @@ import platformdirs
 
 from workbench.files.private import PRIVATE_FILE, private_dir, tighten
 
-from . import queue
+from . import queue, workspace_rows
 from .database import (
     BUSY_TIMEOUT_MS,
     Backend,
@@ -56,6 +56,7 @@ from .names import name_key
 from .pending import FIELDS, PendingWrite, load_pending, save_pending
 from .queue import QueueEntry, QueueState
 from .signlog import GENESIS, entry_hash, next_place, parse_metrics, signed_payload
+from .workspace_rows import LIMITS, FileRow, WorkspaceLimits
 
 __all__ = [
     "LogMissing",
@@ -739,6 +740,45 @@ class Store:
             sql += " WHERE instructor = ?"
             params = (instructor,)
         return [Event(*r) for r in self._read(sql + " ORDER BY id", params)]
+
+    # the students' workspace files (see workspace_rows.py and workspace_sync.py)
+
+    def put_workspace_file(
+        self,
+        student: str,
+        path: str,
+        data: bytes,
+        mtime: float,
+        limits: WorkspaceLimits = LIMITS,
+        now: datetime | None = None,
+    ) -> FileRow:
+        """Keep ``data`` as ``student``'s workspace file ``path`` within ``limits``;
+        :class:`~.workspace_rows.WorkspaceRefused` says which bound it would pass. Needs the
+        database (:class:`StoreUnavailable` while it is away)."""
+        with self._write() as tx:
+            return workspace_rows.put(tx, student, path, data, mtime, utc_iso(now or _now()),
+                                      limits)  # fmt: skip
+
+    def remove_workspace_file(
+        self, student: str, path: str, now: datetime | None = None
+    ) -> FileRow | None:
+        """Mark ``student``'s workspace file ``path`` removed; None when it was not kept."""
+        with self._write() as tx:
+            return workspace_rows.remove(tx, student, path, utc_iso(now or _now()))
+
+    def workspace_index(self, student: str) -> dict[str, FileRow]:
+        """The workspace files the store holds for ``student`` (removed ones too), by path."""
+        return workspace_rows.index(self._read, student)
+
+    def workspace_file(self, student: str, path: str) -> tuple[FileRow, bytes] | None:
+        """One workspace file's row and bytes; None when the store does not hold it."""
+        return workspace_rows.content(self._read, student, path)
+
+    def workspace_files_by_digest(
+        self, sha256: str, students: tuple[str, ...]
+    ) -> list[tuple[str, str, bytes]]:
+        """The files of ``students`` stored with the digest ``sha256`` (hex)."""
+        return workspace_rows.by_digest(self._read, sha256, students)
 
     # the instructors' roster (PostgreSQL; a SQLite store keeps it in the data folder)
 
