@@ -516,7 +516,7 @@ def test_records_made_before_the_chain_are_read_as_legacy_then_chained_by_the_up
     assert all("legacy record" in v.notes[0] for v in read_only.verdicts)
     assert (data_dir / DB_NAME).read_bytes() == before  # reading did not upgrade it
     with Store.open(data_dir) as store:
-        assert store.schema_version() == 5
+        assert store.schema_version() == 6
         assert store.signoffs() == read_signoffs(data_dir)  # upgraded to what was read
         sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
         log = verify_log(store.signoffs(), roster(data_dir), kept=read_only.head)

@@ -119,8 +119,8 @@ def copy_store(source: Store, target: Store) -> CopyReport:
     stored_files = int(target._read("SELECT count(*) FROM workspace_files")[0][0])
     if stored_files:
         raise StoreError(
-            f"{target.where} already holds {stored_files} workspace file(s): move a data folder into "
-            "an empty database (or one made for it with CREATE DATABASE)"
+            f"{target.where} already holds {stored_files} workspace file(s): move a data "
+            "folder into an empty database (or one made for it with CREATE DATABASE)"
         )
     rows = {t: source._read(f"SELECT {', '.join(c)} FROM {t}") for t, c in TABLES.items()}
     files, left = _workspace_files(source.data_dir)
