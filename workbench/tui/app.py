@@ -625,12 +625,14 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
 
     async def _shut_down(self) -> None:
         self.station.close()
+        sent: asyncio.Future[bool] | None = None
         if self.pusher is not None:
-            # the last records closed just now go while the database answers; what does not
-            # go is on this server's disk and is sent when the student's next session starts
-            pusher = self.pusher
-            await asyncio.to_thread(pusher.wait_idle, STORE_LAST_TRY_SECONDS)
-            pusher.stop()
+            # the run record closed just now goes while the database answers (alongside the
+            # last try below); what does not go is on this server's disk, and is sent when
+            # the student's next session starts
+            sent = asyncio.ensure_future(
+                asyncio.to_thread(self.pusher.wait_idle, STORE_LAST_TRY_SECONDS)
+            )
         if self.store is not None:
             # a last try for what the database did not get yet (never shown as saved); while
             # it is away the pending writes are in their file already, for the next app
@@ -646,6 +648,9 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
                 with contextlib.suppress(Exception):
                     store.flush()
             store.close()
+        if sent is not None and self.pusher is not None:
+            await sent
+            self.pusher.stop()
         if self.endpoints is not None:
             await self.endpoints.close()
         self.exit()
