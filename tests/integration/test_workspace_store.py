@@ -187,6 +187,26 @@ def test_files_changed_while_the_store_was_away_are_sent_at_the_next_start(serve
     assert not (two.workspace() / "new.txt").exists()
 
 
+def test_a_file_changed_on_both_servers_keeps_the_one_modified_last(servers):
+    one, two = servers
+    one.save("a.txt", b"first")
+    one.save("b.txt", b"first")
+    sync_at_start(two.data_dir, two.db, "alice", two.workspace())
+    # a.txt: changed on two (sent), then changed again on one later (not sent)
+    two.save("a.txt", b"from two")
+    (one.workspace() / "a.txt").write_bytes(b"from one, later")
+    os.utime(one.workspace() / "a.txt", (4_000_000_000, 4_000_000_000))
+    # b.txt: changed on one first (not sent), then on two (sent)
+    (one.workspace() / "b.txt").write_bytes(b"from one, earlier")
+    os.utime(one.workspace() / "b.txt", (1_000_000_000, 1_000_000_000))
+    two.save("b.txt", b"from two, later")
+    report = sync_at_start(one.data_dir, one.db, "alice", one.workspace())
+    assert report.pushed == ["a.txt"] and report.fetched == ["b.txt"]
+    assert (one.workspace() / "b.txt").read_bytes() == b"from two, later"
+    sync_at_start(two.data_dir, two.db, "alice", two.workspace())
+    assert (two.workspace() / "a.txt").read_bytes() == b"from one, later"
+
+
 def test_a_file_past_the_bounds_stays_on_its_server_and_the_report_says_why(servers):
     one, two = servers
     big = one.workspace() / "big.bin"
