@@ -9,7 +9,10 @@ on this server's disk; this module copies it to and from the store's workspace f
   this server's copy are written into the folder, the files removed elsewhere are removed
   here, and the files changed here while the store could not be reached are sent.
 * :func:`push_file` / :func:`remove_file`: one file sent to the store (or marked removed) at
-  once, for whatever has just committed a file (the SFTP server after an upload).
+  once, for whatever has just committed a file (the SFTP server after an upload). Each call
+  waits for the database (up to its statement deadline): call it from a thread, never on an
+  event loop. The bounds it enforces are :data:`~.workspace_rows.LIMITS`, and the names it
+  takes are those :func:`~.workspace_rows.check_path` passes.
 * :class:`WorkspacePusher`: the app's files sent as it commits them (the atomic writer and a
   closed run record announce them, :mod:`workbench.files.commits`), in a thread of its own
   with a store connection of its own, so a store that hangs never holds up the app; a push
