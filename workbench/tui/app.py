@@ -231,6 +231,12 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
         self._check_size(self.size.width, self.size.height)
         self._ask_for_names()
 
+    def on_unmount(self) -> None:
+        """However the app ends (quitting, or its session closing), its workspace sends stop:
+        a file not sent yet is on this server's disk, and the next session's start sends it."""
+        if self.pusher is not None:
+            self.pusher.stop()
+
     def _ask_for_names(self) -> None:
         """The names dialog, once, when the terminal is big enough for it (else the size
         message comes first and the dialog after it)."""
