@@ -7,6 +7,7 @@ from __future__ import annotations
 import hashlib
 import os
 import threading
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -17,6 +18,7 @@ from workbench.files.workspace import workspace_folder
 from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.roster import offered_roster
 from workbench.labs.signing import sign_off
+from workbench.labs.signoff_errors import SignoffError
 from workbench.labs.signoff_record import Evidence, RecordFields, record_digest
 from workbench.labs.store import Store, StoreError, read_signoffs
 from workbench.labs.storecopy import copy_store
@@ -231,7 +233,7 @@ def test_a_link_in_the_workspace_is_never_followed_or_sent(servers, tmp_path):
             push_file(s, "alice", "link.txt", one.workspace())
 
 
-def test_a_run_record_signed_on_one_server_verifies_from_the_course_store_elsewhere(
+def test_a_run_record_made_on_one_server_is_signed_and_verified_from_the_course_store(
     servers, tmp_path
 ):
     one, two = servers
@@ -251,15 +253,19 @@ def test_a_run_record_signed_on_one_server_verifies_from_the_course_store_elsewh
         pusher.stop()
     assert told == []
     digest = record_digest(record)
-    with one.store() as s:
-        create_instructor(one.data_dir, "Dr Chen", PASS, kdf=FAST, store=s)
+    record.unlink()  # as on any machine but the first server
+    # the instructor signs at the second server: the record is checked from the store
+    with two.store() as s:
+        create_instructor(two.data_dir, "Dr Chen", PASS, kdf=FAST, store=s)
         roster = offered_roster(s)
         fields = RecordFields(
             student="alice", lab="unity-simulator", exercise="wall-following", driver="alice",
             evidence=Evidence(str(record), digest, {"exit_time": 41.5}), objectives_passed=True,
         )  # fmt: skip
         sign_off(s, "Dr Chen", PASS, fields)
-    record.unlink()  # as on any machine but the first server
+        elsewhere = Evidence(str(record.with_name("run-2.jsonl")), "sha256:" + "0" * 64, {})
+        with pytest.raises(SignoffError, match="neither on this machine nor in the course store"):
+            sign_off(s, "Dr Chen", PASS, replace(fields, evidence=elsewhere))
     rows = read_signoffs(two.data_dir, two.db)
     with course_evidence(two.db) as evidence:
         [verdict] = verify_log(rows, roster, evidence=evidence).verdicts
