@@ -273,9 +273,16 @@ def test_a_run_record_made_on_one_server_is_signed_and_verified_from_the_course_
     # without the store the digest is not checked, as before
     [plain] = verify_log(rows, roster).verdicts
     assert "not present" in plain.notes[0]
-    # a copy changed in the database fails
+    # the student removes the record: the copy kept with the sign-off still checks it
+    rel = record.relative_to(one.workspace()).as_posix()
+    with two.store() as s:
+        remove_file(s, "alice", rel, two.workspace())
+    with course_evidence(two.db) as evidence:
+        [kept] = verify_log(rows, roster, evidence=evidence).verdicts
+    assert kept.ok and "the copy kept when it was signed" in kept.notes[0]
+    # copies changed in the database fail
     with two.store() as s, s.backend.write() as tx:
-        tx.execute("UPDATE workspace_files SET content = ? WHERE student = 'alice'", (b"{}",))
+        tx.execute("UPDATE signoff_evidence SET content = ?", (b"{}",))
     with course_evidence(two.db) as evidence:
         [bad] = verify_log(rows, roster, evidence=evidence).verdicts
     assert not bad.ok and "no longer has the signed digest" in bad.problems[0]

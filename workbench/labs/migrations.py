@@ -233,7 +233,8 @@ def _progress_evidence(tx: Tx, kind: str) -> None:
 
 
 #: step 6: a student's workspace files (see :mod:`.workspace_rows`); a removed file stays as a
-#: row without content (``deleted``) so that other servers remove their copy too
+#: row without content (``deleted``) so that other servers remove their copy too; and, in a
+#: course database, a copy of each run record a sign-off rests on, by its digest
 WORKSPACE = """
 CREATE TABLE IF NOT EXISTS workspace_files (
     student TEXT NOT NULL,
@@ -247,7 +248,13 @@ CREATE TABLE IF NOT EXISTS workspace_files (
     updated_at TEXT NOT NULL,
     PRIMARY KEY (student, path)
 );
-CREATE INDEX IF NOT EXISTS workspace_files_by_sha ON workspace_files (sha256)
+CREATE INDEX IF NOT EXISTS workspace_files_by_sha ON workspace_files (sha256);
+CREATE TABLE IF NOT EXISTS signoff_evidence (
+    digest TEXT PRIMARY KEY,
+    size {bigint} NOT NULL,
+    content {bytes} NOT NULL,
+    kept_at TEXT NOT NULL
+)
 """
 
 

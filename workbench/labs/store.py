@@ -475,12 +475,16 @@ class Store:
 
     # sign-off records
 
-    def append_signoff(self, sign: Callable[[int, str], dict[str, Any]]) -> StoredSignoff:
+    def append_signoff(
+        self, sign: Callable[[int, str], dict[str, Any]], evidence: bytes | None = None
+    ) -> StoredSignoff:
         """Add a record at the end of the log. ``sign(seq, prev_hash)`` returns the record's
         columns (those of :data:`RECORD_COLUMNS`) signed for that place; it is called inside
         the write transaction, which holds the log (SQLite: the write lock; PostgreSQL: an
         advisory lock), so two processes signing at once queue and never take the same
-        place. Returns the row as stored."""
+        place. A course database keeps ``evidence``, the bytes of the run record the record
+        rests on, with it (a data folder's records stay on its disk). Returns the row as
+        stored."""
         postgres = self.backend.postgres
         with self._write() as tx:
             if postgres:
@@ -520,6 +524,10 @@ class Store:
                 row,
             ).fetchone()
             row_id = int(new[0])
+            if postgres and evidence is not None and draft.evidence_digest:
+                workspace_rows.keep_evidence(
+                    tx, draft.evidence_digest, evidence, utc_iso(_now())
+                )
         return replace(draft, id=row_id, entry_hash=digest)
 
     def signoffs(self, student: str | None = None, lab: str | None = None) -> list[StoredSignoff]:

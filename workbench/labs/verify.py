@@ -147,20 +147,24 @@ def _check_stored_record(
         if f"sha256:{hashlib.sha256(data).hexdigest()}" == row.evidence_digest:
             notes.append(
                 f"run record {row.run_record} not on this machine: its digest was checked in "
-                f"the course store ({student}'s ~/{path})"
+                f"the course store ({_copy_words(student, path)})"
             )
             return
     if copies:
         student, path, _ = copies[0]
         problems.append(
             f"the run record {row.run_record} no longer has the signed digest (the course "
-            f"store's copy, {student}'s ~/{path})"
+            f"store's copy, {_copy_words(student, path)})"
         )
         return
     notes.append(
         f"run record {row.run_record} not present here nor in the course store: its digest "
         "was not checked"
     )
+
+
+def _copy_words(student: str, path: str) -> str:
+    return f"{student}'s ~/{path}" if path else "the copy kept when it was signed"
 
 
 @contextmanager

@@ -237,6 +237,22 @@ def by_digest(read: Read, sha256: str, students: tuple[str, ...]) -> list[tuple[
     return [(str(s), str(p), bytes(c or b"")) for s, p, c in rows]
 
 
+#: the largest run record a sign-off keeps a copy of (the default record cap is 20 MB)
+EVIDENCE_CAP = 32 * MIB
+
+
+def keep_evidence(tx: Tx, digest: str, data: bytes, now: str) -> None:
+    """Keep ``data``, the run record a sign-off rests on, under its digest (``sha256:HEX``);
+    a copy already kept stays as it is."""
+    if f"sha256:{sha256_hex(data)}" != digest or len(data) > EVIDENCE_CAP:
+        return
+    tx.execute(
+        "INSERT INTO signoff_evidence (digest, size, content, kept_at) VALUES (?, ?, ?, ?) "
+        "ON CONFLICT (digest) DO NOTHING",
+        (digest, len(data), data, now),
+    )
+
+
 def students(read: Read) -> list[str]:
     return [str(r[0]) for r in read("SELECT DISTINCT student FROM workspace_files ORDER BY 1")]
 
@@ -254,12 +270,16 @@ def record_place(run_record: str, people: tuple[str, ...]) -> tuple[str, str] | 
 def evidence_copies(
     read: Read, run_record: str, digest: str, people: tuple[str, ...]
 ) -> list[tuple[str, str, bytes]]:
-    """The copies in the store of a sign-off's run record: the files of ``people`` (the pair)
-    stored with its digest (``sha256:HEX``), and the file at the record's own place in the
-    workspace whatever it holds now. The caller hashes each copy's bytes."""
+    """The copies in the store of a sign-off's run record, as (student, path, bytes): the
+    files of ``people`` (the pair) stored with its digest (``sha256:HEX``), the copy kept
+    when it was signed (student and path empty), and the file at the record's own place in
+    the workspace whatever it holds now. The caller hashes each copy's bytes."""
     people = tuple(p for p in people if p)
     hexdigest = digest.removeprefix("sha256:")
     found = by_digest(read, hexdigest, people) if hexdigest else []
+    if hexdigest:
+        kept = read("SELECT content FROM signoff_evidence WHERE digest = ?", (digest,))
+        found += [("", "", bytes(row[0] or b"")) for row in kept]
     place = record_place(run_record, people)
     if place is not None and not any((s, p) == place for s, p, _ in found):
         got = content(read, *place)
