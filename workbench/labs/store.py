@@ -525,9 +525,7 @@ class Store:
             ).fetchone()
             row_id = int(new[0])
             if postgres and evidence is not None and draft.evidence_digest:
-                workspace_rows.keep_evidence(
-                    tx, draft.evidence_digest, evidence, utc_iso(_now())
-                )
+                workspace_rows.keep_evidence(tx, draft.evidence_digest, evidence, utc_iso(_now()))
         return replace(draft, id=row_id, entry_hash=digest)
 
     def signoffs(self, student: str | None = None, lab: str | None = None) -> list[StoredSignoff]:
