@@ -107,7 +107,8 @@ def state_path(folder: Path) -> Path:
 @contextlib.contextmanager
 def _state(folder: Path) -> Iterator[dict[str, Seen]]:
     """The workspace's last seen state, held for changing (one process at a time) and
-    written back whole afterwards."""
+    written back whole afterwards: also when the work stopped half way, since what it holds
+    is what was done."""
     path = state_path(folder)
     path.parent.mkdir(parents=True, exist_ok=True, mode=0o700)
     with open(path.with_suffix(".lock"), "a") as lock:
@@ -115,10 +116,12 @@ def _state(folder: Path) -> Iterator[dict[str, Seen]]:
         try:
             state = _load_state(path)
             before = dict(state)
-            yield state
-            if state != before:
-                text = json.dumps({p: s.to_json() for p, s in sorted(state.items())})
-                write_bytes_atomic(path, text.encode(), 0o600)
+            try:
+                yield state
+            finally:
+                if state != before:
+                    text = json.dumps({p: s.to_json() for p, s in sorted(state.items())})
+                    write_bytes_atomic(path, text.encode(), 0o600)
         finally:
             fcntl.flock(lock, fcntl.LOCK_UN)
 
@@ -205,26 +208,40 @@ def push_file(
     :class:`StoreUnavailable` (the database is away; try again later) or
     :class:`StoreError`."""
     root = Path(folder)
-    full = _inside(root, relpath)
-    local = read_local(full, limits.file_cap)
-    if local is None:
-        remove_file(store, user, relpath, root)
-        return None
-    data, info = local
-    row = store.put_workspace_file(user, relpath, data, info.st_mtime, limits)
     with _state(root) as state:
-        state[relpath] = Seen(row.sha256, row.revision, info.st_size, info.st_mtime_ns)
-    return row
+        return _send(store, user, relpath, root, limits, state)
 
 
 def remove_file(store: Store, user: str, relpath: str, folder: str | os.PathLike) -> FileRow | None:
     """Mark the file ``relpath`` of ``user``'s workspace removed in the store (call it once
     it is removed from the folder ``folder``); None when the store did not hold it. Raises as
     :func:`push_file`."""
+    with _state(Path(folder)) as state:
+        return _unsend(store, user, relpath, state)
+
+
+def _send(
+    store: Store,
+    user: str,
+    relpath: str,
+    root: Path,
+    limits: WorkspaceLimits,
+    state: dict[str, Seen],
+) -> FileRow | None:
+    full = _inside(root, relpath)
+    local = read_local(full, limits.file_cap)
+    if local is None:
+        return _unsend(store, user, relpath, state)
+    data, info = local
+    row = store.put_workspace_file(user, relpath, data, info.st_mtime, limits)
+    state[relpath] = Seen(row.sha256, row.revision, info.st_size, info.st_mtime_ns)
+    return row
+
+
+def _unsend(store: Store, user: str, relpath: str, state: dict[str, Seen]) -> FileRow | None:
     check_path(relpath)
     row = store.remove_workspace_file(user, relpath)
-    with _state(Path(folder)) as state:
-        state.pop(relpath, None)
+    state.pop(relpath, None)
     return row
 
 
@@ -272,7 +289,8 @@ def _local_sha(root: Path, rel: str, info: os.stat_result, seen: Seen | None) ->
     if seen is not None and seen.size == info.st_size and seen.mtime_ns == info.st_mtime_ns:
         return seen.sha256  # unchanged since it was last in step
     try:
-        with open(root / rel, "rb") as fh:
+        fd = os.open(root / rel, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC)
+        with os.fdopen(fd, "rb") as fh:
             return hashlib.file_digest(fh, "sha256").hexdigest()
     except OSError:
         return ""
@@ -284,108 +302,117 @@ def pull_workspace(
     """Bring ``user``'s workspace ``folder`` in step with the store (see the module's notes);
     a file that cannot be brought is named in the report and the rest go on. Raises
     :class:`StoreUnavailable` when the database is away (the folder is left as it is, save
-    what was done before)."""
+    what was done before). The workspace's state is held for the whole pull (a send of the
+    same workspace waits for it) and written once."""
     root = Path(folder)
     root.mkdir(parents=True, exist_ok=True, mode=0o700)
     report = SyncReport()
-    remote = store.workspace_index(user)
-    local, problems = local_files(root, limits)
-    report.problems.extend(problems)
     with _state(root) as state:
-        known = dict(state)
-    for rel in sorted(set(remote) | set(local) | set(known)):
-        row, info, seen = remote.get(rel), local.get(rel), known.get(rel)
-        sha = _local_sha(root, rel, info, seen) if info is not None else None
-        try:
-            _settle(store, user, root, rel, row, info, sha, seen, report, limits)
-        except WorkspaceRefused as exc:
-            report.problems.append(str(exc))
-        except StoreUnavailable:
-            raise
-        except StoreError as exc:
-            report.problems.append(f"{rel}: {exc}")
-        except OSError as exc:
-            report.problems.append(f"{rel}: cannot be written here ({exc.strerror or exc})")
+        remote = store.workspace_index(user)
+        local, problems = local_files(root, limits)
+        report.problems.extend(problems)
+        for rel in sorted(set(remote) | set(local) | set(state)):
+            row, info, seen = remote.get(rel), local.get(rel), state.get(rel)
+            sha = _local_sha(root, rel, info, seen) if info is not None else None
+            step = _Step(store, user, root, limits, state, report)
+            try:
+                step.settle(rel, row, info, sha, seen)
+            except WorkspaceRefused as exc:
+                report.problems.append(str(exc))
+            except StoreUnavailable:
+                raise
+            except StoreError as exc:
+                report.problems.append(f"{rel}: {exc}")
+            except OSError as exc:
+                report.problems.append(f"{rel}: cannot be written here ({exc.strerror or exc})")
     return report
 
 
-def _settle(
-    store: Store,
-    user: str,
-    root: Path,
-    rel: str,
-    row: FileRow | None,
-    info: os.stat_result | None,
-    sha: str | None,
-    seen: Seen | None,
-    report: SyncReport,
-    limits: WorkspaceLimits,
-) -> None:
-    """Bring one file in step (the table of cases is the module's notes)."""
-    if row is not None and not row.deleted:
-        if sha == row.sha256:
-            assert info is not None
-            _remember(root, rel, Seen(sha, row.revision, info.st_size, info.st_mtime_ns))
-        elif sha is None:
-            if seen is not None and seen.revision >= row.revision:
-                remove_file(store, user, rel, root)  # removed here, not changed there
-                report.removed.append(rel)
+@dataclass
+class _Step:
+    """Bringing one file in step, within a pull (the table of cases is the module's notes)."""
+
+    store: Store
+    user: str
+    root: Path
+    limits: WorkspaceLimits
+    state: dict[str, Seen]
+    report: SyncReport
+
+    def settle(
+        self,
+        rel: str,
+        row: FileRow | None,
+        info: os.stat_result | None,
+        sha: str | None,
+        seen: Seen | None,
+    ) -> None:
+        if row is not None and not row.deleted:
+            if sha == row.sha256:
+                assert info is not None
+                self.state[rel] = Seen(sha, row.revision, info.st_size, info.st_mtime_ns)
+            elif sha is None:
+                if seen is not None and seen.revision >= row.revision:
+                    self.remove_there(rel)  # removed here, not changed there since
+                else:
+                    self.fetch(rel)
             else:
-                _fetch(store, user, root, rel, report)
+                assert info is not None
+                changed_here = seen is None or sha != seen.sha256
+                changed_there = seen is None or row.revision > seen.revision
+                if changed_here and (not changed_there or info.st_mtime > row.mtime):
+                    self.send(rel)
+                else:
+                    self.fetch(rel)
+        elif row is not None:  # removed elsewhere
+            if sha is None:
+                self.state.pop(rel, None)
+            elif seen is not None and sha == seen.sha256 and row.revision > seen.revision:
+                self.remove_here(rel)
+            else:  # changed here after (or never in step): kept, and sent
+                self.send(rel)
+        elif sha is not None:  # new here, or made while the store was away
+            self.send(rel)
         else:
-            assert info is not None
-            changed_here = seen is None or sha != seen.sha256
-            changed_there = seen is None or row.revision > seen.revision
-            here_later = info.st_mtime > row.mtime
-            if changed_here and (not changed_there or here_later):
-                push_file(store, user, rel, root, limits)
-                report.pushed.append(rel)
-            else:
-                _fetch(store, user, root, rel, report)
-    elif row is not None:  # removed elsewhere
-        if sha is None:
-            _forget(root, rel)
-        elif seen is not None and sha == seen.sha256 and row.revision > seen.revision:
-            _remove_local(root, rel)
-            report.removed.append(rel)
-        else:  # changed here after (or never in step): kept, and sent
-            push_file(store, user, rel, root, limits)
-            report.pushed.append(rel)
-    elif sha is not None:  # new here, or made while the store was away
-        push_file(store, user, rel, root, limits)
-        report.pushed.append(rel)
-    else:
-        _forget(root, rel)
+            self.state.pop(rel, None)
 
+    def send(self, rel: str) -> None:
+        _send(self.store, self.user, rel, self.root, self.limits, self.state)
+        self.report.pushed.append(rel)
 
-def _remember(root: Path, rel: str, seen: Seen) -> None:
-    with _state(root) as state:
-        state[rel] = seen
+    def remove_there(self, rel: str) -> None:
+        _unsend(self.store, self.user, rel, self.state)
+        self.report.removed.append(rel)
 
+    def fetch(self, rel: str) -> None:
+        got = self.store.workspace_file(self.user, rel)
+        if got is None:
+            return
+        row, data = got
+        if sha256_hex(data) != row.sha256:
+            self.report.problems.append(
+                f"{rel}: the store's copy does not match its digest: not taken"
+            )
+            return
+        root = self.root
+        full = _inside(root, rel)
+        _make_folders(root, full.parent)
+        if full.is_symlink() or (full.exists() and not full.is_file()):
+            self.report.problems.append(f"{rel}: something that is not a file is in its place")
+            return
+        write_bytes_atomic(full, data, 0o600)
+        os.utime(full, (row.mtime, row.mtime), follow_symlinks=False)
+        info = full.stat(follow_symlinks=False)
+        self.state[rel] = Seen(row.sha256, row.revision, info.st_size, info.st_mtime_ns)
+        self.report.fetched.append(rel)
 
-def _forget(root: Path, rel: str) -> None:
-    with _state(root) as state:
-        state.pop(rel, None)
-
-
-def _fetch(store: Store, user: str, root: Path, rel: str, report: SyncReport) -> None:
-    got = store.workspace_file(user, rel)
-    if got is None:
-        return
-    row, data = got
-    if sha256_hex(data) != row.sha256:
-        report.problems.append(f"{rel}: the store's copy does not match its digest: not taken")
-        return
-    full = _inside(root, rel)
-    _make_folders(root, full.parent)
-    if full.is_symlink() or (full.exists() and not full.is_file()):
-        report.problems.append(f"{rel}: something that is not a file is in its place here")
-        return
-    write_bytes_atomic(full, data, 0o600)
-    os.utime(full, (row.mtime, row.mtime), follow_symlinks=False)
-    info = full.stat(follow_symlinks=False)
-    _remember(root, rel, Seen(row.sha256, row.revision, info.st_size, info.st_mtime_ns))
-    report.fetched.append(rel)
+    def remove_here(self, rel: str) -> None:
+        full = _inside(self.root, rel)
+        with contextlib.suppress(FileNotFoundError):
+            if full.is_file() and not full.is_symlink():
+                full.unlink()
+        self.state.pop(rel, None)
+        self.report.removed.append(rel)
 
 
 def _make_folders(root: Path, folder: Path) -> None:
@@ -398,14 +425,6 @@ def _make_folders(root: Path, folder: Path) -> None:
             raise WorkspaceRefused(f"{part.relative_to(root)}: not a folder here")
         if not part.exists():
             part.mkdir(mode=0o700)
-
-
-def _remove_local(root: Path, rel: str) -> None:
-    full = _inside(root, rel)
-    with contextlib.suppress(FileNotFoundError):
-        if full.is_file() and not full.is_symlink():
-            full.unlink()
-    _forget(root, rel)
 
 
 class WorkspacePusher:
