@@ -330,6 +330,35 @@ def test_a_store_that_hangs_never_holds_up_a_save_and_the_file_goes_once_it_answ
     assert report.fetched == ["saved.txt"]
 
 
+def test_a_pusher_with_nothing_to_send_gives_its_connection_back(servers):
+    import psycopg
+
+    one, _ = servers
+
+    def connections() -> int:
+        with psycopg.connect(one.db) as conn:
+            row = conn.execute(
+                "SELECT count(*) FROM pg_stat_activity WHERE datname = current_database() "
+                "AND application_name = 'viple-workbench'"
+            ).fetchone()
+        return int(row[0])
+
+    told: list[str] = []
+    pusher = WorkspacePusher(one.store, "alice", one.workspace(), told.append, idle_close=0.3)
+    pusher.start()
+    try:
+        write_text_atomic(one.workspace() / "first.txt", MAZE)
+        assert pusher.wait_idle(30)
+        wait_until(lambda: connections() == 0, "the connection given back")
+        write_text_atomic(one.workspace() / "second.txt", MAZE)  # a new one is opened
+        assert pusher.wait_idle(30)
+    finally:
+        pusher.stop()
+    with one.store() as s:
+        assert {"first.txt", "second.txt"} <= set(s.workspace_index("alice"))
+    assert told == []
+
+
 def test_a_file_the_store_refuses_is_said_at_once(servers):
     one, _ = servers
     told: list[str] = []

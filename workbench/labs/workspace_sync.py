@@ -65,6 +65,8 @@ RETRY_FIRST_S = 1.0
 RETRY_MOST_S = 30.0
 #: failed tries of one file before the student is told
 TELL_AFTER = 3
+#: seconds with nothing to send after which the pusher gives its connection back
+IDLE_CLOSE_S = 60.0
 
 
 @dataclass
@@ -432,7 +434,8 @@ class WorkspacePusher:
     thread of its own with a store of its own (``open_store`` makes it there). A push that
     fails is tried again, sooner at first, then every :data:`RETRY_MOST_S`; ``tell`` (called
     from that thread) says so once a file has failed :data:`TELL_AFTER` times, again when it
-    is sent, and at once when the store refuses a file."""
+    is sent, and at once when the store refuses a file. After ``idle_close`` seconds with
+    nothing to send it gives its connection back."""
 
     def __init__(
         self,
@@ -443,6 +446,7 @@ class WorkspacePusher:
         limits: WorkspaceLimits = LIMITS,
         retry_first: float = RETRY_FIRST_S,
         retry_most: float = RETRY_MOST_S,
+        idle_close: float = IDLE_CLOSE_S,
     ) -> None:
         self.open_store = open_store
         self.user = user
@@ -451,6 +455,7 @@ class WorkspacePusher:
         self.limits = limits
         self.retry_first = retry_first
         self.retry_most = retry_most
+        self.idle_close = idle_close
         self._cond = threading.Condition()
         #: the files waiting to be sent, in the order they were committed
         self._waiting: dict[str, None] = {}
@@ -502,7 +507,12 @@ class WorkspacePusher:
             with self._cond:
                 if delay:
                     self._cond.wait_for(lambda: self._stopped, delay)
-                self._cond.wait_for(lambda: self._stopped or bool(self._waiting))
+                    delay = 0.0
+                idle = not self._cond.wait_for(self._ready, self.idle_close)
+            if idle:
+                self._close_store()
+                continue
+            with self._cond:
                 if self._stopped:
                     break
                 rel = next(iter(self._waiting))
@@ -516,9 +526,18 @@ class WorkspacePusher:
                 self._cond.notify_all()
             tries = self._failures.get(rel, 0)
             delay = min(self.retry_most, self.retry_first * 2 ** (tries - 1)) if failed else 0.0
-        if self._store is not None:
+        self._close_store()
+
+    def _close_store(self) -> None:
+        """Give the connection back (after a while with nothing to send: a class's apps must
+        not hold two connections each); the next send opens one again."""
+        store, self._store = self._store, None
+        if store is not None:
             with contextlib.suppress(Exception):
-                self._store.close()
+                store.close()
+
+    def _ready(self) -> bool:
+        return self._stopped or bool(self._waiting)
 
     def _push(self, rel: str) -> bool:
         """One try; True when it failed and is to be tried again."""
