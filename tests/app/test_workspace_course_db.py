@@ -1,8 +1,10 @@
 """A served student's app on a course database: a run record closed by the end of its run and
-a maze saved in the editor reach the database as soon as they are on disk."""
+a maze saved in the editor reach the database as soon as they are on disk; a database that
+hangs holds up neither the save nor the keys, and the file goes once it answers."""
 
 from __future__ import annotations
 
+import threading
 from pathlib import Path
 
 from textual.pilot import Pilot
@@ -60,5 +62,47 @@ def test_a_saved_maze_and_a_closed_run_record_reach_the_course_database(tmp_path
             every=0.2,
         )
         assert "course store" not in said(app)  # nothing to tell while sends succeed
+
+    run(app, body)
+
+
+def test_a_save_while_the_course_database_hangs_returns_at_once_and_is_sent_later(
+    tmp_path, pg_server, pg_url, monkeypatch
+):
+    monkeypatch.setenv("WORKBENCH_DB_TIMEOUT", "1")
+    data = tmp_path / "server-one"
+    workspace = workspace_folder(data, "ann")
+    app = make_app(
+        AppSettings(
+            noise="off", student="ann", student_fixed=True, data_dir=data, db=pg_url,
+            workspace=workspace,
+        )
+    )  # fmt: skip
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.press("e")
+        editor = app.screen
+        assert isinstance(editor, EditorScreen)
+        pids = pg_server.freeze()
+        safety = threading.Timer(60, pg_server.thaw, (pids,))
+        safety.start()
+        try:
+            await pilot.press("space", "ctrl+s")
+            await type_path(pilot, "mine.txt")
+            assert editor.status == "saved to ~/mine.txt"
+            assert app.pusher is not None and app.pusher.waiting == ["mine.txt"]
+            cursor = editor.editor.cursor
+            await pilot.press("right", "down")  # the editor still takes keys
+            await until(lambda: editor.editor.cursor != cursor, "the cursor moving")
+        finally:
+            safety.cancel()
+            pg_server.thaw(pids)
+        saved = (app.station.files.workspace / "mine.txt").read_bytes()
+        await until(
+            lambda: stored(data, pg_url, "mine.txt") == saved,
+            "the maze in the course database once it answers",
+            timeout=60,
+            every=0.2,
+        )
 
     run(app, body)
