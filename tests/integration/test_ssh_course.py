@@ -1,12 +1,15 @@
 """Two lab servers on loopback sharing one PostgreSQL store: a student who passed an
-objective on one finds it passed on the other, where the labs reopen at the same exercise."""
+objective on one finds it passed on the other, where the labs reopen at the same exercise,
+and finds there the files saved on the first."""
 
 from __future__ import annotations
 
 import pytest
 
 from tests.app.support import sync
+from workbench.files.workspace import workspace_folder
 from workbench.labs.store import Store
+from workbench.labs.workspace_sync import push_file
 
 from .ssh_support import Account, lab_host, open_exercise
 
@@ -22,8 +25,8 @@ async def test_a_student_moves_between_two_servers_sharing_one_database(
     monkeypatch.setenv("WORKBENCH_DB", pg_url)  # as serve-ssh --db hands it to its apps
     ann = Account("ann")
     async with (
-        lab_host(tmp_path / "one", [ann]) as one,
-        lab_host(tmp_path / "two", [ann]) as two,
+        lab_host(tmp_path / "one", [ann], db=pg_url) as one,
+        lab_host(tmp_path / "two", [ann], db=pg_url) as two,
     ):
         term = await one.terminal("ann", size=(100, 30))
         await term.start_app()
@@ -37,9 +40,16 @@ async def test_a_student_moves_between_two_servers_sharing_one_database(
         term.send("l")
         await term.wait_for(KEYS_DONE)
         await term.close()
+        # a maze saved in the workspace on server one (as a file transfer saves one)
+        first = workspace_folder(one.data_dir, "ann")
+        (first / "mine.txt").write_text("3 3\n###\n#S#\n###\n")
+        with Store.open(one.data_dir, db=pg_url) as store:
+            push_file(store, "ann", "mine.txt", first)
 
         again = await two.terminal("ann", size=(100, 30))
         await again.start_app()
+        second = workspace_folder(two.data_dir, "ann")
+        assert (second / "mine.txt").read_text() == (first / "mine.txt").read_text()
         again.send("l")
         await again.wait_for("esc Back", "Sign off")
         screen = await again.wait_until(

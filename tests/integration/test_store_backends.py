@@ -110,6 +110,7 @@ def test_schema_steps_are_numbered_and_recorded_once(where):
         expected.append((3, "instructors' roster"))
     expected.append((4, "sign-off queue"))
     expected.append((5, "progress evidence"))
+    expected.append((6, "workspace files"))
     assert steps == expected and version == expected[-1][0]
 
 

@@ -354,7 +354,7 @@ def test_data_dir_comes_from_the_option_then_the_environment(monkeypatch, tmp_pa
 
 def test_store_uses_wal_and_a_schema_version(data_dir):
     with Store.open(data_dir) as s:
-        assert s.schema_version() == 5  # the last step: progress evidence
+        assert s.schema_version() == 6  # the last step: workspace files
     with sqlite3.connect(data_dir / DB_NAME) as conn:
         assert conn.execute("PRAGMA journal_mode").fetchone()[0] == "wal"
 
@@ -516,7 +516,7 @@ def test_records_made_before_the_chain_are_read_as_legacy_then_chained_by_the_up
     assert all("legacy record" in v.notes[0] for v in read_only.verdicts)
     assert (data_dir / DB_NAME).read_bytes() == before  # reading did not upgrade it
     with Store.open(data_dir) as store:
-        assert store.schema_version() == 5
+        assert store.schema_version() == 6
         assert store.signoffs() == read_signoffs(data_dir)  # upgraded to what was read
         sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
         log = verify_log(store.signoffs(), roster(data_dir), kept=read_only.head)

@@ -28,7 +28,7 @@ from workbench.labs.store import (
     resolve_data_dir,
     resolve_db,
 )
-from workbench.labs.verify import LogVerdict, verify_log
+from workbench.labs.verify import LogVerdict, course_evidence, verify_log
 
 from .common import db_option
 from .instructor import data_dir_option
@@ -36,7 +36,7 @@ from .instructor import data_dir_option
 CHECKS = (
     "each record's signature, over every field and its place in the log, by its instructor's "
     "key in the trusted roster; the chain linking every record to the one before it; the run "
-    "record's SHA-256 digest where the file is present"
+    "record's SHA-256 digest where the file is present (here, or in the course database)"
 )
 
 
@@ -136,7 +136,8 @@ def _checked_log(args: argparse.Namespace) -> tuple[Path, LogVerdict]:
         raise _Refused(f"{exc}\nthe records were NOT checked", 1) from None
     except StoreError as exc:  # LogMissing too: no log where one should be
         raise _Refused(f"{exc}\nthe log does NOT verify", 1) from None
-    return path, verify_log(rows, roster, kept, local)
+    with course_evidence(db) as evidence:  # run records not on this machine's disk
+        return path, verify_log(rows, roster, kept, local, evidence)
 
 
 def cmd_list(args: argparse.Namespace) -> int:

@@ -362,6 +362,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
         app=WORKBENCH_APP,
         record_quota=RecordQuota(args.record_cap, args.runs_quota),
         uploads=UploadLimits(args.upload_cap or 0, args.workspace_quota or 0, args.workspace_files),
+        db=db,
     )
     try:
         log_path = setup_logging(data_dir)

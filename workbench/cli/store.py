@@ -62,6 +62,12 @@ def cmd_migrate(args: argparse.Namespace) -> int:
     for table, n in report.counts.items():
         print(f"  {table:<12} {n} row(s), the same in both")
     print(f"  sign-off log head {report.head}, the same in both")
+    files = sum(report.workspaces.values())
+    print(
+        f"  workspaces   {files} file(s) of {len(report.workspaces)} student(s), the same in both"
+    )
+    for why in report.left:
+        print(f"  left in the data folder only: {why}")
     print(
         "from now on give every lab server and command --db URL (or set $WORKBENCH_DB); the "
         f"SQLite file {source.where} is left as it was: keep it as a backup"

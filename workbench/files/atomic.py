@@ -5,6 +5,7 @@ piece, :class:`PendingFile`, in a hidden folder on the same file system), is flu
 disk, and then takes the target's place in one step (``os.replace``). The one way every file
 the workbench writes in place is saved: mazes, rosters, gradebooks, the SSH users file, the
 last pair, the pending store writes and the files students upload to the lab server.
+Once in place, the file is announced (:func:`.commits.committed`).
 """
 
 from __future__ import annotations
@@ -13,6 +14,8 @@ import contextlib
 import os
 import tempfile
 from pathlib import Path
+
+from .commits import committed
 
 
 def write_text_atomic(path: str | os.PathLike, text: str, mode: int | None = None) -> None:
@@ -37,6 +40,7 @@ def write_bytes_atomic(path: str | os.PathLike, data: bytes, mode: int | None = 
         with contextlib.suppress(OSError):
             os.unlink(temp)
         raise
+    committed(target)
 
 
 def _mode_for(path: Path) -> int:

@@ -11,8 +11,10 @@ them one after the other.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import logging
+import os
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from datetime import UTC, datetime
@@ -29,6 +31,7 @@ from .signoff_record import (
     record_digest,
 )
 from .store import Store, utc_iso
+from .workspace_rows import EVIDENCE_CAP, evidence_copies
 
 log = logging.getLogger(__name__)
 
@@ -42,7 +45,11 @@ def _now() -> datetime:
     return datetime.now(UTC)
 
 
-def _check_fields(fields: RecordFields) -> Evidence:
+def _check_fields(
+    fields: RecordFields, store: Store | None = None
+) -> tuple[Evidence, bytes | None]:
+    """The evidence as it will be signed, and the run record's bytes when they were read
+    (for a course database to keep with the record)."""
     for label, value in (
         ("student", fields.student),
         ("lab", fields.lab),
@@ -60,16 +67,53 @@ def _check_fields(fields: RecordFields) -> Evidence:
         raise SignoffError("the evidence metrics must be a mapping")
     metrics = json.loads(canonical_json(ev.metrics))
     digest = ev.digest
+    data: bytes | None = None
     if ev.run_record:
-        actual = record_digest(ev.run_record)
         expected = digest if not digest or digest.startswith("sha256:") else f"sha256:{digest}"
+        if store is not None and store.postgres and expected and not os.path.exists(ev.run_record):
+            actual, data = _stored_copy(store, fields, expected)
+        elif store is not None and store.postgres:
+            actual, data = _read_record(ev.run_record)
+        else:
+            actual = record_digest(ev.run_record)
         if expected and expected != actual:
             raise SignoffError(
                 f"{ev.run_record}: the run record changed since it was checked "
                 f"(digest {actual}, expected {expected})"
             )
         digest = actual
-    return Evidence(str(ev.run_record), digest, metrics)
+    return Evidence(str(ev.run_record), digest, metrics), data
+
+
+def _read_record(path: str) -> tuple[str, bytes | None]:
+    """A run record's digest, and its bytes when it is small enough to keep a copy of."""
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read(EVIDENCE_CAP + 1)
+    except OSError as exc:
+        raise SignoffError(f"{path}: cannot read the run record: {exc.strerror}") from None
+    if len(data) > EVIDENCE_CAP:
+        return record_digest(path), None
+    return f"sha256:{hashlib.sha256(data).hexdigest()}", data
+
+
+def _stored_copy(store: Store, fields: RecordFields, expected: str) -> tuple[str, bytes]:
+    """The digest and bytes of the run record's copy in the course store (a served student's
+    record kept on another lab server): the copy with the ``expected`` digest when there is
+    one, else the copy at the record's place. :class:`SignoffError` when the store holds no
+    copy."""
+    record = fields.evidence.run_record
+    copies = evidence_copies(store._read, record, expected, (fields.student, fields.partner))
+    digests = [(f"sha256:{hashlib.sha256(data).hexdigest()}", data) for _, _, data in copies]
+    for found in digests:
+        if found[0] == expected:
+            return found
+    if digests:
+        return digests[0]
+    raise SignoffError(
+        f"{record}: the run record is neither on this machine nor in the course store (it "
+        "is kept on the lab server where it was made until it is sent)"
+    )
 
 
 def sign_off(
@@ -105,6 +149,8 @@ class PendingSignoff:
     #: wrong passphrases in a row before this attempt
     failures: int
     now: datetime
+    #: the run record's bytes, kept with the record in a course database
+    evidence: bytes | None = None
 
     def unlock(self, passphrase: str) -> Instructor | None:
         """The instructor, their key opened with ``passphrase``; None when it is the wrong
@@ -138,7 +184,7 @@ class PendingSignoff:
             placed = replace(record, seq=seq, prev=prev)
             return placed.columns(signer.sign(placed.canonical()))
 
-        stored = store.append_signoff(sign_at)
+        stored = store.append_signoff(sign_at, self.evidence)
         return stored.id, replace(record, seq=stored.seq, prev=stored.prev_hash)
 
 
@@ -163,7 +209,7 @@ def prepare_signoff(
         raise SignoffError("the objectives have not all passed: sign off with an override")
     if override and not note:
         raise SignoffError("an override needs a note saying why")
-    evidence = _check_fields(record_fields)
+    evidence, data = _check_fields(record_fields, store)
     now = clock()
     state = store.lockout(instructor)
     if state.locked_until > now.timestamp():
@@ -181,4 +227,4 @@ def prepare_signoff(
         override=override,
         evidence=evidence,
     )
-    return PendingSignoff(store, record, key, state.failures, now)
+    return PendingSignoff(store, record, key, state.failures, now, data)

@@ -37,7 +37,7 @@ import platformdirs
 
 from workbench.files.private import PRIVATE_FILE, private_dir, tighten
 
-from . import queue
+from . import queue, workspace_rows
 from .database import (
     BUSY_TIMEOUT_MS,
     Backend,
@@ -56,6 +56,7 @@ from .names import name_key
 from .pending import FIELDS, PendingWrite, load_pending, save_pending
 from .queue import QueueEntry, QueueState
 from .signlog import GENESIS, entry_hash, next_place, parse_metrics, signed_payload
+from .workspace_rows import LIMITS, FileRow, WorkspaceLimits
 
 __all__ = [
     "LogMissing",
@@ -474,12 +475,16 @@ class Store:
 
     # sign-off records
 
-    def append_signoff(self, sign: Callable[[int, str], dict[str, Any]]) -> StoredSignoff:
+    def append_signoff(
+        self, sign: Callable[[int, str], dict[str, Any]], evidence: bytes | None = None
+    ) -> StoredSignoff:
         """Add a record at the end of the log. ``sign(seq, prev_hash)`` returns the record's
         columns (those of :data:`RECORD_COLUMNS`) signed for that place; it is called inside
         the write transaction, which holds the log (SQLite: the write lock; PostgreSQL: an
         advisory lock), so two processes signing at once queue and never take the same
-        place. Returns the row as stored."""
+        place. A course database keeps ``evidence``, the bytes of the run record the record
+        rests on, with it (a data folder's records stay on its disk). Returns the row as
+        stored."""
         postgres = self.backend.postgres
         with self._write() as tx:
             if postgres:
@@ -519,6 +524,8 @@ class Store:
                 row,
             ).fetchone()
             row_id = int(new[0])
+            if postgres and evidence is not None and draft.evidence_digest:
+                workspace_rows.keep_evidence(tx, draft.evidence_digest, evidence, utc_iso(_now()))
         return replace(draft, id=row_id, entry_hash=digest)
 
     def signoffs(self, student: str | None = None, lab: str | None = None) -> list[StoredSignoff]:
@@ -739,6 +746,45 @@ class Store:
             sql += " WHERE instructor = ?"
             params = (instructor,)
         return [Event(*r) for r in self._read(sql + " ORDER BY id", params)]
+
+    # the students' workspace files (see workspace_rows.py and workspace_sync.py)
+
+    def put_workspace_file(
+        self,
+        student: str,
+        path: str,
+        data: bytes,
+        mtime: float,
+        limits: WorkspaceLimits = LIMITS,
+        now: datetime | None = None,
+    ) -> FileRow:
+        """Keep ``data`` as ``student``'s workspace file ``path`` within ``limits``;
+        :class:`~.workspace_rows.WorkspaceRefused` says which bound it would pass. Needs the
+        database (:class:`StoreUnavailable` while it is away)."""
+        with self._write() as tx:
+            return workspace_rows.put(tx, student, path, data, mtime, utc_iso(now or _now()),
+                                      limits)  # fmt: skip
+
+    def remove_workspace_file(
+        self, student: str, path: str, now: datetime | None = None
+    ) -> FileRow | None:
+        """Mark ``student``'s workspace file ``path`` removed; None when it was not kept."""
+        with self._write() as tx:
+            return workspace_rows.remove(tx, student, path, utc_iso(now or _now()))
+
+    def workspace_index(self, student: str) -> dict[str, FileRow]:
+        """The workspace files the store holds for ``student`` (removed ones too), by path."""
+        return workspace_rows.index(self._read, student)
+
+    def workspace_file(self, student: str, path: str) -> tuple[FileRow, bytes] | None:
+        """One workspace file's row and bytes; None when the store does not hold it."""
+        return workspace_rows.content(self._read, student, path)
+
+    def workspace_files_by_digest(
+        self, sha256: str, students: tuple[str, ...]
+    ) -> list[tuple[str, str, bytes]]:
+        """The files of ``students`` stored with the digest ``sha256`` (hex)."""
+        return workspace_rows.by_digest(self._read, sha256, students)
 
     # the instructors' roster (PostgreSQL; a SQLite store keeps it in the data folder)
 

@@ -9,17 +9,25 @@ from __future__ import annotations
 
 import base64
 import binascii
+import hashlib
 import os
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, replace
 
 from cryptography.exceptions import InvalidSignature
 
-from . import signlog
+from . import signlog, workspace_rows
+from .database import PostgresBackend
 from .roster import RosterEntry
 from .signlog import Head
 from .signoff_errors import SignoffError
 from .signoff_record import name_problems, record_digest
-from .store import Store, StoredSignoff
+from .store import Store, StoredSignoff, StoreError
+
+#: the copies of a record's run record the course store holds: (student, path, bytes) each
+#: (see :func:`.workspace_rows.evidence_copies`); raises StoreError when it cannot be asked
+EvidenceLookup = Callable[[StoredSignoff], list[tuple[str, str, bytes]]]
 
 
 @dataclass(frozen=True)
@@ -87,11 +95,13 @@ def verify_row(
     row: StoredSignoff,
     roster: dict[str, RosterEntry],
     local: dict[str, RosterEntry] | None = None,
+    evidence: EvidenceLookup | None = None,
 ) -> Verdict:
     """Check one stored record: its signature by the trusted roster's key, its students'
-    names, and its run record if present (its place in the log is checked by
-    :func:`verify_log`). ``local`` is the data folder's roster, used only to explain a
-    signature by a key that is not the trusted one."""
+    names, and its run record if present, on this machine or else in the course store
+    (``evidence``) (its place in the log is checked by :func:`verify_log`). ``local`` is the
+    data folder's roster, used only to explain a signature by a key that is not the trusted
+    one."""
     problems: list[str] = []
     notes: list[str] = []
     signature = _signature_problem(row, roster, local)
@@ -114,9 +124,69 @@ def verify_row(
                     problems.append(
                         f"the run record {row.run_record} no longer has the signed digest"
                     )
+        elif evidence is not None:
+            _check_stored_record(row, evidence, problems, notes)
         else:
             notes.append(f"run record {row.run_record} not present: its digest was not checked")
     return Verdict(row, tuple(problems), tuple(notes))
+
+
+def _check_stored_record(
+    row: StoredSignoff, evidence: EvidenceLookup, problems: list[str], notes: list[str]
+) -> None:
+    """The run record not on this machine: checked against the course store's copies."""
+    try:
+        copies = evidence(row)
+    except StoreError as exc:
+        notes.append(
+            f"run record {row.run_record} not present, and the course store could not be "
+            f"asked ({exc}): its digest was not checked"
+        )
+        return
+    for student, path, data in copies:
+        if f"sha256:{hashlib.sha256(data).hexdigest()}" == row.evidence_digest:
+            notes.append(
+                f"run record {row.run_record} not on this machine: its digest was checked in "
+                f"the course store ({_copy_words(student, path)})"
+            )
+            return
+    if copies:
+        student, path, _ = copies[0]
+        problems.append(
+            f"the run record {row.run_record} no longer has the signed digest (the course "
+            f"store's copy, {_copy_words(student, path)})"
+        )
+        return
+    notes.append(
+        f"run record {row.run_record} not present here nor in the course store: its digest "
+        "was not checked"
+    )
+
+
+def _copy_words(student: str, path: str) -> str:
+    return f"{student}'s ~/{path}" if path else "the copy kept when it was signed"
+
+
+@contextmanager
+def course_evidence(db: str | None) -> Iterator[EvidenceLookup | None]:
+    """The run records kept in the course database ``db`` (students' workspace files), read
+    in a read-only session; None without a course database (a data folder's records are on
+    its own disk)."""
+    if not db:
+        yield None
+        return
+    backend = PostgresBackend(db, read_only=True)
+
+    def lookup(row: StoredSignoff) -> list[tuple[str, str, bytes]]:
+        people = (row.student, row.partner)
+        return workspace_rows.evidence_copies(
+            backend.read, row.run_record, row.evidence_digest, people
+        )
+
+    try:
+        yield lookup
+    finally:
+        backend.close()
 
 
 def _entry(row: StoredSignoff) -> signlog.Entry:
@@ -136,13 +206,15 @@ def verify_log(
     roster: dict[str, RosterEntry],
     kept: Head | None = None,
     local: dict[str, RosterEntry] | None = None,
+    evidence: EvidenceLookup | None = None,
 ) -> LogVerdict:
     """Check the whole log (``rows`` in the order of the log): every record and the chain
-    that links them, and, given the head the instructor kept, that the log still holds it."""
+    that links them, and, given the head the instructor kept, that the log still holds it.
+    ``evidence`` finds the run records not on this machine in the course store."""
     chain = signlog.check_chain([_entry(r) for r in rows], kept)
     verdicts = []
     for row in rows:
-        own = verify_row(row, roster, local)
+        own = verify_row(row, roster, local, evidence)
         linked = chain.by_row.get(row.id, ())
         verdicts.append(replace(own, problems=(*linked, *own.problems)))
     legacy = sum(1 for r in rows if r.legacy)

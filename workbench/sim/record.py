@@ -20,6 +20,7 @@ from typing import IO, Any
 import pymunk
 
 import workbench
+from workbench.files.commits import committed
 
 from .commands import MotorPower, MoveAtPower, Stop, TurnByDegrees, WheelPowers
 from .driver import BY_KEYS, NOBODY, Driver
@@ -247,6 +248,8 @@ class Recorder:
         self._write({"type": "summary", **metrics, **extra}, summary=True)
 
     def close(self) -> None:
+        """Write what is left and close the file; a record closed whole is announced
+        (:func:`workbench.files.commits.committed`)."""
         self.flush()
         if self._file is not None and not self._file.closed:
             try:
@@ -255,6 +258,9 @@ class Recorder:
                 if not self.keep_going:
                     raise
                 self._failed(exc)
+            else:
+                if self.path is not None:
+                    committed(self.path)
 
 
 @dataclass

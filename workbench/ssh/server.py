@@ -19,6 +19,7 @@ import asyncssh
 from workbench.control.recording import RecordQuota, shown_size
 from workbench.files.workspace import workspace_folder
 from workbench.files.workspace_files import UploadLimits
+from workbench.labs.workspace_sync import sync_at_start
 
 from .applog import make_room
 from .appproc import RESTORE_TERMINAL, AppEntry, AppProcess, AppSpec, app_env, forward_hint
@@ -44,6 +45,8 @@ TOO_MANY_WAITING = (
     "try again in a minute."
 )
 OUT_OF_FILES = "The lab server is full; try again in a few minutes."
+#: seconds a session's start waits for the student's files from the course store
+WORKSPACE_SYNC_WAIT = 20.0
 #: the ciphers the server takes, AES only: a client picks the first of its own list the server
 #: has, and OpenSSH's list starts with chacha20-poly1305, which asyncssh does per packet in
 #: several Python calls (about five times the CPU of AES-GCM, measured in bench/startup.py);
@@ -90,6 +93,9 @@ class ServerConfig:
     record_quota: RecordQuota = field(default_factory=RecordQuota, kw_only=True)
     #: what a student may upload by SFTP
     uploads: UploadLimits = field(default_factory=UploadLimits, kw_only=True)
+    #: the course's PostgreSQL database (None: the SQLite file in the data folder); with one,
+    #: each session starts with the student's workspace brought in step with it
+    db: str | None = field(default=None, repr=False, kw_only=True)
 
     def __post_init__(self) -> None:
         self.data_dir = Path(self.data_dir)
@@ -708,6 +714,8 @@ class LabSession(asyncssh.SSHServerSession):
         tcp_port, ws_port = self.ports
         stamp = time.strftime("%Y%m%d-%H%M%S")
         workspace = workspace_folder(config.data_dir, user)
+        if config.db:
+            await self._bring_workspace(user, workspace)
         runs = workspace / "runs"
         record_dir = runs / stamp
         if record_dir.exists() or any(
@@ -775,6 +783,29 @@ class LabSession(asyncssh.SSHServerSession):
                 )  # fmt: skip
                 message = limits.memory_message()
             await self._finish(message, code)
+
+    async def _bring_workspace(self, user: str, workspace: Path) -> None:
+        """Bring the student's files from the course store before their app starts (in a
+        thread; a store that does not answer within :data:`WORKSPACE_SYNC_WAIT` lets the
+        session start with the files this server has)."""
+        config = self.server.config
+        assert config.db is not None
+        sync = asyncio.to_thread(sync_at_start, config.data_dir, config.db, user, workspace)
+        try:
+            report = await asyncio.wait_for(sync, WORKSPACE_SYNC_WAIT)
+        except TimeoutError:
+            log.warning("session %d: %s's workspace: the course store did not answer within "
+                        "%g s: starting with this server's files", self.id, user,
+                        WORKSPACE_SYNC_WAIT)  # fmt: skip
+            return
+        if report.fetched or report.removed or report.pushed:
+            log.info(
+                "session %d: %s's workspace: %d file(s) brought, %d removed, %d sent",
+                self.id, user, len(report.fetched), len(report.removed), len(report.pushed),
+            )  # fmt: skip
+        for problem in report.problems[:20]:
+            text = "".join(c if c.isprintable() else "?" for c in problem[:300])
+            log.warning("session %d: %s's workspace: %s", self.id, user, text)
 
     def _make_log_room(self, log_path: Path) -> None:
         """Remove the user's oldest logs until their folder has room for this session's."""

@@ -34,6 +34,7 @@ from workbench.labs.model import Setup
 from workbench.labs.names import NameProblem, check_pair
 from workbench.labs.pending import pending_path
 from workbench.labs.store import Store, StoreError, resolve_data_dir
+from workbench.labs.workspace_sync import WorkspacePusher
 from workbench.sim.maze import Maze, MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.noise import NOISE_LEVELS
@@ -131,6 +132,8 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
         self._labs: LabsScreen | None = None
         self._viple_configs = viple_configs(settings)
         self.endpoints: Endpoints | None = None
+        #: sends the files saved in a served student's workspace to the course database
+        self.pusher: WorkspacePusher | None = None
         #: the endpoints' status line as last handed to the screens
         self._connection = ""
         self.station = station
@@ -219,6 +222,7 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
             # built lives as long as it, so the garbage collector's full passes (some 70 ms
             # each while a student drives) leave it alone from the first screen on
             self.call_after_refresh(gc.freeze)
+        self._start_pusher()
         if self.settings.db and self._pending_file().is_file():
             # what an earlier app could not save: written as soon as the database answers
             self.run_worker(self._save_kept(), group="store")
@@ -226,6 +230,12 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
             self._remember_pair()
         self._check_size(self.size.width, self.size.height)
         self._ask_for_names()
+
+    def on_unmount(self) -> None:
+        """However the app ends (quitting, or its session closing), its workspace sends stop:
+        a file not sent yet is on this server's disk, and the next session's start sends it."""
+        if self.pusher is not None:
+            self.pusher.stop()
 
     def _ask_for_names(self) -> None:
         """The names dialog, once, when the terminal is big enough for it (else the size
@@ -528,6 +538,23 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
             store.write_in_background(self._store_trouble)
         self.store = store
 
+    def _start_pusher(self) -> None:
+        """With a course database, a served student's workspace follows them to any server:
+        each file saved here is sent to the database as it is saved, in a thread of its own."""
+        settings = self.settings
+        if not settings.db or settings.workspace is None or self.station.files.workspace is None:
+            return
+        db = settings.db
+
+        def open_store() -> Store:
+            return Store.open(settings.data_dir, db=db, offline_ok=True)
+
+        def tell(text: str) -> None:
+            self.call_from_thread(self._say, text)
+
+        self.pusher = WorkspacePusher(open_store, self.student, self.station.files.workspace, tell)
+        self.pusher.start()
+
     def _store_trouble(self, error: StoreError) -> None:
         """A save failed in the store's thread: the labs screen says so (from that thread)."""
         labs = self._labs
@@ -612,6 +639,14 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
 
     async def _shut_down(self) -> None:
         self.station.close()
+        sent: asyncio.Future[bool] | None = None
+        if self.pusher is not None:
+            # the run record closed just now goes while the database answers (alongside the
+            # last try below); what does not go is on this server's disk, and is sent when
+            # the student's next session starts
+            sent = asyncio.ensure_future(
+                asyncio.to_thread(self.pusher.wait_idle, STORE_LAST_TRY_SECONDS)
+            )
         if self.store is not None:
             # a last try for what the database did not get yet (never shown as saved); while
             # it is away the pending writes are in their file already, for the next app
@@ -627,6 +662,9 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
                 with contextlib.suppress(Exception):
                     store.flush()
             store.close()
+        if sent is not None and self.pusher is not None:
+            await sent
+            self.pusher.stop()
         if self.endpoints is not None:
             await self.endpoints.close()
         self.exit()
