@@ -214,6 +214,34 @@ def push_file(
         return _send(store, user, relpath, root, limits, state)
 
 
+def push_path(
+    store: Store,
+    user: str,
+    relpath: str,
+    folder: str | os.PathLike,
+    limits: WorkspaceLimits = LIMITS,
+) -> None:
+    """Bring what ``relpath`` names in the workspace ``folder`` to the store, whatever it is
+    now: a file is sent; a folder (made, or renamed here) has every file in it sent; a path
+    gone (a file or a folder removed or renamed away) is marked removed, with every file the
+    store holds under it. Raises as :func:`push_file`."""
+    root = Path(folder)
+    full = _inside(root, relpath)
+    with _state(root) as state:
+        if full.is_dir() and not full.is_symlink():
+            found, _left_out = local_files(root, limits)
+            for rel in found:
+                if rel.startswith(relpath + "/"):
+                    _send(store, user, rel, root, limits, state)
+            return
+        _send(store, user, relpath, root, limits, state)
+        if not full.exists():
+            inside = relpath + "/"
+            for rel, row in store.workspace_index(user).items():
+                if rel.startswith(inside) and not row.deleted and not (root / rel).exists():
+                    _unsend(store, user, rel, state)
+
+
 def remove_file(store: Store, user: str, relpath: str, folder: str | os.PathLike) -> FileRow | None:
     """Mark the file ``relpath`` of ``user``'s workspace removed in the store (call it once
     it is removed from the folder ``folder``); None when the store did not hold it. Raises as
@@ -544,7 +572,7 @@ class WorkspacePusher:
         try:
             if self._store is None:
                 self._store = self.open_store()
-            push_file(self._store, self.user, rel, self.folder, self.limits)
+            push_path(self._store, self.user, rel, self.folder, self.limits)
         except WorkspaceRefused as exc:
             self._failures.pop(rel, None)
             self._say(f"~/{rel} is kept on this server only: {exc}")

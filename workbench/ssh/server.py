@@ -23,6 +23,7 @@ from workbench.labs.workspace_sync import sync_at_start
 
 from .applog import make_room
 from .appproc import RESTORE_TERMINAL, AppEntry, AppProcess, AppSpec, app_env, forward_hint
+from .course_files import CourseWorkspaces
 from .forkserver import ForkServer, ForkServerError
 from .forwarding import local_forward_refusal, remote_forward_refusal
 from .hostkey import host_key_path, load_or_create_host_key
@@ -133,6 +134,10 @@ class LabServer:
         self._previous_handler: Handler = None
         self.forkserver: ForkServer | None = None
         self.sftp = SFTPService(config.data_dir, config.uploads)
+        #: with a course database, uploads go on to it (and so to every server of the course)
+        self.course_files = CourseWorkspaces(config.data_dir, config.db) if config.db else None
+        if self.course_files is not None:
+            self.sftp.on_change = self.course_files.changed
 
     @property
     def port(self) -> int:
@@ -240,6 +245,12 @@ class LabServer:
             await self._acceptor.wait_closed()
         if self.forkserver is not None:
             await self.forkserver.close()
+        if self.course_files is not None:
+            unsent = await asyncio.to_thread(self.course_files.close, 5.0)
+            if unsent:
+                log.warning("stopping: %d uploaded file(s) not in the course store yet (sent "
+                            "at each student's next session start): %s", len(unsent),
+                            ", ".join(unsent[:10]))  # fmt: skip
         asyncio.get_running_loop().set_exception_handler(self._previous_handler)
 
     async def __aenter__(self) -> LabServer:

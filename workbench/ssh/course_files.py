@@ -1,0 +1,66 @@
+"""The students' uploads, sent on to the course database when the server shares one.
+
+A file a student puts, removes or renames over SFTP changes their workspace folder on this
+server; with ``--db postgresql://...`` the change goes on to the course store, so the next
+session finds it on whichever server it lands. Each student's changes are sent by a
+:class:`~workbench.labs.workspace_sync.WorkspacePusher` of their own (a thread with a store
+connection it gives back when idle), so a database that is slow or away never holds the
+server's event loop or the transfer: what is not sent yet stays on this server's disk and is
+sent again, or at the student's next session start.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import threading
+import time
+from pathlib import Path
+
+from workbench.files.workspace import workspace_folder
+from workbench.labs.store import Store
+from workbench.labs.workspace_sync import WorkspacePusher
+
+log = logging.getLogger("workbench.ssh")
+
+
+class CourseWorkspaces:
+    """Sends the SFTP changes of every student to the course store ``db``."""
+
+    def __init__(self, data_dir: str | os.PathLike, db: str) -> None:
+        self.data_dir = Path(data_dir)
+        self.db = db
+        self._pushers: dict[str, WorkspacePusher] = {}
+        self._lock = threading.Lock()
+
+    def changed(self, user: str, relpath: str) -> None:
+        """``relpath`` of ``user``'s workspace changed (a file, a folder, or a path now gone);
+        returns at once (called from the transfer's thread or the event loop)."""
+        self._pusher(user).committed(workspace_folder(self.data_dir, user) / relpath)
+
+    def _pusher(self, user: str) -> WorkspacePusher:
+        with self._lock:
+            pusher = self._pushers.get(user)
+            if pusher is None:
+                pusher = self._pushers[user] = WorkspacePusher(
+                    lambda: Store.open(self.data_dir, db=self.db, offline_ok=True),
+                    user,
+                    workspace_folder(self.data_dir, user),
+                    lambda text, user=user: log.warning("workspace of %s: %s", user, text),
+                )
+                pusher.start()
+            return pusher
+
+    def close(self, wait: float) -> list[str]:
+        """Stop sending, after at most ``wait`` seconds for what is on its way; the files not
+        sent (``user: path``), which each student's next session start sends."""
+        with self._lock:
+            pushers = dict(self._pushers)
+            self._pushers.clear()
+        deadline = time.monotonic() + wait
+        left: list[str] = []
+        for user, pusher in pushers.items():
+            pusher.wait_idle(max(0.0, deadline - time.monotonic()))
+            pusher.stop()
+            left += [f"{user}: {path}" for path in pusher.waiting]
+        return left
