@@ -11,6 +11,7 @@ from pathlib import Path
 
 import pytest
 
+from tests.program import hostile
 from tests.program.graded_programs import right_wall
 from tests.program.hostile_pilots import HostilePilot
 from workbench.program.grade_table import COLUMNS, csv_text, json_text, summary
@@ -129,3 +130,11 @@ def test_the_runs_a_program_finished_before_its_deadline_keep_their_measures(tmp
     assert (first.maze, first.reached_exit, first.refusal) == ("rank-wall-wins.txt", True, "")
     assert second.maze == "web.txt" and not second.reached_exit
     assert second.refusal.startswith("stopped after 3 s of wall-clock time")
+
+
+def test_a_program_its_interpreter_stops_keeps_its_measures_and_says_why(tmp_path):
+    (tmp_path / "spin.viple").write_text(hostile.merge_spin())
+    plan = Plan(str(tmp_path), (WEB,), profile="web", max_time=5)
+    (row,) = grade(find_submissions(tmp_path), plan, jobs=1, limits=Limits(deadline=60))
+    assert row.loads and not row.reached_exit and row.time is not None
+    assert row.refusal.startswith("stopped at ") and "one simulated second" in row.refusal

@@ -23,6 +23,7 @@ from workbench.program.grading import (
 from workbench.program.keys import KeyScriptError
 from workbench.program.submissions import FolderError, find_submissions
 
+from .common import report_ms_option
 from .run import _simulation_options, common_keys, key_options
 
 NAME = "workbench grade"
@@ -59,6 +60,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="seeds 0..N-1 on each maze (default: the exercise's, else 1)",
     )
     _simulation_options(g)
+    report_ms_option(g)
     g.add_argument(
         "--sensor",
         action="append",
@@ -165,6 +167,7 @@ def _plan(args: argparse.Namespace) -> tuple[Plan, dict[str, str], str]:
         "noise": args.noise,
         "noise_params": tuple(args.noise_set),
         "kinds": kinds,
+        "report_ms": args.report_ms,
     }
     if args.lab or args.exercise:
         if not (args.lab and args.exercise):

@@ -73,6 +73,8 @@ class Plan:
     noise_params: tuple[str, ...] = ()
     max_time: float | None = None
     kinds: str | None = None
+    #: how often the programs' sensors are reported, ms (None: the profile's period)
+    report_ms: int | None = None
     #: what drives each run: made of the program's path, its key script and the kinds map
     pilot: type[ProgramPilot] = ProgramPilot
 
@@ -82,7 +84,9 @@ class Plan:
         return [(maze, seed) for maze in self.mazes for seed in range(self.seeds)]
 
     def specs(self, submission: Submission) -> list[RunSpec]:
-        pilot = self.pilot(submission.path, keys=submission.keys, kinds=self.kinds)
+        pilot = self.pilot(
+            submission.path, keys=submission.keys, kinds=self.kinds, report_ms=self.report_ms
+        )
         return [
             RunSpec(
                 maze=maze,
@@ -389,4 +393,6 @@ def _measures(result: dict[str, Any]) -> dict[str, Any]:
         "turn_degrees": round(float(result["turn_degrees"]), 3),
         "collisions": int(result["collisions"]),
         "errors": len(result["errors"]),
+        # a program past its bounds is stopped by the interpreter: its measures so far, and why
+        "refusal": _short(f"stopped at {result['stopped']}") if result.get("stopped") else "",
     }

@@ -15,6 +15,7 @@ import logging
 import os
 import threading
 import time
+from functools import partial
 from pathlib import Path
 
 from workbench.files.workspace import workspace_folder
@@ -22,6 +23,11 @@ from workbench.labs.store import Store
 from workbench.labs.workspace_sync import WorkspacePusher
 
 log = logging.getLogger("workbench.ssh")
+
+
+def _tell(user: str, text: str) -> None:
+    """What the pusher would tell the student: on the server, a line in its log."""
+    log.warning("workspace of %s: %s", user, text)
 
 
 class CourseWorkspaces:
@@ -46,7 +52,7 @@ class CourseWorkspaces:
                     lambda: Store.open(self.data_dir, db=self.db, offline_ok=True),
                     user,
                     workspace_folder(self.data_dir, user),
-                    lambda text, user=user: log.warning("workspace of %s: %s", user, text),
+                    partial(_tell, user),
                 )
                 pusher.start()
             return pusher
