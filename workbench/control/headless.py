@@ -207,7 +207,12 @@ def run(spec: RunSpec) -> RunResult:
     session, driving = ready.session, ready.driving
     session.record_header(**record_fields(driving.driver, driving), max_time=ready.max_time)
     try:
-        metrics = session.run(ready.max_time)
+        stopped = driving.stopped
+        metrics = session.run(
+            ready.max_time,
+            # a program stopped past its limits never moves again: the run ends there
+            given_up=(lambda: stopped() is not None) if stopped is not None else None,
+        )
         cut = bool(session.maze.exits) and not metrics.reached_exit
         session.record_summary(final_state=driving.controller.state, cut_by_limit=cut)
     finally:

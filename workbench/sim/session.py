@@ -303,13 +303,21 @@ class Session:
     def reached_exit(self) -> bool:
         return self.world.odometry.exit_time is not None
 
-    def run(self, max_time: float, stop_at_exit: bool = True) -> Metrics:
-        """Step until an exit is reached (when the maze has exits) or ``max_time`` passes."""
+    def run(
+        self,
+        max_time: float,
+        stop_at_exit: bool = True,
+        given_up: Callable[[], bool] | None = None,
+    ) -> Metrics:
+        """Step until an exit is reached (when the maze has exits), ``max_time`` passes, or
+        ``given_up()`` says the controller will never move the robot again."""
         steps = math.ceil(max_time / self.world.dt - 1e-9)
         step = self.step
         stop = stop_at_exit and bool(self.maze.exits)
         for _ in range(steps - self._steps):
             if EXIT in step() and stop:
+                break
+            if given_up is not None and given_up():
                 break
         self.settle()
         return self.metrics()
