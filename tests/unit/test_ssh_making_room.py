@@ -65,9 +65,7 @@ def test_a_full_gate_refuses_while_every_place_is_within_its_grace():
 
 def test_the_oldest_of_the_source_holding_the_most_places_makes_room():
     gate, clock = small_gate()
-    a1, b1, *_ = fill(
-        gate, clock, ["10.6.6.1", "10.6.6.2"] * 2 + ["10.6.6.2", "10.6.6.3"]
-    )
+    a1, b1, *_ = fill(gate, clock, ["10.6.6.1", "10.6.6.2"] * 2 + ["10.6.6.2", "10.6.6.3"])
     clock.now = 30.0  # all past their grace
     student, admission = arrive(gate, "10.0.0.7")
     assert admission.refused is None
