@@ -13,7 +13,7 @@ dialog and drive at 20 keys a second, probing key-to-screen time every 2 s (``p`
 - ``flood``: 10 addresses hold 10 idle connections each (the caps on connections not logged in)
   and open new ones as the old ones close; the phase also times how long a new student from a
   fresh address takes to get in, retrying every half second, from 1 s into the flood and again
-  from 10 s in, and counts the connections the flood opened;
+  from 10 s in, and counts what the server told the flood's connections it closed;
 - ``terminal``: two of mallory's sessions ask for a 65535x65535 terminal and send window
   changes between huge and small sizes without pause (clamped to 500x200, passed on at most
   every 0.1 s, so her apps draw a 500x200 screen ten times a second: as near to pinning a core
@@ -42,6 +42,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections import Counter
 from pathlib import Path
 
 import asyncssh
@@ -155,24 +156,30 @@ async def late_login(port: int, address: str) -> tuple[float, int]:
 
 async def flood(port: int, notes: list[str]) -> None:
     held: set[tuple[asyncio.StreamReader, asyncio.StreamWriter]] = set()
-    opened = 0
+    #: what the server told the flood's connections it closed
+    told: Counter[str] = Counter()
 
     async def hold(address: str) -> None:
-        nonlocal opened
         while True:
             try:
                 pair = await asyncio.open_connection("127.0.0.1", port, local_addr=(address, 0))
             except OSError:
                 await asyncio.sleep(0.1)
                 continue
-            opened += 1
             held.add(pair)
             reader, writer = pair
+            said = b""
             with contextlib.suppress(OSError):
-                while await reader.read(4096):
-                    pass
+                while chunk := await reader.read(4096):
+                    said = (said + chunk)[-400:]
             held.discard(pair)
             writer.close()
+            if b"to make room" in said:
+                told["closed to make room"] += 1
+            elif b"too many connections waiting" in said:
+                told["turned away at once"] += 1
+            else:
+                told["closed otherwise"] += 1
 
     tasks = [asyncio.create_task(hold(f"127.0.9.{a}")) for a in range(1, 11) for _ in range(10)]
     began = time.perf_counter()
@@ -189,7 +196,8 @@ async def flood(port: int, notes: list[str]) -> None:
             notes.append(
                 f"a new student did not get in within {time.perf_counter() - began - 1:.1f} s"
             )
-        notes.append(f"the flood opened {opened} connections, {len(held)} open at the end")
+        tally = ", ".join(f"{n} {what}" for what, n in told.most_common())
+        notes.append(f"the flood's connections: {tally}")
         for task in tasks:
             task.cancel()
         await asyncio.gather(*tasks, return_exceptions=True)
