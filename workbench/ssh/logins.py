@@ -279,9 +279,10 @@ class ConnectionGate(Generic[Key]):
         """Free the place of the connection that makes room (see the class), if one may."""
         now = self._clock()
         grace = self.policy.unauthenticated_grace
-        stale = [(k, p) for k, p in self._places.items() if now - p.opened > grace]
-        if not stale:
+        oldest = next(iter(self._places.values()), None)  # kept in the order they came
+        if oldest is None or now - oldest.opened <= grace:
             return None
+        stale = [(k, p) for k, p in self._places.items() if now - p.opened > grace]
         key, place = min(
             stale, key=lambda kp: (kp[1].stage, -self.unauthenticated[kp[1].source], kp[1].opened)
         )
