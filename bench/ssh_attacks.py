@@ -12,7 +12,8 @@ dialog and drive at 20 keys a second, probing key-to-screen time every 2 s (``p`
   (the server caps her at --max-connections-per-user, default 10);
 - ``flood``: 10 addresses hold 10 idle connections each (the caps on connections not logged in)
   and open new ones as the old ones close; the phase also times how long a new student from a
-  fresh address takes to get in, retrying every half second;
+  fresh address takes to get in, retrying every half second, from 1 s into the flood and again
+  from 10 s in, and counts what the server told the flood's connections it closed;
 - ``terminal``: two of mallory's sessions ask for a 65535x65535 terminal and send window
   changes between huge and small sizes without pause (clamped to 500x200, passed on at most
   every 0.1 s, so her apps draw a 500x200 screen ten times a second: as near to pinning a core
@@ -41,6 +42,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections import Counter
 from pathlib import Path
 
 import asyncssh
@@ -137,8 +139,25 @@ async def let_go(reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> 
         await writer.wait_closed()
 
 
+async def late_login(port: int, address: str) -> tuple[float, int]:
+    """Seconds until a new student from ``address`` gets in, retrying every half second, and
+    the tries it took."""
+    started = time.perf_counter()
+    tries = 0
+    while True:
+        tries += 1
+        try:
+            conn = await connect(port, "late", LATE_KEY, address)
+            await close_all([conn])
+            return time.perf_counter() - started, tries
+        except (OSError, asyncssh.Error):
+            await asyncio.sleep(0.5)
+
+
 async def flood(port: int, notes: list[str]) -> None:
     held: set[tuple[asyncio.StreamReader, asyncio.StreamWriter]] = set()
+    #: what the server told the flood's connections it closed
+    told: Counter[str] = Counter()
 
     async def hold(address: str) -> None:
         while True:
@@ -149,36 +168,36 @@ async def flood(port: int, notes: list[str]) -> None:
                 continue
             held.add(pair)
             reader, writer = pair
+            said = b""
             with contextlib.suppress(OSError):
-                while await reader.read(4096):
-                    pass
+                while chunk := await reader.read(4096):
+                    said = (said + chunk)[-400:]
             held.discard(pair)
             writer.close()
+            if b"to make room" in said:
+                told["closed to make room"] += 1
+            elif b"too many connections waiting" in said:
+                told["turned away at once"] += 1
+            else:
+                told["closed otherwise"] += 1
 
     tasks = [asyncio.create_task(hold(f"127.0.9.{a}")) for a in range(1, 11) for _ in range(10)]
-    started = time.perf_counter()
-    tries = 0
+    began = time.perf_counter()
     try:
         await asyncio.sleep(1.0)  # the places are full
-        started = time.perf_counter()
-        while True:
-            tries += 1
-            try:
-                conn = await connect(port, "late", LATE_KEY, "127.0.10.1")
-                await close_all([conn])
-                break
-            except (OSError, asyncssh.Error):
-                await asyncio.sleep(0.5)
-        notes.append(
-            f"a new student got in after {time.perf_counter() - started:.1f} s ({tries} tries)"
-        )
+        seconds, tries = await late_login(port, "127.0.10.1")
+        notes.append(f"a new student got in after {seconds:.1f} s ({tries} tries)")
+        await asyncio.sleep(max(0.0, began + 10.0 - time.perf_counter()))
+        seconds, tries = await late_login(port, "127.0.10.2")
+        notes.append(f"another, 10 s into the flood, after {seconds:.1f} s ({tries} tries)")
         await asyncio.Event().wait()
     finally:
         if not notes:
             notes.append(
-                f"a new student did not get in within {time.perf_counter() - started:.1f} s "
-                f"({tries} tries)"
+                f"a new student did not get in within {time.perf_counter() - began - 1:.1f} s"
             )
+        tally = ", ".join(f"{n} {what}" for what, n in told.most_common())
+        notes.append(f"the flood's connections: {tally}")
         for task in tasks:
             task.cancel()
         await asyncio.gather(*tasks, return_exceptions=True)

@@ -136,6 +136,43 @@ async def test_idle_connections_from_several_addresses_do_not_keep_a_student_out
             writer.close()
 
 
+@sync
+async def test_a_student_gets_in_while_idle_connections_from_ten_addresses_fill_the_places(
+    tmp_path, caplog
+):
+    """The places at the login (20, 2 an address) filled with idle connections from ten
+    addresses that would not time out for two minutes: once they have sat on their places for
+    the grace (1 s), a student from an eleventh address takes the place of one of them, and
+    the others stay open."""
+    caplog.set_level(logging.INFO, logger="workbench.ssh")
+    policy = LoginPolicy(
+        max_unauthenticated=20,
+        max_unauthenticated_per_address=2,
+        unauthenticated_grace=1.0,
+        login_timeout=120.0,
+    )
+    attackers = [f"127.0.0.{n}" for n in range(2, 12)]
+    async with lab_host(tmp_path, [Account("ann")], logins=policy) as host:
+        gate = host.server.gate
+        flood = [await idle_socket(host.port, a) for a in attackers for _ in range(2)]
+        await asyncio.wait_for(_until(lambda: gate.unauthenticated.total() == 20), 10)
+        await asyncio.sleep(policy.unauthenticated_grace)  # every place is past its grace
+        reads = [asyncio.create_task(all_it_says(r, 60)) for r, _ in flood]
+        ann = await host.connect("ann", local_addr=("127.0.0.20", 0))
+        assert gate.unauthenticated.total() == 19  # one gave up its place; ann logged in
+        done, _ = await asyncio.wait(reads, timeout=30, return_when=asyncio.FIRST_COMPLETED)
+        [closed] = done
+        assert b"closed this connection to make room for others" in closed.result()
+        said = "to make room for one from 127.0.0.20: it held a place at the login"
+        assert said in caplog.text
+        assert sum(r.done() for r in reads) == 1  # the other 19 still hold their places
+        ann.close()
+        for read in reads:
+            read.cancel()
+        for _, writer in flood:
+            writer.close()
+
+
 async def all_it_says(reader: asyncio.StreamReader, seconds: float) -> bytes:
     """What the server sends on a connection that says nothing, until it closes it."""
     said = b""
@@ -147,7 +184,9 @@ async def all_it_says(reader: asyncio.StreamReader, seconds: float) -> bytes:
 
 @sync
 async def test_a_refused_connection_reads_why(tmp_path):
-    policy = LoginPolicy(max_unauthenticated=2, max_unauthenticated_per_address=2)
+    policy = LoginPolicy(
+        max_unauthenticated=2, max_unauthenticated_per_address=2, unauthenticated_grace=60
+    )
     async with lab_host(tmp_path, [Account("ann")], logins=policy) as host:
         held = [await idle_socket(host.port) for _ in range(2)]
         await asyncio.wait_for(_until(lambda: host.server.gate.unauthenticated.total() == 2), 10)

@@ -16,6 +16,12 @@ class Clock:
         return self.now
 
 
+def arrive(gate: ConnectionGate, address: str) -> tuple[object, str | None]:
+    """A new connection from ``address``: its key, and why it was refused (None: let in)."""
+    key = object()
+    return key, gate.admit(key, address).refused
+
+
 def guard(**numbers) -> tuple[LoginGuard, Clock]:
     clock = Clock()
     return LoginGuard(LoginPolicy(**numbers), clock), clock
@@ -78,17 +84,20 @@ def test_failures_are_forgotten_after_a_quiet_period():
 
 def test_connections_not_logged_in_are_capped_per_address_and_in_all():
     gate = ConnectionGate(LoginPolicy(max_unauthenticated=5, max_unauthenticated_per_address=3))
+    keys = []
     for _ in range(3):
-        assert gate.refuse_connection(STUDENT_PC) is None
-        gate.opened(STUDENT_PC)
-    assert "3 connections from this address" in gate.refuse_connection(STUDENT_PC)
+        key, refused = arrive(gate, STUDENT_PC)
+        assert refused is None
+        keys.append(key)
+    assert "3 connections from this address" in arrive(gate, STUDENT_PC)[1]
     for host in ("10.0.0.8", "10.0.0.9"):
-        assert gate.refuse_connection(host) is None
-        gate.opened(host)
-    assert "5 connections have not logged in" in gate.refuse_connection("10.0.0.10")
-    gate.settled(STUDENT_PC)  # one of them logged in
-    assert gate.refuse_connection("10.0.0.10") is None
-    assert gate.refuse_connection(STUDENT_PC) is None
+        assert arrive(gate, host)[1] is None
+    assert "5 connections have not logged in" in arrive(gate, "10.0.0.10")[1]
+    assert gate.settled(keys[0]) is False  # one of them logged in
+    assert arrive(gate, "10.0.0.10")[1] is None
+    assert "5 connections have not logged in" in arrive(gate, STUDENT_PC)[1]
+    gate.settled(keys[1])
+    assert arrive(gate, STUDENT_PC)[1] is None
 
 
 def test_password_attempts_waiting_at_once_are_capped():
@@ -129,11 +138,10 @@ def test_sources_are_ipv4_addresses_and_ipv6_networks_of_64():
 def test_one_ipv6_network_is_capped_as_one_address():
     gate = ConnectionGate(LoginPolicy(max_unauthenticated=50, max_unauthenticated_per_address=3))
     for n in range(3):
-        assert gate.refuse_connection(f"2001:db8:0:1::{n + 1}") is None
-        gate.opened(f"2001:db8:0:1::{n + 1}")
-    why = gate.refuse_connection("2001:db8:0:1:abcd::99")  # a fresh address of the same /64
+        assert arrive(gate, f"2001:db8:0:1::{n + 1}")[1] is None
+    why = arrive(gate, "2001:db8:0:1:abcd::99")[1]  # a fresh address of the same /64
     assert why == "3 connections from 2001:db8:0:1::/64 have not logged in yet"
-    assert gate.refuse_connection("2001:db8:0:2::1") is None
+    assert arrive(gate, "2001:db8:0:2::1")[1] is None
 
 
 def test_past_the_start_new_connections_are_dropped_ever_more_often_the_same_way_per_seed():
@@ -145,11 +153,7 @@ def test_past_the_start_new_connections_are_dropped_ever_more_often_the_same_way
         gate = ConnectionGate(policy)
         let_in = []
         for n in range(200):
-            address = f"10.1.{n // 250}.{n % 250}"
-            ok = gate.refuse_connection(address) is None
-            if ok:
-                gate.opened(address)
-            let_in.append(ok)
+            let_in.append(arrive(gate, f"10.1.{n // 250}.{n % 250}")[1] is None)
         return let_in
 
     first = fill(seed=3)
@@ -166,35 +170,35 @@ def test_a_source_holding_places_without_logging_in_is_refused_for_a_while():
     policy = LoginPolicy(penalty_least=90, penalty_longest=600)
     gate = ConnectionGate(policy, clock)
     # a lab behind one address: one student gave up at the password prompt after 30 s
-    gate.opened(STUDENT_PC)
-    assert gate.settled(STUDENT_PC, held=30, logged_in=False) is False
-    assert gate.refuse_connection(STUDENT_PC) is None
-    gate.opened(STUDENT_PC)
-    assert gate.settled(STUDENT_PC, held=40, logged_in=True) is False  # logged in: no charge
+    key, _ = arrive(gate, STUDENT_PC)
+    clock.now = 30
+    assert gate.settled(key, logged_in=False) is False
+    key, refused = arrive(gate, STUDENT_PC)
+    assert refused is None
+    clock.now = 70
+    assert gate.settled(key, logged_in=True) is False  # logged in: no charge
     # ten idle connections that time out after 30 s each
-    starts = []
-    for _ in range(10):
-        gate.opened("10.6.6.6")
-    for _ in range(10):
-        starts.append(gate.settled("10.6.6.6", held=30, logged_in=False))
+    idle = [arrive(gate, "10.6.6.6")[0] for _ in range(10)]
+    clock.now = 100
+    starts = [gate.settled(key, logged_in=False) for key in idle]
     assert starts == [False, False, True] + [False] * 7
-    assert "refused for another 300 s" in gate.refuse_connection("10.6.6.6")
-    assert gate.refuse_connection(STUDENT_PC) is None
-    clock.now = 299
-    assert gate.refuse_connection("10.6.6.6") is not None
-    clock.now = 300
-    assert gate.refuse_connection("10.6.6.6") is None  # served: let in again
+    assert "refused for another 300 s" in arrive(gate, "10.6.6.6")[1]
+    assert arrive(gate, STUDENT_PC)[1] is None
+    clock.now = 399
+    assert arrive(gate, "10.6.6.6")[1] is not None
+    clock.now = 400
+    assert arrive(gate, "10.6.6.6")[1] is None  # served: let in again
 
 
 def test_penalties_last_at_most_their_longest_and_can_be_turned_off():
     clock = Clock()
     gate = ConnectionGate(LoginPolicy(penalty_least=10, penalty_longest=60), clock)
-    for _ in range(10):
-        gate.opened("10.6.6.6")
-        gate.settled("10.6.6.6", held=30, logged_in=False)
-    assert "another 60 s" in gate.refuse_connection("10.6.6.6")
     off = ConnectionGate(LoginPolicy(penalty_longest=0), clock)
-    for _ in range(10):
-        off.opened("10.6.6.6")
-        assert off.settled("10.6.6.6", held=30, logged_in=False) is False
-    assert off.refuse_connection("10.6.6.6") is None
+    idle = [arrive(gate, "10.6.6.6")[0] for _ in range(10)]
+    idle_off = [arrive(off, "10.6.6.6")[0] for _ in range(10)]
+    clock.now = 30
+    for key in idle:
+        gate.settled(key, logged_in=False)
+    assert "another 60 s" in arrive(gate, "10.6.6.6")[1]
+    assert [off.settled(key, logged_in=False) for key in idle_off] == [False] * 10
+    assert arrive(off, "10.6.6.6")[1] is None

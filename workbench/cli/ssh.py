@@ -112,6 +112,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         "more often the nearer --max-unauthenticated (default 50)",
     )  # fmt: skip
     serve.add_argument(
+        "--unauthenticated-grace", type=float, default=5,
+        help="seconds a connection not logged in keeps its place for sure; past them it is "
+        "closed to make room when a new connection finds the places full or would be dropped "
+        "at random, from the address holding the most places first (default 5; at or above "
+        "--login-timeout: never)",
+    )  # fmt: skip
+    serve.add_argument(
         "--penalty-min", type=float, default=90,
         help="seconds of places at the login held by connections that went without logging "
         "in, beyond what time has paid back, before their address (IPv6: /64) is refused "
@@ -307,6 +314,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
         )
     login_numbers = (
         args.login_timeout,
+        args.unauthenticated_grace,
         args.max_unauthenticated,
         args.max_unauthenticated_per_address,
         args.password_lock_after,
@@ -315,8 +323,9 @@ def cmd_serve(args: argparse.Namespace) -> int:
     if not all(math.isfinite(x) and x > 0 for x in login_numbers):
         return fail(
             "serve-ssh",
-            "--login-timeout, --max-unauthenticated, --max-unauthenticated-per-address, "
-            "--password-lock-after and --password-lock-for must be > 0",
+            "--login-timeout, --unauthenticated-grace, --max-unauthenticated, "
+            "--max-unauthenticated-per-address, --password-lock-after and --password-lock-for "
+            "must be > 0",
         )
     logins = LoginPolicy(
         login_timeout=args.login_timeout,
@@ -325,6 +334,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
         lock_after=args.password_lock_after,
         lock_for=args.password_lock_for,
         unauthenticated_start=args.unauthenticated_start,
+        unauthenticated_grace=args.unauthenticated_grace,
         penalty_least=args.penalty_min,
         penalty_longest=args.penalty_max,
     )

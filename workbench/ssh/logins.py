@@ -13,8 +13,9 @@ Plain bookkeeping with an injectable clock; the server does the waiting. Three r
 - connections that have not logged in are capped in all and per source (an IPv4 address, an
   IPv6 /64, see :mod:`.sources`), and so are the password attempts waiting out a delay, so
   neither can pile up; past a start threshold new connections are dropped at random, more
-  often the fuller it is (as OpenSSH's MaxStartups), and a source whose connections hold
-  places without logging in is refused for a while (its penalty).
+  often the fuller it is (as OpenSSH's MaxStartups), unless a connection that has sat on its
+  place past a short grace makes room for them, and a source whose connections hold places
+  without logging in is refused for a while (its penalty).
 """
 
 from __future__ import annotations
@@ -22,12 +23,16 @@ from __future__ import annotations
 import random
 import time
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Hashable
 from dataclasses import dataclass
+from enum import IntEnum
+from typing import Generic, TypeVar
 
 from .sources import Penalties, source_of
 
 Clock = Callable[[], float]
+#: how the server knows a connection (its connection object)
+Key = TypeVar("Key", bound=Hashable)
 
 
 @dataclass(frozen=True)
@@ -52,6 +57,9 @@ class LoginPolicy:
     #: ``start_drop`` chance at first, rising evenly to certainty at ``max_unauthenticated``
     unauthenticated_start: int = 50
     start_drop: float = 0.3
+    #: seconds a connection not logged in keeps its place for sure; past them it makes room
+    #: for a new connection that would find the places full or be dropped at random
+    unauthenticated_grace: float = 5.0
     #: a source is refused once its connections that went without logging in held places for
     #: ``penalty_least`` seconds more than time has paid back; for at most ``penalty_longest``
     #: seconds (0: no penalties)
@@ -161,35 +169,101 @@ class LoginGuard:
         self._accounts.clear(account)
 
 
-class ConnectionGate:
+class Stage(IntEnum):
+    """How far a connection not logged in yet has come; the least advanced make room first."""
+
+    #: it holds a socket (and may have done the key exchange) but has not named a user
+    CONNECTED = 0
+    #: it named a user and is authenticating (or sits at a password prompt)
+    AUTHENTICATING = 1
+    #: a password of it is being checked (or waits out its delay)
+    CHECKING = 2
+
+
+@dataclass
+class _Place:
+    """A connection's place at the login."""
+
+    source: str
+    opened: float
+    stage: Stage = Stage.CONNECTED
+
+
+@dataclass(frozen=True)
+class Eviction(Generic[Key]):
+    """A connection closed to make room for a new one: its place is free at once."""
+
+    key: Key
+    source: str
+    #: seconds it held its place without logging in (charged to its source)
+    held: float
+    #: the charge started its source's penalty
+    penalized: bool
+
+
+@dataclass(frozen=True)
+class Admission(Generic[Key]):
+    """What the gate makes of a new connection: let in (perhaps in the place of an older one)
+    or closed at once, and why."""
+
+    refused: str | None = None
+    evicted: Eviction[Key] | None = None
+
+
+class ConnectionGate(Generic[Key]):
     """Caps on connections not logged in yet and on password attempts waiting out a delay.
 
-    Connections are counted by source (:func:`.sources.source_of`), password attempts by
-    address."""
+    Connections are counted by source (:func:`.sources.source_of`) and known by a key the
+    server chooses (its connection object); password attempts are counted by address.
+
+    When a new connection would find the places full, or be dropped at random past the start,
+    it takes the place of a connection that has held one for longer than
+    ``unauthenticated_grace`` without logging in, if there is one: of those that have come the
+    least far (see :class:`Stage`), one of the source holding the most places, the oldest of
+    them. That connection is charged to its source as one that went without logging in. A
+    student's client logs in well within the grace, so only connections that sit on their
+    place make room, and the sources that keep making new ones are soon refused."""
 
     def __init__(self, policy: LoginPolicy, clock: Clock = time.monotonic) -> None:
         self.policy = policy
         self.unauthenticated: Counter[str] = Counter()
         self.waiting: Counter[str] = Counter()
         self.penalties = Penalties(policy.penalty_least, policy.penalty_longest, clock)
+        self._clock = clock
+        self._places: dict[Key, _Place] = {}
         self._random = random.Random(policy.seed)
 
-    def refuse_connection(self, address: str) -> str | None:
-        """Why a new connection from ``address`` is closed at once, or None to let it in."""
+    def admit(self, key: Key, address: str) -> Admission[Key]:
+        """Let a new connection from ``address`` in, known as ``key`` from now on, or say why
+        it is closed at once."""
         policy = self.policy
         source = source_of(address)
         penalty = self.penalties.refused_for(source)
         if penalty:
-            return (
+            return Admission(
                 f"refused for another {penalty:.0f} s: connections from {source} held places "
                 "at the login without logging in"
             )
         if self.unauthenticated[source] >= policy.max_unauthenticated_per_address:
             where = "this address" if source == address else source
-            return (
+            return Admission(
                 f"{policy.max_unauthenticated_per_address} connections from {where} "
                 "have not logged in yet"
             )
+        crowded = self._crowded()
+        evicted = None
+        if crowded is not None:
+            evicted = self._evict()
+            if evicted is None:
+                return Admission(crowded)
+        self._places[key] = _Place(source, self._clock())
+        self.unauthenticated[source] += 1
+        return Admission(evicted=evicted)
+
+    def _crowded(self) -> str | None:
+        """Why a new connection finds no place: all taken, or dropped at random past the
+        start (as OpenSSH's MaxStartups); None when it finds one."""
+        policy = self.policy
         waiting = self.unauthenticated.total()
         if waiting >= policy.max_unauthenticated:
             return f"{policy.max_unauthenticated} connections have not logged in yet"
@@ -201,18 +275,46 @@ class ConnectionGate:
                 return f"dropped at random: {waiting} connections have not logged in yet"
         return None
 
-    def opened(self, address: str) -> None:
-        self.unauthenticated[source_of(address)] += 1
+    def _evict(self) -> Eviction[Key] | None:
+        """Free the place of the connection that makes room (see the class), if one may."""
+        now = self._clock()
+        grace = self.policy.unauthenticated_grace
+        oldest = next(iter(self._places.values()), None)  # kept in the order they came
+        if oldest is None or now - oldest.opened <= grace:
+            return None
+        stale = [(k, p) for k, p in self._places.items() if now - p.opened > grace]
+        key, place = min(
+            stale, key=lambda kp: (kp[1].stage, -self.unauthenticated[kp[1].source], kp[1].opened)
+        )
+        held = now - place.opened
+        self._release(key)
+        penalized = self.penalties.charge(place.source, held)
+        return Eviction(key, place.source, held, penalized)
 
-    def settled(self, address: str, held: float = 0.0, logged_in: bool = True) -> bool:
-        """The connection logged in or went away after ``held`` seconds: it no longer counts
-        as waiting to log in; one that went without logging in is charged to its source.
-        True when that starts the source's penalty."""
-        source = source_of(address)
-        self.unauthenticated[source] -= 1
-        if self.unauthenticated[source] <= 0:
-            del self.unauthenticated[source]
-        return not logged_in and self.penalties.charge(source, held)
+    def progressed(self, key: Key, stage: Stage) -> None:
+        """The connection ``key`` has come as far as ``stage`` (or gone back, after a password
+        check)."""
+        place = self._places.get(key)
+        if place is not None:
+            place.stage = stage
+
+    def settled(self, key: Key, logged_in: bool = True) -> bool:
+        """The connection ``key`` logged in or went away: it no longer holds a place; one that
+        went without logging in is charged to its source for the time it held it. True when
+        that starts the source's penalty. Nothing happens for a connection that holds no place
+        (never let in, or closed to make room)."""
+        place = self._release(key)
+        if place is None or logged_in:
+            return False
+        return self.penalties.charge(place.source, self._clock() - place.opened)
+
+    def _release(self, key: Key) -> _Place | None:
+        place = self._places.pop(key, None)
+        if place is not None:
+            self.unauthenticated[place.source] -= 1
+            if self.unauthenticated[place.source] <= 0:
+                del self.unauthenticated[place.source]
+        return place
 
     def start_waiting(self, address: str) -> bool:
         """Take a place for a password attempt to wait in; False when none is free."""

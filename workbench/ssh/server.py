@@ -28,7 +28,7 @@ from .forkserver import ForkServer, ForkServerError
 from .forwarding import local_forward_refusal, remote_forward_refusal
 from .hostkey import host_key_path, load_or_create_host_key
 from .limits import SessionLimits, describe_duration, describe_memory
-from .logins import ConnectionGate, LoginGuard, LoginPolicy, QuietLog
+from .logins import ConnectionGate, Eviction, LoginGuard, LoginPolicy, QuietLog, Stage
 from .openfiles import Handler, near_the_limit, quiet_accept_errors, raise_file_limit
 from .passwords import hash_password, verify_password
 from .ports import PoolExhausted, PortPool
@@ -46,6 +46,11 @@ TOO_MANY_WAITING = (
     "try again in a minute."
 )
 OUT_OF_FILES = "The lab server is full; try again in a few minutes."
+#: what a client that sat on its place at the login reads when it is closed to make room
+MADE_ROOM = (
+    "The lab server closed this connection to make room for others: it had not logged in "
+    "after {grace:g} s while the places at the login were full; try again."
+)
 #: seconds a session's start waits for the student's files from the course store
 WORKSPACE_SYNC_WAIT = 20.0
 #: the ciphers the server takes, AES only: a client picks the first of its own list the server
@@ -122,7 +127,7 @@ class LabServer:
         self.file_limit = 0
         self.remote_listens: dict[str, Counter[int]] = {}
         self.guard = LoginGuard(config.logins)
-        self.gate = ConnectionGate(config.logins)
+        self.gate: ConnectionGate[LabConnection] = ConnectionGate(config.logins)
         self.quiet_log = QuietLog()
         #: password checks for one account take turns, so parallel guesses wait in line
         self._account_turns: dict[str, asyncio.Lock] = {}
@@ -165,11 +170,12 @@ class LabServer:
         )  # fmt: skip
         logins = config.logins
         log.info(
-            "logins: %g s to log in; at most %d connections not logged in (%d per address); "
-            "passwords locked for %s after %d failures",
+            "logins: %g s to log in; at most %d connections not logged in (%d per address), "
+            "those past %g s making room for new ones when full; passwords locked for %s "
+            "after %d failures",
             logins.login_timeout, logins.max_unauthenticated,
-            logins.max_unauthenticated_per_address, describe_duration(logins.lock_for),
-            logins.lock_after,
+            logins.max_unauthenticated_per_address, logins.unauthenticated_grace,
+            describe_duration(logins.lock_for), logins.lock_after,
         )  # fmt: skip
         limits = config.limits
         raised = f" (raised from {files_before})" if files_before != self.file_limit else ""
@@ -260,6 +266,15 @@ class LabServer:
     async def __aexit__(self, *exc: object) -> None:
         await self.close()
 
+    def penalty_started(self, source: str) -> None:
+        self.say_now_and_then(
+            f"penalty {source}",
+            "connections from %s refused for %.0f s: they held places at the login without "
+            "logging in",
+            source,
+            self.gate.penalties.refused_for(source),
+        )
+
     def say_now_and_then(self, key: str, message: str, *args: object) -> None:
         """Log a warning that an attacker could repeat thousands of times, once per 10 s."""
         held = self.quiet_log.due(key)
@@ -324,13 +339,12 @@ class LabConnection(asyncssh.SSHServer):
         self.user: User | None = None
         self.failed = False
         self.remote_ports: Counter[int] = Counter()
-        #: counted among the connections that have not logged in yet
-        self.counted = False
+        #: closed to make room at the login for a newer connection
+        self.evicted = False
         #: counted among its user's logged-in connections
         self.holds_place = False
         #: logged in, and closed at once: its user held too many connections
         self.over_cap = False
-        self.opened_at = time.monotonic()
         self._pending_key = "?"
         self._login: tuple[User, str] | None = None
 
@@ -349,12 +363,12 @@ class LabConnection(asyncssh.SSHServer):
                 OUT_OF_FILES,
             )
             return
-        why = server.gate.refuse_connection(self.peer)
-        if why is not None:
-            self._turn_away(f"turned away {self.peer}", why, TOO_MANY_WAITING)
+        admission = server.gate.admit(self, self.peer)
+        if admission.refused is not None:
+            self._turn_away(f"turned away {self.peer}", admission.refused, TOO_MANY_WAITING)
             return
-        server.gate.opened(self.peer)
-        self.counted = True
+        if admission.evicted is not None:
+            self._make_room(admission.evicted)
         # agent and X11 forwarding are off; these make their refusals show in the log (asyncssh
         # has no hook for that, so its methods are replaced; the X11 one refuses whatever it gets)
         conn.create_agent_listener = self._refuse_agent  # type: ignore[method-assign]
@@ -370,21 +384,28 @@ class LabConnection(asyncssh.SSHServer):
             self.conn.disconnect, asyncssh.DISC_TOO_MANY_CONNECTIONS, message
         )
 
+    def _make_room(self, eviction: Eviction[LabConnection]) -> None:
+        """Close the connection that gave up its place at the login for this one."""
+        server, victim = self.server, eviction.key
+        victim.evicted = True
+        server.say_now_and_then(
+            "made room",
+            "connection from %s closed to make room for one from %s: it held a place at the "
+            "login for %.0f s without logging in (%s holds %d more)",
+            victim.peer, self.peer, eviction.held, eviction.source,
+            server.gate.unauthenticated[eviction.source],
+        )  # fmt: skip
+        if eviction.penalized:
+            server.penalty_started(eviction.source)
+        if victim.conn is not None:
+            grace = server.config.logins.unauthenticated_grace
+            victim.conn.disconnect(
+                asyncssh.DISC_TOO_MANY_CONNECTIONS, MADE_ROOM.format(grace=grace)
+            )
+
     def _settle(self, logged_in: bool) -> None:
-        if self.counted:
-            self.counted = False
-            server = self.server
-            held = time.monotonic() - self.opened_at
-            if server.gate.settled(self.peer, held, logged_in):
-                penalties = server.gate.penalties
-                source = source_of(self.peer)
-                server.say_now_and_then(
-                    f"penalty {source}",
-                    "connections from %s refused for %.0f s: they held places at the login "
-                    "without logging in",
-                    source,
-                    penalties.refused_for(source),
-                )
+        if self.server.gate.settled(self, logged_in):
+            self.server.penalty_started(source_of(self.peer))
 
     def connection_lost(self, exc: Exception | None) -> None:
         self._settle(logged_in=False)
@@ -396,7 +417,8 @@ class LabConnection(asyncssh.SSHServer):
             counts[self.user.name] -= 1
             if counts[self.user.name] <= 0:
                 del counts[self.user.name]
-        if self.username and self.user is None and not self.failed and not self.over_cap:
+        gave_up = not (self.failed or self.over_cap or self.evicted)
+        if self.username and self.user is None and gave_up:
             # every offered key was refused and the client gave up
             self.server.guard.key_failed(self.peer)
             self.server.say_now_and_then(
@@ -429,6 +451,7 @@ class LabConnection(asyncssh.SSHServer):
     # -- authentication ----------------------------------------------------------------------
     def begin_auth(self, username: str) -> bool:
         self.username = username
+        self.server.gate.progressed(self, Stage.AUTHENTICATING)
         return True
 
     def _known(self, username: str) -> User | None:
@@ -449,8 +472,11 @@ class LabConnection(asyncssh.SSHServer):
             self.server.say_now_and_then(key, message, shown(username), self.peer, why)
 
     def _accepted(self, user: User, how: str) -> None:
-        """Let the user in, unless they hold as many connections as one user may."""
+        """Let the user in, unless they hold as many connections as one user may (or the
+        connection was closed to make room while its password was checked)."""
         server = self.server
+        if self.evicted:
+            return
         self._settle(logged_in=True)
         why = server.config.limits.connection_refusal(server.user_connections[user.name])
         if why is not None:
@@ -498,11 +524,13 @@ class LabConnection(asyncssh.SSHServer):
             why = "too many password attempts at once, not checked"
             self._refused(username, why, checked=False)
             return False
+        server.gate.progressed(self, Stage.CHECKING)
         try:
             async with server.account_turn(username):
                 return await self._check_password(username, password)
         finally:
             server.gate.stop_waiting(peer)
+            server.gate.progressed(self, Stage.AUTHENTICATING)
 
     async def _check_password(self, username: str, password: str) -> bool:
         guard = self.server.guard
