@@ -7,11 +7,13 @@ import asyncio
 import json
 import os
 import socket
+import subprocess
 import sys
 from pathlib import Path
 
 import pytest
 
+from tests.waiting import wait_until
 from workbench.ssh.appproc import AppProcess, AppSpec, forward_hint
 from workbench.ssh.forkserver import APP_NICENESS
 from workbench.ssh.forwarding import local_forward_refusal, remote_forward_refusal
@@ -217,3 +219,30 @@ def test_limits_say_why_a_session_is_refused():
     assert "You already have 2 workbench sessions open" in limits.refusal(2, 3)
     assert describe_duration(7200) == "2 h" and describe_duration(90) == "90 s"
     assert describe_duration(120) == "2 min"
+
+
+def test_a_group_niceness_the_kernel_asks_to_wait_for_is_set_a_moment_later(tmp_path, monkeypatch):
+    """An unprivileged server may change one scheduling group's niceness every 0.1 s; a class
+    logging in at once asks for more, and each app's group is set all the same, a moment
+    later, while the app goes on starting."""
+    from workbench.ssh import forkserver
+
+    written = tmp_path / "autogroup"
+    refusals = [BlockingIOError(11, "Resource temporarily unavailable")] * 3
+
+    def fake_open(path: str, mode: str = "r"):
+        assert path.endswith("/autogroup") and mode == "w"
+        if refusals:
+            raise refusals.pop()
+        return open(written, mode)
+
+    monkeypatch.setattr(forkserver, "open", fake_open, raising=False)
+    app = subprocess.Popen([sys.executable, "-c", "import sys; sys.stdin.read()"],
+                           stdin=subprocess.PIPE)  # fmt: skip
+    try:
+        forkserver.lower_priority(APP_NICENESS, app.pid)
+        wait_until(lambda: written.exists() and written.read_text() == str(APP_NICENESS),
+                   "the group's niceness set once the kernel lets it")  # fmt: skip
+    finally:
+        app.communicate(b"")
+    assert not refusals

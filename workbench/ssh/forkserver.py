@@ -42,6 +42,7 @@ import json
 import logging
 import os
 import pkgutil
+import random
 import resource
 import selectors
 import signal
@@ -219,8 +220,36 @@ def lower_priority(niceness: int, pid: int = 0) -> None:
     with contextlib.suppress(OSError):
         ours = os.getpriority(os.PRIO_PROCESS, 0)
         os.setpriority(os.PRIO_PROCESS, pid, min(19, ours + niceness))
-    with contextlib.suppress(OSError), open(f"/proc/{pid or 'self'}/autogroup", "w") as group:
-        group.write(str(niceness))
+    group = f"/proc/{pid or 'self'}/autogroup"
+    if not _set_group_niceness(group, niceness):
+        # the kernel takes one such change every 0.1 s from an unprivileged server (a class
+        # logging in at once asks for more): it is tried again beside the app
+        threading.Thread(target=_retry_group_niceness, args=(group, niceness), daemon=True).start()
+
+
+#: how long a group's niceness is tried again for, seconds
+GROUP_NICENESS_TRIES_S = 60.0
+
+
+def _set_group_niceness(group: str, niceness: int) -> bool:
+    """False when the kernel asks to try again later; True when set or not to be had."""
+    try:
+        with open(group, "w") as file:
+            file.write(str(niceness))
+    except BlockingIOError:  # EAGAIN: another process set one within the last 0.1 s
+        return False
+    except OSError:  # no autogroup here, or not allowed: the process runs as it is
+        return True
+    return True
+
+
+def _retry_group_niceness(group: str, niceness: int) -> None:
+    deadline = time.monotonic() + GROUP_NICENESS_TRIES_S
+    spread = random.Random(os.getpid())  # processes retrying at once do not keep colliding
+    while time.monotonic() < deadline:
+        time.sleep(0.05 + spread.random() * 0.1)
+        if _set_group_niceness(group, niceness):
+            return
 
 
 def limit_memory(cap: int, pid: int = 0) -> None:
