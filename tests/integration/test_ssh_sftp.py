@@ -3,6 +3,7 @@ from their workspace and nowhere else, within the upload limits, and the app ope
 
 from __future__ import annotations
 
+import gzip
 import logging
 import os
 import re
@@ -250,3 +251,26 @@ async def test_uploads_stay_private_to_the_server_s_account(tmp_path):
         space = host.data_dir / "workspaces" / "ann"
         assert (space / "d").stat().st_mode & 0o777 == 0o700
         assert (space / "d" / "p.viple").stat().st_mode & 0o777 == 0o600
+
+
+@sync
+async def test_a_gzip_bomb_uploaded_as_a_program_is_refused_when_the_app_opens_it(tmp_path):
+    """The upload cap counts the bytes sent; what a file unpacks to is the loader's to bound."""
+    bomb = tmp_path / "bomb.viple"
+    bomb.write_bytes(gzip.compress(b"<Program>" + b" " * (200 << 20) + b"</Program>", 1))
+    assert bomb.stat().st_size < 5_000_000  # within the upload cap
+    async with lab_host(tmp_path, [Account("ann")]) as host:
+        done = await OpenSSH(host, tmp_path).sftp("ann", f"put {bomb}")
+        assert done.status == 0, done.said
+        term = await host.terminal("ann")
+        await term.start_app()
+        term.send("g")
+        await term.wait_for("Built-in", "Load file")
+        term.send("\t")
+        await type_in(term, "bomb.viple")
+        await term.wait_for("decompresses to more than")
+        term.send("\x1b")  # the dialog closes, the app goes on
+        await term.wait_gone("Built-in")
+        term.send("w")
+        await term.wait_until(lambda t: "distance 0.00 unit" not in t, "the robot driven")
+        await term.close()
