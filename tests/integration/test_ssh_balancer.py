@@ -224,14 +224,11 @@ async def run_program(term: Terminal, name: str) -> None:
     await term.wait_for("Run: Web Simulator lab maze (web)")
     term.send("g")
     await term.wait_for("Built-in")
-    term.send("\t")
-    await asyncio.sleep(0.3)
-    term.send(f"\x15~/{name}\r")
-    await term.wait_for("runs it", timeout=30)
-    await asyncio.sleep(0.5)
-    term.send("\r")  # Start
-    await term.wait_gone("runs it")
-    term.send("++++")  # 2x, 4x, 10x, max
+    term.send(f"\t\x15~/{name}\r")  # the path field, cleared, the program's name, load
+    await term.wait_for(f"{name}  (VIPLE program)", "sensors it reads", timeout=30)
+    term.send("\x1b")
+    await term.wait_gone("Built-in")
+    term.send("x++++")  # run it from the start block at 2x, 4x, 10x, then top speed
     await term.wait_for("out at ", "the robot is out", timeout=240)
     term.send("l")
     await term.wait_for(PASSED_EXIT, timeout=30)
