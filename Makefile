@@ -31,7 +31,8 @@ test: $(TEST_STAMP) haproxy
 # the balancer test needs HAProxy: installed here as root where apt-get is, else skipped
 # (never a reason for the build to fail)
 haproxy:
-	@command -v haproxy >/dev/null 2>&1 || { \
+	@export PATH="$$PATH:/usr/local/sbin:/usr/sbin:/sbin"; \
+	command -v haproxy >/dev/null 2>&1 || { \
 	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
 	    echo "installing Debian's haproxy for the balancer test"; \
 	    export DEBIAN_FRONTEND=noninteractive; \

@@ -41,8 +41,10 @@ PASSED_EXIT = "[X] your program got out of the Web maze within 300 s"
 ANSWERED = "[X] questions answered"
 ANSWERS = ("-0.3", "0.5", "1500")  # Backward's and Forward's power, the Right90 spin in ms
 
+#: HAProxy, also where Debian puts it off an ordinary user's PATH
+HAPROXY = shutil.which("haproxy", path=f"{os.environ.get('PATH', '')}:/usr/local/sbin:/usr/sbin")
 needs_haproxy = pytest.mark.skipif(
-    shutil.which("haproxy") is None,
+    HAPROXY is None,
     reason="no HAProxy here (Debian package haproxy; 'make test' installs it when run as root)",
 )
 
@@ -267,7 +269,7 @@ async def test_a_student_moves_between_servers_behind_haproxy_and_outlives_a_cra
         )
         haproxy_out = (tmp_path / "haproxy.out").open("wb")
         haproxy = subprocess.Popen(
-            ["haproxy", "-f", str(config), "-db"], stdout=haproxy_out, stderr=subprocess.STDOUT
+            [HAPROXY, "-f", str(config), "-db"], stdout=haproxy_out, stderr=subprocess.STDOUT
         )
         haproxy_out.close()
 
