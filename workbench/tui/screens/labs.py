@@ -218,6 +218,8 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self._retry_timer: Timer | None = None
         self._retrying = False
         self._reload_when_back = False
+        #: the student was told the database is away (and so is told when it is back)
+        self._said_away = False
         #: a sign-off seen while another screen was over this one
         self._signed_later: SignoffStatus.Signed | None = None
         self.unicode = False
@@ -256,6 +258,7 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self._store_problem = self._work_problem(work) or self._store_problem
         if work.away:
             self._reload_when_back = True
+            self._said_away = True
             self._wait_for_store()
         if not self._ready:
             return
@@ -306,6 +309,7 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         if store is None:
             return
         if store.pending:
+            self._said_away = True
             self.say(
                 f"{UNREACHABLE}: your progress is kept here ({store.pending} change(s)) and "
                 "saved as soon as it is back"
@@ -355,7 +359,9 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         if self._retry_timer is not None:
             self._retry_timer.stop()
             self._retry_timer = None
-        self.say("the course database is back: your progress is saved")
+        if self._said_away:  # (a save merely on its way when the screen opened is no news)
+            self._said_away = False
+            self.say("the course database is back: your progress is saved")
 
     # -- layout --------------------------------------------------------------------------
     def compose(self) -> ComposeResult:
