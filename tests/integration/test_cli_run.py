@@ -161,3 +161,13 @@ def test_eval_fits_80_columns_and_wide_keeps_one_line_per_entrant(tmp_path, caps
     wide = capsys.readouterr().out.splitlines()
     assert any(line.split()[-2:] == ["collisions", "touches"] for line in wide)
     assert sum(path in line for line in wide for path in paths) == 2
+
+
+def test_a_bundled_maze_is_found_by_its_name(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # nothing named web here: the bundled maze is meant
+    assert main(["run", "--maze", "web", "--algorithm", "web-wall-following", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["reached_exit"] and out["distance_cells"] > 50  # the Web Simulator's maze
+    (tmp_path / "web").write_text("not a maze")  # a file of that name is what is meant
+    assert main(["run", "--maze", "web", "--algorithm", "right-wall"]) == 2
+    assert "web" in capsys.readouterr().err

@@ -10,6 +10,7 @@ import time
 from pathlib import Path
 
 from workbench.files.atomic import write_text_atomic
+from workbench.files.bundled import maze_path
 from workbench.labs.model import Exercise, Lab, LabFileError, load_lab, load_labs
 from workbench.program.grade_table import csv_text, json_text, summary
 from workbench.program.grading import (
@@ -190,11 +191,12 @@ def _plan(args: argparse.Namespace) -> tuple[Plan, dict[str, str], str]:
         return plan, {"lab": lab.id, "exercise": exercise.id}, keys
     if not args.maze:
         raise GradeUsageError("give --lab L --exercise E, or the mazes with --maze M ...")
-    for maze in args.maze:
+    mazes = [maze_path(m) for m in args.maze]
+    for typed, maze in zip(args.maze, mazes, strict=True):
         if not os.path.isfile(maze):
-            raise GradeUsageError(f"--maze {maze}: no such file")
+            raise GradeUsageError(f"--maze {typed}: no such file, nor a bundled maze's name")
     plan = Plan(
-        mazes=tuple(os.path.abspath(m) for m in args.maze),
+        mazes=tuple(os.path.abspath(m) for m in mazes),
         seeds=args.seeds or 1,
         profile=args.profile,
         sensors=tuple(args.sensor),

@@ -44,7 +44,11 @@ def _simulation_options(parser: argparse.ArgumentParser) -> None:
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("run", help="run one algorithm on one maze and print its metrics")
-    p.add_argument("--maze", required=True, help="maze file (any supported format)")
+    p.add_argument(
+        "--maze",
+        required=True,
+        help="maze file (any supported format), or a bundled maze by name (web, erobotic, ...)",
+    )
     p.add_argument("--algorithm", required=True, help="built-in name or an FSM .yaml file")
     _simulation_options(p)
     p.add_argument(

@@ -48,7 +48,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 
     r = psub.add_parser("run", help="run a program on a maze and print its measures")
     r.add_argument("file", metavar="FILE")
-    r.add_argument("--maze", help="maze file (any supported format); not with --connect")
+    r.add_argument(
+        "--maze",
+        help="maze file (any supported format) or a bundled maze's name; not with --connect",
+    )
     _simulation_options(r)
     r.add_argument(
         "--sensor",

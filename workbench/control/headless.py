@@ -12,6 +12,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
+from workbench.files.bundled import maze_path
 from workbench.sim.maze import Maze, MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.noise import noise_settings
@@ -175,7 +176,7 @@ def prepare(spec: RunSpec) -> Prepared:
     """Load and check everything the run needs; bad input is a :class:`RunSetupError` (or the
     pilot's own error)."""
     try:
-        maze = load_maze(spec.maze)
+        maze = load_maze(maze_path(spec.maze))
     except MazeError as exc:
         raise RunSetupError(str(exc)) from None
     problems = maze.validate()

@@ -14,3 +14,16 @@ DEFAULT_MAZE = "unity-default.txt"
 
 def default_maze_path() -> Path:
     return MAZE_DIR / DEFAULT_MAZE
+
+
+def maze_path(typed: str) -> str:
+    """The maze file ``typed`` names: the path itself when it exists, else a bundled maze of
+    that name (``web`` or ``web.txt``: ``mazes/web.txt``), else ``typed`` as it is (so that
+    reading it says what is missing)."""
+    if Path(typed).exists() or "/" in typed or "\\" in typed:
+        return typed
+    for name in (typed, f"{typed}.txt"):
+        candidate = MAZE_DIR / name
+        if candidate.is_file():
+            return str(candidate)
+    return typed
