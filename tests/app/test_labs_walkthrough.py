@@ -249,7 +249,7 @@ class Walkthrough:
         for text in (
             f"out at {want['exit_time']:.1f} s",
             f"distance {number(want['distance'], unit)} {unit}",
-            f"turned {degrees(want['turn_degrees'], False)} in {want['turns']} turn",
+            f"turned {degrees(want['turn_degrees'], False)}; {want['turns']} turn",
             f"collisions {want['collisions']}",
         ):
             assert text in shown, (text, panel)

@@ -43,7 +43,8 @@ class RunStatus(TextLines):
                 clock += f" ({m.efficiency:.0%} efficient)"
         travel = f"distance {number(m.distance, unit)} {unit} ({m.distance_cells:.1f} blocks)"
         turning = (
-            f"turned {degrees(m.turn_degrees, unicode)} in {m.turns} "
+            # every degree counts; a turn is a rotation of 45 degrees or more
+            f"turned {degrees(m.turn_degrees, unicode)}; {m.turns} "
             f"turn{'' if m.turns == 1 else 's'}"
         )
         hits = f"collisions {m.collisions}"
