@@ -104,9 +104,12 @@ async def test_a_connection_from_the_balancer_without_a_header_is_closed_with_on
         await until(lambda: line in caplog.text, "the refusal logged")
         oversized = v2("192.0.2.7")[:14] + b"\xff\xff"
         assert await what_it_reads(await through_balancer(host.port, oversized)) == b""
-        # a health check's bare TCP connection is closed without a word, and nothing is stuck
+        # a health check (a bare TCP connection, or a LOCAL header) is closed without a word
         check = await through_balancer(host.port, b"")
         check.close()
+        local = await through_balancer(host.port, v2("127.0.0.1", command=0) + b"SSH-2.0-x\r\n")
+        assert await what_it_reads(local) == b""
+        local.close()
         conn = await login_as(host, "ana", await through_balancer(host.port, v2("192.0.2.7")))
         conn.close()
         garbage.close()

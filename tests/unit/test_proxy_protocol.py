@@ -62,7 +62,7 @@ def test_a_v2_header_names_an_ipv6_client_even_with_tlvs_after_the_addresses():
 
 def test_a_local_header_from_a_health_check_names_no_client():
     header, rest = read_like_the_server(v2("192.0.2.7", command=0) + BANNER)
-    assert header.client is None
+    assert (header.client, header.local) == (None, True)
     assert rest == BANNER
 
 
@@ -71,7 +71,7 @@ def test_a_v1_text_header_names_the_client():
     assert header.client == "192.0.2.9"
     assert rest == BANNER
     header, _ = read_like_the_server(b"PROXY UNKNOWN\r\n" + BANNER)
-    assert header.client is None
+    assert (header.client, header.local) == (None, False)
 
 
 @pytest.mark.parametrize(

@@ -36,11 +36,13 @@ class ProxyHeaderError(ValueError):
 
 @dataclass(frozen=True)
 class ProxyHeader:
-    """A whole header: ``client`` is the address it names, or None (a balancer's own
-    connection, such as a health check: LOCAL, UNKNOWN or an address family without one)."""
+    """A whole header: ``client`` is the address it names, or None (an address family
+    without one, or UNKNOWN: the balancer's own address stands); ``local`` for the LOCAL
+    command, a balancer's own connection such as a health check."""
 
     client: str | None
     length: int
+    local: bool = False
 
 
 def parse_networks(text: str) -> tuple[Network, ...]:
@@ -109,8 +111,8 @@ def _parse_v2(data: bytes) -> ProxyHeader:
     version, command = data[12] >> 4, data[12] & 0x0F
     if version != 2 or command not in (0, 1):
         raise ProxyHeaderError(f"its PROXY header has version {version} command {command}")
-    if command == 0:  # LOCAL: the balancer's own connection
-        return ProxyHeader(None, len(data))
+    if command == 0:
+        return ProxyHeader(None, len(data), local=True)
     family, transport = data[13] >> 4, data[13] & 0x0F
     body = data[16:]
     if family in (1, 2):
@@ -224,8 +226,10 @@ class ProxyAcceptor:
             try:
                 async with asyncio.timeout(self._deadline):
                     header = await read_header(asyncio.get_running_loop(), sock)
+                if header.local:  # the balancer's health check: it has nothing for SSH
+                    raise EOFError
                 client = header.client or peer
-            except EOFError:  # the balancer's health check: nothing to say
+            except EOFError:  # a health check, or a connection given up: nothing to log
                 sock.close()
                 return
             except ProxyHeaderError as exc:
