@@ -41,6 +41,8 @@ PASSED_EXIT = "[X] your program got out of the Web maze within 300 s"
 ANSWERED = "[X] questions answered"
 ANSWERS = ("-0.3", "0.5", "1500")  # Backward's and Forward's power, the Right90 spin in ms
 
+#: the address the student connects from: HAProxy's PROXY header names it to the servers
+STUDENT = "127.0.0.5"
 #: HAProxy, also where Debian puts it off an ordinary user's PATH
 HAPROXY = shutil.which("haproxy", path=f"{os.environ.get('PATH', '')}:/usr/local/sbin:/usr/sbin")
 needs_haproxy = pytest.mark.skipif(
@@ -99,7 +101,7 @@ class Balancer:
         key = self.accounts[name].key
         return await asyncssh.connect(
             "127.0.0.1", self.port, username=name, client_keys=[key], known_hosts=None,
-            agent_path=None, preferred_auth=["publickey"],
+            agent_path=None, preferred_auth=["publickey"], local_addr=(STUDENT, 0),
         )  # fmt: skip
 
     async def servers(self) -> dict[str, tuple[str, int]]:
@@ -135,7 +137,7 @@ def start_lab(name: str, tmp_path: Path, shared: Path, db: str) -> LabProcess:
                 "--port", "0", "--data-dir", str(tmp_path / name),
                 "--host-key", str(shared / "ssh_host_ed25519_key"),
                 "--users", str(users_path(shared)), "--port-range", f"{low}-{high}",
-                "--public-host", "lab.example",
+                "--public-host", "lab.example", "--proxy-protocol", "127.0.0.1",
             ],
             stdout=out, stderr=subprocess.STDOUT, env=os.environ | {"WORKBENCH_DB": db},
         )  # fmt: skip
@@ -296,6 +298,7 @@ async def test_a_student_moves_between_servers_behind_haproxy_and_outlives_a_cra
             "the held connection logged in on a server",
         )
         other = next(lab for lab in labs if lab is not first)
+        assert f"login: ann (student) from {STUDENT} with key" in first.log()
         ssh = OpenSSH(balancer, tmp_path)  # OpenSSH's own scp, through the balancer
         done = await ssh.scp("ann", str(PROGRAM), "@:right-wall.viple")
         assert done.status == 0, done.said

@@ -99,6 +99,7 @@ def test_serve_ssh_refuses_a_broken_users_file_naming_line_and_fix(tmp_path):
         (["--app-memory", "10"], "--app-memory 10: give at least 64"),
         (["--penalty-max", "-1"], "--penalty-min and --penalty-max must be 0 or more"),
         (["--unauthenticated-grace", "0"], "--unauthenticated-grace, --max-unauthenticated"),
+        (["--proxy-protocol", "10.0.0.5,lb"], "--proxy-protocol 'lb' is not an address or net"),
     ],
 )
 def test_serve_ssh_refuses_bad_options_before_it_starts(tmp_path, options, message):

@@ -50,6 +50,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     serve.add_argument("--port", type=int, default=2222, help="SSH port (default 2222)")
     serve.add_argument("--bind", default="", help="address to listen on (default: all)")
     serve.add_argument(
+        "--proxy-protocol", metavar="FROM", default="",
+        help="connections from FROM (the load balancer's addresses or networks, "
+        "comma-separated) start with a PROXY protocol header (HAProxy's send-proxy-v2) naming "
+        "the student's address, which the login limits and the log then use (default: none)",
+    )  # fmt: skip
+    serve.add_argument(
         "--host-key", help="the server's private key (default <data-dir>/ssh_host_ed25519_key, "
         "made on first start)"
     )  # fmt: skip
@@ -287,6 +293,12 @@ def cmd_serve(args: argparse.Namespace) -> int:
             f"--port {args.port} lies inside --port-range {args.port_range}, which is kept for "
             "the sessions' VIPLE ports: choose a port outside it",
         )
+    from workbench.ssh.proxy_protocol import parse_networks
+
+    try:
+        proxy_from = parse_networks(args.proxy_protocol) if args.proxy_protocol else ()
+    except ValueError as exc:
+        return fail("serve-ssh", f"--proxy-protocol {exc}")
     if args.max_per_user < 1 or args.max_sessions < 1 or not args.idle_timeout > 0:
         return fail("serve-ssh", "--max-per-user, --max-sessions and --idle-timeout must be > 0")
     if args.max_connections_per_user < 1:
@@ -373,6 +385,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
         record_quota=RecordQuota(args.record_cap, args.runs_quota),
         uploads=UploadLimits(args.upload_cap or 0, args.workspace_quota or 0, args.workspace_files),
         db=db,
+        proxy_from=proxy_from,
     )
     try:
         log_path = setup_logging(data_dir)

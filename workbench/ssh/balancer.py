@@ -1,9 +1,11 @@
 """The HAProxy configuration that puts several lab servers behind one address.
 
 HAProxy passes each SSH connection through as TCP (it never sees keys or passwords), sends a
-new connection to the server holding the fewest, and takes a server that stops accepting
-connections out of the rotation by a TCP health check. docs/deploy.md shows this text as the
-balancer test runs it; the test and the documentation both take it from here.
+new connection to the server holding the fewest, starts each with a PROXY protocol header
+naming the student's address (the servers run with ``--proxy-protocol``), and takes a server
+that stops accepting connections out of the rotation by a TCP health check. docs/deploy.md
+shows this text as the balancer test runs it; the test and the documentation both take it
+from here.
 """
 
 from __future__ import annotations
@@ -32,8 +34,9 @@ frontend lab
 
 backend lab_servers
     balance leastconn
-    # a TCP connection every 2 s; 2 failures take a server out, 2 successes bring it back
-    default-server check inter 2s fall 2 rise 2
+    # a TCP connection every 2 s; 2 failures take a server out, 2 successes bring it back;
+    # each connection starts with the student's address (serve-ssh --proxy-protocol)
+    default-server check inter 2s fall 2 rise 2 send-proxy-v2
 {servers}
 """
 

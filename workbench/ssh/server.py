@@ -32,6 +32,7 @@ from .logins import ConnectionGate, Eviction, LoginGuard, LoginPolicy, QuietLog,
 from .openfiles import Handler, near_the_limit, quiet_accept_errors, raise_file_limit
 from .passwords import hash_password, verify_password
 from .ports import PoolExhausted, PortPool
+from .proxy_protocol import Network, ProxyAcceptor, accept_behind_balancer
 from .refusals import refusal_message
 from .serverlog import shown
 from .sftp import SFTPChannel, SFTPService
@@ -51,6 +52,8 @@ MADE_ROOM = (
     "The lab server closed this connection to make room for others: it had not logged in "
     "after {grace:g} s while the places at the login were full; try again."
 )
+#: seconds a connection from a balancer has to send its PROXY header
+PROXY_HEADER_WAIT = 5.0
 #: seconds a session's start waits for the student's files from the course store
 WORKSPACE_SYNC_WAIT = 20.0
 #: the ciphers the server takes, AES only: a client picks the first of its own list the server
@@ -102,6 +105,9 @@ class ServerConfig:
     #: the course's PostgreSQL database (None: the SQLite file in the data folder); with one,
     #: each session starts with the student's workspace brought in step with it
     db: str | None = field(default=None, repr=False, kw_only=True)
+    #: the load balancers whose connections start with a PROXY protocol header naming the
+    #: student's address (none: every connection is the student's own)
+    proxy_from: tuple[Network, ...] = field(default=(), kw_only=True)
 
     def __post_init__(self) -> None:
         self.data_dir = Path(self.data_dir)
@@ -133,7 +139,7 @@ class LabServer:
         self._account_turns: dict[str, asyncio.Lock] = {}
         self._account_queue: Counter[str] = Counter()
         self._ids = itertools.count(1)
-        self._acceptor: asyncssh.SSHAcceptor | None = None
+        self._acceptor: asyncssh.SSHAcceptor | ProxyAcceptor | None = None
         self._sweeper: asyncio.Task[None] | None = None
         self._closing = False
         self._previous_handler: Handler = None
@@ -189,12 +195,10 @@ class LabServer:
             self.file_limit, raised,
         )  # fmt: skip
 
-    async def _listen(self) -> asyncssh.SSHAcceptor:
+    async def _listen(self) -> asyncssh.SSHAcceptor | ProxyAcceptor:
         config = self.config
-        return await asyncssh.create_server(
-            lambda: LabConnection(self),
-            config.bind or None,
-            config.port,
+        options = dict(
+            server_factory=lambda: LabConnection(self),
             server_host_keys=[self.host_key],
             encryption_algs=CIPHERS,
             mac_algs=MACS,
@@ -207,6 +211,20 @@ class LabServer:
             keepalive_interval=config.keepalive_interval,
             keepalive_count_max=4,
             server_version="workbench",
+        )
+        if not config.proxy_from:
+            return await asyncssh.listen(config.bind or None, config.port, **options)
+        log.info(
+            "connections from %s start with a PROXY header naming the client",
+            ", ".join(map(str, config.proxy_from)),
+        )
+        return await accept_behind_balancer(
+            config.bind,
+            config.port,
+            config.proxy_from,
+            lambda key, line: self.say_now_and_then(key, "%s", line),
+            min(PROXY_HEADER_WAIT, config.logins.login_timeout),
+            **options,
         )
 
     async def _start_forkserver(self) -> None:
@@ -354,7 +372,8 @@ class LabConnection(asyncssh.SSHServer):
         server = self.server
         server.connections.add(self)
         peer = conn.get_extra_info("peername")
-        self.peer = str(peer[0]) if peer else "?"
+        # behind a balancer, the address its PROXY header named
+        self.peer = conn.get_extra_info("client_address") or (str(peer[0]) if peer else "?")
         sock = conn.get_extra_info("socket")
         if sock is not None and near_the_limit(sock.fileno(), server.file_limit):
             self._turn_away(
