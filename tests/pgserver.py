@@ -17,11 +17,12 @@ import os
 import pwd
 import shutil
 import signal
-import socket
 import subprocess
 import tempfile
 from dataclasses import dataclass
 from pathlib import Path
+
+from tests.sessions import free_port
 
 SERVER_USER_CANDIDATES = ("postgres", "nobody")
 
@@ -87,12 +88,6 @@ def _run_as() -> pwd.struct_passwd | None:
         except KeyError:
             continue
     raise NoServer("running as root and no unprivileged account (postgres, nobody) to run as")
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 @dataclass

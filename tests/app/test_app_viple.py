@@ -5,17 +5,12 @@ from __future__ import annotations
 import asyncio
 import socket
 
+from tests.sessions import free_port
 from workbench.tui.app import WorkbenchApp, make_app
 from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.run_status import RunStatus
 
 ROOM = "#########\n#.......#\n#...S...#\n#.......#\n#########\n"
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def maze(tmp_path) -> str:

@@ -14,7 +14,6 @@ import os
 import re
 import shutil
 import signal
-import socket
 import subprocess
 import sys
 from dataclasses import dataclass, field
@@ -24,6 +23,7 @@ import asyncssh
 import pytest
 
 from tests.app.support import sync
+from tests.sessions import free_port
 from tests.waiting import until
 from workbench.labs.store import Store
 from workbench.ssh.balancer import EXAMPLE, LabBackend, haproxy_config
@@ -54,12 +54,6 @@ needs_haproxy = pytest.mark.skipif(
 def test_the_deployment_guide_shows_the_configuration_the_balancer_test_runs():
     guide = (ROOT / "docs" / "deploy.md").read_text()
     assert f"```\n{EXAMPLE}```" in guide
-
-
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
 
 
 @dataclass

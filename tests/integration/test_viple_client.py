@@ -16,6 +16,7 @@ from pathlib import Path
 import pytest
 from websockets.asyncio.client import connect as ws_connect
 
+from tests.sessions import free_port
 from workbench.cli import main
 from workbench.control.headless import AlgorithmPilot, RunSpec, run
 from workbench.sim.commands import MoveAtPower, Stop, TurnByDegrees
@@ -250,12 +251,6 @@ def test_cli_listening_on_a_port_in_use_exits_1(capsys):
 
 
 # ----------------------------------------------------------------------------- on the wire
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 @pytest.fixture
