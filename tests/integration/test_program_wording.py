@@ -148,6 +148,8 @@ def test_run_words_turns_degrees_and_one_line_truly(tmp_path, capsys):
     turning = re.search(r"turning degrees +(\d+) deg in all; (.*)", out)
     assert turning and int(turning.group(1)) < 45
     assert turning.group(2) == "0 turns of 45 deg or more"
+    # cut by the time limit: said of the program's flows, never as an algorithm's state
+    assert "(the run was cut; 0 flows of the program still going)" in out
 
 
 def test_the_printed_summary_shows_the_true_first_and_last_lines(tmp_path):

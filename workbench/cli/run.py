@@ -16,6 +16,7 @@ from workbench.control.evaluate import (
     write_csv,
 )
 from workbench.control.headless import AlgorithmPilot, RunResult, RunSetupError, RunSpec, run
+from workbench.program.interp import ProgramController
 from workbench.program.keyfiles import program_keys, read_key_file
 from workbench.program.keys import KeyScriptError, parse_key_script
 from workbench.program.pilot import program_entrant
@@ -158,6 +159,17 @@ def run_head(result: RunResult, name: str) -> str:
     return f"{name} on {result.maze.name} ({result.profile}, seed {result.spec.seed})"
 
 
+def _final_words(result: RunResult) -> str:
+    """Where the driver was when the run was cut: an algorithm's state, or how many of a
+    program's flows were still going."""
+    state = result.as_dict()["final_state"]
+    if not isinstance(result.driving.controller, ProgramController):
+        return f"final state {state}"
+    if state == "stopped":
+        return "the program was stopped"
+    return f"{state or '0 flows'} of the program still going"
+
+
 def describe_measures(result: RunResult) -> list[str]:
     """The measures of a run, one per line (an algorithm's or a VIPLE program's)."""
     d = result.as_dict()
@@ -168,7 +180,7 @@ def describe_measures(result: RunResult) -> list[str]:
     elif result.maze.exits:
         outcome = (
             f"did NOT get out within the {result.max_time:g} s limit "
-            f"(the run was cut; final state {d['final_state']})"
+            f"(the run was cut; {_final_words(result)})"
         )
     else:
         outcome = f"free exploration for {result.max_time:g} s (the maze has no exit)"
