@@ -125,18 +125,24 @@ def sign_off(
     note: str = "",
     *,
     clock: Callable[[], datetime] = _now,
+    say: Callable[[str], None] | None = None,
 ) -> tuple[int, SignoffRecord]:
-    """Sign and store a record; returns its id and the record.
+    """Sign and store a record; returns its id and the record. ``say`` is told of each slow
+    step as it begins (unlocking the key, signing), for a screen that shows them.
 
     Allowed when ``record_fields.objectives_passed`` or with ``override`` (which needs a note).
     Raises :class:`LockedOut` while locked, :class:`WrongPassphrase` (counted: the fifth in a
     row locks this instructor for a minute), :class:`UnknownInstructor`, or
-    :class:`SignoffError`. An app that must stay responsive takes the three steps itself:
-    :func:`prepare_signoff`, then :meth:`PendingSignoff.unlock` in a thread, then
-    :meth:`PendingSignoff.complete`.
+    :class:`SignoffError`. Every step may wait (for the store, for scrypt): an app calls it
+    in a thread.
     """
     pending = prepare_signoff(store, instructor, record_fields, override, note, clock=clock)
-    return pending.complete(pending.unlock(passphrase))
+    if say is not None:
+        say(f"unlocking the key of {instructor}...")
+    signer = pending.unlock(passphrase)
+    if signer is not None and say is not None:
+        say(f"signing as {instructor}...")
+    return pending.complete(signer)
 
 
 @dataclass(frozen=True)

@@ -22,7 +22,7 @@ from textual.worker import Worker
 
 from workbench.labs.checks import ExerciseProgress
 from workbench.labs.roster import roster_names
-from workbench.labs.signing import prepare_signoff
+from workbench.labs.signing import sign_off
 from workbench.labs.signoff_errors import SignoffError
 from workbench.labs.signoff_record import Evidence, RecordFields, SignoffRecord
 from workbench.labs.store import Store
@@ -184,6 +184,9 @@ class SignoffModal(ModalScreen[str | None]):
         self._focus_first()
 
     # -- signing ---------------------------------------------------------------------------
+    def _say_from_thread(self, message: str) -> None:
+        self.app.call_from_thread(self._say, message)
+
     def _say(self, message: str) -> None:
         self.query_one("#signoff-status", Static).update(message)
 
@@ -229,19 +232,14 @@ class SignoffModal(ModalScreen[str | None]):
     async def _sign_off(
         self, instructor: str, fields: RecordFields, override: bool, note: str, passphrase: str
     ) -> None:
-        """Check, unlock the key (scrypt) and sign, each in a thread: the store may wait for
-        its database (a save on its way, a database that does not answer) and the app keeps
+        """Check, unlock the key (scrypt) and sign in a thread: the store may wait for its
+        database (a save on its way, a database that does not answer) and the app keeps
         answering meanwhile."""
-        store = self.store
         try:
-            pending = await asyncio.to_thread(
-                prepare_signoff, store, instructor, fields, override, note
-            )
-            self._say(f"unlocking the key of {instructor}...")
-            signer = await asyncio.to_thread(pending.unlock, passphrase)
-            if signer is not None:
-                self._say(f"signing as {instructor}...")
-            _, record = await asyncio.to_thread(pending.complete, signer)
+            _, record = await asyncio.to_thread(
+                sign_off, self.store, instructor, passphrase, fields, override, note,
+                say=self._say_from_thread,
+            )  # fmt: skip
         except SignoffError as exc:
             self.query_one(SignoffForm).take_passphrase()
             self._say(str(exc))

@@ -25,7 +25,7 @@ from workbench.labs.classview import Request, read_request
 from workbench.labs.model import Lab
 from workbench.labs.queue import QueueEntry
 from workbench.labs.roster import roster_names
-from workbench.labs.signing import prepare_signoff
+from workbench.labs.signing import sign_off
 from workbench.labs.signoff_errors import SignoffError
 from workbench.labs.store import Store, StoreError
 from workbench.sim.record import RecordError
@@ -249,7 +249,7 @@ class RequestScreen(Screen[str | None]):
             self._say("choose the instructor")
             return
         self.busy = True
-        self._say(f"unlocking the key of {instructor}...")
+        self._say(f"checking {instructor}'s key...")
         secret = form.take_passphrase()
         self.run_worker(
             self._sign(request, instructor, secret, entry.note, entry.override),
@@ -260,14 +260,13 @@ class RequestScreen(Screen[str | None]):
     async def _sign(
         self, request: Request, instructor: str, passphrase: str, note: str, override: bool
     ) -> None:
-        """Check, unlock (scrypt) and sign, each in a thread; then close the request."""
+        """Check, unlock (scrypt) and sign in a thread; then close the request."""
         store, entry = self.store, self.entry
         try:
-            pending = await asyncio.to_thread(
-                prepare_signoff, store, instructor, request.fields(), override, note
-            )
-            signer = await asyncio.to_thread(pending.unlock, passphrase)
-            await asyncio.to_thread(pending.complete, signer)
+            _, record = await asyncio.to_thread(
+                sign_off, store, instructor, passphrase, request.fields(), override, note,
+                say=lambda text: self.app.call_from_thread(self._say, text),
+            )  # fmt: skip
         except SignoffError as exc:
             self._say(str(exc))
             return
@@ -276,7 +275,6 @@ class RequestScreen(Screen[str | None]):
             return
         finally:
             self.busy = False
-        record = pending.record
         problems = []
         try:
             await asyncio.to_thread(store.mark_signed, entry.id, instructor)
