@@ -24,6 +24,7 @@ from workbench.sim.noise import noise_settings
 from workbench.sim.profiles import get_profile
 from workbench.viple import client as client_mod
 from workbench.viple.client import (
+    MAX_LAG_S,
     ClientRunError,
     ClientSetupError,
     Departures,
@@ -609,3 +610,5 @@ def test_commands_are_held_to_their_time_only_while_a_timer_runs():
     assert departures.due(0.3) == pytest.approx(0.315)
     departures.begin(timing=False)  # no timer ran: nothing to keep apart, no wait
     assert departures.due(1.0) == 1.0
+    departures.left(2.0, 62.0)  # a minute's stall (a suspended process) is no step's run time
+    assert departures.due(3.0) == pytest.approx(3.0 + MAX_LAG_S)

@@ -97,6 +97,9 @@ TURN_MARGIN_S = 0.3
 #: how long ``--connect`` keeps retrying while nothing listens, and how often
 CONNECT_PATIENCE_S = 5.0
 CONNECT_RETRY_S = 0.25
+#: the longest delay of earlier commands that later ones are held for (see Departures); a
+#: step runs in milliseconds (its activities are bounded), so more is the machine's stall
+MAX_LAG_S = 0.25
 #: rejected reports are printed one by one up to this many, then only counted
 SHOWN_REJECTIONS = 10
 
@@ -383,7 +386,9 @@ class Departures:
     it has run, ``lag`` later. While a timer runs, each step's commands wait until ``t`` plus
     the largest lag of the steps before them (the first command of a 40 ms pulse left 6 ms
     late: its end leaves 6 ms late too, however quickly its step ran). With no timer running
-    nothing spans from earlier commands to later ones, so the lag starts again from zero."""
+    nothing spans from earlier commands to later ones, so the lag starts again from zero. A
+    lag over :data:`MAX_LAG_S` is a stall of the whole machine (a suspended process), not the
+    time a step ran: it is carried only up to that bound."""
 
     lag: float = 0.0
 
@@ -399,7 +404,7 @@ class Departures:
     def left(self, t: float, now: float) -> None:
         """The commands of the step of time ``t`` leave at ``now``, not held (``now`` is at or
         past their :meth:`due` time)."""
-        self.lag = max(self.lag, now - t)
+        self.lag = min(max(self.lag, now - t), MAX_LAG_S)
 
 
 # ----------------------------------------------------------------------------- channels
