@@ -6,6 +6,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import os
 import re
 import sys
 from pathlib import Path
@@ -120,6 +121,37 @@ def test_grade_refuses_what_it_cannot_use(tmp_path, capsys):
         assert message in capsys.readouterr().err
     assert main(["grade", str(tmp_path / "gone"), "--maze", WEB]) == 2
     assert "no such folder" in capsys.readouterr().err
+
+
+def test_a_viple_3_xml_hand_in_is_graded_and_every_file_passed_over_is_named(tmp_path, capsys):
+    folder = tmp_path / "handins"
+    folder.mkdir()
+    right_wall(folder / "ana.xml", viple3=True)  # as VIPLE 3.1 saves: gzip-compressed XML
+    right_wall(folder / "ben.viple")
+    (folder / "notes.txt").write_text("ed said he would hand in later")
+    os.mkfifo(folder / "ed.viple")  # never opened: reading it would block the grading
+    table = tmp_path / "t.json"
+    args = ["grade", str(folder), "--maze", WEB, "--profile", "web", "--max-time", "400"]
+    assert main([*args, "--out", str(table)]) == 0
+    err = capsys.readouterr().err
+    assert err.startswith("2 programs, 2 runs: 2 load, 2 reached the exit on every run")
+    assert "skipped 2 files of the folder:\n" in err
+    assert "  ed.viple: a named pipe (FIFO), not a plain file: never opened" in err
+    assert "  notes.txt: not a VIPLE program (the app runs .viple or .xml files)" in err
+    data = json.loads(table.read_text())
+    assert [(r["student"], r["file"], r["reached_exit"]) for r in data["rows"]] == [
+        ("ana", "ana.xml", True),
+        ("ben", "ben.viple", True),
+    ]
+    assert [s["file"] for s in data["skipped"]] == ["ed.viple", "notes.txt"]
+    assert all(s["reason"] for s in data["skipped"])
+    # a folder with nothing to grade says what it passed over
+    (folder / "ana.xml").unlink()
+    (folder / "ben.viple").unlink()
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert "holds no programs (NAME.viple or .xml files" in err
+    assert "ed.viple: a named pipe (FIFO)" in err and "notes.txt: not a VIPLE program" in err
 
 
 def test_eval_presses_a_key_script_for_a_program_that_waits_for_one(tmp_path, capsys):

@@ -4,9 +4,14 @@ the address its own Robot activity names, here the robot `workbench serve` plays
 from __future__ import annotations
 
 import json
+import platform
 import signal
+import socket
+import struct
 import subprocess
 import sys
+import threading
+import time
 
 import pytest
 
@@ -121,3 +126,91 @@ def test_connect_problems_are_explained(tmp_path, capsys):
     assert "must be tcp://HOST:PORT" in capsys.readouterr().err
     assert main(["viple", "run", no_robot]) == 2
     assert "give --maze" in capsys.readouterr().err
+
+
+# -- the wire's clock: a step's commands leave when its timers say ---------------------------
+
+#: Linux's SO_TIMESTAMPNS (asm-generic): the kernel stamps each segment as it is received,
+#: so the robot below knows when a command arrived even when its thread reads late
+_SO_TIMESTAMPNS = (
+    35 if sys.platform == "linux" and platform.machine() in ("x86_64", "aarch64") else None
+)
+
+
+class FakeRobot:
+    """A robot on a real loopback socket: it writes down each command line and when it arrived
+    (the kernel's receive time where it gives one, else when the line was read)."""
+
+    def __init__(self) -> None:
+        self.server = socket.create_server(("127.0.0.1", 0))
+        if _SO_TIMESTAMPNS is not None:
+            self.server.setsockopt(socket.SOL_SOCKET, _SO_TIMESTAMPNS, 1)  # accepted: inherited
+        self.port = self.server.getsockname()[1]
+        self.arrivals: list[tuple[float, dict]] = []
+        self.thread = threading.Thread(target=self._serve, daemon=True)
+        self.thread.start()
+
+    def _serve(self) -> None:
+        conn, _ = self.server.accept()
+        pending = b""
+        with conn:
+            while True:
+                data, ancillary, _, _ = conn.recvmsg(65536, socket.CMSG_SPACE(16))
+                when = time.time()
+                if not data:
+                    return
+                for level, kind, raw in ancillary:
+                    if level == socket.SOL_SOCKET and kind == _SO_TIMESTAMPNS:
+                        seconds, nanoseconds = struct.unpack("qq", raw[:16])
+                        when = seconds + nanoseconds / 1e9
+                *lines, pending = (pending + data).split(b"\r\n")
+                self.arrivals.extend((when, json.loads(line)) for line in lines)
+
+    def close(self) -> None:
+        self.thread.join(timeout=30)
+        self.server.close()
+
+
+def pulse_program(tmp_path) -> str:
+    """Forward for 40 ms by a Timer, then stop; beside it, the same start runs a counting loop
+    of some 2,000 activities, each count a long sum (a busy step: its commands can leave only
+    once it has run), and a Calculate that fails (a run-time error)."""
+    b = ProgramBuilder()
+    b.var("n")
+    m = b.panel("Main")
+    m.add(19, "127.0.0.1", "1", "WiFi", "3000")
+    robot = "Robot/IoT Controller 0"
+    m.chain(m.add(3, "1"), m.add(20, "0.5", "0.5", robot, "3", "5"), m.add(3, "40"),
+            m.add(15, ""), m.add(20, "0", "0", robot, "3", "5"))  # fmt: skip
+    merge, count = m.add(5), m.add(6, "state.n < 500")
+    slow_plus_one = "value" + " + 1 - 1" * 15 + " + 1"  # some 60 tokens to work through
+    m.chain(m.add(3, "0"), merge, m.add(1, "n"), count, m.add(2, slow_plus_one), merge)
+    m.chain(m.add(3, '"text"'), m.add(2, "value * 2"), m.add(28, ""))
+    return b.write(tmp_path / "pulse.viple")
+
+
+def _powers(command: dict) -> tuple[float, float]:
+    speeds = {s["servoId"]: s["servoSpeed"] for s in command["servos"]}
+    return speeds[3], speeds[5]
+
+
+def test_a_timed_pulse_keeps_its_length_on_the_wire(tmp_path, capsys):
+    robot = FakeRobot()
+    try:
+        args = ["viple", "run", pulse_program(tmp_path), "--connect"]
+        args += [f"tcp://127.0.0.1:{robot.port}", "--duration", "0.5", "--json", "--no-keyboard"]
+        code = main(args)
+    finally:
+        robot.close()
+    captured = capsys.readouterr()
+    assert code == 0, captured.err
+    commands = [_powers(c) for _, c in robot.arrivals]
+    assert commands == [(0.5, 0.5), (0.0, 0.0), (0.0, 0.0)]  # go, stop, and the final stop
+    (go, _), (stop, _) = robot.arrivals[:2]
+    # the stop comes no sooner than the program's 40 ms after the go, however long the busy
+    # start took to run (a loaded machine only makes it later)
+    assert stop - go >= 0.040
+    data = json.loads(captured.out)
+    assert data["errors"] == 1 and data["stopped"] is None
+    assert "cannot" in captured.err or "needs numbers" in captured.err  # the error was shown
+    assert data["profile"] is None  # a robot over the wire is no simulated profile

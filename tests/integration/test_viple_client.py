@@ -24,8 +24,10 @@ from workbench.sim.noise import noise_settings
 from workbench.sim.profiles import get_profile
 from workbench.viple import client as client_mod
 from workbench.viple.client import (
+    MAX_LAG_S,
     ClientRunError,
     ClientSetupError,
+    Departures,
     Endpoint,
     RemoteFsm,
     parse_endpoint,
@@ -595,3 +597,18 @@ def test_viple_client_in_wheel_powers_drives_out_through_serve(tmp_path, in_proc
     assert at_exit["turn_degrees"] == pytest.approx(in_process["turn_degrees"], abs=10.0)
     assert summary["collisions"] == 0
     assert "TurningRight -> TurnedRight" in out and "TurnedLeft -> Forward" in out
+
+
+def test_commands_are_held_to_their_time_only_while_a_timer_runs():
+    departures = Departures()
+    departures.begin(timing=False)
+    assert departures.due(0.0) == 0.0
+    departures.left(0.0, 0.015)  # the first step of a pulse took 15 ms to run
+    departures.begin(timing=True)  # its Timer runs: the pulse's end leaves as late
+    assert departures.due(0.040) == pytest.approx(0.055)
+    departures.left(0.2, 0.203)  # a quicker step later does not undo the earlier delay
+    assert departures.due(0.3) == pytest.approx(0.315)
+    departures.begin(timing=False)  # no timer ran: nothing to keep apart, no wait
+    assert departures.due(1.0) == 1.0
+    departures.left(2.0, 62.0)  # a minute's stall (a suspended process) is no step's run time
+    assert departures.due(3.0) == pytest.approx(3.0 + MAX_LAG_S)

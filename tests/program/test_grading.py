@@ -16,7 +16,13 @@ from tests.program.graded_programs import right_wall
 from tests.program.hostile_pilots import HostilePilot
 from workbench.program.grade_table import COLUMNS, csv_text, json_text, summary
 from workbench.program.grading import Limits, Plan, Row, grade
-from workbench.program.submissions import FolderError, find_submissions, shown_name
+from workbench.program.submissions import (
+    FolderError,
+    Skipped,
+    find_submissions,
+    scan_folder,
+    shown_name,
+)
 
 MAZES = Path(__file__).resolve().parents[2] / "mazes"
 WEB = str(MAZES / "web.txt")
@@ -47,11 +53,46 @@ def test_a_folder_holds_files_and_subfolders_one_student_each(tmp_path):
     assert zoe.keys == "d@1" and not zoe.refused  # the common script, having none of its own
     assert zoe.file == "zoe.VIPLE"
     assert "badkeys.keys: key 1 'w'" in badkeys.refused and "KEY@SECONDS" in badkeys.refused
-    assert empty.refused == "the folder holds no .viple program"
+    assert empty.refused == "the folder holds no VIPLE program (.viple or .xml)"
     assert link.refused == "a symbolic link: hand in the file"
     assert two.refused == "the folder holds 2 programs (a.viple, b.viple): leave one to grade"
     with pytest.raises(FolderError, match="cannot read the folder"):
         find_submissions(tmp_path / "gone")
+
+
+def test_every_program_file_the_app_runs_is_graded_and_the_rest_is_listed(tmp_path):
+    right_wall(tmp_path / "ana.xml", viple3=True)  # VIPLE 3.1: gzip-compressed XML
+    (tmp_path / "ana.keys").write_text("a@1\n")
+    (tmp_path / "ben").mkdir()
+    right_wall(tmp_path / "ben" / "Walls.XML", viple3=True)
+    (tmp_path / "ben" / "notes.txt").write_text("my notes")
+    (tmp_path / "ben" / ".swap").write_text("")
+    right_wall(tmp_path / "cy.viple")
+    (tmp_path / "lost.keys").write_text("w@1\n")
+    (tmp_path / "readme.txt").write_text("not a program")
+    (tmp_path / ".git").mkdir()
+    os.mkfifo(tmp_path / "pipe.viple")  # reading it would wait for a writer for ever
+    (tmp_path / "dee").mkdir()
+    os.mkfifo(tmp_path / "dee" / "walls.viple")
+
+    found = scan_folder(tmp_path)
+    assert [(s.student, s.file, s.refused) for s in found.submissions] == [
+        ("ana", "ana.xml", ""),
+        ("ben", "ben/Walls.XML", ""),
+        ("cy", "cy.viple", ""),
+        ("dee", "dee", "the folder holds no VIPLE program (.viple or .xml)"),
+    ]
+    assert found.submissions[0].keys == "a@1"
+    fifo = "a named pipe (FIFO), not a plain file: never opened; hand in the file"
+    assert found.skipped == [
+        Skipped(".git", "a hidden folder (its name starts with a dot)"),
+        Skipped("ben/.swap", "a hidden file (its name starts with a dot)"),
+        Skipped("ben/notes.txt", "not a VIPLE program (the app runs .viple or .xml files)"),
+        Skipped("dee/walls.viple", fifo),
+        Skipped("lost.keys", "a key script with no program lost.viple or lost.xml beside it"),
+        Skipped("pipe.viple", fifo),
+        Skipped("readme.txt", "not a VIPLE program (the app runs .viple or .xml files)"),
+    ]
 
 
 def test_names_are_shown_printable():

@@ -317,3 +317,17 @@ def test_typed_keys_hold_while_repeating_and_release_after_a_quiet_gap():
     ]
     with pytest.raises(KeyScriptError, match="type one key an item"):
         typed_events(parse_key_script("w+d@1"), until=10)
+
+
+def test_print_line_writes_reals_as_viple_does(tmp_path):
+    b = ProgramBuilder()
+    main = b.panel("Main")
+    main.chain(main.add(3, "0.1"), main.add(2, "value + 0.2"), main.add(28, ""))
+    main.chain(main.add(3, "1E+21"), main.add(28, ""))
+    main.chain(main.add(3, "2"), main.add(2, "value / 3.0"), main.add(28, ""))
+    b.var("Ratio", "System.String")
+    main.chain(main.add(3, "0.7"), main.add(2, "value * 3"), main.add(1, "Ratio"),
+               main.add(2, '"ratio " + state.Ratio'), main.add(28, ""))  # fmt: skip
+    c = controller(b, tmp_path)
+    run(c, 0.1)
+    assert sorted(texts(c)) == ["0.3", "0.666666666666667", "1E+21", "ratio 2.1"]

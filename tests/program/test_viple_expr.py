@@ -3,12 +3,23 @@
 from __future__ import annotations
 
 import contextlib
+import math
+import re
+from decimal import Decimal
 
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from workbench.program.viple_expr import MAX_DEPTH, ExprError, Scope, literal, parse, show
+from workbench.program.viple_expr import (
+    MAX_DEPTH,
+    ExprError,
+    Scope,
+    literal,
+    parse,
+    show,
+    show_double,
+)
 
 SCOPE = Scope(
     value=25,
@@ -146,6 +157,75 @@ def test_data_literals(text, value):
 
 def test_values_show_as_csharp_prints_them():
     assert [show(1.0), show(0.5), show(True), show(None), show(7)] == ["1", "0.5", "True", "", "7"]
+
+
+@pytest.mark.parametrize(
+    ("value", "text"),
+    [
+        # the examples of .NET's Double.ToString() documentation
+        (1.6e20, "1.6E+20"),
+        (1.6e2, "160"),
+        (-3.541, "-3.541"),
+        (-1502345222199e-07, "-150234.5222199"),
+        (-15023452221990199574e-09, "-15023452221.9902"),
+        (0.60344, "0.60344"),
+        (0.000000001, "1E-09"),
+        # 15 significant digits, not the 17 a round trip needs
+        (0.1 + 0.2, "0.3"),
+        (1 / 3, "0.333333333333333"),
+        (2 / 3, "0.666666666666667"),
+        (123456789012345.6, "123456789012346"),
+        # fixed point for exponents -4 to 14, else E with a sign and two digits or more
+        (1e21, "1E+21"),
+        (1e15, "1E+15"),
+        (999999999999999.0, "999999999999999"),
+        (999999999999999.9, "1E+15"),
+        (0.0001, "0.0001"),
+        (0.00001, "1E-05"),
+        (-2.5e-7, "-2.5E-07"),
+        (1.7976931348623157e308, "1.79769313486232E+308"),
+        (5e-324, "4.94065645841247E-324"),
+        (2.0, "2"),
+        (-0.0, "0"),
+        (math.nan, "NaN"),
+        (math.inf, "Infinity"),
+        (-math.inf, "-Infinity"),
+    ],
+)
+def test_reals_print_as_dotnet_writes_a_double(value, text):
+    assert show_double(value) == text
+    assert show(value) == text
+
+
+@pytest.mark.parametrize(
+    ("expression", "text"),
+    [
+        ('"sum " + (0.1 + 0.2)', "sum 0.3"),
+        ('"big " + 1.0E21', "big 1E+21"),
+        ("Convert.ToString(1.0 / 3.0)", "0.333333333333333"),
+        ('0.5 * 0.2 + ""', "0.1"),
+    ],
+)
+def test_text_made_of_reals_reads_as_in_viple(expression, text):
+    assert parse(expression)(SCOPE) == text
+
+
+_FIXED = re.compile(r"-?(0|[1-9]\d*)(\.\d*[1-9])?")
+_EXPONENT = re.compile(r"-?[1-9](\.\d*[1-9])?E[+-]\d{2,3}")
+
+
+@settings(max_examples=2000)
+@given(st.floats(allow_nan=False, allow_infinity=False))
+def test_every_finite_double_reads_back_to_its_15_digits(x):
+    text = show_double(x)
+    assert float(text) == float(f"{x:.14e}")  # the value rounded to 15 significant digits
+    digits = re.sub(r"E.*", "", text).replace("-", "").replace(".", "").strip("0")
+    assert len(digits) <= 15
+    exponent = Decimal(text).adjusted()  # the decimal exponent of what is written
+    if -4 <= exponent <= 14:
+        assert _FIXED.fullmatch(text), text
+    else:
+        assert _EXPONENT.fullmatch(text), text
 
 
 _ATOMS = st.sampled_from(

@@ -12,7 +12,7 @@ from pathlib import Path
 from workbench.files.atomic import write_text_atomic
 from workbench.files.bundled import maze_path
 from workbench.labs.model import Exercise, Lab, LabFileError, load_lab, load_labs
-from workbench.program.grade_table import csv_text, json_text, summary
+from workbench.program.grade_table import csv_text, json_text, skipped_lines, summary
 from workbench.program.grading import (
     DEFAULT_DEADLINE,
     DEFAULT_MEMORY,
@@ -22,7 +22,7 @@ from workbench.program.grading import (
     grade,
 )
 from workbench.program.keys import KeyScriptError
-from workbench.program.submissions import FolderError, find_submissions
+from workbench.program.submissions import PROGRAM_FILES, FolderError, scan_folder
 
 from .common import report_ms_option
 from .run import _simulation_options, common_keys, key_options
@@ -42,11 +42,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     g = sub.add_parser(
         "grade",
         help="grade a folder of students' VIPLE programs on an exercise's mazes into a table",
-        description="Run every student's VIPLE program in FOLDER (NAME.viple files, or one "
-        "subfolder per student holding one .viple file) on the exercise's mazes and seeds, "
+        description="Run every student's VIPLE program in FOLDER (NAME.viple or NAME.xml "
+        "files, or one subfolder per student holding one) on the exercise's mazes and seeds, "
         "each program in a process of its own, and write one table: a row per program, maze "
         "and seed. A program that does not load, crashes, hangs or runs out of memory gets "
-        "the reason in its rows; the others are graded as usual.",
+        "the reason in its rows; the others are graded as usual. Every file of FOLDER that is "
+        "not graded is listed with the reason.",
     )
     g.add_argument("folder", metavar="FOLDER", help="the folder of the students' programs")
     g.add_argument("--lab", metavar="L", help="a bundled lab's id, or a lab file (.yaml)")
@@ -117,16 +118,18 @@ def cmd_grade(args: argparse.Namespace) -> int:
         for out in args.out:
             if Path(out).suffix.lower() not in OUT_FORMATS:
                 raise GradeUsageError(f"--out {out}: name a .csv or a .json file")
-        submissions = find_submissions(args.folder, keys)
+        handins = scan_folder(args.folder, keys)
     except (GradeUsageError, FolderError, KeyScriptError) as exc:
         print(f"{NAME}: {exc}", file=sys.stderr)
         return 2
+    submissions, skipped = handins.submissions, handins.skipped
     if not submissions:
-        print(
-            f"{NAME}: {args.folder} holds no programs (NAME.viple files, or one subfolder "
-            "per student holding one)",
-            file=sys.stderr,
-        )
+        lines = [
+            f"{NAME}: {args.folder} holds no programs (NAME{PROGRAM_FILES} files, or one "
+            "subfolder per student holding one)",
+            *skipped_lines(skipped),
+        ]
+        print("\n".join(lines), file=sys.stderr)
         return 2
     shown = sys.stderr.isatty()
     started = time.monotonic()
@@ -137,7 +140,7 @@ def cmd_grade(args: argparse.Namespace) -> int:
         sys.stderr.write("\r\x1b[K")
     for out in args.out:
         as_csv = Path(out).suffix.lower() == ".csv"
-        text = csv_text(rows) if as_csv else json_text(rows, plan, what)
+        text = csv_text(rows) if as_csv else json_text(rows, plan, what, skipped)
         try:
             write_text_atomic(out, text)
         except OSError as exc:
@@ -148,6 +151,7 @@ def cmd_grade(args: argparse.Namespace) -> int:
         sys.stdout.flush()
     lines = summary(rows)
     lines[0] += f" ({time.monotonic() - started:.1f} s)"
+    lines += skipped_lines(skipped)
     print("\n".join(lines), file=sys.stderr)
     return 0
 

@@ -242,6 +242,21 @@ class _ProgramBrain:
     def state(self) -> str | None:
         return self.remote.state
 
+    @property
+    def timing(self) -> bool:
+        return self.remote.timing
+
+    @property
+    def errors(self) -> int:
+        """The program's run-time errors so far, all counted."""
+        return self.remote.controller.errors_total
+
+    @property
+    def stopped(self) -> str | None:
+        """Where and why the program was stopped for good (None: it was not)."""
+        stopped = self.remote.controller.stopped
+        return None if stopped is None else str(stopped)
+
     def next_tick(self) -> float:
         return self.remote.next_tick()
 
@@ -323,6 +338,12 @@ def cmd_connect(args: argparse.Namespace) -> int:
         progress.flush()
 
     ports = wheel_ports(compiled)
+    made: list[_ProgramBrain] = []
+
+    def brain() -> _ProgramBrain:
+        made.append(_ProgramBrain(RemoteProgram(compiled, keys), log))
+        return made[-1]
+
     setup = ClientSetup(
         definition=None,
         profile=profile,
@@ -331,7 +352,7 @@ def cmd_connect(args: argparse.Namespace) -> int:
         binding={},
         endpoint=endpoint,
         duration=args.duration,
-        brain=lambda: _ProgramBrain(RemoteProgram(compiled, keys), log),
+        brain=brain,
         title=os.path.basename(args.file),
         ports=WheelPorts(*ports) if ports else None,
     )
@@ -347,8 +368,14 @@ def cmd_connect(args: argparse.Namespace) -> int:
             result = asyncio.run(run_client(setup, log, attach=attach_keyboard(fd)))
     else:
         result = asyncio.run(run_client(setup, log))
+    program = made[-1] if made else None
     data = {**result.as_dict(), "program_sha256": compiled.program.digest}
     data["events"] = data.pop("transitions")
+    # the robot over the wire is no simulated profile: a profile is named only when one was
+    # given (its wheel ports serve a program whose Robot Drive names none)
+    data["profile"] = args.profile
+    data["errors"] = program.errors if program is not None else 0
+    data["stopped"] = program.stopped if program is not None else None
     if args.json:
         print(json.dumps(data))
     elif result.ended != "no connection":
@@ -361,6 +388,8 @@ def cmd_connect(args: argparse.Namespace) -> int:
                     f"  reports         {result.reports} received, {result.rejected} rejected",
                     f"  commands sent   {result.commands}",
                     f"  events          {result.transitions}",
+                    f"  errors          {data['errors']}",
+                    *([f"  STOPPED at      {data['stopped']}"] if data["stopped"] else []),
                 ]
             )
         )

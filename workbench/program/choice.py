@@ -17,11 +17,9 @@ from workbench.sim.sensors import MOUNTS, SensorSpec
 
 from . import kinds as K
 from .compiled import Compiled
+from .loader import is_program_name
 from .pilot import SENSOR_NEEDS, check_sensors, load_compiled, program_driving
 from .problems import ProgramError
-
-#: the file endings the app takes for a VIPLE program (VIPLE 4.x, and 3.x XML)
-PROGRAM_SUFFIXES = (".viple", ".xml")
 
 _SENSOR_WORDS = {
     K.TOUCH: "touch",
@@ -32,7 +30,8 @@ _SENSOR_WORDS = {
 
 
 def is_program_path(text: str) -> bool:
-    return text.strip().lower().endswith(PROGRAM_SUFFIXES)
+    """A path the app loads as a VIPLE program (``.viple``, VIPLE 3.x ``.xml``)."""
+    return is_program_name(text)
 
 
 def choose_program(station: LabStation, path: str) -> ProgramChoice:

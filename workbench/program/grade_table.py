@@ -14,9 +14,12 @@ import json
 from collections.abc import Sequence
 from dataclasses import asdict
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from .grading import Plan, Row
+
+if TYPE_CHECKING:
+    from .submissions import Skipped
 
 COLUMNS = (
     "student",
@@ -33,8 +36,9 @@ COLUMNS = (
     "errors",
     "refusal",
 )
-#: how many refused programs the summary names
+#: how many refused programs and skipped files the summary names
 SHOWN_REFUSALS = 20
+SHOWN_SKIPPED = 20
 _FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
 
 
@@ -47,9 +51,12 @@ def csv_text(rows: Sequence[Row]) -> str:
     return out.getvalue()
 
 
-def json_text(rows: Sequence[Row], plan: Plan, what: dict[str, Any]) -> str:
+def json_text(
+    rows: Sequence[Row], plan: Plan, what: dict[str, Any], skipped: Sequence[Skipped] = ()
+) -> str:
     """The rows as JSON, under what was graded (``what``: the lab and exercise, or nothing)
-    and the plan's mazes, seeds and profile."""
+    and the plan's mazes, seeds and profile; ``skipped``: the folder's files not graded,
+    each with the reason."""
     data = {
         **what,
         "mazes": [_name(m) for m in plan.mazes],
@@ -57,6 +64,7 @@ def json_text(rows: Sequence[Row], plan: Plan, what: dict[str, Any]) -> str:
         "profile": plan.profile,
         "max_time": plan.max_time,
         "rows": [asdict(row) for row in rows],
+        "skipped": [asdict(s) for s in skipped],
     }
     return json.dumps(data, indent=1, ensure_ascii=False) + "\n"
 
@@ -79,6 +87,18 @@ def summary(rows: Sequence[Row]) -> list[str]:
         lines.append(f"  {reason}" if named else f"  {rs[0].file}: {reason}")
     if len(refused) > SHOWN_REFUSALS:
         lines.append(f"  and {len(refused) - SHOWN_REFUSALS} more (see the table)")
+    return lines
+
+
+def skipped_lines(skipped: Sequence[Skipped]) -> list[str]:
+    """The files of the folder that were not graded, each with the reason (the first
+    :data:`SHOWN_SKIPPED`; the JSON table lists them all)."""
+    if not skipped:
+        return []
+    lines = [f"skipped {_many(len(skipped), 'file')} of the folder:"]
+    lines += [f"  {s.file}: {s.reason}" for s in skipped[:SHOWN_SKIPPED]]
+    if len(skipped) > SHOWN_SKIPPED:
+        lines.append(f"  and {len(skipped) - SHOWN_SKIPPED} more (see the JSON table)")
     return lines
 
 

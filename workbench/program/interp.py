@@ -208,6 +208,8 @@ class ProgramController:
         self.recent: deque[Printed] = deque(maxlen=RECENT_PRINTED)
         self.fired: list[Fired] = []
         self.errors: list[RunError] = []
+        #: every run-time error, counted (``errors`` keeps the first MAX_ERRORS)
+        self.errors_total = 0
         self.commands: list[Any] = []
         self.changes = 0
         self.now = 0.0
@@ -294,6 +296,13 @@ class ProgramController:
         if self._next_key < len(script) and script[self._next_key].time < due:
             due = script[self._next_key].time
         return None if due == _NEVER else due
+
+    @property
+    def timing(self) -> bool:
+        """Whether something of the program runs on its own clock now: a Timer sleeps, or a
+        scripted key is still to come (the time between its commands is then the program's
+        to say)."""
+        return bool(self._sleeping) or self._next_key < len(self.key_script)
 
     def _report_due(self, t: float) -> bool:
         period = self.report_period
@@ -699,6 +708,7 @@ class ProgramController:
         to stop."""
         act = self.program.activities[aid]
         self.stopped = RunError(self.now, act.panel, aid, self.program.label(act), message)
+        self.errors_total += 1
         if len(self.errors) >= MAX_ERRORS:
             self.errors.pop()
         self.errors.append(self.stopped)
@@ -730,6 +740,7 @@ class ProgramController:
             self.printed_dropped += 1
 
     def _error(self, aid: int, message: str) -> None:
+        self.errors_total += 1
         if len(self.errors) < MAX_ERRORS:
             act = self.program.activities[aid]
             self.errors.append(RunError(self.now, act.panel, aid, self.program.label(act), message))

@@ -47,6 +47,15 @@ MAX_ID = 10_000_000
 _GZIP = b"\x1f\x8b"
 _SAVE_AGAIN = "open it in VIPLE and save it again, or fix the lists by hand"
 _NUMBER = re.compile(r"\s*-?\d{1,9}\s*")
+#: the file endings of a VIPLE program, in any case: VIPLE 3.5 and 4.x save ``.viple``,
+#: VIPLE 3.1 saved gzip-compressed ``.xml`` (the container is told by the bytes, not the name)
+PROGRAM_SUFFIXES = (".viple", ".xml")
+
+
+def is_program_name(name: str) -> bool:
+    """A VIPLE program's file name: ``NAME.viple`` or ``NAME.xml``, in any case."""
+    lower = name.strip().lower()
+    return any(lower.endswith(s) and len(lower) > len(s) for s in PROGRAM_SUFFIXES)
 
 
 class _Refused(Exception):

@@ -7,7 +7,9 @@ activities name the wheel ports the commands go to.
 
 :class:`RemoteProgram` runs the program on the client's own clock: each sensor report fires
 the sensor activities (one report, one firing), and between reports the program ticks at the
-control rate so its keys and waiting flows go on, and at each Timer's own time. The protocol
+control rate so its keys and waiting flows go on, and at each Timer's own time. While a Timer
+runs (:attr:`RemoteProgram.timing`), the client keeps the commands' departures as far apart
+as the program's times say. The protocol
 side (sockets, the wire) is ``workbench.viple.client``; the command line joins the two.
 """
 
@@ -132,6 +134,12 @@ class RemoteProgram:
         tick = self.last_tick + 1.0 / CONTROL_HZ
         due = self.controller.next_due()
         return tick if due is None or due > tick else due
+
+    @property
+    def timing(self) -> bool:
+        """A Timer of the program runs (or a scripted key is to come): see
+        :attr:`ProgramController.timing`."""
+        return self.controller.timing
 
     def type_key(self, key: str, t: float) -> None:
         self.controller.type_key(key, t)

@@ -189,10 +189,42 @@ def _show_one(value: Value) -> str:
     if isinstance(value, bool):
         return "True" if value else "False"
     if isinstance(value, float):
-        if math.isfinite(value) and value == int(value) and abs(value) < 1e15:
-            return str(int(value))
-        return repr(value)
+        return show_double(value)
     return str(value)
+
+
+#: the significant digits .NET Framework's ``Double.ToString()`` writes (its "G" format)
+DOUBLE_DIGITS = 15
+#: a double is written in fixed point when its decimal exponent (after rounding to
+#: DOUBLE_DIGITS digits) lies in this range, else as ``1.5E+21`` / ``1E-05``
+_FIXED_EXPONENTS = range(-4, DOUBLE_DIGITS)
+_NOT_FINITE = {math.inf: "Infinity", -math.inf: "-Infinity"}
+
+
+def show_double(x: float) -> str:
+    """A double as VIPLE (a .NET Framework program) writes it with ``ToString()``: rounded to
+    15 significant digits, trailing zeros dropped, no point for a whole number (``0.1 + 0.2``
+    is ``0.3``, ``2.0`` is ``2``); fixed point when the decimal exponent is from -4 to 14,
+    otherwise ``d.dddE+XX`` with a sign and at least two exponent digits (``1E+21``,
+    ``1.5E-07``). Zero of either sign is ``0``; ``NaN``, ``Infinity``, ``-Infinity``."""
+    if math.isnan(x):
+        return "NaN"
+    if math.isinf(x):
+        return _NOT_FINITE[x]
+    if x == 0:
+        return "0"
+    sign = "-" if x < 0 else ""
+    mantissa, _, exp = f"{abs(x):.{DOUBLE_DIGITS - 1}e}".partition("e")
+    digits = mantissa.replace(".", "").rstrip("0")
+    e = int(exp)
+    if e in _FIXED_EXPONENTS:
+        if e >= 0:
+            whole, frac = digits[: e + 1].ljust(e + 1, "0"), digits[e + 1 :]
+        else:
+            whole, frac = "0", "0" * (-e - 1) + digits
+        return sign + whole + ("." + frac if frac else "")
+    frac = "." + digits[1:] if len(digits) > 1 else ""
+    return f"{sign}{digits[0]}{frac}E{'+' if e >= 0 else '-'}{abs(e):02d}"
 
 
 def type_name(value: Value) -> str:

@@ -10,6 +10,13 @@ Time is the client's own monotonic clock, counted from the moment the robot is c
 FSM's timers run on it, as VIPLE's Timer activities do. The FSM ticks on every report and at
 least ``CONTROL_HZ`` times a second, with the latest readings.
 
+A step (a start, a tick, a report) runs at one time on that clock, and its commands leave once
+it has run. On the robot what counts is the time between commands: a 40 ms pulse is the 40 ms
+between the two commands. So while a timer of the brain runs (:attr:`Brain.timing`), the
+client holds each step's commands until its time plus the delay of the commands before it
+(:class:`Departures`): a step that took long to run (or a late wake-up) never shortens the
+time a timer says. Without a running timer, commands leave as soon as their step has run.
+
 The protocol has no "turn finished" signal: a VIPLE program that uses Turn by Degree waits with
 a Timer. The client does the same for the FSM's ``turn_done``: it raises the event
 :func:`turn_wait` seconds after sending the turn, the profile's Turn by Degree time plus
@@ -90,6 +97,9 @@ TURN_MARGIN_S = 0.3
 #: how long ``--connect`` keeps retrying while nothing listens, and how often
 CONNECT_PATIENCE_S = 5.0
 CONNECT_RETRY_S = 0.25
+#: the longest delay of earlier commands that later ones are held for (see Departures); a
+#: step runs in milliseconds (its activities are bounded), so more is the machine's stall
+MAX_LAG_S = 0.25
 #: rejected reports are printed one by one up to this many, then only counted
 SHOWN_REJECTIONS = 10
 
@@ -179,6 +189,12 @@ class Brain(Protocol):
     def next_tick(self) -> float: ...
 
     def tick(self, t: float) -> Step: ...
+
+    @property
+    def timing(self) -> bool:
+        """Whether a timer of the brain runs (a Timer, a turn waited for): the time between
+        its commands is then the brain's to say (see :class:`Departures`)."""
+        ...
 
 
 @runtime_checkable
@@ -310,6 +326,10 @@ class RemoteFsm:
     def state(self) -> str:
         return self.controller.state
 
+    @property
+    def timing(self) -> bool:
+        return self.turn_due is not None
+
     def start(self, t: float) -> Step:
         return self._step(t, self.controller.start(t), None, started=True)
 
@@ -352,6 +372,39 @@ class RemoteFsm:
             )
         due = self.turn_due if commands and isinstance(commands[-1], TurnByDegrees) else None
         return Step(t, commands, fired, due, started)
+
+
+# ----------------------------------------------------------------------------- departures
+
+
+@dataclass
+class Departures:
+    """When a step's commands leave, so that the time between two commands on the robot is
+    never shorter than the time between their steps.
+
+    A step runs at its time ``t`` on the client's clock, but its commands can leave only once
+    it has run, ``lag`` later. While a timer runs, each step's commands wait until ``t`` plus
+    the largest lag of the steps before them (the first command of a 40 ms pulse left 6 ms
+    late: its end leaves 6 ms late too, however quickly its step ran). With no timer running
+    nothing spans from earlier commands to later ones, so the lag starts again from zero. A
+    lag over :data:`MAX_LAG_S` is a stall of the whole machine (a suspended process), not the
+    time a step ran: it is carried only up to that bound."""
+
+    lag: float = 0.0
+
+    def begin(self, timing: bool) -> None:
+        """A step is about to run; ``timing``: a timer of the brain was running before it."""
+        if not timing:
+            self.lag = 0.0
+
+    def due(self, t: float) -> float:
+        """When the commands of the step of time ``t`` may leave."""
+        return t + self.lag
+
+    def left(self, t: float, now: float) -> None:
+        """The commands of the step of time ``t`` leave at ``now``, not held (``now`` is at or
+        past their :meth:`due` time)."""
+        self.lag = min(max(self.lag, now - t), MAX_LAG_S)
 
 
 # ----------------------------------------------------------------------------- channels
@@ -509,6 +562,7 @@ class VipleClient:
         self._released = asyncio.Event()
         self._t0 = 0.0
         self._wheel_drive = WheelDrive(setup.profile) if setup.wheels_only else None
+        self._departures = Departures()
 
     def interrupt(self, signum: int = signal.SIGINT) -> None:
         """Stop the run (from a signal handler): stop the robot, close, summarise."""
@@ -615,11 +669,12 @@ class VipleClient:
     # -- driving -------------------------------------------------------------------------
 
     async def _drive(self, channel: Channel) -> None:
-        self._t0 = time.monotonic()
         fsm: Brain = self.setup.brain() if self.setup.brain else RemoteFsm(self.setup)
+        self._t0 = time.monotonic()  # the brain is made: its time starts now
         pump = asyncio.create_task(self._pump(channel))
         try:
-            await self._send(channel, self._shown(fsm.start(0.0), fsm))
+            self._departures.begin(False)
+            await self._send_step(channel, fsm.start(0.0), fsm)
             await self._loop(channel, fsm)
         finally:
             pump.cancel()
@@ -649,15 +704,17 @@ class VipleClient:
                 if self._wheel_drive is not None and self._wheel_drive.spin_over(now):
                     await self._send(channel, [Stop()])
                 if now >= fsm.next_tick():
-                    await self._send(channel, self._shown(fsm.tick(now), fsm))
+                    self._departures.begin(fsm.timing)
+                    await self._send_step(channel, fsm.tick(now), fsm)
                 continue
             if isinstance(item, _Received):
                 await self._reports(channel, fsm, item)
             elif isinstance(item, _Key):
                 if isinstance(fsm, TakesKeys):
+                    self._departures.begin(fsm.timing)
                     now = self._now()
                     fsm.type_key(item.key, now)
-                    await self._send(channel, self._shown(fsm.tick(now), fsm))
+                    await self._send_step(channel, fsm.tick(now), fsm)
             elif isinstance(item, (_Interrupted, _Stopped)):
                 await self._stop_robot(channel)
                 self._ends(item)
@@ -675,6 +732,7 @@ class VipleClient:
             except ValueError as err:
                 self._reject(_refusal(line) or str(err))
                 continue
+            self._departures.begin(fsm.timing)
             try:
                 step = fsm.report(self._now(), readings, line)
             except CodecError as err:
@@ -684,7 +742,7 @@ class VipleClient:
                 await self._stop_robot(channel)
                 raise _Abort(str(exc)) from None
             self.result.reports += 1
-            await self._send(channel, self._shown(step, fsm))
+            await self._send_step(channel, step, fsm)
 
     async def _pump(self, channel: Channel) -> None:
         try:
@@ -692,6 +750,20 @@ class VipleClient:
                 self.inbox.put_nowait(_Received(*got))
         finally:
             self.inbox.put_nowait(_Closed())
+
+    async def _send_step(self, channel: Channel, step: Step, fsm: Brain) -> None:
+        """Send a step's commands at their time (see :class:`Departures`)."""
+        commands = self._shown(step, fsm)
+        if not commands:
+            return
+        wait = self._departures.due(step.t) - self._now()
+        if wait > 0:
+            # held to its time: it leaves as late as the ones before it, the lag stays (the
+            # event loop's few tenths of a millisecond past it are not added to every later one)
+            await asyncio.sleep(wait)
+        else:
+            self._departures.left(step.t, self._now())
+        await self._send(channel, commands)
 
     async def _send(self, channel: Channel, commands: list[Command]) -> None:
         wheels = self.setup.wheels
