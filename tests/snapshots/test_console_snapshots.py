@@ -53,3 +53,12 @@ def test_console_request_opened(snap_compare, tmp_path):
         await pilot.pause()
 
     assert snap_compare(console(tmp_path / "data"), terminal_size=SIZE, run_before=before)
+
+
+def test_console_grid_of_students_by_exercises(snap_compare, tmp_path):
+    async def before(pilot: Pilot) -> None:
+        await class_shown(pilot)
+        await pilot.press("g")
+        await pilot.pause()
+
+    assert snap_compare(console(tmp_path / "data"), terminal_size=SIZE, run_before=before)
