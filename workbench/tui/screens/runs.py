@@ -2,9 +2,9 @@
 
 Each row is one run with the course's measures, so students can answer "which algorithm is
 better on this maze": it shows the runs on the station's maze and profile, and ``a`` shows the
-runs on every maze, grouped by maze and profile. The table keeps the columns that fit the
-width; the line under it says the chosen run whole. Enter (or a click) on a run with a record
-opens its replay; ``o`` opens any run record (JSONL) by path.
+runs on every maze, grouped by maze and profile. The table always keeps the graded measures,
+shortening long names to fit the width; the line under it says the chosen run whole. Enter
+(or a click) on a run with a record opens its replay; ``o`` opens any run record by path.
 """
 
 from __future__ import annotations
@@ -143,11 +143,12 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         table = self.query_one(DataTable)
         scrollbar = table.styles.scrollbar_size_vertical
         width = (self.size.width or self.app.size.width) - scrollbar
-        columns = fit_columns(runs, self.unicode, width, self.scope, table.cell_padding)
+        fitted = fit_columns(runs, self.unicode, width, self.scope, table.cell_padding)
+        columns = fitted.columns
         self.query_one("#runs-title", Static).update(self._title(len(runs)))
         self.query_one("#runs-help", Static).update(self._help(runs))
-        rows = tuple(tuple(c.cell(run, self.unicode) for c in columns) for run in runs)
-        shown = (self.scope, self.unicode, tuple(c.key for c in columns), rows)
+        rows = tuple(fitted.cells(run, self.unicode) for run in runs)
+        shown = (self.scope, self.unicode, fitted.keys, rows)
         if shown == self._shown:
             return
         self._shown = shown
