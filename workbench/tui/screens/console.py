@@ -1,11 +1,14 @@
 """The instructor's console: the class live from the store, and the sign-off queue.
 
 At the top, the requests for sign-off in the order the students asked; below, every student
-with the exercise they have open and its objectives (✓/✗, ``[X]``/``[ ]`` in ASCII mode), and
-their place in the queue. A thread of the screen's own reads the store about once a second
-(:func:`workbench.labs.classview.read_class`), never the event loop: a course database may be
-across the network. Enter on a request opens it (:mod:`.console_request`), where the instructor
-signs it off with their own key, typed in their own session, or declines it with a note.
+with the exercise they have open (its id whole, on a line of its own where the columns do not
+fit), its objectives (✓/✗, ``X``/``.`` in ASCII mode) and their place in the queue, and a
+line of marks where the evidence mixes programs or shares a program with another student's.
+``g`` opens the grid of students by exercises (:mod:`.console_grid`). A thread of the
+screen's own reads the store about once a second (:func:`workbench.labs.classview.read_class`),
+never the event loop: a course database may be across the network. Enter on a request opens
+it (:mod:`.console_request`), where the instructor signs it off with their own key, typed in
+their own session, or declines it with a note.
 """
 
 from __future__ import annotations
