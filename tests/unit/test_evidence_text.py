@@ -4,6 +4,8 @@ the console shows, from evidence dicts as the checks save them, old and new."""
 from __future__ import annotations
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from tests.app.console_support import progress, wall_main, wall_run
 from workbench.labs.checks import ExerciseProgress, ObjectiveState
@@ -142,3 +144,48 @@ def test_only_passed_objectives_count_as_a_program_a_student_used():
     ])  # fmt: skip
     assert program_uses("ana", failing) == []
     assert program_uses("ana", done, frozenset({"ab" * 32})) == []
+
+
+JSON = st.recursive(
+    st.none() | st.booleans() | st.integers() | st.floats(allow_nan=False) | st.text(max_size=8),
+    lambda inner: (
+        st.lists(inner, max_size=3) | st.dictionaries(st.text(max_size=8), inner, max_size=3)
+    ),
+    max_leaves=12,
+)
+KEYS = st.sampled_from(
+    [
+        "run",
+        "metrics",
+        "sensors",
+        "program_sha256",
+        "program_name",
+        "tries",
+        "waiting",
+        "runs",
+        "role",
+        "distance",
+        "profile",
+        "correct",
+        "edit",
+    ]
+)
+
+
+@given(
+    kind=st.sampled_from(
+        ["exit", "sensors", "questions", "keys", "viple", "maze-edited", "compare", "other"]
+    ),
+    evidence=st.dictionaries(KEYS | st.text(max_size=6), JSON, max_size=6)
+    | st.lists(JSON, max_size=2),
+    profile=st.sampled_from(["unity", "web", "erobotic", "", "nonsense"]),
+)
+def test_any_saved_evidence_is_said_without_an_error(kind, evidence, profile):
+    """Evidence read back from a store may be old, odd or edited: it is said, never a crash."""
+    state = ObjectiveState(kind, "t", True, "r", evidence)
+    lines = evidence_lines(state, profile)
+    assert all(isinstance(line, str) and "\n" not in line for line in lines)
+    progress_ = ExerciseProgress("lab", "ex", [state, state])
+    lines_of_progress(progress_, profile, unicode=False)
+    programs_of(progress_)
+    program_uses("ana", progress_)

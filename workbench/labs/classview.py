@@ -102,8 +102,9 @@ def profiles(labs: list[Lab]) -> dict[tuple[str, str], str]:
 
 def _waiting_questions(progress: ExerciseProgress) -> tuple[str, ...]:
     for state in progress.objectives:
-        if state.kind == "questions" and isinstance(state.evidence.get("waiting"), list):
-            return tuple(str(q) for q in state.evidence["waiting"])
+        evidence = state.evidence if isinstance(state.evidence, dict) else {}
+        if state.kind == "questions" and isinstance(evidence.get("waiting"), list):
+            return tuple(str(q) for q in evidence["waiting"])
     return ()
 
 

@@ -10,7 +10,7 @@ built-in algorithms) are everyone's, and never a hint.
 from __future__ import annotations
 
 import functools
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -72,7 +72,7 @@ def program_uses(
     """The programs the passed objectives of one student's exercise rest on (not bundled)."""
     uses: dict[str, ProgramUse] = {}
     for state in progress.objectives:
-        if not state.passed:
+        if not state.passed or not isinstance(state.evidence, Mapping):
             continue
         program = program_of(state.evidence)
         if program is None or program[0] in bundled:
