@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import pytest
 from textual.screen import Screen
@@ -17,6 +18,13 @@ from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.host import ScreenHost
 from workbench.tui.screens.replay import ReplayScreen
 from workbench.tui.screens.runs import RunsScreen
+from workbench.tui.screens.runs_table import (
+    ALL_MAZES,
+    THIS_MAZE,
+    fit_columns,
+    one_profile,
+    scope_columns,
+)
 from workbench.tui.widgets import MazeView
 
 SIZE = (80, 24)
@@ -135,15 +143,14 @@ async def test_no_column_is_cut_and_the_rest_is_on_the_detail_line(tmp_path, wid
 
         await pilot.press("a")
         await pilot.pause()
-        assert text(screen.query_one("#runs-title")).startswith("Runs on every maze: 3")
+        # one profile: the title names it, and its column gives the names the room
+        title = text(screen.query_one("#runs-title"))
+        assert title.startswith("Runs on every maze: 3, all erobotic, by maze")
         headings = check_no_column_is_cut(app)
-        assert headings[:4] == ["#", "Driver", "Maze", "Profile"]
+        assert headings[:4] == ["#", "Driver", "Maze", "Out"] and "Profile" not in headings
         assert set(GRADED) <= set(headings)
         rows = table_rows(screen.query_one(DataTable))
-        assert [(row[0], row[2], row[3]) for row in rows][:2] == [
-            ("1", "Bend", "erobotic"),
-            ("2", "Bend", "erobotic"),
-        ]
+        assert [(row[0], row[2]) for row in rows][:2] == [("1", "Bend"), ("2", "Bend")]
         # where the names do not fit whole they are shortened, marked, and said whole below
         web = rows[2][2]
         assert web == "Web Simulator lab maze" or (
@@ -374,3 +381,17 @@ async def test_both_views_keep_every_graded_measure_at_80x24_with_long_driver_na
             assert detail.startswith(f"run {run.number}: {run.driver} on ")
             await pilot.press("a")
             await pilot.pause()
+
+
+def test_the_profile_column_stands_where_the_runs_were_made_with_several(tmp_path):
+    erobotic = two_runs(tmp_path)
+    web = run_algorithms(LabStation.open(BEND, "web", noise="off"), "right-wall")
+    runs = [*erobotic.runs, replace(web.runs[0], number=3)]
+    assert one_profile(runs) == "" and one_profile(erobotic.runs) == "erobotic"
+    assert "profile" in scope_columns(runs, ALL_MAZES)
+    assert "profile" not in scope_columns(erobotic.runs, ALL_MAZES)
+    assert not {"maze", "profile"} & scope_columns(runs, THIS_MAZE)
+    fitted = fit_columns(runs, False, 78, ALL_MAZES)
+    assert fitted.keys[:4] == ("number", "driver", "maze", "profile")
+    assert {"reached", "time", "distance", "turning", "turns", "contacts"} <= set(fitted.keys)
+    assert [fitted.cells(r, False)[3] for r in runs] == ["erobotic", "erobotic", "web"]

@@ -36,6 +36,7 @@ from .runs_table import (
     RunColumn,
     fit_columns,
     heading,
+    one_profile,
     run_detail,
     runs_in_scope,
 )
@@ -97,6 +98,8 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         #: which runs the table shows: :data:`THIS_MAZE` or :data:`ALL_MAZES`
         self.scope = THIS_MAZE
         self._runs: list[RunEntry] = []
+        #: the runs the scope shows now (the title names their profile when they share one)
+        self._in_scope: list[RunEntry] = []
         self._columns: tuple[RunColumn, ...] = COLUMNS
         #: the last message shown under the table (what happened, or why not)
         self.status = ""
@@ -143,6 +146,7 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         table = self.query_one(DataTable)
         scrollbar = table.styles.scrollbar_size_vertical
         width = (self.size.width or self.app.size.width) - scrollbar
+        self._in_scope = runs
         fitted = fit_columns(runs, self.unicode, width, self.scope, table.cell_padding)
         columns = fitted.columns
         self.query_one("#runs-title", Static).update(self._title(len(runs)))
@@ -168,7 +172,9 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         station = self.station
         total = len(station.runs)
         if self.scope == ALL_MAZES:
-            return f"Runs on every maze: {total}, by maze and profile  (a: this maze only)"
+            profile = one_profile(self._in_scope)
+            grouped = f"all {profile}, by maze" if profile else "by maze and profile"
+            return f"Runs on every maze: {total}, {grouped}  (a: this maze only)"
         where = f"{station.maze.name or '-'} ({station.profile})"
         others = total - shown
         more = f", {others} on other mazes (a shows all)" if others else ""

@@ -106,6 +106,21 @@ def runs_in_scope(
     return sorted(runs, key=lambda r: (r.maze, r.profile, r.number))
 
 
+def one_profile(runs: Sequence[RunEntry]) -> str:
+    """The profile every run in ``runs`` was made with ("" when they differ or none are)."""
+    profiles = {r.profile for r in runs}
+    return profiles.pop() if len(profiles) == 1 else ""
+
+
+def scope_columns(runs: Sequence[RunEntry], scope: str) -> set[str]:
+    """The columns a scope shows: the maze only where runs on several mazes are, and the
+    profile only where they were made with more than one (the title names a single one)."""
+    keys = {c.key for c in COLUMNS}
+    if scope != ALL_MAZES:
+        return keys - {"maze", "profile"}
+    return keys - ({"profile"} if one_profile(runs) else set())
+
+
 def shorten(text: str, width: int, unicode: bool) -> str:
     """``text`` cut to ``width`` cells, with a mark (``…``, ``~`` in ASCII) where it was cut."""
     if cell_len(text) <= width:
@@ -148,10 +163,11 @@ def fit_columns(
 ) -> FittedColumns:
     """The columns that fit ``width`` cells, in table order, each as wide as its widest cell
     or heading plus ``padding`` on each side: the run's number and its graded measures
-    always; the names (driver; maze and profile where runs on several mazes are shown)
-    whole where they fit, else shortened (the longest first, never below their heading or
-    :data:`SHORTEST_NAME`); then the other columns, the lowest ranks first, while they fit."""
-    wanted = [c for c in COLUMNS if scope == ALL_MAZES or c.key not in ("maze", "profile")]
+    always; the names (driver; maze, and profile where they differ, where runs on several
+    mazes are shown) whole where they fit, else shortened (the longest first, never below
+    their heading or :data:`SHORTEST_NAME`); then the other columns, the lowest ranks
+    first, while they fit."""
+    wanted = [c for c in COLUMNS if c.key in scope_columns(runs, scope)]
     widest = {c.key: _widest(c, runs, unicode) for c in wanted}
     used = sum(widest[key] + 2 * padding for key in KEPT)
     names = {c.key: widest[c.key] for c in wanted if c.key in NAMES}
