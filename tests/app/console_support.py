@@ -62,3 +62,69 @@ async def until(pilot: Pilot, done: Callable[[], object], what: str, seconds: fl
     while not done():
         assert time.monotonic() < deadline, f"waited {seconds} s for {what}"
         await pilot.pause(0.05)
+
+
+WEB_LAB, WALL_MAIN = "web-simulator", "wall-main"
+LONG_EXERCISE = ("unity-simulator", "reading-wall-following")
+
+
+def wall_run(person: str, program: str, digest: str, attempt: str, run: int = 4) -> dict:
+    """The evidence of a run of ``program`` on the Web maze, as the workbench now saves it:
+    the sensors the run used, the program's name and digest, and its measures in pixels."""
+    return {
+        "attempt": attempt,
+        "run": run,
+        "driver": f"VIPLE program {program}",
+        "person": person,
+        "program_sha256": digest,
+        "program_name": program,
+        "sensors": ["distance:1:right", "touch:2:front"],
+        "maze": "Web Simulator lab maze",
+        "maze_digest": "f" * 64,
+        "profile": "web",
+        "ended": "exit",
+        "metrics": {
+            "reached_exit": True,
+            "exit_time": 61.25,
+            "sim_time": 61.25,
+            "distance": 4245.42,
+            "distance_cells": 60.65,
+            "turn_degrees": 1980.0,
+            "turns": 22,
+            "collisions": 1,
+            "efficiency": 0.4,
+            "touches": 9,
+        },
+        "record": "",
+        "record_sha256": None,
+    }
+
+
+def wall_main(
+    person: str,
+    program: str = "wall.viple",
+    digest: str = "ab" * 32,
+    attempt: str = "att-1",
+    sensors_program: tuple[str, str] | None = None,
+) -> ExerciseProgress:
+    """web-simulator/wall-main done with ``program``: the sensors objective on one run (of
+    ``sensors_program`` (name, digest) when given: the evidence then mixes programs), the exit
+    on another, the questions right with their tries and none waiting."""
+    sensor_name, sensor_digest = sensors_program or (program, digest)
+    states = [
+        ObjectiveState("sensors", "distance 1 right and touch 2 front", True,
+                       "run 3 used distance:1:right, touch:2:front",
+                       wall_run(person, sensor_name, sensor_digest, attempt, 3)),
+        ObjectiveState("exit", "your program got out of the Web maze", True,
+                       "run 4 got out", wall_run(person, program, digest, attempt)),
+        ObjectiveState("questions", "questions answered", True, "all 2 answered correctly",
+                       {"correct": 2, "of": 2, "tries": {"base": 1, "margin": 3},
+                        "waiting": []}),
+    ]  # fmt: skip
+    return ExerciseProgress(WEB_LAB, WALL_MAIN, states)
+
+
+def save_progress(store: Store, student: str, progress: ExerciseProgress) -> None:
+    """``student`` at ``progress``'s exercise, with that progress saved."""
+    store.set_place(student, progress.lab, progress.exercise)
+    store.save_progress(student, progress.lab, progress.exercise, json.loads(progress.to_json()))

@@ -3,26 +3,33 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 
 import pytest
 from textual.screen import Screen
 from textual.widgets import DataTable, Input, Static
 
+from tests.app.runs_support import BEND, run_algorithms, runs_with_long_driver_names
 from tests.app.support import screen_lines, sync
 from workbench.control.station import LabStation
-from workbench.sim.mazefile import parse_maze
 from workbench.sim.mazeio import load_maze
 from workbench.sim.record import FORMAT
 from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.host import ScreenHost
 from workbench.tui.screens.replay import ReplayScreen
 from workbench.tui.screens.runs import RunsScreen
+from workbench.tui.screens.runs_table import (
+    ALL_MAZES,
+    THIS_MAZE,
+    fit_columns,
+    one_profile,
+    scope_columns,
+)
 from workbench.tui.widgets import MazeView
 
-BEND = parse_maze(
-    "---\nname: Bend\n---\n#######\n#S....#\n#####.#\n#E....#\n#######\n", source="bend.txt"
-)
 SIZE = (80, 24)
+#: the headings of the graded measures, which every view keeps at any width
+GRADED = ("Out", "Time s", "Blocks", "Turn deg", "Turns", "Hit/Tch")
 
 
 class Host(ScreenHost):
@@ -34,19 +41,6 @@ class Host(ScreenHost):
 
     def on_mount(self) -> None:
         self.push_screen(self.under_test)
-
-
-def run_algorithms(station: LabStation, *names: str) -> LabStation:
-    for name in names:
-        station.select_algorithm(name)
-        station.apply_algorithm_preset()
-        station.start()
-        before = len(station.runs)
-        for _ in range(200):
-            station.step(60)
-            if len(station.runs) > before:
-                break
-    return station
 
 
 def two_runs(tmp_path) -> LabStation:
@@ -136,6 +130,7 @@ async def test_no_column_is_cut_and_the_rest_is_on_the_detail_line(tmp_path, wid
         )
         headings = check_no_column_is_cut(app)
         assert headings[:3] == ["#", "Driver", "Out"] and "Maze" not in headings
+        assert set(GRADED) <= set(headings)
         assert [row[1] for row in table_rows(screen.query_one(DataTable))] == [
             "two-distance-local-best"
         ]
@@ -145,19 +140,22 @@ async def test_no_column_is_cut_and_the_rest_is_on_the_detail_line(tmp_path, wid
             "run 3: algorithm two-distance-local-best on Web Simulator lab maze (erobotic"
         )
         assert (eff in detail) == ("Eff" not in headings)
-        assert ("Turn deg" in detail) == ("Turn deg" not in headings)
 
         await pilot.press("a")
         await pilot.pause()
-        assert text(screen.query_one("#runs-title")).startswith("Runs on every maze: 3")
+        # one profile: the title names it, and its column gives the names the room
+        title = text(screen.query_one("#runs-title"))
+        assert title.startswith("Runs on every maze: 3, all erobotic, by maze")
         headings = check_no_column_is_cut(app)
-        assert headings[:4] == ["#", "Driver", "Maze", "Profile"]
+        assert headings[:4] == ["#", "Driver", "Maze", "Out"] and "Profile" not in headings
+        assert set(GRADED) <= set(headings)
         rows = table_rows(screen.query_one(DataTable))
-        assert [(row[0], row[2], row[3]) for row in rows] == [
-            ("1", "Bend", "erobotic"),
-            ("2", "Bend", "erobotic"),
-            ("3", "Web Simulator lab maze", "erobotic"),
-        ]
+        assert [(row[0], row[2]) for row in rows][:2] == [("1", "Bend"), ("2", "Bend")]
+        # where the names do not fit whole they are shortened, marked, and said whole below
+        web = rows[2][2]
+        assert web == "Web Simulator lab maze" or (
+            web.endswith("~") and "Web Simulator lab maze".startswith(web[:-1])
+        )
         if width == 132:
             assert "Ended" in headings and "Rec" in headings
 
@@ -346,3 +344,54 @@ async def test_runs_that_end_while_the_screen_is_open_appear(tmp_path):
         screen.show_snapshot(station.snapshot())
         await pilot.pause()
         assert screen.query_one(DataTable).row_count == 3
+
+
+@pytest.mark.parametrize("unicode", [False, True])
+@sync
+async def test_both_views_keep_every_graded_measure_at_80x24_with_long_driver_names(
+    tmp_path, unicode
+):
+    station = runs_with_long_driver_names(tmp_path)
+    screen = RunsScreen(station, unicode=unicode)
+    app = Host(screen)
+    turn = "Turn °" if unicode else "Turn deg"
+    graded = [turn if g == "Turn deg" else g for g in GRADED]
+    cut = "…" if unicode else "~"
+    async with app.run_test(size=SIZE) as pilot:
+        await pilot.pause()
+        for scope in ("this maze", "all mazes"):
+            assert screen.scope == scope
+            table = screen.query_one(DataTable)
+            headings = [str(c.label) for c in table.columns.values()]
+            assert set(graded) <= set(headings), (scope, headings)
+            assert table.virtual_size.width <= table.scrollable_content_region.width
+            rows = {row[0]: row for row in table_rows(table)}
+            program = rows["1"][1]
+            assert program.endswith(cut)
+            assert "my-own-right-wall-follower-for-the-web-maze.viple".startswith(program[:-1])
+            m = station.runs[0].metrics
+            figures = [f"{m.exit_time:.1f}", f"{m.distance_cells:.2f}", f"{m.turn_degrees:.0f}",
+                       str(m.turns), f"{m.collisions}/{m.touches}"]  # fmt: skip
+            assert rows["1"][-len(figures) :] == figures
+            screen_text = "\n".join(screen_lines(app))
+            assert all(f in screen_text for f in figures)
+            detail = " ".join(text(screen.query_one("#runs-detail")).split())
+            chosen = table.get_row_at(table.cursor_row)[0]
+            run = station.runs[int(str(chosen)) - 1]
+            assert detail.startswith(f"run {run.number}: {run.driver} on ")
+            await pilot.press("a")
+            await pilot.pause()
+
+
+def test_the_profile_column_stands_where_the_runs_were_made_with_several(tmp_path):
+    erobotic = two_runs(tmp_path)
+    web = run_algorithms(LabStation.open(BEND, "web", noise="off"), "right-wall")
+    runs = [*erobotic.runs, replace(web.runs[0], number=3)]
+    assert one_profile(runs) == "" and one_profile(erobotic.runs) == "erobotic"
+    assert "profile" in scope_columns(runs, ALL_MAZES)
+    assert "profile" not in scope_columns(erobotic.runs, ALL_MAZES)
+    assert not {"maze", "profile"} & scope_columns(runs, THIS_MAZE)
+    fitted = fit_columns(runs, False, 78, ALL_MAZES)
+    assert fitted.keys[:4] == ("number", "driver", "maze", "profile")
+    assert {"reached", "time", "distance", "turning", "turns", "contacts"} <= set(fitted.keys)
+    assert [fitted.cells(r, False)[3] for r in runs] == ["erobotic", "erobotic", "web"]

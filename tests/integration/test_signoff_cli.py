@@ -119,6 +119,11 @@ def test_export_contains_exactly_the_verifying_records(data_dir, tmp_path, capsy
         ("carol", "wall-following"),
     ]
     assert rows[0]["signed_at"] == "2026-03-02T10:02:00Z" and rows[0]["instructor"] == "Dr Chen"
+    header = target.read_text().splitlines()[0].split(",")
+    assert header[header.index("evidence_digest") + 1 :][:5] == [
+        "program", "program_sha256", "run", "profile", "time_s",
+    ]  # fmt: skip
+    assert "distance_unit" in header and header[-2:] == ["seq", "log_head"]
 
 
 def test_a_damaged_database_does_not_verify_and_bad_input_exits_2(data_dir, tmp_path, capsys):

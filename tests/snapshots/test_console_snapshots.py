@@ -9,7 +9,16 @@ from datetime import UTC, datetime
 from textual.pilot import Pilot
 from textual.widgets import Input
 
-from tests.app.console_support import EXERCISE, LAB, save_student, until
+from tests.app.console_support import (
+    EXERCISE,
+    LAB,
+    WALL_MAIN,
+    WEB_LAB,
+    save_progress,
+    save_student,
+    until,
+    wall_main,
+)
 from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.model import load_labs
 from workbench.labs.store import Store
@@ -53,3 +62,36 @@ def test_console_request_opened(snap_compare, tmp_path):
         await pilot.pause()
 
     assert snap_compare(console(tmp_path / "data"), terminal_size=SIZE, run_before=before)
+
+
+def test_console_grid_of_students_by_exercises(snap_compare, tmp_path):
+    async def before(pilot: Pilot) -> None:
+        await class_shown(pilot)
+        await pilot.press("g")
+        await pilot.pause()
+
+    assert snap_compare(console(tmp_path / "data"), terminal_size=SIZE, run_before=before)
+
+
+def test_console_request_with_a_programs_evidence(snap_compare, tmp_path):
+    """The evidence of a program's runs in words: program and digest, sensors, measures in
+    blocks and pixels, tries per question; the marks for mixed and shared programs."""
+    data = tmp_path / "data"
+    create_instructor(data, "Dr Chen", "correct horse battery", kdf=FAST)
+    with Store.open(data) as store:
+        mixed = wall_main("ana", sensors_program=("other.viple", "cd" * 32))
+        save_progress(store, "ana", mixed)
+        save_progress(store, "ben", wall_main("ben", attempt="att-2"))
+        store.request_signoff("ana", "", "ana", WEB_LAB, WALL_MAIN, now=T0)
+
+    async def before(pilot: Pilot) -> None:
+        await class_shown(pilot)
+        await pilot.press("enter")
+        screen = pilot.app.screen
+        await until(pilot, lambda: getattr(screen, "request", None) is not None, "the request")
+        for field in screen.query(Input):
+            field.cursor_blink = False
+        await pilot.pause()
+
+    app = ConsoleApp(Store.open(data), load_labs())
+    assert snap_compare(app, terminal_size=SIZE, run_before=before)

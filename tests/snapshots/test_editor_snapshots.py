@@ -13,6 +13,7 @@ from textual.pilot import Pilot
 from textual.screen import Screen
 from textual.widgets import Input
 
+from tests.app.runs_support import runs_with_long_driver_names
 from workbench.control.station import LabStation
 from workbench.sim.generate import generate
 from workbench.sim.mazeio import load_maze
@@ -136,3 +137,12 @@ def test_replay_at_the_end_80x24(snap_compare, web_runs):
     record = web_runs.runs[1].record
     app = Host(ReplayScreen(record, mazes=(web_runs.maze,), unicode=False))
     assert snap_compare(app, press=("end",), terminal_size=SMALL)
+
+
+@pytest.mark.parametrize("unicode", [False, True], ids=["ascii", "unicode"])
+@pytest.mark.parametrize("press", [(), ("a",)], ids=["this-maze", "all-mazes"])
+def test_runs_with_a_long_driver_name_80x24(snap_compare, tmp_path, unicode, press):
+    """Every graded measure stands at 80 columns; the long names are shortened."""
+    station = runs_with_long_driver_names(tmp_path)
+    app = Host(RunsScreen(station, unicode=unicode))
+    assert snap_compare(app, press=press, terminal_size=SMALL)

@@ -16,7 +16,9 @@ import sys
 from pathlib import Path
 
 from workbench.files.atomic import write_text_atomic
+from workbench.labs.classview import profiles
 from workbench.labs.gradebook import GRADEBOOK_COLUMNS, gradebook_rows, head_from_gradebook
+from workbench.labs.model import LabFileError, load_labs
 from workbench.labs.roster import load_roster, roster_path, trusted_roster_path
 from workbench.labs.signlog import Head, LogError
 from workbench.labs.signoff_errors import SignoffError, UntrustedRoster
@@ -206,6 +208,15 @@ def cmd_verify(args: argparse.Namespace) -> int:
     return 0
 
 
+def _exercise_profiles() -> dict[tuple[str, str], str]:
+    """Each exercise's profile, for the unit of records that name none (none when the lab
+    files cannot be read: those rows then leave the unit empty)."""
+    try:
+        return profiles(load_labs())
+    except LabFileError:
+        return {}
+
+
 def cmd_export(args: argparse.Namespace) -> int:
     try:
         _, log = _checked_log(args)
@@ -215,7 +226,7 @@ def cmd_export(args: argparse.Namespace) -> int:
         for problem in log.breaks:
             print(f"FAIL log: {problem}", file=sys.stderr)
         return fail("the log is broken, so no gradebook was written (see 'signoff verify')", 1)
-    rows = gradebook_rows(log.verified_rows(), log.head)
+    rows = gradebook_rows(log.verified_rows(), log.head, _exercise_profiles())
     out = io.StringIO()
     writer = csv.DictWriter(out, fieldnames=GRADEBOOK_COLUMNS, lineterminator="\n")
     writer.writeheader()

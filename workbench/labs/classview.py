@@ -1,5 +1,6 @@
 """The class as the instructor's console shows it: every student, the exercise they have open,
-its objectives and who waits for sign-off, read from the store.
+its objectives and who waits for sign-off; every student's standing in every exercise (the
+grid); and the programs two students' evidence share (the copy hints), read from the store.
 
 :func:`read_class` reads it all in one go (the console calls it about once a second, in a
 thread); :func:`read_request` reads what one request rests on: the exercise's saved progress,
@@ -13,6 +14,8 @@ from dataclasses import dataclass
 from typing import Any
 
 from .checks import ExerciseProgress
+from .copy_hints import CopyHint, ProgramUse, bundled_digests, copy_hints, program_uses
+from .evidence_text import programs_of
 from .model import Lab
 from .progress import signoff_driver
 from .queue import QueueEntry
@@ -39,16 +42,87 @@ class StudentRow:
     signed: bool
     #: the saved progress could not be read (why)
     problem: str = ""
+    #: the programs (sha256 to name) the open exercise's passed objectives rest on, when
+    #: more than one: its evidence mixes programs
+    mixed: tuple[tuple[str, str], ...] = ()
+    #: the other students whose evidence has a program of this student's (copy hints)
+    same_program_as: tuple[str, ...] = ()
+
+
+#: where a student stands in one exercise (a cell of the grid)
+NOTHING, STARTED, PASSED, ASKED, SIGNED = "nothing", "started", "passed", "asked", "signed"
+
+
+@dataclass(frozen=True)
+class Standing:
+    """One student in one exercise: how far, and whether asked for or given a sign-off."""
+
+    state: str
+    #: objectives passed, of how many (0 of 0: nothing saved)
+    passed: int = 0
+    of: int = 0
+    #: questions that used up their tries and wait for the instructor
+    waiting_questions: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class ClassGrid:
+    """Every student (rows) in every exercise of the labs (columns, lab by lab)."""
+
+    students: tuple[str, ...]
+    #: (lab, exercise) in the labs' order
+    exercises: tuple[tuple[str, str], ...]
+    #: (student, lab, exercise) to where they stand; absent: nothing saved, not asked
+    cells: dict[tuple[str, str, str], Standing]
+
+    def standing(self, student: str, lab: str, exercise: str) -> Standing:
+        return self.cells.get((student, lab, exercise), Standing(NOTHING))
+
+    def labs(self) -> tuple[str, ...]:
+        return tuple(dict.fromkeys(lab for lab, _ in self.exercises))
 
 
 @dataclass(frozen=True)
 class ClassView:
     rows: tuple[StudentRow, ...]
     queue: tuple[QueueEntry, ...]
+    grid: ClassGrid = ClassGrid((), (), {})
+    #: programs that are the evidence of two students or more who did not work together
+    hints: tuple[CopyHint, ...] = ()
 
 
 def titles(labs: list[Lab]) -> dict[tuple[str, str], str]:
     return {(lab.id, ex.id): ex.title for lab in labs for ex in lab.exercises}
+
+
+def profiles(labs: list[Lab]) -> dict[tuple[str, str], str]:
+    """Each exercise's profile (the unit its evidence is measured in)."""
+    return {(lab.id, ex.id): ex.setup.profile for lab in labs for ex in lab.exercises}
+
+
+def _waiting_questions(progress: ExerciseProgress) -> tuple[str, ...]:
+    for state in progress.objectives:
+        evidence = state.evidence if isinstance(state.evidence, dict) else {}
+        if state.kind == "questions" and isinstance(evidence.get("waiting"), list):
+            return tuple(str(q) for q in evidence["waiting"])
+    return ()
+
+
+def _standing(progress: ExerciseProgress | None, asked: bool, signed: bool) -> Standing:
+    passed = sum(o.passed for o in progress.objectives) if progress else 0
+    of = len(progress.objectives) if progress else 0
+    waiting = _waiting_questions(progress) if progress else ()
+    if signed:
+        state = SIGNED
+    elif asked:
+        state = ASKED
+    elif progress is not None and progress.objectives and progress.passed:
+        state = PASSED
+    elif progress is not None:
+        state = STARTED
+    else:
+        state = NOTHING
+    return Standing(state, passed, of, waiting)
 
 
 def read_class(store: Store, labs: list[Lab]) -> ClassView:
@@ -60,18 +134,39 @@ def read_class(store: Store, labs: list[Lab]) -> ClassView:
     signed = {(r.student, r.lab, r.exercise) for r in records}
     signed |= {(r.partner, r.lab, r.exercise) for r in records if r.partner}
     waiting = {(e.student, e.lab, e.exercise): n for n, e in enumerate(queue, 1)}
+    waiting |= {(e.partner, e.lab, e.exercise): n for n, e in enumerate(queue, 1) if e.partner}
     partners = {e.student: e.partner for e in queue}
-    rows = []
-    for student, (lab, exercise) in sorted(places.items(), key=lambda p: p[0].casefold()):
-        objectives: tuple[tuple[str, bool], ...] = ()
-        problem = ""
-        saved = store.progress(student, lab).get((lab, exercise))
-        if saved is not None:
+    pairs = [(e.student, e.partner) for e in queue] + [(r.student, r.partner) for r in records]
+    students = sorted(
+        set(places) | {person for s, p in pairs for person in (s, p) if person}, key=str.casefold
+    )
+    bundled = bundled_digests()
+    saved: dict[tuple[str, str, str], ExerciseProgress] = {}
+    problems: dict[tuple[str, str, str], str] = {}
+    uses: list[ProgramUse] = []
+    for student in students:
+        for (lab, exercise), data in store.progress(student).items():
             try:
-                progress = ExerciseProgress.from_dict(saved)
-                objectives = tuple((o.text, o.passed) for o in progress.objectives)
+                progress = ExerciseProgress.from_dict(data)
             except ValueError as exc:
-                problem = str(exc)
+                problems[(student, lab, exercise)] = str(exc)
+                continue
+            saved[(student, lab, exercise)] = progress
+            uses += program_uses(student, progress, bundled)
+    hints = copy_hints(uses, pairs)
+    sharing: dict[str, set[str]] = {}
+    for hint in hints:
+        for student in hint.students:
+            sharing.setdefault(student, set()).update(set(hint.students) - {student})
+    rows = []
+    for student in students:
+        if student not in places:
+            continue
+        lab, exercise = places[student]
+        key = (student, lab, exercise)
+        found = saved.get(key)
+        objectives = tuple((o.text, o.passed) for o in found.objectives) if found else ()
+        mixed = programs_of(found, bundled) if found else {}
         rows.append(
             StudentRow(
                 student=student,
@@ -80,12 +175,25 @@ def read_class(store: Store, labs: list[Lab]) -> ClassView:
                 exercise=exercise,
                 title=names.get((lab, exercise), ""),
                 objectives=objectives,
-                waiting=waiting.get((student, lab, exercise)),
-                signed=(student, lab, exercise) in signed,
-                problem=problem,
+                waiting=waiting.get(key),
+                signed=key in signed,
+                problem=problems.get(key, ""),
+                mixed=tuple(sorted(mixed.items())) if len(mixed) > 1 else (),
+                same_program_as=tuple(sorted(sharing.get(student, ()), key=str.casefold)),
             )
         )
-    return ClassView(tuple(rows), tuple(queue))
+    exercises = tuple((lab.id, ex.id) for lab in labs for ex in lab.exercises)
+    cells = {
+        (student, lab, exercise): _standing(
+            saved.get((student, lab, exercise)),
+            (student, lab, exercise) in waiting,
+            (student, lab, exercise) in signed,
+        )
+        for student in students
+        for lab, exercise in exercises
+    }
+    grid = ClassGrid(tuple(students), exercises, cells)
+    return ClassView(tuple(rows), tuple(queue), grid, hints)
 
 
 @dataclass(frozen=True)
@@ -99,6 +207,16 @@ class Request:
     #: the run the objectives rest on: its record file and figures (None: no run)
     run: dict[str, Any] | None
     problem: str = ""
+    #: the exercise's profile: the unit its lengths are in
+    profile: str = ""
+
+    @property
+    def programs(self) -> dict[str, str]:
+        """The programs (sha256 to name, bundled files aside) the passed objectives rest on:
+        more than one, and the evidence mixes programs."""
+        if self.progress is None:
+            return {}
+        return programs_of(self.progress, bundled_digests())
 
     @property
     def passed(self) -> bool:
@@ -134,12 +252,14 @@ def evidence_run(progress: ExerciseProgress) -> dict[str, Any] | None:
 
 def read_request(store: Store, entry: QueueEntry, labs: list[Lab]) -> Request:
     """The saved progress of ``entry``'s exercise and the run its objectives rest on."""
-    title = titles(labs).get((entry.lab, entry.exercise), entry.exercise)
-    saved = store.progress(entry.student, entry.lab).get((entry.lab, entry.exercise))
+    key = (entry.lab, entry.exercise)
+    title = titles(labs).get(key, entry.exercise)
+    profile = profiles(labs).get(key, "")
+    saved = store.progress(entry.student, entry.lab).get(key)
     if saved is None:
-        return Request(entry, title, None, None, "nothing saved for this exercise yet")
+        return Request(entry, title, None, None, "nothing saved for this exercise yet", profile)
     try:
         progress = ExerciseProgress.from_dict(saved)
     except ValueError as exc:
-        return Request(entry, title, None, None, str(exc))
-    return Request(entry, title, progress, evidence_run(progress))
+        return Request(entry, title, None, None, str(exc), profile)
+    return Request(entry, title, progress, evidence_run(progress), profile=profile)

@@ -1,18 +1,39 @@
 """The gradebook: the sign-off log exported as CSV, one row per student and exercise.
 
 Every row carries the record's place in the log and the log's head at export, so a kept
-gradebook is also a kept head: ``workbench signoff verify --head-from`` reads it back.
+gradebook is also a kept head: ``workbench signoff verify --head-from`` reads it back. Each
+row also has the measures of the run the sign-off rests on (time, distance in blocks and in
+the profile's unit, named in ``distance_unit``, turning, turns, collisions) and the program
+that drove it. Every digest is written one way: ``sha256:`` and 64 hex digits (empty where
+there is none).
 """
 
 from __future__ import annotations
 
 import csv
+from collections.abc import Mapping
 from pathlib import Path
+from typing import Any
 
+from .evidence_text import measures_of, program_of
 from .signlog import Head, LogError
 from .signoff_errors import SignoffError
 from .store import StoredSignoff
 
+#: the columns of the run a sign-off rests on: the program that drove it and its measures
+RUN_COLUMNS = (
+    "program",
+    "program_sha256",
+    "run",
+    "profile",
+    "time_s",
+    "distance_blocks",
+    "distance",
+    "distance_unit",
+    "turn_degrees",
+    "turns",
+    "collisions",
+)
 GRADEBOOK_COLUMNS = (
     "student",
     "partner",
@@ -24,9 +45,66 @@ GRADEBOOK_COLUMNS = (
     "override",
     "note",
     "evidence_digest",
+    *RUN_COLUMNS,
     "seq",
     "log_head",
 )
+
+#: how a length in each unit is written in the gradebook (decimals), as the screens round it
+DECIMALS = {"px": 0, "unit": 2}
+
+
+def sha256_text(digest: str) -> str:
+    """A digest as the gradebook writes every digest: ``sha256:`` and its hex ("" for none)."""
+    return f"sha256:{digest.removeprefix('sha256:')}" if digest else ""
+
+
+def evidence_run(metrics: Any) -> Mapping[str, Any] | None:
+    """The run a signed record's evidence rests on: the first passed objective's evidence
+    that has a run's figures; a record signed with bare figures (no objectives) is its own."""
+    if not isinstance(metrics, Mapping):
+        return None
+    objectives = metrics.get("objectives")
+    if not isinstance(objectives, list):
+        return {"metrics": metrics} if "exit_time" in metrics or "distance" in metrics else None
+    for objective in objectives:
+        if not isinstance(objective, Mapping) or not objective.get("passed"):
+            continue
+        evidence = objective.get("evidence")
+        if isinstance(evidence, Mapping) and isinstance(evidence.get("metrics"), Mapping):
+            return evidence
+    return None
+
+
+def _figure(value: float | int | None, decimals: int) -> str:
+    return "" if value is None else f"{value:.{decimals}f}"
+
+
+def run_cells(metrics: Any, profile: str = "") -> dict[str, str]:
+    """The gradebook's run columns for a record's evidence (empty where it has no run);
+    ``profile`` is the exercise's, for evidence that names none."""
+    run = evidence_run(metrics)
+    cells = dict.fromkeys(RUN_COLUMNS, "")
+    if run is None:
+        return cells
+    program = program_of(run)
+    if program is not None:
+        cells["program"], cells["program_sha256"] = program[1], sha256_text(program[0])
+    m = measures_of(run, profile)
+    run_number = run.get("run")
+    cells["run"] = str(run_number) if isinstance(run_number, int) else ""
+    cells["profile"] = str(run.get("profile") or profile)
+    if m is not None:
+        cells.update(
+            time_s=_figure(m.time, 2),
+            distance_blocks=_figure(m.blocks, 2),
+            distance=_figure(m.distance, DECIMALS.get(m.unit, 2)),
+            distance_unit=m.unit if m.distance is not None else "",
+            turn_degrees=_figure(m.turn_degrees, 1),
+            turns=_figure(m.turns, 0),
+            collisions=_figure(m.collisions, 0),
+        )
+    return cells
 
 
 def head_from_gradebook(path: Path) -> Head:
@@ -51,11 +129,18 @@ def head_from_gradebook(path: Path) -> Head:
         raise SignoffError(str(exc)) from None
 
 
-def gradebook_rows(rows: list[StoredSignoff], head: Head) -> list[dict[str, str]]:
+def gradebook_rows(
+    rows: list[StoredSignoff],
+    head: Head,
+    profiles: Mapping[tuple[str, str], str] | None = None,
+) -> list[dict[str, str]]:
     """One row per student and exercise (each member of a pair gets one); the latest wins.
-    Every row carries the record's place in the log and the log's head at export."""
+    Every row carries the record's place in the log, the log's head at export, and the
+    measures of the evidence run (lengths in the unit of its profile, else of the exercise's
+    in ``profiles``)."""
     latest: dict[tuple[str, str, str], dict[str, str]] = {}
     for row in rows:
+        run = run_cells(row.metrics_value(), (profiles or {}).get((row.lab, row.exercise), ""))
         for person, other in ((row.student, row.partner), (row.partner, row.student)):
             if not person:
                 continue
@@ -69,7 +154,8 @@ def gradebook_rows(rows: list[StoredSignoff], head: Head) -> list[dict[str, str]
                 "driver": row.driver,
                 "override": "yes" if row.override else "no",
                 "note": row.note,
-                "evidence_digest": row.evidence_digest,
+                "evidence_digest": sha256_text(row.evidence_digest),
+                **run,
                 "seq": "" if row.seq is None else str(row.seq),
                 "log_head": str(head),
             }

@@ -127,8 +127,12 @@ class StartEndpoint(Message):
 class ScreenHost(App[ReturnType]):
     """The Unicode setting of an app that hosts the workbench's screens, in one place."""
 
-    # ASCII mode: Textual's own widgets without block-element borders (plain.py replaces
-    # their glyphs); here rather than in the app's stylesheet, so every host has them
+    # ASCII mode: Textual's own widgets and the side rules of the screens every host may open
+    # (the replay, the editor) without block-element borders (plain.py replaces their
+    # glyphs); here rather than in the app's stylesheet, so every host has them. Not scoped:
+    # Textual would scope these rules to the app's descendants, and the app is not its own
+    # descendant, so only the first selector of each list would match.
+    SCOPED_CSS = False
     DEFAULT_CSS = """
     App.-ascii OptionList,
     App.-ascii OptionList:focus {
@@ -142,6 +146,10 @@ class ScreenHost(App[ReturnType]):
     App.-ascii CommandPalette LoadingIndicator {
         border: none;
         border-bottom: ascii $border;
+    }
+    App.-ascii #editor-side,
+    App.-ascii #replay-side {
+        border-left: ascii $panel;
     }
     App.-ascii CommandPalette CommandList,
     App.-ascii CommandPalette CommandList:focus {

@@ -523,6 +523,21 @@ KEY_TABLE: dict[str, Key] = {
         "open the request",
         "Open the chosen request: the objectives, their evidence, the run and the sign-off.",
     ),
+    "console.grid": Key(
+        "g",
+        "grid",
+        "Grid",
+        "Console",
+        "students by exercises",
+        "Show every student in every exercise: passed, waiting for sign-off or signed off.",
+        rank=1,
+    ),
+    "grid.lab": Key(
+        "l", "next_lab", "Next lab", "Console", "next lab", "Show the next lab's exercises."
+    ),
+    "grid.leave": Key(
+        "escape", "leave", "Back", "Console", "back", "Back to the queue and the class.", rank=1
+    ),
     "console.replay": Key(
         "p",
         "replay",

@@ -1,18 +1,22 @@
 """The instructor's console: the class live from the store, and the sign-off queue.
 
 At the top, the requests for sign-off in the order the students asked; below, every student
-with the exercise they have open and its objectives (✓/✗, ``[X]``/``[ ]`` in ASCII mode), and
-their place in the queue. A thread of the screen's own reads the store about once a second
-(:func:`workbench.labs.classview.read_class`), never the event loop: a course database may be
-across the network. Enter on a request opens it (:mod:`.console_request`), where the instructor
-signs it off with their own key, typed in their own session, or declines it with a note.
+with the exercise they have open (its id whole, on a line of its own where the columns do not
+fit), its objectives (✓/✗, ``X``/``.`` in ASCII mode) and their place in the queue, and a
+line of marks where the evidence mixes programs or shares a program with another student's.
+``g`` opens the grid of students by exercises (:mod:`.console_grid`). A thread of the
+screen's own reads the store about once a second (:func:`workbench.labs.classview.read_class`),
+never the event loop: a course database may be across the network. Enter on a request opens
+it (:mod:`.console_request`), where the instructor signs it off with their own key, typed in
+their own session, or declines it with a note.
 """
 
 from __future__ import annotations
 
 import threading
 import time
-from typing import ClassVar
+from collections.abc import Callable, Sequence
+from typing import Any, ClassVar
 
 from textual import on
 from textual.app import ComposeResult
@@ -24,6 +28,7 @@ from textual.widgets.option_list import Option
 
 from workbench.labs.classview import ClassView, StudentRow, read_class
 from workbench.labs.model import Lab
+from workbench.labs.queue import QueueEntry
 from workbench.labs.store import Store, StoreUnavailable
 
 from ..host import FollowsUnicode
@@ -51,19 +56,54 @@ def objective_marks(row: StudentRow, unicode: bool) -> str:
     return "".join(passed if ok else failed for _text, ok in row.objectives) or "-"
 
 
-def row_text(row: StudentRow, unicode: bool) -> str:
-    """One student's line: who, the exercise, the objectives, the queue."""
-    who = row.student + (f"+{row.partner}" if row.partner else "")
+def _state(row: StudentRow) -> str:
     if row.signed:
-        state = "signed off"
-    elif row.waiting is not None:
-        state = f"waiting #{row.waiting}"
-    elif row.problem:
-        state = "progress unreadable"
-    else:
-        state = ""
-    where = f"{row.lab}/{row.exercise}"
-    return f"{who[:18]:<18} {where[:30]:<30} {objective_marks(row, unicode):<8} {state}"
+        return "signed off"
+    if row.waiting is not None:
+        return f"waiting #{row.waiting}"
+    if row.problem:
+        return "unreadable"
+    return ""
+
+
+def _flags(row: StudentRow) -> str:
+    """What the instructor should look at: evidence on several programs, a shared program."""
+    flags = []
+    if row.mixed:
+        flags.append(f"evidence mixes {len(row.mixed)} programs")
+    if row.same_program_as:
+        flags.append(f"same program as {', '.join(row.same_program_as)}")
+    return "; ".join(flags)
+
+
+def class_prompts(rows: Sequence[StudentRow], unicode: bool, width: int) -> list[str]:
+    """Each student's entry in the class list: who, the exercise (whole: never cut), the
+    objectives, the queue; on one line in columns where they fit ``width``, else the
+    exercise on a line of its own; and a line of flags (mixed programs, copy hints)."""
+    who = [r.student + (f"+{r.partner}" if r.partner else "") for r in rows]
+    where = [f"{r.lab}/{r.exercise}" for r in rows]
+    marks = [objective_marks(r, unicode) for r in rows]
+    states = [_state(r) for r in rows]
+    widths = [max(map(len, column), default=0) for column in (who, where, marks, states)]
+    one_line = sum(widths) + 3 <= width
+    prompts = []
+    for row, w, x, m, st in zip(rows, who, where, marks, states, strict=True):
+        if one_line:
+            text = f"{w:<{widths[0]}} {x:<{widths[1]}} {m:<{widths[2]}} {st}".rstrip()
+        else:
+            text = f"{w:<{widths[0]}} {m:<{widths[2]}} {st}".rstrip() + f"\n  {x}"
+        flags = _flags(row)
+        prompts.append(text + (f"\n  ! {flags}" if flags else ""))
+    return prompts
+
+
+def queue_prompt(n: int, entry: QueueEntry, width: int) -> str:
+    """One request of the queue: its place, the pair, the exercise (whole) and when asked."""
+    first = f"{n}. {entry.pair}"
+    rest = f"{entry.lab}/{entry.exercise}  asked {entry.requested_at[11:16]}"
+    if len(first) + 2 + len(rest) <= width:
+        return f"{first:<{width - len(rest) - 1}} {rest}"
+    return f"{first}\n   {rest}"
 
 
 class ConsoleScreen(FollowsUnicode, Screen[None]):
@@ -92,7 +132,7 @@ class ConsoleScreen(FollowsUnicode, Screen[None]):
     }
     """
 
-    BINDINGS: ClassVar[list[BindingType]] = [*bindings("console.open")]
+    BINDINGS: ClassVar[list[BindingType]] = [*bindings("console.open", "console.grid")]
 
     def __init__(self, store: Store, labs: list[Lab], instructor: str = "") -> None:
         super().__init__()
@@ -106,8 +146,8 @@ class ConsoleScreen(FollowsUnicode, Screen[None]):
         self.unicode = False
         self._stop = threading.Event()
         self._wake = threading.Event()
-        #: called with each read, once shown (the bench measures with it)
-        self.on_shown: list = []
+        #: called with each read, once shown (the bench measures with it; the grid follows it)
+        self.on_shown: list[Callable[[Any], None]] = []
 
     def compose(self) -> ComposeResult:
         yield Static("Sign-off queue", id="console-queue-title", markup=False)
@@ -164,12 +204,9 @@ class ConsoleScreen(FollowsUnicode, Screen[None]):
     def _show(self, view: ClassView) -> None:
         queue = self.query_one("#console-queue", OptionList)
         chosen = queue.highlighted_option.id if queue.highlighted_option is not None else None
+        width = self._room(queue)
         options = [
-            Option(
-                f"{n}. {e.pair[:24]:<24} {e.lab}/{e.exercise}  asked {e.requested_at[11:16]} UTC",
-                id=f"q{e.id}",
-            )
-            for n, e in enumerate(view.queue, 1)
+            Option(queue_prompt(n, e, width), id=f"q{e.id}") for n, e in enumerate(view.queue, 1)
         ]
         queue.clear_options()
         queue.add_options(options)
@@ -179,13 +216,14 @@ class ConsoleScreen(FollowsUnicode, Screen[None]):
         waiting = len(view.queue)
         self.query_one("#console-queue-title", Static).update(
             f"Sign-off queue: {waiting} waiting"
-            + ("; enter opens the highlighted request" if waiting else " (nobody has asked)")
+            + ("; times UTC; enter opens one" if waiting else " (nobody has asked)")
         )
         listing = self.query_one("#console-class", OptionList)
         top = listing.scroll_offset.y
         listing.clear_options()
+        prompts = class_prompts(view.rows, self.unicode, self._room(listing))
         listing.add_options(
-            [Option(row_text(r, self.unicode), id=f"s:{r.student}") for r in view.rows]
+            [Option(p, id=f"s:{r.student}") for r, p in zip(view.rows, prompts, strict=True)]
         )
         listing.scroll_to(y=top, animate=False)
         passed, failed = ("✓", "✗") if self.unicode else ("X", ".")
@@ -193,6 +231,23 @@ class ConsoleScreen(FollowsUnicode, Screen[None]):
             f"Class: {len(view.rows)} at work; objectives {passed} passed, {failed} not yet"
             + (f"; console of {self.instructor}" if self.instructor else "")
         )
+
+    def _room(self, listing: OptionList) -> int:
+        """The columns an option of ``listing`` has (inside its frame and scroll bar)."""
+        scrollbar = listing.styles.scrollbar_size_vertical
+        if listing.size.width:  # the content's width: inside the frame
+            return max(20, listing.size.width - scrollbar)
+        return max(20, self.app.size.width - listing.styles.gutter.width - scrollbar)
+
+    def on_resize(self) -> None:
+        if self.view is not None:
+            self._show(self.view)
+
+    def action_grid(self) -> None:
+        """The students by exercises grid, read with the class."""
+        from .console_grid import GridScreen
+
+        self.app.push_screen(GridScreen(self))
 
     def action_open_entry(self) -> None:
         queue = self.query_one("#console-queue", OptionList)
@@ -205,7 +260,8 @@ class ConsoleScreen(FollowsUnicode, Screen[None]):
             return
         from .console_request import RequestScreen
 
-        self.app.push_screen(RequestScreen(self.store, entry, self.labs), self._decided)
+        hints = self.view.hints
+        self.app.push_screen(RequestScreen(self.store, entry, self.labs, hints), self._decided)
 
     @on(OptionList.OptionSelected, "#console-queue")
     def _selected(self, event: OptionList.OptionSelected) -> None:

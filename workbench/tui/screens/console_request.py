@@ -12,6 +12,7 @@ It returns what was done, in words for the console's message line (None: closed)
 from __future__ import annotations
 
 import asyncio
+import textwrap
 from typing import Any, ClassVar
 
 from textual import on
@@ -22,6 +23,8 @@ from textual.screen import Screen
 from textual.widgets import Button, Input, Static
 
 from workbench.labs.classview import Request, read_request
+from workbench.labs.copy_hints import CopyHint, hints_for
+from workbench.labs.evidence_text import lines_of_progress, mixed_programs_text, short_digest
 from workbench.labs.model import Lab
 from workbench.labs.queue import QueueEntry
 from workbench.labs.roster import roster_names
@@ -37,57 +40,42 @@ from ..widgets.field import Field
 from ..widgets.key_bar import KeyBar
 from ..widgets.signoff_form import READING_ROSTER, SignoffForm
 
-#: the run figures shown, in this order, with their units
-FIGURES = (
-    ("exit_time", "time to the exit", "s"),
-    ("distance", "distance", "m"),
-    ("collisions", "collisions", ""),
-    ("turns", "turns", ""),
-)
 
-
-def figure_lines(run: dict[str, Any]) -> list[str]:
-    """The evidence run in a few lines: which run, who drove, the maze, its figures."""
-    lines = [
-        f"run {run.get('run', '?')} by {run.get('driver', '?')} on {run.get('maze', '?')} "
-        f"({run.get('profile', '?')}), ended: {run.get('ended', '?')}"
-    ]
-    metrics = run.get("metrics")
-    if isinstance(metrics, dict):
-        known = [k for k, *_ in FIGURES]
-        shown = [
-            f"{label} {_number(metrics[k])}{(' ' + unit) if unit else ''}"
-            for k, label, unit in FIGURES
-            if k in metrics
-        ]
-        shown += [f"{k} {_number(v)}" for k, v in sorted(metrics.items()) if k not in known]
-        lines.append("; ".join(shown))
+def record_line(run: dict[str, Any] | None) -> str:
+    """Where the evidence run's record is, and whether it replays."""
+    if run is None:
+        return "no run among the evidence"
     record = run.get("record")
-    lines.append(f"record: {record}" if record else "the run was not recorded (no replay)")
-    return lines
+    if not record:
+        return f"run {run.get('run', '?')} was not recorded (no replay)"
+    return f"run {run.get('run', '?')} is recorded in {record}: p replays it"
 
 
-def _number(value: object) -> str:
-    if isinstance(value, float):
-        return f"{value:.2f}"
-    return str(value)
+def hanging(lines: list[str], width: int) -> list[str]:
+    """``lines`` wrapped to ``width`` columns, each line's rest indented under its words (so
+    an objective's evidence stays apart from the next objective); words are never cut."""
+    out = []
+    for line in lines:
+        text = line.lstrip(" ")
+        indent = " " * (len(line) - len(text))
+        mark = text.split(" ", 1)[0] if text[:1] in "[!✓✗" else ""
+        rest = indent + " " * (len(mark) + 1 if mark else 2)
+        out += textwrap.wrap(
+            line,
+            max(width, len(rest) + 10),
+            subsequent_indent=rest,
+            break_long_words=False,
+            break_on_hyphens=False,
+        ) or [""]
+    return out
 
 
-def evidence_words(evidence: object) -> str:
-    """An objective's evidence in one short line."""
-    if not isinstance(evidence, dict) or not evidence:
-        return ""
-    if "run" in evidence:
-        return f"run {evidence.get('run')} by {evidence.get('driver', '?')}"
-    parts = []
-    for key, value in sorted(evidence.items()):
-        if value in (None, "", [], {}):
-            continue
-        text = ", ".join(map(str, value)) if isinstance(value, list) else str(value)
-        parts.append(f"{key.replace('_', ' ')} {text[:30]}")
-        if len(parts) == 3:
-            break
-    return "; ".join(parts)
+def hint_lines(student: str, hints: tuple[CopyHint, ...]) -> list[str]:
+    """The copy hints that name ``student``: the program and the other students."""
+    return [
+        f"same program as {', '.join(others)}: {hint.name} (sha256 {short_digest(hint.digest)})"
+        for hint, others in hints_for(student, hints)
+    ]
 
 
 class RequestScreen(Screen[str | None]):
@@ -137,11 +125,21 @@ class RequestScreen(Screen[str | None]):
         *bindings("dialog.close", "console.sign", "console.decline", "console.replay")
     ]
 
-    def __init__(self, store: Store, entry: QueueEntry, labs: list[Lab]) -> None:
+    def __init__(
+        self,
+        store: Store,
+        entry: QueueEntry,
+        labs: list[Lab],
+        hints: tuple[CopyHint, ...] = (),
+    ) -> None:
         super().__init__()
         self.store = store
         self.entry = entry
         self.labs = labs
+        #: the class's copy hints as the console last read them
+        self.hints = hints
+        #: what the objectives part says, before it is wrapped to the screen's width
+        self._lines: list[str] = []
         self.request: Request | None = None
         #: a sign-off or decline under way (one at a time)
         self.busy = False
@@ -199,28 +197,42 @@ class RequestScreen(Screen[str | None]):
 
     def _show(self, request: Request) -> None:
         unicode = getattr(self.app, "unicode", False)
-        passed, failed = ("✓", "✗") if unicode else ("[X]", "[ ]")
+        marks = ("✓", "✗") if unicode else ("[X]", "[ ]")
         lines = [f"{request.title}"]
-        if request.progress is None:
+        progress = request.progress
+        if progress is None:
             lines.append(request.problem)
         else:
-            for o in request.progress.objectives:
-                lines.append(f"{passed if o.passed else failed} {o.text}: {o.reason}")
-                said = evidence_words(o.evidence)
-                if said:
-                    lines.append(f"    evidence: {said}")
-            count = sum(o.passed for o in request.progress.objectives)
-            total = len(request.progress.objectives)
+            warnings = [mixed_programs_text(request.programs)]
+            entry = self.entry
+            for person in (entry.student, entry.partner):
+                if person:
+                    who = f"{person}: " if entry.partner else ""
+                    warnings += [who + line for line in hint_lines(person, self.hints)]
+            lines += [f"! {w}" for w in warnings if w]
+            lines += lines_of_progress(progress, request.profile, unicode, marks)
+            count = sum(o.passed for o in progress.objectives)
+            total = len(progress.objectives)
             lines.append(
                 "all objectives pass"
                 if request.passed
                 else f"{count} of {total} objectives pass: signing needs an override and a note"
             )
-        self.query_one("#request-objectives", Static).update("\n".join(lines))
-        run = request.run
-        self.query_one("#request-run", Static).update(
-            "\n".join(figure_lines(run)) if run else "no run among the evidence"
-        )
+        self._lines = lines
+        self._wrap()
+        self.query_one("#request-run", Static).update(record_line(request.run))
+
+    def _wrap(self) -> None:
+        scroll = self.query_one("#request-scroll", VerticalScroll)
+        width = (
+            scroll.size.width or self.app.size.width - 2
+        ) - scroll.styles.scrollbar_size_vertical
+        text = "\n".join(hanging(self._lines, width))
+        self.query_one("#request-objectives", Static).update(text)
+
+    def on_resize(self) -> None:
+        if self._lines:
+            self._wrap()
 
     def _say(self, message: str) -> None:
         self.query_one("#request-status", Static).update(message)

@@ -2,9 +2,9 @@
 
 Each row is one run with the course's measures, so students can answer "which algorithm is
 better on this maze": it shows the runs on the station's maze and profile, and ``a`` shows the
-runs on every maze, grouped by maze and profile. The table keeps the columns that fit the
-width; the line under it says the chosen run whole. Enter (or a click) on a run with a record
-opens its replay; ``o`` opens any run record (JSONL) by path.
+runs on every maze, grouped by maze and profile. The table always keeps the graded measures,
+shortening long names to fit the width; the line under it says the chosen run whole. Enter
+(or a click) on a run with a record opens its replay; ``o`` opens any run record by path.
 """
 
 from __future__ import annotations
@@ -36,6 +36,7 @@ from .runs_table import (
     RunColumn,
     fit_columns,
     heading,
+    one_profile,
     run_detail,
     runs_in_scope,
 )
@@ -97,6 +98,8 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         #: which runs the table shows: :data:`THIS_MAZE` or :data:`ALL_MAZES`
         self.scope = THIS_MAZE
         self._runs: list[RunEntry] = []
+        #: the runs the scope shows now (the title names their profile when they share one)
+        self._in_scope: list[RunEntry] = []
         self._columns: tuple[RunColumn, ...] = COLUMNS
         #: the last message shown under the table (what happened, or why not)
         self.status = ""
@@ -143,11 +146,13 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         table = self.query_one(DataTable)
         scrollbar = table.styles.scrollbar_size_vertical
         width = (self.size.width or self.app.size.width) - scrollbar
-        columns = fit_columns(runs, self.unicode, width, self.scope, table.cell_padding)
+        self._in_scope = runs
+        fitted = fit_columns(runs, self.unicode, width, self.scope, table.cell_padding)
+        columns = fitted.columns
         self.query_one("#runs-title", Static).update(self._title(len(runs)))
         self.query_one("#runs-help", Static).update(self._help(runs))
-        rows = tuple(tuple(c.cell(run, self.unicode) for c in columns) for run in runs)
-        shown = (self.scope, self.unicode, tuple(c.key for c in columns), rows)
+        rows = tuple(fitted.cells(run, self.unicode) for run in runs)
+        shown = (self.scope, self.unicode, fitted.keys, rows)
         if shown == self._shown:
             return
         self._shown = shown
@@ -167,7 +172,9 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         station = self.station
         total = len(station.runs)
         if self.scope == ALL_MAZES:
-            return f"Runs on every maze: {total}, by maze and profile  (a: this maze only)"
+            profile = one_profile(self._in_scope)
+            grouped = f"all {profile}, by maze" if profile else "by maze and profile"
+            return f"Runs on every maze: {total}, {grouped}  (a: this maze only)"
         where = f"{station.maze.name or '-'} ({station.profile})"
         others = total - shown
         more = f", {others} on other mazes (a shows all)" if others else ""
