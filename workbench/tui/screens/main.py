@@ -22,6 +22,7 @@ from workbench.control.fsm import FsmError
 from workbench.control.station import ALGORITHM_FAILED, PROGRAM_STOPPED, LabStation, Notice
 from workbench.files.workspace import OutsideWorkspace
 from workbench.program.keys import known_key
+from workbench.sim.driver import Driver
 from workbench.sim.maze import MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.sensors import SensorConfigError
@@ -298,8 +299,12 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
             self.refresh_views()
 
     def action_pause(self) -> None:
-        paused = self.station.toggle_pause()
-        self.say("paused: n steps, p resumes" if paused else "")
+        station = self.station
+        paused = station.toggle_pause()
+        if paused and station.live_viple is not None:
+            self.say(HELD_WHILE_PAUSED)
+        else:
+            self.say("paused: n steps, p resumes" if paused else "")
 
     def action_step(self) -> None:
         station = self.station
@@ -308,8 +313,11 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
         self.refresh_views()
 
     def action_speed(self) -> None:
-        self.station.pacer.next_speed()
-        self.refresh_views()
+        station = self.station
+        if station.next_speed() or station.live_viple is None:
+            self.refresh_views()
+        else:
+            self.say(speed_held(station.live_viple))
 
     def action_reset(self) -> None:
         self.station.reset_robot()
@@ -425,6 +433,18 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
 
     def action_viple_ws(self) -> None:
         self.post_message(StartEndpoint("ws"))
+
+
+#: the message line when the station is paused while a VIPLE program over the network drives
+HELD_WHILE_PAUSED = (
+    "paused: the VIPLE program's commands are held, not applied, until p resumes; "
+    "it still gets the robot's readings"
+)
+
+
+def speed_held(driver: Driver) -> str:
+    """Why the speed key changes nothing while ``driver`` (a live VIPLE program) drives."""
+    return f"speed held at 1x while {driver} drives: its Timers count real time"
 
 
 def worded(notice: Notice, shown: Callable[[str | os.PathLike], str] = str) -> str:
