@@ -15,13 +15,16 @@ import logging
 import pytest
 
 from tests.integration.test_tcp_server import MOVE, STOP, Client
-from tests.sessions import CORRIDOR
+from tests.integration.test_ws_client import MOVE as WS_MOVE
+from tests.integration.test_ws_client import RETRY, FakeViple
+from tests.sessions import CORRIDOR, free_port
 from tests.waiting import until
 from workbench.control.station import LabStation
 from workbench.sim.mazeio import load_maze
 from workbench.sim.metrics import Metrics
 from workbench.viple.codec import parse_report
 from workbench.viple.tcp_server import TcpConfig, TcpServer
+from workbench.viple.ws_client import WsClient, WsConfig
 
 
 def station() -> LabStation:
@@ -51,6 +54,28 @@ def test_a_connected_program_runs_the_station_at_1x_and_the_speed_is_held():
             assert b.pacer.speed == 1.0  # its run is over: 1x, as after every run
             assert b.runs[-1].driver.is_viple and b.runs[-1].ended == "stopped"
             assert b.next_speed() and b.pacer.speed == 2.0  # the speed key works again
+
+    asyncio.run(scenario())
+
+
+def test_a_program_over_websocket_holds_the_speed_and_is_held_while_paused_too():
+    async def scenario() -> None:
+        b = station()
+        b.set_speed(10.0)
+        viple = await FakeViple(free_port()).start()
+        config = WsConfig(url=viple.url, retry_seconds=RETRY, report_ms=1000)
+        async with WsClient(b, config) as client:
+            robot = await viple.connected()
+            await viple.report()
+            assert str(b.live_viple) == f"VIPLE ws {viple.url}" and b.pacer.speed == 1.0
+            assert not b.next_speed()
+            b.pause()
+            await robot.send(WS_MOVE)
+            await viple.report()  # answered with the readings of the robot standing
+            await until(lambda: client.status.held == 1 and b.held_count == 1)
+            assert b.snapshot().metrics.distance == 0
+        await viple.stop()
+        assert b.live_viple is None and b.pacer.speed == 1.0
 
     asyncio.run(scenario())
 

@@ -392,9 +392,9 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
 
     def refresh_views(self) -> None:
         """Draw the station's current snapshot on every screen of the stack that shows one;
-        at rest (nothing moves, only the clock runs) with a dialog open, on the dialog only:
-        the screen dimmed under it is brought up to date when it is on top again (the clock
-        had redrawn a whole dimmed screen every second, 8 KB a second over SSH)."""
+        at rest (nothing moves, and no time passes behind a dialog) with a dialog open, on the
+        dialog only: the screen dimmed under it is brought up to date when it is on top again
+        (the clock had redrawn a whole dimmed screen every second, 8 KB a second over SSH)."""
         station = self.station
         self._drawn = self._state()
         snapshot = station.snapshot()
