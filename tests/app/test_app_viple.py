@@ -195,3 +195,19 @@ def test_no_time_passes_while_the_names_are_asked(tmp_path):
         assert app.station.session.world.time < 0.5  # the first run starts from here
 
     run(app, body)
+
+
+def test_a_program_that_connects_to_a_paused_station_is_told_its_commands_wait(tmp_path):
+    port = free_port()
+    app = make_app(AppSettings(maze(tmp_path), tcp_port=port, noise="off", paused=True))
+
+    async def body(pilot) -> None:
+        reader, writer = await connected(app, port)
+        writer.write(MOVE)
+        await writer.drain()
+        await asyncio.wait_for(reader.readline(), 5)
+        await until(lambda: "commands are held, not applied" in said(app), "the message line")
+        assert "1 command held while paused, not applied" in run_panel(app)
+        writer.close()
+
+    run(app, body)

@@ -428,6 +428,8 @@ class LabStation:
         the keys or an algorithm that had it. While the station is paused the command is held,
         not applied (False): the robot stands as time does, and the last commands held go to
         the motors when time runs again (:meth:`pause`)."""
+        if driver != self.live_viple:
+            return True  # it lost the seat (cut off as idle, its connection closing): dropped
         self._activity()
         if self.pacer.paused:
             self._hold(cmd)

@@ -108,6 +108,8 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
         self._said = ""
         self._connection = ""
         self._notice: Notice | None = station.notice
+        #: a live VIPLE program's commands are being held (paused), and the line said so
+        self._holding = False
         #: every key goes to the running program (ctrl+k), not only the free ones
         self._all_keys = False
 
@@ -174,6 +176,11 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
             self._notice = station.notice
             if station.notice is not None:
                 self._said = worded(station.notice, station.files.shown)
+        holding = station.held_count > 0
+        if holding != self._holding:  # (a program that connected while paused, too)
+            self._holding = holding
+            if holding:
+                self._said = HELD_WHILE_PAUSED
         moment = (
             station.paused,
             self._said,
