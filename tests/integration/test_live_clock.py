@@ -101,6 +101,11 @@ def test_a_paused_station_holds_the_commands_and_keeps_reporting_true_readings(c
             assert b.snapshot().pose == pose  # held, not applied
             held = [r.getMessage() for r in caplog.records if "held" in r.getMessage()]
             assert len(held) == 1 and "commands held, not applied" in held[0]  # once
+            b.step(1)  # a single step: time runs, and the program's last command with it
+            assert b.held_count == 0 and b.paused and b.snapshot().pose.x > pose.x
+            await client.send(MOVE)
+            await client.report()
+            await until(lambda: b.held_count == 1)  # paused still: held again
             b.pause(False)  # time runs again: the program's last command is in force
             assert b.held_count == 0
             b.step(60)

@@ -313,7 +313,9 @@ class LabStation:
         return steps
 
     def step(self, steps: int = 1) -> None:
-        """Exactly ``steps`` physics steps (pause + single step, tests, snapshots)."""
+        """Exactly ``steps`` physics steps (pause + single step, tests, snapshots); the commands
+        a live VIPLE program sent while paused apply first (time runs for these steps)."""
+        self._release_held()
         try:
             self.pacer.single_step(steps)
         except FsmRuntimeError as exc:
