@@ -149,9 +149,7 @@ KEY_TABLE: dict[str, Key] = {
         "Speed",
         "Simulation",
         "speed",
-        "Cycle the speed: 1x, 2x, 4x, 10x, max (as fast as the machine allows); back to 1x "
-        "when a run ends, held at 1x while a VIPLE program is connected (its Timers count "
-        "real time).",
+        "Cycle the speed: 1x, 2x, 4x, 10x, max (as fast as the machine allows).",
         display="+",
         rank=3,
     ),
