@@ -3,12 +3,20 @@
 from __future__ import annotations
 
 import asyncio
+import re
 import socket
 
+from textual.command import CommandList
+
 from tests.sessions import free_port
+from tests.waiting import until
 from workbench.tui.app import WorkbenchApp, make_app
+from workbench.tui.dialogs.identity import IdentityDialog
+from workbench.tui.screens.main import MainScreen
 from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.run_status import RunStatus
+
+from .support import run, run_panel, said
 
 ROOM = "#########\n#.......#\n#...S...#\n#.......#\n#########\n"
 
@@ -72,3 +80,134 @@ def test_a_port_in_use_is_shown_and_the_app_keeps_working(tmp_path):
                 assert app.station.keys_used == {"d"}
 
         asyncio.run(go())
+
+
+# -- the real clock for a live program ---------------------------------------------------------
+MOVE = b'{"servos":[{"isTurn":false,"servoId":-1,"servoSpeed":"1"}]}\r\n'
+
+
+Peer = tuple[asyncio.StreamReader, asyncio.StreamWriter]
+
+
+async def connected(app: WorkbenchApp, port: int) -> Peer:
+    """A scripted VIPLE program connected to the app's TCP port, holding the robot."""
+    reader, writer = await asyncio.open_connection("127.0.0.1", port)
+    await asyncio.wait_for(reader.readline(), 5)
+    await until(lambda: app.station.live_viple is not None, "the program holds the robot")
+    return reader, writer
+
+
+async def palette_runs(pilot, words: str) -> None:
+    """Run the command palette's first command for ``words``."""
+    app = pilot.app
+    await pilot.press("ctrl+p")
+    await pilot.pause()
+    await pilot.press(*words)
+    await until(lambda: app.screen.query_one(CommandList).option_count, "the palette's hits")
+    await pilot.press("enter")
+    await until(lambda: isinstance(app.screen, MainScreen), "the palette closed")
+
+
+def test_a_live_program_runs_at_1x_and_the_speed_keys_say_why_they_are_held(tmp_path):
+    port = free_port()
+    app = make_app(AppSettings(maze(tmp_path), tcp_port=port, noise="off"))
+
+    async def body(pilot) -> None:
+        await pilot.press("+", "+", "+", "+")  # 2x, 4x, 10x, max: left from before
+        assert app.station.pacer.speed is None
+        _reader, writer = await connected(app, port)
+        assert app.station.pacer.speed == 1.0
+        await until(lambda: "running at 1x" in run_panel(app), "the panel at 1x")
+        await pilot.press("+")
+        await until(lambda: "speed held at 1x while VIPLE tcp 127.0.0.1:" in said(app))
+        assert "its Timers count real time" in said(app) and app.station.pacer.speed == 1.0
+        app.say("")
+        await palette_runs(pilot, "speed")  # the palette's speed command, the same
+        await until(lambda: "speed held at 1x" in said(app), "the palette's speed held")
+        assert app.station.pacer.speed == 1.0
+        writer.close()
+        await until(lambda: app.station.live_viple is None, "the program let go")
+        await pilot.press("+")
+        await until(lambda: app.station.pacer.speed == 2.0, "the speed key works again")
+
+    run(app, body)
+
+
+def test_a_paused_station_says_the_programs_commands_are_held_and_counts_on(tmp_path):
+    port = free_port()
+    app = make_app(AppSettings(maze(tmp_path), tcp_port=port, noise="off"))
+
+    async def body(pilot) -> None:
+        reader, writer = await connected(app, port)
+        await pilot.press("p")
+        assert app.station.paused
+        assert "commands are held, not applied, until p resumes" in said(app)
+        pose = app.station.snapshot().pose
+        for _ in range(3):
+            writer.write(MOVE)
+            await writer.drain()
+            await asyncio.wait_for(reader.readline(), 5)  # still answered with a report
+        await until(lambda: "3 commands held while paused, not applied" in run_panel(app))
+        # the panel's counters keep counting while paused (the clock ticks at rest)
+        await until(lambda: re.search(r": in 3 out \d+", run_panel(app)), "the counters")
+        assert app.station.snapshot().pose == pose
+        await pilot.press("p")  # time runs again: the program's last command drives
+        await until(lambda: app.station.snapshot().pose.x > pose.x + 5, "the robot moving")
+        assert "held" not in run_panel(app)
+        writer.close()
+
+    run(app, body)
+
+
+def test_a_reset_and_the_end_of_a_run_put_the_speed_back_to_1x(tmp_path):
+    app = make_app(AppSettings(maze(tmp_path), noise="off", paused=True))
+
+    async def body(pilot) -> None:
+        await pilot.press("+", "+", "+", "+")
+        assert "at max" in run_panel(app)
+        await pilot.press("r")
+        await until(lambda: "PAUSED at 1x" in run_panel(app), "1x after a reset")
+        await pilot.press("+", "+", "d")  # 4x, a run by the keys
+        assert app.station.pacer.speed == 4.0
+        app.station.select_algorithm("right-wall")
+        app.station.apply_algorithm_preset()
+        await pilot.press("x")  # a new run at the speed chosen; the keys' run ended
+        assert app.station.driving is not None and app.station.pacer.speed == 4.0
+        await pilot.press("x")  # stopped: the run is over
+        await until(lambda: app.station.pacer.speed == 1.0, "1x after the run")
+        assert "at 1x" in run_panel(app)
+
+    run(app, body)
+
+
+def test_no_time_passes_while_the_names_are_asked(tmp_path):
+    app = make_app(AppSettings(maze(tmp_path), noise="off", ask_names=True, student="ann",
+                               data_dir=tmp_path / "data"))  # fmt: skip
+
+    async def body(pilot) -> None:
+        assert isinstance(app.screen, IdentityDialog)
+        # the clock has ticked (at its full rate first, then at rest) with the dialog open
+        await until(lambda: app._resting, "the clock at rest")
+        await pilot.pause(0.2)
+        assert app.station.session.world.time == 0.0
+        await pilot.press("enter")
+        await until(lambda: isinstance(app.screen, MainScreen), "the main screen")
+        assert app.station.session.world.time < 0.5  # the first run starts from here
+
+    run(app, body)
+
+
+def test_a_program_that_connects_to_a_paused_station_is_told_its_commands_wait(tmp_path):
+    port = free_port()
+    app = make_app(AppSettings(maze(tmp_path), tcp_port=port, noise="off", paused=True))
+
+    async def body(pilot) -> None:
+        reader, writer = await connected(app, port)
+        writer.write(MOVE)
+        await writer.drain()
+        await asyncio.wait_for(reader.readline(), 5)
+        await until(lambda: "commands are held, not applied" in said(app), "the message line")
+        assert "1 command held while paused, not applied" in run_panel(app)
+        writer.close()
+
+    run(app, body)

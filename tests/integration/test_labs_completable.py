@@ -85,7 +85,7 @@ def reach_exit(station: LabStation, ex: Exercise, obj: Objective) -> None:
 
 async def drive_over_tcp(station: LabStation) -> None:
     """A scripted VIPLE program in the Unity-simulator role: connect, move, leave."""
-    async with TcpServer(station.session, TcpConfig(port=0)) as server:
+    async with TcpServer(station, TcpConfig(port=0)) as server:
         reader, writer = await asyncio.open_connection("127.0.0.1", server.port)
         writer.write(MOVE.encode() + b"\r\n")
         await writer.drain()
@@ -107,7 +107,7 @@ async def drive_over_ws(station: LabStation) -> None:
 
     port = free_port()
     async with serve(robot, "127.0.0.1", port):
-        client = WsClient(station.session, WsConfig(url=f"ws://127.0.0.1:{port}/"))
+        client = WsClient(station, WsConfig(url=f"ws://127.0.0.1:{port}/"))
         await client.start()
         try:
             await asyncio.wait_for(arrived.get(), DEADLINE)

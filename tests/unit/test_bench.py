@@ -209,13 +209,13 @@ def test_a_failing_algorithm_is_stopped_with_the_reason_instead_of_raising(tmp_p
     assert str(b.snapshot().driver) == "keys"
 
 
-def test_a_new_maze_keeps_pause_speed_and_frame_budget():
+def test_a_new_maze_keeps_pause_and_frame_budget_and_starts_at_1x():
     b = station()
     b.toggle_pause()
-    b.pacer.next_speed()
+    assert b.next_speed()
     b.pacer.budget = 0.03
     b.load_maze(CORRIDOR)
-    assert (b.pacer.paused, b.pacer.speed, b.pacer.budget) == (True, 2.0, 0.03)
+    assert (b.pacer.paused, b.pacer.speed, b.pacer.budget) == (True, 1.0, 0.03)
     assert b.pacer.session is b.session and b.snapshot().block == CORRIDOR.start
 
 
@@ -230,7 +230,7 @@ def test_a_viple_program_that_drives_is_recorded_with_its_role_and_a_run():
     b.step(10)
     b.key("space")
     b.step(10)
-    link = Link(b.session, "tcp")
+    link = Link(b, "tcp")
     assert link.connect("127.0.0.1:50312")
     b.step(1)
     assert [(c.role, c.peer, c.drove) for c in b.viple] == [("tcp", "127.0.0.1:50312", False)]
@@ -254,7 +254,7 @@ def test_a_viple_program_that_only_connects_has_not_driven():
     from workbench.viple.link import Link
 
     b = station(CORRIDOR, profile="unity")
-    link = Link(b.session, "ws", "ws://localhost:8124/")
+    link = Link(b, "ws", "ws://localhost:8124/")
     link.connect("ws://localhost:8124/")
     b.step(30)
     link.disconnect()
@@ -269,7 +269,7 @@ def test_a_viple_program_that_takes_the_robot_from_an_algorithm_ends_its_run():
     b.select_algorithm("right-wall")
     b.start()
     b.step(20)
-    Link(b.session, "tcp").connect("127.0.0.1:1")
+    Link(b, "tcp").connect("127.0.0.1:1")
     b.step(1)
     assert b.driving is None
     assert str(b.runs[-1].driver) == "algorithm right-wall"
@@ -282,12 +282,12 @@ def test_an_attempt_keeps_apart_keys_and_viple_seen_before_but_not_the_one_drivi
     b = station(CORRIDOR, profile="unity")
     for key in ("w", "a"):
         b.key(key)
-    old = Link(b.session, "ws", "ws://localhost:8124/")
+    old = Link(b, "ws", "ws://localhost:8124/")
     old.connect("ws://localhost:8124/")
     old.apply(MOVE)
     b.step(30)
     old.disconnect()
-    link = Link(b.session, "tcp")
+    link = Link(b, "tcp")
     link.connect("127.0.0.1:50400")
     b.step(1)
     attempt = b.begin_attempt("lab", "ex")
@@ -329,7 +329,7 @@ def test_a_viple_program_drives_on_after_the_maze_is_changed_under_it():
 
     b = LabStation.open(ROOM, "erobotic", noise="off")
     session = b.session
-    link = Link(session, "tcp")
+    link = Link(b, "tcp")
     assert link.connect("127.0.0.1:50312")
     b.load_maze(CORRIDOR)
     assert b.session is session and link.session is session  # one session, one reference

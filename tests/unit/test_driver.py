@@ -57,7 +57,7 @@ def test_older_headless_and_driverless_records_read_as_viple_and_keys():
 
 def test_a_station_record_holds_the_driver_both_ways(tmp_path):
     b = LabStation.open(BEND, "erobotic", noise="off", record_dir=str(tmp_path))
-    link = Link(b.session, "tcp")
+    link = Link(b, "tcp")
     assert link.connect("127.0.0.1:50312")
     assert link.apply(MOVE)
     b.step(30)

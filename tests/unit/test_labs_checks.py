@@ -100,7 +100,7 @@ def test_viple_objective_needs_the_role_and_real_driving():
         False,
         "no VIPLE program has connected over TCP (the Unity simulator's role) yet",
     )
-    ws = Link(b.session, "ws")
+    ws = Link(b, "ws")
     ws.connect("ws://localhost:8124/")
     ws.apply(MOVE)
     b.step(30)
@@ -110,7 +110,7 @@ def test_viple_objective_needs_the_role_and_real_driving():
         False,
         "VIPLE connected over ws; this exercise needs TCP (the Unity simulator's role)",
     )
-    tcp = Link(b.session, "tcp")
+    tcp = Link(b, "tcp")
     tcp.connect("127.0.0.1:50000")
     b.step(5)
     assert check(obj, ex, b) == (False, "VIPLE tcp program connected but has not moved the robot")
@@ -350,7 +350,7 @@ def test_keys_objective_with_a_role_accepts_a_viple_program_making_the_five_moti
     ex = exercise(obj)
     b = station_for(ex)
     assert check(obj, ex, b) == (False, "not used yet: w, a, s, d, space")
-    link = Link(b.session, "tcp")
+    link = Link(b, "tcp")
     link.connect("127.0.0.1:50500")
     turn = '{"servos":[{"isTurn":true,"servoId":-1,"servoSpeed":%d}]}'
     for message in (MOVE, turn % 90, MOVE.replace(":1}", ":-1}")):

@@ -67,7 +67,7 @@ def do_the_work(b: LabStation, kind: str) -> None:
         b.key("w")
         b.key("a")
     elif kind in ("keys-viple", "viple"):
-        link = Link(b.session, "tcp")
+        link = Link(b, "tcp")
         link.connect("127.0.0.1:50500")
         link.apply(MOVE)
         b.step(30)

@@ -14,8 +14,8 @@ from typing import Any
 
 from workbench.files.workspace import LOCAL, FileAccess
 from workbench.sim.clock import Pacer
-from workbench.sim.commands import Command, Stop, motion_of
-from workbench.sim.driver import BY_KEYS, Driver
+from workbench.sim.commands import Command, MotorPower, Stop, motion_of
+from workbench.sim.driver import BY_KEYS, NOBODY, Driver
 from workbench.sim.maze import Maze
 from workbench.sim.metrics import Metrics
 from workbench.sim.noise import NoiseSettings
@@ -255,13 +255,21 @@ class LabStation:
     #: robot: a front end that advances time in larger steps while the station is at rest
     #: (see :attr:`at_rest`) brings the clock up to now first
     on_activity: Callable[[], None] | None = None
+    #: the VIPLE program over the network that holds the robot's seat (connected through
+    #: :meth:`take_seat`), else None: while one does, the clock runs at 1x (its Timers count
+    #: wall time) and the speed is held
+    live_viple: Driver | None = None
+    #: commands the live VIPLE program sent while the station was paused (held, not applied)
+    held_count: int = 0
+    _held: list[Command] = field(default_factory=list)
     _run_open: bool = False
     _run_driver: Driver = BY_KEYS
     _run_source: str | None = None
     _run_attempt: str = ""
     _run_person: str = ""
     _viple_now: VipleConnection | None = None
-    _odometry_seen: tuple[float, float] = (0.0, 0.0)
+    #: the odometry (distance, degrees) last counted into :attr:`_viple_now`
+    _viple_mark: tuple[float, float] = (0.0, 0.0)
     _recorder: Recorder | None = None
     _record_path: str | None = None
     #: the record stopped mid-run, and the person at the station was told
@@ -287,8 +295,6 @@ class LabStation:
         self.session = Session(self.maze, self.profile, self.sensors, self.noise, self.seed)
         self.pacer = Pacer(self.session)
         self.session.driver = BY_KEYS
-        self.session.on_command = self._commanded
-        self.session.before_command = self._activity
 
     # -- time ----------------------------------------------------------------------------
     def advance(self, wall_seconds: float, lag: float | None = None) -> int:
@@ -307,7 +313,9 @@ class LabStation:
         return steps
 
     def step(self, steps: int = 1) -> None:
-        """Exactly ``steps`` physics steps (pause + single step, tests, snapshots)."""
+        """Exactly ``steps`` physics steps (pause + single step, tests, snapshots); the commands
+        a live VIPLE program sent while paused apply first (time runs for these steps)."""
+        self._release_held()
         try:
             self.pacer.single_step(steps)
         except FsmRuntimeError as exc:
@@ -316,14 +324,37 @@ class LabStation:
         self._after_steps()
 
     @property
+    def idle(self) -> bool:
+        """True while time changes nothing on the station but the clock: the robot stands with
+        its motors off, and no algorithm, program file or live VIPLE program drives it."""
+        return self.session.still and self.live_viple is None
+
+    @property
     def at_rest(self) -> bool:
         """True while time changes nothing but the clock until someone acts: paused, or (at a
-        set speed) the robot standing with its motors off and no algorithm or VIPLE program
-        driving it. Stepping then gives the same run however seldom a front end ticks."""
+        set speed) :attr:`idle`. Stepping then gives the same run however seldom a front end
+        ticks."""
         if self.pacer.paused:
             return True
-        session = self.session
-        return self.pacer.speed is not None and session.still and not session.driver.is_viple
+        return self.pacer.speed is not None and self.idle
+
+    # -- speed ---------------------------------------------------------------------------
+    def set_speed(self, speed: float | None) -> bool:
+        """Run at ``speed`` (one of the pacer's speeds); False (and 1x kept) while a live VIPLE
+        program holds the robot: its Timers count wall time, so its simulation runs at 1x."""
+        if self.live_viple is not None:
+            self.pacer.set_speed(1.0)
+            return speed == 1.0
+        self.pacer.set_speed(speed)
+        return True
+
+    def next_speed(self) -> bool:
+        """The next speed of the cycle (1x, 2x, 4x, 10x, max); False, and nothing changed,
+        while the speed is held at 1x for a live VIPLE program (:attr:`live_viple`)."""
+        if self.live_viple is not None:
+            return False
+        self.pacer.next_speed()
+        return True
 
     def _activity(self) -> None:
         if self.on_activity is not None:
@@ -335,7 +366,7 @@ class LabStation:
         self.notice = Notice(ALGORITHM_FAILED, str(exc))
 
     def _after_steps(self) -> None:
-        self._watch_viple()
+        self._count_viple()
         driving = self.driving
         why = driving.stopped() if driving is not None and driving.stopped is not None else None
         if why is not None:
@@ -353,35 +384,107 @@ class LabStation:
             self._held_at_exit = True
             self.notice = Notice(OUT)
 
-    def _watch_viple(self) -> None:
-        """Notice a VIPLE program taking or leaving the robot; its driving is a run."""
+    def _count_viple(self) -> None:
+        """The distance and degrees of the steps just run go to the VIPLE program driving."""
+        now = self._viple_now
+        if now is None or not self._viple_drives(now):
+            return
         odometry = self.session.world.odometry
         seen = (odometry.distance, odometry.turn_degrees)
-        last = self._odometry_seen
-        if seen[0] < last[0] or seen[1] < last[1]:  # the robot was reset in between
-            last = (0.0, 0.0)
-        self._odometry_seen = seen
-        driver = self.session.driver
-        if not driver.is_viple:
-            self._viple_now = None
-            if self._run_open and self._run_driver.is_viple:
-                self._close_run("stopped")
-            return
-        role, peer = driver.role, driver.peer
-        now = self._viple_now
-        if now is None or (now.role, now.peer) != (role, peer):  # another program took over
-            now = self._viple_now = self._connection(role, peer)
-            self.viple.append(now)
+        last = self._viple_mark
+        self._viple_mark = seen
         now.distance += seen[0] - last[0]
         now.turn_degrees += seen[1] - last[1]
-        if self.driving is not None and self.session.controller is None:
-            self.driving = None  # the VIPLE program took the robot from the algorithm or file
-            if self._run_open:
-                self._close_run("stopped")
+
+    def _viple_drives(self, connection: VipleConnection) -> bool:
+        driver = self.session.driver
+        return driver.is_viple and (driver.role, driver.peer) == (connection.role, connection.peer)
+
+    # -- the VIPLE seat ------------------------------------------------------------------
+    def take_seat(self, driver: Driver) -> None:
+        """A VIPLE program over the network connected as ``driver`` (a VIPLE driver with role
+        and peer): it takes the robot from whatever drove it, its driving is a run, and until
+        :meth:`leave_seat` the clock runs at 1x (its Timers count wall time)."""
+        self._activity()
+        self.live_viple = driver
+        self._drop_held()
+        self._viple_takes(driver)
+        self.pacer.set_speed(1.0)
+
+    def leave_seat(self, driver: Driver) -> None:
+        """The VIPLE program ``driver`` went (or lost the seat): the motors stop, its run ends,
+        and the speed is 1x, as after every run (nothing when it does not hold the seat)."""
+        if driver != self.live_viple:
+            return
+        self._activity()
+        self.live_viple = None
+        self._drop_held()
+        if self.session.driver == driver:
+            self.session.command(Stop(), driver=NOBODY)
+        if self._run_open and self._run_driver == driver:
+            self._close_run("stopped")
+        self.pacer.set_speed(1.0)
+
+    def drive(self, cmd: Command, driver: Driver) -> bool:
+        """A motor command from the VIPLE program ``driver``; it takes the robot back from
+        the keys or an algorithm that had it. While the station is paused the command is held,
+        not applied (False): the robot stands as time does, and the last commands held go to
+        the motors when time runs again (:meth:`pause`)."""
+        if driver != self.live_viple:
+            return True  # it lost the seat (cut off as idle, its connection closing): dropped
+        self._activity()
+        if self.pacer.paused:
+            self._hold(cmd)
+            return False
+        self._apply_viple(cmd, driver)
+        return True
+
+    def _apply_viple(self, cmd: Command, driver: Driver) -> None:
+        if self.session.driver != driver or self.driving is not None:
+            self._viple_takes(driver)
+        self.session.command(cmd, driver=driver)
+        motion = motion_of(cmd)
+        if motion is not None and self._viple_now is not None:
+            self._viple_now.motions.add(motion)
+
+    def _viple_takes(self, driver: Driver) -> None:
+        """The VIPLE program ``driver`` drives from now on: what drove lets go (its run ends),
+        the program's driving is a run of its own, and it is seen as a connection."""
+        self.stop("stopped")  # takes the robot from the algorithm or the program file
         if self._run_open and self._run_driver != driver:
             self._close_run("stopped")
+        self.session.detach(driver)
+        self._viple_now = self._connection(driver.role, driver.peer)
+        self.viple.append(self._viple_now)
+        odometry = self.session.world.odometry
+        self._viple_mark = (odometry.distance, odometry.turn_degrees)
         if not self._run_open and not self.session.reached_exit:
             self._open_run(driver)
+
+    def _hold(self, cmd: Command) -> None:
+        """Keep a command sent while paused, with those it does not override: a one-wheel
+        power keeps the other wheel's, every other command sets both wheels."""
+        self.held_count += 1
+        if isinstance(cmd, MotorPower):
+            self._held = [
+                c for c in self._held if not (isinstance(c, MotorPower) and c.wheel == cmd.wheel)
+            ]
+        else:
+            self._held = []
+        self._held.append(cmd)
+
+    def _drop_held(self) -> None:
+        self._held = []
+        self.held_count = 0
+
+    def _release_held(self) -> None:
+        """Time runs again: the commands held while paused go to the motors, as the live VIPLE
+        program last asked."""
+        held, driver = self._held, self.live_viple
+        self._drop_held()
+        if driver is not None:
+            for cmd in held:
+                self._apply_viple(cmd, driver)
 
     def _connection(self, role: str, peer: str) -> VipleConnection:
         attempt = self.attempt.id if self.attempt is not None else ""
@@ -399,8 +502,9 @@ class LabStation:
         attempt = Attempt(secrets.token_hex(8), lab, exercise, self.profile, self.person)
         self.attempt = attempt
         self.attempts.append(attempt)
-        if self._viple_now is not None:
-            self._viple_now = self._connection(self._viple_now.role, self._viple_now.peer)
+        now = self._viple_now
+        if now is not None and self._viple_drives(now):
+            self._viple_now = self._connection(now.role, now.peer)
             self.viple.append(self._viple_now)
         return attempt
 
@@ -411,23 +515,18 @@ class LabStation:
         attempt = self.attempt_id
         return {use.key for use in self.key_uses if use.attempt == attempt}
 
-    def _commanded(self, cmd: Command, driver: Driver) -> None:
-        """A VIPLE program's command: remember the motion it asked for (its drive keys)."""
-        if not driver.is_viple:
-            return
-        self._watch_viple()  # the connection that sent it is the current one
-        motion = motion_of(cmd)
-        if motion is not None and self._viple_now is not None:
-            self._viple_now.motions.add(motion)
-
     @property
     def paused(self) -> bool:
         return self.pacer.paused
 
     def pause(self, paused: bool = True) -> None:
-        """Stop simulated time (or, with False, let it run again): the user's choice."""
+        """Stop simulated time (or, with False, let it run again): the user's choice. When
+        time runs again, the commands a live VIPLE program sent meanwhile are applied."""
         self._held_at_exit = False
+        was = self.pacer.paused
         self.pacer.paused = paused
+        if was and not paused:
+            self._release_held()
 
     def toggle_pause(self) -> bool:
         self.pause(not self.pacer.paused)
@@ -437,6 +536,7 @@ class LabStation:
         """The run that ended at the exit paused the robot; a new action lets time run again
         (keys would otherwise seem dead after a run)."""
         if self._held_at_exit:
+            self._drop_held()  # sent to a robot standing at the exit: not for the next run
             self.pause(False)
 
     def snapshot(self) -> Snapshot:
@@ -458,10 +558,12 @@ class LabStation:
         cmd = key_command(self.profile, key)
         if cmd is None:
             return False
+        self._activity()
         self._go_on_after_exit()
         self.stop("stopped")
         if self._run_open and self._run_driver != BY_KEYS:
             self._close_run("stopped")  # the keys take the robot from a VIPLE program
+        self._drop_held()  # ... and from what it sent while paused
         if not self._run_open and not self.session.reached_exit:
             self._open_run(BY_KEYS)  # a run starts at the robot's last reset
         self.key_uses.add(KeyUse(key, self.attempt_id, self.profile, self.person))
@@ -607,6 +709,8 @@ class LabStation:
         else:
             raise ValueError("choose an algorithm first")
         binding = driving.bind(self.sensors)
+        speed = self.pacer.speed  # chosen for this run: the run before ends at 1x
+        self._drop_held()
         self.stop("stopped")
         if self._run_open:
             self._close_run("stopped")
@@ -615,6 +719,7 @@ class LabStation:
         self.driving = driving
         self.session.attach(driving.controller, binding, driving.driver)
         self._open_run(driving.driver)
+        self.set_speed(speed)
         self.pause(False)
 
     def stop(self, ended: str = "stopped") -> None:
@@ -635,8 +740,10 @@ class LabStation:
         if self._run_open:
             self._close_run("reset")
         self.stop("reset")
+        self._drop_held()
         self.session.reset()
         self.session.driver = BY_KEYS
+        self.pacer.set_speed(1.0)  # a run from the start begins at 1x
 
     def put_edited_maze(self, maze: Maze, opened: Maze) -> MazeEdit:
         """Put a maze edited in the editor on the station (``opened``: the maze the editor
@@ -660,6 +767,8 @@ class LabStation:
         if self._run_open:
             self._close_run("maze changed")
         self.stop("maze changed")
+        self._drop_held()
+        self.pacer.set_speed(1.0)
         self.maze = maze
         self.session.load_maze(maze, self.profile, self.sensors, self.noise, self.seed)
         self.session.driver = BY_KEYS
@@ -705,7 +814,10 @@ class LabStation:
         self._recorder = None
 
     def _close_run(self, ended: str) -> None:
+        """The run ends: it is kept (and its record closed), and the speed is 1x again (a
+        speed chosen for one run does not carry into the next)."""
         self._run_open = False
+        self.pacer.set_speed(1.0)
         if ended == "exit":  # the run is over as a headless one ends: same numbers, same record
             self.session.settle()
         entry = RunEntry(

@@ -206,7 +206,7 @@ def apply_setup(station: LabStation, setup: Setup, *, lab: str, exercise: str) -
     else:
         station.clear_algorithm()
     station.program = None
-    station.pacer.set_speed(setup.speed)
+    station.set_speed(setup.speed)  # held at 1x while a live VIPLE program drives
     station.pause(False)
     station.begin_attempt(lab, exercise)
     algorithm_after = station.algorithm.name if station.algorithm is not None else None

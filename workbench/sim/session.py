@@ -87,11 +87,6 @@ class Session:
         self._next_due: Callable[[], float | None] | None = None
         self.binding: dict[str, int] = {}
         self.driver = NOBODY
-        #: told of every command from outside the controller, with the driver that sent it
-        self.on_command: Callable[[Any, Driver], None] | None = None
-        #: told just before such a command changes the robot (a front end that lets time pass
-        #: in larger steps while nothing moves catches up then)
-        self.before_command: Callable[[], None] | None = None
         self._reset_run_state()
 
     def _reset_run_state(self) -> None:
@@ -130,15 +125,11 @@ class Session:
 
         It cancels a command still waiting from :meth:`command_after`.
         """
-        if self.before_command is not None:
-            self.before_command()
         self._scheduled = None
         self.world.apply(cmd)
         self._commands.append(cmd)
         if driver is not None:
             self.driver = driver
-        if self.on_command is not None:
-            self.on_command(cmd, self.driver)
 
     def command_after(self, seconds: float, cmd: Any) -> None:
         """Apply ``cmd`` after exactly ``seconds`` of simulated time (to the step)."""

@@ -207,7 +207,7 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
         if not self.settings.ws_at_start:
             ws = None  # later: a WebSocket exercise's set-up or the v key starts it
         if tcp is not None or ws is not None:
-            self.endpoints = await Endpoints.open(self.station.session, tcp, ws)
+            self.endpoints = await Endpoints.open(self.station, tcp, ws)
         self.mark_ascii()
         self._show_maze_title()
         self._last_tick = perf_counter()
@@ -292,20 +292,42 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
         if self.endpoints is not None:
             self._show_connection(self.endpoints.summary())
         steps = self._advance()
-        state = (station.paused, station.notice, station.driving, len(station.runs))
-        if steps or state != self._drawn:
+        if steps or self._state() != self._drawn:
             self.refresh_views()
         self._rest(station.at_rest)
 
+    def _state(self) -> tuple[object, ...]:
+        """What, beside the steps, asks for a redraw when it changes: a paused station still
+        shows a live VIPLE program's counters and the commands it holds."""
+        station = self.station
+        return (
+            station.paused,
+            station.notice,
+            station.driving,
+            len(station.runs),
+            station.held_count,
+            self._connection,
+        )
+
     def _advance(self) -> int:
-        """Hand the station the real time since the last tick."""
+        """Hand the station the real time since the last tick; none passes behind the names
+        asked at start, nor behind a dialog while nothing but the clock would change (a run's
+        time is the time the robot could have moved)."""
         now = perf_counter()
         elapsed = now - self._last_tick
         self._last_tick = now
         station = self.station
+        if self._behind_dialog() and (station.paused or station.idle):
+            return 0
         # at rest the ticks are far apart on purpose: all the time they owe is kept
         lag = self._rest_period + station.pacer.max_lag if self._resting else None
         return station.advance(elapsed, lag)
+
+    def _behind_dialog(self) -> bool:
+        """A dialog, or the arrival screen asking the names, is in front of the station."""
+        stack = self.screen_stack
+        top = stack[-1] if stack else None
+        return isinstance(top, (ModalScreen, ArrivalScreen))
 
     def _rest(self, resting: bool) -> None:
         """Tick at REST_HZ while the station is at rest, else at the full rate."""
@@ -370,11 +392,11 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
 
     def refresh_views(self) -> None:
         """Draw the station's current snapshot on every screen of the stack that shows one;
-        at rest (nothing moves, only the clock runs) with a dialog open, on the dialog only:
-        the screen dimmed under it is brought up to date when it is on top again (the clock
-        had redrawn a whole dimmed screen every second, 8 KB a second over SSH)."""
+        at rest (nothing moves, and no time passes behind a dialog) with a dialog open, on the
+        dialog only: the screen dimmed under it is brought up to date when it is on top again
+        (the clock had redrawn a whole dimmed screen every second, 8 KB a second over SSH)."""
         station = self.station
-        self._drawn = (station.paused, station.notice, station.driving, len(station.runs))
+        self._drawn = self._state()
         snapshot = station.snapshot()
         stack = self.screen_stack
         dialog = stack[-1] if stack and isinstance(stack[-1], ModalScreen) else None
@@ -600,14 +622,14 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
         tcp, ws = self._viple_configs
         if self.endpoints is None:
             self.endpoints = Endpoints()
-        endpoints, session = self.endpoints, self.station.session
+        endpoints, station = self.endpoints, self.station
         if role == "tcp":
-            if await endpoints.start_tcp(session, tcp or TcpConfig()) and endpoints.tcp:
+            if await endpoints.start_tcp(station, tcp or TcpConfig()) and endpoints.tcp:
                 text = f"VIPLE: connect your program (TCP) to localhost:{endpoints.tcp.port}"
             else:
                 text = endpoints.problems[-1]
         else:
-            await endpoints.start_ws(session, ws or WsConfig())
+            await endpoints.start_ws(station, ws or WsConfig())
             url = endpoints.ws.config.url if endpoints.ws else ""
             text = f"VIPLE: start your program's WebSocket server; the robot connects to {url}"
         if self.settings.connect_hint:

@@ -1,4 +1,5 @@
-"""The VIPLE endpoints an interactive front end hosts on its live session.
+"""The VIPLE endpoints an interactive front end hosts on its live session (the app: on its lab
+station, which takes the robot for a connected program and keeps its clock at 1x).
 
 Unlike ``workbench serve``, a front end keeps running when an endpoint cannot start (a port
 in use, say): the reason is shown in the status line instead.
@@ -10,7 +11,7 @@ from dataclasses import dataclass, field
 
 from workbench.sim.session import Session
 
-from .link import LinkStatus, Seat
+from .link import Cockpit, LinkStatus, Seat
 from .tcp_server import EndpointError, TcpConfig, TcpServer
 from .ws_client import WsClient, WsConfig
 
@@ -25,20 +26,20 @@ class Endpoints:
 
     @classmethod
     async def open(
-        cls, session: Session, tcp: TcpConfig | None = None, ws: WsConfig | None = None
+        cls, robot: Session | Cockpit, tcp: TcpConfig | None = None, ws: WsConfig | None = None
     ) -> Endpoints:
         hosted = cls()
         if tcp is not None:
-            await hosted.start_tcp(session, tcp)
+            await hosted.start_tcp(robot, tcp)
         if ws is not None:
-            await hosted.start_ws(session, ws)
+            await hosted.start_ws(robot, ws)
         return hosted
 
-    async def start_tcp(self, session: Session, config: TcpConfig) -> bool:
+    async def start_tcp(self, robot: Session | Cockpit, config: TcpConfig) -> bool:
         """Listen for VIPLE (Unity-simulator role) unless already listening; False if it cannot."""
         if self.tcp is not None:
             return True
-        server = TcpServer(session, config, self.seat)
+        server = TcpServer(robot, config, self.seat)
         try:
             await server.start()
         except EndpointError as exc:
@@ -50,10 +51,10 @@ class Endpoints:
         self.tcp = server
         return True
 
-    async def start_ws(self, session: Session, config: WsConfig) -> None:
+    async def start_ws(self, robot: Session | Cockpit, config: WsConfig) -> None:
         """Keep connecting to VIPLE's WebSocket server (Web-Simulator role), unless already."""
         if self.ws is None:
-            self.ws = WsClient(session, config, self.seat)
+            self.ws = WsClient(robot, config, self.seat)
             await self.ws.start()
 
     @property

@@ -18,6 +18,11 @@ take them, a new report is dropped (the next one carries fresher readings anyway
 A driver that has sent nothing and taken none of its reports for ``idle_s`` seconds loses the
 seat (see :meth:`Link.idle_for`): a VIPLE program that is merely quiet still reads its reports,
 so its writes keep going out and it is never dropped.
+
+A link drives through a :class:`Cockpit`: the app's lab station is one (it takes the robot for
+the program, runs its clock at 1x while the program is connected, and holds its commands while
+paused); a bare :class:`Session` (``workbench serve``) is driven through
+:class:`SessionCockpit`.
 """
 
 from __future__ import annotations
@@ -31,7 +36,7 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from typing import Protocol
 
-from workbench.sim.commands import Stop
+from workbench.sim.commands import Command, Stop
 from workbench.sim.driver import NOBODY, Driver
 
 # the report interval's rule, shared with offline program runs (named here for the endpoints)
@@ -74,6 +79,50 @@ def check_idle_s(value: object) -> float | None:
     return float(value)
 
 
+class Cockpit(Protocol):
+    """Where a VIPLE program over the network sits to drive: the robot's session, read for
+    its profile and readings, and the seat's three moves."""
+
+    @property
+    def session(self) -> Session: ...
+
+    def take_seat(self, driver: Driver) -> None:
+        """The program ``driver`` connected: it drives from now on."""
+        ...
+
+    def leave_seat(self, driver: Driver) -> None:
+        """The program ``driver`` went: its motors stop (nothing if it no longer drives)."""
+        ...
+
+    def drive(self, cmd: Command, driver: Driver) -> bool:
+        """A command of the program's; False when it was held, not applied (paused)."""
+        ...
+
+
+@dataclass
+class SessionCockpit:
+    """A bare session's seat (``workbench serve``): commands apply at once, time is the
+    server's."""
+
+    session: Session
+
+    def take_seat(self, driver: Driver) -> None:
+        self.session.detach(driver)  # the program takes over from any controller
+
+    def leave_seat(self, driver: Driver) -> None:
+        if self.session.driver == driver:
+            self.session.command(Stop(), driver=NOBODY)
+
+    def drive(self, cmd: Command, driver: Driver) -> bool:
+        self.session.command(cmd, driver=driver)
+        return True
+
+
+def cockpit_of(robot: Session | Cockpit) -> Cockpit:
+    """The seat of ``robot``: a station is its own, a bare session gets one."""
+    return SessionCockpit(robot) if isinstance(robot, Session) else robot
+
+
 @dataclass(frozen=True)
 class LinkStatus:
     """What a front end shows about one endpoint."""
@@ -95,6 +144,8 @@ class LinkStatus:
     dropped: int = 0
     #: connections that lost the driver's seat for being idle
     idled: int = 0
+    #: commands held, not applied, because the robot's station was paused
+    held: int = 0
 
     @property
     def connected(self) -> bool:
@@ -161,7 +212,7 @@ class Link:
 
     def __init__(
         self,
-        session: Session,
+        robot: Session | Cockpit,
         role: str,
         address: str = "",
         seat: Seat | None = None,
@@ -172,7 +223,8 @@ class Link:
         if batch < 1:
             raise ValueError(f"batch must be at least 1, not {batch!r}")
         self.idle_s = check_idle_s(idle_s)
-        self.session = session
+        self.cockpit = cockpit_of(robot)
+        self.session = self.cockpit.session
         self.seat = seat if seat is not None else Seat()
         self.log = logger or logging.getLogger(f"workbench.viple.{role}")
         self.batch = batch
@@ -187,6 +239,9 @@ class Link:
         self.refused = 0
         self.dropped = 0
         self.idled = 0
+        self.held = 0
+        #: the last command was held (the station is paused): said once in the log
+        self._holding = False
         self._line_no = 0
         self._active_at = time.monotonic()
         self._driver: Driver | None = None
@@ -209,6 +264,7 @@ class Link:
             refused=self.refused,
             dropped=self.dropped,
             idled=self.idled,
+            held=self.held,
         )
 
     @property
@@ -240,7 +296,8 @@ class Link:
         self._driver = Driver.viple(self.role, peer)
         self._bad_log = RateLimitedLog(self.log)
         self._active_at = time.monotonic()
-        self.session.detach(self._driver)
+        self._holding = False
+        self.cockpit.take_seat(self._driver)
         return True
 
     def refuse(self, peer: str) -> None:
@@ -268,8 +325,8 @@ class Link:
         self.log.info("%s disconnected%s; motors stopped", peer, f" ({reason})" if reason else "")
 
     def _stop_motors(self) -> None:
-        if self._driver is not None and self.session.driver == self._driver:
-            self.session.command(Stop(), driver=NOBODY)
+        if self._driver is not None:
+            self.cockpit.leave_seat(self._driver)
 
     # -- messages ------------------------------------------------------------------------
     def report(self) -> str:
@@ -332,11 +389,28 @@ class Link:
             self.reject(str(err), line_no)
             return False
         driver = self._driver or Driver.viple(self.role)
-        for cmd in commands:
-            self.session.command(cmd, driver=driver)
+        applied = [self.cockpit.drive(cmd, driver) for cmd in commands]
+        self._held_or_applied(len(applied) - sum(applied), line_no)
         if self.log.isEnabledFor(logging.DEBUG):
             self.log.debug("%s: line %d: %s", self.peer or "VIPLE", line_no, commands)
         return True
+
+    def _held_or_applied(self, held: int, line_no: int) -> None:
+        """Count the commands the station held (paused); the log says when holding begins
+        and ends, not at every line."""
+        self.held += held
+        who = self.peer or "VIPLE"
+        if held and not self._holding:
+            self._holding = True
+            self.log.warning(
+                "%s: line %d: commands held, not applied: the station is paused (the program "
+                "still gets the robot's readings)",
+                who,
+                line_no,
+            )
+        elif not held and self._holding:
+            self._holding = False
+            self.log.warning("%s: line %d: commands applied again", who, line_no)
 
     async def handle(self, lines: Iterable[str], outbox: Outbox) -> None:
         """Apply each line and answer each accepted one with a report, yielding between batches."""

@@ -32,6 +32,7 @@ from .codec import DEFAULT_MAX_LINE_BYTES, FrameError, LineSplitter
 from .link import (
     IDLE_S_DEFAULT,
     REPORT_MS_DEFAULT,
+    Cockpit,
     Link,
     LinkStatus,
     Seat,
@@ -107,18 +108,19 @@ class _Outbox:
 
 
 class TcpServer:
-    """Serves ``session`` to one VIPLE program at a time over TCP."""
+    """Serves ``robot`` (a session, or a station as its :class:`Cockpit`) to one VIPLE program
+    at a time over TCP."""
 
     def __init__(
         self,
-        session: Session,
+        robot: Session | Cockpit,
         config: TcpConfig | None = None,
         seat: Seat | None = None,
         logger: logging.Logger | None = None,
     ) -> None:
         self.config = config or TcpConfig()
         self.log = logger or log
-        self.link = Link(session, "tcp", seat=seat, logger=self.log, idle_s=self.config.idle_s)
+        self.link = Link(robot, "tcp", seat=seat, logger=self.log, idle_s=self.config.idle_s)
         self._servers: list[asyncio.Server] = []
         self._handlers: set[asyncio.Task] = set()
         self.addresses: list[tuple[str, int]] = []

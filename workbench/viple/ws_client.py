@@ -30,6 +30,7 @@ from .codec import DEFAULT_MAX_LINE_BYTES, split_frame
 from .link import (
     IDLE_S_DEFAULT,
     REPORT_MS_DEFAULT,
+    Cockpit,
     Link,
     LinkStatus,
     Seat,
@@ -91,11 +92,12 @@ class WsConfig:
 
 
 class WsClient:
-    """Connects ``session`` to VIPLE's WebSocket server and keeps it connected."""
+    """Connects ``robot`` (a session, or a station as its :class:`Cockpit`) to VIPLE's
+    WebSocket server and keeps it connected."""
 
     def __init__(
         self,
-        session: Session,
+        robot: Session | Cockpit,
         config: WsConfig | None = None,
         seat: Seat | None = None,
         logger: logging.Logger | None = None,
@@ -103,7 +105,7 @@ class WsClient:
         self.config = config or WsConfig()
         self.log = logger or log
         self.link = Link(
-            session,
+            robot,
             "ws",
             address=self.config.url,
             seat=seat,

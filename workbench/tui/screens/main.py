@@ -22,6 +22,7 @@ from workbench.control.fsm import FsmError
 from workbench.control.station import ALGORITHM_FAILED, PROGRAM_STOPPED, LabStation, Notice
 from workbench.files.workspace import OutsideWorkspace
 from workbench.program.keys import known_key
+from workbench.sim.driver import Driver
 from workbench.sim.maze import MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.sensors import SensorConfigError
@@ -107,6 +108,8 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
         self._said = ""
         self._connection = ""
         self._notice: Notice | None = station.notice
+        #: a live VIPLE program's commands are being held (paused), and the line said so
+        self._holding = False
         #: every key goes to the running program (ctrl+k), not only the free ones
         self._all_keys = False
 
@@ -173,6 +176,11 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
             self._notice = station.notice
             if station.notice is not None:
                 self._said = worded(station.notice, station.files.shown)
+        holding = station.held_count > 0
+        if holding != self._holding:  # (a program that connected while paused, too)
+            self._holding = holding
+            if holding:
+                self._said = HELD_WHILE_PAUSED
         moment = (
             station.paused,
             self._said,
@@ -298,8 +306,12 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
             self.refresh_views()
 
     def action_pause(self) -> None:
-        paused = self.station.toggle_pause()
-        self.say("paused: n steps, p resumes" if paused else "")
+        station = self.station
+        paused = station.toggle_pause()
+        if paused and station.live_viple is not None:
+            self.say(HELD_WHILE_PAUSED)
+        else:
+            self.say("paused: n steps, p resumes" if paused else "")
 
     def action_step(self) -> None:
         station = self.station
@@ -308,8 +320,11 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
         self.refresh_views()
 
     def action_speed(self) -> None:
-        self.station.pacer.next_speed()
-        self.refresh_views()
+        station = self.station
+        if station.next_speed() or station.live_viple is None:
+            self.refresh_views()
+        else:
+            self.say(speed_held(station.live_viple))
 
     def action_reset(self) -> None:
         self.station.reset_robot()
@@ -425,6 +440,18 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
 
     def action_viple_ws(self) -> None:
         self.post_message(StartEndpoint("ws"))
+
+
+#: the message line when the station is paused while a VIPLE program over the network drives
+HELD_WHILE_PAUSED = (
+    "paused: the VIPLE program's commands are held, not applied, until p resumes; "
+    "it still gets the robot's readings"
+)
+
+
+def speed_held(driver: Driver) -> str:
+    """Why the speed key changes nothing while ``driver`` (a live VIPLE program) drives."""
+    return f"speed held at 1x while {driver} drives: its Timers count real time"
 
 
 def worded(notice: Notice, shown: Callable[[str | os.PathLike], str] = str) -> str:

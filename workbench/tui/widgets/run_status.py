@@ -54,4 +54,17 @@ class RunStatus(TextLines):
             contact = (turning, f"{hits}{sep}touches {m.touches}")
         else:
             contact = (f"{turning}{sep}{hits}",)
-        self.set_lines([driver, clock, travel, *contact, *([connection] if connection else [])])
+        held = _held_line(station)
+        self.set_lines(
+            [driver, clock, *held, travel, *contact, *([connection] if connection else [])]
+        )
+
+
+def _held_line(station: LabStation) -> tuple[str, ...]:
+    """While paused, what a live VIPLE program sends waits: the panel says so, and counts."""
+    live = station.live_viple
+    if live is None or not station.paused:
+        return ()
+    n = station.held_count
+    what = f"{n} command{'' if n == 1 else 's'}" if n else "its commands"
+    return (f"{live}: {what} held while paused, not applied",)
