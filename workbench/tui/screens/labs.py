@@ -497,10 +497,14 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         box.remove_children()
         answers = self.lab_progress.answers.get((lab.id, exercise.id), {})
         for q in exercise.questions:
+            answer_box = self._answer_widget(q, answers.get(q.id, ""))
+            answer_box.disabled = not self.lab_progress.can_answer(
+                (lab.id, exercise.id), q.id, q.max_tries
+            )
             box.mount(
                 Vertical(
                     Static(prose(q.text, unicode), markup=False, classes="question-text"),
-                    self._answer_widget(q, answers.get(q.id, "")),
+                    answer_box,
                     Static(
                         self._answer_reason(exercise, q.id),
                         classes="question-reason",
@@ -542,20 +546,46 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             select_on_focus=False,
         )
 
-    def _answer_reason(self, exercise: Exercise, question_id: str) -> str:
+    def _answer_reason(self, exercise: Exercise, question_id: str, typed: str = "") -> str:
+        """The line under an answer: whether it is right, its tries, and (while a typed
+        answer is not yet tried) that enter tries it."""
         lab = self.selected[0] if self.selected else None
-        answers = self.lab_progress.answers.get((lab.id, exercise.id), {}) if lab else {}
+        key = (lab.id, exercise.id) if lab else ("", exercise.id)
+        answers = self.lab_progress.answers.get(key, {})
         text = answers.get(question_id, "").strip()
+        q = next(q for q in exercise.questions if q.id == question_id)
+        used = self.lab_progress.tries_of(key, question_id)
+        tries = f"try {used} of {q.max_tries}" if q.max_tries else f"tries {used}"
+        locked = not self.lab_progress.can_answer(key, question_id, q.max_tries)
+        marks = self.marks
+        if typed.strip() and typed.strip() != text and not locked:
+            left = f", {q.max_tries - used} left" if q.max_tries else ""
+            return prose(f"press enter to try this answer ({tries}{left})", self.unicode)
         if not text:
             return "not answered yet"
-        q = next(q for q in exercise.questions if q.id == question_id)
         ok, reason = q.check(text)
-        marks = self.marks
-        return prose(f"{marks.passed if ok else marks.failed} {reason}", self.unicode)
+        if locked and not ok:
+            return prose(
+                f"{marks.failed} {reason}; no tries left ({tries}): the answer box takes no "
+                "more answers and waits for the instructor",
+                self.unicode,
+            )
+        return prose(f"{marks.passed if ok else marks.failed} {reason} ({tries})", self.unicode)
+
+    @on(Input.Changed)
+    def _typed(self, event: Input.Changed) -> None:
+        """A typed answer is not tried until enter: the line under it says so."""
+        field_id = event.input.id or ""
+        if not field_id.startswith("q-") or self.selected is None:
+            return
+        box = event.input.parent
+        if box is not None:
+            box.query_one(".question-reason", Static).update(
+                self._answer_reason(self.selected[1], field_id[2:], event.value)
+            )
 
     @on(Input.Submitted)
-    @on(Input.Changed)
-    def _typed(self, event: Input.Changed | Input.Submitted) -> None:
+    def _submitted(self, event: Input.Submitted) -> None:
         self._answered(event.input, event.value)
 
     @on(RadioSet.Changed)
@@ -564,12 +594,17 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             self._answered(event.radio_set, event.radio_set.answer)
 
     def _answered(self, widget: Widget, answer: str) -> None:
+        """One try at a question (enter in its field, or a choice picked)."""
         field_id = widget.id or ""
         if not field_id.startswith("q-") or self.selected is None:
             return
         lab, exercise = self.selected
         question_id = field_id[2:]
-        self.lab_progress.answer((lab.id, exercise.id), question_id, answer)
+        q = next(q for q in exercise.questions if q.id == question_id)
+        key = (lab.id, exercise.id)
+        self.lab_progress.answer(key, question_id, answer, q.max_tries)
+        if not self.lab_progress.can_answer(key, question_id, q.max_tries):
+            widget.disabled = True
         box = widget.parent
         if box is not None:
             box.query_one(".question-reason", Static).update(
