@@ -11,7 +11,9 @@ and the parameters in force have the same values.
   profile the run is on.
 - A lab's starter (``labs/starters``) is matched on its ``FILL IN`` parameters only: a starter
   whose FILL IN values are as shipped is the starter, whatever else was tuned; one whose FILL
-  IN values the student set is the student's.
+  IN values the student set is the student's. An FSM shaped as a starter is judged as that
+  starter only, never as a built-in: a starter completed as the lab asks may well behave as
+  the built-in it was cut from, and it is still the student's work.
 """
 
 from __future__ import annotations
@@ -96,7 +98,9 @@ def bundled_fsm(definition: FsmDefinition, values: Mapping[str, float], profile:
     """Which shipped FSM ``definition`` with the parameters ``values`` in force is, in words
     ("the built-in algorithm algorithms/right-wall.yaml"); "" when it is none of them."""
     run_shape = shape(definition)
-    for bundled in bundled_fsms():
+    known = bundled_fsms()
+    starters = [b for b in known if b.pinned is not None and b.shape == run_shape]
+    for bundled in starters or known:
         if bundled.matches(run_shape, values, profile):
             return bundled.shown
     return ""

@@ -522,8 +522,7 @@ def check_maze_edited(exercise: Exercise, station: LabStation, attempt: Attempt)
         e for e in station.edits if e.attempt == attempt.id and e.maze_digest != e.opened_digest
     ]
     changed = [e for e in edits if e.maze_digest != original.digest()]
-    by_hand = [e for e in changed if e.hand_blocks > 0]
-    good = [e for e in by_hand if e.valid]
+    good = [e for e in changed if e.hand_blocks > 0 and e.valid]
     if good:
         e = good[-1]
         evidence = {ATTEMPT: attempt.id, "edit": e.number, "maze": e.maze, "person": e.person,
@@ -531,14 +530,14 @@ def check_maze_edited(exercise: Exercise, station: LabStation, attempt: Attempt)
                     "hand_blocks": e.hand_blocks}  # fmt: skip
         blocks = f"{e.hand_blocks} block{'s' if e.hand_blocks != 1 else ''}"
         return Check(True, f"edit {e.number} changed {blocks} by hand, {e.maze!r}", evidence)
-    if by_hand:
-        return Check(False, "the edited maze has problems: fix them in the editor (e)")
-    if changed:
+    if changed and changed[-1].hand_blocks == 0:
         return Check(
             False,
             f"edit {changed[-1].number} added or removed no block by hand (Generate, New and "
             "loading do not count): in the editor (e) put or take away a block yourself",
         )
+    if changed:
+        return Check(False, "the edited maze has problems: fix them in the editor (e)")
     if edits:
         return Check(False, f"the edits left {original.name!r} as set up: add or remove a block")
     return Check(

@@ -5,7 +5,8 @@ the docs; they solve lab exercises, so a lab must not take one as a student's ow
 Two programs are the same here when their diagrams are: the same panels with the same inputs,
 the same blocks (kind, name and values) under the same ids, the same links and the same
 global variables. What the file keeps beside that (where each block is drawn, the sizes of
-the panels, Comment blocks, the VIPLE version that saved it, whitespace) is set aside.
+the panels, Comment blocks, the address a Robot block names for VIPLE's own connection, the
+VIPLE version that saved it, whitespace) is set aside.
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ from .problems import ProgramError
 def shape(program: Program) -> str:
     """A program's diagrams, without what does not change how it runs."""
     kept = {
-        aid: (a.kind, a.panel, a.name, a.values)
+        aid: (a.kind, a.panel, a.name, () if a.kind == K.ROBOT else a.values)
         for aid, a in program.activities.items()
         if a.kind != K.COMMENT
     }
