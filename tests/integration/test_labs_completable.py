@@ -205,8 +205,9 @@ def test_a_starter_run_as_given_does_not_count_as_getting_out():
     station.start()
     station.step(60 * 120)
     assert reasons("unity-simulator", "wall-following", station)[:2] == [
-        "✓ run 1 (algorithm starter-unity-wall-following) carried distance:1:right, "
-        "distance:2:front",
+        "✗ run 1 was driven by the lab starter starters/unity-wall-following.yaml, which comes "
+        "with the workbench: drive a run with these sensors yourself (keys, VIPLE or your own "
+        "program)",
         "✗ no run by viple or fsm has reached the exit of 'eRobotic lab maze' (unity) yet",
     ]
 

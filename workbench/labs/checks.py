@@ -373,14 +373,24 @@ def check_sensors(
     obj: Objective, exercise: Exercise, station: LabStation, attempt: Attempt
 ) -> Check:
     """A run of the attempt, on the exercise's profile, in which the robot moved carrying
-    exactly these sensors (the run under way counts as it stands). Fitting the sensors is not
-    enough: the set-up fits them; the work is a run with them."""
+    exactly these sensors (the run under way counts as it stands), driven by the student: the
+    keys, VIPLE, or a program or FSM of their own. Fitting the sensors is not enough: the
+    set-up fits them; the work is a run with them."""
     want = set(sensor_texts(obj.sensors))
     moved = [
         r for r in attempt_runs(station, attempt)
         if r.moved and r.profile == exercise.setup.profile
     ]  # fmt: skip
     with_them = [r for r in moved if set(sensor_texts(r.sensors)) == want]
+    shipped = [r for r in with_them if r.bundled]
+    with_them = [r for r in with_them if not r.bundled]
+    if not with_them and shipped:
+        last = shipped[-1]
+        return Check(
+            False,
+            f"run {last.number} was driven by {last.bundled}, which comes with the workbench: "
+            "drive a run with these sensors yourself (keys, VIPLE or your own program)",
+        )
     if with_them:
         run = with_them[-1]
         evidence = run_evidence(run)

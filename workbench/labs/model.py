@@ -409,8 +409,12 @@ def _max_tries(r: _Reader, node: yaml.Node, where: str) -> int:
     value = yaml.safe_load(yaml.serialize(node)) if isinstance(node, yaml.ScalarNode) else None
     if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= MAX_TRIES:
         shown = repr(node.value) if isinstance(node, yaml.ScalarNode) else "this"
-        r.fail(node, f"{where}: max_tries", f"{shown} is not a whole number from 1 to "
-               f"{MAX_TRIES}", "write how many answers a student may try, e.g. 'max_tries: 3'")  # fmt: skip
+        r.fail(
+            node,
+            f"{where}: max_tries",
+            f"{shown} is not a whole number from 1 to {MAX_TRIES}",
+            "write how many answers a student may try, e.g. 'max_tries: 3'",
+        )
     return int(value)
 
 
@@ -545,18 +549,14 @@ def _objective(r: _Reader, node: yaml.Node, where: str) -> Objective:
             limits["max_collisions"] = int(limits["max_collisions"])
         run_sensors = r.sensors(keys["sensors"], here) if "sensors" in keys else None
         maze = r.maze(keys["maze"], here)
-        return Objective(
-            kind, text, maze=maze, drivers=drivers, run_sensors=run_sensors, **limits
-        )
+        return Objective(kind, text, maze=maze, drivers=drivers, run_sensors=run_sensors, **limits)
     if kind == "compare":
         mazes = tuple(r.maze(n, here) for n in r.items(keys["mazes"], here))
         return Objective(kind, text, algorithms=r.texts(keys["algorithms"], here), mazes=mazes)
     return Objective(kind, text)
 
 
-def _question(
-    r: _Reader, node: yaml.Node, where: str, max_tries: int | None = None
-) -> Question:
+def _question(r: _Reader, node: yaml.Node, where: str, max_tries: int | None = None) -> Question:
     keys = r.mapping(
         node, f"{where}: question", ("id", "text", "answer"), ("choices", "unit", "max_tries")
     )

@@ -3,8 +3,9 @@
 Every edit makes a new immutable :class:`Maze`; the undo and redo stacks hold whole mazes, so
 undo is exact and cheap. Each maze is kept with the one it was made from by hand (the maze
 opened, or the last one New or Generate made), so the editor can say how many blocks the
-student added or removed by hand (:meth:`MazeEditor.hand_blocks`). The editor never loses work: a failed save raises
-:class:`EditorError` with a readable reason and leaves the edited maze in memory.
+student added or removed by hand (:meth:`MazeEditor.hand_blocks`). The editor never loses
+work: a failed save raises :class:`EditorError` with a readable reason and leaves the edited
+maze in memory.
 """
 
 from __future__ import annotations
