@@ -555,22 +555,25 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         text = answers.get(question_id, "").strip()
         q = next(q for q in exercise.questions if q.id == question_id)
         used = self.lab_progress.tries_of(key, question_id)
-        tries = f"try {used} of {q.max_tries}" if q.max_tries else f"tries {used}"
         locked = not self.lab_progress.can_answer(key, question_id, q.max_tries)
         marks = self.marks
         if typed.strip() and typed.strip() != text and not locked:
-            left = f", {q.max_tries - used} left" if q.max_tries else ""
-            return prose(f"press enter to try this answer ({tries}{left})", self.unicode)
+            left = f": {q.max_tries - used} of {q.max_tries} tries left" if q.max_tries else ""
+            return prose(f"press enter to try this answer{left}", self.unicode)
         if not text:
             return "not answered yet"
         ok, reason = q.check(text)
+        if q.max_tries:
+            tries = f" (try {used} of {q.max_tries})"
+        else:
+            tries = f" ({used} {'try' if used == 1 else 'tries'})" if used else ""
         if locked and not ok:
             return prose(
-                f"{marks.failed} {reason}; no tries left ({tries}): the answer box takes no "
-                "more answers and waits for the instructor",
+                f"{marks.failed} {reason}{tries}: no tries left, the answer waits for the "
+                "instructor",
                 self.unicode,
             )
-        return prose(f"{marks.passed if ok else marks.failed} {reason} ({tries})", self.unicode)
+        return prose(f"{marks.passed if ok else marks.failed} {reason}{tries}", self.unicode)
 
     @on(Input.Changed)
     def _typed(self, event: Input.Changed) -> None:
