@@ -28,6 +28,7 @@ from .checks import (
     SetupChanges,
     apply_setup,
     evaluate,
+    evidence_programs,
     keep_passed,
 )
 from .model import Exercise, Lab
@@ -291,6 +292,28 @@ def questions_words(ev: Mapping[str, Any]) -> str:
     if waiting:
         words += f"; waiting for the instructor: {', '.join(map(str, waiting))}"
     return words
+
+
+def signoff_words(progress: ExerciseProgress) -> str:
+    """What a sign-off should know beyond the objectives' marks, in one line ("" for
+    nothing): the program the evidence rests on (or that it mixes programs), and the
+    questions whose tries are used up and wait for the instructor."""
+    parts = []
+    programs = evidence_programs(progress)
+    named = [f"{name} sha256 {digest[:12]}" for digest, name in programs.items()]
+    if len(named) == 1:
+        parts.append(f"program {named[0]}")
+    elif named:
+        parts.append(f"the evidence mixes {len(named)} programs: {', '.join(named)}")
+    waiting = [
+        str(q)
+        for o in progress.objectives
+        if o.kind == "questions"
+        for q in o.evidence.get("waiting") or []
+    ]
+    if waiting:
+        parts.append(f"out of tries, for you to judge: {', '.join(waiting)}")
+    return "; ".join(parts)
 
 
 def evidence_words(state: ObjectiveState) -> str:
