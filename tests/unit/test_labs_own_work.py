@@ -202,3 +202,21 @@ def test_a_pass_saved_without_evidence_needs_redoing_until_the_work_is_done_agai
     do_the_work(b, "keys")
     again = keep_passed(shown, evaluate("lab", ex, b))
     assert again.passed and not again.objectives[0].redo
+
+
+def test_a_pass_saved_under_the_old_rules_needs_redoing():
+    """Passes saved before a sensors objective needed a run, an exit the run's sensors and an
+    edit blocks changed by hand: they were judged by other rules, and are done again."""
+    old = {
+        "lab": "lab", "exercise": "mine", "answers": {},
+        "objectives": [
+            {"kind": "sensors", "text": "sensors", "passed": True, "reason": "sensors are ...",
+             "evidence": {"attempt": "a1", "sensors": ["touch:2:front"], "person": "ana"}},
+            {"kind": "exit", "text": "out", "passed": True, "reason": "run 1 ...",
+             "evidence": {"attempt": "a1", "run": 1, "driver": "keys"}},
+            {"kind": "maze-edited", "text": "edited", "passed": True, "reason": "edit 1 ...",
+             "evidence": {"attempt": "a1", "edit": 1}},
+        ],
+    }  # fmt: skip
+    saved = ExerciseProgress.from_dict(old)
+    assert [(o.passed, o.reason) for o in saved.objectives] == [(False, REDO)] * 3

@@ -56,10 +56,19 @@ ATTEMPT = "attempt"
 REDO = REDO_REASON
 
 
+#: what a pass of these kinds keeps since it rests on the student's own run or hand edit: a
+#: pass saved without it was judged by the rules before (the set-up's sensors, a shipped
+#: program, Generate) and needs redoing
+OWN_WORK_KEYS = {"sensors": "run", "exit": "sensors", "maze-edited": "hand_blocks"}
+
+
 def proven(state: ObjectiveState) -> bool:
     """Whether a passed objective rests on evidence of its exercise's own work (the
     questions rest on the answers kept with the exercise)."""
-    return state.kind == "questions" or bool(state.evidence.get(ATTEMPT))
+    if state.kind == "questions":
+        return True
+    key = OWN_WORK_KEYS.get(state.kind)
+    return bool(state.evidence.get(ATTEMPT)) and (key is None or key in state.evidence)
 
 
 def unproven_to_redo(state: ObjectiveState) -> ObjectiveState:
