@@ -27,6 +27,8 @@ def test_a_student_resumes_on_another_server_where_they_left_off(tmp_path, pg_ur
         await pilot.press("a", "escape", "w", "a", "s", "d", "space", "l")
         await pilot.pause()
         assert text(screen, "#labs-objectives").startswith("[X] drove with w, a, s, d and space")
+        try_answer(screen, "tcp-port", "1351")
+        await pilot.pause()
         try_answer(screen, "tcp-port", "1350")
         await pilot.pause()
 
@@ -40,6 +42,9 @@ def test_a_student_resumes_on_another_server_where_they_left_off(tmp_path, pg_ur
             "[X] drove with w, a, s, d and space: passed earlier"
         )
         assert screen.query_one("#q-tcp-port", Input).value == "1350"
+        # both tries came back from the course database, and are shown
+        reason = screen.query_one("#q-tcp-port", Input).parent.query_one(".question-reason")
+        assert str(reason.render()) == "[X] correct (2 tries)"
 
     run(second, resume)
 
