@@ -257,6 +257,8 @@ def run_evidence(run: RunEntry) -> dict[str, Any]:
     program = {"program_sha256": digest} if digest else {}
     if run.program_name:
         program["program_name"] = run.program_name
+    if run.bundled:  # a built-in a lab asked for (compare, "algorithm NAME"): not a copy hint
+        program["bundled"] = run.bundled
     under_way = run.ended == UNDER_WAY
     return {
         ATTEMPT: run.attempt,
