@@ -4,8 +4,9 @@ On the left, every lab and its exercises (✓ once an exercise's objectives pass
 instructor has signed it off; ``[X]`` and ``[*]`` in ASCII mode); on the right, the chosen
 exercise: its instructions, its objectives with ✓/✗ (``[X]``/``[ ]``) and a one-line reason
 that follow the station as the student works, and its questions (a multiple-choice one's
-choices picked with the arrows and enter or a click, any other typed in its field); under a
-passed objective, the work it rests on. The list has the focus whenever the screen comes up,
+choices picked with the arrows and enter or a click, any other typed in its field and tried
+with enter; each try is counted, shown under the question, and a question out of tries takes
+no more answers); under a passed objective, the work it rests on. The list has the focus whenever the screen comes up,
 so its keys never land in an answer: ``a`` puts the exercise's set-up on the station, ``r``
 asks for sign-off (the exercise joins the store's sign-off queue, which the instructor's
 console shows; the screen follows the request), and ``i`` opens the instructor's sign-off at
