@@ -12,8 +12,9 @@ and the parameters in force have the same values.
 - A lab's starter (``labs/starters``) is matched on its ``FILL IN`` parameters only: a starter
   whose FILL IN values are as shipped is the starter, whatever else was tuned; one whose FILL
   IN values the student set is the student's. An FSM shaped as a starter is judged as that
-  starter only, never as a built-in: a starter completed as the lab asks may well behave as
-  the built-in it was cut from, and it is still the student's work.
+  starter, not as a built-in (a starter completed as the lab asks may well behave as the
+  built-in it was cut from, and it is still the student's work), unless its file declares
+  the built-in's own parameter defaults too: then it is that built-in, copied.
 """
 
 from __future__ import annotations
@@ -49,6 +50,11 @@ def shape(definition: FsmDefinition) -> str:
     return repr((definition.initial, states, sensors, params, variables))
 
 
+def declared(definition: FsmDefinition) -> str:
+    """The parameter defaults an FSM file declares, every profile's."""
+    return repr(sorted((p.name, sorted(p.defaults.items())) for p in definition.parameters))
+
+
 @dataclass(frozen=True)
 class BundledFsm:
     """An FSM file the workbench ships: where it is (as the reason names it), its shape, and
@@ -57,6 +63,8 @@ class BundledFsm:
     shown: str
     shape: str
     definition: FsmDefinition
+    #: its declared parameter defaults (:func:`declared`)
+    defaults: str
     #: None: every parameter; else only these (a starter's FILL IN parameters)
     pinned: frozenset[str] | None
 
@@ -90,17 +98,23 @@ def bundled_fsms() -> tuple[BundledFsm, ...]:
                 continue
             pinned = _fill_ins(definition.parameters) if starters else None
             shown = f"the {label} {path.parent.name}/{path.name}"
-            found.append(BundledFsm(shown, shape(definition), definition, pinned))
+            found.append(
+                BundledFsm(shown, shape(definition), definition, declared(definition), pinned)
+            )
     return tuple(found)
 
 
 def bundled_fsm(definition: FsmDefinition, values: Mapping[str, float], profile: str) -> str:
     """Which shipped FSM ``definition`` with the parameters ``values`` in force is, in words
     ("the built-in algorithm algorithms/right-wall.yaml"); "" when it is none of them."""
-    run_shape = shape(definition)
+    run_shape, run_defaults = shape(definition), declared(definition)
     known = bundled_fsms()
+    copied = [
+        b for b in known
+        if b.pinned is None and b.shape == run_shape and b.defaults == run_defaults
+    ]  # fmt: skip
     starters = [b for b in known if b.pinned is not None and b.shape == run_shape]
-    for bundled in starters or known:
+    for bundled in copied or starters or known:
         if bundled.matches(run_shape, values, profile):
             return bundled.shown
     return ""
