@@ -5,18 +5,19 @@ instructor has signed it off; ``[X]`` and ``[*]`` in ASCII mode); on the right, 
 exercise: its instructions, its objectives with ✓/✗ (``[X]``/``[ ]``) and a one-line reason
 that follow the station as the student works, and its questions (a multiple-choice one's
 choices picked with the arrows and enter or a click, any other typed in its field and tried
-with enter; each try is counted, shown under the question, and a question out of tries takes
-no more answers); under a passed objective, the work it rests on. The list has the focus whenever the screen comes up,
-so its keys never land in an answer: ``a`` puts the exercise's set-up on the station, ``r``
-asks for sign-off (the exercise joins the store's sign-off queue, which the instructor's
-console shows; the screen follows the request), and ``i`` opens the instructor's sign-off at
-this station where signing here is allowed (not in a served student's session, whose terminal
-is the student's). What the student has done is held by :class:`LabProgress` (in the core):
-the screen draws it and routes the student's input to it. Progress is saved in the store as
-soon as an exercise is opened and each time an objective or an answer changes; an objective
-that passed once stays passed, with its evidence, after a restart. The saved work is read in
-a thread as the screen comes up (a course database may be slow, or hang until its deadline):
-until it is read the screen says so and opens no exercise, so nothing is saved over it.
+with enter; each try is counted, shown under the question, and a question out of tries takes no
+more answers); under a passed objective, the work it rests on. The list has the focus whenever
+the screen comes up, so its keys never land in an answer: ``a`` puts the exercise's set-up on
+the station, ``r`` asks for sign-off (the exercise joins the store's sign-off queue, which the
+instructor's console shows; the screen follows the request), and ``i`` opens the instructor's
+sign-off at this station where signing here is allowed (not in a served student's session,
+whose terminal is the student's). What the student has done is held by :class:`LabProgress` (in
+the core): the screen draws it and routes the student's input to it. Progress is saved in the
+store as soon as an exercise is opened and each time an objective or an answer changes; an
+objective that passed once stays passed, with its evidence, after a restart. The saved work is
+read in a thread as the screen comes up (a course database may be slow, or hang until its
+deadline): until it is read the screen says so and opens no exercise, so nothing is saved over
+it.
 """
 
 from __future__ import annotations
