@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from textual.pilot import Pilot
-from textual.widgets import OptionList, Static
+from textual.widgets import Input, OptionList, Static
 
 from tests.waiting import until
 from workbench.tui.app import WorkbenchApp, make_app
@@ -63,3 +63,11 @@ async def signing_over(pilot: Pilot, modal: SignoffModal) -> None:
     if modal.signing is not None:
         await modal.signing.wait()
     await pilot.pause()
+
+
+def try_answer(screen, question_id: str, answer: str) -> None:
+    """``answer`` typed into the field of ``question_id`` and tried, as enter there tries it
+    (the focus stays where it is); the try is taken once the app has handled its message."""
+    field = screen.query_one(f"#q-{question_id}", Input)
+    field.value = answer
+    field.post_message(Input.Submitted(field, answer))

@@ -15,7 +15,7 @@ from workbench.labs.store import Store
 from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
 
-from .labs_support import DRIVE, lab_app, open_exercise, open_labs, text
+from .labs_support import DRIVE, lab_app, open_exercise, open_labs, text, try_answer
 from .support import run, said
 
 
@@ -27,7 +27,9 @@ def test_a_student_resumes_on_another_server_where_they_left_off(tmp_path, pg_ur
         await pilot.press("a", "escape", "w", "a", "s", "d", "space", "l")
         await pilot.pause()
         assert text(screen, "#labs-objectives").startswith("[X] drove with w, a, s, d and space")
-        screen.query_one("#q-tcp-port", Input).value = "1350"
+        try_answer(screen, "tcp-port", "1351")
+        await pilot.pause()
+        try_answer(screen, "tcp-port", "1350")
         await pilot.pause()
 
     run(first, drive)
@@ -40,6 +42,9 @@ def test_a_student_resumes_on_another_server_where_they_left_off(tmp_path, pg_ur
             "[X] drove with w, a, s, d and space: passed earlier"
         )
         assert screen.query_one("#q-tcp-port", Input).value == "1350"
+        # both tries came back from the course database, and are shown
+        reason = screen.query_one("#q-tcp-port", Input).parent.query_one(".question-reason")
+        assert str(reason.render()) == "[X] correct (2 tries)"
 
     run(second, resume)
 
@@ -53,7 +58,7 @@ def test_the_database_going_away_is_shown_and_the_work_is_saved_when_it_is_back(
         screen = await open_exercise(pilot, DRIVE)
         pg_server.stop()
         try:
-            screen.query_one("#q-tcp-port", Input).value = "1350"
+            try_answer(screen, "tcp-port", "1350")
             await pilot.pause()
             message = text(screen, "#labs-message")
             assert message.startswith("the course database cannot be reached: your progress")
@@ -84,7 +89,7 @@ def test_changes_kept_while_the_database_is_down_outlive_the_app_and_are_saved_b
     async def work_offline(pilot: Pilot) -> None:
         screen = await open_exercise(pilot, DRIVE)
         pg_server.stop()
-        screen.query_one("#q-tcp-port", Input).value = "4242"
+        try_answer(screen, "tcp-port", "4242")
         await pilot.pause()
         assert "saved as soon as it is back" in text(screen, "#labs-message")
         assert kept.is_file()  # kept in the data folder at once, not only at the end
@@ -136,7 +141,7 @@ def test_retries_run_beside_the_app_one_at_a_time(tmp_path, pg_server, pg_url, m
         monkeypatch.setattr(store, "flush", slow_flush)
         pg_server.stop()
         try:
-            screen.query_one("#q-tcp-port", Input).value = "77"
+            try_answer(screen, "tcp-port", "77")
             await pilot.pause()
             await until(lambda: running, "a retry under way")
             assert running == 1  # a retry is under way now, waiting for the database
@@ -203,7 +208,7 @@ def test_a_database_that_hangs_never_freezes_the_app_and_the_work_waits_for_it(
         store = app.store
         hang.start()
         try:
-            screen.query_one("#q-tcp-port", Input).value = "1350"  # saving the answer begins
+            try_answer(screen, "tcp-port", "1350")  # saving the answer begins
             await pilot.pause()
             # while the save waits for the database, keys are handled and the screen drawn
             await pilot.press("escape", "p")
@@ -244,7 +249,7 @@ def test_the_labs_open_beside_a_database_that_hangs_and_the_student_goes_on(
 
     async def work(pilot: Pilot) -> None:
         screen = await open_exercise(pilot, DRIVE)
-        screen.query_one("#q-tcp-port", Input).value = "1350"
+        try_answer(screen, "tcp-port", "1350")
         await pilot.pause()
 
     run(first, work)  # saved progress the hung database holds

@@ -58,7 +58,7 @@ def test_reopening_the_labs_focuses_the_list_and_its_keys_leave_the_answers_alon
         assert screen.focused is listing
         field = screen.query_one("#q-tcp-port", Input)
         field.focus()
-        await pilot.press("1", "3", "5", "0")
+        await pilot.press("1", "3", "5", "0", "enter")  # typed and tried
         assert field.value == "1350"
         await pilot.press("escape")  # back to the maze from the answer field
         await pilot.press("l")
@@ -76,7 +76,7 @@ def test_reopening_the_labs_focuses_the_list_and_its_keys_leave_the_answers_alon
         await pilot.press("i", "escape", "a")
         await pilot.pause()
         assert field.value == "1350"
-        assert reason_of(screen, "tcp-port") == "[X] correct"
+        assert reason_of(screen, "tcp-port") == "[X] correct (1 try)"
         saved = app.store.progress("ana")[("unity-simulator", "drive-by-wire")]
         assert saved["answers"] == {"tcp-port": "1350"}
 
@@ -148,14 +148,14 @@ def test_a_choice_is_picked_with_the_keys_and_saved_as_its_text(tmp_path):
         await pilot.pause()
         right = rules_question().choices[right_choice()]
         assert choices.answer == right
-        assert reason_of(screen, QUESTION) == "[X] correct"
+        assert reason_of(screen, QUESTION) == "[X] correct (1 try)"
         saved = app.store.progress("ana")[("maze-algorithms", "erobotic-rules")]
         assert saved["answers"][QUESTION] == right
         wrong = (right_choice() + 1) % len(rules_question().choices)
         await pilot.press(*["up"] * right_choice(), *["down"] * wrong, "space")
         await pilot.pause()
         assert choices.answer == rules_question().choices[wrong]
-        assert reason_of(screen, QUESTION) == "[ ] not the expected answer"
+        assert reason_of(screen, QUESTION) == "[ ] not the expected answer (2 tries)"
 
     run(app, body)
 
@@ -172,7 +172,7 @@ def test_a_choice_is_picked_with_the_mouse(tmp_path):
         await pilot.click(target)
         await pilot.pause()
         assert choices.answer == rules_question().choices[right_choice()]
-        assert reason_of(screen, QUESTION) == "[X] correct"
+        assert reason_of(screen, QUESTION) == "[X] correct (1 try)"
 
     run(app, body)
 

@@ -13,7 +13,7 @@ from workbench.labs.store import Store
 from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
 
-from .labs_support import DRIVE, lab_app, open_exercise, text
+from .labs_support import DRIVE, lab_app, open_exercise, text, try_answer
 from .support import run
 
 
@@ -25,7 +25,7 @@ def test_the_keys_are_answered_while_the_saved_work_is_read_and_it_shows_once_re
 
     async def work(pilot: Pilot) -> None:
         screen = await open_exercise(pilot, DRIVE)
-        screen.query_one("#q-tcp-port", Input).value = "1350"
+        try_answer(screen, "tcp-port", "1350")
         await pilot.pause()
 
     run(first, work)

@@ -23,6 +23,7 @@ from .labs_support import (
     open_exercise,
     signing_over,
     text,
+    try_answer,
 )
 from .support import run
 
@@ -107,7 +108,7 @@ def test_the_sign_off_names_who_did_the_work_and_shows_the_moment_it_is_saved(tm
                 screen.query_one(f"#q-{q.id}", Choices).focus()
                 await pilot.press(*["down"] * q.choices.index(answer(q)), "enter")
             else:
-                screen.query_one(f"#q-{q.id}", Input).value = answer(q)
+                try_answer(screen, q.id, answer(q))
         await pilot.pause()
         assert screen.progress is not None and screen.progress.passed
         assert evidence_lines(screen)[0].startswith("run 1 by ana (algorithm right-wall)")
@@ -117,9 +118,10 @@ def test_the_sign_off_names_who_did_the_work_and_shows_the_moment_it_is_saved(tm
         maze = station.maze
         inner = next((x, y) for y in range(1, maze.height - 1) for x in range(1, maze.width - 1)
                      if maze.is_wall(x, y))  # fmt: skip
-        station.put_edited_maze(maze.with_block(*inner, wall=False), maze)  # the editor's report
+        # the editor's report of one block taken away by hand
+        station.put_edited_maze(maze.with_block(*inner, wall=False), maze, hand_blocks=1)
         await pilot.press("l")
-        screen.query_one("#q-tcp-port", Input).value = "1350"
+        try_answer(screen, "tcp-port", "1350")
         await pilot.pause()
         await sign(pilot, "ana")
         # saved: the title and the list say so before the dialog is closed

@@ -5,21 +5,21 @@ evidence and the signed record name the program by its sha256."""
 from __future__ import annotations
 
 import hashlib
-import json
 from pathlib import Path
 
 from textual.pilot import Pilot
 from textual.widgets import Input
 
+from tests.students_work import own_right_wall
 from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.store import Store
 from workbench.tui.dialogs.algorithm import AlgorithmModal
 from workbench.tui.dialogs.signoff import SignoffModal
 
-from .labs_support import lab_app, open_exercise, signing_over, text
+from .labs_support import lab_app, open_exercise, signing_over, text, try_answer
 from .support import run
 
-PROGRAM = Path(__file__).resolve().parents[2] / "programs" / "right-wall.viple"
+EXAMPLE = Path(__file__).resolve().parents[2] / "programs" / "web-wall-following.viple"
 EXERCISE = "web-simulator/wall-activities"
 FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
 PASS = "correct horse battery"
@@ -29,7 +29,8 @@ def test_a_viple_exercise_is_passed_and_signed_off_with_the_students_program(tmp
     data = tmp_path / "data"
     create_instructor(data, "Dr Chen", PASS, kdf=FAST)
     app = lab_app(data)
-    digest = hashlib.sha256(PROGRAM.read_bytes()).hexdigest()
+    mine = own_right_wall(tmp_path)
+    digest = hashlib.sha256(mine.read_bytes()).hexdigest()
 
     async def body(pilot: Pilot) -> None:
         station = app.station
@@ -42,8 +43,8 @@ def test_a_viple_exercise_is_passed_and_signed_off_with_the_students_program(tmp
         await pilot.pause()
         dialog = app.screen
         assert isinstance(dialog, AlgorithmModal)
-        dialog.query_one("#alg-path", Input).value = str(PROGRAM)
-        await dialog.choose(str(PROGRAM))
+        dialog.query_one("#alg-path", Input).value = str(mine)
+        await dialog.choose(str(mine))
         await pilot.press("escape")
         await pilot.press("x")  # the program drives from the start block
         station.pause()
@@ -56,14 +57,16 @@ def test_a_viple_exercise_is_passed_and_signed_off_with_the_students_program(tmp
         await pilot.pause()
         objectives = text(screen, "#labs-objectives").splitlines()
         assert objectives[0].startswith("[X] your program got out of the Web maze within 300 s")
-        assert "VIPLE program right-wall.viple" in objectives[0]
+        assert "VIPLE program my-right-wall.viple" in objectives[0]
         progress = app.store.progress("ana")[("web-simulator", "wall-activities")]
         evidence = progress["objectives"][0]["evidence"]
         assert evidence["program_sha256"] == digest
-        assert evidence["driver"] == "VIPLE program right-wall.viple"
+        assert evidence["driver"] == "VIPLE program my-right-wall.viple"
+        assert evidence["program_name"] == "my-right-wall.viple"
+        assert evidence["sensors"] == ["distance:1:right", "touch:2:front"]
         answers = (("backward", "-0.3"), ("forward", "0.5"), ("spin-ms", "1500"))
         for question, answer in answers:  # the exercise's questions, as the text tells them
-            screen.query_one(f"#q-{question}", Input).value = answer
+            try_answer(screen, question, answer)
         await pilot.pause()
         assert screen.progress is not None and screen.progress.passed, screen.progress
         await pilot.press("i")
@@ -80,6 +83,41 @@ def test_a_viple_exercise_is_passed_and_signed_off_with_the_students_program(tmp
             (row,) = store.signoffs(student="ana")
         assert (row.lab, row.exercise) == ("web-simulator", "wall-activities")
         assert row.evidence_digest == screen.progress.evidence_digest()
-        assert digest in json.dumps(row.metrics_value())  # the signed record names the program
+        # the signed record names the program the evidence rests on
+        assert row.metrics_value()["programs"] == {digest: "my-right-wall.viple"}
+
+    run(app, body)
+
+
+def test_the_example_program_that_solves_the_exercise_does_not_pass_it(tmp_path):
+    app = lab_app(tmp_path / "data")
+
+    async def body(pilot: Pilot) -> None:
+        station = app.station
+        screen = await open_exercise(pilot, EXERCISE)
+        await pilot.press("a")
+        await pilot.press("escape", "g")
+        await pilot.pause()
+        dialog = app.screen
+        assert isinstance(dialog, AlgorithmModal)
+        dialog.query_one("#alg-path", Input).value = str(EXAMPLE)
+        await dialog.choose(str(EXAMPLE))
+        await pilot.press("escape")
+        await pilot.press("x")
+        station.pause()
+        for _ in range(300):
+            station.step(60)
+            if station.runs and station.runs[-1].ended == "exit":
+                break
+        assert station.runs[-1].ended == "exit"  # it does get out
+        app.refresh_views()
+        await pilot.press("l")
+        await pilot.pause()
+        objectives = text(screen, "#labs-objectives")
+        assert objectives.startswith(
+            "[ ] your program got out of the Web maze within 300 s: run 1 (VIPLE program "
+            "web-wall-following.viple) is the example program programs/web-wall-following.viple,"
+            " which comes with the workbench, not your own program"
+        ), objectives
 
     run(app, body)

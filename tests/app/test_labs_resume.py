@@ -13,7 +13,15 @@ from workbench.tui.screens.main import MainScreen
 from workbench.tui.settings import AppSettings
 from workbench.viple.tcp_server import TcpConfig
 
-from .labs_support import DRIVE, lab_app, objective_lines, open_exercise, open_labs, text
+from .labs_support import (
+    DRIVE,
+    lab_app,
+    objective_lines,
+    open_exercise,
+    open_labs,
+    text,
+    try_answer,
+)
 from .support import endpoints_started, run, run_panel, said
 
 CONNECT = "web-simulator/connect"
@@ -40,7 +48,7 @@ def test_what_passed_before_a_restart_is_still_passed_after_it(tmp_path):
         await pilot.press("a", "escape", "w", "a", "s", "d", "space", "l")
         await pilot.pause()
         assert text(screen, "#labs-objectives").startswith("[X] drove with w, a, s, d and space")
-        screen.query_one("#q-tcp-port", Input).value = "13"  # half typed when the app dies
+        try_answer(screen, "tcp-port", "13")  # tried just before the app dies
         await pilot.pause()
 
     run(first, drive)

@@ -19,7 +19,15 @@ from workbench.tui.dialogs.signoff import SignoffModal
 from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
 
-from .labs_support import DRIVE, lab_app, objective_lines, open_exercise, signing_over, text
+from .labs_support import (
+    DRIVE,
+    lab_app,
+    objective_lines,
+    open_exercise,
+    signing_over,
+    text,
+    try_answer,
+)
 from .support import run
 
 FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
@@ -35,10 +43,11 @@ async def complete_drive_by_wire(pilot: Pilot, screen: LabsScreen) -> None:
     maze = station.maze
     inner = next((x, y) for y in range(1, maze.height - 1) for x in range(1, maze.width - 1)
                  if maze.is_wall(x, y))  # fmt: skip
-    station.put_edited_maze(maze.with_block(*inner, wall=False), maze)  # the editor's report
+    # the editor's report of one block taken away by hand
+    station.put_edited_maze(maze.with_block(*inner, wall=False), maze, hand_blocks=1)
     await pilot.press("l")
     await pilot.pause()
-    screen.query_one("#q-tcp-port", Input).value = "1350"
+    try_answer(screen, "tcp-port", "1350")
     await pilot.pause()
 
 
@@ -81,7 +90,7 @@ def test_set_up_then_driving_flips_the_keys_objective_and_saves_progress(tmp_pat
     run(app, body)
 
 
-def test_a_question_is_checked_as_it_is_answered(tmp_path):
+def test_a_question_is_checked_when_an_answer_is_tried_and_every_try_counts(tmp_path):
     app = lab_app(tmp_path / "data")
 
     async def body(pilot: Pilot) -> None:
@@ -91,13 +100,20 @@ def test_a_question_is_checked_as_it_is_answered(tmp_path):
         screen.query_one("#q-tcp-port", Input).focus()
         await pilot.press("1", "3", "5", "1")
         await pilot.pause()
-        assert str(reason.render()).startswith("[ ]")
-        await pilot.press("backspace", "0")
+        # typing is not trying: nothing is checked (or counted) before enter
+        assert str(reason.render()) == "press enter to try this answer"
+        assert "[ ] question answered: not answered yet" in text(screen, "#labs-objectives")
+        await pilot.press("enter")
         await pilot.pause()
-        assert str(reason.render()) == "[X] correct"
+        assert str(reason.render()) == "[ ] not the expected answer (1 try)"
+        await pilot.press("backspace", "0", "enter")
+        await pilot.pause()
+        assert str(reason.render()) == "[X] correct (2 tries)"
         assert "[X] question answered" in text(screen, "#labs-objectives")
+        assert "  1 of 1 right; tries: tcp-port 2" in text(screen, "#labs-objectives")
         saved = app.store.progress("ana")[("unity-simulator", "drive-by-wire")]
         assert saved["answers"] == {"tcp-port": "1350"}
+        assert saved["tries"] == {"tcp-port": 2}
 
     run(app, body)
 

@@ -27,7 +27,7 @@ from textual.pilot import Pilot
 from textual.widgets import Input, Markdown, OptionList, Select, Static
 from websockets.asyncio.server import serve
 
-from tests.app.labs_support import objective_lines, open_labs, signing_over
+from tests.app.labs_support import objective_lines, open_labs, signing_over, try_answer
 from tests.integration.test_labs_completable import DRIVE, SOLUTIONS, answer
 from tests.sessions import free_port
 from tests.waiting import DEADLINE, until
@@ -264,8 +264,10 @@ class Walkthrough:
             runs.extend(state.evidence.get("runs", []))
         kinds = [o.kind for o in ex.objectives]
         compared = sum(len(o.mazes) * len(o.algorithms) for o in ex.objectives)
-        assert len(runs) == kinds.count("exit") + compared, runs
+        assert len(runs) == kinds.count("exit") + kinds.count("sensors") + compared, runs
         for evidence in runs:
+            if evidence["driver"] == "keys":  # a drive with the sensors: no run to repeat
+                continue
             want = self.headless[(evidence["maze_digest"], evidence["driver"], evidence["profile"])]
             for key in MEASURES:
                 assert evidence["metrics"][key] == pytest.approx(want[key], abs=1e-9), key
@@ -316,6 +318,18 @@ class Walkthrough:
         await self.press("escape")
         assert {str(s) for s in self.station.sensors} == {str(s) for s in obj.sensors}
 
+    async def passes(self, lab: Lab, ex: Exercise, obj: Objective) -> bool:
+        screen = await self.open(lab, ex)
+        assert screen.progress is not None
+        return next(o for o in screen.progress.objectives if o.text == obj.text).passed
+
+    async def drive_a_run(self) -> None:
+        """Back to the start (r) and a short drive with the keys: a run on the sensors."""
+        await self.main_screen()
+        await self.press("r", "w")
+        self.station.step(20)
+        await self.press("space")
+
     async def edit_maze(self) -> None:
         """The maze editor: open an inner wall, save the maze as a new file, go back."""
         await self.main_screen()
@@ -347,10 +361,10 @@ class Walkthrough:
                 screen.query_one(f"#q-{q.id}", Choices).focus()
                 await self.press(*["down"] * q.choices.index(answer(q)), "enter")
             else:
-                screen.query_one(f"#q-{q.id}", Input).value = answer(q)
+                try_answer(screen, q.id, answer(q))
         await self.pilot.pause()
         reasons = [str(s.render()) for s in screen.query(".question-reason").results(Static)]
-        assert reasons == ["[X] correct"] * len(ex.questions), reasons
+        assert reasons == ["[X] correct (1 try)"] * len(ex.questions), reasons
 
     async def do(self, lab: Lab, ex: Exercise) -> None:
         """Everything the exercise asks, in the order a pair would do it."""
@@ -366,6 +380,8 @@ class Walkthrough:
             if obj.kind == "sensors":
                 if {str(s) for s in self.station.sensors} != {str(s) for s in obj.sensors}:
                     await self.set_sensors(obj)
+                if not await self.passes(lab, ex, obj):  # a run with them is the work
+                    await self.drive_a_run()
             elif obj.kind == "keys":
                 await self.drive_keys(obj)
             elif obj.kind == "maze-edited":

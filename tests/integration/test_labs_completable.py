@@ -15,6 +15,7 @@ from tests.waiting import DEADLINE, until
 from workbench.control.station import LabStation
 from workbench.labs.checks import ExerciseProgress, apply_setup, evaluate
 from workbench.labs.model import Exercise, LabMaze, Objective, Question, load_labs
+from workbench.sim.editing import MazeEditor
 from workbench.viple.tcp_server import TcpConfig, TcpServer
 from workbench.viple.ws_client import WsClient, WsConfig
 
@@ -151,7 +152,12 @@ def complete(station: LabStation, ex: Exercise) -> dict[str, str]:
     station.apply_sensors(ex.setup.sensors or station.sensors)
     for obj in ex.objectives:
         if obj.kind == "sensors":
+            # the sensors fitted, and a run with them (fitting them is not the work)
             station.apply_sensors(obj.sensors)
+            station.reset_robot()
+            station.key("w")
+            station.step(20)
+            station.reset_robot()
         elif obj.kind == "keys":
             for key in obj.keys:
                 station.key(key)
@@ -162,7 +168,9 @@ def complete(station: LabStation, ex: Exercise) -> dict[str, str]:
         maze = station.maze
         inner = next((x, y) for y in range(1, maze.height - 1) for x in range(1, maze.width - 1)
                      if maze.is_wall(x, y))  # fmt: skip
-        station.put_edited_maze(maze.with_block(*inner, wall=False), maze)
+        editor = MazeEditor(maze)
+        editor.toggle_wall(inner)  # one block taken away by hand, as in the editor
+        station.put_edited_maze(editor.maze, editor.opened, hand_blocks=editor.hand_blocks())
     return {q.id: answer(q) for q in ex.questions}
 
 
@@ -186,7 +194,9 @@ def reasons(lab_id: str, ex_id: str, station: LabStation | None = None, answers=
 
 
 def test_web_sensors_left_at_the_default_show_what_is_missing():
-    assert reasons("web-simulator", "sensors")[0] == "✗ missing distance:3:left"
+    assert reasons("web-simulator", "sensors")[0] == (
+        "✗ missing distance:3:left: fit them (sensor panel, o), then drive a run"
+    )
 
 
 def test_a_starter_run_as_given_does_not_count_as_getting_out():
@@ -195,7 +205,9 @@ def test_a_starter_run_as_given_does_not_count_as_getting_out():
     station.start()
     station.step(60 * 120)
     assert reasons("unity-simulator", "wall-following", station)[:2] == [
-        "✓ sensors are distance:1:right, distance:2:front",
+        "✗ run 1 was driven by the lab starter starters/unity-wall-following.yaml, which comes "
+        "with the workbench: drive a run with these sensors yourself (keys, VIPLE or your own "
+        "program)",
         "✗ no run by viple or fsm has reached the exit of 'eRobotic lab maze' (unity) yet",
     ]
 
@@ -205,7 +217,8 @@ def test_the_wrong_sensor_for_local_best_on_the_web():
     station = fresh_station(ex)
     station.apply_sensors(LABS["web-simulator"].exercise("wall-main").setup.sensors)
     assert reasons("web-simulator", "local-best-activities", station)[0] == (
-        "✗ missing distance:3:front; not wanted distance:1:right, touch:2:front"
+        "✗ missing distance:3:front; not wanted distance:1:right, touch:2:front: fit them "
+        "(sensor panel, o), then drive a run"
     )
 
 
@@ -223,7 +236,9 @@ def test_a_built_in_algorithm_does_not_stand_in_for_the_students_program():
     station = fresh_station(ex)
     run_on(station, ex.setup.maze, "web-wall-following")
     assert reasons("web-simulator", "wall-main", station)[1] == (
-        "✗ no run by viple or fsm has reached the exit of 'Web Simulator lab maze' (web) yet"
+        "✗ run 1 (algorithm web-wall-following) is the built-in algorithm "
+        "algorithms/web-wall-following.yaml, which comes with the workbench, not your own "
+        "program: complete it or write yours, and run that"
     )
 
 

@@ -304,3 +304,42 @@ def test_the_editor_refuses_to_save_a_maze_named_with_a_bidi_override(tmp_path):
     # a file name with one is refused as a path (control characters are never in one)
     with pytest.raises(EditorError, match="control characters"):
         MazeEditor(ROOM).save(tmp_path / "maze\u202etxt.exe")
+
+
+def test_hand_blocks_count_only_what_was_walled_or_cleared_by_hand():
+    ed = MazeEditor(ROOM)
+    assert ed.hand_blocks() == 0
+    ed.toggle_wall((2, 1))
+    ed.toggle_wall((3, 1))
+    assert ed.hand_blocks() == 2
+    ed.undo()
+    assert ed.hand_blocks() == 1  # an edit undone is not counted
+    ed.toggle_wall((2, 1))  # walled and cleared again: back as it was
+    assert ed.hand_blocks() == 0
+    ed.redo()  # nothing to redo after a new edit
+    assert ed.hand_blocks() == 0
+
+
+def test_generate_and_new_are_not_hand_edits_but_edits_after_them_are():
+    ed = MazeEditor(ROOM)
+    ed.toggle_wall((2, 1))
+    ed.generate(4, 3, 7, "braid", "center")
+    assert ed.maze != ROOM and ed.hand_blocks() == 0
+    inner = next((x, y) for y in range(1, ed.maze.height - 1)
+                 for x in range(1, ed.maze.width - 1) if ed.maze.is_wall(x, y))  # fmt: skip
+    ed.toggle_wall(inner)
+    assert ed.hand_blocks() == 1
+    ed.undo()
+    ed.undo()  # back before Generate: the hand edit on the room counts again
+    assert ed.maze.width == ROOM.width and ed.hand_blocks() == 1
+    ed.new(6, 5)
+    assert ed.hand_blocks() == 0
+
+
+def test_hand_blocks_of_the_maze_last_saved(tmp_path):
+    ed = MazeEditor(ROOM)
+    ed.toggle_wall((2, 1))
+    ed.save(tmp_path / "mine.txt")
+    ed.generate(4, 3, 7, "braid", "center")
+    assert ed.hand_blocks() == 0
+    assert ed.hand_blocks(discard=True) == 1  # what leaving with "discard" hands over

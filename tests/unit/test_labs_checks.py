@@ -84,12 +84,59 @@ def test_sensors_objective_lists_what_is_missing_and_what_is_extra():
     obj = Objective("sensors", "sensors", sensors=want)
     ex = exercise(obj)
     b = station_for(ex)
-    assert check(obj, ex, b) == (False, "missing touch:2:front; not wanted distance:2:front")
+    assert check(obj, ex, b) == (
+        False,
+        "missing touch:2:front; not wanted distance:2:front: fit them (sensor panel, o), "
+        "then drive a run",
+    )
     b.apply_sensors(want)
-    assert check(obj, ex, b) == (True, "sensors are distance:1:right, touch:2:front")
+    # fitting them is not the work: a run with them is
+    assert check(obj, ex, b) == (
+        False,
+        "the robot carries them: now drive it (keys, x or VIPLE) for a run",
+    )
+    b.key("w")
+    b.step(30)
+    assert check(obj, ex, b) == (True, "run 1 (keys) carried distance:1:right, touch:2:front")
+    b.reset_robot()
     evidence = evidence_of(obj, ex, b)
-    assert evidence == {"attempt": b.attempt.id, "person": "",
-                        "sensors": ["distance:1:right", "touch:2:front"]}  # fmt: skip
+    assert evidence["run"] == 1 and evidence["driver"] == "keys"
+    assert evidence["sensors"] == ["distance:1:right", "touch:2:front"]
+    assert evidence["attempt"] == b.attempt.id and evidence["ended"] == "reset"
+
+
+def test_a_sensors_objective_is_not_met_by_the_sensors_the_set_up_fits():
+    """The set-up puts the objective's own sensors on the robot: that alone passes nothing."""
+    obj = Objective("sensors", "sensors", sensors=tuple(SensorSpec.parse(s) for s in RIGHT_WALL))
+    ex = exercise(obj)
+    b = station_for(ex)
+    assert [str(s) for s in b.sensors] == RIGHT_WALL
+    assert check(obj, ex, b)[0] is False
+    b.key("space")  # a run that goes nowhere is no run with the sensors
+    b.step(10)
+    assert check(obj, ex, b)[0] is False
+
+
+def test_a_run_whose_sensors_changed_carries_both_sets():
+    want = (SensorSpec("distance", 1, "right"), SensorSpec("touch", 2, "front"))
+    obj = Objective("sensors", "sensors", sensors=want)
+    ex = exercise(obj)
+    b = station_for(ex)
+    b.key("w")
+    b.step(30)
+    b.apply_sensors(want)  # fitted while the run goes on
+    b.step(30)
+    assert check(obj, ex, b) == (
+        False,
+        "run 1 carried other sensors (not wanted distance:2:front): they changed during it; "
+        "reset the robot (r on the maze) and drive a run with only these",
+    )
+    b.reset_robot()
+    assert [str(s) for s in b.runs[-1].sensors] == [
+        "distance:1:right", "distance:2:front", "touch:2:front"]  # fmt: skip
+    b.key("w")
+    b.step(30)
+    assert check(obj, ex, b) == (True, "run 2 (keys) carried distance:1:right, touch:2:front")
 
 
 def test_viple_objective_needs_the_role_and_real_driving():
@@ -190,7 +237,8 @@ def test_maze_edited_objective_wants_a_change_and_a_valid_maze():
     b.load_maze(RANK.maze)  # loading another maze is not editing
     assert not check(obj, ex, b)[0]
     b.load_maze(maze)
-    b.put_edited_maze(maze.with_block(0, 0, wall=False), maze)  # a hole in the outer wall
+    # a hole in the outer wall
+    b.put_edited_maze(maze.with_block(0, 0, wall=False), maze, hand_blocks=1)
     assert check(obj, ex, b) == (
         False,
         "the edited maze has problems: fix them in the editor (e)",
@@ -198,10 +246,17 @@ def test_maze_edited_objective_wants_a_change_and_a_valid_maze():
     inner = next((x, y) for y in range(1, maze.height - 1) for x in range(1, maze.width - 1)
                  if maze.is_wall(x, y))  # fmt: skip
     edited = maze.with_block(*inner, wall=False)
-    b.put_edited_maze(edited, maze)
-    assert check(obj, ex, b) == (True, f"edit 2 left a valid maze, {edited.name!r}")
+    b.put_edited_maze(edited, maze, hand_blocks=0)  # as Generate would leave it: not by hand
+    assert check(obj, ex, b) == (
+        False,
+        "edit 2 added or removed no block by hand (Generate, New and loading do not count): "
+        "in the editor (e) put or take away a block yourself",
+    )
+    b.put_edited_maze(edited, maze, hand_blocks=1)
+    assert check(obj, ex, b) == (True, f"edit 3 changed 1 block by hand, {edited.name!r}")
     evidence = evidence_of(obj, ex, b)
-    assert evidence["edit"] == 2 and evidence["maze_digest"] == edited.digest()
+    assert evidence["edit"] == 3 and evidence["maze_digest"] == edited.digest()
+    assert evidence["hand_blocks"] == 1
 
 
 def test_compare_objective_names_the_missing_runs():
@@ -372,9 +427,10 @@ def test_keys_objective_with_a_role_accepts_a_viple_program_making_the_five_moti
     assert check(other, exercise(other), b) == (False, "not used yet: w")  # tcp is not ws
 
 
-def test_a_viple_exercise_passes_with_the_students_program_run_here():
+def test_a_viple_exercise_passes_with_the_students_program_run_here(tmp_path):
     import hashlib
 
+    from tests.students_work import own_right_wall
     from workbench.program.choice import choose_program
 
     web = LabMaze.read(MAZES / "web.txt")
@@ -384,19 +440,22 @@ def test_a_viple_exercise_passes_with_the_students_program_run_here():
     ex = Exercise("ex", "Ex", "do it", Setup("web", web, sensors, Controller("keys", "")),
                   (for_viple, for_fsm), ())  # fmt: skip
     b = station_for(ex)
-    choose_program(b, "programs/right-wall.viple")
+    mine = own_right_wall(tmp_path)
+    choose_program(b, str(mine))
     b.start()
     for _ in range(200):
         b.step(60)
         if b.runs and b.runs[-1].ended == "exit":
             break
     run = b.runs[-1]
-    assert run.ended == "exit" and str(run.driver) == "VIPLE program right-wall.viple"
+    assert run.ended == "exit" and str(run.driver) == "VIPLE program my-right-wall.viple"
     passed, reason = check(for_viple, ex, b)
-    assert passed and reason.startswith(f"run {run.number} (VIPLE program right-wall.viple)")
+    assert passed and reason.startswith(f"run {run.number} (VIPLE program my-right-wall.viple)")
     evidence = evidence_of(for_viple, ex, b)
-    digest = hashlib.sha256(Path("programs/right-wall.viple").read_bytes()).hexdigest()
+    digest = hashlib.sha256(mine.read_bytes()).hexdigest()
     assert evidence["program_sha256"] == digest
+    assert evidence["program_name"] == "my-right-wall.viple"
+    assert evidence["sensors"] == ["distance:1:right", "touch:2:front"]
     assert check(for_fsm, ex, b)[0] is False  # a VIPLE program is not an FSM file
 
 

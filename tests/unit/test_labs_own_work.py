@@ -75,6 +75,8 @@ def do_the_work(b: LabStation, kind: str) -> None:
         b.step(1)
     elif kind == "sensors":
         b.apply_sensors(TOUCH)
+        b.key("w")  # a run with them is the work, not the sensors alone
+        b.step(30)
     elif kind in ("exit", "compare"):
         b.load_maze(RANK.maze)
         run_to_exit(b)
@@ -82,7 +84,7 @@ def do_the_work(b: LabStation, kind: str) -> None:
         maze = b.maze
         inner = next((x, y) for y in range(1, maze.height - 1) for x in range(1, maze.width - 1)
                      if maze.is_wall(x, y))  # fmt: skip
-        b.put_edited_maze(maze.with_block(*inner, wall=False), maze)
+        b.put_edited_maze(maze.with_block(*inner, wall=False), maze, hand_blocks=1)
 
 
 def test_every_kind_passes_on_its_own_work_after_its_set_up():
@@ -152,7 +154,7 @@ def test_loading_a_maze_is_not_editing_it():
         False,
         "the maze has not been edited yet: open the editor (e), add or remove a block",
     )
-    b.put_edited_maze(EROBOTIC.maze, RANK.maze)  # edited back into the set-up maze
+    b.put_edited_maze(EROBOTIC.maze, RANK.maze, hand_blocks=4)  # edited back into the set-up maze
     assert evaluate("lab", ex, b).objectives[0].reason == (
         "the edits left 'eRobotic lab maze' as set up: add or remove a block"
     )
@@ -200,3 +202,21 @@ def test_a_pass_saved_without_evidence_needs_redoing_until_the_work_is_done_agai
     do_the_work(b, "keys")
     again = keep_passed(shown, evaluate("lab", ex, b))
     assert again.passed and not again.objectives[0].redo
+
+
+def test_a_pass_saved_under_the_old_rules_needs_redoing():
+    """Passes saved before a sensors objective needed a run, an exit the run's sensors and an
+    edit blocks changed by hand: they were judged by other rules, and are done again."""
+    old = {
+        "lab": "lab", "exercise": "mine", "answers": {},
+        "objectives": [
+            {"kind": "sensors", "text": "sensors", "passed": True, "reason": "sensors are ...",
+             "evidence": {"attempt": "a1", "sensors": ["touch:2:front"], "person": "ana"}},
+            {"kind": "exit", "text": "out", "passed": True, "reason": "run 1 ...",
+             "evidence": {"attempt": "a1", "run": 1, "driver": "keys"}},
+            {"kind": "maze-edited", "text": "edited", "passed": True, "reason": "edit 1 ...",
+             "evidence": {"attempt": "a1", "edit": 1}},
+        ],
+    }  # fmt: skip
+    saved = ExerciseProgress.from_dict(old)
+    assert [(o.passed, o.reason) for o in saved.objectives] == [(False, REDO)] * 3

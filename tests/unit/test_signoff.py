@@ -472,6 +472,31 @@ def test_evidence_of_an_exercise_points_at_the_run_record_it_rests_on(tmp_path):
     assert Evidence.of_progress(progress).run_record == ""
 
 
+def test_the_sign_off_names_the_program_and_older_records_still_verify(store, data_dir):
+    from types import SimpleNamespace
+
+    digest = "ab" * 32
+    run = {"run": 2, "driver": "VIPLE program mine.viple", "program_sha256": digest,
+           "program_name": "mine.viple", "sensors": ["distance:1:right"]}  # fmt: skip
+    progress = SimpleNamespace(
+        objectives=[
+            SimpleNamespace(kind="sensors", passed=True, evidence=run),
+            SimpleNamespace(kind="exit", passed=True, evidence=run),
+            SimpleNamespace(kind="questions", passed=True, evidence={"correct": 1, "of": 1}),
+        ],
+        evidence_digest=lambda: "abc",
+    )
+    evidence = Evidence.of_progress(progress)
+    assert evidence.metrics["programs"] == {digest: "mine.viple"}
+    # a record made before the sign-off named its program (no "programs" in its evidence)
+    sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+    _, record = sign_off(store, "Dr Chen", PASS, fields(evidence=evidence), clock=Clock())
+    [_, row] = store.signoffs()
+    assert row.metrics_value()["programs"] == {digest: "mine.viple"}
+    assert record_from_stored(row) == record
+    assert problems(store, data_dir) == [(), ()]
+
+
 # the chained log in the store
 
 V1_SCHEMA = """

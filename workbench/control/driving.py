@@ -10,12 +10,14 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 from workbench.sim.driver import Driver
 from workbench.sim.sensors import SensorSpec
 from workbench.sim.session import Controller
 
+from .bundled import bundled_fsm, fsm_digest
 from .fsm import FsmController, FsmDefinition, bind_sensors
 
 
@@ -41,6 +43,14 @@ class Driving:
     type_key: Callable[[str, float], None] | None = None
     #: why it stopped itself for good (a program past its limits), None while it may run
     stopped: Callable[[], str | None] | None = None
+    #: the file that drives as the student sees it named, and the digest of what runs: a
+    #: program file's bytes, an FSM's text with the parameters set for it (see
+    #: :func:`~.bundled.fsm_digest`); "" for none
+    program_name: str = ""
+    program_sha256: str = ""
+    #: the file that comes with the workbench that this is, behaviour for behaviour ("" when
+    #: it is none): it is not the student's own program
+    bundled: str = ""
 
 
 def record_fields(driver: Driver, driving: Driving | None) -> dict[str, Any]:
@@ -67,4 +77,7 @@ def algorithm_driving(
         bind=bind,
         header={"algorithm": definition.name, "params": controller.params},
         source=definition.source,
+        program_name=Path(definition.source).name if definition.source else "",
+        program_sha256=fsm_digest(definition, overrides),
+        bundled=bundled_fsm(definition, controller.params, profile),
     )

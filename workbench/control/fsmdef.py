@@ -10,7 +10,7 @@ from __future__ import annotations
 import difflib
 import keyword
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from workbench.control.fsm_expr import FUNCTIONS, ExprError, Value, compile_expr
 from workbench.sim.sensors import KINDS, MOUNTS, PORT_RANGE, SensorSpec
@@ -165,6 +165,8 @@ class FsmDefinition:
     parameters: tuple[Parameter, ...] = ()
     variables: tuple[Variable, ...] = ()
     source: str = ""
+    #: sha256 of the file's text as it was read ("" when not read from a file)
+    digest: str = field(default="", compare=False)
 
     def state(self, name: str) -> State:
         for s in self.states:

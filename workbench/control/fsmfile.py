@@ -8,8 +8,10 @@ See docs/fsm-format.md for the format.
 from __future__ import annotations
 
 import difflib
+import hashlib
 import math
 from collections.abc import Callable, Iterable
+from dataclasses import replace
 from pathlib import Path
 
 import yaml
@@ -120,7 +122,7 @@ def loads_fsm(text: str, filename: str = "<text>") -> FsmDefinition:
     if reader.problems:
         reader.problems.sort(key=lambda p: (p.line, p.column))
         raise FsmFileError(reader.problems)
-    return definition
+    return replace(definition, digest=hashlib.sha256(text.encode("utf-8")).hexdigest())
 
 
 def parse_param_overrides(definition: FsmDefinition, items: Iterable[str]) -> dict[str, float]:

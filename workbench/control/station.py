@@ -77,6 +77,23 @@ class RunEntry:
     attempt: str = ""
     #: who of the pair was at the station when the run began ("" nobody named)
     person: str = ""
+    #: every sensor the robot carried during the run, sorted by their text: the ones it
+    #: began with and any fitted while it went on (a run on changed sensors carries both)
+    sensors: tuple[SensorSpec, ...] = ()
+    #: the program file or FSM file that drove, its digest, and the file that comes with
+    #: the workbench that it is ("" for none; see ``Driving``)
+    program_name: str = ""
+    program_sha256: str = ""
+    bundled: str = ""
+
+    @property
+    def moved(self) -> bool:
+        """The robot went somewhere or turned during the run."""
+        return self.metrics.distance > 0 or self.metrics.turn_degrees > 0
+
+
+#: how a run still under way is ended in :meth:`LabStation.run_so_far`
+UNDER_WAY = "under way"
 
 
 @dataclass(frozen=True)
@@ -106,6 +123,9 @@ class MazeEdit:
     valid: bool
     attempt: str = ""
     person: str = ""
+    #: the blocks added or removed by hand in the editor (what Generate, New or loading
+    #: made, and edits undone, are not counted)
+    hand_blocks: int = 0
 
 
 @dataclass(frozen=True)
@@ -267,6 +287,10 @@ class LabStation:
     _run_source: str | None = None
     _run_attempt: str = ""
     _run_person: str = ""
+    #: the sensors the run under way has carried so far, by their text
+    _run_sensors: dict[str, SensorSpec] = field(default_factory=dict)
+    #: the program that drives the run under way: its name, digest and what it is if bundled
+    _run_program: tuple[str, str, str] = ("", "", "")
     _viple_now: VipleConnection | None = None
     #: the odometry (distance, degrees) last counted into :attr:`_viple_now`
     _viple_mark: tuple[float, float] = (0.0, 0.0)
@@ -617,6 +641,8 @@ class LabStation:
         specs = check_ports(specs)
         self.session.set_sensors(specs)
         self.sensors = list(specs)
+        if self._run_open:
+            self._run_sensors.update((str(spec), spec) for spec in specs)
         if self.driving is not None:
             self.session.binding = self.driving.bind(specs)
 
@@ -745,9 +771,10 @@ class LabStation:
         self.session.driver = BY_KEYS
         self.pacer.set_speed(1.0)  # a run from the start begins at 1x
 
-    def put_edited_maze(self, maze: Maze, opened: Maze) -> MazeEdit:
+    def put_edited_maze(self, maze: Maze, opened: Maze, *, hand_blocks: int) -> MazeEdit:
         """Put a maze edited in the editor on the station (``opened``: the maze the editor
-        began with), and keep the edit with the attempt under way."""
+        began with; ``hand_blocks``: how many blocks the student added or removed by hand, as
+        the editor counts them), and keep the edit with the attempt under way."""
         edit = MazeEdit(
             number=len(self.edits) + 1,
             maze=maze.name,
@@ -756,6 +783,7 @@ class LabStation:
             valid=not maze.validate(),
             attempt=self.attempt_id,
             person=self.person,
+            hand_blocks=hand_blocks,
         )
         self.edits.append(edit)
         self.load_maze(maze)
@@ -778,8 +806,15 @@ class LabStation:
         self._run_open = True
         self._run_driver = driver
         self._run_source = self.driving.source if self.driving is not None else None
+        driving = self.driving
+        self._run_program = (
+            (driving.program_name, driving.program_sha256, driving.bundled)
+            if driving is not None
+            else ("", "", "")
+        )
         self._run_attempt = self.attempt_id
         self._run_person = self.person
+        self._run_sensors = {str(spec): spec for spec in self.sensors}
         self._record_stop_told = False
         if self.record_dir:
             recorder, trouble = open_record(
@@ -820,20 +855,7 @@ class LabStation:
         self.pacer.set_speed(1.0)
         if ended == "exit":  # the run is over as a headless one ends: same numbers, same record
             self.session.settle()
-        entry = RunEntry(
-            number=len(self.runs) + 1,
-            driver=self._run_driver,
-            maze=self.maze.name,
-            profile=self.profile,
-            seed=self.seed,
-            metrics=self.session.metrics(),
-            ended=ended,
-            record=self._record_path,
-            source=self._run_source,
-            maze_digest=self.maze.digest(),
-            attempt=self._run_attempt,
-            person=self._run_person,
-        )
+        entry = self._entry(ended)
         self.runs.append(entry)
         recorder = self._recorder
         if recorder is not None:
@@ -846,6 +868,32 @@ class LabStation:
                 self._tell_record_stopped(recorder)
             self._drop_recorder()
         self._record_path = None
+
+    def _entry(self, ended: str) -> RunEntry:
+        """The run under way as a run entry, ended as ``ended``."""
+        name, digest, bundled = self._run_program
+        return RunEntry(
+            number=len(self.runs) + 1,
+            driver=self._run_driver,
+            maze=self.maze.name,
+            profile=self.profile,
+            seed=self.seed,
+            metrics=self.session.metrics(),
+            ended=ended,
+            record=self._record_path,
+            source=self._run_source,
+            maze_digest=self.maze.digest(),
+            attempt=self._run_attempt,
+            person=self._run_person,
+            sensors=tuple(spec for _, spec in sorted(self._run_sensors.items())),
+            program_name=name,
+            program_sha256=digest,
+            bundled=bundled,
+        )
+
+    def run_so_far(self) -> RunEntry | None:
+        """The run under way as it stands (ended :data:`UNDER_WAY`), None when none is."""
+        return self._entry(UNDER_WAY) if self._run_open else None
 
     def close(self) -> None:
         """End the session: an open run is kept (with its record) as stopped."""

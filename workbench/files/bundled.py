@@ -1,4 +1,5 @@
-"""Where the mazes that come with the workbench are, and the one a session starts on."""
+"""Where the files that come with the workbench are (mazes, example programs, the labs'
+starters), and the maze a session starts on."""
 
 from __future__ import annotations
 
@@ -8,6 +9,9 @@ import workbench
 
 #: the bundled maze files (beside the package, as in a source checkout or an editable install)
 MAZE_DIR = Path(workbench.__file__).resolve().parent.parent / "mazes"
+#: the example VIPLE programs, and the starter FSMs the labs hand out to complete
+PROGRAM_DIR = MAZE_DIR.parent / "programs"
+STARTER_DIR = MAZE_DIR.parent / "labs" / "starters"
 #: the maze the app and ``workbench serve`` open when no maze is named (the Unity simulator's)
 DEFAULT_MAZE = "unity-default.txt"
 

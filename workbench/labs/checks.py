@@ -14,16 +14,17 @@ from __future__ import annotations
 
 import hashlib
 import json
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
 from workbench.control.algorithms import ALGORITHM_DIR
 from workbench.control.manual import KEY_NAMES
-from workbench.control.station import Attempt, LabStation, RunEntry
+from workbench.control.station import UNDER_WAY, Attempt, LabStation, RunEntry
 from workbench.sim.profiles import get_profile
 from workbench.sim.record import file_sha256
+from workbench.sim.sensors import SensorSpec
 
 from .migrations import REDO_REASON
 from .model import Exercise, LabMaze, Objective, Setup
@@ -55,10 +56,19 @@ ATTEMPT = "attempt"
 REDO = REDO_REASON
 
 
+#: what a pass of these kinds keeps since it rests on the student's own run or hand edit: a
+#: pass saved without it was judged by the rules before (the set-up's sensors, a shipped
+#: program, Generate) and needs redoing
+OWN_WORK_KEYS = {"sensors": "run", "exit": "sensors", "maze-edited": "hand_blocks"}
+
+
 def proven(state: ObjectiveState) -> bool:
     """Whether a passed objective rests on evidence of its exercise's own work (the
     questions rest on the answers kept with the exercise)."""
-    return state.kind == "questions" or bool(state.evidence.get(ATTEMPT))
+    if state.kind == "questions":
+        return True
+    key = OWN_WORK_KEYS.get(state.kind)
+    return bool(state.evidence.get(ATTEMPT)) and (key is None or key in state.evidence)
 
 
 def unproven_to_redo(state: ObjectiveState) -> ObjectiveState:
@@ -99,12 +109,15 @@ class ExerciseProgress:
     exercise: str
     objectives: list[ObjectiveState]
     answers: dict[str, str] = field(default_factory=dict)
+    #: how many answers each question has been given (every try, right or wrong)
+    tries: dict[str, int] = field(default_factory=dict)
     #: questions whose answers, as read back, were longer than is kept and were cut
     cut: tuple[str, ...] = field(default=(), compare=False)
 
     def __post_init__(self) -> None:
         self.answers, cut = capped_answers(self.answers)
         self.cut = (*self.cut, *cut)
+        self.tries = dict(list(self.tries.items())[:MAX_ANSWERS])
 
     @property
     def passed(self) -> bool:
@@ -129,7 +142,8 @@ class ExerciseProgress:
         try:
             objectives = [unproven_to_redo(ObjectiveState(**o)) for o in data["objectives"]]
             answers = dict(data.get("answers") or {})
-            return cls(str(data["lab"]), str(data["exercise"]), objectives, answers)
+            tries = {str(k): int(v) for k, v in dict(data.get("tries") or {}).items()}
+            return cls(str(data["lab"]), str(data["exercise"]), objectives, answers, tries)
         except (KeyError, TypeError, ValueError) as exc:
             raise ValueError(f"saved progress is not in the expected shape: {exc}") from None
 
@@ -166,7 +180,7 @@ def keep_passed(saved: ExerciseProgress | None, live: ExerciseProgress) -> Exerc
         else:
             reason = before.reason if before.reason.startswith(KEPT) else KEPT + before.reason
             objectives.append(ObjectiveState(o.kind, o.text, True, reason, before.evidence))
-    return ExerciseProgress(live.lab, live.exercise, objectives, live.answers)
+    return ExerciseProgress(live.lab, live.exercise, objectives, live.answers, live.tries)
 
 
 # -- set-up --------------------------------------------------------------------------------
@@ -230,26 +244,47 @@ def record_digest(path: str | None) -> str | None:
         return None
 
 
+def sensor_texts(sensors: Iterable[SensorSpec]) -> list[str]:
+    """Sensors as evidence keeps them: their text (``distance:1:right``), sorted."""
+    return sorted(str(s) for s in sensors)
+
+
 def run_evidence(run: RunEntry) -> dict[str, Any]:
-    program = {"program_sha256": run.driver.digest} if run.driver.digest else {}
+    """What a pass on ``run`` keeps: the run, who drove it and what with (the sensors it
+    carried, the file that drove and its digest), its maze, metrics and record. A run still
+    under way keeps no record (its file is still growing)."""
+    digest = run.program_sha256 or run.driver.digest
+    program = {"program_sha256": digest} if digest else {}
+    if run.program_name:
+        program["program_name"] = run.program_name
+    if run.bundled:  # a built-in a lab asked for (compare, "algorithm NAME"): not a copy hint
+        program["bundled"] = run.bundled
+    under_way = run.ended == UNDER_WAY
     return {
         ATTEMPT: run.attempt,
         "run": run.number,
         "driver": str(run.driver),
         "person": run.person,
         **program,
+        "sensors": sensor_texts(run.sensors),
         "maze": run.maze,
         "maze_digest": run.maze_digest,
         "profile": run.profile,
         "ended": run.ended,
         "metrics": run.metrics.as_dict(),
-        "record": run.record,
-        "record_sha256": record_digest(run.record),
+        "record": None if under_way else run.record,
+        "record_sha256": None if under_way else record_digest(run.record),
     }
 
 
+#: the drivers that stand for the student's own program ("your program" objectives)
+OWN_PROGRAM_DRIVERS = frozenset({"viple", "program", "fsm"})
+
+
 def driver_kinds(run: RunEntry) -> set[str]:
-    """What kinds of driver an ``exit`` objective would see in ``run``."""
+    """What kinds of driver an ``exit`` objective would see in ``run``. A program or FSM
+    that is one the workbench ships (:attr:`RunEntry.bundled`) is none of the student's
+    kinds (viple, program, fsm)."""
     kinds = {"any"}
     if run.driver.kind == "viple":
         kinds.add("viple")
@@ -260,7 +295,23 @@ def driver_kinds(run: RunEntry) -> set[str]:
             kinds.add(f"algorithm {run.driver.name}")
         else:
             kinds.add("fsm")
+    if run.bundled:
+        kinds -= OWN_PROGRAM_DRIVERS
     return kinds
+
+
+def evidence_programs(progress: ExerciseProgress) -> dict[str, str]:
+    """The programs an exercise's evidence rests on: program_sha256 -> program_name, over
+    every objective's evidence (the runs an objective compares are built-ins, not the
+    student's program, and are left out). More than one entry: the evidence mixes
+    programs."""
+    programs: dict[str, str] = {}
+    for o in progress.objectives:
+        digest = o.evidence.get("program_sha256")
+        if o.passed and isinstance(digest, str) and digest:
+            name = o.evidence.get("program_name") or o.evidence.get("driver") or ""
+            programs.setdefault(digest, str(name))
+    return programs
 
 
 # -- the exercise's own work ---------------------------------------------------------------
@@ -311,21 +362,66 @@ def check_keys(obj: Objective, station: LabStation, attempt: Attempt) -> Check:
     return Check(False, f"not used yet: {', '.join(missing)}", {})
 
 
-def check_sensors(obj: Objective, station: LabStation, attempt: Attempt) -> Check:
-    """The robot's sensors while the exercise's attempt is the one under way."""
-    if station.attempt != attempt:
-        return Check(False, "another exercise is set up now: press a to set this one up again")
-    have = {str(s) for s in station.sensors}
-    want = {str(s) for s in obj.sensors}
-    evidence = {ATTEMPT: attempt.id, "sensors": sorted(have), "person": station.person}
-    if have == want:
-        return Check(True, f"sensors are {', '.join(sorted(want)) or 'none'}", evidence)
+def _sensor_difference(have: set[str], want: set[str]) -> str:
     parts = []
     if want - have:
         parts.append(f"missing {', '.join(sorted(want - have))}")
     if have - want:
         parts.append(f"not wanted {', '.join(sorted(have - want))}")
-    return Check(False, "; ".join(parts), {})
+    return "; ".join(parts)
+
+
+def attempt_runs(station: LabStation, attempt: Attempt) -> list[RunEntry]:
+    """The attempt's runs, oldest first, with the run under way (as it stands) last."""
+    runs = _runs(station, attempt)
+    now = station.run_so_far()
+    if now is not None and now.attempt == attempt.id:
+        runs.append(now)
+    return runs
+
+
+def check_sensors(
+    obj: Objective, exercise: Exercise, station: LabStation, attempt: Attempt
+) -> Check:
+    """A run of the attempt, on the exercise's profile, in which the robot moved carrying
+    exactly these sensors (the run under way counts as it stands), driven by the student: the
+    keys, VIPLE, or a program or FSM of their own. Fitting the sensors is not enough: the
+    set-up fits them; the work is a run with them."""
+    want = set(sensor_texts(obj.sensors))
+    moved = [
+        r for r in attempt_runs(station, attempt)
+        if r.moved and r.profile == exercise.setup.profile
+    ]  # fmt: skip
+    with_them = [r for r in moved if set(sensor_texts(r.sensors)) == want]
+    shipped = [r for r in with_them if r.bundled]
+    with_them = [r for r in with_them if not r.bundled]
+    if not with_them and shipped:
+        last = shipped[-1]
+        return Check(
+            False,
+            f"run {last.number} was driven by {last.bundled}, which comes with the workbench: "
+            "drive a run with these sensors yourself (keys, VIPLE or your own program)",
+        )
+    if with_them:
+        run = with_them[-1]
+        evidence = run_evidence(run)
+        reason = f"run {run.number} ({run.driver}) carried {', '.join(sorted(want)) or 'none'}"
+        return Check(True, reason, evidence)
+    have = set(sensor_texts(station.sensors))
+    if have != want:
+        return Check(
+            False,
+            f"{_sensor_difference(have, want)}: fit them (sensor panel, o), then drive a run",
+        )
+    if moved:
+        last = moved[-1]
+        differs = _sensor_difference(set(sensor_texts(last.sensors)), want)
+        return Check(
+            False,
+            f"run {last.number} carried other sensors ({differs}): they changed during it; "
+            "reset the robot (r on the maze) and drive a run with only these",
+        )
+    return Check(False, "the robot carries them: now drive it (keys, x or VIPLE) for a run")
 
 
 def check_viple(obj: Objective, station: LabStation, attempt: Attempt) -> Check:
@@ -392,8 +488,29 @@ def check_exit(obj: Objective, exercise: Exercise, station: LabStation, attempt:
     maze = obj.maze
     profile = exercise.setup.profile
     wanted = set(obj.drivers)
-    runs = [r for r in _exits(station, attempt, maze, profile) if driver_kinds(r) & wanted]
+    exits = _exits(station, attempt, maze, profile)
+    by_them = [r for r in exits if driver_kinds(r) & wanted]
+    want = set(sensor_texts(obj.run_sensors or ()))
+    runs = by_them
+    if obj.run_sensors is not None:
+        runs = [r for r in by_them if set(sensor_texts(r.sensors)) == want]
     drivers = " or ".join(obj.drivers)
+    if not runs and by_them:
+        last = by_them[-1]
+        return Check(
+            False,
+            f"run {last.number} ({last.driver}) got out carrying "
+            f"{', '.join(sensor_texts(last.sensors)) or 'no sensors'}; this exercise's robot "
+            f"carries {', '.join(sorted(want)) or 'none'}: fit them (o) and run again",
+        )
+    shipped = [r for r in exits if r.bundled and wanted & OWN_PROGRAM_DRIVERS]
+    if not runs and shipped:
+        last = shipped[-1]
+        return Check(
+            False,
+            f"run {last.number} ({last.driver}) is {last.bundled}, which comes with the "
+            "workbench, not your own program: complete it or write yours, and run that",
+        )
     if not runs:
         other = _not_the_lab_maze(station, attempt, maze, profile)
         if other is not None:
@@ -418,19 +535,28 @@ def check_exit(obj: Objective, exercise: Exercise, station: LabStation, attempt:
 
 
 def check_maze_edited(exercise: Exercise, station: LabStation, attempt: Attempt) -> Check:
-    """An edit made in the editor during the attempt that left a valid maze other than the
-    set-up maze (loading a maze is not editing)."""
+    """An edit made in the editor during the attempt, with blocks added or removed by hand,
+    that left a valid maze other than the set-up maze (loading a maze is not editing, and
+    what Generate or New made is not done by hand)."""
     original = exercise.setup.maze.maze
     edits = [
         e for e in station.edits if e.attempt == attempt.id and e.maze_digest != e.opened_digest
     ]
     changed = [e for e in edits if e.maze_digest != original.digest()]
-    good = [e for e in changed if e.valid]
+    good = [e for e in changed if e.hand_blocks > 0 and e.valid]
     if good:
         e = good[-1]
         evidence = {ATTEMPT: attempt.id, "edit": e.number, "maze": e.maze, "person": e.person,
-                    "maze_digest": e.maze_digest, "original_digest": original.digest()}  # fmt: skip
-        return Check(True, f"edit {e.number} left a valid maze, {e.maze!r}", evidence)
+                    "maze_digest": e.maze_digest, "original_digest": original.digest(),
+                    "hand_blocks": e.hand_blocks}  # fmt: skip
+        blocks = f"{e.hand_blocks} block{'s' if e.hand_blocks != 1 else ''}"
+        return Check(True, f"edit {e.number} changed {blocks} by hand, {e.maze!r}", evidence)
+    if changed and changed[-1].hand_blocks == 0:
+        return Check(
+            False,
+            f"edit {changed[-1].number} added or removed no block by hand (Generate, New and "
+            "loading do not count): in the editor (e) put or take away a block yourself",
+        )
     if changed:
         return Check(False, "the edited maze has problems: fix them in the editor (e)")
     if edits:
@@ -462,13 +588,42 @@ def check_compare(
     return Check(True, f"{len(table)} runs to compare", {ATTEMPT: attempt.id, "runs": table})
 
 
-def check_questions(exercise: Exercise, answers: Mapping[str, str]) -> Check:
+def waiting_questions(
+    exercise: Exercise, answers: Mapping[str, str], tries: Mapping[str, int]
+) -> list[str]:
+    """The questions whose tries are used up without a right answer: they wait for the
+    instructor (the student's answer box takes no more answers)."""
+    return [
+        q.id
+        for q in exercise.questions
+        if q.max_tries is not None
+        and tries.get(q.id, 0) >= q.max_tries
+        and not q.check(str(answers.get(q.id, "")))[0]
+    ]
+
+
+def check_questions(
+    exercise: Exercise, answers: Mapping[str, str], tries: Mapping[str, int] | None = None
+) -> Check:
     answers, _ = capped_answers(answers)
+    tries = tries or {}
     unanswered = [q.id for q in exercise.questions if not str(answers.get(q.id, "")).strip()]
     wrong = [q.id for q in exercise.questions if q.id not in unanswered
              and not q.check(answers[q.id])[0]]  # fmt: skip
     total = len(exercise.questions)
-    evidence = {"correct": total - len(unanswered) - len(wrong), "of": total}
+    waiting = waiting_questions(exercise, answers, tries)
+    evidence = {
+        "correct": total - len(unanswered) - len(wrong),
+        "of": total,
+        "tries": {q.id: int(tries.get(q.id, 0)) for q in exercise.questions},
+        "waiting": waiting,
+    }
+    if waiting:
+        return Check(
+            False,
+            f"no tries left, waiting for the instructor: {', '.join(waiting)}",
+            evidence,
+        )
     if unanswered:
         return Check(False, f"not answered yet: {', '.join(unanswered)}", evidence)
     if wrong:
@@ -482,16 +637,17 @@ def check_objective(
     station: LabStation,
     answers: Mapping[str, str] | None = None,
     attempt: Attempt | None = None,
+    tries: Mapping[str, int] | None = None,
 ) -> Check:
     """``obj`` checked against the work of ``attempt`` (the exercise's latest attempt on the
-    station), and the answers given in the exercise."""
+    station), and the answers given in the exercise (with how often each was tried)."""
     if obj.kind == "questions":
-        return check_questions(exercise, answers or {})
+        return check_questions(exercise, answers or {}, tries)
     if attempt is None:
         return Check(False, NOT_SET_UP)
     by_kind: dict[str, Callable[[Attempt], Check]] = {
         "keys": lambda a: check_keys(obj, station, a),
-        "sensors": lambda a: check_sensors(obj, station, a),
+        "sensors": lambda a: check_sensors(obj, exercise, station, a),
         "viple": lambda a: check_viple(obj, station, a),
         "exit": lambda a: check_exit(obj, exercise, station, a),
         "maze-edited": lambda a: check_maze_edited(exercise, station, a),
@@ -501,15 +657,20 @@ def check_objective(
 
 
 def evaluate(
-    lab_id: str, exercise: Exercise, station: LabStation, answers: Mapping[str, str] | None = None
+    lab_id: str,
+    exercise: Exercise,
+    station: LabStation,
+    answers: Mapping[str, str] | None = None,
+    tries: Mapping[str, int] | None = None,
 ) -> ExerciseProgress:
     """Every objective of ``exercise`` checked against its own work on the station now: the
-    work of its latest attempt, and its answers."""
+    work of its latest attempt, and its answers (``tries``: how many times each question was
+    answered)."""
     attempt = attempt_of(station, lab_id, exercise)
     states = []
     for obj in exercise.objectives:
-        check = check_objective(obj, exercise, station, answers, attempt)
+        check = check_objective(obj, exercise, station, answers, attempt, tries)
         states.append(
             ObjectiveState(obj.kind, obj.text, check.passed, check.reason, check.evidence)
         )
-    return ExerciseProgress(lab_id, exercise.id, states, dict(answers or {}))
+    return ExerciseProgress(lab_id, exercise.id, states, dict(answers or {}), dict(tries or {}))

@@ -9,7 +9,7 @@ from __future__ import annotations
 import hashlib
 import math
 import secrets
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from decimal import Decimal
 from pathlib import Path
 from typing import Any
@@ -103,6 +103,9 @@ class Question:
     #: the rounding step of a numeric answer ("0.1"); None for multiple choice
     step: str | None = None
     unit: str = ""
+    #: how many answers the student may try (None: as many as they like); once they are
+    #: used up, a question not answered right waits for the instructor
+    max_tries: int | None = None
 
     @property
     def numeric(self) -> bool:
@@ -198,6 +201,10 @@ class Objective:
     max_collisions: int | None = None
     algorithms: tuple[str, ...] = ()
     mazes: tuple[LabMaze, ...] = ()
+    #: ``exit``: the sensors its run must have carried, no more and no fewer (its own
+    #: ``sensors:``, else the exercise's ``sensors`` objective's, else the set-up's; None:
+    #: any, when the exercise names none)
+    run_sensors: tuple[SensorSpec, ...] | None = None
 
 
 @dataclass(frozen=True)
@@ -355,15 +362,16 @@ def _exercise(r: _Reader, node: yaml.Node) -> Exercise:
         node,
         "exercise",
         ("id", "title", "instructions", "setup", "objectives"),
-        ("questions", "signoff", "grading"),
+        ("questions", "signoff", "grading", "max_tries"),
     )
     ex_id = r.text(keys["id"], "exercise")
     where = f"exercise {ex_id!r}"
+    max_tries = _max_tries(r, keys["max_tries"], where) if "max_tries" in keys else None
     questions = (
         tuple(
             r.each(
                 r.items(keys["questions"], f"{where}: questions"),
-                lambda q: _question(r, q, where),
+                lambda q: _question(r, q, where, max_tries),
             )
         )
         if "questions" in keys
@@ -381,14 +389,45 @@ def _exercise(r: _Reader, node: yaml.Node) -> Exercise:
         r.note(keys["objectives"], where, "a 'questions' objective but no questions", "add them")
     if "signoff" in keys and keys["signoff"].value != "required":
         r.note(keys["signoff"], where, "sign-off can only be 'required'", "write it so")
+    setup = _setup(r, keys["setup"], where)
     return Exercise(
         ex_id,
         r.text(keys["title"], where),
         r.text(keys["instructions"], where),
-        _setup(r, keys["setup"], where),
-        objectives,
+        setup,
+        _with_run_sensors(objectives, setup),
         questions,
         grading=_grading(r, keys["grading"], where) if "grading" in keys else None,
+    )
+
+
+#: the most tries a question may allow
+MAX_TRIES = 100
+
+
+def _max_tries(r: _Reader, node: yaml.Node, where: str) -> int:
+    value = yaml.safe_load(yaml.serialize(node)) if isinstance(node, yaml.ScalarNode) else None
+    if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= MAX_TRIES:
+        shown = repr(node.value) if isinstance(node, yaml.ScalarNode) else "this"
+        r.fail(
+            node,
+            f"{where}: max_tries",
+            f"{shown} is not a whole number from 1 to {MAX_TRIES}",
+            "write how many answers a student may try, e.g. 'max_tries: 3'",
+        )
+    return int(value)
+
+
+def _with_run_sensors(objectives: tuple[Objective, ...], setup: Setup) -> tuple[Objective, ...]:
+    """The exercise's ``exit`` objectives with the sensors their runs must carry: their own,
+    else those of the exercise's ``sensors`` objective, else the set-up's (when it names
+    any)."""
+    named = next((o.sensors for o in objectives if o.kind == "sensors"), None)
+    if named is None and setup.sensors:
+        named = setup.sensors
+    return tuple(
+        replace(o, run_sensors=named) if o.kind == "exit" and o.run_sensors is None else o
+        for o in objectives
     )
 
 
@@ -461,7 +500,10 @@ _OBJECTIVE_KEYS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
     "keys": ((), ("keys", "role")),
     "sensors": (("sensors",), ()),
     "viple": (("role",), ()),
-    "exit": (("maze", "driver"), ("max_time", "max_turn_degrees", "max_collisions")),
+    "exit": (
+        ("maze", "driver"),
+        ("max_time", "max_turn_degrees", "max_collisions", "sensors"),
+    ),
     "maze-edited": ((), ()),
     "compare": (("algorithms", "mazes"), ()),
     "questions": ((), ()),
@@ -498,22 +540,30 @@ def _objective(r: _Reader, node: yaml.Node, where: str) -> Objective:
             if head not in DRIVER_KINDS or (head == "algorithm") != bool(name):
                 r.fail(keys["driver"], here, f"unknown driver {d!r}",
                        "use viple, program, fsm, algorithm NAME or any")  # fmt: skip
-        # the optional keys of "exit" are Objective's limits: max_time, max_turn_degrees, ...
+        # the optional keys of "exit" but sensors are Objective's limits: max_time, ...
         limits: dict[str, Any]
-        limits = {k: r.number(keys[k], f"{here}: {k}") for k in optional if k in keys}
+        limits = {
+            k: r.number(keys[k], f"{here}: {k}") for k in optional if k in keys and k != "sensors"
+        }
         if "max_collisions" in limits:
             limits["max_collisions"] = int(limits["max_collisions"])
-        return Objective(kind, text, maze=r.maze(keys["maze"], here), drivers=drivers, **limits)
+        run_sensors = r.sensors(keys["sensors"], here) if "sensors" in keys else None
+        maze = r.maze(keys["maze"], here)
+        return Objective(kind, text, maze=maze, drivers=drivers, run_sensors=run_sensors, **limits)
     if kind == "compare":
         mazes = tuple(r.maze(n, here) for n in r.items(keys["mazes"], here))
         return Objective(kind, text, algorithms=r.texts(keys["algorithms"], here), mazes=mazes)
     return Objective(kind, text)
 
 
-def _question(r: _Reader, node: yaml.Node, where: str) -> Question:
-    keys = r.mapping(node, f"{where}: question", ("id", "text", "answer"), ("choices", "unit"))
+def _question(r: _Reader, node: yaml.Node, where: str, max_tries: int | None = None) -> Question:
+    keys = r.mapping(
+        node, f"{where}: question", ("id", "text", "answer"), ("choices", "unit", "max_tries")
+    )
     q_id = r.text(keys["id"], f"{where}: question")
     here = f"{where}: question {q_id!r}"
+    if "max_tries" in keys:
+        max_tries = _max_tries(r, keys["max_tries"], here)
     answer = r.mapping(keys["answer"], f"{here}: answer", ("salt", "sha256"), ("step",))
     hashes = r.texts(answer["sha256"], f"{here}: answer")
     for h, n in zip(hashes, r.items(answer["sha256"], here), strict=True):
@@ -542,4 +592,5 @@ def _question(r: _Reader, node: yaml.Node, where: str) -> Question:
         choices,
         step,
         r.text(keys["unit"], here) if "unit" in keys else "",
+        max_tries,
     )

@@ -28,6 +28,7 @@ from .checks import (
     SetupChanges,
     apply_setup,
     evaluate,
+    evidence_programs,
     keep_passed,
 )
 from .model import Exercise, Lab
@@ -126,6 +127,8 @@ class LabProgress:
     #: the progress last saved (or read back) for each exercise
     saved: dict[ExerciseKey, ExerciseProgress] = field(default_factory=dict)
     answers: dict[ExerciseKey, dict[str, str]] = field(default_factory=dict)
+    #: how many answers each question of each exercise has been given
+    tries: dict[ExerciseKey, dict[str, int]] = field(default_factory=dict)
     signed: dict[ExerciseKey, SignedOff] = field(default_factory=dict)
     #: who drove (or drives) each exercise, as recorded
     drivers: dict[ExerciseKey, str] = field(default_factory=dict)
@@ -144,6 +147,7 @@ class LabProgress:
         for key, progress in loaded.progress.items():
             self.saved[key] = progress
             self.answers[key] = dict(progress.answers)
+            self.tries[key] = dict(progress.tries)
         self.signed.update(loaded.signed)
         self.drivers.update(loaded.drivers)
 
@@ -173,14 +177,37 @@ class LabProgress:
         station.person = self.open((lab.id, exercise.id))
         return apply_setup(station, exercise.setup, lab=lab.id, exercise=exercise.id)
 
-    def answer(self, key: ExerciseKey, question: str, text: str) -> None:
-        self.answers.setdefault(key, {})[question] = text
+    def answer(
+        self, key: ExerciseKey, question: str, text: str, max_tries: int | None = None
+    ) -> bool:
+        """One try at ``question``: ``text`` is kept as its answer and counted, unless it is
+        empty or the answer kept already (nothing new tried). With ``max_tries``, a question
+        whose tries are used up takes no more answers. True when the answer was taken."""
+        if not self.can_answer(key, question, max_tries):
+            return False
+        answers = self.answers.setdefault(key, {})
+        if not text.strip() or text.strip() == answers.get(question, "").strip():
+            return False
+        answers[question] = text
+        tries = self.tries.setdefault(key, {})
+        tries[question] = tries.get(question, 0) + 1
+        return True
+
+    def tries_of(self, key: ExerciseKey, question: str) -> int:
+        """How many answers ``question`` of exercise ``key`` has been given."""
+        return self.tries.get(key, {}).get(question, 0)
+
+    def can_answer(self, key: ExerciseKey, question: str, max_tries: int | None) -> bool:
+        """Whether ``question`` takes another answer (False once its tries are used up)."""
+        return max_tries is None or self.tries_of(key, question) < max_tries
 
     def check(self, lab_id: str, exercise: Exercise, station: LabStation) -> ExerciseProgress:
         """The exercise checked against its own work on the station now, with every pass
         saved before kept (and every pass saved without evidence still needing redoing)."""
         key = (lab_id, exercise.id)
-        live = evaluate(lab_id, exercise, station, self.answers.get(key, {}))
+        live = evaluate(
+            lab_id, exercise, station, self.answers.get(key, {}), self.tries.get(key, {})
+        )
         return keep_passed(self.saved.get(key), live)
 
     def changed(self, progress: ExerciseProgress) -> bool:
@@ -193,7 +220,11 @@ class LabProgress:
         def states(p: ExerciseProgress) -> list[tuple[str, bool, bool]]:
             return [(o.text, o.passed, o.redo) for o in p.objectives]
 
-        return states(saved) != states(progress) or saved.answers != progress.answers
+        return (
+            states(saved) != states(progress)
+            or saved.answers != progress.answers
+            or saved.tries != progress.tries
+        )
 
     def save(self, store: Store | None, progress: ExerciseProgress) -> bool:
         """Keep ``progress`` as the exercise's, and write it to ``store``: True when written
@@ -250,6 +281,41 @@ def signoff_driver(progress: ExerciseProgress, people: set[str]) -> str:
     return ""
 
 
+def questions_words(ev: Mapping[str, Any]) -> str:
+    """``5 of 5 right; tries: base 1, margin 3`` (the tries where evidence keeps them), with
+    ``; waiting for the instructor: ...`` for questions whose tries are used up."""
+    words = f"{ev.get('correct', 0)} of {ev.get('of', 0)} right"
+    tries = ev.get("tries")
+    if isinstance(tries, Mapping) and tries:
+        words += "; tries: " + ", ".join(f"{q} {n}" for q, n in tries.items())
+    waiting = ev.get("waiting")
+    if waiting:
+        words += f"; waiting for the instructor: {', '.join(map(str, waiting))}"
+    return words
+
+
+def signoff_words(progress: ExerciseProgress) -> str:
+    """What a sign-off should know beyond the objectives' marks, in one line ("" for
+    nothing): the program the evidence rests on (or that it mixes programs), and the
+    questions whose tries are used up and wait for the instructor."""
+    parts = []
+    programs = evidence_programs(progress)
+    named = [f"{name} sha256 {digest[:12]}" for digest, name in programs.items()]
+    if len(named) == 1:
+        parts.append(f"program {named[0]}")
+    elif named:
+        parts.append(f"the evidence mixes {len(named)} programs: {', '.join(named)}")
+    waiting = [
+        str(q)
+        for o in progress.objectives
+        if o.kind == "questions"
+        for q in o.evidence.get("waiting") or []
+    ]
+    if waiting:
+        parts.append(f"out of tries, for you to judge: {', '.join(waiting)}")
+    return "; ".join(parts)
+
+
 def evidence_words(state: ObjectiveState) -> str:
     """What a pass rests on, in one short line ("" for none): the run (its driver, who was at
     the station, its record and digest), the edit, the keys or the VIPLE program."""
@@ -257,7 +323,7 @@ def evidence_words(state: ObjectiveState) -> str:
     if not state.passed or not ev:
         return ""
     if state.kind == "questions":
-        return f"{ev.get('correct', 0)} of {ev.get('of', 0)} right"
+        return questions_words(ev)
     by = f" by {ev['person']}" if ev.get("person") else ""
     if "run" in ev:
         words = f"run {ev['run']}{by} ({ev.get('driver', '')})"

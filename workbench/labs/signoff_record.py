@@ -14,6 +14,7 @@ from typing import Any
 from workbench.sim.record import file_sha256
 
 from . import signlog
+from .checks import evidence_programs
 from .names import NameProblem, check_student
 from .signoff_errors import SignoffError
 from .store import StoredSignoff
@@ -30,13 +31,18 @@ class Evidence:
     @classmethod
     def of_progress(cls, progress: Any) -> Evidence:
         """The evidence of an exercise's checks (an ``ExerciseProgress``): the run record of
-        the first passing objective that rests on one, and every objective's evidence with
-        the digest of them all."""
+        the first passing objective that rests on one, every objective's evidence with the
+        digest of them all, and (as ``programs``: digest -> file name) the programs the
+        evidence rests on. Records made before ``programs`` was kept lack it and verify as
+        they did."""
         objectives = [
             {"kind": o.kind, "passed": o.passed, "evidence": o.evidence}
             for o in progress.objectives
         ]
         metrics = {"objectives": objectives, "evidence_digest": progress.evidence_digest()}
+        programs = evidence_programs(progress)
+        if programs:  # the program the evidence rests on (more than one: it mixes them)
+            metrics["programs"] = programs
         for o in progress.objectives:
             record, sha = o.evidence.get("record"), o.evidence.get("record_sha256")
             if o.passed and record and sha:

@@ -18,6 +18,7 @@ from workbench.sim.profiles import Profile, check_report_ms
 from workbench.sim.sensors import SensorSpec
 
 from . import kinds as K
+from .bundled import bundled_program
 from .compiled import Compiled, compile_program
 from .interp import ProgramController
 from .keys import KeyEvent, parse_key_script, typed_events
@@ -103,6 +104,9 @@ def program_driving(
         source=shown,
         type_key=controller.type_key,
         stopped=lambda: str(controller.stopped) if controller.stopped is not None else None,
+        program_name=name,
+        program_sha256=digest,
+        bundled=bundled_program(compiled.program),
     )
 
 

@@ -1,8 +1,11 @@
 """The maze editor's model: a cursor, edits with undo/redo, live validation, saving.
 
 Every edit makes a new immutable :class:`Maze`; the undo and redo stacks hold whole mazes, so
-undo is exact and cheap. The editor never loses work: a failed save raises
-:class:`EditorError` with a readable reason and leaves the edited maze in memory.
+undo is exact and cheap. Each maze is kept with the one it was made from by hand (the maze
+opened, or the last one New or Generate made), so the editor can say how many blocks the
+student added or removed by hand (:meth:`MazeEditor.hand_blocks`). The editor never loses
+work: a failed save raises :class:`EditorError` with a readable reason and leaves the edited
+maze in memory.
 """
 
 from __future__ import annotations
@@ -122,8 +125,11 @@ class MazeEditor:
         self.opened = maze
         self.saved = maze
         self.cursor: Cell = self._clamp(maze.start if maze.start is not None else (0, 0))
-        self._undo: list[Maze] = []
-        self._redo: list[Maze] = []
+        #: the maze the current one (and the one last saved) was made from by hand
+        self._base = maze
+        self._saved_base = maze
+        self._undo: list[tuple[Maze, Maze]] = []
+        self._redo: list[tuple[Maze, Maze]] = []
         self._findings: tuple[Maze, list[Finding]] | None = None
 
     # -- state ---------------------------------------------------------------------------
@@ -202,13 +208,29 @@ class MazeEditor:
         return self.cursor
 
     # -- edits ---------------------------------------------------------------------------
-    def _apply(self, maze: Maze) -> bool:
+    def hand_blocks(self, discard: bool = False) -> int:
+        """How many blocks of the maze (with ``discard``: of the one last saved) were walled
+        or cleared by hand: the blocks that differ from the maze it was made from (the one
+        opened, or the last one New or Generate made). An edit undone, or made back by hand,
+        is not counted."""
+        maze, base = (self.saved, self._saved_base) if discard else (self.maze, self._base)
+        if (maze.width, maze.height) != (base.width, base.height):
+            return 0  # not made from it by hand (a maze is resized only whole)
+        return sum(
+            maze.is_wall(x, y) != base.is_wall(x, y)
+            for y in range(maze.height)
+            for x in range(maze.width)
+        )
+
+    def _apply(self, maze: Maze, base: Maze | None = None) -> bool:
         if maze == self.maze:
             return False
-        self._undo.append(self.maze)
+        self._undo.append((self.maze, self._base))
         del self._undo[:-UNDO_LIMIT]
         self._redo.clear()
         self.maze = maze
+        if base is not None:
+            self._base = base
         self.cursor = self._clamp(self.cursor)
         return True
 
@@ -264,23 +286,23 @@ class MazeEditor:
         self._replace_whole(maze)
 
     def _replace_whole(self, maze: Maze) -> None:
-        self._apply(maze)
+        self._apply(maze, base=maze)
         self.path = None
         self.cursor = self._clamp(maze.start if maze.start is not None else (0, 0))
 
     def undo(self) -> bool:
         if not self._undo:
             return False
-        self._redo.append(self.maze)
-        self.maze = self._undo.pop()
+        self._redo.append((self.maze, self._base))
+        self.maze, self._base = self._undo.pop()
         self.cursor = self._clamp(self.cursor)
         return True
 
     def redo(self) -> bool:
         if not self._redo:
             return False
-        self._undo.append(self.maze)
-        self.maze = self._redo.pop()
+        self._undo.append((self.maze, self._base))
+        self.maze, self._base = self._redo.pop()
         self.cursor = self._clamp(self.cursor)
         return True
 
@@ -320,4 +342,5 @@ class MazeEditor:
             ) from None
         self.path = target
         self.saved = self.maze
+        self._saved_base = self._base
         return target

@@ -21,6 +21,7 @@ from textual.widgets import Button, Input, Label, Static
 from textual.worker import Worker
 
 from workbench.labs.checks import ExerciseProgress
+from workbench.labs.progress import signoff_words
 from workbench.labs.roster import roster_names
 from workbench.labs.signing import sign_off
 from workbench.labs.signoff_errors import SignoffError
@@ -138,6 +139,9 @@ class SignoffModal(ModalScreen[str | None]):
                     markup=False,
                 )
             yield Static(f"{who}, driver {self.driver}; {state}", id="signoff-state", markup=False)
+            notes = signoff_words(progress)
+            if notes:
+                yield Static(notes, id="signoff-evidence", markup=False)
             with Vertical(id="signoff-sign-off"):
                 yield SignoffForm(
                     "signoff",

@@ -414,7 +414,9 @@ class EditorScreen(FollowsUnicode, Screen[Maze | None]):
         kept = editor.saved if discard else editor.maze
         maze, note = editor.handover(discard)
         if maze is not None:
-            self.station.put_edited_maze(maze, editor.opened)
+            self.station.put_edited_maze(
+                maze, editor.opened, hand_blocks=editor.hand_blocks(discard)
+            )
         on_robot = maze is not None or kept == editor.opened
         if editor.path is not None and kept == editor.saved and on_robot:
             # the maze the robot is on is this file: the editor opens it there next time

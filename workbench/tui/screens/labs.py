@@ -4,18 +4,20 @@ On the left, every lab and its exercises (✓ once an exercise's objectives pass
 instructor has signed it off; ``[X]`` and ``[*]`` in ASCII mode); on the right, the chosen
 exercise: its instructions, its objectives with ✓/✗ (``[X]``/``[ ]``) and a one-line reason
 that follow the station as the student works, and its questions (a multiple-choice one's
-choices picked with the arrows and enter or a click, any other typed in its field); under a
-passed objective, the work it rests on. The list has the focus whenever the screen comes up,
-so its keys never land in an answer: ``a`` puts the exercise's set-up on the station, ``r``
-asks for sign-off (the exercise joins the store's sign-off queue, which the instructor's
-console shows; the screen follows the request), and ``i`` opens the instructor's sign-off at
-this station where signing here is allowed (not in a served student's session, whose terminal
-is the student's). What the student has done is held by :class:`LabProgress` (in the core):
-the screen draws it and routes the student's input to it. Progress is saved in the store as
-soon as an exercise is opened and each time an objective or an answer changes; an objective
-that passed once stays passed, with its evidence, after a restart. The saved work is read in
-a thread as the screen comes up (a course database may be slow, or hang until its deadline):
-until it is read the screen says so and opens no exercise, so nothing is saved over it.
+choices picked with the arrows and enter or a click, any other typed in its field and tried
+with enter; each try is counted, shown under the question, and a question out of tries takes no
+more answers); under a passed objective, the work it rests on. The list has the focus whenever
+the screen comes up, so its keys never land in an answer: ``a`` puts the exercise's set-up on
+the station, ``r`` asks for sign-off (the exercise joins the store's sign-off queue, which the
+instructor's console shows; the screen follows the request), and ``i`` opens the instructor's
+sign-off at this station where signing here is allowed (not in a served student's session,
+whose terminal is the student's). What the student has done is held by :class:`LabProgress` (in
+the core): the screen draws it and routes the student's input to it. Progress is saved in the
+store as soon as an exercise is opened and each time an objective or an answer changes; an
+objective that passed once stays passed, with its evidence, after a restart. The saved work is
+read in a thread as the screen comes up (a course database may be slow, or hang until its
+deadline): until it is read the screen says so and opens no exercise, so nothing is saved over
+it.
 """
 
 from __future__ import annotations
@@ -497,10 +499,14 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         box.remove_children()
         answers = self.lab_progress.answers.get((lab.id, exercise.id), {})
         for q in exercise.questions:
+            answer_box = self._answer_widget(q, answers.get(q.id, ""))
+            answer_box.disabled = not self.lab_progress.can_answer(
+                (lab.id, exercise.id), q.id, q.max_tries
+            )
             box.mount(
                 Vertical(
                     Static(prose(q.text, unicode), markup=False, classes="question-text"),
-                    self._answer_widget(q, answers.get(q.id, "")),
+                    answer_box,
                     Static(
                         self._answer_reason(exercise, q.id),
                         classes="question-reason",
@@ -542,20 +548,49 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             select_on_focus=False,
         )
 
-    def _answer_reason(self, exercise: Exercise, question_id: str) -> str:
+    def _answer_reason(self, exercise: Exercise, question_id: str, typed: str = "") -> str:
+        """The line under an answer: whether it is right, its tries, and (while a typed
+        answer is not yet tried) that enter tries it."""
         lab = self.selected[0] if self.selected else None
-        answers = self.lab_progress.answers.get((lab.id, exercise.id), {}) if lab else {}
+        key = (lab.id, exercise.id) if lab else ("", exercise.id)
+        answers = self.lab_progress.answers.get(key, {})
         text = answers.get(question_id, "").strip()
+        q = next(q for q in exercise.questions if q.id == question_id)
+        used = self.lab_progress.tries_of(key, question_id)
+        locked = not self.lab_progress.can_answer(key, question_id, q.max_tries)
+        marks = self.marks
+        if typed.strip() and typed.strip() != text and not locked:
+            left = f": {q.max_tries - used} of {q.max_tries} tries left" if q.max_tries else ""
+            return prose(f"press enter to try this answer{left}", self.unicode)
         if not text:
             return "not answered yet"
-        q = next(q for q in exercise.questions if q.id == question_id)
         ok, reason = q.check(text)
-        marks = self.marks
-        return prose(f"{marks.passed if ok else marks.failed} {reason}", self.unicode)
+        if q.max_tries:
+            tries = f" (try {used} of {q.max_tries})"
+        else:
+            tries = f" ({used} {'try' if used == 1 else 'tries'})" if used else ""
+        if locked and not ok:
+            return prose(
+                f"{marks.failed} {reason}{tries}: no tries left, the answer waits for the "
+                "instructor",
+                self.unicode,
+            )
+        return prose(f"{marks.passed if ok else marks.failed} {reason}{tries}", self.unicode)
+
+    @on(Input.Changed)
+    def _typed(self, event: Input.Changed) -> None:
+        """A typed answer is not tried until enter: the line under it says so."""
+        field_id = event.input.id or ""
+        if not field_id.startswith("q-") or self.selected is None:
+            return
+        box = event.input.parent
+        if box is not None:
+            box.query_one(".question-reason", Static).update(
+                self._answer_reason(self.selected[1], field_id[2:], event.value)
+            )
 
     @on(Input.Submitted)
-    @on(Input.Changed)
-    def _typed(self, event: Input.Changed | Input.Submitted) -> None:
+    def _submitted(self, event: Input.Submitted) -> None:
         self._answered(event.input, event.value)
 
     @on(RadioSet.Changed)
@@ -564,12 +599,17 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             self._answered(event.radio_set, event.radio_set.answer)
 
     def _answered(self, widget: Widget, answer: str) -> None:
+        """One try at a question (enter in its field, or a choice picked)."""
         field_id = widget.id or ""
         if not field_id.startswith("q-") or self.selected is None:
             return
         lab, exercise = self.selected
         question_id = field_id[2:]
-        self.lab_progress.answer((lab.id, exercise.id), question_id, answer)
+        q = next(q for q in exercise.questions if q.id == question_id)
+        key = (lab.id, exercise.id)
+        self.lab_progress.answer(key, question_id, answer, q.max_tries)
+        if not self.lab_progress.can_answer(key, question_id, q.max_tries):
+            widget.disabled = True
         box = widget.parent
         if box is not None:
             box.query_one(".question-reason", Static).update(
