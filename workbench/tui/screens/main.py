@@ -21,6 +21,7 @@ from textual.containers import Horizontal, Vertical
 from workbench.control.fsm import FsmError
 from workbench.control.station import ALGORITHM_FAILED, PROGRAM_STOPPED, LabStation, Notice
 from workbench.files.workspace import OutsideWorkspace
+from workbench.program.choice import ProgramChoice
 from workbench.program.keys import known_key
 from workbench.sim.maze import MazeError
 from workbench.sim.mazeio import load_maze
@@ -352,6 +353,10 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
 
     def action_fix_sensors(self) -> None:
         station = self.station
+        program = station.program
+        if program is not None:  # a program file chosen drives on start, not the algorithm
+            self._fit_program(program)
+            return
         if station.algorithm is None:
             self.say("choose an algorithm first (g)")
             return
@@ -365,6 +370,21 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
             return
         ports = ", ".join(str(s) for s in station.sensors)
         self.say(f"sensors set for {station.algorithm.name}: {ports}; x starts it")
+
+    def _fit_program(self, program: ProgramChoice) -> None:
+        station = self.station
+        if program.needs(station.sensors) is None or program.fit is None:
+            self.say(f"the sensors already fit {program.name}")
+            return
+        fitted, cannot = program.fit(station.sensors)
+        try:
+            station.apply_sensors(fitted)
+        except SensorConfigError as exc:
+            self.say(f"cannot fit the sensors {program.name} reads: {exc}")
+            return
+        ports = ", ".join(str(s) for s in station.sensors)
+        rest = f"; cannot fit: {cannot}" if cannot else "; x starts it"
+        self.say(f"sensors set for {program.name}: {ports}{rest}")
 
     def action_unicode(self) -> None:
         self.post_message(ToggleUnicode())
