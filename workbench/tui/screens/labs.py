@@ -224,6 +224,11 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self._signed_later: SignoffStatus.Signed | None = None
         self.unicode = False
 
+    def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None:
+        """A served student's session has no signing here: its key is neither shown nor
+        offered in the command palette (``r`` asks for sign-off at the console)."""
+        return self.signs_here or action != "sign_off"
+
     @property
     def driver(self) -> str:
         """Who of the pair drives now, as far as the workbench knows."""
@@ -689,12 +694,6 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
     def action_sign_off(self) -> None:
         self._catch_up()
         if not self._choose_first():
-            return
-        if not self.signs_here:
-            self.say(
-                "sign-off is given at the instructor's console, not here: press r to ask "
-                "for it (your place in the queue shows below)"
-            )
             return
         if self.store is None:
             self.say(self._store_problem or "no data folder: sign-off is not available")
