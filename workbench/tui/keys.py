@@ -569,6 +569,8 @@ KEY_TABLE: dict[str, Key] = {
     "unsaved.cancel": Key(
         "c,escape", "choose('cancel')", "Cancel", "Unsaved changes", "cancel", "Cancel."
     ),
+    "confirm.yes": Key("y", "answer(True)", "Yes", "Dialog", "yes", "Yes: go ahead."),
+    "confirm.no": Key("n", "answer(False)", "No", "Dialog", "no", "No: leave things as they are."),
     "help.close": Key(
         "escape,question_mark,q", "close", "Close", "Dialog", "close", "Close this dialog."
     ),

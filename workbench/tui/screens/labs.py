@@ -35,6 +35,7 @@ from textual.widgets import Input, Markdown, OptionList, RadioSet, Static
 from textual.widgets.option_list import Option
 
 from workbench.control.station import LabStation
+from workbench.labs.attempt_work import work_at_stake
 from workbench.labs.checks import MAX_ANSWER, ExerciseProgress, SetupChanges
 from workbench.labs.model import Exercise, Lab, LabFileError, Question, Setup, load_labs
 from workbench.labs.progress import (
@@ -645,6 +646,29 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             return
         assert self.selected is not None
         lab, exercise = self.selected
+        work = work_at_stake(self.station, lab.id, exercise, self.track())
+        if work is None:
+            self._set_up(lab, exercise)
+            return
+        from ..dialogs.confirm import ConfirmDialog
+
+        left = len(work.open_objectives)
+        lines = [
+            f"{exercise.title} is under way: {work.words()} so far.",
+            f"A new set-up begins a new attempt, and that work stops counting for the {left} "
+            f"objective{'' if left == 1 else 's'} not passed yet (passed ones stay passed, "
+            "answers stay).",
+        ]
+        dialog = ConfirmDialog("Set up again?", lines, "Set up again", "Keep working")
+        self.app.push_screen(dialog, lambda yes: self._set_up_again(lab, exercise, yes))
+
+    def _set_up_again(self, lab: Lab, exercise: Exercise, yes: bool | None) -> None:
+        if yes:
+            self._set_up(lab, exercise)
+        else:
+            self.say("not set up again: the attempt under way goes on")
+
+    def _set_up(self, lab: Lab, exercise: Exercise) -> None:
         try:
             changes = self.lab_progress.set_up(self.station, lab, exercise)
         except Exception as exc:
