@@ -23,7 +23,7 @@ from __future__ import annotations
 import asyncio
 from typing import ClassVar, NamedTuple
 
-from textual import on
+from textual import events, on
 from textual.app import ComposeResult
 from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical, VerticalScroll
@@ -445,10 +445,20 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         # back on the list, whatever had the focus before: the screen's keys (a, i) never
         # land in an answer; an answer takes keys only once the student moves to it
         self.query_one("#labs-list", OptionList).focus()
+        self._objectives_in_view()
         self.show_snapshot(self.station.snapshot())
         later, self._signed_later = self._signed_later, None
         if later is not None:
             self._signed_elsewhere(later)
+
+    def on_descendant_focus(self, event: events.DescendantFocus) -> None:
+        if event.widget.id == "labs-list":  # back from an answer: the objectives again
+            self._objectives_in_view()
+
+    def _objectives_in_view(self) -> None:
+        """The exercise pane back at its top, where the objectives are (it stays where an
+        answer scrolled it otherwise, the objectives out of sight)."""
+        self.query_one("#labs-scroll", VerticalScroll).scroll_home(animate=False)
 
     def _refresh_list(self) -> None:
         # each option's text replaced where it is: the list keeps its highlight and scroll,
