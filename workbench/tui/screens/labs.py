@@ -50,7 +50,7 @@ from workbench.labs.store import Store, StoreError, StoreUnavailable
 from workbench.sim.session import Snapshot
 
 from ..host import FollowsUnicode, SetUpDone, ShowsSnapshot
-from ..keys import bindings
+from ..keys import LABS_KEY_IDS, bindings
 from ..plain import follow_app, prose
 from ..widgets.choices import Choices
 from ..widgets.field import Field
@@ -180,9 +180,7 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
     }
     """
 
-    BINDINGS: ClassVar[list[BindingType]] = [
-        *bindings("labs.close", "labs.setup", "labs.ready", "labs.signoff")
-    ]
+    BINDINGS: ClassVar[list[BindingType]] = [*bindings(*LABS_KEY_IDS)]
 
     def __init__(
         self,
