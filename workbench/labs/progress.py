@@ -117,6 +117,12 @@ def read_work(store: Store, student: str, partner: str = "") -> SavedWork:
     return SavedWork(saved, place)
 
 
+def shown_values(station: LabStation) -> dict[str, str]:
+    """What the station's screen shows that a question may accept (see ``model.SHOWN``)."""
+    port = station.tcp_port
+    return {"viple-tcp-port": str(port)} if port is not None else {}
+
+
 @dataclass
 class LabProgress:
     """One student's (or pair's) progress through the labs, in one app."""
@@ -180,6 +186,7 @@ class LabProgress:
         """The exercise checked against its own work on the station now, with every pass
         saved before kept (and every pass saved without evidence still needing redoing)."""
         key = (lab_id, exercise.id)
+        exercise = exercise.with_shown(shown_values(station))
         live = evaluate(lab_id, exercise, station, self.answers.get(key, {}))
         return keep_passed(self.saved.get(key), live)
 

@@ -44,6 +44,7 @@ from workbench.labs.progress import (
     SignedOff,
     evidence_words,
     read_work,
+    shown_values,
 )
 from workbench.labs.signoff_record import SignoffRecord
 from workbench.labs.store import Store, StoreError, StoreUnavailable
@@ -562,7 +563,8 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         text = answers.get(question_id, "").strip()
         if not text:
             return "not answered yet"
-        q = next(q for q in exercise.questions if q.id == question_id)
+        shown = exercise.with_shown(shown_values(self.station))  # (the port it listens on)
+        q = next(q for q in shown.questions if q.id == question_id)
         ok, reason = q.check(text)
         marks = self.marks
         return prose(f"{marks.passed if ok else marks.failed} {reason}", self.unicode)
