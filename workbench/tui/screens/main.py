@@ -106,6 +106,9 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
         self._panels_at = 0.0
         #: the message line's text, and the VIPLE endpoints' status line
         self._said = ""
+        #: while what the message says of the station stays true (None: it says what was
+        #: done, which later work does not make untrue); the line clears once it is not
+        self._said_while: StillTrue | None = None
         self._connection = ""
         self._notice: Notice | None = station.notice
         #: every key goes to the running program (ctrl+k), not only the free ones
@@ -174,6 +177,9 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
             self._notice = station.notice
             if station.notice is not None:
                 self._said = worded(station.notice, station.files.shown)
+                self._said_while = None
+        if self._said_while is not None and not self._said_while(station):
+            self._said, self._said_while = "", None  # the message is no longer true
         moment = (
             station.paused,
             self._said,
@@ -213,8 +219,9 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
         """What the message line says now."""
         return self._said
 
-    def show_message(self, text: str) -> None:
+    def show_message(self, text: str, true_while: StillTrue | None = None) -> None:
         self._said = text
+        self._said_while = true_while if text else None
         if self._ready:
             self._message.message = text
 
@@ -231,15 +238,17 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
         """The file of the maze now on the station: the maze dialog starts in its folder."""
         self.maze_path = path
 
-    def say(self, message: str) -> None:
-        self.show_message(message)
+    def say(self, message: str, true_while: StillTrue | None = None) -> None:
+        """Say ``message`` on the message line; with ``true_while``, only for as long as
+        that holds of the station (it is checked at each redraw)."""
+        self.show_message(message, true_while)
         self.refresh_views()
 
     # -- actions -------------------------------------------------------------------------------
     def action_drive(self, key: str) -> None:
         station = self.station
         program = station.program_drives
-        self._said = ""
+        self._said, self._said_while = "", None
         station.key(key)
         if program and not station.program_drives:
             self._said = "program stopped: the keys drive"
@@ -300,7 +309,7 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
 
     def action_pause(self) -> None:
         paused = self.station.toggle_pause()
-        self.say("paused: n steps, p resumes" if paused else "")
+        self.say("paused: n steps, p resumes" if paused else "", is_paused)
 
     def action_step(self) -> None:
         station = self.station
@@ -339,7 +348,7 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
             self.action_algorithm()
             return
         if not program and station.missing_sensors():
-            self.say("the algorithm lacks a sensor: f fits the sensors it needs")
+            self.say("the algorithm lacks a sensor: f fits the sensors it needs", lacks_sensor)
             return
         try:
             station.start()
@@ -445,6 +454,18 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
 
     def action_viple_ws(self) -> None:
         self.post_message(StartEndpoint("ws"))
+
+
+#: whether a message still holds of the station
+StillTrue = Callable[[LabStation], bool]
+
+
+def is_paused(station: LabStation) -> bool:
+    return station.paused
+
+
+def lacks_sensor(station: LabStation) -> bool:
+    return station.driving is None and station.missing_sensors() is not None
 
 
 def worded(notice: Notice, shown: Callable[[str | os.PathLike], str] = str) -> str:
