@@ -623,9 +623,10 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             return
         marks = self.marks
         lines = []
+        profile = self.selected[1].setup.profile if self.selected is not None else ""
         for o in progress.objectives:
             lines.append(f"{marks.passed if o.passed else marks.failed} {o.text}: {o.reason}")
-            evidence = evidence_words(o)
+            evidence = evidence_words(o, profile)
             if evidence:
                 lines.append(f"  {evidence}")
         self.query_one("#labs-objectives", Static).update(prose("\n".join(lines), self.unicode))
