@@ -8,6 +8,7 @@ from time import perf_counter
 
 import pytest
 from rich.console import Console
+from textual.binding import Binding
 from textual.command import CommandList
 from textual.pilot import Pilot
 from textual.widgets import Static
@@ -186,6 +187,29 @@ def test_help_explains_every_key(tmp_path):
         assert isinstance(app.screen, MainScreen)
 
     run(app, body, size=(120, 40))
+
+
+def test_help_has_a_labs_section_with_the_labs_screens_keys(tmp_path):
+    from workbench.tui.screens.labs import LabsScreen
+
+    app = make_app(AppSettings(paused=True, data_dir=tmp_path / "data"))
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.press("l", "question_mark")  # asked on the labs screen
+        await pilot.pause()
+        assert isinstance(app.screen, HelpScreen)
+        console = Console(width=76, record=True, file=io.StringIO())
+        console.print(app.screen.query_one("#help-text", Static).content)
+        lines = console.export_text().splitlines()
+        at = lines.index("Labs")
+        section = " ".join(" ".join(lines[at : at + 16]).split())
+        for binding in LabsScreen.BINDINGS:
+            assert isinstance(binding, Binding)
+            info = KEY_TABLE[binding.id]
+            shown = binding.key_display or app.get_key_display(binding)
+            assert f"{shown} {info.title}: {' '.join(info.explanation.split())[:30]}" in section
+
+    run(app, body)
 
 
 def test_every_binding_has_an_id_and_a_help_entry():

@@ -240,6 +240,32 @@ def test_start_and_the_state_display_follows_the_engine():
     run(app, body)
 
 
+def test_the_transition_log_follows_the_newest_transitions():
+    """However many transitions there are, and however the panel above the log grows or shrinks
+    (the last transition's lines come and go), the log shows the newest one at its bottom."""
+    app = unity_app()
+    station = app.station
+
+    async def body(pilot: Pilot) -> None:
+        station.select_algorithm("right-wall")
+        await pilot.press("x")
+        station.pacer.paused = True
+        log = app.screen.query_one(TransitionLog)
+        history = station.driving.controller.history
+        while len(history) < 12:
+            station.step(30)
+            app.refresh_views()
+            await pilot.pause()
+        await pilot.pause()
+        assert log.line_count > log.scrollable_content_region.height  # more than it can show
+        newest = history[-1]
+        shown = " ".join(" ".join(screen_lines(app)).split())
+        assert f"{newest.time:.1f} {newest.source} -> " in shown, screen_lines(app)
+        assert log.scroll_y == log.max_scroll_y
+
+    run(app, body)
+
+
 def test_pause_step_and_reset_from_the_dialog():
     app = unity_app()
     station = app.station

@@ -337,3 +337,26 @@ def test_a_program_is_read_and_checked_beside_the_event_loop(tmp_path, monkeypat
         assert app.station.program is not None and app.station.program.name == "wire.viple"
 
     run(app, body)
+
+
+def test_f_on_the_main_screen_fits_the_chosen_program_not_the_algorithm_before_it(tmp_path):
+    from tests.app.support import said
+    from workbench.sim.sensors import SensorSpec
+
+    app = make_app(AppSettings(maze_file(tmp_path), paused=True, noise="off"))
+    path = drive_by_wire(tmp_path)
+
+    async def body(pilot: Pilot) -> None:
+        station = app.station
+        station.select_algorithm("right-wall")  # chosen first, then the program file
+        await load(pilot, path)
+        await pilot.press("escape")
+        station.apply_sensors([SensorSpec("touch", 1, "right")])  # port 1 is not a distance
+        await pilot.press("f")
+        await pilot.pause()
+        assert said(app) == "sensors set for wire.viple: distance:1:right; x starts it"
+        assert station.program.needs(station.sensors) is None
+        await pilot.press("f")
+        assert said(app) == "the sensors already fit wire.viple"
+
+    run(app, body)

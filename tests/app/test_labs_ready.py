@@ -47,7 +47,6 @@ async def test_a_served_student_asks_with_r_and_sees_the_queue_and_the_sign_off(
         # the instructor's sign-off dialog is not offered here
         await pilot.press("i")
         assert not isinstance(app.screen, SignoffModal)
-        assert "instructor's console" in text(screen, "#labs-message")
         await pilot.press("r")
         await until(pilot, lambda: "2nd in the queue" in status(screen), "the place")
         with Store.open(data) as console:
@@ -75,3 +74,31 @@ async def test_at_a_workbench_of_ones_own_the_dialog_stays(tmp_path):
         await open_exercise(pilot, f"{LAB}/{EXERCISE}")
         await pilot.press("i")
         assert isinstance(app.screen, SignoffModal)
+
+
+def offered(app) -> tuple[str, list[str]]:
+    """The key bar's row and the command palette's titles on the screen shown."""
+    from workbench.tui.commands import WorkbenchCommands
+
+    from .support import screen_lines
+
+    titles = [title for title, _help, _run in WorkbenchCommands(app.screen)._commands()]
+    return screen_lines(app)[-1], titles
+
+
+@sync
+async def test_a_served_student_is_not_offered_the_sign_off_key(tmp_path):
+    data = tmp_path / "data"
+    create_instructor(data, "Dr Chen", PASS, kdf=FAST)
+    app = served_app(data)
+    async with app.run_test(size=(80, 24)) as pilot:
+        await open_exercise(pilot, f"{LAB}/{EXERCISE}")
+        bar, titles = offered(app)
+        assert "Ready" in bar and "Sign off" not in bar
+        assert "Labs: ready for sign-off" in titles
+        assert "Labs: instructor sign-off" not in titles
+    app = make_app(AppSettings(paused=True, student="ana", data_dir=data))
+    async with app.run_test(size=(80, 24)) as pilot:  # at a workbench of one's own it is
+        await open_exercise(pilot, f"{LAB}/{EXERCISE}")
+        bar, titles = offered(app)
+        assert "i Sign off" in bar and "Labs: instructor sign-off" in titles

@@ -35,6 +35,9 @@ def test_run_json_has_the_documented_keys(capsys):
         "seed",
     ]
     assert 0 < data["efficiency"] <= 1
+    # what ran: the maze, the profile and the driver
+    assert data["maze"] == "eRobotic lab maze" and len(data["maze_digest"]) == 16
+    assert data["profile"] == "erobotic" and data["driver"] == "algorithm right-wall"
 
 
 def test_run_cut_by_the_time_limit_exits_1_and_says_so(capsys):

@@ -123,6 +123,9 @@ def test_a_good_small_lab_loads(folder):
         ('step: "1", ', "",
          "small.yaml:19: exercise 'drive': question 'port': neither choices nor a numeric step"),
         ("lab: small", "lab: other", "small.yaml:1: lab: id 'other' differs from the file name"),
+        ("text: Which port?\n", "text: Which port?\n        shown: ssh-port\n",
+         "small.yaml:21: exercise 'drive': question 'port': unknown shown value 'ssh-port' (use "
+         "viple-tcp-port"),
     ],
 )  # fmt: skip
 def test_schema_errors_name_the_file_line_key_and_fix(folder, old, new, message):
@@ -267,3 +270,17 @@ def test_an_exercise_says_what_its_students_programs_are_graded_on(folder):
         load_lab(with_grading(own.replace("max_time: 300", "max_time: 0")))
     with pytest.raises(LabFileError, match=r":27:\d+: .*grading: no file 'mazes/gone.txt'"):
         load_lab(with_grading(own.replace("mazes/other.txt", "mazes/gone.txt")))
+
+
+def test_a_question_takes_a_shown_value_only_once_the_workbench_shows_one(folder):
+    text = good_text().replace(
+        "text: Which port?\n", "text: Which port?\n        shown: viple-tcp-port\n"
+    )
+    exercise = load_lab(write(folder, text)).exercises[0]
+    (q,) = exercise.questions
+    assert q.shown == "viple-tcp-port" and q.check("1350")[0] and not q.check("20345")[0]
+    (bound,) = exercise.with_shown({"viple-tcp-port": "20345"}).questions
+    assert bound.check("20345") == (
+        True, "correct: the TCP port your workbench shows VIPLE's robot listening on")  # fmt: skip
+    assert bound.check("1350")[0] and not bound.check("20346")[0]
+    assert exercise.with_shown({}) is exercise

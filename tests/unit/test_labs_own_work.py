@@ -3,6 +3,7 @@ no work passes nothing, and the work of another exercise passes nothing."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 from workbench.control.station import LabStation
@@ -180,7 +181,11 @@ def test_a_pass_keeps_the_run_its_driver_and_the_person_at_the_station(tmp_path)
     assert state.evidence["record"].endswith("run-001.jsonl")
     assert progress.signoff_driver(checked) == "ana"
     words = evidence_words(state)
-    assert words.startswith("run 1 by ana (algorithm right-wall), record run-001.jsonl sha256 ")
+    # its measures with the units of its profile, then its record
+    figures = r"\d+\.\d s, \d+\.\d unit \(\d+\.\d blocks\), \d+ deg turned, \d+ collisions?"
+    assert re.match(
+        rf"run 1 by ana \(algorithm right-wall\): {figures}; record run-001\.jsonl sha256 ", words
+    ), words
     assert signoff_driver(checked, {"carl"}) == ""  # names nobody of that pair
 
 

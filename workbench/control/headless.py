@@ -40,6 +40,10 @@ RESULT_KEYS = (
     "final_state",
     "seed",
     "cut_by_limit",
+    "maze",
+    "maze_digest",
+    "profile",
+    "driver",
 )
 
 
@@ -109,6 +113,11 @@ class RunResult:
             "final_state": self.final_state,
             "seed": self.spec.seed,
             "cut_by_limit": self.cut_by_limit,
+            # what ran: the maze (its name and layout digest), the profile and who drove
+            "maze": self.maze.name,
+            "maze_digest": self.maze.digest(),
+            "profile": self.profile,
+            "driver": str(self.driving.driver),
         }
 
     def as_dict(self) -> dict[str, Any]:

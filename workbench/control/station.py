@@ -263,6 +263,9 @@ class LabStation:
     notice: Notice | None = None
     #: every VIPLE program seen driving this station, oldest first
     viple: list[VipleConnection] = field(default_factory=list)
+    #: the TCP port this station's VIPLE endpoint listens on, as its screen shows it (None:
+    #: not listening); a lab question about the port also accepts it
+    tcp_port: int | None = None
     #: the program file chosen to drive (most recent choice wins over :attr:`algorithm`)
     program: ProgramChoice | None = None
     #: how often a program file driving gets its sensor reports, milliseconds (None: the

@@ -9,6 +9,7 @@ from __future__ import annotations
 import hashlib
 import math
 import secrets
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from decimal import Decimal
 from pathlib import Path
@@ -93,6 +94,12 @@ def hash_answer(
     return {"salt": salt, "step": step, "sha256": sorted(_digest(salt, t) for t in texts)}
 
 
+#: the values a question may also accept as the workbench shows them (``shown:`` in a lab
+#: file), each with what the reason says of it: over SSH a student's workbench listens on a
+#: port of its own, and that is the port its screen shows
+SHOWN = {"viple-tcp-port": "the TCP port your workbench shows VIPLE's robot listening on"}
+
+
 @dataclass(frozen=True)
 class Question:
     id: str
@@ -106,6 +113,10 @@ class Question:
     #: how many answers the student may try (None: as many as they like); once they are
     #: used up, a question not answered right waits for the instructor
     max_tries: int | None = None
+    #: a value the workbench shows that also counts as the answer (one of :data:`SHOWN`;
+    #: "" none), and what it shows now (bound by :meth:`Exercise.with_shown`)
+    shown: str = ""
+    shown_now: frozenset[str] = frozenset()
 
     @property
     def numeric(self) -> bool:
@@ -123,6 +134,8 @@ class Question:
             if abs(value) > LARGEST_ANSWER:
                 return False, f"{answer[:20]!r}... is far larger than any answer here"
             text = _grid_text(value, self.step or "1")
+            if text in self.shown_now:
+                return True, f"correct: {SHOWN[self.shown]}"
         else:
             text = normalise_choice(answer)
             if self.choices and text not in {normalise_choice(c) for c in self.choices}:
@@ -229,6 +242,17 @@ class Exercise:
     signoff: bool = True
     #: the exercise's ``grading:`` (None: the defaults, see :attr:`graded`)
     grading: Grading | None = None
+
+    def with_shown(self, values: Mapping[str, str]) -> Exercise:
+        """The exercise with each question that accepts a shown value (``shown:``) also
+        accepting what the workbench shows now (``values``: :data:`SHOWN` key -> text)."""
+        questions = tuple(
+            replace(q, shown_now=frozenset({_grid_text(float(values[q.shown]), q.step)}))
+            if q.shown and q.step is not None and values.get(q.shown)
+            else q
+            for q in self.questions
+        )
+        return self if questions == self.questions else replace(self, questions=questions)
 
     @property
     def graded(self) -> Grading:
@@ -558,7 +582,10 @@ def _objective(r: _Reader, node: yaml.Node, where: str) -> Objective:
 
 def _question(r: _Reader, node: yaml.Node, where: str, max_tries: int | None = None) -> Question:
     keys = r.mapping(
-        node, f"{where}: question", ("id", "text", "answer"), ("choices", "unit", "max_tries")
+        node,
+        f"{where}: question",
+        ("id", "text", "answer"),
+        ("choices", "unit", "max_tries", "shown"),
     )
     q_id = r.text(keys["id"], f"{where}: question")
     here = f"{where}: question {q_id!r}"
@@ -584,6 +611,11 @@ def _question(r: _Reader, node: yaml.Node, where: str, max_tries: int | None = N
         r.fail(node, here, "neither choices nor a numeric step", "add 'choices:' or answer 'step:'")
     if step is not None and choices:
         r.fail(keys["choices"], here, "a numeric question has no choices", "drop one of them")
+    shown = r.text(keys["shown"], here) if "shown" in keys else ""
+    if shown and shown not in SHOWN:
+        r.fail(keys["shown"], here, f"unknown shown value {shown!r}", f"use {', '.join(SHOWN)}")
+    if shown and step is None:
+        r.fail(keys["shown"], here, "a shown value is a number", "give the answer a 'step:'")
     return Question(
         q_id,
         r.text(keys["text"], here),
@@ -593,4 +625,5 @@ def _question(r: _Reader, node: yaml.Node, where: str, max_tries: int | None = N
         step,
         r.text(keys["unit"], here) if "unit" in keys else "",
         max_tries,
+        shown,
     )

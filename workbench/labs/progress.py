@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from workbench.control.station import LabStation
+from workbench.sim.profiles import PROFILES
 
 from .checks import (
     ExerciseProgress,
@@ -118,6 +119,12 @@ def read_work(store: Store, student: str, partner: str = "") -> SavedWork:
     return SavedWork(saved, place)
 
 
+def shown_values(station: LabStation) -> dict[str, str]:
+    """What the station's screen shows that a question may accept (see ``model.SHOWN``)."""
+    port = station.tcp_port
+    return {"viple-tcp-port": str(port)} if port is not None else {}
+
+
 @dataclass
 class LabProgress:
     """One student's (or pair's) progress through the labs, in one app."""
@@ -205,6 +212,7 @@ class LabProgress:
         """The exercise checked against its own work on the station now, with every pass
         saved before kept (and every pass saved without evidence still needing redoing)."""
         key = (lab_id, exercise.id)
+        exercise = exercise.with_shown(shown_values(station))
         live = evaluate(
             lab_id, exercise, station, self.answers.get(key, {}), self.tries.get(key, {})
         )
@@ -316,9 +324,42 @@ def signoff_words(progress: ExerciseProgress) -> str:
     return "; ".join(parts)
 
 
-def evidence_words(state: ObjectiveState) -> str:
+def _unit(profile: str) -> str:
+    known = PROFILES.get(profile)
+    return known.unit if known is not None else ""
+
+
+def _length(value: object, unit: str) -> str:
+    """A distance in the profile's unit: whole pixels, one decimal of a metre-like unit."""
+    if not isinstance(value, int | float):
+        return "?"
+    figure = f"{value:.0f}" if unit == "px" else f"{value:.1f}"
+    return f"{figure} {unit}" if unit else figure
+
+
+def run_figures(metrics: Mapping[str, Any], profile: str) -> str:
+    """A run's measures with their units: ``42.1 s, 9.1 unit (4.5 blocks), 450 deg turned,
+    0 collisions`` (the time to the exit, else the time it ran)."""
+    took = metrics.get("exit_time")
+    if not isinstance(took, int | float):
+        took = metrics.get("sim_time")
+    parts = [f"{took:.1f} s" if isinstance(took, int | float) else "? s"]
+    length = _length(metrics.get("distance"), _unit(profile))
+    blocks = metrics.get("distance_cells")
+    parts.append(f"{length} ({blocks:.1f} blocks)" if isinstance(blocks, int | float) else length)
+    if isinstance(metrics.get("turn_degrees"), int | float):
+        parts.append(f"{metrics['turn_degrees']:.0f} deg turned")
+    collisions = metrics.get("collisions")
+    if isinstance(collisions, int):
+        parts.append(f"{collisions} collision{'' if collisions == 1 else 's'}")
+    return ", ".join(parts)
+
+
+def evidence_words(state: ObjectiveState, profile: str = "") -> str:
     """What a pass rests on, in one short line ("" for none): the run (its driver, who was at
-    the station, its record and digest), the edit, the keys or the VIPLE program."""
+    the station, its measures with the units of its profile, its record and digest), the
+    edit, the keys or the VIPLE program (how far it drove). ``profile``: the exercise's, for
+    evidence that does not name its own."""
     ev: Mapping[str, Any] = state.evidence
     if not state.passed or not ev:
         return ""
@@ -327,9 +368,12 @@ def evidence_words(state: ObjectiveState) -> str:
     by = f" by {ev['person']}" if ev.get("person") else ""
     if "run" in ev:
         words = f"run {ev['run']}{by} ({ev.get('driver', '')})"
+        metrics = ev.get("metrics")
+        if isinstance(metrics, Mapping) and metrics:
+            words += f": {run_figures(metrics, str(ev.get('profile', profile)))}"
         if ev.get("record"):
             sha = ev.get("record_sha256") or "unreadable"
-            words += f", record {Path(str(ev['record'])).name} sha256 {str(sha)[:12]}"
+            words += f"; record {Path(str(ev['record'])).name} sha256 {str(sha)[:12]}"
     elif "edit" in ev:
         words = f"edit {ev['edit']}{by}: {ev.get('maze', '')} {str(ev.get('maze_digest'))[:12]}"
     elif "runs" in ev:
@@ -342,7 +386,11 @@ def evidence_words(state: ObjectiveState) -> str:
         words = f"keys {' '.join(ev['keys_used'])} on {ev.get('profile')}"
         words += f" by {people}" if people else ""
     elif "role" in ev:
-        words = f"VIPLE {ev['role']} at {ev.get('peer')}{by} drove {ev.get('distance')}"
+        unit = _unit(str(ev.get("profile", profile)))
+        distance = _length(ev.get("distance"), unit)
+        words = f"VIPLE {ev['role']} at {ev.get('peer')}{by} drove {distance}"
+        if isinstance(ev.get("turn_degrees"), int | float):
+            words += f", turned {ev['turn_degrees']:.0f} deg"
     elif "sensors" in ev:
         words = f"sensors {', '.join(ev['sensors'])}{by}"
     else:

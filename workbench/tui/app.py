@@ -644,6 +644,9 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
 
     def _show_connection(self, text: str) -> None:
         """Hand the VIPLE endpoints' status line to the screens that show it, when it changed."""
+        endpoints = self.endpoints
+        tcp = endpoints.tcp if endpoints is not None else None
+        self.station.tcp_port = tcp.port if tcp is not None else None  # (as the panel says)
         if text == self._connection:
             return
         self._connection = text

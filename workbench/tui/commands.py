@@ -1,11 +1,13 @@
 """The command palette: the keys of the screen it was opened on (and the app's) as commands,
-named and explained by the one key table, :data:`~workbench.tui.keys.KEY_TABLE`."""
+named and explained by the one key table, :data:`~workbench.tui.keys.KEY_TABLE`; a key its
+screen hides (``check_action`` says False) is not offered."""
 
 from __future__ import annotations
 
 from collections.abc import Awaitable, Callable, Iterator
 from functools import partial
 
+from textual.actions import parse
 from textual.binding import Binding
 from textual.command import DiscoveryHit, Hit, Hits, Provider
 from textual.dom import DOMNode
@@ -42,6 +44,9 @@ class WorkbenchCommands(Provider):
                 if binding.id in seen or binding.id == "app.commands":
                     continue
                 seen.add(binding.id)
+                _namespace, name, params = parse(binding.action)
+                if node.check_action(name, params) is False:
+                    continue  # a key the screen hides now does nothing now
                 info = KEY_TABLE[binding.id]
                 title = f"{info.group}: {info.title}"
                 help_text = f"key {key_display(node, binding)}: {info.explanation}"

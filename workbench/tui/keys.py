@@ -495,7 +495,8 @@ KEY_TABLE: dict[str, Key] = {
         "Set up",
         "Labs",
         "set up the exercise",
-        "Put the exercise's profile, maze, sensors and controller on the bench.",
+        "Put the exercise's profile, maze, sensors and controller on the bench and begin a "
+        "new attempt (over work not yet counted it asks first).",
     ),
     "labs.signoff": Key(
         "i",
@@ -584,6 +585,8 @@ KEY_TABLE: dict[str, Key] = {
     "unsaved.cancel": Key(
         "c,escape", "choose('cancel')", "Cancel", "Unsaved changes", "cancel", "Cancel."
     ),
+    "confirm.yes": Key("y", "answer(True)", "Yes", "Dialog", "yes", "Yes: go ahead."),
+    "confirm.no": Key("n", "answer(False)", "No", "Dialog", "no", "No: leave things as they are."),
     "help.close": Key(
         "escape,question_mark,q", "close", "Close", "Dialog", "close", "Close this dialog."
     ),
@@ -674,9 +677,12 @@ REPLAY_KEY_IDS = (
     "replay.unicode",
     "replay.leave",
 )
+#: the labs screen's keys
+LABS_KEY_IDS = ("labs.close", "labs.setup", "labs.ready", "labs.signoff")
 #: the help's sections of screen keys: heading, and the keys in the order explained
 HELP_SECTIONS: tuple[tuple[str, tuple[str, ...]], ...] = (
     ("Workbench", MAIN_KEY_IDS + APP_KEY_IDS),
+    ("Labs (l)", LABS_KEY_IDS),
     ("Maze editor (e)", EDITOR_KEY_IDS),
     ("Runs (R)", RUNS_KEY_IDS),
     ("Replay (enter on a run)", REPLAY_KEY_IDS),

@@ -25,7 +25,7 @@ from __future__ import annotations
 import asyncio
 from typing import ClassVar, NamedTuple
 
-from textual import on
+from textual import events, on
 from textual.app import ComposeResult
 from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical, VerticalScroll
@@ -37,6 +37,7 @@ from textual.widgets import Input, Markdown, OptionList, RadioSet, Static
 from textual.widgets.option_list import Option
 
 from workbench.control.station import LabStation
+from workbench.labs.attempt_work import work_at_stake
 from workbench.labs.checks import MAX_ANSWER, ExerciseProgress, SetupChanges
 from workbench.labs.model import Exercise, Lab, LabFileError, Question, Setup, load_labs
 from workbench.labs.progress import (
@@ -45,13 +46,14 @@ from workbench.labs.progress import (
     SignedOff,
     evidence_words,
     read_work,
+    shown_values,
 )
 from workbench.labs.signoff_record import SignoffRecord
 from workbench.labs.store import Store, StoreError, StoreUnavailable
 from workbench.sim.session import Snapshot
 
 from ..host import FollowsUnicode, SetUpDone, ShowsSnapshot
-from ..keys import bindings
+from ..keys import LABS_KEY_IDS, bindings
 from ..plain import follow_app, prose
 from ..widgets.choices import Choices
 from ..widgets.field import Field
@@ -181,9 +183,7 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
     }
     """
 
-    BINDINGS: ClassVar[list[BindingType]] = [
-        *bindings("labs.close", "labs.setup", "labs.ready", "labs.signoff")
-    ]
+    BINDINGS: ClassVar[list[BindingType]] = [*bindings(*LABS_KEY_IDS)]
 
     def __init__(
         self,
@@ -225,6 +225,11 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         #: a sign-off seen while another screen was over this one
         self._signed_later: SignoffStatus.Signed | None = None
         self.unicode = False
+
+    def check_action(self, action: str, parameters: tuple[object, ...]) -> bool | None:
+        """A served student's session has no signing here: its key is neither shown nor
+        offered in the command palette (``r`` asks for sign-off at the console)."""
+        return self.signs_here or action != "sign_off"
 
     @property
     def driver(self) -> str:
@@ -441,10 +446,20 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         # back on the list, whatever had the focus before: the screen's keys (a, i) never
         # land in an answer; an answer takes keys only once the student moves to it
         self.query_one("#labs-list", OptionList).focus()
+        self._objectives_in_view()
         self.show_snapshot(self.station.snapshot())
         later, self._signed_later = self._signed_later, None
         if later is not None:
             self._signed_elsewhere(later)
+
+    def on_descendant_focus(self, event: events.DescendantFocus) -> None:
+        if event.widget.id == "labs-list":  # back from an answer: the objectives again
+            self._objectives_in_view()
+
+    def _objectives_in_view(self) -> None:
+        """The exercise pane back at its top, where the objectives are (it stays where an
+        answer scrolled it otherwise, the objectives out of sight)."""
+        self.query_one("#labs-scroll", VerticalScroll).scroll_home(animate=False)
 
     def _refresh_list(self) -> None:
         # each option's text replaced where it is: the list keeps its highlight and scroll,
@@ -555,7 +570,8 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         key = (lab.id, exercise.id) if lab else ("", exercise.id)
         answers = self.lab_progress.answers.get(key, {})
         text = answers.get(question_id, "").strip()
-        q = next(q for q in exercise.questions if q.id == question_id)
+        shown = exercise.with_shown(shown_values(self.station))  # (the port it listens on)
+        q = next(q for q in shown.questions if q.id == question_id)
         used = self.lab_progress.tries_of(key, question_id)
         locked = not self.lab_progress.can_answer(key, question_id, q.max_tries)
         marks = self.marks
@@ -647,9 +663,10 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             return
         marks = self.marks
         lines = []
+        profile = self.selected[1].setup.profile if self.selected is not None else ""
         for o in progress.objectives:
             lines.append(f"{marks.passed if o.passed else marks.failed} {o.text}: {o.reason}")
-            evidence = evidence_words(o)
+            evidence = evidence_words(o, profile)
             if evidence:
                 lines.append(f"  {evidence}")
         self.query_one("#labs-objectives", Static).update(prose("\n".join(lines), self.unicode))
@@ -680,6 +697,29 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             return
         assert self.selected is not None
         lab, exercise = self.selected
+        work = work_at_stake(self.station, lab.id, exercise, self.track())
+        if work is None:
+            self._set_up(lab, exercise)
+            return
+        from ..dialogs.confirm import ConfirmDialog
+
+        left = len(work.open_objectives)
+        lines = [
+            f"{exercise.title} is under way: {work.words()} so far.",
+            f"A new set-up begins a new attempt, and that work stops counting for the {left} "
+            f"objective{'' if left == 1 else 's'} not passed yet (passed ones stay passed, "
+            "answers stay).",
+        ]
+        dialog = ConfirmDialog("Set up again?", lines, "Set up again", "Keep working")
+        self.app.push_screen(dialog, lambda yes: self._set_up_again(lab, exercise, yes))
+
+    def _set_up_again(self, lab: Lab, exercise: Exercise, yes: bool | None) -> None:
+        if yes:
+            self._set_up(lab, exercise)
+        else:
+            self.say("not set up again: the attempt under way goes on")
+
+    def _set_up(self, lab: Lab, exercise: Exercise) -> None:
         try:
             changes = self.lab_progress.set_up(self.station, lab, exercise)
         except Exception as exc:
@@ -729,12 +769,6 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
     def action_sign_off(self) -> None:
         self._catch_up()
         if not self._choose_first():
-            return
-        if not self.signs_here:
-            self.say(
-                "sign-off is given at the instructor's console, not here: press r to ask "
-                "for it (your place in the queue shows below)"
-            )
             return
         if self.store is None:
             self.say(self._store_problem or "no data folder: sign-off is not available")

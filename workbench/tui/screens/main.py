@@ -21,6 +21,7 @@ from textual.containers import Horizontal, Vertical
 from workbench.control.fsm import FsmError
 from workbench.control.station import ALGORITHM_FAILED, PROGRAM_STOPPED, LabStation, Notice
 from workbench.files.workspace import OutsideWorkspace
+from workbench.program.choice import ProgramChoice
 from workbench.program.keys import known_key
 from workbench.sim.driver import Driver
 from workbench.sim.maze import MazeError
@@ -106,6 +107,9 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
         self._panels_at = 0.0
         #: the message line's text, and the VIPLE endpoints' status line
         self._said = ""
+        #: while what the message says of the station stays true (None: it says what was
+        #: done, which later work does not make untrue); the line clears once it is not
+        self._said_while: StillTrue | None = None
         self._connection = ""
         self._notice: Notice | None = station.notice
         #: a live VIPLE program's commands are being held (paused), and the line said so
@@ -176,11 +180,14 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
             self._notice = station.notice
             if station.notice is not None:
                 self._said = worded(station.notice, station.files.shown)
+                self._said_while = None
         holding = station.held_count > 0
         if holding != self._holding:  # (a program that connected while paused, too)
             self._holding = holding
             if holding:
-                self._said = HELD_WHILE_PAUSED
+                self._said, self._said_while = HELD_WHILE_PAUSED, is_paused
+        if self._said_while is not None and not self._said_while(station):
+            self._said, self._said_while = "", None  # the message is no longer true
         moment = (
             station.paused,
             self._said,
@@ -220,8 +227,9 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
         """What the message line says now."""
         return self._said
 
-    def show_message(self, text: str) -> None:
+    def show_message(self, text: str, true_while: StillTrue | None = None) -> None:
         self._said = text
+        self._said_while = true_while if text else None
         if self._ready:
             self._message.message = text
 
@@ -238,15 +246,17 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
         """The file of the maze now on the station: the maze dialog starts in its folder."""
         self.maze_path = path
 
-    def say(self, message: str) -> None:
-        self.show_message(message)
+    def say(self, message: str, true_while: StillTrue | None = None) -> None:
+        """Say ``message`` on the message line; with ``true_while``, only for as long as
+        that holds of the station (it is checked at each redraw)."""
+        self.show_message(message, true_while)
         self.refresh_views()
 
     # -- actions -------------------------------------------------------------------------------
     def action_drive(self, key: str) -> None:
         station = self.station
         program = station.program_drives
-        self._said = ""
+        self._said, self._said_while = "", None
         station.key(key)
         if program and not station.program_drives:
             self._said = "program stopped: the keys drive"
@@ -309,9 +319,9 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
         station = self.station
         paused = station.toggle_pause()
         if paused and station.live_viple is not None:
-            self.say(HELD_WHILE_PAUSED)
+            self.say(HELD_WHILE_PAUSED, is_paused)
         else:
-            self.say("paused: n steps, p resumes" if paused else "")
+            self.say("paused: n steps, p resumes" if paused else "", is_paused)
 
     def action_step(self) -> None:
         station = self.station
@@ -353,7 +363,7 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
             self.action_algorithm()
             return
         if not program and station.missing_sensors():
-            self.say("the algorithm lacks a sensor: f fits the sensors it needs")
+            self.say("the algorithm lacks a sensor: f fits the sensors it needs", lacks_sensor)
             return
         try:
             station.start()
@@ -367,6 +377,10 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
 
     def action_fix_sensors(self) -> None:
         station = self.station
+        program = station.program
+        if program is not None:  # a program file chosen drives on start, not the algorithm
+            self._fit_program(program)
+            return
         if station.algorithm is None:
             self.say("choose an algorithm first (g)")
             return
@@ -380,6 +394,21 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
             return
         ports = ", ".join(str(s) for s in station.sensors)
         self.say(f"sensors set for {station.algorithm.name}: {ports}; x starts it")
+
+    def _fit_program(self, program: ProgramChoice) -> None:
+        station = self.station
+        if program.needs(station.sensors) is None or program.fit is None:
+            self.say(f"the sensors already fit {program.name}")
+            return
+        fitted, cannot = program.fit(station.sensors)
+        try:
+            station.apply_sensors(fitted)
+        except SensorConfigError as exc:
+            self.say(f"cannot fit the sensors {program.name} reads: {exc}")
+            return
+        ports = ", ".join(str(s) for s in station.sensors)
+        rest = f"; cannot fit: {cannot}" if cannot else "; x starts it"
+        self.say(f"sensors set for {program.name}: {ports}{rest}")
 
     def action_unicode(self) -> None:
         self.post_message(ToggleUnicode())
@@ -452,6 +481,18 @@ HELD_WHILE_PAUSED = (
 def speed_held(driver: Driver) -> str:
     """Why the speed key changes nothing while ``driver`` (a live VIPLE program) drives."""
     return f"speed held at 1x while {driver} drives: its Timers count real time"
+
+
+#: whether a message still holds of the station
+StillTrue = Callable[[LabStation], bool]
+
+
+def is_paused(station: LabStation) -> bool:
+    return station.paused
+
+
+def lacks_sensor(station: LabStation) -> bool:
+    return station.driving is None and station.missing_sensors() is not None
 
 
 def worded(notice: Notice, shown: Callable[[str | os.PathLike], str] = str) -> str:

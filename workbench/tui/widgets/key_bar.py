@@ -11,6 +11,10 @@ Textual's footer styles every key as it mounts it and then again, for each key, 
 takes the footer's ``compact`` setting and with it the ``-compact`` class: a third of the CPU
 a served app spends before its first screen went on styling the footer's keys. Here the keys
 carry the class from the start, so the second styling finds nothing to change.
+
+While a dialog is open over the bar's screen, the bar shows the dialog's keys instead (and of
+the app's keys only its priority ones, such as ``^q``, which reach it past a dialog): the
+screen's own keys do nothing then, so they are not shown.
 """
 
 from __future__ import annotations
@@ -22,7 +26,8 @@ from textual.app import ComposeResult
 from textual.widgets import Footer
 
 from ..keys import KEY_TABLE
-from ..serving.internals import FooterKey, footer_ready
+from ..serving.internals import FooterKey, bindings_of, footer_ready
+from .under_dialog import DialogWatch
 
 #: the rank of a key that is not in the workbench's table (Textual's own)
 DEFAULT_RANK = 2
@@ -53,6 +58,41 @@ class KeyBar(Footer):
         super().__init__(id=id, classes=classes, compact=True, show_command_palette=False)
         #: the keys shown, as (key, action) pairs, and the width they were chosen for
         self._shown: tuple[tuple[str, str], ...] = ()
+        #: the dialog open over the bar's screen, whose keys the bar shows then
+        self._under = DialogWatch(self, lambda: self.call_after_refresh(self.recompose), keys=True)
+
+    def on_mount(self) -> None:
+        self._under.start()
+
+    def on_unmount(self) -> None:
+        self._under.stop()
+
+    def _keys(self) -> list[FooterKey]:
+        """Every key the bar could show now, in order."""
+        dialog = self._under.dialog
+        if dialog is None:
+            return [w for w in super().compose() if isinstance(w, FooterKey)]
+        keys: list[FooterKey] = []
+        actions: set[str] = set()
+        app_keys = [
+            (self.app, binding, True, binding.tooltip)
+            for _key, binding in bindings_of(self.app)
+            if binding.priority  # the app's other keys do not reach it past a dialog
+        ]
+        for _node, binding, enabled, tooltip in [*dialog.active_bindings.values(), *app_keys]:
+            if not binding.show or binding.action in actions:
+                continue
+            actions.add(binding.action)
+            key = FooterKey(
+                binding.key,
+                self.app.get_key_display(binding),
+                binding.description,
+                binding.action,
+                disabled=not enabled,
+                tooltip=tooltip,
+            )
+            keys.append(key)
+        return keys
 
     def _width(self) -> int:
         return self.size.width or self.app.size.width
@@ -60,7 +100,8 @@ class KeyBar(Footer):
     def _ranks(self) -> dict[str, int]:
         """Each action's rank, from the workbench's key table."""
         ranks = {}
-        for _node, binding, _enabled, _tooltip in self.screen.active_bindings.values():
+        screen = self._under.dialog or self.screen
+        for _node, binding, _enabled, _tooltip in screen.active_bindings.values():
             key = KEY_TABLE.get(binding.id or "")
             ranks[binding.action] = key.rank if key is not None else DEFAULT_RANK
         return ranks
@@ -72,7 +113,7 @@ class KeyBar(Footer):
         return [keys[i] for i in shown]
 
     def compose(self) -> ComposeResult:
-        keys = [w for w in super().compose() if isinstance(w, FooterKey)]
+        keys = self._keys()
         chosen = self._choose(keys)
         self._shown = tuple((k.key, k.action) for k in chosen)
         for widget in chosen:
@@ -82,6 +123,6 @@ class KeyBar(Footer):
     def on_resize(self, event: events.Resize) -> None:
         if not footer_ready(self):
             return
-        keys = [w for w in super().compose() if isinstance(w, FooterKey)]
+        keys = self._keys()
         if tuple((k.key, k.action) for k in self._choose(keys)) != self._shown:
             self.call_after_refresh(self.recompose)

@@ -26,6 +26,10 @@ class TransitionLog(Log):
     An entry longer than the panel is wrapped onto indented lines below it (the log does not
     scroll sideways, so a cut entry would lose the state it went to and the values that fired
     it).
+
+    It keeps its newest entry in sight: Textual's log follows only while it is already at its
+    end, and the panel above it grows and shrinks with the last transition's text, which would
+    leave it behind for good.
     """
 
     DEFAULT_CSS = """
@@ -74,4 +78,12 @@ class TransitionLog(Log):
                 lines.append(text)
             else:
                 lines += textwrap.wrap(text, width, subsequent_indent=" " * 7)
-        self.write_lines(lines)
+        self.write_lines(lines, scroll_end=False)
+        self._follow()
+
+    def on_resize(self) -> None:
+        self._follow()
+
+    def _follow(self) -> None:
+        # after the next layout, when the log's height and length are both known
+        self.scroll_end(animate=False, immediate=False, x_axis=False)
