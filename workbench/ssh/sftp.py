@@ -6,11 +6,17 @@ upload limits and quota, uploads written whole or not at all); this module speak
 it turns a client's paths into workspace paths (refusing bad ones with the reason), a refusal
 into an SFTP status whose message says why (and one line on the channel's error output, which
 OpenSSH's ``sftp`` and ``scp`` print), and logs one line per file opened.
+
+Replies are flow-controlled as OpenSSH's sftp-server does it: a channel's requests are
+answered one at a time, and the next is read only once the reply before it has left the
+channel's output buffer (below asyncssh's high-water mark, 64 KiB), so a client that asks and
+never reads what it asked for stops its own requests; one read's reply is at most
+:data:`MAX_READ` bytes. Listings and file reads run in worker threads, never on the event
+loop that serves every student.
 """
 
 from __future__ import annotations
 
-import asyncio
 import contextlib
 import logging
 import os
@@ -43,6 +49,7 @@ from workbench.files.names import (
 )
 from workbench.files.workspace import workspace_folder, workspaces_folder
 from workbench.files.workspace_files import (
+    Entry,
     Refusal,
     Upload,
     UploadLimits,
@@ -51,6 +58,7 @@ from workbench.files.workspace_files import (
 )
 
 from .users import User
+from .workers import FILES, in_pool
 
 log = logging.getLogger("workbench.ssh")
 
@@ -59,6 +67,11 @@ MAX_OPEN_FILES = 32
 MAX_OPEN_FOLDERS = 32
 #: refusal lines written to one channel's error output; the rest go as SFTP statuses only
 MAX_SAID = 50
+#: the most bytes one read sends back (a client asking for more gets this much, which SFTP
+#: allows: it reads on from where the reply ended), as OpenSSH's sftp-server caps it
+MAX_READ = 256 * 1024
+#: what a client reads when a file or folder cannot be opened for want of descriptors
+OUT_OF_FILES = "the lab server has too many files open just now: try again in a few minutes"
 
 _ERRORS: dict[Refusal, Callable[[str], asyncssh.SFTPError]] = {
     Refusal.MISSING: asyncssh.SFTPNoSuchFile,
@@ -77,9 +90,16 @@ class SFTPService:
     """The server's SFTP side: one :class:`WorkspaceFiles` per student while they have SFTP
     channels open (so racing uploads share one quota count), and the channels per user."""
 
-    def __init__(self, data_dir: os.PathLike | str, limits: UploadLimits) -> None:
+    def __init__(
+        self,
+        data_dir: os.PathLike | str,
+        limits: UploadLimits,
+        room: Callable[[], bool] = lambda: True,
+    ) -> None:
         self.data_dir = data_dir
         self.limits = limits
+        #: whether a file opened now stays out of the descriptors kept for the live sessions
+        self.room = room
         self._files: dict[str, WorkspaceFiles] = {}
         self.channels: dict[str, int] = {}
         #: called with each change's workspace path, for a workspace kept elsewhere too
@@ -149,10 +169,16 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
     """One SFTP channel's requests, answered from one workspace's files."""
 
     def __init__(
-        self, chan: asyncssh.SSHServerChannel, files: WorkspaceFiles, user: User, peer: str
+        self,
+        chan: asyncssh.SSHServerChannel,
+        files: WorkspaceFiles,
+        user: User,
+        peer: str,
+        room: Callable[[], bool] = lambda: True,
     ) -> None:
         super().__init__(chan)
         self.files = files
+        self.room = room
         self.user = user
         self.peer = peer
         #: set when the client is gone: an upload still open then is dropped, not kept
@@ -229,8 +255,7 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
     async def scandir(self, path: bytes) -> AsyncIterator[asyncssh.SFTPName]:
         parts = self._parts(path)
         try:
-            entries = self.files.list(parts)
-            here = self.files.stat(parts)
+            entries, here = await in_pool(FILES, self._listing, parts)
         except WorkspaceError as exc:
             raise self._refusal(exc) from None
         dots = self._attrs(True, here.size, here.mtime, here.atime)
@@ -239,6 +264,9 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
         for entry in entries:
             attrs = self._attrs(entry.is_folder, entry.size, entry.mtime, entry.atime)
             yield asyncssh.SFTPName(entry.name.encode(), attrs=attrs)
+
+    def _listing(self, parts: Parts) -> tuple[list[Entry], Entry]:
+        return self.files.list(parts), self.files.stat(parts)
 
     def statvfs(self, path: bytes) -> asyncssh.SFTPVFSAttrs:
         """The room the quota leaves (``df`` in ``sftp``), never the server's disks."""
@@ -273,6 +301,7 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
     # -- open files --------------------------------------------------------------------------
     def open(self, path: bytes, pflags: int, attrs: asyncssh.SFTPAttrs) -> int:
         parts = self._parts(path)
+        self.check_room()
         if len(self._handles) >= MAX_OPEN_FILES:
             raise self._refused(
                 asyncssh.SFTPFailure,
@@ -294,6 +323,14 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
         self._handles[key] = handle
         return key
 
+    def check_room(self) -> None:
+        """Refuse to open a file or folder while the server's last descriptors are all that is
+        left (they are kept for the sessions already in)."""
+        if not self.room():
+            log.warning("sftp: %s from %s: open refused: few open files left",
+                        self.user.name, self.peer)  # fmt: skip
+            raise self._refused(asyncssh.SFTPFailure, OUT_OF_FILES)
+
     def _open_writing(self, parts: Parts, pflags: int) -> _Writing:
         if not pflags & FXF_CREAT:
             self.files.stat(parts)  # a file that is not there is not made
@@ -302,11 +339,12 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
         )
         return _Writing(parts, upload, append=bool(pflags & FXF_APPEND))
 
-    def read(self, file_obj: object, offset: int, size: int) -> bytes:
+    async def read(self, file_obj: object, offset: int, size: int) -> bytes:
         handle = self._handle(file_obj)
+        size = min(size, MAX_READ)
         if isinstance(handle, _Writing):
-            return handle.upload.read(offset, size)
-        data = os.pread(handle.file.fileno(), size, offset)
+            return await in_pool(FILES, handle.upload.read, offset, size)
+        data = await in_pool(FILES, os.pread, handle.file.fileno(), size, offset)
         handle.sent += len(data)
         return data
 
@@ -356,7 +394,7 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
             self._log(handle.parts, "write", upload.size, "dropped: the client left mid-way")
             return
         try:  # flushed to the disk away from the loop that serves every student
-            await asyncio.to_thread(upload.commit)
+            await in_pool(FILES, upload.commit)
             if handle.times is not None:
                 self.files.set_times(handle.parts, *handle.times)
         except WorkspaceError as exc:
@@ -478,9 +516,17 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
 
 class _Handler(SFTPServerHandler):
     """asyncssh's SFTP protocol, told when the client has gone (so an open upload is dropped,
-    not kept), and with the folders one channel holds open capped."""
+    not kept), with the folders one channel holds open capped, and each reply out of the
+    channel's buffer before the next request is read."""
 
     _packet_handlers = dict(SFTPServerHandler._packet_handlers)  # noqa: RUF012
+
+    async def _process_packet(self, pkttype: int, pktid: int, packet: SSHPacket) -> None:
+        await super()._process_packet(pkttype, pktid, packet)
+        if self._writer is not None:
+            # asyncssh buffers what the client's window does not take yet without a bound:
+            # wait (reading no more requests) until it is below the high-water mark
+            await self._writer.drain()
 
     async def _cleanup(self, exc: Exception | None) -> None:
         server = self._server
@@ -491,6 +537,9 @@ class _Handler(SFTPServerHandler):
         await super()._cleanup(exc)
 
     async def _process_opendir(self, packet: SSHPacket) -> bytes:
+        server = self._server
+        if isinstance(server, WorkspaceSFTPServer):
+            server.check_room()
         if len(self._dir_handles) >= MAX_OPEN_FOLDERS:
             raise asyncssh.SFTPFailure(
                 f"at most {MAX_OPEN_FOLDERS} folders can be open at once: close some"
@@ -533,7 +582,7 @@ class SFTPChannel:
             chan.write_stderr(b"Your workspace cannot be used now; tell the instructor.\r\n")
             chan.exit(1)
             return
-        self.server = WorkspaceSFTPServer(chan, files, self.user, self.peer)
+        self.server = WorkspaceSFTPServer(chan, files, self.user, self.peer, self.service.room)
         log.info("sftp: %s (%s) from %s", self.user.name, self.user.role, self.peer)
         self.stream.session_started()
 
