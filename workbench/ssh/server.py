@@ -154,7 +154,10 @@ class LabServer:
         self._previous_handler: Handler = None
         self.forkserver: ForkServer | None = None
         self.sftp = SFTPService(
-            config.data_dir, config.uploads, room=lambda: room_for_a_file(self.file_limit)
+            config.data_dir,
+            config.uploads,
+            room=lambda: room_for_a_file(self.file_limit),
+            say=lambda key, line: self.say_now_and_then(key, "%s", line),
         )
         #: with a course database, uploads go on to it (and so to every server of the course)
         self.course_files = CourseWorkspaces(config.data_dir, config.db) if config.db else None
@@ -324,7 +327,8 @@ class LabServer:
         self.say_now_and_then(
             "short of memory",
             "%s of %s refused: the server uses %s, past its ceiling of %s",
-            what, who, describe_memory(self.memory.last >> 20), describe_memory(self.memory.ceiling),
+            what, who, describe_memory(self.memory.last >> 20),
+            describe_memory(self.memory.ceiling),
         )  # fmt: skip
         return True
 

@@ -95,11 +95,14 @@ class SFTPService:
         data_dir: os.PathLike | str,
         limits: UploadLimits,
         room: Callable[[], bool] = lambda: True,
+        say: Callable[[str, str], None] = lambda key, line: log.warning("%s", line),
     ) -> None:
         self.data_dir = data_dir
         self.limits = limits
         #: whether a file opened now stays out of the descriptors kept for the live sessions
         self.room = room
+        #: logs a line an attacker could repeat (``say(key, line)``: repeats held back)
+        self.say = say
         self._files: dict[str, WorkspaceFiles] = {}
         self.channels: dict[str, int] = {}
         #: called with each change's workspace path, for a workspace kept elsewhere too
@@ -175,10 +178,12 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
         user: User,
         peer: str,
         room: Callable[[], bool] = lambda: True,
+        say: Callable[[str, str], None] = lambda key, line: log.warning("%s", line),
     ) -> None:
         super().__init__(chan)
         self.files = files
         self.room = room
+        self.say = say
         self.user = user
         self.peer = peer
         #: set when the client is gone: an upload still open then is dropped, not kept
@@ -327,8 +332,10 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
         """Refuse to open a file or folder while the server's last descriptors are all that is
         left (they are kept for the sessions already in)."""
         if not self.room():
-            log.warning("sftp: %s from %s: open refused: few open files left",
-                        self.user.name, self.peer)  # fmt: skip
+            self.say(
+                "sftp out of files",
+                f"sftp: {self.user.name} from {self.peer}: open refused: few open files left",
+            )
             raise self._refused(asyncssh.SFTPFailure, OUT_OF_FILES)
 
     def _open_writing(self, parts: Parts, pflags: int) -> _Writing:
@@ -582,7 +589,9 @@ class SFTPChannel:
             chan.write_stderr(b"Your workspace cannot be used now; tell the instructor.\r\n")
             chan.exit(1)
             return
-        self.server = WorkspaceSFTPServer(chan, files, self.user, self.peer, self.service.room)
+        self.server = WorkspaceSFTPServer(
+            chan, files, self.user, self.peer, self.service.room, self.service.say
+        )
         log.info("sftp: %s (%s) from %s", self.user.name, self.user.role, self.peer)
         self.stream.session_started()
 
