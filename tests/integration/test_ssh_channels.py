@@ -130,3 +130,15 @@ async def test_short_of_memory_the_server_refuses_new_work_and_keeps_live_sessio
         for closing in (bob, ann):
             await closing.close()
         mallory.close()
+
+
+@sync
+async def test_a_flood_of_typed_keys_is_dropped_past_the_budget_and_the_app_answers(tmp_path):
+    async with lab_host(tmp_path, [Account("mallory")]) as host:
+        term = await host.terminal("mallory")
+        await term.start_app()
+        term.send("z" * 65536)  # 64 KiB of typed keys in one go (each a key event)
+        await term.wait_for("typed keys were dropped")
+        term.send("p")
+        await term.wait_for("PAUSED")
+        await term.close()
