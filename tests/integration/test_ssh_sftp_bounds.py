@@ -5,7 +5,6 @@ descriptors kept for the live sessions."""
 
 from __future__ import annotations
 
-import asyncio
 import gc
 import os
 import struct
@@ -21,6 +20,11 @@ from workbench.files.workspace_files import WorkspaceFiles
 from workbench.ssh.server import LabSession
 from workbench.ssh.sftp import MAX_READ, OUT_OF_FILES
 
+from .sftp_support import (
+    FXP_DATA,
+    raw_sftp_open,
+    sftp_read,
+)
 from .ssh_support import Account, lab_host
 
 #: reads the attack asks for without reading a reply (the live attack asked without end)
@@ -30,43 +34,6 @@ READ_SIZE = 64 * 1024
 FILE_SIZE = 2_000_000
 #: asyncssh's high-water mark of a channel's output buffer
 HIGH_WATER = 64 * 1024
-
-FXP_INIT, FXP_VERSION, FXP_OPEN, FXP_READ = 1, 2, 3, 5
-FXP_STATUS, FXP_HANDLE, FXP_DATA = 101, 102, 103
-FXF_READ = 1
-
-
-def _string(data: bytes) -> bytes:
-    return struct.pack(">I", len(data)) + data
-
-
-def _packet(kind: int, body: bytes) -> bytes:
-    return struct.pack(">IB", len(body) + 1, kind) + body
-
-
-class RawSFTP(asyncssh.SSHClientSession[bytes]):
-    """An SFTP client that writes the protocol's packets itself, so it can ask and not read."""
-
-    def __init__(self) -> None:
-        self.buffer = bytearray()
-        self.replies: list[tuple[int, bytes]] = []
-        self.arrived = asyncio.Event()
-
-    def data_received(self, data: bytes, datatype: asyncssh.DataType) -> None:
-        self.buffer += data
-        while len(self.buffer) >= 4:
-            (length,) = struct.unpack(">I", self.buffer[:4])
-            if len(self.buffer) < 4 + length:
-                break
-            body = bytes(self.buffer[4 : 4 + length])
-            del self.buffer[: 4 + length]
-            self.replies.append((body[0], body[1:]))
-        self.arrived.set()
-
-    async def reply(self, count: int) -> tuple[int, bytes]:
-        """The ``count``-th reply (from 1), once it has come."""
-        await until(lambda: len(self.replies) >= count, f"reply {count}")
-        return self.replies[count - 1]
 
 
 def sftp_sessions() -> list[LabSession]:
@@ -81,19 +48,10 @@ async def test_reads_never_read_back_stop_the_channel_s_requests_not_grow_its_bu
         folder.mkdir(parents=True, exist_ok=True)
         (folder / "big.viple").write_bytes(os.urandom(FILE_SIZE))
         conn = await host.connect("mallory")
-        chan, client = await conn.create_session(RawSFTP, subsystem="sftp", encoding=None)
-        chan.write(_packet(FXP_INIT, struct.pack(">I", 3)))
-        kind, _ = await client.reply(1)
-        assert kind == FXP_VERSION
-        chan.write(_packet(FXP_OPEN, struct.pack(">I", 1) + _string(b"/big.viple")
-                           + struct.pack(">II", FXF_READ, 0)))  # fmt: skip
-        kind, body = await client.reply(2)
-        assert kind == FXP_HANDLE, body
-        handle = body[8 : 8 + struct.unpack(">I", body[4:8])[0]]
+        chan, client, handle = await raw_sftp_open(conn, b"/big.viple")
 
         def read(request: int, offset: int, size: int) -> bytes:
-            return _packet(FXP_READ, struct.pack(">I", request) + _string(handle)
-                           + struct.pack(">QI", offset, size))  # fmt: skip
+            return sftp_read(request, handle, offset, size)
 
         # a read asking for more than a reply may carry gets what one may
         chan.write(read(2, 0, 4_000_000))
