@@ -18,7 +18,7 @@ from tests.waiting import until
 from workbench.files.workspace import workspace_folder
 from workbench.files.workspace_files import WorkspaceFiles
 from workbench.ssh.server import LabSession
-from workbench.ssh.sftp import MAX_READ, OUT_OF_FILES
+from workbench.ssh.sftp import MAX_READ, OUT_OF_FILES, REQUESTS_WAITING
 
 from .sftp_support import (
     FXP_DATA,
@@ -28,10 +28,12 @@ from .sftp_support import (
 from .ssh_support import Account, lab_host
 
 #: reads the attack asks for without reading a reply (the live attack asked without end)
-READS = 400
-READ_SIZE = 64 * 1024
+READS = 16000
+READ_SIZE = 1024
 #: the file read: the live attack read a 4.9 MB upload of the student's own
 FILE_SIZE = 2_000_000
+#: the bytes of one READ request, as sent here
+READ_REQUEST = 4 + 1 + 4 + 4 + 4 + 8 + 4
 #: asyncssh's high-water mark of a channel's output buffer
 HIGH_WATER = 64 * 1024
 
@@ -75,7 +77,14 @@ async def test_reads_never_read_back_stop_the_channel_s_requests_not_grow_its_bu
 
         await until(lambda: waiting() or buffered() > 8 * MAX_READ, "the server stopped")
         assert buffered() <= HIGH_WATER + READ_SIZE
-        assert stream._recv_buf_len > 0  # the requests past it wait, unread
+        # the requests past it wait, unread: what the channel takes off the client's window
+        # is bounded too (the rest stays in that window, which the client is not given more of)
+        await until(
+            lambda: stream._read_paused or stream._recv_buf_len > 2 * REQUESTS_WAITING,
+            "the channel stopped taking requests",
+        )
+        assert stream._recv_buf_len <= REQUESTS_WAITING + READ_REQUEST
+        assert buffered() <= HIGH_WATER + READ_SIZE
         # reading again, every read is answered
         chan.resume_reading()
         await client.reply(3 + READS)

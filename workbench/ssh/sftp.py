@@ -17,6 +17,7 @@ loop that serves every student.
 
 from __future__ import annotations
 
+import asyncio
 import contextlib
 import logging
 import os
@@ -26,6 +27,7 @@ from dataclasses import dataclass, field
 from typing import BinaryIO
 
 import asyncssh
+from asyncssh.channel import SSHChannel
 from asyncssh.packet import SSHPacket
 from asyncssh.sftp import (
     FXF_APPEND,
@@ -49,7 +51,6 @@ from workbench.files.names import (
 )
 from workbench.files.workspace import workspace_folder, workspaces_folder
 from workbench.files.workspace_files import (
-    Entry,
     Refusal,
     Upload,
     UploadLimits,
@@ -70,6 +71,8 @@ MAX_SAID = 50
 #: the most bytes one read sends back (a client asking for more gets this much, which SFTP
 #: allows: it reads on from where the reply ended), as OpenSSH's sftp-server caps it
 MAX_READ = 256 * 1024
+#: bytes of a transfer's requests taken off the channel and waiting to be handled
+REQUESTS_WAITING = 256 * 1024
 #: what a client reads when a file or folder cannot be opened for want of descriptors
 OUT_OF_FILES = "the lab server has too many files open just now: try again in a few minutes"
 
@@ -103,6 +106,8 @@ class SFTPService:
         self.room = room
         #: logs a line an attacker could repeat (``say(key, line)``: repeats held back)
         self.say = say
+        #: per student with transfers open: one listing at a time
+        self._listing_turns: dict[str, asyncio.Lock] = {}
         self._files: dict[str, WorkspaceFiles] = {}
         self.channels: dict[str, int] = {}
         #: called with each change's workspace path, for a workspace kept elsewhere too
@@ -124,6 +129,10 @@ class SFTPService:
             )
         return files
 
+    def listing_turn(self, user: User) -> asyncio.Lock:
+        """The lock the student's listings take turns at (while their transfers are open)."""
+        return self._listing_turns.setdefault(user.name, asyncio.Lock())
+
     def workspace(self, name: str) -> WorkspaceFiles | None:
         """The files of student ``name`` while they have SFTP channels open."""
         return self._files.get(name)
@@ -134,6 +143,7 @@ class SFTPService:
             self.channels[user.name] = left
             return
         self.channels.pop(user.name, None)
+        self._listing_turns.pop(user.name, None)
         files = self._files.pop(user.name, None)  # counted afresh next time: the app writes too
         if files is not None:
             with contextlib.suppress(OSError):
@@ -179,11 +189,14 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
         peer: str,
         room: Callable[[], bool] = lambda: True,
         say: Callable[[str, str], None] = lambda key, line: log.warning("%s", line),
+        listing_turn: asyncio.Lock | None = None,
     ) -> None:
         super().__init__(chan)
         self.files = files
         self.room = room
         self.say = say
+        #: taken while one of the student's listings is made (shared by their transfers)
+        self.listing_turn = listing_turn or asyncio.Lock()
         self.user = user
         self.peer = peer
         #: set when the client is gone: an upload still open then is dropped, not kept
@@ -260,18 +273,22 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
     async def scandir(self, path: bytes) -> AsyncIterator[asyncssh.SFTPName]:
         parts = self._parts(path)
         try:
-            entries, here = await in_pool(FILES, self._listing, parts)
+            async with self.listing_turn:  # one listing of the student's at a time
+                names = await in_pool(FILES, self._listing, parts)
         except WorkspaceError as exc:
             raise self._refusal(exc) from None
+        for name in names:
+            yield name
+
+    def _listing(self, parts: Parts) -> list[asyncssh.SFTPName]:
+        """A folder's names with their attributes (in a worker thread)."""
+        entries, here = self.files.list(parts), self.files.stat(parts)
         dots = self._attrs(True, here.size, here.mtime, here.atime)
-        for dot in (b".", b".."):
-            yield asyncssh.SFTPName(dot, attrs=dots)
+        names = [asyncssh.SFTPName(dot, attrs=dots) for dot in (b".", b"..")]
         for entry in entries:
             attrs = self._attrs(entry.is_folder, entry.size, entry.mtime, entry.atime)
-            yield asyncssh.SFTPName(entry.name.encode(), attrs=attrs)
-
-    def _listing(self, parts: Parts) -> tuple[list[Entry], Entry]:
-        return self.files.list(parts), self.files.stat(parts)
+            names.append(asyncssh.SFTPName(entry.name.encode(), attrs=attrs))
+        return names
 
     def statvfs(self, path: bytes) -> asyncssh.SFTPVFSAttrs:
         """The room the quota leaves (``df`` in ``sftp``), never the server's disks."""
@@ -589,9 +606,11 @@ class SFTPChannel:
             chan.write_stderr(b"Your workspace cannot be used now; tell the instructor.\r\n")
             chan.exit(1)
             return
+        service = self.service
         self.server = WorkspaceSFTPServer(
-            chan, files, self.user, self.peer, self.service.room, self.service.say
-        )
+            chan, files, self.user, self.peer, service.room, service.say,
+            service.listing_turn(self.user),
+        )  # fmt: skip
         log.info("sftp: %s (%s) from %s", self.user.name, self.user.role, self.peer)
         self.stream.session_started()
 
@@ -611,6 +630,12 @@ class _Stream(SSHServerStreamSession):
     ) -> None:
         super().__init__(None)
         self._run = run
+
+    def connection_made(self, chan: SSHChannel[bytes]) -> None:
+        super().connection_made(chan)
+        # requests read from the channel and not handled yet: past this the channel stops
+        # taking them (and so stops widening the client's window) until the handler catches up
+        self._limit = REQUESTS_WAITING
 
     def session_started(self) -> None:
         assert self._chan is not None and self._conn is not None
