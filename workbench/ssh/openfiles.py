@@ -86,7 +86,7 @@ def quiet_accept_errors(loop: asyncio.AbstractEventLoop, say: Say) -> Handler:
             return
         if isinstance(exc, MemoryError):
             what = str(context.get("message", "a task"))[:80]
-            say("out of memory", f"out of memory in {what}: that work was dropped")
+            say("out of memory", f"out of memory ({what}): that work was dropped")
             return
         if previous is not None:
             previous(loop, context)
