@@ -30,7 +30,7 @@ dialog and drive at 20 keys a second, probing key-to-screen time every 2 s (``p`
   10 connections (capped at 10 channels each, each closed after the 10 s grace);
 - ``sftp-reads``: mallory asks for 64 KiB READs of her own 4.9 MB file on one SFTP channel and
   never reads a reply (the server stops reading her requests while its reply buffer is full);
-- ``listings``: mallory lists a folder of 2,000 files of hers without pause on three SFTP
+- ``listings``: mallory lists a folder of 1,500 files of hers without pause on three SFTP
   channels;
 - ``keys``: mallory sends her own app 64 KiB of typed keys, waits for her screen to say keys
   were dropped, then types ``p``, over and over, and notes how long her app took to say so and
@@ -87,7 +87,7 @@ PHASES = (
 UPLOAD = 4_000_000
 #: mallory's own upload that ``sftp-reads`` reads, and the folder ``listings`` lists
 READ_BACK = 4_900_000
-LISTED_FILES = 2000
+LISTED_FILES = 1500  # with the rest of her files, within the 2,000 files she may keep
 
 
 async def drive(student: Student, seconds: float, ready: asyncio.Event) -> None:
