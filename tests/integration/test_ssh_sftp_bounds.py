@@ -18,7 +18,13 @@ from tests.waiting import until
 from workbench.files.workspace import workspace_folder
 from workbench.files.workspace_files import WorkspaceFiles
 from workbench.ssh.server import LabSession
-from workbench.ssh.sftp import MAX_READ, OUT_OF_FILES, REQUESTS_WAITING
+from workbench.ssh.sftp import (
+    MAX_OPEN_FILES,
+    MAX_OPEN_FILES_PER_STUDENT,
+    MAX_READ,
+    OUT_OF_FILES,
+    REQUESTS_WAITING,
+)
 
 from .sftp_support import (
     FXP_DATA,
@@ -136,4 +142,29 @@ async def test_files_are_not_opened_into_the_descriptors_kept_for_live_sessions(
             async with sftp.open("/up.txt", "w") as f:
                 await f.write("hello")
         assert (workspace_folder(host.data_dir, "mallory") / "up.txt").read_text() == "hello"
+        conn.close()
+
+
+@sync
+async def test_a_student_s_open_files_are_capped_over_all_their_transfers(tmp_path):
+    async with lab_host(tmp_path, [Account("mallory")]) as host:
+        folder = workspace_folder(host.data_dir, "mallory")
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / "a.txt").write_text("a")
+        conn = await host.connect("mallory")
+        clients = [await conn.start_sftp_client() for _ in range(3)]
+        held = []
+        for sftp in clients[:2]:  # 32 files on each of two transfers: 64 in all
+            held += [await sftp.open("/a.txt") for _ in range(MAX_OPEN_FILES)]
+        assert len(held) == MAX_OPEN_FILES_PER_STUDENT
+        with pytest.raises(asyncssh.SFTPFailure) as caught:
+            await clients[2].open("/a.txt")
+        assert "at most 64 files can be open at once over all your transfers" in (
+            caught.value.reason
+        )
+        await held.pop().close()  # one closed: one may be opened, on any transfer
+        again = await clients[2].open("/a.txt")
+        assert await again.read() == "a"
+        for sftp in clients:
+            sftp.exit()
         conn.close()

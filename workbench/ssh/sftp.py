@@ -65,6 +65,9 @@ log = logging.getLogger("workbench.ssh")
 
 #: files and folders one SFTP channel may hold open at once (each file holds a descriptor)
 MAX_OPEN_FILES = 32
+#: files one student may hold open over all their transfers (with 10 transfers of 32 each, four
+#: students took every descriptor of a server with a limit of 1,024)
+MAX_OPEN_FILES_PER_STUDENT = 64
 MAX_OPEN_FOLDERS = 32
 #: refusal lines written to one channel's error output; the rest go as SFTP statuses only
 MAX_SAID = 50
@@ -106,8 +109,8 @@ class SFTPService:
         self.room = room
         #: logs a line an attacker could repeat (``say(key, line)``: repeats held back)
         self.say = say
-        #: per student with transfers open: one listing at a time
-        self._listing_turns: dict[str, asyncio.Lock] = {}
+        #: per student with transfers open: what their transfers share
+        self._shares: dict[str, StudentShare] = {}
         self._files: dict[str, WorkspaceFiles] = {}
         self.channels: dict[str, int] = {}
         #: called with each change's workspace path, for a workspace kept elsewhere too
@@ -129,9 +132,12 @@ class SFTPService:
             )
         return files
 
-    def listing_turn(self, user: User) -> asyncio.Lock:
-        """The lock the student's listings take turns at (while their transfers are open)."""
-        return self._listing_turns.setdefault(user.name, asyncio.Lock())
+    def share(self, user: User) -> StudentShare:
+        """What the student's transfers share while any is open."""
+        share = self._shares.get(user.name)
+        if share is None:
+            share = self._shares[user.name] = StudentShare()
+        return share
 
     def workspace(self, name: str) -> WorkspaceFiles | None:
         """The files of student ``name`` while they have SFTP channels open."""
@@ -143,7 +149,7 @@ class SFTPService:
             self.channels[user.name] = left
             return
         self.channels.pop(user.name, None)
-        self._listing_turns.pop(user.name, None)
+        self._shares.pop(user.name, None)
         files = self._files.pop(user.name, None)  # counted afresh next time: the app writes too
         if files is not None:
             with contextlib.suppress(OSError):
@@ -157,6 +163,15 @@ class SFTPService:
             f"You already have {most} file transfers open, the most one user may have: "
             "wait for one to end and try again."
         )
+
+
+@dataclass
+class StudentShare:
+    """What all of one student's transfers share: one listing at a time, and a count of the
+    files they hold open."""
+
+    listing_turn: asyncio.Lock = field(default_factory=asyncio.Lock)
+    open_files: int = 0
 
 
 @dataclass
@@ -189,14 +204,14 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
         peer: str,
         room: Callable[[], bool] = lambda: True,
         say: Callable[[str, str], None] = lambda key, line: log.warning("%s", line),
-        listing_turn: asyncio.Lock | None = None,
+        share: StudentShare | None = None,
     ) -> None:
         super().__init__(chan)
         self.files = files
         self.room = room
         self.say = say
-        #: taken while one of the student's listings is made (shared by their transfers)
-        self.listing_turn = listing_turn or asyncio.Lock()
+        #: what the student's transfers share (one listing at a time, the files open)
+        self.share = share or StudentShare()
         self.user = user
         self.peer = peer
         #: set when the client is gone: an upload still open then is dropped, not kept
@@ -273,7 +288,7 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
     async def scandir(self, path: bytes) -> AsyncIterator[asyncssh.SFTPName]:
         parts = self._parts(path)
         try:
-            async with self.listing_turn:  # one listing of the student's at a time
+            async with self.share.listing_turn:  # one listing of the student's at a time
                 names = await in_pool(FILES, self._listing, parts)
         except WorkspaceError as exc:
             raise self._refusal(exc) from None
@@ -329,6 +344,12 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
                 asyncssh.SFTPFailure,
                 f"at most {MAX_OPEN_FILES} files can be open at once on one transfer: close some",
             )
+        if self.share.open_files >= MAX_OPEN_FILES_PER_STUDENT:
+            raise self._refused(
+                asyncssh.SFTPFailure,
+                f"at most {MAX_OPEN_FILES_PER_STUDENT} files can be open at once over all your "
+                "transfers: close some",
+            )
         handle: _Open
         try:
             if pflags & (FXF_WRITE | FXF_APPEND):
@@ -343,6 +364,7 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
             raise self._refusal(exc) from None
         key = id(handle)
         self._handles[key] = handle
+        self.share.open_files += 1
         return key
 
     def check_room(self) -> None:
@@ -405,6 +427,7 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
         handle = self._handles.pop(file_obj, None)  # type: ignore[call-overload]
         if handle is None:
             return
+        self.share.open_files -= 1
         if isinstance(handle, _Reading):
             handle.file.close()
             self._log(handle.parts, "read", handle.sent, "done")
@@ -609,7 +632,7 @@ class SFTPChannel:
         service = self.service
         self.server = WorkspaceSFTPServer(
             chan, files, self.user, self.peer, service.room, service.say,
-            service.listing_turn(self.user),
+            service.share(self.user),
         )  # fmt: skip
         log.info("sftp: %s (%s) from %s", self.user.name, self.user.role, self.peer)
         self.stream.session_started()
