@@ -26,6 +26,18 @@ dialog and drive at 20 keys a second, probing key-to-screen time every 2 s (``p`
   connections at once (put, then rm, so her quota never stops her), as fast as they go; the
   phase gives the upload throughput the server kept up (from its log's transfer lines) and,
   before the students start, one 4 MB upload's time with nothing else running.
+- ``channels``: mallory opens session channels that ask for nothing, as fast as they open, on
+  10 connections (capped at 10 channels each, each closed after the 10 s grace);
+- ``sftp-reads``: mallory asks for 64 KiB READs of her own 4.9 MB file on one SFTP channel and
+  never reads a reply (the server stops reading her requests while its reply buffer is full);
+- ``listings``: mallory lists a folder of 1,500 files of hers without pause on three SFTP
+  channels;
+- ``keys``: mallory sends her own app 64 KiB of typed keys, waits for her screen to say keys
+  were dropped, then types ``p``, over and over, and notes how long her app took to say so and
+  to answer the ``p``.
+
+Each phase also gives the server process's peak resident memory (sampled every 0.1 s) beside
+what it had at the phase's start.
 
 Usage: ``python bench/ssh_attacks.py [--students 4] [--seconds 20] [--only flood]``.
 Figures vary from run to run; the machine is shared by the clients, the server and the apps.
@@ -53,6 +65,8 @@ sys.path.insert(0, str(ROOT))
 
 from ssh_load import Result, Student, free_port, pct, start_server, student_address  # noqa: E402
 
+from tests.integration.sftp_support import raw_sftp_open, sftp_read  # noqa: E402
+from tests.integration.ssh_support import open_bare_channel  # noqa: E402
 from tests.program import hostile  # noqa: E402
 from workbench.files.workspace import workspace_folder  # noqa: E402
 from workbench.ssh.users import add_user  # noqa: E402
@@ -64,9 +78,16 @@ PHASES = (
     "flood",
     "terminal",
     "uploads",
+    "channels",
+    "sftp-reads",
+    "listings",
+    "keys",
     *(f"program-{p}" for p in PROGRAMS),
 )
 UPLOAD = 4_000_000
+#: mallory's own upload that ``sftp-reads`` reads, and the folder ``listings`` lists
+READ_BACK = 4_900_000
+LISTED_FILES = 1500  # with the rest of her files, within the 2,000 files she may keep
 
 
 async def drive(student: Student, seconds: float, ready: asyncio.Event) -> None:
@@ -334,13 +355,132 @@ def upload_alone(port: int, folder: Path) -> float:
     return time.perf_counter() - started
 
 
+async def flood_channels(port: int, key, notes: list[str]) -> None:
+    conns = [await connect(port, "mallory", key, f"127.0.8.{20 + n}") for n in range(10)]
+    held: list = []
+    opened = refused = 0
+    try:
+        while True:
+            for conn in conns:
+                try:
+                    held.append(await open_bare_channel(conn))
+                    opened += 1
+                except asyncssh.ChannelOpenError:
+                    refused += 1
+            held = [(chan, s) for chan, s in held if not s.closed.is_set()]
+            await asyncio.sleep(0)
+    finally:
+        notes.append(
+            f"mallory opened {opened} channels ({len(held)} open at the end), {refused} refused"
+        )
+        await close_all(conns)
+
+
+async def read_never_read_back(port: int, key, notes: list[str]) -> None:
+    conn = await connect(port, "mallory", key, "127.0.8.30")
+    chan, _, handle = await raw_sftp_open(conn, b"/read-back.bin")
+    chan.pause_reading()
+    sent = 0
+    try:
+        while True:
+            if chan.get_write_buffer_size() < 1_000_000:  # the client's own side bounded
+                for _ in range(100):
+                    offset = (sent * 65536) % (READ_BACK - 65536)
+                    chan.write(sftp_read(3 + sent, handle, offset, 65536))
+                    sent += 1
+            await asyncio.sleep(0.01)
+    finally:
+        waiting = chan.get_write_buffer_size()
+        notes.append(f"mallory asked for {sent} reads of 64 KiB ({waiting} bytes not yet taken)")
+        await close_all([conn])
+
+
+async def list_without_pause(port: int, key, notes: list[str]) -> None:
+    conns = [await connect(port, "mallory", key, f"127.0.8.{40 + n}") for n in range(3)]
+    listings = 0
+
+    async def lister(conn) -> None:
+        nonlocal listings
+        async with conn.start_sftp_client() as sftp:
+            while True:
+                await sftp.listdir("/many")
+                listings += 1
+
+    tasks = [asyncio.create_task(lister(c)) for c in conns]
+    try:
+        await asyncio.Event().wait()
+    finally:
+        for task in tasks:
+            task.cancel()
+        await asyncio.gather(*tasks, return_exceptions=True)
+        notes.append(f"mallory listed {LISTED_FILES} files {listings} times on 3 channels")
+        await close_all(conns)
+
+
+async def key_flood(port: int, key, notes: list[str]) -> None:
+    mallory = Student("mallory", key, port, Result(), "127.0.8.50", "asyncssh", Path())
+    answers: list[tuple[float, float]] = []
+    try:
+        async with mallory.terminal() as write:
+            if write is None or not await mallory.wait_for(b"Who is at this robot", 0, 60):
+                return
+            write(b"\r")
+            if not await mallory.wait_for(b"running", 0, 60):
+                return
+            paused = False
+            while True:
+                mark = len(mallory.buffer)
+                started = time.perf_counter()
+                write(b"z" * 65536)
+                if not await mallory.wait_for(b"dropped", mark, 300):  # the line may wrap
+                    return
+                told = time.perf_counter() - started
+                mark = len(mallory.buffer)
+                started = time.perf_counter()
+                write(b"p")
+                paused = not paused
+                if not await mallory.wait_for(b"PAUSED" if paused else b"running", mark, 300):
+                    return
+                answers.append((told, time.perf_counter() - started))
+    finally:
+        shown = ", ".join(f"{t:.2f}/{a:.2f}" for t, a in answers[:6])
+        notes.append(
+            f"mallory sent {len(answers)} floods of 64 KiB of keys; her app said keys were "
+            f"dropped / answered her next key after {shown or '-'} s"
+        )
+
+
+def resident_mb(pid: int) -> float:
+    """The resident memory of process ``pid`` in MB (0 when it cannot be read)."""
+    try:
+        for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1000
+    except OSError:
+        pass
+    return 0.0
+
+
+async def peak_memory(pid: int, peak: list[float]) -> None:
+    while True:
+        peak[0] = max(peak[0], resident_mb(pid))
+        await asyncio.sleep(0.1)
+
+
 LATE_KEY = asyncssh.generate_private_key("ssh-ed25519")
 #: seconds the server has to let go of a connection the bench closes (it takes milliseconds)
 RELEASE_TIMEOUT = 30.0
 
 
 async def phase(
-    name: str, port: int, students: list[Student], keys, seconds: float, folder: Path, data: Path
+    name: str,
+    port: int,
+    students: list[Student],
+    keys,
+    seconds: float,
+    folder: Path,
+    data: Path,
+    server_pid: int,
 ):
     for student in students:
         student.result = Result()
@@ -352,6 +492,10 @@ async def phase(
         "flood": lambda: flood(port, notes),
         "terminal": lambda: storm_terminal(port, keys["mallory"], notes),
         "uploads": lambda: upload_flood(port, folder, data, notes),
+        "channels": lambda: flood_channels(port, keys["mallory"], notes),
+        "sftp-reads": lambda: read_never_read_back(port, keys["mallory"], notes),
+        "listings": lambda: list_without_pause(port, keys["mallory"], notes),
+        "keys": lambda: key_flood(port, keys["mallory"], notes),
     }
     for program in PROGRAMS:
         attacks[f"program-{program}"] = lambda program=program: run_program(
@@ -374,12 +518,17 @@ async def phase(
         await asyncio.gather(*drivers, return_exceptions=True)
         raise SystemExit(f"{name}: not every student got to drive: {failures[:3]}")
     attack = attacks[name]
+    at_start = resident_mb(server_pid)
+    peak = [at_start]
+    sampler = asyncio.create_task(peak_memory(server_pid, peak))
     task = asyncio.create_task(attack()) if attack else None
     await asyncio.gather(*drivers)
     if task is not None:
         task.cancel()
         with contextlib.suppress(asyncio.CancelledError):
             await task
+    sampler.cancel()
+    notes.append(f"server memory {at_start:.0f} MB at the start, peak {peak[0]:.0f} MB")
     latency = [t for s in students for t in s.result.latency]
     failures = [f for s in students for f in s.result.failures]
     print(
@@ -411,6 +560,10 @@ async def main() -> None:
         keys["mallory"].write_private_key(Path(tmp) / "mallory.key")
         (Path(tmp) / "mallory.key").chmod(0o600)
         upload_files(Path(tmp), 3)
+        (workspace / "read-back.bin").write_bytes(os.urandom(READ_BACK))
+        (workspace / "many").mkdir()
+        for n in range(LISTED_FILES):
+            (workspace / "many" / f"f{n:04d}.txt").write_text("x")
         port = free_port()
         server = start_server(data, port, args.students + 4, fork=True)
         try:
@@ -422,7 +575,7 @@ async def main() -> None:
                 for n, name in enumerate(names[:-1])
             ]
             for name in args.only or PHASES:
-                await phase(name, port, students, keys, args.seconds, Path(tmp), data)
+                await phase(name, port, students, keys, args.seconds, Path(tmp), data, server.pid)
         finally:
             server.terminate()
             server.wait(30)

@@ -5,11 +5,15 @@ from __future__ import annotations
 
 import asyncio
 import shutil
+import struct
 import subprocess
 from dataclasses import dataclass
 from pathlib import Path
 
+import asyncssh
 import pytest
+
+from tests.waiting import until
 
 from .ssh_support import LabHost
 
@@ -83,3 +87,64 @@ def files_under(folder: Path) -> dict[str, bytes]:
         for p in sorted(folder.rglob("*"))
         if p.is_file() and not p.is_symlink()
     }
+
+
+# -- the protocol spoken by hand, for what no client sends ------------------------------------
+FXP_INIT, FXP_VERSION, FXP_OPEN, FXP_READ = 1, 2, 3, 5
+FXP_STATUS, FXP_HANDLE, FXP_DATA = 101, 102, 103
+FXF_READ = 1
+
+
+def sftp_string(data: bytes) -> bytes:
+    return struct.pack(">I", len(data)) + data
+
+
+def sftp_packet(kind: int, body: bytes) -> bytes:
+    return struct.pack(">IB", len(body) + 1, kind) + body
+
+
+class RawSFTP(asyncssh.SSHClientSession[bytes]):
+    """An SFTP client that writes the protocol's packets itself, so it can ask and not read."""
+
+    def __init__(self) -> None:
+        self.buffer = bytearray()
+        self.replies: list[tuple[int, bytes]] = []
+        self.arrived = asyncio.Event()
+
+    def data_received(self, data: bytes, datatype: asyncssh.DataType) -> None:
+        self.buffer += data
+        while len(self.buffer) >= 4:
+            (length,) = struct.unpack(">I", self.buffer[:4])
+            if len(self.buffer) < 4 + length:
+                break
+            body = bytes(self.buffer[4 : 4 + length])
+            del self.buffer[: 4 + length]
+            self.replies.append((body[0], body[1:]))
+        self.arrived.set()
+
+    async def reply(self, count: int) -> tuple[int, bytes]:
+        """The ``count``-th reply (from 1), once it has come."""
+        await until(lambda: len(self.replies) >= count, f"reply {count}")
+        return self.replies[count - 1]
+
+
+def sftp_read(request: int, handle: bytes, offset: int, size: int) -> bytes:
+    """A READ request's packet."""
+    body = struct.pack(">I", request) + sftp_string(handle) + struct.pack(">QI", offset, size)
+    return sftp_packet(FXP_READ, body)
+
+
+async def raw_sftp_open(
+    conn: asyncssh.SSHClientConnection, path: bytes
+) -> tuple[asyncssh.SSHClientChannel[bytes], RawSFTP, bytes]:
+    """An SFTP channel spoken by hand, with ``path`` open to read: the channel, its client
+    (two replies in: the version and the handle) and the file's handle."""
+    chan, client = await conn.create_session(RawSFTP, subsystem="sftp", encoding=None)
+    chan.write(sftp_packet(FXP_INIT, struct.pack(">I", 3)))
+    kind, _ = await client.reply(1)
+    assert kind == FXP_VERSION
+    body = struct.pack(">I", 1) + sftp_string(path) + struct.pack(">II", FXF_READ, 0)
+    chan.write(sftp_packet(FXP_OPEN, body))
+    kind, body = await client.reply(2)
+    assert kind == FXP_HANDLE, body
+    return chan, client, body[8 : 8 + struct.unpack(">I", body[4:8])[0]]

@@ -230,3 +230,37 @@ async def open_exercise(term: Terminal, title: str, presses: int = 20) -> str:
             lambda t, before=before: t.splitlines()[0] != before, "the next exercise"
         )
     raise AssertionError(f"{title!r} not found in the labs list:\n{screen}")
+
+
+class BareChannel(asyncssh.SSHClientSession[bytes]):
+    """The client's side of a session channel that asks for nothing: what the server writes
+    on it, and whether it was closed."""
+
+    def __init__(self) -> None:
+        self.said = bytearray()
+        self.closed = asyncio.Event()
+
+    def data_received(self, data: bytes, datatype: asyncssh.DataType) -> None:
+        self.said += data
+
+    def connection_lost(self, exc: Exception | None) -> None:
+        self.closed.set()
+
+
+async def open_bare_channel(
+    conn: asyncssh.SSHClientConnection,
+) -> tuple[asyncssh.SSHClientChannel[bytes], BareChannel]:
+    """Open a session channel and ask for nothing on it (no terminal, command or subsystem),
+    as an attacker would: asyncssh's client always asks for something, so this opens the
+    channel the way its ``create_session`` does and stops there. Raises
+    :class:`asyncssh.ChannelOpenError` when the server refuses the channel."""
+    chan: asyncssh.SSHClientChannel[bytes] = asyncssh.SSHClientChannel(
+        conn, asyncio.get_running_loop(), "strict", None, "strict", 2 * 1024 * 1024, 32768
+    )
+    packet = await chan._open(b"session")
+    packet.check_end()
+    session = BareChannel()
+    chan._session = session
+    session.connection_made(chan)
+    chan.resume_reading()  # a new channel holds what it receives until it is started
+    return chan, session

@@ -25,6 +25,7 @@ from workbench.labs.store import (
 )
 from workbench.ssh.appproc import AppEntry
 from workbench.ssh.limits import SessionLimits
+from workbench.ssh.serverlog import SERVER_LOG_SIZE
 
 from .common import db_option, record_quota_options, size, upload_options
 
@@ -80,6 +81,27 @@ def register(sub: argparse._SubParsersAction) -> None:
     serve.add_argument(
         "--max-connections-per-user", type=int, default=10,
         help="connections one user may hold logged in, with or without a session (default 10)",
+    )  # fmt: skip
+    serve.add_argument(
+        "--max-channels-per-connection", type=int, default=SessionLimits.channels_per_connection,
+        metavar="N",
+        help="channels one connection may hold open at once: sessions, file transfers and "
+        "forwards (default 10)",
+    )  # fmt: skip
+    serve.add_argument(
+        "--channel-grace", type=float, default=SessionLimits.channel_grace, metavar="SECONDS",
+        help="seconds a session channel has to ask for a terminal, a command or a file "
+        "transfer before it is closed (default 10)",
+    )  # fmt: skip
+    serve.add_argument(
+        "--server-memory", type=int, default=SessionLimits.server_memory, metavar="MIB",
+        help="the server process's own memory, in MiB, past which it takes no new connections, "
+        "channels or sessions while the live ones go on (default 1024; 0: not watched)",
+    )  # fmt: skip
+    serve.add_argument(
+        "--server-log-size", type=size, default=SERVER_LOG_SIZE, metavar="SIZE",
+        help="the largest ssh.log grows; a full one is kept as ssh.log.1 and a new one begun "
+        "(e.g. 20M; 0: no limit; default 20 MB)",
     )  # fmt: skip
     serve.add_argument(
         "--max-terminal", default="500x200", metavar="COLSxROWS",
@@ -307,6 +329,22 @@ def cmd_serve(args: argparse.Namespace) -> int:
             f"--max-connections-per-user {args.max_connections_per_user}: must be at least 1 "
             "(default 10)",
         )
+    if args.max_channels_per_connection < 1:
+        return fail(
+            "serve-ssh",
+            f"--max-channels-per-connection {args.max_channels_per_connection}: must be at "
+            "least 1 (default 10)",
+        )
+    if not (math.isfinite(args.channel_grace) and args.channel_grace > 0):
+        return fail(
+            "serve-ssh", f"--channel-grace {args.channel_grace:g}: must be > 0 (default 10)"
+        )
+    if args.server_memory < 0 or 0 < args.server_memory < 128:
+        return fail(
+            "serve-ssh",
+            f"--server-memory {args.server_memory}: give at least 128 (MiB; the server needs "
+            "about 60) or 0 to leave it unwatched (default 1024)",
+        )
     try:
         columns, rows = parse_terminal(args.max_terminal)
     except ValueError as exc:
@@ -378,6 +416,9 @@ def cmd_serve(args: argparse.Namespace) -> int:
             app_memory=args.app_memory,
             app_log=args.app_log_size or 0,
             user_logs=args.user_logs_quota or 0,
+            channels_per_connection=args.max_channels_per_connection,
+            channel_grace=args.channel_grace,
+            server_memory=args.server_memory,
         ),
         logins=logins,
         fork_server=not args.no_fork_server,
@@ -388,7 +429,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
         proxy_from=proxy_from,
     )
     try:
-        log_path = setup_logging(data_dir)
+        log_path = setup_logging(data_dir, size=args.server_log_size or 0)
         server = LabServer(config)
     except (UsersFileError, HostKeyError) as exc:
         return fail("serve-ssh", f"{exc}\nthe server did not start")

@@ -9,7 +9,11 @@
 
 from __future__ import annotations
 
-from collections.abc import Collection
+import asyncio
+from collections.abc import Callable, Collection
+
+import asyncssh
+from asyncssh import SSHForwarder
 
 LOOPBACK = frozenset({"localhost", "127.0.0.1", "::1"})
 LISTEN_HOSTS = frozenset({"localhost", "127.0.0.1"})
@@ -37,3 +41,29 @@ def _not_own(port: int, own_ports: Collection[int], what: str) -> str | None:
         return f"port {port}: the user has no workbench session running"
     mine = ", ".join(str(p) for p in sorted(own_ports))
     return f"port {port} is not the {what} port of the user's sessions ({mine})"
+
+
+class CountedForwarder(SSHForwarder):
+    """The channel's side of a local forward, which gives its place among the connection's
+    channels back when it closes."""
+
+    def __init__(self, peer: SSHForwarder, release: Callable[[], None]) -> None:
+        super().__init__(peer)
+        self._release: Callable[[], None] | None = release
+
+    def connection_lost(self, exc: Exception | None) -> None:
+        if self._release is not None:
+            release, self._release = self._release, None
+            release()
+        super().connection_lost(exc)
+
+
+async def forward(host: str, port: int, release: Callable[[], None]) -> CountedForwarder:
+    """Connect to ``host:port`` for a forward channel; ``release`` is called when the channel
+    closes (or here, when the connection cannot be made)."""
+    try:
+        _, peer = await asyncio.get_running_loop().create_connection(SSHForwarder, host, port)
+    except OSError as exc:
+        release()
+        raise asyncssh.ChannelOpenError(asyncssh.OPEN_CONNECT_FAILED, str(exc)) from None
+    return CountedForwarder(peer, release)

@@ -1,6 +1,7 @@
 """The server's limits on what one user may spend: sessions per user and in all, the idle
-timeout, connections per user, the terminal's size and how often it may change, each
-app's memory and the room its error log takes."""
+timeout, connections per user and channels per connection, the terminal's size and how often
+it may change, each app's memory and the room its error log takes, and the server's own
+memory."""
 
 from __future__ import annotations
 
@@ -25,6 +26,15 @@ class SessionLimits:
     #: of one user's logs, the oldest removed at a session's start (0: no limit)
     app_log: int = 1_000_000
     user_logs: int = 20_000_000
+    #: channels one connection may hold open at once: sessions (a terminal, a file transfer,
+    #: or one refused and not yet closed) and forwards to a VIPLE port
+    channels_per_connection: int = 10
+    #: seconds a session channel has to ask for a terminal, a command or a subsystem before it
+    #: is closed
+    channel_grace: float = 10.0
+    #: the server process's own memory, in MiB, past which it takes no new connections,
+    #: channels or sessions (the live ones go on); 0: not watched
+    server_memory: int = 1024
 
     def refusal(self, user_sessions: int, all_sessions: int) -> str | None:
         """The message for a user who would open one more session, or None when it may."""
@@ -48,6 +58,16 @@ class SessionLimits:
             f"You already have {self.connections_per_user} {many} to the lab server, the most "
             "one user may have: close the ones you do not use (lost ones end within a few "
             "minutes) and try again."
+        )
+
+    def channel_refusal(self, open_channels: int) -> str | None:
+        """The reason given to a connection that would open one more channel, or None."""
+        if open_channels < self.channels_per_connection:
+            return None
+        many = "channel" if self.channels_per_connection == 1 else "channels"
+        return (
+            f"this connection has {self.channels_per_connection} {many} open, the most one "
+            "connection may have: close one, or open another connection"
         )
 
     def terminal_size(self, width: int, height: int) -> tuple[int, int]:

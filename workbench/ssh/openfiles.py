@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import asyncio
 import errno
+import os
 import resource
 from collections.abc import Callable
 from typing import Any
@@ -50,6 +51,17 @@ def near_the_limit(fd: int, limit: int) -> bool:
     return fd >= max(limit - RESERVE, limit // 2)
 
 
+def room_for_a_file(limit: int) -> bool:
+    """Whether a file opened now would stay out of the last :data:`RESERVE` descriptors (a
+    probe is opened and closed at once: it takes the number the file would)."""
+    try:
+        fd = os.open(os.devnull, os.O_RDONLY)
+    except OSError:
+        return False
+    os.close(fd)
+    return not near_the_limit(fd, limit)
+
+
 Say = Callable[[str, str], None]
 
 
@@ -57,9 +69,10 @@ Handler = Callable[[asyncio.AbstractEventLoop, dict[str, Any]], object] | None
 
 
 def quiet_accept_errors(loop: asyncio.AbstractEventLoop, say: Say) -> Handler:
-    """Have ``loop`` report an ``accept`` that ran out of descriptors with ``say(key,
-    message)`` (which keeps repeats out of the log) instead of a traceback; other errors go
-    on to the handler there was, which is returned (to be put back)."""
+    """Have ``loop`` report an ``accept`` that ran out of descriptors, and anything that ran
+    out of memory, with ``say(key, message)`` (which keeps repeats out of the log) instead of
+    a traceback; other errors go on to the handler there was, which is returned (to be put
+    back)."""
     previous = loop.get_exception_handler()
 
     def handle(loop: asyncio.AbstractEventLoop, context: dict[str, Any]) -> None:
@@ -70,6 +83,10 @@ def quiet_accept_errors(loop: asyncio.AbstractEventLoop, say: Say) -> Handler:
                 f"new connections wait: the server cannot take them ({exc.strerror}, "
                 f"limit {file_limit()} open files)",
             )
+            return
+        if isinstance(exc, MemoryError):
+            what = str(context.get("message", "a task"))[:80]
+            say("out of memory", f"out of memory ({what}): that work was dropped")
             return
         if previous is not None:
             previous(loop, context)

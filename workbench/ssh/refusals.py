@@ -7,6 +7,11 @@ NOT_A_TERMINAL = (
     "This lab server runs the workbench only, in a terminal: "
     "connect with plain 'ssh -p {port} {user}@{host}'."
 )
+#: what a session channel that asked for nothing within the grace reads as it is closed
+ASKED_NOTHING = (
+    "This lab server closed a channel that asked for nothing (no terminal, command or "
+    "subsystem) within {grace:g} s."
+)
 NO_COMMANDS = "This lab server runs the workbench only: no commands ({what} refused)."
 NO_FILES = "This lab server takes files by SFTP only ({what} refused)."
 #: the old scp protocol runs a command on the server (``scp -t``/``scp -f``), which is not offered

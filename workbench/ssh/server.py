@@ -25,19 +25,27 @@ from .applog import make_room
 from .appproc import RESTORE_TERMINAL, AppEntry, AppProcess, AppSpec, app_env, forward_hint
 from .course_files import CourseWorkspaces
 from .forkserver import ForkServer, ForkServerError
-from .forwarding import local_forward_refusal, remote_forward_refusal
+from .forwarding import forward, local_forward_refusal, remote_forward_refusal
 from .hostkey import host_key_path, load_or_create_host_key
 from .limits import SessionLimits, describe_duration, describe_memory
 from .logins import ConnectionGate, Eviction, LoginGuard, LoginPolicy, QuietLog, Stage
-from .openfiles import Handler, near_the_limit, quiet_accept_errors, raise_file_limit
+from .memory import SHORT_OF_MEMORY, MemoryWatch
+from .openfiles import (
+    Handler,
+    near_the_limit,
+    quiet_accept_errors,
+    raise_file_limit,
+    room_for_a_file,
+)
 from .passwords import hash_password, verify_password
 from .ports import PoolExhausted, PortPool
 from .proxy_protocol import Network, ProxyAcceptor, accept_behind_balancer
-from .refusals import refusal_message
+from .refusals import ASKED_NOTHING, refusal_message
 from .serverlog import shown
 from .sftp import SFTPChannel, SFTPService
 from .sources import source_of
 from .users import User, UsersFile, users_path
+from .workers import PASSWORDS, STORE, in_pool
 
 log = logging.getLogger("workbench.ssh")
 
@@ -135,6 +143,7 @@ class LabServer:
         self.guard = LoginGuard(config.logins)
         self.gate: ConnectionGate[LabConnection] = ConnectionGate(config.logins)
         self.quiet_log = QuietLog()
+        self.memory = MemoryWatch(config.limits.server_memory)
         #: password checks for one account take turns, so parallel guesses wait in line
         self._account_turns: dict[str, asyncio.Lock] = {}
         self._account_queue: Counter[str] = Counter()
@@ -144,7 +153,12 @@ class LabServer:
         self._closing = False
         self._previous_handler: Handler = None
         self.forkserver: ForkServer | None = None
-        self.sftp = SFTPService(config.data_dir, config.uploads)
+        self.sftp = SFTPService(
+            config.data_dir,
+            config.uploads,
+            room=lambda: room_for_a_file(self.file_limit),
+            say=lambda key, line: self.say_now_and_then(key, "%s", line),
+        )
         #: with a course database, uploads go on to it (and so to every server of the course)
         self.course_files = CourseWorkspaces(config.data_dir, config.db) if config.db else None
         if self.course_files is not None:
@@ -186,13 +200,16 @@ class LabServer:
         limits = config.limits
         raised = f" (raised from {files_before})" if files_before != self.file_limit else ""
         log.info(
-            "limits: %d connections per user; terminals at most %dx%d; app memory %s; "
-            "app logs %s each, %s per user; %d open files%s",
-            limits.connections_per_user, limits.max_columns, limits.max_rows,
+            "limits: %d connections per user, %d channels per connection (%g s to ask for "
+            "something); terminals at most %dx%d; app memory %s; "
+            "app logs %s each, %s per user; %d open files%s; server memory %s",
+            limits.connections_per_user, limits.channels_per_connection,
+            limits.channel_grace, limits.max_columns, limits.max_rows,
             describe_memory(limits.app_memory) if limits.app_memory else "not capped",
             shown_size(limits.app_log) if limits.app_log else "not capped",
             shown_size(limits.user_logs) if limits.user_logs else "not capped",
             self.file_limit, raised,
+            describe_memory(limits.server_memory) if limits.server_memory else "not watched",
         )  # fmt: skip
 
     async def _listen(self) -> asyncssh.SSHAcceptor | ProxyAcceptor:
@@ -270,7 +287,7 @@ class LabServer:
         if self.forkserver is not None:
             await self.forkserver.close()
         if self.course_files is not None:
-            unsent = await asyncio.to_thread(self.course_files.close, 5.0)
+            unsent = await in_pool(STORE, self.course_files.close, 5.0)
             if unsent:
                 log.warning("stopping: %d uploaded file(s) not in the course store yet (sent "
                             "at each student's next session start): %s", len(unsent),
@@ -301,6 +318,19 @@ class LabServer:
         if held:
             message += f" ({held} more like it not logged)"
         log.warning(message, *args)
+
+    def short_of_memory(self, what: str, who: str) -> bool:
+        """Whether the server is past its memory ceiling: then ``what`` (new work) of ``who``
+        is refused, and said in the log now and then."""
+        if not self.memory.short():
+            return False
+        self.say_now_and_then(
+            "short of memory",
+            "%s of %s refused: the server uses %s, past its ceiling of %s",
+            what, who, describe_memory(self.memory.last >> 20),
+            describe_memory(self.memory.ceiling),
+        )  # fmt: skip
+        return True
 
     @contextlib.asynccontextmanager
     async def account_turn(self, account: str):
@@ -363,6 +393,8 @@ class LabConnection(asyncssh.SSHServer):
         self.holds_place = False
         #: logged in, and closed at once: its user held too many connections
         self.over_cap = False
+        #: session and forward channels open on this connection
+        self.channels = 0
         self._pending_key = "?"
         self._login: tuple[User, str] | None = None
 
@@ -381,6 +413,9 @@ class LabConnection(asyncssh.SSHServer):
                 f"{sock.fileno()} of the server's {server.file_limit} open files are in use",
                 OUT_OF_FILES,
             )
+            return
+        if server.short_of_memory("connection", self.peer):
+            self._turn_away("short of memory", "the server is short of memory", SHORT_OF_MEMORY)
             return
         admission = server.gate.admit(self, self.peer)
         if admission.refused is not None:
@@ -563,7 +598,7 @@ class LabConnection(asyncssh.SSHServer):
             await asyncio.sleep(delay)
         user = self._known(username)
         stored = user.password if user is not None and user.password else _DUMMY_HASH
-        ok = await asyncio.to_thread(verify_password, password, stored)
+        ok = await in_pool(PASSWORDS, verify_password, password, stored)
         if user is not None and ok and user.password:
             guard.password_succeeded(username)
             self._login = (user, "password")
@@ -581,9 +616,31 @@ class LabConnection(asyncssh.SSHServer):
         return False
 
     # -- channels ----------------------------------------------------------------------------
+    def _take_channel(self, kind: str) -> None:
+        """Count one more channel of ``kind`` on this connection, or refuse it (past the cap,
+        or while the server is short of memory) with the reason and one log line now and
+        then."""
+        assert self.user is not None
+        server = self.server
+        if server.short_of_memory(f"{kind} channel", self.user.name):
+            raise asyncssh.ChannelOpenError(asyncssh.OPEN_RESOURCE_SHORTAGE, SHORT_OF_MEMORY)
+        why = server.config.limits.channel_refusal(self.channels)
+        if why is not None:
+            server.say_now_and_then(
+                f"channels of {self.user.name}",
+                "%s channel refused: %s from %s: %s",
+                kind, self.user.name, self.peer, why,
+            )  # fmt: skip
+            raise asyncssh.ChannelOpenError(asyncssh.OPEN_RESOURCE_SHORTAGE, f"lab server: {why}")
+        self.channels += 1
+
+    def release_channel(self) -> None:
+        self.channels = max(0, self.channels - 1)
+
     def session_requested(self) -> LabSession | bool:
         if self.user is None or self.server._closing:
             return False
+        self._take_channel("session")
         return LabSession(self.server, self, self.user)
 
     def connection_requested(
@@ -606,8 +663,9 @@ class LabConnection(asyncssh.SSHServer):
             raise asyncssh.ChannelOpenError(
                 asyncssh.OPEN_ADMINISTRATIVELY_PROHIBITED, f"forward refused: {why}"
             )
+        self._take_channel("forward")
         log.info("forward: %s to %s:%d", user.name, dest_host, dest_port)
-        return True
+        return forward(dest_host, dest_port, self.release_channel)  # type: ignore[return-value]
 
     def server_requested(self, listen_host: str, listen_port: int) -> bool:
         user = self.user
@@ -668,6 +726,10 @@ class LabSession(asyncssh.SSHServerSession):
         self._resize: asyncio.TimerHandle | None = None
         #: a file transfer (the ``sftp`` subsystem) runs on this channel instead of the app
         self.sftp: SFTPChannel | None = None
+        #: closes the channel if it asks for nothing within the grace
+        self._grace: asyncio.TimerHandle | None = None
+        #: the channel's place among its connection's channels, not given back yet
+        self._counted = True
 
     @property
     def running(self) -> bool:
@@ -676,6 +738,31 @@ class LabSession(asyncssh.SSHServerSession):
     # -- requests ----------------------------------------------------------------------------
     def connection_made(self, chan: asyncssh.SSHServerChannel) -> None:
         self.chan = chan
+        grace = self.server.config.limits.channel_grace
+        if grace > 0:
+            self._grace = asyncio.get_running_loop().call_later(grace, self._asked_nothing)
+
+    def _asked(self) -> None:
+        """The channel asked for something: the grace is over."""
+        if self._grace is not None:
+            self._grace.cancel()
+            self._grace = None
+
+    def _asked_nothing(self) -> None:
+        """Close a channel that asked for no terminal, command or subsystem in time."""
+        self._grace = None
+        if self.request or self.chan is None or self._closed:
+            return
+        grace = self.server.config.limits.channel_grace
+        self.server.say_now_and_then(
+            f"asked nothing {self.user.name}",
+            "session channel closed: %s from %s asked for nothing within %g s",
+            self.user.name, self.connection.peer, grace,
+        )  # fmt: skip
+        self._closed = True
+        with contextlib.suppress(Exception):
+            self.chan.write_stderr(ASKED_NOTHING.format(grace=grace).encode() + b"\r\n")
+            self.chan.exit(1)
 
     def pty_requested(self, term_type: str, term_size, term_modes) -> bool:
         self.has_pty = True
@@ -697,15 +784,18 @@ class LabSession(asyncssh.SSHServerSession):
         return size
 
     def shell_requested(self) -> bool:
+        self._asked()
         self.request = "shell"
         return True
 
     def exec_requested(self, command: str) -> bool:
+        self._asked()
         self.request = f"command {command[:60]!r}"
         self.command = command[:200]
         return True
 
     def subsystem_requested(self, subsystem: str) -> bool:
+        self._asked()
         self.request = f"subsystem {subsystem[:30]!r}"
         if subsystem == "sftp" and self.chan is not None:
             self.sftp = SFTPChannel(self.server.sftp, self.user, self.connection.peer)
@@ -713,6 +803,12 @@ class LabSession(asyncssh.SSHServerSession):
         return True
 
     def session_started(self) -> None:
+        if self.server.short_of_memory(self.request or "session", self.user.name):
+            assert self.chan is not None
+            self._closed = True
+            self.chan.write_stderr(SHORT_OF_MEMORY.encode() + b"\r\n")
+            self.chan.exit(1)
+            return
         if self.sftp is not None and self.chan is not None:
             self.sftp.start(self.chan, self.server.config.limits.connections_per_user)
             return
@@ -848,7 +944,7 @@ class LabSession(asyncssh.SSHServerSession):
         session start with the files this server has)."""
         config = self.server.config
         assert config.db is not None
-        sync = asyncio.to_thread(sync_at_start, config.data_dir, config.db, user, workspace)
+        sync = in_pool(STORE, sync_at_start, config.data_dir, config.db, user, workspace)
         try:
             report = await asyncio.wait_for(sync, WORKSPACE_SYNC_WAIT)
         except TimeoutError:
@@ -990,6 +1086,10 @@ class LabSession(asyncssh.SSHServerSession):
             self.app.resume_output()
 
     def connection_lost(self, exc: Exception | None) -> None:
+        self._asked()
+        if self._counted:
+            self._counted = False
+            self.connection.release_channel()
         if self.sftp is not None:
             self.sftp.stream.connection_lost(exc)
         self._closed = True

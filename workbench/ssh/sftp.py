@@ -6,6 +6,13 @@ upload limits and quota, uploads written whole or not at all); this module speak
 it turns a client's paths into workspace paths (refusing bad ones with the reason), a refusal
 into an SFTP status whose message says why (and one line on the channel's error output, which
 OpenSSH's ``sftp`` and ``scp`` print), and logs one line per file opened.
+
+Replies are flow-controlled as OpenSSH's sftp-server does it: a channel's requests are
+answered one at a time, and the next is read only once the reply before it has left the
+channel's output buffer (below asyncssh's high-water mark, 64 KiB), so a client that asks and
+never reads what it asked for stops its own requests; one read's reply is at most
+:data:`MAX_READ` bytes. Listings and file reads run in worker threads, never on the event
+loop that serves every student.
 """
 
 from __future__ import annotations
@@ -20,6 +27,7 @@ from dataclasses import dataclass, field
 from typing import BinaryIO
 
 import asyncssh
+from asyncssh.channel import SSHChannel
 from asyncssh.packet import SSHPacket
 from asyncssh.sftp import (
     FXF_APPEND,
@@ -51,14 +59,25 @@ from workbench.files.workspace_files import (
 )
 
 from .users import User
+from .workers import FILES, in_pool
 
 log = logging.getLogger("workbench.ssh")
 
 #: files and folders one SFTP channel may hold open at once (each file holds a descriptor)
 MAX_OPEN_FILES = 32
+#: files one student may hold open over all their transfers (with 10 transfers of 32 each, four
+#: students took every descriptor of a server with a limit of 1,024)
+MAX_OPEN_FILES_PER_STUDENT = 64
 MAX_OPEN_FOLDERS = 32
 #: refusal lines written to one channel's error output; the rest go as SFTP statuses only
 MAX_SAID = 50
+#: the most bytes one read sends back (a client asking for more gets this much, which SFTP
+#: allows: it reads on from where the reply ended), as OpenSSH's sftp-server caps it
+MAX_READ = 256 * 1024
+#: bytes of a transfer's requests taken off the channel and waiting to be handled
+REQUESTS_WAITING = 256 * 1024
+#: what a client reads when a file or folder cannot be opened for want of descriptors
+OUT_OF_FILES = "the lab server has too many files open just now: try again in a few minutes"
 
 _ERRORS: dict[Refusal, Callable[[str], asyncssh.SFTPError]] = {
     Refusal.MISSING: asyncssh.SFTPNoSuchFile,
@@ -77,9 +96,21 @@ class SFTPService:
     """The server's SFTP side: one :class:`WorkspaceFiles` per student while they have SFTP
     channels open (so racing uploads share one quota count), and the channels per user."""
 
-    def __init__(self, data_dir: os.PathLike | str, limits: UploadLimits) -> None:
+    def __init__(
+        self,
+        data_dir: os.PathLike | str,
+        limits: UploadLimits,
+        room: Callable[[], bool] = lambda: True,
+        say: Callable[[str, str], None] = lambda key, line: log.warning("%s", line),
+    ) -> None:
         self.data_dir = data_dir
         self.limits = limits
+        #: whether a file opened now stays out of the descriptors kept for the live sessions
+        self.room = room
+        #: logs a line an attacker could repeat (``say(key, line)``: repeats held back)
+        self.say = say
+        #: per student with transfers open: what their transfers share
+        self._shares: dict[str, StudentShare] = {}
         self._files: dict[str, WorkspaceFiles] = {}
         self.channels: dict[str, int] = {}
         #: called with each change's workspace path, for a workspace kept elsewhere too
@@ -101,6 +132,13 @@ class SFTPService:
             )
         return files
 
+    def share(self, user: User) -> StudentShare:
+        """What the student's transfers share while any is open."""
+        share = self._shares.get(user.name)
+        if share is None:
+            share = self._shares[user.name] = StudentShare()
+        return share
+
     def workspace(self, name: str) -> WorkspaceFiles | None:
         """The files of student ``name`` while they have SFTP channels open."""
         return self._files.get(name)
@@ -111,6 +149,7 @@ class SFTPService:
             self.channels[user.name] = left
             return
         self.channels.pop(user.name, None)
+        self._shares.pop(user.name, None)
         files = self._files.pop(user.name, None)  # counted afresh next time: the app writes too
         if files is not None:
             with contextlib.suppress(OSError):
@@ -124,6 +163,15 @@ class SFTPService:
             f"You already have {most} file transfers open, the most one user may have: "
             "wait for one to end and try again."
         )
+
+
+@dataclass
+class StudentShare:
+    """What all of one student's transfers share: one listing at a time, and a count of the
+    files they hold open."""
+
+    listing_turn: asyncio.Lock = field(default_factory=asyncio.Lock)
+    open_files: int = 0
 
 
 @dataclass
@@ -149,10 +197,21 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
     """One SFTP channel's requests, answered from one workspace's files."""
 
     def __init__(
-        self, chan: asyncssh.SSHServerChannel, files: WorkspaceFiles, user: User, peer: str
+        self,
+        chan: asyncssh.SSHServerChannel,
+        files: WorkspaceFiles,
+        user: User,
+        peer: str,
+        room: Callable[[], bool] = lambda: True,
+        say: Callable[[str, str], None] = lambda key, line: log.warning("%s", line),
+        share: StudentShare | None = None,
     ) -> None:
         super().__init__(chan)
         self.files = files
+        self.room = room
+        self.say = say
+        #: what the student's transfers share (one listing at a time, the files open)
+        self.share = share or StudentShare()
         self.user = user
         self.peer = peer
         #: set when the client is gone: an upload still open then is dropped, not kept
@@ -229,16 +288,22 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
     async def scandir(self, path: bytes) -> AsyncIterator[asyncssh.SFTPName]:
         parts = self._parts(path)
         try:
-            entries = self.files.list(parts)
-            here = self.files.stat(parts)
+            async with self.share.listing_turn:  # one listing of the student's at a time
+                names = await in_pool(FILES, self._listing, parts)
         except WorkspaceError as exc:
             raise self._refusal(exc) from None
+        for name in names:
+            yield name
+
+    def _listing(self, parts: Parts) -> list[asyncssh.SFTPName]:
+        """A folder's names with their attributes (in a worker thread)."""
+        entries, here = self.files.list(parts), self.files.stat(parts)
         dots = self._attrs(True, here.size, here.mtime, here.atime)
-        for dot in (b".", b".."):
-            yield asyncssh.SFTPName(dot, attrs=dots)
+        names = [asyncssh.SFTPName(dot, attrs=dots) for dot in (b".", b"..")]
         for entry in entries:
             attrs = self._attrs(entry.is_folder, entry.size, entry.mtime, entry.atime)
-            yield asyncssh.SFTPName(entry.name.encode(), attrs=attrs)
+            names.append(asyncssh.SFTPName(entry.name.encode(), attrs=attrs))
+        return names
 
     def statvfs(self, path: bytes) -> asyncssh.SFTPVFSAttrs:
         """The room the quota leaves (``df`` in ``sftp``), never the server's disks."""
@@ -273,10 +338,17 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
     # -- open files --------------------------------------------------------------------------
     def open(self, path: bytes, pflags: int, attrs: asyncssh.SFTPAttrs) -> int:
         parts = self._parts(path)
+        self.check_room()
         if len(self._handles) >= MAX_OPEN_FILES:
             raise self._refused(
                 asyncssh.SFTPFailure,
                 f"at most {MAX_OPEN_FILES} files can be open at once on one transfer: close some",
+            )
+        if self.share.open_files >= MAX_OPEN_FILES_PER_STUDENT:
+            raise self._refused(
+                asyncssh.SFTPFailure,
+                f"at most {MAX_OPEN_FILES_PER_STUDENT} files can be open at once over all your "
+                "transfers: close some",
             )
         handle: _Open
         try:
@@ -292,7 +364,18 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
             raise self._refusal(exc) from None
         key = id(handle)
         self._handles[key] = handle
+        self.share.open_files += 1
         return key
+
+    def check_room(self) -> None:
+        """Refuse to open a file or folder while the server's last descriptors are all that is
+        left (they are kept for the sessions already in)."""
+        if not self.room():
+            self.say(
+                "sftp out of files",
+                f"sftp: {self.user.name} from {self.peer}: open refused: few open files left",
+            )
+            raise self._refused(asyncssh.SFTPFailure, OUT_OF_FILES)
 
     def _open_writing(self, parts: Parts, pflags: int) -> _Writing:
         if not pflags & FXF_CREAT:
@@ -302,11 +385,12 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
         )
         return _Writing(parts, upload, append=bool(pflags & FXF_APPEND))
 
-    def read(self, file_obj: object, offset: int, size: int) -> bytes:
+    async def read(self, file_obj: object, offset: int, size: int) -> bytes:
         handle = self._handle(file_obj)
+        size = min(size, MAX_READ)
         if isinstance(handle, _Writing):
-            return handle.upload.read(offset, size)
-        data = os.pread(handle.file.fileno(), size, offset)
+            return await in_pool(FILES, handle.upload.read, offset, size)
+        data = await in_pool(FILES, os.pread, handle.file.fileno(), size, offset)
         handle.sent += len(data)
         return data
 
@@ -343,6 +427,7 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
         handle = self._handles.pop(file_obj, None)  # type: ignore[call-overload]
         if handle is None:
             return
+        self.share.open_files -= 1
         if isinstance(handle, _Reading):
             handle.file.close()
             self._log(handle.parts, "read", handle.sent, "done")
@@ -356,7 +441,7 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
             self._log(handle.parts, "write", upload.size, "dropped: the client left mid-way")
             return
         try:  # flushed to the disk away from the loop that serves every student
-            await asyncio.to_thread(upload.commit)
+            await in_pool(FILES, upload.commit)
             if handle.times is not None:
                 self.files.set_times(handle.parts, *handle.times)
         except WorkspaceError as exc:
@@ -478,9 +563,17 @@ class WorkspaceSFTPServer(asyncssh.SFTPServer):
 
 class _Handler(SFTPServerHandler):
     """asyncssh's SFTP protocol, told when the client has gone (so an open upload is dropped,
-    not kept), and with the folders one channel holds open capped."""
+    not kept), with the folders one channel holds open capped, and each reply out of the
+    channel's buffer before the next request is read."""
 
     _packet_handlers = dict(SFTPServerHandler._packet_handlers)  # noqa: RUF012
+
+    async def _process_packet(self, pkttype: int, pktid: int, packet: SSHPacket) -> None:
+        await super()._process_packet(pkttype, pktid, packet)
+        if self._writer is not None:
+            # asyncssh buffers what the client's window does not take yet without a bound:
+            # wait (reading no more requests) until it is below the high-water mark
+            await self._writer.drain()
 
     async def _cleanup(self, exc: Exception | None) -> None:
         server = self._server
@@ -491,6 +584,9 @@ class _Handler(SFTPServerHandler):
         await super()._cleanup(exc)
 
     async def _process_opendir(self, packet: SSHPacket) -> bytes:
+        server = self._server
+        if isinstance(server, WorkspaceSFTPServer):
+            server.check_room()
         if len(self._dir_handles) >= MAX_OPEN_FOLDERS:
             raise asyncssh.SFTPFailure(
                 f"at most {MAX_OPEN_FOLDERS} folders can be open at once: close some"
@@ -533,7 +629,11 @@ class SFTPChannel:
             chan.write_stderr(b"Your workspace cannot be used now; tell the instructor.\r\n")
             chan.exit(1)
             return
-        self.server = WorkspaceSFTPServer(chan, files, self.user, self.peer)
+        service = self.service
+        self.server = WorkspaceSFTPServer(
+            chan, files, self.user, self.peer, service.room, service.say,
+            service.share(self.user),
+        )  # fmt: skip
         log.info("sftp: %s (%s) from %s", self.user.name, self.user.role, self.peer)
         self.stream.session_started()
 
@@ -553,6 +653,12 @@ class _Stream(SSHServerStreamSession):
     ) -> None:
         super().__init__(None)
         self._run = run
+
+    def connection_made(self, chan: SSHChannel[bytes]) -> None:
+        super().connection_made(chan)
+        # requests read from the channel and not handled yet: past this the channel stops
+        # taking them (and so stops widening the client's window) until the handler catches up
+        self._limit = REQUESTS_WAITING
 
     def session_started(self) -> None:
         assert self._chan is not None and self._conn is not None

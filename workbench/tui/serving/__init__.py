@@ -16,6 +16,8 @@ second; the modules here cut what each key, tick and frame costs the server (mea
 
 ``ordered_keys`` makes keys typed together act as they would one by one: a key is handed on
 only once the key before it has gone its whole way, bindings and all.
+``key_budget`` bounds what a flood of typed keys costs the app: past a burst and a rate the
+keys are dropped and the student told how many.
 
 These reach into Textual beyond its public interface, and so does ``internals``, the few
 private parts the rest of the TUI needs (each behind a name that says what it gives). Nothing

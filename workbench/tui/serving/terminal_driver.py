@@ -40,6 +40,7 @@ from textual._xterm_parser import XTermParser
 from textual.app import App
 from textual.drivers.web_driver import WebDriver, _ExitInput
 
+from .key_budget import KeyBudget, dropped_message
 from .packets import DATA, PacketReader
 
 #: how long to wait while the parser's own time limit cannot be read (Textual's interval)
@@ -85,6 +86,17 @@ class TakesTypedKeys(Protocol):
         ...
 
 
+@runtime_checkable
+class SaysThings(Protocol):
+    """An app with a message line for the student."""
+
+    def say(self, text: str) -> None: ...
+
+
+#: seconds between a flood's first dropped key and the line that tells how many were
+TELL_AFTER = 0.2
+
+
 class LoopInput:
     """The server's packets on standard input, read on the event loop and handed to a driver.
 
@@ -112,6 +124,9 @@ class LoopInput:
         self._pasting = False
         #: the end of the text the parser was last given, for a paste mark split over packets
         self._tail = ""
+        #: typed keys past it are dropped, and the student told how many
+        self.budget = KeyBudget()
+        self._telling: asyncio.TimerHandle | None = None
 
     def start(self) -> None:
         """Read from the next turn of the loop on: what the driver posted while starting (the
@@ -130,6 +145,9 @@ class LoopInput:
         if self._escape is not None:
             self._escape.cancel()
             self._escape = None
+        if self._telling is not None:
+            self._telling.cancel()
+            self._telling = None
         if self.reading and loop is not None:
             self.reading = False
             with contextlib.suppress(Exception):
@@ -178,6 +196,7 @@ class LoopInput:
             and parser_wait(parser) is None
             and all(character in plain for character in text)
         ):
+            text = self._within_budget(text)
             take = self._take
             for character in text:
                 key, char = plain[character]
@@ -193,7 +212,31 @@ class LoopInput:
             self._pasting = started > ended
         self._tail = seen[-(len(PASTE_START) - 1) :]
         for event in parser.feed(text):
+            if isinstance(event, events.Key) and not self.budget.take(1):
+                self._dropped()
+                continue
             driver.process_message(event)
+
+    def _within_budget(self, text: str) -> str:
+        """The first of ``text``'s keys the budget lets through."""
+        allowed = self.budget.take(len(text))
+        if allowed < len(text):
+            self._dropped()
+        return text[:allowed]
+
+    def _dropped(self) -> None:
+        """Keys were dropped: tell the student, once the flood has had a moment."""
+        if self._telling is None and self._loop is not None:
+            self._telling = self._loop.call_later(TELL_AFTER, self._tell)
+
+    def _tell(self) -> None:
+        self._telling = None
+        count = self.budget.told()
+        app = self._driver._app
+        if count:
+            log(f"{count} typed keys dropped")
+            if isinstance(app, SaysThings):
+                app.say(dropped_message(count))
 
     def _tick(self) -> None:
         """Hand on what the parser's time limit settled (a lone Escape), and wake again at its
