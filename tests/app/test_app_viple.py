@@ -127,6 +127,7 @@ def test_a_live_program_runs_at_1x_and_the_speed_keys_say_why_they_are_held(tmp_
         assert app.station.pacer.speed == 1.0
         writer.close()
         await until(lambda: app.station.live_viple is None, "the program let go")
+        await until(lambda: "speed held" not in said(app), "the held message goes with it")
         await pilot.press("+")
         await until(lambda: app.station.pacer.speed == 2.0, "the speed key works again")
 

@@ -334,7 +334,7 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
         if station.next_speed() or station.live_viple is None:
             self.refresh_views()
         else:
-            self.say(speed_held(station.live_viple))
+            self.say(speed_held(station.live_viple), live_viple_drives)
 
     def action_reset(self) -> None:
         self.station.reset_robot()
@@ -489,6 +489,10 @@ StillTrue = Callable[[LabStation], bool]
 
 def is_paused(station: LabStation) -> bool:
     return station.paused
+
+
+def live_viple_drives(station: LabStation) -> bool:
+    return station.live_viple is not None
 
 
 def lacks_sensor(station: LabStation) -> bool:
