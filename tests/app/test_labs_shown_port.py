@@ -9,7 +9,7 @@ from textual.widgets import Input, Static
 
 from tests.sessions import free_port
 
-from .labs_support import lab_app, open_exercise, text
+from .labs_support import lab_app, open_exercise, text, try_answer
 from .support import endpoints_started, run, run_panel, screen_lines
 
 
@@ -27,15 +27,15 @@ def test_the_port_the_screen_shows_answers_the_tcp_port_question(tmp_path):
         reason = field.parent.query_one(".question-reason", Static)
 
         async def answer(value: str) -> str:
-            field.value = value
+            try_answer(screen, "tcp-port", value)  # typed and tried with enter
             await pilot.pause()
             return str(reason.render())
 
-        assert (await answer(str(port + 1))).endswith("not the expected answer")
+        assert (await answer(str(port + 1))).endswith("not the expected answer (1 try)")
         shown = await answer(str(port))
         assert "correct: the TCP port your workbench shows" in shown
         assert "not answered yet: tcp-port" not in text(screen, "#labs-objectives")
         assert "question answered" in " ".join(screen_lines(app))
-        assert (await answer("1350")).endswith("correct")
+        assert (await answer("1350")).endswith("correct (3 tries)")
 
     run(app, body)

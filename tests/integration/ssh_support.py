@@ -219,7 +219,7 @@ def moved(text: str) -> bool:
 async def open_exercise(term: Terminal, title: str, presses: int = 20) -> str:
     """Open the labs (``l``) and move down the list until ``title`` is the exercise shown."""
     term.send("l")
-    await term.wait_for("esc Back", "Sign off")
+    await term.wait_for("esc Back", "r Ready")
     screen = await term.wait_until(lambda t: "loading saved work" not in t, "the saved work read")
     for _ in range(presses):
         if title in screen.splitlines()[0]:

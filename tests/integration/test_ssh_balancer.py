@@ -337,7 +337,7 @@ async def test_a_student_moves_between_servers_behind_haproxy_and_outlives_a_cra
         again.send("\r")
         await again.wait_for("distance 0.00 unit", timeout=60)
         again.send("l")
-        await again.wait_for("esc Back", "Sign off", timeout=60)
+        await again.wait_for("esc Back", "r Ready", timeout=60)
         screen = await again.wait_until(
             lambda t: "loading saved work" not in t, "the saved work read", 60
         )

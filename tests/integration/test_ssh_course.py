@@ -55,7 +55,7 @@ async def test_a_student_moves_between_two_servers_sharing_one_database(
         second = workspace_folder(two.data_dir, "ann")
         assert (second / "mine.txt").read_text() == (first / "mine.txt").read_text()
         again.send("l")
-        await again.wait_for("esc Back", "Sign off")
+        await again.wait_for("esc Back", "r Ready")
         screen = await again.wait_until(
             lambda t: "loading saved work" not in t, "the saved work read"
         )

@@ -65,7 +65,9 @@ def test_a_run_says_its_driver_program_and_sensors_and_old_ones_what_they_have()
         == "program wall.viple (sha256 abababababab); sensors distance:1:right, touch:2:front"
     )
     assert lines[2].startswith("out in 61.2 s, 60.65 blocks (4245 px)")
-    old = progress().objectives[0]  # saved before sensors and program names were kept
+    kept = progress().objectives[0]
+    before = {k: v for k, v in kept.evidence.items() if k not in ("sensors", "hand_blocks")}
+    old = ObjectiveState(kept.kind, kept.text, True, "ok", before)  # saved before sensors were
     assert evidence_lines(old, "unity") == [
         "run 3 by keys (ben) on Unity maze (unity), ended by exit",
         "out in 41.5 s, 6.12 blocks (12.25 units), 0 collisions",
