@@ -5,12 +5,20 @@ its objectives and who waits for sign-off, read from the store.
 thread); :func:`read_request` reads what one request rests on: the exercise's saved progress,
 the objectives' evidence and the run they rest on, and the sign-off fields an instructor signs.
 Nothing here imports Textual.
+
+Everything read here reaches the instructor's terminal, and much of it was written by a
+student's app (the evidence, the driver, the partner's name) or read from their files (a
+maze's or program's name). So every text the console is handed is made
+:func:`~workbench.files.terminal.terminal_safe` here, whatever the console does with it; the
+sign-off itself is made from the progress as saved (:meth:`Request.fields`).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field, fields, replace
 from typing import Any
+
+from workbench.files.terminal import terminal_safe, terminal_safe_data
 
 from .checks import ExerciseProgress
 from .model import Lab
@@ -69,23 +77,37 @@ def read_class(store: Store, labs: list[Lab]) -> ClassView:
         if saved is not None:
             try:
                 progress = ExerciseProgress.from_dict(saved)
-                objectives = tuple((o.text, o.passed) for o in progress.objectives)
+                objectives = tuple((safe(o.text), o.passed) for o in progress.objectives)
             except ValueError as exc:
                 problem = str(exc)
         rows.append(
             StudentRow(
-                student=student,
-                partner=partners.get(student, ""),
-                lab=lab,
-                exercise=exercise,
-                title=names.get((lab, exercise), ""),
+                student=safe(student),
+                partner=safe(partners.get(student, "")),
+                lab=safe(lab),
+                exercise=safe(exercise),
+                title=safe(names.get((lab, exercise), "")),
                 objectives=objectives,
                 waiting=waiting.get((student, lab, exercise)),
                 signed=(student, lab, exercise) in signed,
-                problem=problem,
+                problem=safe(problem),
             )
         )
-    return ClassView(tuple(rows), tuple(queue))
+    return ClassView(tuple(rows), tuple(safe_entry(e) for e in queue))
+
+
+def safe(text: str) -> str:
+    """One line of text as the console may show it (see the module's notes)."""
+    return terminal_safe(text)
+
+
+def safe_entry(entry: QueueEntry) -> QueueEntry:
+    """A request with every text it holds :func:`safe` (an id a lab file gives, or a name the
+    roster holds, is as it was)."""
+    texts: dict[str, Any] = {
+        f.name: safe(v) for f in fields(entry) if isinstance(v := getattr(entry, f.name), str)
+    }
+    return replace(entry, **texts)
 
 
 @dataclass(frozen=True)
@@ -99,6 +121,9 @@ class Request:
     #: the run the objectives rest on: its record file and figures (None: no run)
     run: dict[str, Any] | None
     problem: str = ""
+    #: the progress as saved, which a sign-off records (``progress`` is it made safe to show;
+    #: None: the same)
+    saved: ExerciseProgress | None = field(default=None, repr=False, compare=False)
 
     @property
     def passed(self) -> bool:
@@ -107,7 +132,7 @@ class Request:
     def fields(self) -> RecordFields:
         """The sign-off's fields: the pair of the request, the saved evidence, and as driver
         the person whose work the evidence rests on (else the request's driver)."""
-        progress = self.progress
+        progress = self.saved or self.progress
         if progress is None:
             raise ValueError(f"{self.entry.pair} has no saved progress in this exercise")
         entry = self.entry
@@ -134,12 +159,14 @@ def evidence_run(progress: ExerciseProgress) -> dict[str, Any] | None:
 
 def read_request(store: Store, entry: QueueEntry, labs: list[Lab]) -> Request:
     """The saved progress of ``entry``'s exercise and the run its objectives rest on."""
-    title = titles(labs).get((entry.lab, entry.exercise), entry.exercise)
+    title = safe(titles(labs).get((entry.lab, entry.exercise), entry.exercise))
+    shown = safe_entry(entry)
     saved = store.progress(entry.student, entry.lab).get((entry.lab, entry.exercise))
     if saved is None:
-        return Request(entry, title, None, None, "nothing saved for this exercise yet")
+        return Request(shown, title, None, None, "nothing saved for this exercise yet")
     try:
         progress = ExerciseProgress.from_dict(saved)
+        safe_progress = ExerciseProgress.from_dict(terminal_safe_data(saved))
     except ValueError as exc:
-        return Request(entry, title, None, None, str(exc))
-    return Request(entry, title, progress, evidence_run(progress))
+        return Request(shown, title, None, None, safe(str(exc)))
+    return Request(shown, title, safe_progress, evidence_run(safe_progress), saved=progress)
