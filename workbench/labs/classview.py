@@ -22,6 +22,7 @@ from workbench.files.terminal import terminal_safe, terminal_safe_data
 
 from .checks import ExerciseProgress
 from .model import Lab
+from .partners import PairNotConfirmed, partner_problem
 from .progress import signoff_driver
 from .queue import QueueEntry
 from .signoff_record import Evidence, RecordFields
@@ -124,25 +125,38 @@ class Request:
     #: the progress as saved, which a sign-off records (``progress`` is it made safe to show;
     #: None: the same)
     saved: ExerciseProgress | None = field(default=None, repr=False, compare=False)
+    #: why the partner the request names cannot be on the sign-off ("" when they can, or
+    #: none is named; see :mod:`.partners`)
+    partner_problem: str = ""
 
     @property
     def passed(self) -> bool:
         return self.progress is not None and self.progress.passed
 
-    def fields(self) -> RecordFields:
+    def fields(self, partner_agrees: bool | None = None) -> RecordFields:
         """The sign-off's fields: the pair of the request, the saved evidence, and as driver
-        the person whose work the evidence rests on (else the request's driver)."""
+        the person whose work the evidence rests on (else the request's driver).
+
+        A request that names a partner needs the instructor's word on them: with
+        ``partner_agrees`` the partner is on the sign-off (ValueError when they cannot be,
+        :attr:`partner_problem`), with False it is the student's alone, and without it
+        :class:`~.partners.PairNotConfirmed` is raised."""
         progress = self.saved or self.progress
         if progress is None:
             raise ValueError(f"{self.entry.pair} has no saved progress in this exercise")
         entry = self.entry
-        people = {name for name in (entry.student, entry.partner) if name}
+        if entry.partner and partner_agrees is None:
+            raise PairNotConfirmed(f"confirm that {entry.partner} worked with {entry.student}")
+        if entry.partner and partner_agrees and self.partner_problem:
+            raise ValueError(self.partner_problem)
+        partner = entry.partner if partner_agrees else ""
+        people = {name for name in (entry.student, partner) if name}
         return RecordFields(
             student=entry.student,
             lab=entry.lab,
             exercise=entry.exercise,
             driver=signoff_driver(progress, people) or entry.driver or entry.student,
-            partner=entry.partner,
+            partner=partner,
             evidence=Evidence.of_progress(progress),
             objectives_passed=progress.passed,
         )
@@ -161,12 +175,22 @@ def read_request(store: Store, entry: QueueEntry, labs: list[Lab]) -> Request:
     """The saved progress of ``entry``'s exercise and the run its objectives rest on."""
     title = safe(titles(labs).get((entry.lab, entry.exercise), entry.exercise))
     shown = safe_entry(entry)
+    pairing = safe(partner_problem(entry.student, entry.partner, store.places()))
     saved = store.progress(entry.student, entry.lab).get((entry.lab, entry.exercise))
     if saved is None:
-        return Request(shown, title, None, None, "nothing saved for this exercise yet")
+        return Request(
+            shown, title, None, None, "nothing saved for this exercise yet", partner_problem=pairing
+        )
     try:
         progress = ExerciseProgress.from_dict(saved)
         safe_progress = ExerciseProgress.from_dict(terminal_safe_data(saved))
     except ValueError as exc:
-        return Request(shown, title, None, None, safe(str(exc)))
-    return Request(shown, title, safe_progress, evidence_run(safe_progress), saved=progress)
+        return Request(shown, title, None, None, safe(str(exc)), partner_problem=pairing)
+    return Request(
+        shown,
+        title,
+        safe_progress,
+        evidence_run(safe_progress),
+        saved=progress,
+        partner_problem=pairing,
+    )

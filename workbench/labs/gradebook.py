@@ -52,14 +52,22 @@ def head_from_gradebook(path: Path) -> Head:
 
 
 def gradebook_rows(rows: list[StoredSignoff], head: Head) -> list[dict[str, str]]:
-    """One row per student and exercise (each member of a pair gets one); the latest wins.
-    Every row carries the record's place in the log and the log's head at export."""
+    """One row per student and exercise (each member of a pair gets one); the latest wins,
+    except that a record which only names a person as partner never replaces a row of their
+    own request (see :mod:`.partners`). Every row carries the record's place in the log and
+    the log's head at export."""
     latest: dict[tuple[str, str, str], dict[str, str]] = {}
+    own: set[tuple[str, str, str]] = set()
     for row in rows:
         for person, other in ((row.student, row.partner), (row.partner, row.student)):
             if not person:
                 continue
-            latest[(person, row.lab, row.exercise)] = {
+            key = (person, row.lab, row.exercise)
+            if person == row.student:
+                own.add(key)
+            elif key in own:
+                continue
+            latest[key] = {
                 "student": person,
                 "partner": other,
                 "lab": row.lab,
