@@ -119,3 +119,16 @@ def test_maze_check_prints_a_file_name_with_an_escape_escaped(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "\x1b" not in out and "\x07" not in out
     assert "hall\\x1b]0;PWNED\\x07.txt: valid - Hall" in out
+
+
+def test_a_run_record_with_an_escape_in_its_header_is_refused_with_its_place(tmp_path):
+    from workbench.sim.record import FORMAT, RecordError, read_record
+
+    path = tmp_path / "run-001.jsonl"
+    header = {"type": "header", "format": FORMAT, "maze": {"name": "Hall\x1b]0;PWNED\x07"}}
+    path.write_text(json.dumps(header) + "\n" + json.dumps({"t": 0.0, "pose": [1, 1, 0]}) + "\n")
+    with pytest.raises(RecordError) as caught:
+        read_record(path)
+    words = str(caught.value)
+    assert f"{path}:1: maze.name holds an escape character (ESC)" in words
+    assert "changed after it was written" in words and "\x1b" not in words

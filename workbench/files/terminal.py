@@ -74,6 +74,27 @@ def terminal_problem(text: str, what: str, multiline: bool = False) -> str:
     )
 
 
+def data_problem(value: Any, where: str = "") -> str:
+    """The first text in ``value`` (mappings, lists and plain values read from JSON), key or
+    value, that holds a control character other than tab and newline, as
+    :func:`terminal_problem` words it with its place (``maze.name``); ``""`` when none."""
+    if isinstance(value, str):
+        return terminal_problem(value, where or "a text", multiline=True)
+    if isinstance(value, Mapping):
+        for key, item in value.items():
+            place = f"{where}.{key}" if where else str(key)
+            problem = data_problem(str(key), f"a key of {where or 'the line'}") or data_problem(
+                item, place
+            )
+            if problem:
+                return problem
+    elif isinstance(value, list | tuple):
+        for index, item in enumerate(value):
+            if problem := data_problem(item, f"{where}[{index}]"):
+                return problem
+    return ""
+
+
 _NAMES = {
     0x1B: "an escape character (ESC)",
     0x07: "a bell (BEL)",
