@@ -31,7 +31,7 @@ _SHOWN = re.compile(f"{CONTROLS.pattern[:-1]}{BIDI_CONTROLS.pattern[1:-1]}]")
 _SHOWN_MULTILINE = re.compile(f"{CONTROLS_MULTILINE.pattern[:-1]}{BIDI_CONTROLS.pattern[1:-1]}]")
 
 #: how a refusal says to fix the text
-FIX = "remove it (in YAML it may be written as an escape such as \\e or \\x1b inside quotes)"
+FIX = "remove it: in YAML it may be written as an escape such as \\e or \\x1b inside quotes"
 
 
 def _escaped(found: re.Match[str]) -> str:
