@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 
+from workbench.labs.instructors import create_instructor
 from workbench.labs.model import load_labs
 from workbench.labs.store import Store
 from workbench.tui.console_app import ConsoleApp
@@ -12,6 +13,7 @@ from workbench.tui.screens.console_request import RequestScreen
 
 from .console_support import EXERCISE, LAB, progress, until
 from .support import emulated_terminal, sync, terminal_output
+from .test_console import FAST, PASS, status
 
 #: a maze name as a YAML file could give it before names were checked: set the window title,
 #: write the clipboard (OSC 52), a CSI in its 8-bit form
@@ -41,6 +43,7 @@ def assert_harmless(app) -> None:
 @sync
 async def test_hostile_evidence_reaches_the_console_as_text(tmp_path):
     data = tmp_path / "data"
+    create_instructor(data, "Dr Chen", PASS, kdf=FAST)
     with Store.open(data) as store:
         save_hostile(store, "ana")
         store.request_signoff("ana", "", f"ana{TITLE}", LAB, EXERCISE)
@@ -57,6 +60,10 @@ async def test_hostile_evidence_reaches_the_console_as_text(tmp_path):
         shown = "\n".join(emulated_terminal(app).display)
         # the escapes are there to read, written out
         assert "\\x1b]0;PWNED" in shown
-        # and the sign-off records the evidence as saved, not as shown
-        signed = request.request.fields().evidence.metrics["objectives"][0]["evidence"]
-        assert signed["maze"] == HOSTILE
+        # and such evidence cannot be signed (the workbench never saves it): the console
+        # says why, with the place, and nothing raw
+        await pilot.click("#request-passphrase")
+        await pilot.press(*PASS, "enter")
+        await until(pilot, lambda: "cannot be signed" in status(request), "the refusal")
+        assert "objectives[0].reason holds an escape character" in status(request)
+        assert_harmless(app)

@@ -132,3 +132,28 @@ def test_a_run_record_with_an_escape_in_its_header_is_refused_with_its_place(tmp
     words = str(caught.value)
     assert f"{path}:1: maze.name holds an escape character (ESC)" in words
     assert "changed after it was written" in words and "\x1b" not in words
+
+
+def _texts(value):
+    if isinstance(value, str):
+        yield value
+    elif isinstance(value, dict):
+        for key, item in value.items():
+            yield from _texts(key)
+            yield from _texts(item)
+    elif isinstance(value, list):
+        for item in value:
+            yield from _texts(item)
+
+
+evidence = st.recursive(
+    st.text() | st.integers() | st.none(),
+    lambda inner: st.lists(inner, max_size=3) | st.dictionaries(st.text(), inner, max_size=3),
+    max_leaves=12,
+)
+
+
+@given(evidence)
+def test_saved_evidence_is_handed_to_the_console_without_a_raw_control(value):
+    for text in _texts(terminal_safe_data(value)):
+        assert not RAW.search(text.replace("\n", "").replace("\t", ""))

@@ -15,10 +15,10 @@ sign-off itself is made from the progress as saved (:meth:`Request.fields`).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields, replace
+from dataclasses import asdict, dataclass, field, fields, replace
 from typing import Any
 
-from workbench.files.terminal import terminal_safe, terminal_safe_data
+from workbench.files.terminal import data_problem, terminal_safe, terminal_safe_data
 
 from .checks import ExerciseProgress
 from .model import Lab
@@ -145,6 +145,12 @@ class Request:
         if progress is None:
             raise ValueError(f"{self.entry.pair} has no saved progress in this exercise")
         entry = self.entry
+        saved = data_problem([asdict(o) for o in progress.objectives], "objectives")
+        if saved:  # (what a signing error says would show it raw)
+            raise ValueError(
+                f"the saved progress cannot be signed: {saved}; the workbench never saves one, "
+                "so decline the request and ask for the work again"
+            )
         if entry.partner and partner_agrees is None:
             raise PairNotConfirmed(f"confirm that {entry.partner} worked with {entry.student}")
         if entry.partner and partner_agrees and self.partner_problem:
