@@ -157,3 +157,11 @@ evidence = st.recursive(
 def test_saved_evidence_is_handed_to_the_console_without_a_raw_control(value):
     for text in _texts(terminal_safe_data(value)):
         assert not RAW.search(text.replace("\n", "").replace("\t", ""))
+
+
+def test_a_name_runs_on_one_line():
+    with pytest.raises(MazeError, match="the maze's name holds a control character"):
+        parse_maze(MAZE.format(name='"Hall\\nmaze"'), "hall.txt")
+    with pytest.raises(FsmFileError, match="the FSM's name holds a control character"):
+        loads_fsm(FSM.format(name='"walls\\tfirst"'), "walls.yaml")
+    parse_maze("---\nname: Hall\ndescription: |\n  two\n  lines\n---\n#####\n#S.E#\n#####\n")

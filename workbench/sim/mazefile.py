@@ -128,7 +128,9 @@ def _front_matter(lines: list[str], source: str) -> tuple[dict, int, list[Proble
     for key in ("name", "description"):
         if key in meta and not isinstance(meta[key], str):
             meta[key] = str(meta[key])
-        problem = bidi_problem(str(meta.get(key) or ""), f"the maze's {key}")
+        text = str(meta.get(key) or "")
+        what = f"the maze's {key}"
+        problem = bidi_problem(text, what) or terminal_problem(text, what, key != "name")
         if problem:
             problems.append(
                 Problem(problem, "type it again without it", source, key_lines.get(key, 2), 1)
