@@ -165,3 +165,13 @@ def test_a_name_runs_on_one_line():
     with pytest.raises(FsmFileError, match="the FSM's name holds a control character"):
         loads_fsm(FSM.format(name='"walls\\tfirst"'), "walls.yaml")
     parse_maze("---\nname: Hall\ndescription: |\n  two\n  lines\n---\n#####\n#S.E#\n#####\n")
+
+
+def test_the_command_line_s_output_keeps_its_lines_and_writes_controls_out():
+    import io
+
+    from workbench.files.terminal import TerminalSafeWriter
+
+    out = io.StringIO()
+    TerminalSafeWriter(out).write("a,b\r\nc\td\n\x1b[2J\rx")
+    assert out.getvalue() == "a,b\r\nc\td\n\\x1b[2J\\x0dx"

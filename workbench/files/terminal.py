@@ -105,15 +105,18 @@ _NAMES = {
 
 
 class TerminalSafeWriter:
-    """A text stream that writes everything given to it :func:`terminal_safe` (lines and
-    tabs kept) to ``stream``: the command line's standard output, so no name, label or
-    evidence it prints can act on the terminal. Everything else is the stream's own."""
+    """A text stream that writes everything given to it :func:`terminal_safe` (lines, CR LF
+    line endings and tabs kept) to ``stream``: the command line's standard output, so no
+    name, label or evidence it prints can act on the terminal. Everything else is the
+    stream's own."""
 
     def __init__(self, stream: Any) -> None:
         self.stream = stream
 
     def write(self, text: str) -> int:
-        self.stream.write(terminal_safe(text, multiline=True))
+        # a line ending of CR LF (a CSV a command prints) is a line ending, not a control
+        parts = text.split("\r\n")
+        self.stream.write("\r\n".join(terminal_safe(p, multiline=True) for p in parts))
         return len(text)
 
     def writelines(self, lines: Any) -> None:
