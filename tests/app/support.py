@@ -78,3 +78,21 @@ async def endpoints_started(app) -> None:
     starting = [w for w in app.workers if w.group == "endpoints"]
     if starting:  # (an empty list would make Textual wait for every worker)
         await app.workers.wait_for_complete(starting)
+
+
+def terminal_output(app: App) -> str:
+    """What the app writes to a terminal to draw the whole screen now (dialogs over the
+    screens below them): the characters and escape sequences a real terminal receives."""
+    update = app.screen._compositor.render_update(full=True, screen_stack=app._background_screens)
+    return update.render_segments(app.console)
+
+
+def emulated_terminal(app: App):
+    """A VT emulator (pyte) that has been sent :func:`terminal_output`: its title, and the
+    text it shows row by row (``.display``)."""
+    import pyte
+
+    width, height = app.size
+    terminal = pyte.Screen(width, height)
+    pyte.Stream(terminal).feed(terminal_output(app))
+    return terminal

@@ -11,6 +11,7 @@ from workbench.labs.queue import DECLINED, SIGNED
 from workbench.labs.store import Store
 from workbench.labs.verify import verify_log
 from workbench.tui.console_app import ConsoleApp
+from workbench.tui.dialogs.pair import PairDialog
 from workbench.tui.screens.console import ConsoleScreen
 from workbench.tui.screens.console_request import RequestScreen
 from workbench.tui.screens.replay import ReplayScreen
@@ -78,6 +79,7 @@ async def test_the_instructor_signs_a_request_with_their_own_passphrase(tmp_path
     record = write_record(tmp_path / "run-003.jsonl")
     with Store.open(data) as store:
         save_student(store, "ana", record=str(record))
+        store.set_place("ben", LAB, EXERCISE)  # ben is a student of the class
         store.request_signoff("ana", "ben", "ben", LAB, EXERCISE)
     app = console(data)
     async with app.run_test(size=(80, 24)) as pilot:
@@ -104,6 +106,9 @@ async def test_the_instructor_signs_a_request_with_their_own_passphrase(tmp_path
         # a wrong passphrase is refused and counted
         await pilot.click("#request-passphrase")
         await pilot.press(*"not the one!", "enter")
+        # the pair is the instructor's to confirm: ben worked on it and agrees
+        await until(pilot, lambda: isinstance(app.screen, PairDialog), "the pair's question")
+        await pilot.press("y")
         await until(pilot, lambda: "wrong passphrase" in status(request), "the refusal")
         with Store.open(data) as store:
             assert store.lockout("Dr Chen").failures == 1

@@ -207,3 +207,19 @@ def test_a_full_disk_is_named_as_such(data_dir, monkeypatch, capsys):
     assert err.count("the disk is full (or the account's disk quota is used up)") == 2, err
     assert "not a readable" not in err and "or restore it from a backup" not in err
     assert "the records were NOT checked" in err
+
+
+def test_list_and_verify_print_an_edited_record_s_escapes_written_out(data_dir, capsys):
+    """A record edited in the database to hold terminal escapes (a title change, a clipboard
+    write) is printed with them written out, never sent to the terminal (issue 37)."""
+    sign(data_dir, "alice", "sensors")
+    with sqlite3.connect(data_dir / DB_NAME) as conn:
+        conn.execute(
+            "UPDATE signoffs SET student = ?, note = ? WHERE id = 1",
+            ("alice\x1b]0;PWNED\x07", "ok\x1b]52;c;aGk=\x07\x9b2J"),
+        )
+    assert main(["signoff", "list", "--data-dir", str(data_dir)]) == 0
+    assert main(["signoff", "verify", "--data-dir", str(data_dir)]) == 1
+    out = capsys.readouterr().out
+    assert "alice\\x1b]0;PWNED\\x07" in out and "FAIL #1" in out
+    assert not any(c in out for c in "\x1b\x07\x9b")

@@ -209,6 +209,22 @@ def test_a_file_changed_on_both_servers_keeps_the_one_modified_last(servers):
     assert (two.workspace() / "a.txt").read_bytes() == b"from one, later"
 
 
+def test_a_run_record_here_is_never_replaced_by_another_copy_from_the_store(servers):
+    """The sync keeps the one write rule of ~/runs: a record is written once, by the recorder,
+    so a different copy under its name elsewhere never replaces this server's (issue 37)."""
+    one, two = servers
+    record = "runs/20250101-1/run-001.jsonl"
+    one.save(record, b'{"type": "header"}\n')
+    sync_at_start(two.data_dir, two.db, "alice", two.workspace())
+    two.save(record, b'{"type": "header", "forged": true}\n')  # pushed from elsewhere
+    os.utime(two.workspace() / record, (4_000_000_000, 4_000_000_000))
+    report = sync_at_start(one.data_dir, one.db, "alice", one.workspace())
+    assert report.fetched == []
+    assert report.problems == [f"{record}: a run record is never changed once written: this "
+                               "server's copy is kept"]  # fmt: skip
+    assert (one.workspace() / record).read_bytes() == b'{"type": "header"}\n'
+
+
 def test_a_file_past_the_bounds_stays_on_its_server_and_the_report_says_why(servers):
     one, two = servers
     big = one.workspace() / "big.bin"

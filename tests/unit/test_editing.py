@@ -263,10 +263,11 @@ def test_suggested_path_comes_from_the_file_or_the_title():
 
 
 def test_a_write_error_comes_back_as_a_message(tmp_path, monkeypatch):
-    def refuse(path, maze, fmt="workbench"):
+    def refuse(path, data, mode=None):
         raise PermissionError(13, "Permission denied", str(path))
 
-    monkeypatch.setattr("workbench.sim.editing.save_maze", refuse)
+    # the one writer every save of the app goes through
+    monkeypatch.setattr("workbench.files.workspace.write_bytes_atomic", refuse)
     ed = MazeEditor(ROOM)
     ed.toggle_wall((2, 1))
     with pytest.raises(EditorError, match="Permission denied; the maze is still here"):

@@ -231,10 +231,14 @@ def test_a_binary_file_is_not_a_record(tmp_path):
 
 def test_an_unusable_maze_source_is_explained(tmp_path):
     header = {"type": "header", "format": FORMAT, "maze": {"source": "bad\0name.txt"}}
+    # a control character in a record's names: the record is refused, never shown raw
+    with pytest.raises(RecordError, match=r"1: maze\.source holds a control character"):
+        load_replay(write_record(tmp_path / "r.jsonl", ticks(2), header=header))
+    header["maze"] = {"source": "gone.txt"}
     replay = load_replay(write_record(tmp_path / "r.jsonl", ticks(2), header=header))
     assert replay_maze(replay, tmp_path / "r.jsonl") == (
         None,
-        "the run's maze file bad\0name.txt is not found, so the maze cannot be drawn",
+        "the run's maze file gone.txt is not found, so the maze cannot be drawn",
     )
     (tmp_path / "broken.txt").write_text("---\nname: [\n---\n#S#\n")
     header["maze"] = {"source": "broken.txt"}

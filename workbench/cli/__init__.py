@@ -7,9 +7,11 @@ import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TextIO, cast
 
 from workbench import __version__
 from workbench.files.bundled import default_maze_path
+from workbench.files.terminal import TerminalSafeWriter
 from workbench.labs.store import StoreError, resolve_db
 from workbench.tui.settings import AppSettings
 
@@ -126,6 +128,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.command is None:
         return open_app(args)
+    # whatever a command prints (names, labels, evidence read from files and stores) is
+    # printed with its control characters escaped: none of it acts on the terminal
+    shown, sys.stdout = sys.stdout, cast(TextIO, TerminalSafeWriter(sys.stdout))
     try:
         return int(args.func(args) or 0)
     except KeyboardInterrupt:
@@ -135,6 +140,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         # the reader went away (e.g. `| head`): stop quietly, as other command-line tools do
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 141
+    finally:
+        sys.stdout = shown
 
 
 def open_app(args: argparse.Namespace) -> int:

@@ -45,6 +45,7 @@ from workbench.files.bounded import (
     compose_yaml,
     read_text,
 )
+from workbench.files.terminal import terminal_problem
 from workbench.files.yamlread import FileProblem, problem_list
 
 TOP_KEYS = ("name", "description", "sensors", "parameters", "variables", "initial", "states")
@@ -304,7 +305,11 @@ class _Reader:
             self.nodes[(key,)] = k
         name = Path(self.filename).stem
         if "name" in fields:
-            name = self.text(fields["name"][1], ("name",), "name") or name
+            given = self.text(fields["name"][1], ("name",), "name") or ""
+            problem = terminal_problem(given, "the FSM's name")  # one line: no tab or newline
+            if problem:
+                self.report(fields["name"][1], problem, "write the name on one line", ("name",))
+            name = given or name
         description = ""
         if "description" in fields:
             description = (

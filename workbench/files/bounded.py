@@ -27,6 +27,9 @@ from yaml.constructor import SafeConstructor
 from yaml.events import AliasEvent
 from yaml.nodes import Node, ScalarNode
 
+from .terminal import FIX as TERMINAL_FIX
+from .terminal import terminal_problem
+
 BOM = "\ufeff"
 #: a number in a file (YAML or an FSM expression) has at most this many digits
 MAX_DIGITS = 30
@@ -334,6 +337,11 @@ class _BoundedLoader(yaml.SafeLoader):
                 reason = finite_problem(self.construct_yaml_float(node))
             if reason is not None:
                 raise self.refuse(node.start_mark, reason, "write a plain finite number")
+        if isinstance(node, ScalarNode):
+            field = f"{index.value[:40]!r}" if isinstance(index, ScalarNode) else "a value"
+            problem = terminal_problem(str(node.value), field, multiline=True)
+            if problem:
+                raise self.refuse(node.start_mark, problem, TERMINAL_FIX)
         return node
 
     def count(self, mark: _Mark | None, nodes: int) -> None:

@@ -11,12 +11,15 @@ from __future__ import annotations
 
 import os
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import workbench
 
+from .atomic import write_bytes_atomic
 from .bundled import MAZE_DIR
+from .reserved import reserved_problem
+from .workspace_files import UploadLimits, WorkspaceError, WorkspaceFiles
 
 _PACKAGE = Path(workbench.__file__).resolve().parent
 #: the bundled mazes, labs and starter algorithms: readable by everyone, written by nobody
@@ -25,14 +28,23 @@ BUNDLED = (
     _PACKAGE.parent / "labs",
     _PACKAGE / "control" / "algorithms",
 )
-#: the folders the app keeps in a workspace (its run records): never a student's file's name
-RESERVED = ("runs",)
 #: a login name as a folder name: what the users file allows, nothing that walks
 _FOLDER_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,63}")
 
 
 class OutsideWorkspace(ValueError):
     """A path the app may not open (for this student, or at all); the message says why."""
+
+
+class NoRoom(OutsideWorkspace):
+    """A file the workspace has no room for (its quota, file count or file cap)."""
+
+
+#: how a served student frees room in their workspace, for the app's refusals
+FREE_ROOM = (
+    "save over one of your files instead, or remove files you no longer need "
+    "(sftp, then rm NAME) and save again"
+)
 
 
 @dataclass(frozen=True)
@@ -46,14 +58,21 @@ class FileAccess:
 
     workspace: Path | None = None
     bundled: tuple[Path, ...] = BUNDLED
+    #: the workspace's quota, file count and file cap, as the file server keeps them (None:
+    #: none); every file the app saves in the workspace is counted against it
+    quota: WorkspaceFiles | None = field(default=None, compare=False, repr=False)
 
     @classmethod
-    def confined_to(cls, workspace: str | os.PathLike) -> FileAccess:
-        """Access for a served student, creating the workspace folder (mode 0700) if needed."""
+    def confined_to(
+        cls, workspace: str | os.PathLike, limits: UploadLimits | None = None
+    ) -> FileAccess:
+        """Access for a served student, creating the workspace folder (mode 0700) if needed;
+        with ``limits``, what the app saves there is held to them."""
         root = Path(workspace)
         root.mkdir(parents=True, exist_ok=True, mode=0o700)
         root.chmod(0o700)
-        return cls(root.resolve(), tuple(p.resolve() for p in BUNDLED))
+        quota = WorkspaceFiles(root, limits, shared=True) if limits is not None else None
+        return cls(root.resolve(), tuple(p.resolve() for p in BUNDLED), quota)
 
     @property
     def confined(self) -> bool:
@@ -99,16 +118,28 @@ class FileAccess:
         if self.workspace is None:
             return path
         if self._inside(path, (self.workspace,)):
-            if path.parent == self.workspace and path.name in RESERVED:
-                raise OutsideWorkspace(
-                    f"{self.shown(path)} is the folder the workbench keeps your run records "
-                    f"in: save under another name, e.g. ~/{path.name}-maze.txt"
-                )
+            problem = reserved_problem(path.relative_to(self.workspace).parts)
+            if problem:
+                raise OutsideWorkspace(f"{self.shown(path)} {problem}")
             return path
         raise OutsideWorkspace(
             f"{self.shown(typed)} is outside your workspace: you can save only in your "
             f"workspace, {self.shown(self.workspace)}"
         )
+
+    def write_bytes(self, typed: str | os.PathLike, data: bytes) -> Path:
+        """Save ``data`` whole at ``typed`` (:func:`~.atomic.write_bytes_atomic`), within the
+        write rules of :meth:`for_writing` and the workspace's quota; :class:`OutsideWorkspace`
+        (:class:`NoRoom` for the quota) when it may not be. The path written is returned."""
+        path = self.for_writing(typed)
+        if self.quota is not None and self.workspace is not None:
+            parts = path.relative_to(self.workspace).parts
+            try:
+                self.quota.room_for(parts, len(data), self.shown(path), FREE_ROOM)
+            except WorkspaceError as exc:
+                raise NoRoom(exc.message) from None
+        write_bytes_atomic(path, data)
+        return path
 
     def allows_writing(self, path: str | os.PathLike) -> bool:
         try:

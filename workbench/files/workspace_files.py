@@ -31,8 +31,8 @@ from typing import BinaryIO
 
 from .atomic import PendingFile
 from .names import UPLOADS_FOLDER, Parts, shown_path
+from .reserved import RESERVED
 from .sizes import shown_size
-from .workspace import RESERVED
 
 #: the largest one file may be, all of a student's files together, and how many
 FILE_CAP = 5_000_000
@@ -103,6 +103,9 @@ class WorkspaceFiles:
 
     ``read_only`` refuses every change (an instructor's view of the workspaces); the folders
     in ``protected`` (the run records the app keeps) can be read and never changed.
+    ``shared`` is the quota as the app keeps it: the file server of another process may be
+    uploading into the same workspace, so its uploads are left alone, and the room is
+    counted afresh from the disk each time a file is saved (:meth:`room_for`).
     """
 
     root: Path
@@ -110,6 +113,7 @@ class WorkspaceFiles:
     read_only: bool = False
     protected: tuple[str, ...] = RESERVED
     on_change: ChangeHook | None = None
+    shared: bool = False
     usage: Usage = field(init=False)
 
     def __post_init__(self) -> None:
@@ -118,7 +122,8 @@ class WorkspaceFiles:
         self.usage = Usage()
         if not self.read_only:
             self.root.mkdir(parents=True, exist_ok=True, mode=0o700)
-            self.clear_uploads()
+            if not self.shared:
+                self.clear_uploads()
             self.usage.bytes, self.usage.files = self._count()
 
     # -- reading -----------------------------------------------------------------------------
@@ -263,13 +268,40 @@ class WorkspaceFiles:
             self.usage.reserved_bytes += size
             self.usage.reserved_files += files
 
+    def room_for(self, parts: Parts, size: int, shown: str | None = None, free: str = "") -> None:
+        """Refuse (:class:`WorkspaceError`, ``TOO_BIG`` or ``QUOTA``) a whole file of ``size``
+        bytes saved at ``parts`` (replacing what is there) when it would pass the file cap,
+        the quota or the file count: the check an upload makes, for a writer that writes the
+        file whole itself (the app). ``shown`` is the path as that writer shows it, ``free``
+        how its user frees room. A ``shared`` workspace is counted afresh from the disk."""
+        where = shown or shown_path(parts)
+        self._writable(parts)
+        cap = self.limits.file_size
+        if cap and size > cap:
+            raise WorkspaceError(
+                Refusal.TOO_BIG,
+                f"{where}: a file may be at most {shown_size(cap)} on this server and this one "
+                f"would be {shown_size(size)}",
+            )
+        old = self._file_size(self._path(parts), parts)
+        with self._lock:
+            if self.shared:
+                self.usage.bytes, self.usage.files = self._count()
+            self._check_room(
+                max(0, size - (old or 0)), 0 if old is not None else 1, parts, where, free
+            )
+
     def release(self, size: int, files: int) -> None:
         with self._lock:
             self.usage.reserved_bytes -= size
             self.usage.reserved_files -= files
 
-    def _check_room(self, size: int, files: int, parts: Parts) -> None:
+    def _check_room(
+        self, size: int, files: int, parts: Parts, shown: str | None = None, free: str = ""
+    ) -> None:
         limits, usage = self.limits, self.usage
+        where = shown or shown_path(parts)
+        free = free or "remove some files and try again"
         if (
             limits.quota_bytes
             and size
@@ -277,10 +309,9 @@ class WorkspaceFiles:
         ):
             raise WorkspaceError(
                 Refusal.QUOTA,
-                f"{shown_path(parts)}: your files may take at most "
+                f"{where}: your files may take at most "
                 f"{shown_size(limits.quota_bytes)} on this server and take "
-                f"{shown_size(usage.bytes + usage.reserved_bytes)} already: remove some files "
-                "and try again",
+                f"{shown_size(usage.bytes + usage.reserved_bytes)} already: {free}",
             )
         if (
             limits.quota_files
@@ -289,8 +320,8 @@ class WorkspaceFiles:
         ):
             raise WorkspaceError(
                 Refusal.QUOTA,
-                f"{shown_path(parts)}: you may keep at most {limits.quota_files} files and "
-                "folders on this server, and you have that many: remove some and try again",
+                f"{where}: you may keep at most {limits.quota_files} files and "
+                f"folders on this server, and you have that many: {free}",
             )
 
     def _count(self) -> tuple[int, int]:

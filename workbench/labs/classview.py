@@ -6,17 +6,26 @@ grid); and the programs two students' evidence share (the copy hints), read from
 thread); :func:`read_request` reads what one request rests on: the exercise's saved progress,
 the objectives' evidence and the run they rest on, and the sign-off fields an instructor signs.
 Nothing here imports Textual.
+
+Everything read here reaches the instructor's terminal, and much of it was written by a
+student's app (the evidence, the driver, the partner's name) or read from their files (a
+maze's or program's name). So every text the console is handed is made
+:func:`~workbench.files.terminal.terminal_safe` here, whatever the console does with it; the
+sign-off itself is made from the progress as saved (:meth:`Request.fields`).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass, field, fields, replace
 from typing import Any
+
+from workbench.files.terminal import data_problem, terminal_safe, terminal_safe_data
 
 from .checks import ExerciseProgress
 from .copy_hints import CopyHint, ProgramUse, bundled_digests, copy_hints, program_uses
 from .evidence_text import programs_of
 from .model import Lab
+from .partners import PairNotConfirmed, partner_problem
 from .progress import signoff_driver
 from .queue import QueueEntry
 from .signoff_record import Evidence, RecordFields
@@ -165,19 +174,19 @@ def read_class(store: Store, labs: list[Lab]) -> ClassView:
         lab, exercise = places[student]
         key = (student, lab, exercise)
         found = saved.get(key)
-        objectives = tuple((o.text, o.passed) for o in found.objectives) if found else ()
-        mixed = programs_of(found, bundled) if found else {}
+        objectives = tuple((safe(o.text), o.passed) for o in found.objectives) if found else ()
+        mixed = {d: safe(n) for d, n in programs_of(found, bundled).items()} if found else {}
         rows.append(
             StudentRow(
-                student=student,
-                partner=partners.get(student, ""),
-                lab=lab,
-                exercise=exercise,
-                title=names.get((lab, exercise), ""),
+                student=safe(student),
+                partner=safe(partners.get(student, "")),
+                lab=safe(lab),
+                exercise=safe(exercise),
+                title=safe(names.get((lab, exercise), "")),
                 objectives=objectives,
                 waiting=waiting.get(key),
                 signed=key in signed,
-                problem=problems.get(key, ""),
+                problem=safe(problems.get(key, "")),
                 mixed=tuple(sorted(mixed.items())) if len(mixed) > 1 else (),
                 same_program_as=tuple(sorted(sharing.get(student, ()), key=str.casefold)),
             )
@@ -193,7 +202,22 @@ def read_class(store: Store, labs: list[Lab]) -> ClassView:
         for lab, exercise in exercises
     }
     grid = ClassGrid(tuple(students), exercises, cells)
-    return ClassView(tuple(rows), tuple(queue), grid, hints)
+    safe_hints = tuple(replace(h, name=safe(h.name)) for h in hints)
+    return ClassView(tuple(rows), tuple(safe_entry(e) for e in queue), grid, safe_hints)
+
+
+def safe(text: str) -> str:
+    """One line of text as the console may show it (see the module's notes)."""
+    return terminal_safe(text)
+
+
+def safe_entry(entry: QueueEntry) -> QueueEntry:
+    """A request with every text it holds :func:`safe` (an id a lab file gives, or a name the
+    roster holds, is as it was)."""
+    texts: dict[str, Any] = {
+        f.name: safe(v) for f in fields(entry) if isinstance(v := getattr(entry, f.name), str)
+    }
+    return replace(entry, **texts)
 
 
 @dataclass(frozen=True)
@@ -207,6 +231,12 @@ class Request:
     #: the run the objectives rest on: its record file and figures (None: no run)
     run: dict[str, Any] | None
     problem: str = ""
+    #: the progress as saved, which a sign-off records (``progress`` is it made safe to show;
+    #: None: the same)
+    saved: ExerciseProgress | None = field(default=None, repr=False, compare=False)
+    #: why the partner the request names cannot be on the sign-off ("" when they can, or
+    #: none is named; see :mod:`.partners`)
+    partner_problem: str = ""
     #: the exercise's profile: the unit its lengths are in
     profile: str = ""
 
@@ -222,20 +252,36 @@ class Request:
     def passed(self) -> bool:
         return self.progress is not None and self.progress.passed
 
-    def fields(self) -> RecordFields:
+    def fields(self, partner_agrees: bool | None = None) -> RecordFields:
         """The sign-off's fields: the pair of the request, the saved evidence, and as driver
-        the person whose work the evidence rests on (else the request's driver)."""
-        progress = self.progress
+        the person whose work the evidence rests on (else the request's driver).
+
+        A request that names a partner needs the instructor's word on them: with
+        ``partner_agrees`` the partner is on the sign-off (ValueError when they cannot be,
+        :attr:`partner_problem`), with False it is the student's alone, and without it
+        :class:`~.partners.PairNotConfirmed` is raised."""
+        progress = self.saved or self.progress
         if progress is None:
             raise ValueError(f"{self.entry.pair} has no saved progress in this exercise")
         entry = self.entry
-        people = {name for name in (entry.student, entry.partner) if name}
+        saved = data_problem([asdict(o) for o in progress.objectives], "objectives")
+        if saved:  # (what a signing error says would show it raw)
+            raise ValueError(
+                f"the saved progress cannot be signed: {saved}; the workbench never saves one, "
+                "so decline the request and ask for the work again"
+            )
+        if entry.partner and partner_agrees is None:
+            raise PairNotConfirmed(f"confirm that {entry.partner} worked with {entry.student}")
+        if entry.partner and partner_agrees and self.partner_problem:
+            raise ValueError(self.partner_problem)
+        partner = entry.partner if partner_agrees else ""
+        people = {name for name in (entry.student, partner) if name}
         return RecordFields(
             student=entry.student,
             lab=entry.lab,
             exercise=entry.exercise,
             driver=signoff_driver(progress, people) or entry.driver or entry.student,
-            partner=entry.partner,
+            partner=partner,
             evidence=Evidence.of_progress(progress),
             objectives_passed=progress.passed,
         )
@@ -253,13 +299,34 @@ def evidence_run(progress: ExerciseProgress) -> dict[str, Any] | None:
 def read_request(store: Store, entry: QueueEntry, labs: list[Lab]) -> Request:
     """The saved progress of ``entry``'s exercise and the run its objectives rest on."""
     key = (entry.lab, entry.exercise)
-    title = titles(labs).get(key, entry.exercise)
+    title = safe(titles(labs).get(key, entry.exercise))
     profile = profiles(labs).get(key, "")
+    shown = safe_entry(entry)
+    pairing = safe(partner_problem(entry.student, entry.partner, store.places()))
     saved = store.progress(entry.student, entry.lab).get(key)
     if saved is None:
-        return Request(entry, title, None, None, "nothing saved for this exercise yet", profile)
+        return Request(
+            shown,
+            title,
+            None,
+            None,
+            "nothing saved for this exercise yet",
+            profile,
+            partner_problem=pairing,
+        )
     try:
         progress = ExerciseProgress.from_dict(saved)
+        safe_progress = ExerciseProgress.from_dict(terminal_safe_data(saved))
     except ValueError as exc:
-        return Request(entry, title, None, None, str(exc), profile)
-    return Request(entry, title, progress, evidence_run(progress), profile=profile)
+        return Request(
+            shown, title, None, None, safe(str(exc)), profile, partner_problem=pairing
+        )
+    return Request(
+        shown,
+        title,
+        safe_progress,
+        evidence_run(safe_progress),
+        profile=profile,
+        saved=progress,
+        partner_problem=pairing,
+    )

@@ -134,17 +134,24 @@ def gradebook_rows(
     head: Head,
     profiles: Mapping[tuple[str, str], str] | None = None,
 ) -> list[dict[str, str]]:
-    """One row per student and exercise (each member of a pair gets one); the latest wins.
-    Every row carries the record's place in the log, the log's head at export, and the
-    measures of the evidence run (lengths in the unit of its profile, else of the exercise's
-    in ``profiles``)."""
+    """One row per student and exercise (each member of a pair gets one); the latest wins,
+    except that a record which only names a person as partner never replaces a row of their
+    own request (see :mod:`.partners`). Every row carries the record's place in the log, the
+    log's head at export, and the measures of the evidence run (lengths in the unit of its
+    profile, else of the exercise's in ``profiles``)."""
     latest: dict[tuple[str, str, str], dict[str, str]] = {}
+    own: set[tuple[str, str, str]] = set()
     for row in rows:
         run = run_cells(row.metrics_value(), (profiles or {}).get((row.lab, row.exercise), ""))
         for person, other in ((row.student, row.partner), (row.partner, row.student)):
             if not person:
                 continue
-            latest[(person, row.lab, row.exercise)] = {
+            key = (person, row.lab, row.exercise)
+            if person == row.student:
+                own.add(key)
+            elif key in own:
+                continue
+            latest[key] = {
                 "student": person,
                 "partner": other,
                 "lab": row.lab,

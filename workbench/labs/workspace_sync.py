@@ -42,6 +42,7 @@ from pathlib import Path
 
 from workbench.files.atomic import write_bytes_atomic
 from workbench.files.commits import forget, on_commit
+from workbench.files.reserved import reserved_problem
 
 from .database import StoreError, StoreUnavailable
 from .store import Store
@@ -429,6 +430,12 @@ class _Step:
         _make_folders(root, full.parent)
         if full.is_symlink() or (full.exists() and not full.is_file()):
             self.report.problems.append(f"{rel}: something that is not a file is in its place")
+            return
+        if reserved_problem(tuple(rel.split("/"))) and full.exists():
+            # the recorder writes a run record once: another copy under its name is not its
+            self.report.problems.append(
+                f"{rel}: a run record is never changed once written: this server's copy is kept"
+            )
             return
         write_bytes_atomic(full, data, 0o600)
         os.utime(full, (row.mtime, row.mtime), follow_symlinks=False)

@@ -22,6 +22,8 @@ from defusedxml import DefusedXmlException
 from defusedxml.ElementTree import XMLParser
 
 from workbench.files.bounded import BoundedFileError, Limits, decode_text, read_bytes
+from workbench.files.bounded import position as text_position
+from workbench.files.terminal import terminal_problem
 
 from . import kinds as K
 from .kinds import KindMap, kind_label
@@ -155,8 +157,30 @@ def _count_marks(text: str, source: str) -> None:
         )
 
 
+#: a character reference (``&#155;``, ``&#x9b;``): how a control character gets past the file's
+#: own check into a name
+_CHAR_REF = re.compile(r"&#(x[0-9a-fA-F]{1,8}|[0-9]{1,10});")
+
+
+def _refuse_control_refs(text: str, source: str) -> None:
+    """Refuse a character reference to a control character a terminal acts on (DEL, the C1
+    controls; XML refuses the C0 ones itself, tab and line breaks aside), at its place."""
+    for found in _CHAR_REF.finditer(text):
+        ref = found.group(1)
+        code = int(ref[1:], 16) if ref.startswith("x") else int(ref)
+        if code in (0x09, 0x0A, 0x0D) or code > 0x10FFFF:
+            continue
+        problem = terminal_problem(chr(code), f"the character reference {found.group()}")
+        if problem:
+            line, column = text_position(text, found.start())
+            raise BoundedFileError(
+                source, problem, "remove the reference: write the text without it", line, column
+            )
+
+
 def parse_xml(text: str, source: str) -> Element:
     _count_marks(text, source)
+    _refuse_control_refs(text, source)
     builder = _BoundedBuilder()
     parser = XMLParser(target=builder, forbid_dtd=True)
     try:

@@ -19,7 +19,7 @@ from workbench.files.workspace import LOCAL, FileAccess, OutsideWorkspace
 
 from .generate import EXITS, MAX_CELLS, MIN_CELLS, STYLES, generate
 from .maze import FLOOR, HEADINGS, MAX_SIZE, WALL, Cell, Maze, MazeError, Problem
-from .mazeio import format_for_path, save_maze
+from .mazeio import format_for_path, maze_bytes
 
 #: the order ``s`` cycles the start's heading through when pressed again on the start
 HEADING_CYCLE: tuple[str, ...] = tuple(HEADINGS)
@@ -330,7 +330,9 @@ class MazeEditor:
                 f"cannot save to {shown}: the folder {files.shown(folder)} does not exist"
             )
         try:
-            save_maze(target, self.maze, format_for_path(target))
+            files.write_bytes(target, maze_bytes(target, self.maze, format_for_path(target)))
+        except OutsideWorkspace as exc:  # no room left in the workspace
+            raise EditorError(f"cannot save: {exc}") from None
         except MazeError as exc:
             reasons = "; ".join(f"{p.message} ({p.hint})" for p in exc.problems)
             raise EditorError(f"cannot save as {shown}: {reasons}") from None

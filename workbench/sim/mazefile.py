@@ -21,6 +21,7 @@ import yaml
 from workbench.files.atomic import write_text_atomic
 from workbench.files.bidi import bidi_problem
 from workbench.files.bounded import MAZE_LIMITS, BoundedFileError, check_text, load_yaml
+from workbench.files.terminal import terminal_problem
 
 from .maze import FLOOR, MAX_SIZE, PROFILES, WALL, Maze, MazeError, Problem
 
@@ -127,7 +128,9 @@ def _front_matter(lines: list[str], source: str) -> tuple[dict, int, list[Proble
     for key in ("name", "description"):
         if key in meta and not isinstance(meta[key], str):
             meta[key] = str(meta[key])
-        problem = bidi_problem(str(meta.get(key) or ""), f"the maze's {key}")
+        text = str(meta.get(key) or "")
+        what = f"the maze's {key}"
+        problem = bidi_problem(text, what) or terminal_problem(text, what, key != "name")
         if problem:
             problems.append(
                 Problem(problem, "type it again without it", source, key_lines.get(key, 2), 1)
@@ -278,16 +281,17 @@ def format_maze(maze: Maze, front_matter: bool = True) -> str:
 
 def check_names(path: str | os.PathLike, maze: Maze) -> None:
     """:class:`MazeError` when the maze's name or description, or the file name it is to be
-    saved under, holds a bidi control (see :mod:`workbench.files.bidi`)."""
+    saved under, holds a bidi control (see :mod:`workbench.files.bidi`) or a control
+    character a terminal acts on (:mod:`workbench.files.terminal`)."""
     checks = (
-        (maze.name, "the maze's name"),
-        (maze.description, "the maze's description"),
-        (os.path.basename(os.fspath(path)), "the file name"),
+        (maze.name, "the maze's name", False),
+        (maze.description, "the maze's description", True),
+        (os.path.basename(os.fspath(path)), "the file name", False),
     )
     problems = [
         Problem(problem, "type it again without it", str(path))
-        for text, what in checks
-        if (problem := bidi_problem(text, what))
+        for text, what, lines in checks
+        if (problem := bidi_problem(text, what) or terminal_problem(text, what, lines))
     ]
     if problems:
         raise MazeError(problems)

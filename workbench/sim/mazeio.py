@@ -9,7 +9,7 @@ import re
 from dataclasses import replace
 from pathlib import Path
 
-from workbench.files.atomic import write_bytes_atomic, write_text_atomic
+from workbench.files.atomic import write_bytes_atomic
 from workbench.files.bounded import (
     MAZE_LIMITS,
     BoundedFileError,
@@ -111,12 +111,17 @@ def format_for_path(path: str | os.PathLike) -> str:
 
 def save_maze(path: str | os.PathLike, maze: Maze, fmt: str = "workbench") -> None:
     """Write ``maze`` atomically; MazeError when the format cannot hold it."""
+    write_bytes_atomic(path, maze_bytes(path, maze, fmt))
+
+
+def maze_bytes(path: str | os.PathLike, maze: Maze, fmt: str = "workbench") -> bytes:
+    """The bytes of ``maze`` saved at ``path`` in ``fmt``; MazeError when the format cannot
+    hold it (or the names cannot be saved, :func:`~.mazefile.check_names`)."""
     if fmt not in WRITE_FORMATS:
         raise _unknown(fmt, WRITE_FORMATS, str(path))
     check_names(path, maze)
     if fmt == "maz":
-        write_bytes_atomic(path, format_maz(maze))
-    elif fmt == "micromouse":
-        write_text_atomic(path, format_micromouse(maze))
-    else:
-        write_text_atomic(path, format_maze(maze))
+        return format_maz(maze)
+    if fmt == "micromouse":
+        return format_micromouse(maze).encode("utf-8")
+    return format_maze(maze).encode("utf-8")

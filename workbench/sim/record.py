@@ -21,6 +21,7 @@ import pymunk
 
 import workbench
 from workbench.files.commits import committed
+from workbench.files.terminal import data_problem, terminal_safe
 
 from .commands import MotorPower, MoveAtPower, Stop, TurnByDegrees, WheelPowers
 from .driver import BY_KEYS, NOBODY, Driver
@@ -279,6 +280,11 @@ def file_sha256(path: str | os.PathLike) -> str:
     return h.hexdigest()
 
 
+#: the lines of a record that hold names and words (the maze's, the driver's): read back, none
+#: may hold a control character a terminal would act on (the ticks hold numbers)
+_WORDED = ("header", "summary")
+
+
 def iter_lines(path: str | os.PathLike) -> Iterator[tuple[int, dict[str, Any]]]:
     with open(path, encoding="utf-8") as fh:
         for no, raw in enumerate(fh, start=1):
@@ -292,6 +298,13 @@ def iter_lines(path: str | os.PathLike) -> Iterator[tuple[int, dict[str, Any]]]:
                 ) from None
             if not isinstance(obj, dict):
                 raise RecordError(f"{path}:{no}: each line must be a JSON object")
+            if obj.get("type") in _WORDED:
+                problem = data_problem(obj)
+                if problem:
+                    raise RecordError(
+                        f"{path}:{no}: {terminal_safe(problem)}; the workbench never writes "
+                        "one, so the record was changed after it was written: replay another"
+                    )
             yield no, obj
 
 

@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from workbench.control.recording import RecordQuota
+from workbench.files.workspace_files import UploadLimits
 from workbench.tui.serving import packets
 from workbench.tui.settings import AppSettings
 
@@ -79,6 +80,8 @@ class AppSpec:
     term: str = "xterm-256color"
     #: how much room the app's run records may take (the folder counted: the workspace's runs)
     record_quota: RecordQuota = field(default_factory=RecordQuota)
+    #: what the student may keep in the workspace: the file server's limits, the app's too
+    uploads: UploadLimits = field(default_factory=UploadLimits)
 
     def argv(self, command: tuple[str, ...]) -> list[str]:
         """The command line of the app as a new process: its settings as one JSON argument."""
@@ -103,6 +106,9 @@ class AppSpec:
             record_cap=self.record_quota.record,
             runs_quota=self.record_quota.runs,
             runs_counted=Path(self.workspace) / "runs",
+            upload_cap=self.uploads.file_size,
+            workspace_quota=self.uploads.quota_bytes,
+            workspace_files=self.uploads.quota_files,
         )
 
     def env(self, base: dict[str, str] | None = None) -> dict[str, str]:

@@ -891,6 +891,7 @@ class LabSession(asyncssh.SSHServerSession):
             height,
             self.term,
             config.record_quota,
+            uploads=config.uploads,
         )
         log_path = config.data_dir / "logs" / user / f"{stamp}-{self.id}.log"
         self._make_log_room(log_path)

@@ -743,7 +743,9 @@ def make_app(settings: AppSettings) -> WorkbenchApp:
         raise AppSetupError(f"cannot open the maze {str(path)!r}:\n{problems}") from None
     workspace = settings.workspace
     try:
-        files = FileAccess.confined_to(workspace) if workspace is not None else LOCAL
+        files = (
+            FileAccess.confined_to(workspace, settings.uploads) if workspace is not None else LOCAL
+        )
     except OSError as exc:
         raise AppSetupError(f"cannot use the workspace folder {workspace}: {exc}") from None
     record_dir = str(settings.record_dir) if settings.record_dir is not None else None

@@ -587,6 +587,22 @@ KEY_TABLE: dict[str, Key] = {
     ),
     "confirm.yes": Key("y", "answer(True)", "Yes", "Dialog", "yes", "Yes: go ahead."),
     "confirm.no": Key("n", "answer(False)", "No", "Dialog", "no", "No: leave things as they are."),
+    "pair.agree": Key(
+        "y",
+        "choose(True)",
+        "Pair",
+        "Confirm the pair",
+        "sign for the pair",
+        "The partner worked on it and agrees: sign for both.",
+    ),
+    "pair.alone": Key(
+        "n",
+        "choose(False)",
+        "Alone",
+        "Confirm the pair",
+        "sign for the student alone",
+        "Sign for the student alone: the partner's gradebook row is left as it is.",
+    ),
     "help.close": Key(
         "escape,question_mark,q", "close", "Close", "Dialog", "close", "Close this dialog."
     ),

@@ -20,6 +20,7 @@ from pathlib import Path
 from typing import Any, Union, get_args, get_origin, get_type_hints
 
 from workbench.control.recording import RECORD_CAP, RUNS_QUOTA, RecordQuota
+from workbench.files.workspace_files import UploadLimits
 
 
 class SettingsError(ValueError):
@@ -80,6 +81,11 @@ class AppSettings:
     #: the only folder the app opens and saves files in, besides the bundled ones (a served
     #: student's; None: anywhere)
     workspace: Path | None = None
+    #: what the app may keep in :attr:`workspace`, as the file server allows a student (each
+    #: 0: no limit): the largest file, all the student's files, how many files and folders
+    upload_cap: int = 0
+    workspace_quota: int = 0
+    workspace_files: int = 0
     #: the course's PostgreSQL database URL (None: the SQLite file in the data folder); it may
     #: hold a password, so it is never shown and never sent with the rest
     db: str | None = field(default=None, repr=False)
@@ -119,6 +125,13 @@ class AppSettings:
                 )
             values[name] = _read(name, kinds[name], value)
         return cls(**values)
+
+    @property
+    def uploads(self) -> UploadLimits | None:
+        """What the app may keep in its workspace (None: no limit)."""
+        if not (self.upload_cap or self.workspace_quota or self.workspace_files):
+            return None
+        return UploadLimits(self.upload_cap, self.workspace_quota, self.workspace_files)
 
     @property
     def record_quota(self) -> RecordQuota:

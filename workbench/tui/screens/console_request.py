@@ -147,6 +147,8 @@ class RequestScreen(Screen[str | None]):
         #: the instructors one may sign as, read from the store once the screen is up
         self.roster: list[str] = []
         self.roster_problem = ""
+        #: the instructor's word on the partner the request names (None: not asked yet)
+        self.partner_agrees: bool | None = None
 
     def compose(self) -> ComposeResult:
         e = self.entry
@@ -260,6 +262,9 @@ class RequestScreen(Screen[str | None]):
         if instructor is None:
             self._say("choose the instructor")
             return
+        if request.entry.partner and self.partner_agrees is None:
+            self._confirm_pair(request)
+            return
         self.busy = True
         self._say(f"checking {instructor}'s key...")
         secret = form.take_passphrase()
@@ -269,6 +274,22 @@ class RequestScreen(Screen[str | None]):
             exit_on_error=False,
         )
 
+    def _confirm_pair(self, request: Request) -> None:
+        """Ask whether the partner worked on it and agrees; sign once the instructor says."""
+        from ..dialogs.pair import PairDialog
+
+        def chosen(agrees: bool | None) -> None:
+            if agrees is None:
+                self._say("not signed: say whether the partner is on the sign-off first")
+                return
+            self.partner_agrees = agrees
+            self.action_sign()
+
+        entry = request.entry
+        self.app.push_screen(
+            PairDialog(entry.student, entry.partner, request.partner_problem), chosen
+        )
+
     async def _sign(
         self, request: Request, instructor: str, passphrase: str, note: str, override: bool
     ) -> None:
@@ -276,7 +297,8 @@ class RequestScreen(Screen[str | None]):
         store, entry = self.store, self.entry
         try:
             _, record = await asyncio.to_thread(
-                sign_off, store, instructor, passphrase, request.fields(), override, note,
+                sign_off, store, instructor, passphrase, request.fields(self.partner_agrees),
+                override, note,
                 say=lambda text: self.app.call_from_thread(self._say, text),
             )  # fmt: skip
         except SignoffError as exc:
@@ -294,13 +316,14 @@ class RequestScreen(Screen[str | None]):
             problems.append(f"the request stays in the queue: {exc}")
         try:
             await asyncio.to_thread(
-                store.set_driver, entry.student, entry.partner, entry.lab, entry.exercise,
+                store.set_driver, entry.student, record.partner, entry.lab, entry.exercise,
                 record.driver,
             )  # fmt: skip
         except StoreError as exc:
             problems.append(f"the driver was not recorded: {exc}")
+        pair = entry.student + (f" and {record.partner}" if record.partner else "")
         self.done = (
-            f"signed off {entry.pair} {entry.lab}/{entry.exercise} as {instructor}"
+            f"signed off {pair} {entry.lab}/{entry.exercise} as {instructor}"
             f"{' (override)' if record.override else ''}"
         )
         self._say("; ".join([self.done, *problems]) + "; escape goes back to the class")
