@@ -5,71 +5,21 @@ the sign-off. The student's own session never offers a signing dialog."""
 
 from __future__ import annotations
 
-import asyncio
-import os
 import shutil
 import subprocess
 import sys
-import time
-from pathlib import Path
 
-import pexpect
-import pyte
 import pytest
 
 from tests.app.support import sync
 from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.store import Store
 
+from .openssh_terminal import OpenSshTerminal
 from .ssh_support import Account, lab_host, open_exercise
 
 PASSPHRASE = "correct horse battery"
 FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
-SIZE = (24, 80)
-
-
-class OpenSshTerminal:
-    """OpenSSH's client on a pty (``ssh -tt``), its output fed into an emulated 80x24 screen.
-    Its calls block, so a test running the lab server on its event loop calls them in a
-    thread (:meth:`wait_for` is async)."""
-
-    def __init__(self, user: str, port: int, key: Path) -> None:
-        self.screen = pyte.Screen(SIZE[1], SIZE[0])
-        self.stream = pyte.ByteStream(self.screen)
-        argv = [
-            "-tt", "-F", "/dev/null", "-i", str(key), "-p", str(port),
-            "-o", "StrictHostKeyChecking=no", "-o", "UserKnownHostsFile=/dev/null",
-            "-o", "BatchMode=yes", f"{user}@127.0.0.1",
-        ]  # fmt: skip
-        env = {k: v for k, v in os.environ.items() if not k.startswith(("TEXTUAL", "SSH_"))}
-        env.update(TERM="xterm-256color", LANG="C.UTF-8")
-        self.child = pexpect.spawn("ssh", argv, env=env, dimensions=SIZE)
-
-    def text(self) -> str:
-        return "\n".join(self.screen.display)
-
-    def _wait(self, needles: tuple[str, ...], timeout: float) -> str:
-        end = time.monotonic() + timeout
-        while time.monotonic() < end:
-            try:
-                self.stream.feed(self.child.read_nonblocking(65536, timeout=0.05))
-            except pexpect.TIMEOUT:
-                pass
-            except pexpect.EOF:
-                break
-            if all(n in self.text() for n in needles):
-                return self.text()
-        missing = [n for n in needles if n not in self.text()]
-        raise AssertionError(f"{missing} not on the screen after {timeout} s:\n{self.text()}")
-
-    async def wait_for(self, *needles: str, timeout: float = 30.0) -> str:
-        return await asyncio.to_thread(self._wait, needles, timeout)
-
-    def send(self, keys: str) -> None:
-        self.child.send(keys)
-
-    def close(self) -> None:
-        self.child.terminate(force=True)
 
 
 @pytest.mark.skipif(shutil.which("ssh") is None, reason="no OpenSSH client (openssh-client)")

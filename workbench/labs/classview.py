@@ -311,7 +311,7 @@ def read_request(store: Store, entry: QueueEntry, labs: list[Lab]) -> Request:
             None,
             None,
             "nothing saved for this exercise yet",
-            profile,
+            profile=profile,
             partner_problem=pairing,
         )
     try:
@@ -319,7 +319,7 @@ def read_request(store: Store, entry: QueueEntry, labs: list[Lab]) -> Request:
         safe_progress = ExerciseProgress.from_dict(terminal_safe_data(saved))
     except ValueError as exc:
         return Request(
-            shown, title, None, None, safe(str(exc)), profile, partner_problem=pairing
+            shown, title, None, None, safe(str(exc)), profile=profile, partner_problem=pairing
         )
     return Request(
         shown,
