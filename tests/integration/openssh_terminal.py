@@ -11,11 +11,35 @@ import os
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import Protocol
 
 import pexpect
 import pyte
 
 SIZE = (24, 80)
+
+
+class Screen(Protocol):
+    """A terminal a test types into and reads (either client)."""
+
+    def send(self, keys: str) -> None: ...
+
+    async def wait_for(self, *needles: str, timeout: float = ...) -> str: ...
+
+    async def wait_until(
+        self, check: Callable[[str], bool], what: str, timeout: float = ...
+    ) -> str: ...
+
+
+async def pass_the_names(term: Screen) -> str:
+    """Pass a new session's names dialog with Enter; the app's main screen."""
+    # an app started as a new process imports all of Textual afresh: slow on a busy machine
+    await term.wait_for("Who is at this robot?", "Partner", timeout=90)
+    term.send("\r")
+    return await term.wait_until(
+        lambda t: "Who is at this robot?" not in t and "distance 0.00 unit" in t,
+        "the main screen",
+    )
 
 
 class OpenSshTerminal:
@@ -59,12 +83,7 @@ class OpenSshTerminal:
 
     async def start_app(self) -> str:
         """Pass the names dialog with Enter; the app's main screen."""
-        await self.wait_for("Who is at this robot?", "Partner", timeout=90)
-        self.send("\r")
-        return await self.wait_until(
-            lambda t: "Who is at this robot?" not in t and "distance 0.00 unit" in t,
-            "the main screen",
-        )
+        return await pass_the_names(self)
 
     def send(self, keys: str) -> None:
         self.child.send(keys)

@@ -21,6 +21,8 @@ from workbench.ssh.passwords import hash_password
 from workbench.ssh.server import LabServer, ServerConfig
 from workbench.ssh.users import add_user, users_path
 
+from .openssh_terminal import pass_the_names
+
 PASSWORD = "lab-password-1"
 
 
@@ -176,13 +178,7 @@ class Terminal:
 
     async def start_app(self) -> str:
         """Pass the names dialog with Enter; the app's main screen."""
-        # an app started as a new process imports all of Textual afresh: slow on a busy machine
-        await self.wait_for("Who is at this robot?", "Partner", timeout=90)
-        self.send("\r")
-        return await self.wait_until(
-            lambda t: "Who is at this robot?" not in t and "distance 0.00 unit" in t,
-            "the main screen",
-        )
+        return await pass_the_names(self)
 
     def resize(self, width: int, height: int) -> None:
         self.process.change_terminal_size(width, height)
