@@ -24,6 +24,7 @@ import pytest
 
 from tests.app.support import sync
 from tests.sessions import free_port
+from tests.students_work import own_right_wall
 from tests.waiting import until
 from workbench.labs.store import Store
 from workbench.ssh.balancer import EXAMPLE, LabBackend, haproxy_config
@@ -34,7 +35,6 @@ from .sftp_support import OpenSSH, files_under, needs_openssh
 from .ssh_support import Account, Terminal, make_accounts, open_exercise, port_range
 
 ROOT = Path(__file__).resolve().parents[2]
-PROGRAM = ROOT / "programs" / "right-wall.viple"
 EXERCISE = "Wall following, the timed activities"
 KEY = ("web-simulator", "wall-activities")
 PASSED_EXIT = "[X] your program got out of the Web maze within 300 s"
@@ -236,7 +236,7 @@ async def run_program(term: Terminal, name: str) -> None:
     await term.wait_for(PASSED_EXIT, timeout=30)
     term.send("\t")  # from the list to the instructions, then from field to field
     for answer in ANSWERS:
-        term.send("\t" + answer)
+        term.send("\t" + answer + "\r")  # typed and tried with enter
     await term.wait_until(exercise_passed, "the exercise marked passed in the list", 30)
 
 
@@ -298,7 +298,8 @@ async def test_a_student_moves_between_servers_behind_haproxy_and_outlives_a_cra
         other = next(lab for lab in labs if lab is not first)
         assert f"login: ann (student) from {STUDENT} with key" in first.log()
         ssh = OpenSSH(balancer, tmp_path)  # OpenSSH's own scp, through the balancer
-        done = await ssh.scp("ann", str(PROGRAM), "@:right-wall.viple")
+        program = own_right_wall(tmp_path)  # the student's own (the shipped example is not)
+        done = await ssh.scp("ann", str(program), "@:right-wall.viple")
         assert done.status == 0, done.said
         assert "sftp: ann write /right-wall.viple" in other.log()
         assert "sftp: ann write" not in first.log()
@@ -316,7 +317,7 @@ async def test_a_student_moves_between_servers_behind_haproxy_and_outlives_a_cra
         term.send("\r")
         await term.wait_for("distance 0.00 unit", timeout=60)
         workspace = first.data_dir / "workspaces" / "ann"
-        assert (workspace / "right-wall.viple").read_bytes() == PROGRAM.read_bytes()
+        assert (workspace / "right-wall.viple").read_bytes() == program.read_bytes()
         await run_program(term, "right-wall.viple")
         progress = await until(lambda: passed(reader, pg_url), "the exercise passed, stored", 30)
         evidence = progress["objectives"][0]["evidence"]
@@ -344,13 +345,13 @@ async def test_a_student_moves_between_servers_behind_haproxy_and_outlives_a_cra
         assert EXERCISE in screen.splitlines()[0]  # reopened where the student left off
         assert PASSED_EXIT in screen and ANSWERED in screen and exercise_passed(screen)
         there = other.data_dir / "workspaces" / "ann"
-        assert (there / "right-wall.viple").read_bytes() == PROGRAM.read_bytes()
+        assert (there / "right-wall.viple").read_bytes() == program.read_bytes()
         runs = files_under(workspace / "runs")
         assert runs and files_under(there / "runs") == runs  # the run record came along
         back = tmp_path / "back.viple"
         done = await ssh.scp("ann", "@:right-wall.viple", str(back))
         assert done.status == 0, done.said
-        assert back.read_bytes() == PROGRAM.read_bytes()
+        assert back.read_bytes() == program.read_bytes()
         await again.close()
     finally:
         if haproxy is not None:
