@@ -151,3 +151,15 @@ async def test_a_class_taller_than_the_screen_scrolls(tmp_path):
         assert grid_rows(grid)["student-39"][column - 1] == "ok"
         # every student ran the same program: one hint names them all
         assert text(grid, "#grid-hints").startswith("same program wall.viple (")
+
+
+@sync
+async def test_a_class_of_one_is_counted_as_one_student(tmp_path):
+    data = tmp_path / "data"
+    with Store.open(data) as store:
+        save_progress(store, "ana", progress())
+    app = ConsoleApp(Store.open(data), load_labs())
+    async with app.run_test(size=(80, 24)) as pilot:
+        grid = await open_grid(app, pilot)
+        title = text(grid, "#grid-title")
+        assert ": 1 student" in title and "students" not in title, title

@@ -162,7 +162,9 @@ class GridScreen(FollowsUnicode, Screen[None]):
         grid = view.grid
         exercises = [ex for lab_id, ex in grid.exercises if lab_id == lab]
         more = f"; l: next lab ({self.lab_index + 1} of {len(labs)})" if len(labs) > 1 else ""
-        title.update(f"Class by exercise, lab {lab}: {len(grid.students)} students{more}")
+        count = len(grid.students)
+        people = f"{count} student{'' if count == 1 else 's'}"
+        title.update(f"Class by exercise, lab {lab}: {people}{more}")
         rows = [
             (student, *(cell_text(grid.standing(student, lab, ex), self.unicode)
                         for ex in exercises))
