@@ -14,7 +14,8 @@ from hypothesis import strategies as st
 from tests.students_work import example_copy, own_right_wall
 from workbench.control.algorithms import ALGORITHM_DIR, list_algorithms
 from workbench.control.station import LabStation
-from workbench.labs.checks import evaluate, evidence_programs
+from workbench.labs.checks import evaluate
+from workbench.labs.evidence_text import programs_of
 from workbench.labs.model import Exercise
 from workbench.program.choice import choose_program
 from workbench.sim.sensors import PORT_RANGE, SensorSpec
@@ -102,7 +103,7 @@ def test_the_exit_evidence_names_the_sensors_program_and_driver(tmp_path):
     assert out.evidence["program_sha256"] == digest
     assert out.evidence["program_name"] == "my-right-wall.viple"
     assert out.evidence["driver"] == "VIPLE program my-right-wall.viple"
-    assert evidence_programs(progress) == {digest: "my-right-wall.viple"}
+    assert programs_of(progress) == {digest: "my-right-wall.viple"}
 
 
 def test_the_example_programs_never_pass_the_exercises_they_solve(tmp_path):
@@ -187,7 +188,7 @@ def test_runs_of_one_exercise_on_two_programs_are_told_apart(tmp_path):
         run_to_exit(station)
         values = [*values[:-1], "left_turn=-91"]  # retuned after the first maze
     progress = evaluate("unity-simulator", ex, station)
-    programs = evidence_programs(progress)
+    programs = programs_of(progress)
     assert len(programs) == 2, programs
     assert set(programs.values()) == {"unity-wall-following.yaml"}
 

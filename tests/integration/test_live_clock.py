@@ -20,7 +20,7 @@ from tests.integration.test_ws_client import RETRY, FakeViple
 from tests.sessions import CORRIDOR, free_port
 from tests.waiting import until
 from workbench.control.station import LabStation
-from workbench.sim.mazeio import load_maze
+from workbench.sim.mazeio import load_maze, parse_maze
 from workbench.sim.metrics import Metrics
 from workbench.viple.codec import parse_report
 from workbench.viple.tcp_server import TcpConfig, TcpServer
@@ -176,3 +176,33 @@ def test_a_run_gives_the_same_numbers_at_any_speed():
         return b.runs[-1].metrics
 
     assert metrics(None) == metrics(1.0) == metrics(4.0)
+
+
+BACK = b'{"servos":[{"isTurn":false,"servoId":-1,"servoSpeed":-1}]}\r\n'
+WAY_OUT = parse_maze("#########\n#S......E\n#########\n", source="way-out.txt")
+
+
+def test_what_a_program_sent_to_the_robot_standing_at_the_exit_is_dropped():
+    async def scenario() -> None:
+        b = LabStation.open(WAY_OUT, "unity", noise="off")
+        async with TcpServer(b, TcpConfig(port=0, report_ms=1000)) as server:
+            client = await Client.connect(server.port)
+            await client.report()
+            await client.send(MOVE)
+            await client.report()
+            for _ in range(5000):
+                if b.runs and b.runs[-1].ended == "exit":
+                    break
+                b.advance(0.05)
+            assert b.runs[-1].ended == "exit" and b.paused  # held at the exit
+            at_exit = b.snapshot().pose.x
+            await client.send(BACK)  # sent to the robot standing at the exit
+            await client.report()
+            assert b.held_count == 1
+            b.pause(False)  # p: time runs again, the run is over
+            b.step(60)
+            assert b.held_count == 0
+            assert b.snapshot().pose.x >= at_exit  # it did not drive back into the maze
+            await client.close()
+
+    asyncio.run(scenario())

@@ -388,6 +388,18 @@ def test_saved_progress_in_the_wrong_shape_is_refused_with_a_reason():
         ExerciseProgress.from_dict({"lab": "x", "exercise": "y", "objectives": [{"kind": 1}]})
     with pytest.raises(ValueError, match="not in the expected shape"):
         ExerciseProgress.from_dict({"lab": "x"})
+    state = {"kind": "exit", "text": "out", "passed": True, "reason": "ok"}
+    for bad in ({**state, "evidence": []}, {**state, "evidence": "run 3"}):
+        with pytest.raises(ValueError, match="evidence is not a mapping"):
+            ExerciseProgress.from_dict({"lab": "x", "exercise": "y", "objectives": [bad]})
+    with pytest.raises(ValueError, match="not in the expected shape"):  # tries: 1e999
+        ExerciseProgress.from_dict(
+            {"lab": "x", "exercise": "y", "objectives": [], "tries": {"q": float("inf")}}
+        )
+    kept = ExerciseProgress.from_dict(
+        {"lab": "x", "exercise": "y", "objectives": [], "tries": {"q": -5}}
+    )
+    assert kept.tries == {"q": 0}  # a negative count never buys tries past max_tries
 
 
 def test_the_set_up_starts_the_exercise_afresh():

@@ -341,7 +341,10 @@ class LabStation:
 
     def step(self, steps: int = 1) -> None:
         """Exactly ``steps`` physics steps (pause + single step, tests, snapshots); the commands
-        a live VIPLE program sent while paused apply first (time runs for these steps)."""
+        a live VIPLE program sent while paused apply first (time runs for these steps), unless
+        the robot stands at the exit of the run that ended."""
+        if self._held_at_exit:
+            self._drop_held()
         self._release_held()
         try:
             self.pacer.single_step(steps)
@@ -549,6 +552,8 @@ class LabStation:
     def pause(self, paused: bool = True) -> None:
         """Stop simulated time (or, with False, let it run again): the user's choice. When
         time runs again, the commands a live VIPLE program sent meanwhile are applied."""
+        if self._held_at_exit:
+            self._drop_held()  # sent to a robot standing at the exit: not for what comes next
         self._held_at_exit = False
         was = self.pacer.paused
         self.pacer.paused = paused
@@ -563,8 +568,7 @@ class LabStation:
         """The run that ended at the exit paused the robot; a new action lets time run again
         (keys would otherwise seem dead after a run)."""
         if self._held_at_exit:
-            self._drop_held()  # sent to a robot standing at the exit: not for the next run
-            self.pause(False)
+            self.pause(False)  # (which drops what was held for the robot at the exit)
 
     def snapshot(self) -> Snapshot:
         return self.session.snapshot()

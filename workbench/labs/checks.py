@@ -140,11 +140,14 @@ class ExerciseProgress:
     def from_dict(cls, data: Mapping[str, Any]) -> ExerciseProgress:
         """Progress as saved (:meth:`to_json`); ValueError when it is not in that shape."""
         try:
-            objectives = [unproven_to_redo(ObjectiveState(**o)) for o in data["objectives"]]
+            states = [ObjectiveState(**o) for o in data["objectives"]]
+            if not all(isinstance(o.evidence, dict) for o in states):
+                raise ValueError("an objective's evidence is not a mapping")
+            objectives = [unproven_to_redo(o) for o in states]
             answers = dict(data.get("answers") or {})
-            tries = {str(k): int(v) for k, v in dict(data.get("tries") or {}).items()}
+            tries = {str(k): max(0, int(v)) for k, v in dict(data.get("tries") or {}).items()}
             return cls(str(data["lab"]), str(data["exercise"]), objectives, answers, tries)
-        except (KeyError, TypeError, ValueError) as exc:
+        except (KeyError, TypeError, ValueError, OverflowError) as exc:
             raise ValueError(f"saved progress is not in the expected shape: {exc}") from None
 
     def evidence_digest(self) -> str:
@@ -298,20 +301,6 @@ def driver_kinds(run: RunEntry) -> set[str]:
     if run.bundled:
         kinds -= OWN_PROGRAM_DRIVERS
     return kinds
-
-
-def evidence_programs(progress: ExerciseProgress) -> dict[str, str]:
-    """The programs an exercise's evidence rests on: program_sha256 -> program_name, over
-    every objective's evidence (the runs an objective compares are built-ins, not the
-    student's program, and are left out). More than one entry: the evidence mixes
-    programs."""
-    programs: dict[str, str] = {}
-    for o in progress.objectives:
-        digest = o.evidence.get("program_sha256")
-        if o.passed and isinstance(digest, str) and digest:
-            name = o.evidence.get("program_name") or o.evidence.get("driver") or ""
-            programs.setdefault(digest, str(name))
-    return programs
 
 
 # -- the exercise's own work ---------------------------------------------------------------

@@ -132,10 +132,11 @@ def short_digest(digest: str) -> str:
 
 def program_of(evidence: Mapping[str, Any]) -> tuple[str, str] | None:
     """The program a run's evidence names: its sha256 and its name (the name from the driver
-    when older evidence keeps no ``program_name``); None when no program file drove."""
+    when older evidence keeps no ``program_name``); None when no program file drove, or the
+    one that drove is a file the workbench ships (the evidence says ``bundled``)."""
     digest = evidence.get("program_sha256")
-    if not isinstance(digest, str) or not digest:
-        return None
+    if not isinstance(digest, str) or not digest or evidence.get("bundled"):
+        return None  # (a file the workbench ships, a built-in a lab asked for: nobody's own)
     name = evidence.get("program_name")
     if not isinstance(name, str) or not name:
         driver = str(evidence.get("driver") or "")

@@ -29,9 +29,9 @@ from .checks import (
     SetupChanges,
     apply_setup,
     evaluate,
-    evidence_programs,
     keep_passed,
 )
+from .evidence_text import programs_of
 from .model import Exercise, Lab
 from .store import Store, StoreUnavailable
 
@@ -307,7 +307,7 @@ def signoff_words(progress: ExerciseProgress) -> str:
     nothing): the program the evidence rests on (or that it mixes programs), and the
     questions whose tries are used up and wait for the instructor."""
     parts = []
-    programs = evidence_programs(progress)
+    programs = programs_of(progress)
     named = [f"{name} sha256 {digest[:12]}" for digest, name in programs.items()]
     if len(named) == 1:
         parts.append(f"program {named[0]}")

@@ -14,7 +14,7 @@ from typing import Any
 from workbench.sim.record import file_sha256
 
 from . import signlog
-from .checks import evidence_programs
+from .evidence_text import programs_of
 from .names import NameProblem, check_student
 from .signoff_errors import SignoffError
 from .store import StoredSignoff
@@ -40,7 +40,7 @@ class Evidence:
             for o in progress.objectives
         ]
         metrics = {"objectives": objectives, "evidence_digest": progress.evidence_digest()}
-        programs = evidence_programs(progress)
+        programs = programs_of(progress)
         if programs:  # the program the evidence rests on (more than one: it mixes them)
             metrics["programs"] = programs
         for o in progress.objectives:
