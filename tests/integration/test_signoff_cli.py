@@ -15,7 +15,9 @@ import pytest
 from workbench.cli import main
 from workbench.labs.instructors import create_instructor, unlock_instructor
 from workbench.labs.roster import load_roster, roster_path
-from workbench.labs.store import DB_NAME
+from workbench.labs.signing import sign_off
+from workbench.labs.signoff_record import Evidence, RecordFields
+from workbench.labs.store import DB_NAME, Store
 
 from .signoff_support import FAST, PASS, add_instructor, sign
 
@@ -223,3 +225,24 @@ def test_list_and_verify_print_an_edited_record_s_escapes_written_out(data_dir, 
     out = capsys.readouterr().out
     assert "alice\\x1b]0;PWNED\\x07" in out and "FAIL #1" in out
     assert not any(c in out for c in "\x1b\x07\x9b")
+
+
+def test_a_program_name_that_begins_like_a_formula_is_never_a_formula_in_the_gradebook(
+    data_dir, tmp_path
+):
+    name = '=HYPERLINK("http://x","y").viple'  # a name the student chose for their file
+    run = {"run": 1, "program_sha256": "ab" * 32, "program_name": name,
+           "metrics": {"exit_time": 12.0, "distance": 3.0}}  # fmt: skip
+    fields = RecordFields(
+        student="erin", partner="", driver="erin", lab="web-simulator", exercise="sensors",
+        evidence=Evidence("", "", {"objectives": [{"kind": "exit", "passed": True,
+                                                   "evidence": run}]}),
+        objectives_passed=True,
+    )  # fmt: skip
+    with Store.open(data_dir) as store:
+        sign_off(store, "Dr Chen", PASS, fields)
+    target = tmp_path / "grades.csv"
+    assert main(["signoff", "export", "--csv", str(target), "--data-dir", str(data_dir)]) == 0
+    (row,) = list(csv.DictReader(target.open()))
+    assert row["program"] == "'" + name  # shown as text by a spreadsheet, not run
+    assert row["program_sha256"] == "sha256:" + "ab" * 32

@@ -16,6 +16,7 @@ import sys
 from pathlib import Path
 
 from workbench.files.atomic import write_text_atomic
+from workbench.files.spreadsheet import spreadsheet_cell
 from workbench.labs.classview import profiles
 from workbench.labs.gradebook import GRADEBOOK_COLUMNS, gradebook_rows, head_from_gradebook
 from workbench.labs.model import LabFileError, load_labs
@@ -230,7 +231,7 @@ def cmd_export(args: argparse.Namespace) -> int:
     out = io.StringIO()
     writer = csv.DictWriter(out, fieldnames=GRADEBOOK_COLUMNS, lineterminator="\n")
     writer.writeheader()
-    writer.writerows(rows)
+    writer.writerows({k: spreadsheet_cell(v) for k, v in row.items()} for row in rows)
     target = Path(args.csv)
     try:
         write_text_atomic(target, out.getvalue())

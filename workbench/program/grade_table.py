@@ -16,6 +16,8 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from workbench.files.spreadsheet import spreadsheet_cell
+
 from .grading import Plan, Row
 
 if TYPE_CHECKING:
@@ -39,7 +41,6 @@ COLUMNS = (
 #: how many refused programs and skipped files the summary names
 SHOWN_REFUSALS = 20
 SHOWN_SKIPPED = 20
-_FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
 
 
 def csv_text(rows: Sequence[Row]) -> str:
@@ -47,7 +48,7 @@ def csv_text(rows: Sequence[Row]) -> str:
     writer = csv.writer(out, lineterminator="\n")
     writer.writerow(COLUMNS)
     for row in rows:
-        writer.writerow([_cell(value) for value in _values(row)])
+        writer.writerow([spreadsheet_cell(value) for value in _values(row)])
     return out.getvalue()
 
 
@@ -115,12 +116,6 @@ def _values(row: Row) -> list[Any]:
             value = "yes" if value else "no"
         values.append("" if value is None else value)
     return values
-
-
-def _cell(value: Any) -> Any:
-    if isinstance(value, str) and value.startswith(_FORMULA_START):
-        return "'" + value
-    return value
 
 
 def _name(path: str) -> str:
