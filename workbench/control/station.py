@@ -20,7 +20,7 @@ from workbench.sim.maze import Maze
 from workbench.sim.metrics import Metrics
 from workbench.sim.noise import NoiseSettings
 from workbench.sim.profiles import get_profile
-from workbench.sim.record import CAPPED, TOO_FAST, Recorder
+from workbench.sim.record import RecordStop
 from workbench.sim.sensors import (
     KINDS,
     MOUNTS,
@@ -35,8 +35,9 @@ from .algorithms import load_algorithm
 from .driving import Driving, algorithm_driving, record_fields
 from .fsm import FsmController, FsmDefinition, FsmRuntimeError, bind_sensors, preset_sensors
 from .fsmfile import parse_param_overrides
+from .lifecycle import ERROR, EXIT, Run, ending
 from .manual import exact_move, key_command
-from .recording import RecordQuota, RecordTrouble, open_record, record_stopped
+from .recording import RecordQuota, RecordTrouble, record_stopped
 
 #: the sensor presets of the course's simulators (Web Simulator panel, Unity simulator)
 PRESETS: dict[str, tuple[SensorSpec, ...]] = {
@@ -285,7 +286,6 @@ class LabStation:
     #: commands the live VIPLE program sent while the station was paused (held, not applied)
     held_count: int = 0
     _held: list[Command] = field(default_factory=list)
-    _run_open: bool = False
     _run_driver: Driver = BY_KEYS
     _run_source: str | None = None
     _run_attempt: str = ""
@@ -297,10 +297,8 @@ class LabStation:
     _viple_now: VipleConnection | None = None
     #: the odometry (distance, degrees) last counted into :attr:`_viple_now`
     _viple_mark: tuple[float, float] = (0.0, 0.0)
-    _recorder: Recorder | None = None
-    _record_path: str | None = None
-    #: the record stopped mid-run, and the person at the station was told
-    _record_stop_told: bool = False
+    #: the run under way (its record, how it ends: :mod:`.lifecycle`), None between runs
+    _run: Run | None = None
     #: paused because the robot got out: the next drive, reset, start or maze goes on
     _held_at_exit: bool = False
 
@@ -397,19 +395,17 @@ class LabStation:
 
     def _after_steps(self) -> None:
         self._count_viple()
-        driving = self.driving
-        why = driving.stopped() if driving is not None and driving.stopped is not None else None
-        if why is not None:
-            self.stop("error")
+        over = ending(self.session, self.driving)
+        if over is not None and over.kind == ERROR:
+            self.stop(ERROR)
             self.pause()
-            self.notice = Notice(PROGRAM_STOPPED, why)
-        recorder = self._recorder
-        if recorder is not None and recorder.stopped is not None and not self._record_stop_told:
-            self._tell_record_stopped(recorder)  # the run goes on unrecorded
-            if recorder.stopped.reason not in (CAPPED, TOO_FAST):  # these still take a summary
-                self._drop_recorder()
-        if self._run_open and self.maze.exits and self.session.reached_exit:
-            self._close_run("exit")
+            self.notice = Notice(PROGRAM_STOPPED, over.detail)
+        run = self._run
+        stop = run.watch() if run is not None else None
+        if stop is not None:
+            self._tell_record_stopped(stop)  # the run goes on unrecorded
+        if self._run is not None and over is not None and over.kind == EXIT:
+            self._close_run(EXIT)
             self.pause()
             self._held_at_exit = True
             self.notice = Notice(OUT)
@@ -809,8 +805,11 @@ class LabStation:
         self.session.driver = BY_KEYS
 
     # -- runs ----------------------------------------------------------------------------
+    @property
+    def _run_open(self) -> bool:
+        return self._run is not None
+
     def _open_run(self, driver: Driver) -> None:
-        self._run_open = True
         self._run_driver = driver
         self._run_source = self.driving.source if self.driving is not None else None
         driving = self.driving
@@ -822,59 +821,43 @@ class LabStation:
         self._run_attempt = self.attempt_id
         self._run_person = self.person
         self._run_sensors = {str(spec): spec for spec in self.sensors}
-        self._record_stop_told = False
-        if self.record_dir:
-            recorder, trouble = open_record(
-                self.record_dir,
-                f"run-{len(self.runs) + 1:03d}.jsonl",
-                self.record_quota,
-                self.files.workspace,
-            )
-            if trouble is not None:
-                self._recording_trouble(trouble)
-            if recorder is None:
-                return
-            self._recorder = recorder
-            self._record_path = str(recorder.path)
-            self.session.recorder = recorder
-            person = {"person": self.person} if self.person else {}
-            self.session.record_header(**record_fields(driver, self.driving), **person)
+        person = {"person": self.person} if self.person else {}
+        self._run, trouble = Run.in_folder(
+            self.session,
+            self.record_dir,
+            f"run-{len(self.runs) + 1:03d}.jsonl",
+            self.record_quota,
+            self.files.workspace,
+            **record_fields(driver, self.driving),
+            **person,
+        )
+        if trouble is not None:
+            self._recording_trouble(trouble)
 
-    def _tell_record_stopped(self, recorder: Recorder) -> None:
-        assert recorder.stopped is not None
-        self._record_stop_told = True
-        self._recording_trouble(record_stopped(str(self._record_path), recorder.stopped))
+    def _tell_record_stopped(self, stop: RecordStop) -> None:
+        run = self._run
+        path = run.path if run is not None else None
+        self._recording_trouble(record_stopped(str(path), stop))
 
     def _recording_trouble(self, trouble: RecordTrouble) -> None:
         self.notice = Notice(RECORDING, trouble.detail, trouble)
 
-    def _drop_recorder(self) -> None:
-        """The run goes on unrecorded (its record stopped); the next run tries a new one."""
-        if self._recorder is not None:
-            self._recorder.close()
-        self.session.recorder = None
-        self._recorder = None
-
     def _close_run(self, ended: str) -> None:
         """The run ends: it is kept (and its record closed), and the speed is 1x again (a
         speed chosen for one run does not carry into the next)."""
-        self._run_open = False
+        run = self._run
+        assert run is not None
         self.pacer.set_speed(1.0)
-        if ended == "exit":  # the run is over as a headless one ends: same numbers, same record
+        if ended == EXIT:  # the run is over as a headless one ends: same numbers, same record
             self.session.settle()
-        entry = self._entry(ended)
-        self.runs.append(entry)
-        recorder = self._recorder
-        if recorder is not None:
-            driving = self.driving
-            self.session.record_summary(
-                ended=ended, final_state=driving.controller.state if driving is not None else None
-            )
-            recorder.close()
-            if recorder.stopped is not None and not self._record_stop_told:
-                self._tell_record_stopped(recorder)
-            self._drop_recorder()
-        self._record_path = None
+        self.runs.append(self._entry(ended))
+        driving = self.driving
+        stop = run.end(
+            ended=ended, final_state=driving.controller.state if driving is not None else None
+        )
+        if stop is not None:
+            self._tell_record_stopped(stop)
+        self._run = None
 
     def _entry(self, ended: str) -> RunEntry:
         """The run under way as a run entry, ended as ``ended``."""
@@ -887,7 +870,7 @@ class LabStation:
             seed=self.seed,
             metrics=self.session.metrics(),
             ended=ended,
-            record=self._record_path,
+            record=self._run.path if self._run is not None else None,
             source=self._run_source,
             maze_digest=self.maze.digest(),
             attempt=self._run_attempt,
