@@ -7,8 +7,9 @@ opens it (:func:`record_file` for a file a command names, :meth:`Run.in_folder` 
 record folder within its quota), hands it to the session, which appends a line per control
 tick, watches its bounds (:meth:`Run.watch`), and writes its summary and closes it
 (:meth:`Run.end`). :func:`ending` is the one place that says a run is over on its own: the
-robot got out, its time is up, or the program driving stopped itself past its limits. The
-other ends (a stop, a reset, a new maze) are someone's act, and the front end names them.
+robot got out, or the program driving stopped itself past its limits. The other ends (a
+stop, a reset, a new maze) are someone's act, and the front end names them with the kinds
+here; a headless run also ends at its time limit, where its session stops stepping.
 """
 
 from __future__ import annotations
@@ -30,39 +31,31 @@ RESET = "reset"
 MAZE_CHANGED = "maze changed"
 #: an algorithm failed, or a program stopped itself past its limits
 ERROR = "error"
-#: its time limit passed (a headless run)
-LIMIT = "limit"
 
 #: the stops after which a record still takes its summary (the record goes on to the end)
 _KEEPS_SUMMARY = (CAPPED, TOO_FAST)
-#: times closer than this are the same moment, seconds
-_SAME = 1e-9
 
 
 @dataclass(frozen=True)
 class Ending:
-    """Why a run is over on its own: :data:`EXIT`, :data:`LIMIT` or :data:`ERROR` (with the
-    program's words in ``detail``)."""
+    """Why a run is over on its own: :data:`EXIT` or :data:`ERROR` (with the program's words
+    in ``detail``)."""
 
     kind: str
     detail: str = ""
 
 
-def ending(
-    session: Session, driving: Driving | None = None, max_time: float | None = None
-) -> Ending | None:
+def ending(session: Session, driving: Driving | None = None) -> Ending | None:
     """Why the run on ``session`` is over now, None while it goes on: the program driving
-    stopped itself (:data:`ERROR`, first: its run ends there), the robot got out of a maze
-    that has exits (:data:`EXIT`), or ``max_time`` simulated seconds have passed
-    (:data:`LIMIT`)."""
+    stopped itself (:data:`ERROR`, first: its run ends there), or the robot got out of a maze
+    that has exits (:data:`EXIT`). (A headless run also ends at its time limit: the session
+    steps up to it, :meth:`Session.run`.)"""
     stopped = driving.stopped if driving is not None else None
     why = stopped() if stopped is not None else None
     if why is not None:
         return Ending(ERROR, why)
     if session.maze.exits and session.reached_exit:
         return Ending(EXIT)
-    if max_time is not None and session.world.time >= max_time - _SAME:
-        return Ending(LIMIT)
     return None
 
 

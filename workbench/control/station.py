@@ -35,7 +35,7 @@ from .algorithms import load_algorithm
 from .driving import Driving, algorithm_driving, record_fields
 from .fsm import FsmController, FsmDefinition, FsmRuntimeError, bind_sensors, preset_sensors
 from .fsmfile import parse_param_overrides
-from .lifecycle import ERROR, EXIT, Run, ending
+from .lifecycle import ERROR, EXIT, MAZE_CHANGED, RESET, STOPPED, Run, ending
 from .manual import exact_move, key_command
 from .recording import RecordQuota, RecordTrouble, record_stopped
 
@@ -68,7 +68,8 @@ class RunEntry:
     profile: str
     seed: int
     metrics: Metrics
-    ended: str  # "exit", "stopped", "reset", "maze changed"
+    #: how it ended: EXIT, STOPPED, RESET, MAZE_CHANGED or ERROR (:mod:`.lifecycle`)
+    ended: str
     record: str | None = None
     #: the FSM file of the algorithm, or the program file, that drove (None for keys and VIPLE)
     source: str | None = None
@@ -389,7 +390,7 @@ class LabStation:
             self.on_activity()
 
     def _algorithm_failed(self, exc: FsmRuntimeError) -> None:
-        self.stop("error")
+        self.stop(ERROR)
         self.pause()
         self.notice = Notice(ALGORITHM_FAILED, str(exc))
 
@@ -448,7 +449,7 @@ class LabStation:
         if self.session.driver == driver:
             self.session.command(Stop(), driver=NOBODY)
         if self._run_open and self._run_driver == driver:
-            self._close_run("stopped")
+            self._close_run(STOPPED)
         self.pacer.set_speed(1.0)
 
     def drive(self, cmd: Command, driver: Driver) -> bool:
@@ -476,9 +477,9 @@ class LabStation:
     def _viple_takes(self, driver: Driver) -> None:
         """The VIPLE program ``driver`` drives from now on: what drove lets go (its run ends),
         the program's driving is a run of its own, and it is seen as a connection."""
-        self.stop("stopped")  # takes the robot from the algorithm or the program file
+        self.stop(STOPPED)  # takes the robot from the algorithm or the program file
         if self._run_open and self._run_driver != driver:
-            self._close_run("stopped")
+            self._close_run(STOPPED)
         self.session.detach(driver)
         self._viple_now = self._connection(driver.role, driver.peer)
         self.viple.append(self._viple_now)
@@ -578,7 +579,7 @@ class LabStation:
         """
         if self.program_drives:
             if key == "space":
-                self.stop("stopped")
+                self.stop(STOPPED)
             else:
                 self.type_to_program(key)
             return True
@@ -587,9 +588,9 @@ class LabStation:
             return False
         self._activity()
         self._go_on_after_exit()
-        self.stop("stopped")
+        self.stop(STOPPED)
         if self._run_open and self._run_driver != BY_KEYS:
-            self._close_run("stopped")  # the keys take the robot from a VIPLE program
+            self._close_run(STOPPED)  # the keys take the robot from a VIPLE program
         self._drop_held()  # ... and from what it sent while paused
         if not self._run_open and not self.session.reached_exit:
             self._open_run(BY_KEYS)  # a run starts at the robot's last reset
@@ -667,7 +668,7 @@ class LabStation:
 
     def use_algorithm(self, definition: FsmDefinition) -> FsmDefinition:
         """Choose an algorithm already read (a lab's starter as the lab was loaded)."""
-        self.stop("stopped")
+        self.stop(STOPPED)
         self.algorithm = definition
         self.program = None
         self.overrides = {}
@@ -675,7 +676,7 @@ class LabStation:
 
     def clear_algorithm(self) -> None:
         """No algorithm chosen (the keys drive), and no parameters of one kept."""
-        self.stop("stopped")
+        self.stop(STOPPED)
         self.algorithm = None
         self.overrides = {}
 
@@ -714,7 +715,7 @@ class LabStation:
     # -- program files -------------------------------------------------------------------
     def use_program(self, choice: ProgramChoice) -> None:
         """Choose a program file to drive (the choice of algorithm is kept for later)."""
-        self.stop("stopped")
+        self.stop(STOPPED)
         self.program = choice
 
     @property
@@ -740,9 +741,9 @@ class LabStation:
         binding = driving.bind(self.sensors)
         speed = self.pacer.speed  # chosen for this run: the run before ends at 1x
         self._drop_held()
-        self.stop("stopped")
+        self.stop(STOPPED)
         if self._run_open:
-            self._close_run("stopped")
+            self._close_run(STOPPED)
         self._go_on_after_exit()
         self.session.reset()
         self.driving = driving
@@ -751,7 +752,7 @@ class LabStation:
         self.set_speed(speed)
         self.pause(False)
 
-    def stop(self, ended: str = "stopped") -> None:
+    def stop(self, ended: str = STOPPED) -> None:
         """What drives lets go of the robot, which stops; the keys drive (nothing when the
         keys or a VIPLE program over the network drive)."""
         if self.driving is None:
@@ -767,8 +768,8 @@ class LabStation:
         """Like the Unity simulator's reset button: the robot back at the start, stopped."""
         self._go_on_after_exit()
         if self._run_open:
-            self._close_run("reset")
-        self.stop("reset")
+            self._close_run(RESET)
+        self.stop(RESET)
         self._drop_held()
         self.session.reset()
         self.session.driver = BY_KEYS
@@ -796,8 +797,8 @@ class LabStation:
         """Put a (new or edited) maze on the station; the robot starts over on it."""
         self._go_on_after_exit()
         if self._run_open:
-            self._close_run("maze changed")
-        self.stop("maze changed")
+            self._close_run(MAZE_CHANGED)
+        self.stop(MAZE_CHANGED)
         self._drop_held()
         self.pacer.set_speed(1.0)
         self.maze = maze
@@ -888,4 +889,4 @@ class LabStation:
     def close(self) -> None:
         """End the session: an open run is kept (with its record) as stopped."""
         if self._run_open:
-            self._close_run("stopped")
+            self._close_run(STOPPED)
