@@ -23,7 +23,7 @@ from workbench.sim.session import Session
 
 from .algorithms import load_algorithm
 from .driving import Driving, algorithm_driving, record_fields
-from .fsm import bind_sensors, preset_sensors
+from .fsm import FsmRuntimeError, bind_sensors, preset_sensors
 from .fsmfile import parse_param_overrides
 from .lifecycle import Run, ending, record_file
 
@@ -50,6 +50,11 @@ RESULT_KEYS = (
 
 class RunSetupError(ValueError):
     """The run cannot start: a bad maze, algorithm, sensor, parameter or noise setting."""
+
+
+class RunFailed(ValueError):
+    """The run ended in an error: an algorithm's guard or action failed (its record, if any,
+    reads as a run cut off)."""
 
 
 class Pilot(Protocol):
@@ -223,16 +228,19 @@ def run(spec: RunSpec) -> RunResult:
         session, recorder, **record_fields(driving.driver, driving), max_time=ready.max_time
     )
     try:
-        metrics = session.run(
-            ready.max_time,
-            # a program stopped past its limits never moves again: the run ends there (the
-            # session's steps end at the exit and at the limit themselves)
-            given_up=(
-                (lambda: ending(session, driving) is not None)
-                if driving.stopped is not None
-                else None
-            ),
-        )
+        try:
+            metrics = session.run(
+                ready.max_time,
+                # a program stopped past its limits never moves again: the run ends there
+                # (the session's steps end at the exit and at the limit themselves)
+                given_up=(
+                    (lambda: ending(session, driving) is not None)
+                    if driving.stopped is not None
+                    else None
+                ),
+            )
+        except FsmRuntimeError as exc:  # as at the station, the run ends in an error
+            raise RunFailed(f"the run failed after {session.world.time:.2f} s: {exc}") from None
         cut = bool(session.maze.exits) and not metrics.reached_exit
         the_run.end(final_state=driving.controller.state, cut_by_limit=cut)
     finally:
