@@ -21,7 +21,8 @@ WEB = str(MAZES / "web.txt")
 
 
 def _after(marker: Path, value: str):
-    """A job that waits for ``marker`` (written by another job) before it answers."""
+    """A job that waits for ``marker`` (written when the runner has told of another job's
+    end) before it answers."""
 
     def work(reply: Reply) -> None:
         give_up = time.monotonic() + DEADLINE
@@ -32,27 +33,29 @@ def _after(marker: Path, value: str):
     return work
 
 
-def _writes(marker: Path, value: str):
+def _answers(value: str):
     def work(reply: Reply) -> None:
-        marker.write_text("done")
         reply.result(0, value)
 
     return work
 
 
 def test_outcomes_come_in_the_jobs_order_whatever_finishes_first(tmp_path):
-    marker = tmp_path / "second-done"
+    marker = tmp_path / "third-told"
     seen: list[int] = []
+
+    def progress(done: int, total: int, index: int) -> None:
+        seen.append(index)
+        if index == 2:
+            marker.write_text("told")  # the first job answers only after this
+
     known = Outcome(began=False, stopped="cannot run")
     outcomes = run_jobs(
-        [_after(marker, "first"), known, _writes(marker, "second")],
-        WORDS,
-        workers=2,
-        progress=lambda done, total, index: seen.append(index),
+        [_after(marker, "first"), known, _answers("third")], WORDS, workers=2, progress=progress
     )
-    assert [o.results.get(0) for o in outcomes] == ["first", None, "second"]
+    assert [o.results.get(0) for o in outcomes] == ["first", None, "third"]
     assert outcomes[1] is known
-    # the known outcome at once, then the second job before the first that waited for it
+    # the known outcome at once, then the third job, then the first that waited for it
     assert seen == [1, 2, 0]
 
 
@@ -67,14 +70,14 @@ def _entrant(name: str, attack: str) -> Entrant:
 
 
 @pytest.mark.parametrize(
-    ("attack", "reason"),
+    ("attack", "deadline", "reason"),
     [
-        ("crash", "the run's process was ended by SIGSEGV"),
-        ("hog", "used more than 300 MiB of memory, the cap for one run"),
-        ("sleeper", "stopped after 3 s of wall-clock time, the limit for one run"),
+        ("crash", 60, "the run's process was ended by SIGSEGV"),
+        ("hog", 60, "used more than 300 MiB of memory, the cap for one run"),
+        ("sleeper", 3, "stopped after 3 s of wall-clock time, the limit for one run"),
     ],
 )
-def test_a_run_that_attacks_its_process_ends_the_evaluation_naming_it(attack, reason):
+def test_a_run_that_attacks_its_process_ends_the_evaluation_naming_it(attack, deadline, reason):
     with pytest.raises(EvalError) as raised:
         evaluate(
             [WEB],
@@ -83,7 +86,7 @@ def test_a_run_that_attacks_its_process_ends_the_evaluation_naming_it(attack, re
             profile="web",
             jobs=2,
             others=[_entrant("rogue", attack)],
-            limits=Limits(deadline=3, memory=300),
+            limits=Limits(deadline=deadline, memory=300),
         )
     assert str(raised.value) == f"rogue on {WEB}, seed 1: {reason}"
 
