@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from workbench.sim.record import CAPPED, TOO_FAST, Recorder, RecordStop
+from workbench.sim.record import KEEPS_SUMMARY, Recorder, RecordStop
 from workbench.sim.session import Session
 
 from .driving import Driving
@@ -31,9 +31,6 @@ RESET = "reset"
 MAZE_CHANGED = "maze changed"
 #: an algorithm failed, or a program stopped itself past its limits
 ERROR = "error"
-
-#: the stops after which a record still takes its summary (the record goes on to the end)
-_KEEPS_SUMMARY = (CAPPED, TOO_FAST)
 
 
 @dataclass(frozen=True)
@@ -116,7 +113,7 @@ class Run:
         if recorder is None or recorder.stopped is None or self._told:
             return None
         stop = self._tell(recorder)
-        if stop.reason not in _KEEPS_SUMMARY:
+        if stop.reason not in KEEPS_SUMMARY:
             self.close()
         return stop
 
