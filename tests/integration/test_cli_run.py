@@ -7,6 +7,7 @@ from pathlib import Path
 import pytest
 
 from workbench.cli import main
+from workbench.sim.record import read_record
 
 
 def test_run_prints_a_readable_summary_and_exits_0_when_out(capsys):
@@ -174,3 +175,40 @@ def test_a_bundled_maze_is_found_by_its_name(tmp_path, capsys, monkeypatch):
     (tmp_path / "web").write_text("not a maze")  # a file of that name is what is meant
     assert main(["run", "--maze", "web", "--algorithm", "right-wall"]) == 2
     assert "web" in capsys.readouterr().err
+
+
+#: an algorithm whose guard divides by zero at its first control tick after the start
+FAILING_GUARD = """\
+name: divider
+description: a guard that divides by the difference of a reading with itself
+sensors:
+  front: {kind: distance, mount: front, port: 1}
+initial: go
+states:
+  go:
+    on_enter:
+      - move: 1
+    transitions:
+      - when: "1 / (front - front) > 0"
+        to: go
+"""
+
+
+def test_a_guard_failing_mid_run_is_a_clear_error_and_the_record_reads_as_cut_off(tmp_path, capsys):
+    algorithm = tmp_path / "divider.yaml"
+    algorithm.write_text(FAILING_GUARD)
+    record = tmp_path / "run.jsonl"
+    assert main(["run", "--maze", "mazes/web.txt", "--algorithm", str(algorithm),
+                 "--record", str(record)]) == 2  # fmt: skip
+    err = capsys.readouterr().err
+    assert err.startswith("workbench run: the run failed after 0.10 s: divider, state go: guard")
+    assert "division by zero" in err and "Traceback" not in err
+    cut = read_record(record)
+    assert cut.summary is None and cut.ticks[0]["state"] == "go"
+    # in a matrix the failing entrant is named with its maze and seed, and nothing is ranked
+    args = ["eval", "--maze", "mazes/web.txt", "--algorithm", "right-wall", str(algorithm),
+            "--seeds", "1", "--jobs", "2"]  # fmt: skip
+    assert main(args) == 2
+    out, err = capsys.readouterr()
+    assert out == ""
+    assert err.startswith(f"workbench eval: {algorithm} on mazes/web.txt, seed 0: the run failed")

@@ -13,6 +13,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+from workbench.control.headless import AlgorithmPilot
 from workbench.program.pilot import ProgramPilot
 
 #: the runs a ``later...`` program's process has started
@@ -42,3 +43,22 @@ class HostilePilot(ProgramPilot):
 
 def _deeper(n: int):
     return _deeper(n + 1) + 1
+
+
+@dataclass(frozen=True)
+class HostileAlgorithm(AlgorithmPilot):
+    """An algorithm's run that attacks its process as it starts: ``attack`` is ``hog``,
+    ``sleeper`` or ``crash`` (as above)."""
+
+    attack: str = ""
+
+    def drive(self, profile, sensors):
+        if self.attack == "hog":
+            hoard = []
+            while True:
+                hoard.append(bytearray(1 << 20))
+        if self.attack == "sleeper":
+            time.sleep(3600)
+        if self.attack == "crash":
+            os.kill(os.getpid(), signal.SIGSEGV)
+        return super().drive(profile, sensors)

@@ -15,7 +15,14 @@ from workbench.control.evaluate import (
     format_table,
     write_csv,
 )
-from workbench.control.headless import AlgorithmPilot, RunResult, RunSetupError, RunSpec, run
+from workbench.control.headless import (
+    AlgorithmPilot,
+    RunFailed,
+    RunResult,
+    RunSetupError,
+    RunSpec,
+    run,
+)
 from workbench.program.interp import ProgramController
 from workbench.program.keyfiles import program_keys, read_key_file
 from workbench.program.keys import KeyScriptError, parse_key_script
@@ -131,7 +138,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     )
     try:
         result = run(spec)
-    except RunSetupError as exc:
+    except (RunSetupError, RunFailed) as exc:
         print(f"workbench run: {exc}", file=sys.stderr)
         return 2
     return report(result, args.json, describe_run(args.algorithm))

@@ -17,6 +17,7 @@ import sys
 from dataclasses import dataclass, field
 from typing import Any
 
+from workbench.control.lifecycle import Run, record_file
 from workbench.files.bundled import default_maze_path
 from workbench.sim.clock import Pacer
 from workbench.sim.driver import Driver
@@ -24,7 +25,6 @@ from workbench.sim.maze import MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.noise import noise_settings
 from workbench.sim.profiles import NOISE_LEVELS, PROFILES, get_profile
-from workbench.sim.record import Recorder
 from workbench.sim.sensors import SensorConfigError, SensorSpec, check_ports
 from workbench.sim.session import Session
 from workbench.sim.world import WorldError
@@ -256,7 +256,7 @@ async def serve(the_plan: ServePlan, stop: asyncio.Event | None = None) -> int:
         _off_signals(loop, installed)
         return 1
     try:
-        recorder = Recorder(the_plan.record) if the_plan.record else None
+        recorder = record_file(the_plan.record) if the_plan.record else None
     except OSError as exc:
         print(
             f"workbench serve: {the_plan.record}: cannot write the record: {exc.strerror}",
@@ -265,10 +265,11 @@ async def serve(the_plan: ServePlan, stop: asyncio.Event | None = None) -> int:
         await endpoints.close()
         _off_signals(loop, installed)
         return 2
-    session.recorder = recorder
     config = the_plan.tcp or the_plan.ws
     assert config is not None, "a plan has TCP, a WebSocket URL or both (_endpoint_configs)"
-    session.record_header(
+    the_run = Run.start(
+        session,
+        recorder,
         driver="VIPLE",
         driven_by=Driver.viple().as_json(),
         endpoints=[_endpoint_json(status) for status in endpoints.statuses()],
@@ -289,7 +290,7 @@ async def serve(the_plan: ServePlan, stop: asyncio.Event | None = None) -> int:
         await asyncio.gather(*tasks, return_exceptions=True)
         statuses = endpoints.statuses()
         await endpoints.close()
-        _finish_record(session, statuses)
+        _finish_record(the_run, statuses)
         _off_signals(loop, installed)
     log.info("stopped: %s", status_line(session, statuses))
     return 0
@@ -362,12 +363,9 @@ def _log_setup(session: Session) -> None:
     )
 
 
-def _finish_record(session: Session, statuses: list[LinkStatus]) -> None:
-    recorder = session.recorder
-    if recorder is None:
-        return
+def _finish_record(the_run: Run, statuses: list[LinkStatus]) -> None:
     try:
-        session.record_summary(
+        the_run.end(
             endpoints=[
                 {
                     "role": s.role,
@@ -382,7 +380,7 @@ def _finish_record(session: Session, statuses: list[LinkStatus]) -> None:
             ]
         )
     finally:
-        recorder.close()
+        the_run.close()
 
 
 def _on_signals(loop: asyncio.AbstractEventLoop, callback) -> list[int]:

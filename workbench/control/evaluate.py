@@ -2,8 +2,12 @@
 seeds, in parallel.
 
 An entrant is a name and a way to make the :class:`~.headless.RunSpec` of one run (maze,
-seed); a spec checks itself before anything runs and runs itself in a worker process. An
-algorithm's entrant is made here; a VIPLE program's comes from :mod:`workbench.program.pilot`.
+seed); a spec checks itself before anything runs and runs itself in a process of its own,
+through the one parallel runner (:mod:`.parallel`: forked, behind a wall-clock deadline and a
+memory cap per run, results in the matrix's order whatever the number of workers). A run that
+crashes, hangs or blows its memory ends the evaluation with an :class:`EvalError` naming it.
+An algorithm's entrant is made here; a VIPLE program's comes from
+:mod:`workbench.program.pilot`.
 """
 
 from __future__ import annotations
@@ -11,13 +15,26 @@ from __future__ import annotations
 import csv
 import statistics
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from typing import Any
 
 from .headless import AlgorithmPilot, RunSetupError, RunSpec
+from .parallel import Job, Limits, Reply, Words, run_jobs
 
 MEASURES = ("distance_cells", "turn_degrees", "sim_time", "collisions", "touches", "turns")
+
+#: the outer wall around each run's process: a run is bounded in simulated time already, so
+#: the deadline only catches one that hangs (the largest bundled maze takes a few seconds)
+EVAL_LIMITS = Limits(deadline=600.0, memory=1024)
+#: how a run's process is said to have stopped
+WORDS = Words(
+    deadline="stopped after {deadline:g} s of wall-clock time, the limit for one run",
+    memory="used more than {memory} MiB of memory, the cap for one run",
+    no_result="the run's process ended without a result (exit status {code}); it may have "
+    "run out of its {memory} MiB of memory",
+    killed="the run's process was ended by {signal}",
+    interrupted="the evaluation was interrupted",
+)
 
 
 class EvalError(ValueError):
@@ -101,10 +118,6 @@ class EvalResult:
         }
 
 
-def _one(spec: RunSpec) -> dict[str, Any]:
-    return spec.execute()
-
-
 def _summarise(maze: str, algorithm: str, results: list[dict[str, Any]]) -> Cell:
     mean = {k: statistics.fmean(r[k] for r in results) for k in MEASURES}
     spread = {k: statistics.pstdev([r[k] for r in results]) for k in MEASURES}
@@ -124,8 +137,10 @@ def evaluate(
     jobs: int = 1,
     progress: bool | Callable[[int, int], None] = False,
     others: Sequence[Entrant] = (),
+    limits: Limits = EVAL_LIMITS,
 ) -> EvalResult:
-    """Every algorithm (by name) and every other entrant (VIPLE programs) on every maze."""
+    """Every algorithm (by name) and every other entrant (VIPLE programs) on every maze, each
+    run in a process of its own behind ``limits``."""
     entrants = [
         *(algorithm_entrant(a, profile, noise, noise_params, max_time) for a in algorithms),
         *others,
@@ -137,6 +152,7 @@ def evaluate(
         twice = sorted({n for n in names if names.count(n) > 1})
         raise EvalError(f"two entrants are named {', '.join(twice)}: give each once")
     specs = [e.spec(m, s) for m in mazes for e in entrants for s in range(seeds)]
+    what = [f"{e.name} on {m}, seed {s}" for m in mazes for e in entrants for s in range(seeds)]
     # fail fast, in this process, on inputs that cannot run at all
     for m in mazes:
         for e in entrants:
@@ -144,7 +160,7 @@ def evaluate(
                 e.spec(m, 0).check()
             except (RunSetupError, ValueError) as exc:
                 raise EvalError(f"{e.name} on {m}: {exc}") from None
-    results = _run_all(specs, jobs, progress)
+    results = _run_all(specs, what, jobs, limits, progress)
     cells = []
     for i, (m, name) in enumerate((m, n) for m in mazes for n in names):
         cells.append(_summarise(m, name, results[i * seeds : (i + 1) * seeds]))
@@ -152,28 +168,43 @@ def evaluate(
 
 
 def _run_all(
-    specs: list[RunSpec], jobs: int, progress: bool | Callable[[int, int], None]
+    specs: list[RunSpec],
+    what: list[str],
+    jobs: int,
+    limits: Limits,
+    progress: bool | Callable[[int, int], None],
 ) -> list[dict[str, Any]]:
+    """Each run's result, in the specs' order; an :class:`EvalError` names the first run (in
+    that order) that gave none, and why."""
     report = _progress_bar(len(specs)) if progress is True else progress or None
+    told = (lambda done, total, _: report(done, total)) if report else None
     try:
-        if jobs <= 1:
-            results = []
-            for spec in specs:
-                results.append(_one(spec))
-                if report:
-                    report(len(results), len(specs))
-            return results
-        with ProcessPoolExecutor(max_workers=jobs) as pool:
-            results = []
-            for r in pool.map(_one, specs, chunksize=1):
-                results.append(r)
-                if report:
-                    report(len(results), len(specs))
-            return results
+        outcomes = run_jobs([_job(spec) for spec in specs], WORDS, jobs, limits, told)
     finally:
         close = getattr(report, "close", None)
         if close:
             close()
+    results = []
+    for outcome, name in zip(outcomes, what, strict=True):
+        if 0 not in outcome.results:
+            why = outcome.refused.get(0) or outcome.stopped or "the run gave no result"
+            raise EvalError(f"{name}: {why}")
+        results.append(outcome.results[0])
+    return results
+
+
+def _job(spec: RunSpec) -> Job:
+    """One run in a process of its own: its result, or why it cannot run."""
+
+    def work(reply: Reply) -> None:
+        try:
+            result = spec.execute()
+        except (RunSetupError, ValueError) as exc:  # a program's problems too (ProgramError)
+            reply.refused(0, str(exc))
+            return
+        reply.result(0, result)
+
+    return work
 
 
 class _progress_bar:

@@ -17,14 +17,15 @@ from workbench.sim.maze import Maze, MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.noise import noise_settings
 from workbench.sim.profiles import Profile, get_profile
-from workbench.sim.record import Recorder, RecordStop
+from workbench.sim.record import RecordStop
 from workbench.sim.sensors import SensorSpec, check_ports
 from workbench.sim.session import Session
 
 from .algorithms import load_algorithm
 from .driving import Driving, algorithm_driving, record_fields
-from .fsm import bind_sensors, preset_sensors
+from .fsm import FsmRuntimeError, bind_sensors, preset_sensors
 from .fsmfile import parse_param_overrides
+from .lifecycle import Run, ending, record_file
 
 #: keys of `workbench run --json`, in this order
 RESULT_KEYS = (
@@ -49,6 +50,11 @@ RESULT_KEYS = (
 
 class RunSetupError(ValueError):
     """The run cannot start: a bad maze, algorithm, sensor, parameter or noise setting."""
+
+
+class RunFailed(ValueError):
+    """The run ended in an error: an algorithm's guard or action failed (its record, if any,
+    reads as a run cut off)."""
 
 
 class Pilot(Protocol):
@@ -174,11 +180,13 @@ def parse_noise_params(items: Sequence[str]) -> dict[str, float]:
 
 @dataclass(frozen=True)
 class Prepared:
-    """A run ready to go: its session with the driving attached, and its time limit."""
+    """A run ready to go: its session with the driving attached, its time limit and the
+    file its record goes to (None: unrecorded)."""
 
     session: Session
     driving: Driving
     max_time: float
+    record: str | None = None
 
 
 def prepare(spec: RunSpec) -> Prepared:
@@ -201,33 +209,42 @@ def prepare(spec: RunSpec) -> Prepared:
         noise = noise_settings(
             spec.noise or profile.noise, profile, **parse_noise_params(spec.noise_params)
         )
-        recorder = Recorder(spec.record) if spec.record else None
-        session = Session(maze, profile.name, sensors, noise, spec.seed, spec.dt, recorder=recorder)
+        session = Session(maze, profile.name, sensors, noise, spec.seed, spec.dt)
     except ValueError as exc:  # a bad noise setting, sensor or world (WorldError...)
         raise RunSetupError(str(exc)) from None
-    except OSError as exc:
-        raise RunSetupError(f"{exc.filename}: cannot write the record: {exc.strerror}") from None
     session.attach(driving.controller, driving.bind(sensors), driving.driver)
     max_time = spec.max_time or default_max_time(maze, profile, session.world.cell)
-    return Prepared(session, driving, max_time)
+    return Prepared(session, driving, max_time, spec.record)
 
 
 def run(spec: RunSpec) -> RunResult:
     ready = prepare(spec)
     session, driving = ready.session, ready.driving
-    session.record_header(**record_fields(driving.driver, driving), max_time=ready.max_time)
     try:
-        stopped = driving.stopped
-        metrics = session.run(
-            ready.max_time,
-            # a program stopped past its limits never moves again: the run ends there
-            given_up=(lambda: stopped() is not None) if stopped is not None else None,
-        )
+        recorder = record_file(ready.record) if ready.record else None
+    except OSError as exc:
+        raise RunSetupError(f"{exc.filename}: cannot write the record: {exc.strerror}") from None
+    the_run = Run.start(
+        session, recorder, **record_fields(driving.driver, driving), max_time=ready.max_time
+    )
+    try:
+        try:
+            metrics = session.run(
+                ready.max_time,
+                # a program stopped past its limits never moves again: the run ends there
+                # (the session's steps end at the exit and at the limit themselves)
+                given_up=(
+                    (lambda: ending(session, driving) is not None)
+                    if driving.stopped is not None
+                    else None
+                ),
+            )
+        except FsmRuntimeError as exc:  # as at the station, the run ends in an error
+            raise RunFailed(f"the run failed after {session.world.time:.2f} s: {exc}") from None
         cut = bool(session.maze.exits) and not metrics.reached_exit
-        session.record_summary(final_state=driving.controller.state, cut_by_limit=cut)
+        the_run.end(final_state=driving.controller.state, cut_by_limit=cut)
     finally:
-        if session.recorder is not None:
-            session.recorder.close()
+        the_run.close()
     return RunResult(
         spec=spec,
         maze=session.maze,
@@ -236,5 +253,5 @@ def run(spec: RunSpec) -> RunResult:
         metrics=metrics.as_dict(),
         cut_by_limit=cut,
         max_time=ready.max_time,
-        record_stop=session.recorder.stopped if session.recorder is not None else None,
+        record_stop=the_run.record_stop,
     )

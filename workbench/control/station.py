@@ -20,7 +20,7 @@ from workbench.sim.maze import Maze
 from workbench.sim.metrics import Metrics
 from workbench.sim.noise import NoiseSettings
 from workbench.sim.profiles import get_profile
-from workbench.sim.record import CAPPED, TOO_FAST, Recorder
+from workbench.sim.record import RecordStop
 from workbench.sim.sensors import (
     KINDS,
     MOUNTS,
@@ -35,8 +35,9 @@ from .algorithms import load_algorithm
 from .driving import Driving, algorithm_driving, record_fields
 from .fsm import FsmController, FsmDefinition, FsmRuntimeError, bind_sensors, preset_sensors
 from .fsmfile import parse_param_overrides
+from .lifecycle import ERROR, EXIT, MAZE_CHANGED, RESET, STOPPED, Run, ending
 from .manual import exact_move, key_command
-from .recording import RecordQuota, RecordTrouble, open_record, record_stopped
+from .recording import RecordQuota, RecordTrouble, record_stopped
 
 #: the sensor presets of the course's simulators (Web Simulator panel, Unity simulator)
 PRESETS: dict[str, tuple[SensorSpec, ...]] = {
@@ -67,7 +68,8 @@ class RunEntry:
     profile: str
     seed: int
     metrics: Metrics
-    ended: str  # "exit", "stopped", "reset", "maze changed"
+    #: how it ended: EXIT, STOPPED, RESET, MAZE_CHANGED or ERROR (:mod:`.lifecycle`)
+    ended: str
     record: str | None = None
     #: the FSM file of the algorithm, or the program file, that drove (None for keys and VIPLE)
     source: str | None = None
@@ -285,7 +287,6 @@ class LabStation:
     #: commands the live VIPLE program sent while the station was paused (held, not applied)
     held_count: int = 0
     _held: list[Command] = field(default_factory=list)
-    _run_open: bool = False
     _run_driver: Driver = BY_KEYS
     _run_source: str | None = None
     _run_attempt: str = ""
@@ -297,10 +298,8 @@ class LabStation:
     _viple_now: VipleConnection | None = None
     #: the odometry (distance, degrees) last counted into :attr:`_viple_now`
     _viple_mark: tuple[float, float] = (0.0, 0.0)
-    _recorder: Recorder | None = None
-    _record_path: str | None = None
-    #: the record stopped mid-run, and the person at the station was told
-    _record_stop_told: bool = False
+    #: the run under way (its record, how it ends: :mod:`.lifecycle`), None between runs
+    _run: Run | None = None
     #: paused because the robot got out: the next drive, reset, start or maze goes on
     _held_at_exit: bool = False
 
@@ -391,25 +390,23 @@ class LabStation:
             self.on_activity()
 
     def _algorithm_failed(self, exc: FsmRuntimeError) -> None:
-        self.stop("error")
+        self.stop(ERROR)
         self.pause()
         self.notice = Notice(ALGORITHM_FAILED, str(exc))
 
     def _after_steps(self) -> None:
         self._count_viple()
-        driving = self.driving
-        why = driving.stopped() if driving is not None and driving.stopped is not None else None
-        if why is not None:
-            self.stop("error")
+        over = ending(self.session, self.driving)
+        if over is not None and over.kind == ERROR:
+            self.stop(ERROR)
             self.pause()
-            self.notice = Notice(PROGRAM_STOPPED, why)
-        recorder = self._recorder
-        if recorder is not None and recorder.stopped is not None and not self._record_stop_told:
-            self._tell_record_stopped(recorder)  # the run goes on unrecorded
-            if recorder.stopped.reason not in (CAPPED, TOO_FAST):  # these still take a summary
-                self._drop_recorder()
-        if self._run_open and self.maze.exits and self.session.reached_exit:
-            self._close_run("exit")
+            self.notice = Notice(PROGRAM_STOPPED, over.detail)
+        run = self._run
+        stop = run.watch() if run is not None else None
+        if stop is not None:
+            self._tell_record_stopped(stop)  # the run goes on unrecorded
+        if self._run is not None and over is not None and over.kind == EXIT:
+            self._close_run(EXIT)
             self.pause()
             self._held_at_exit = True
             self.notice = Notice(OUT)
@@ -452,7 +449,7 @@ class LabStation:
         if self.session.driver == driver:
             self.session.command(Stop(), driver=NOBODY)
         if self._run_open and self._run_driver == driver:
-            self._close_run("stopped")
+            self._close_run(STOPPED)
         self.pacer.set_speed(1.0)
 
     def drive(self, cmd: Command, driver: Driver) -> bool:
@@ -480,9 +477,9 @@ class LabStation:
     def _viple_takes(self, driver: Driver) -> None:
         """The VIPLE program ``driver`` drives from now on: what drove lets go (its run ends),
         the program's driving is a run of its own, and it is seen as a connection."""
-        self.stop("stopped")  # takes the robot from the algorithm or the program file
+        self.stop(STOPPED)  # takes the robot from the algorithm or the program file
         if self._run_open and self._run_driver != driver:
-            self._close_run("stopped")
+            self._close_run(STOPPED)
         self.session.detach(driver)
         self._viple_now = self._connection(driver.role, driver.peer)
         self.viple.append(self._viple_now)
@@ -582,7 +579,7 @@ class LabStation:
         """
         if self.program_drives:
             if key == "space":
-                self.stop("stopped")
+                self.stop(STOPPED)
             else:
                 self.type_to_program(key)
             return True
@@ -591,9 +588,9 @@ class LabStation:
             return False
         self._activity()
         self._go_on_after_exit()
-        self.stop("stopped")
+        self.stop(STOPPED)
         if self._run_open and self._run_driver != BY_KEYS:
-            self._close_run("stopped")  # the keys take the robot from a VIPLE program
+            self._close_run(STOPPED)  # the keys take the robot from a VIPLE program
         self._drop_held()  # ... and from what it sent while paused
         if not self._run_open and not self.session.reached_exit:
             self._open_run(BY_KEYS)  # a run starts at the robot's last reset
@@ -671,7 +668,7 @@ class LabStation:
 
     def use_algorithm(self, definition: FsmDefinition) -> FsmDefinition:
         """Choose an algorithm already read (a lab's starter as the lab was loaded)."""
-        self.stop("stopped")
+        self.stop(STOPPED)
         self.algorithm = definition
         self.program = None
         self.overrides = {}
@@ -679,7 +676,7 @@ class LabStation:
 
     def clear_algorithm(self) -> None:
         """No algorithm chosen (the keys drive), and no parameters of one kept."""
-        self.stop("stopped")
+        self.stop(STOPPED)
         self.algorithm = None
         self.overrides = {}
 
@@ -718,7 +715,7 @@ class LabStation:
     # -- program files -------------------------------------------------------------------
     def use_program(self, choice: ProgramChoice) -> None:
         """Choose a program file to drive (the choice of algorithm is kept for later)."""
-        self.stop("stopped")
+        self.stop(STOPPED)
         self.program = choice
 
     @property
@@ -744,9 +741,9 @@ class LabStation:
         binding = driving.bind(self.sensors)
         speed = self.pacer.speed  # chosen for this run: the run before ends at 1x
         self._drop_held()
-        self.stop("stopped")
+        self.stop(STOPPED)
         if self._run_open:
-            self._close_run("stopped")
+            self._close_run(STOPPED)
         self._go_on_after_exit()
         self.session.reset()
         self.driving = driving
@@ -755,7 +752,7 @@ class LabStation:
         self.set_speed(speed)
         self.pause(False)
 
-    def stop(self, ended: str = "stopped") -> None:
+    def stop(self, ended: str = STOPPED) -> None:
         """What drives lets go of the robot, which stops; the keys drive (nothing when the
         keys or a VIPLE program over the network drive)."""
         if self.driving is None:
@@ -771,8 +768,8 @@ class LabStation:
         """Like the Unity simulator's reset button: the robot back at the start, stopped."""
         self._go_on_after_exit()
         if self._run_open:
-            self._close_run("reset")
-        self.stop("reset")
+            self._close_run(RESET)
+        self.stop(RESET)
         self._drop_held()
         self.session.reset()
         self.session.driver = BY_KEYS
@@ -800,8 +797,8 @@ class LabStation:
         """Put a (new or edited) maze on the station; the robot starts over on it."""
         self._go_on_after_exit()
         if self._run_open:
-            self._close_run("maze changed")
-        self.stop("maze changed")
+            self._close_run(MAZE_CHANGED)
+        self.stop(MAZE_CHANGED)
         self._drop_held()
         self.pacer.set_speed(1.0)
         self.maze = maze
@@ -809,8 +806,11 @@ class LabStation:
         self.session.driver = BY_KEYS
 
     # -- runs ----------------------------------------------------------------------------
+    @property
+    def _run_open(self) -> bool:
+        return self._run is not None
+
     def _open_run(self, driver: Driver) -> None:
-        self._run_open = True
         self._run_driver = driver
         self._run_source = self.driving.source if self.driving is not None else None
         driving = self.driving
@@ -822,59 +822,43 @@ class LabStation:
         self._run_attempt = self.attempt_id
         self._run_person = self.person
         self._run_sensors = {str(spec): spec for spec in self.sensors}
-        self._record_stop_told = False
-        if self.record_dir:
-            recorder, trouble = open_record(
-                self.record_dir,
-                f"run-{len(self.runs) + 1:03d}.jsonl",
-                self.record_quota,
-                self.files.workspace,
-            )
-            if trouble is not None:
-                self._recording_trouble(trouble)
-            if recorder is None:
-                return
-            self._recorder = recorder
-            self._record_path = str(recorder.path)
-            self.session.recorder = recorder
-            person = {"person": self.person} if self.person else {}
-            self.session.record_header(**record_fields(driver, self.driving), **person)
+        person = {"person": self.person} if self.person else {}
+        self._run, trouble = Run.in_folder(
+            self.session,
+            self.record_dir,
+            f"run-{len(self.runs) + 1:03d}.jsonl",
+            self.record_quota,
+            self.files.workspace,
+            **record_fields(driver, self.driving),
+            **person,
+        )
+        if trouble is not None:
+            self._recording_trouble(trouble)
 
-    def _tell_record_stopped(self, recorder: Recorder) -> None:
-        assert recorder.stopped is not None
-        self._record_stop_told = True
-        self._recording_trouble(record_stopped(str(self._record_path), recorder.stopped))
+    def _tell_record_stopped(self, stop: RecordStop) -> None:
+        run = self._run
+        path = run.path if run is not None else None
+        self._recording_trouble(record_stopped(str(path), stop))
 
     def _recording_trouble(self, trouble: RecordTrouble) -> None:
         self.notice = Notice(RECORDING, trouble.detail, trouble)
 
-    def _drop_recorder(self) -> None:
-        """The run goes on unrecorded (its record stopped); the next run tries a new one."""
-        if self._recorder is not None:
-            self._recorder.close()
-        self.session.recorder = None
-        self._recorder = None
-
     def _close_run(self, ended: str) -> None:
         """The run ends: it is kept (and its record closed), and the speed is 1x again (a
         speed chosen for one run does not carry into the next)."""
-        self._run_open = False
+        run = self._run
+        assert run is not None
         self.pacer.set_speed(1.0)
-        if ended == "exit":  # the run is over as a headless one ends: same numbers, same record
+        if ended == EXIT:  # the run is over as a headless one ends: same numbers, same record
             self.session.settle()
-        entry = self._entry(ended)
-        self.runs.append(entry)
-        recorder = self._recorder
-        if recorder is not None:
-            driving = self.driving
-            self.session.record_summary(
-                ended=ended, final_state=driving.controller.state if driving is not None else None
-            )
-            recorder.close()
-            if recorder.stopped is not None and not self._record_stop_told:
-                self._tell_record_stopped(recorder)
-            self._drop_recorder()
-        self._record_path = None
+        self.runs.append(self._entry(ended))
+        driving = self.driving
+        stop = run.end(
+            ended=ended, final_state=driving.controller.state if driving is not None else None
+        )
+        if stop is not None:
+            self._tell_record_stopped(stop)
+        self._run = None
 
     def _entry(self, ended: str) -> RunEntry:
         """The run under way as a run entry, ended as ``ended``."""
@@ -887,7 +871,7 @@ class LabStation:
             seed=self.seed,
             metrics=self.session.metrics(),
             ended=ended,
-            record=self._record_path,
+            record=self._run.path if self._run is not None else None,
             source=self._run_source,
             maze_digest=self.maze.digest(),
             attempt=self._run_attempt,
@@ -905,4 +889,4 @@ class LabStation:
     def close(self) -> None:
         """End the session: an open run is kept (with its record) as stopped."""
         if self._run_open:
-            self._close_run("stopped")
+            self._close_run(STOPPED)

@@ -78,7 +78,7 @@ RECORD_RATE = 500_000
 
 
 #: the stops after which the summary line is still written
-_KEEPS_SUMMARY = (CAPPED, TOO_FAST)
+KEEPS_SUMMARY = (CAPPED, TOO_FAST)
 
 
 @dataclass(frozen=True)
@@ -147,7 +147,7 @@ class Recorder:
         self._kept = 0
 
     def _write(self, obj: dict[str, Any], summary: bool = False, t: float | None = None) -> None:
-        if self.stopped is not None and not (summary and self.stopped.reason in _KEEPS_SUMMARY):
+        if self.stopped is not None and not (summary and self.stopped.reason in KEEPS_SUMMARY):
             return
         data = (json.dumps(obj, separators=(",", ":")) + "\n").encode()
         if self.rate is not None and t is not None:
@@ -181,7 +181,7 @@ class Recorder:
         """Hand the lines written so far to the file; a failure stops the record (with
         ``keep_going``) or raises."""
         lines, self._buffer = b"".join(self._buffer), []
-        if self.stopped is not None and self.stopped.reason not in _KEEPS_SUMMARY:
+        if self.stopped is not None and self.stopped.reason not in KEEPS_SUMMARY:
             return
         try:
             if self._stream is not None:
