@@ -13,7 +13,8 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 
 from workbench.control.fsm_expr import FUNCTIONS, ExprError, Value, compile_expr
-from workbench.sim.sensors import KINDS, MOUNTS, PORT_RANGE, SensorSpec
+from workbench.sim.sensor_kinds import KINDS, sensor_kind
+from workbench.sim.sensors import MOUNTS, PORT_RANGE, SensorSpec
 
 PROFILES = ("unity", "web", "erobotic")
 EVENTS = ("turn_done", "timer_done")
@@ -280,6 +281,15 @@ def _check_sensors(defn: FsmDefinition, add: Callable) -> None:
             add(Problem((*path, "kind"), f"unknown sensor kind {s.kind!r}", _one_of(KINDS)))
         if s.mount not in MOUNTS:
             add(Problem((*path, "mount"), f"unknown mount {s.mount!r}", _one_of(MOUNTS)))
+        elif s.kind in KINDS and s.mount not in sensor_kind(s.kind).mounts:
+            allowed = sensor_kind(s.kind).mounts
+            add(
+                Problem(
+                    (*path, "mount"),
+                    f"a {s.kind} sensor cannot be mounted {s.mount}",
+                    _one_of(allowed),
+                )
+            )
         missing = [p for p in PROFILES if s.ports.get(p) is None]
         if missing:
             add(

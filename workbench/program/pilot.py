@@ -15,6 +15,7 @@ from workbench.control.headless import RunResult, RunSetupError, RunSpec
 from workbench.files.bounded import BoundedFileError
 from workbench.sim.driver import Driver
 from workbench.sim.profiles import Profile, check_report_ms
+from workbench.sim.sensor_kinds import DISTANCE, KINDS, TOUCH, sensor_kind
 from workbench.sim.sensors import SensorSpec
 
 from . import kinds as K
@@ -26,11 +27,12 @@ from .kinds import load_kind_map
 from .loader import load_program
 from .problems import Problem, ProgramError
 
-#: which simulated sensor kinds answer each VIPLE sensor activity
-SENSOR_NEEDS = {
-    K.DISTANCE: ("distance",),
-    K.TOUCH: ("touch",),
-    K.OTHER_SENSOR: ("distance", "touch"),
+#: which simulated sensor kinds answer each VIPLE sensor activity (the first: the kind a
+#: missing sensor is added as); VIPLE's Robot Sensor reads a sensor of any kind
+SENSOR_NEEDS: dict[int, tuple[str, ...]] = {
+    K.DISTANCE: (DISTANCE.name,),
+    K.TOUCH: (TOUCH.name,),
+    K.OTHER_SENSOR: KINDS,
 }
 
 
@@ -72,10 +74,16 @@ def check_sensors(compiled: Compiled, sensors: list[SensorSpec]) -> list[Problem
                     program,
                     act,
                     f"it reads port {port}, but {have}",
-                    f"add --sensor {wanted[0]}:{port}:MOUNT (MOUNT front, right, back or left)",
+                    f"add --sensor {wanted[0]}:{port}:MOUNT (MOUNT {_either(wanted[0])})",
                 )
             )
     return problems
+
+
+def _either(kind: str) -> str:
+    """The mounts a sensor of ``kind`` allows, as "front, right, back or left"."""
+    *most, last = sensor_kind(kind).mounts
+    return f"{', '.join(most)} or {last}" if most else last
 
 
 def _problem(program, act, message: str, hint: str) -> Problem:
