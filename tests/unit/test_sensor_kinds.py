@@ -43,18 +43,15 @@ def test_every_kind_is_read_on_every_mount_it_allows_and_reported_under_its_name
 @pytest.mark.parametrize("kind", SENSOR_KINDS, ids=lambda k: k.name)
 def test_the_panel_shows_a_reading_as_its_kind_says(kind):
     web = get_profile("web")
-    shown = reading(SensorSpec(kind.name, 1, kind.mounts[0]), 1, web.unit, web.no_echo)
+    spec = SensorSpec(kind.name, 1, kind.mounts[0])
+    shown = reading(spec, 1, web.unit, web.no_echo)
     if kind.panel.states is not None:
         assert shown == kind.panel.states[1]
-        assert reading(SensorSpec(kind.name, 1, kind.mounts[0]), 0, "px", 1000) == (
-            kind.panel.states[0]
-        )
+        assert reading(spec, 0, "px", 1000) == kind.panel.states[0]
     else:
         assert shown == "1"
         if kind.panel.echo:
-            assert reading(SensorSpec(kind.name, 1, kind.mounts[0]), 1000, "px", 1000) == (
-                "no echo (1000)"
-            )
+            assert reading(spec, 1000, "px", 1000) == "no echo (1000)"
 
 
 def test_distance_and_touch_read_and_show_as_the_course_simulators_do():
