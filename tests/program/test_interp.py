@@ -214,9 +214,7 @@ def test_mapped_move_at_power_uses_the_message(tmp_path):
         ("ignore", []),
     ],
 )
-def test_each_mapped_service_sends_its_command_and_passes_the_message_on(
-    tmp_path, activity, sent
-):
+def test_each_mapped_service_sends_its_command_and_passes_the_message_on(tmp_path, activity, sent):
     b = ProgramBuilder()
     main = b.panel("Main")
     b.robot(main)
