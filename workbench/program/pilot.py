@@ -25,7 +25,7 @@ from .interp import ProgramController
 from .keys import KeyEvent, parse_key_script, typed_events
 from .kinds import load_kind_map
 from .loader import load_program
-from .problems import Problem, ProgramError
+from .problems import Problem, ProgramError, program_problem
 
 #: which simulated sensor kinds answer each VIPLE sensor activity (the first: the kind a
 #: missing sensor is added as); VIPLE's Robot Sensor reads a sensor of any kind
@@ -43,7 +43,7 @@ def load_compiled(path: str, kinds: str | None = None) -> Compiled:
         try:
             mapping = load_kind_map(kinds)
         except BoundedFileError as exc:
-            raise ProgramError([Problem(exc.path, str(exc).split(": ", 1)[1])]) from None
+            raise ProgramError([program_problem(exc.path, str(exc).split(": ", 1)[1])]) from None
     return compile_program(load_program(path, mapping))
 
 
@@ -87,7 +87,9 @@ def _either(kind: str) -> str:
 
 
 def _problem(program, act, message: str, hint: str) -> Problem:
-    return Problem(program.source, message, hint, act.panel, act.id, act.kind, program.label(act))
+    return program_problem(
+        program.source, message, hint, act.panel, act.id, act.kind, program.label(act)
+    )
 
 
 def port_binding(sensors: Sequence[SensorSpec]) -> dict[str, int]:
