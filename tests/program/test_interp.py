@@ -5,14 +5,15 @@ from __future__ import annotations
 import pytest
 
 from tests.program.builder import ProgramBuilder
+from workbench.program import kinds as K
 from workbench.program.compiled import compile_program
-from workbench.program.interp import ProgramController
+from workbench.program.interp import MAPPED_RUNS, RUNS, SENSES, ProgramController
 from workbench.program.keys import KeyScriptError, parse_key_script
 from workbench.program.kinds import parse_kind_map
 from workbench.program.loader import load_program
 from workbench.program.model import ELSE
 from workbench.program.problems import ProgramError
-from workbench.sim.commands import MoveAtPower, WheelPowers
+from workbench.sim.commands import MotorPower, MoveAtPower, TurnByDegrees, WheelPowers
 
 TICK = 0.05
 
@@ -202,6 +203,35 @@ def test_mapped_move_at_power_uses_the_message(tmp_path):
     kinds = parse_kind_map({"kinds": {47: "move-at-power"}}, "k.yaml")
     c = controller(b, tmp_path, kinds=kinds)
     assert run(c, 0.1) == [MoveAtPower(0.8)]
+
+
+@pytest.mark.parametrize(
+    ("activity", "sent"),
+    [
+        ({"activity": "turn-by-degrees", "value": 0}, [TurnByDegrees(-90.0)]),
+        ("motor-left", [MotorPower("left", 0.4)]),
+        ("motor-right", [MotorPower("right", 0.4)]),
+        ("ignore", []),
+    ],
+)
+def test_each_mapped_service_sends_its_command_and_passes_the_message_on(tmp_path, activity, sent):
+    b = ProgramBuilder()
+    main = b.panel("Main")
+    b.robot(main)
+    start = main.add(3, "0.4")
+    service = main.add(48, "-45 * 2")
+    p = main.add(28, "")
+    main.chain(start, service, p)
+    kinds = parse_kind_map({"kinds": {48: activity}}, "k.yaml")
+    c = controller(b, tmp_path, kinds=kinds)
+    assert run(c, 0.1) == sent
+    assert texts(c) == ([] if activity == "ignore" else ["0.4"])
+
+
+def test_every_activity_kind_a_program_may_hold_has_a_handler():
+    assert set(RUNS) == set(K.KNOWN)
+    assert set(MAPPED_RUNS) == set(K.MAPPABLE)
+    assert set(SENSES) == {K.TOUCH, K.DISTANCE, K.OTHER_SENSOR, K.RAW_SENSOR}
 
 
 def test_runtime_errors_name_the_activity_and_end_only_that_flow(tmp_path):

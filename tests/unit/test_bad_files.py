@@ -56,7 +56,7 @@ def test_a_nan_cell_is_refused_at_its_line_by_the_check_not_later(written):
     with pytest.raises(MazeError) as info:
         load_maze(path)
     (problem,) = info.value.problems
-    assert (problem.source, problem.line, problem.col) == (str(path), 2, 7)
+    assert (problem.source, problem.line, problem.column) == (str(path), 2, 7)
 
 
 def test_an_fsm_problem_names_line_and_column(written):

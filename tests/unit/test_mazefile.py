@@ -103,7 +103,7 @@ def test_oversized_maze_is_rejected_before_its_blocks_are_read():
         parse_maze("\n".join([row, "#S" + "." * 198 + "#", row]))
     (problem,) = info.value.problems
     assert "201 blocks wide, wider than the largest maze (200x200 blocks)" in problem.message
-    assert (problem.line, problem.col) == (1, 201)
+    assert (problem.line, problem.column) == (1, 201)
     tall = "\n".join(["#" * 5] * 201)
     with pytest.raises(MazeError, match=r"<maze>:201:1: the grid has 201 rows"):
         parse_maze(tall)

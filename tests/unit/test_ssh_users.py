@@ -79,7 +79,7 @@ def test_a_malformed_file_names_the_line_the_key_and_the_fix(text, line, where, 
         parse_users(text, "/srv/lab/ssh-users.yaml")
     problems = caught.value.problems
     assert any(
-        (p.file, p.line) == ("/srv/lab/ssh-users.yaml", line)
+        (p.source, p.line) == ("/srv/lab/ssh-users.yaml", line)
         and where in p.message
         and fix in f"{p.message} {p.hint}"
         for p in problems

@@ -56,7 +56,7 @@ def test_a_maze_name_with_a_title_escape_is_refused_with_its_place():
     with pytest.raises(MazeError) as caught:
         parse_maze(MAZE.format(name=YAML_TITLE), "hall.txt")
     (problem,) = caught.value.problems
-    assert (problem.line, problem.col) == (2, 7)
+    assert (problem.line, problem.column) == (2, 7)
     assert "'name' holds an escape character (ESC)" in problem.message
     assert "position 6" in problem.message and "remove it" in problem.hint
 

@@ -7,7 +7,7 @@ import json
 import sys
 
 from workbench.sim.generate import EXITS, STYLES, check_seed, check_size, generate
-from workbench.sim.maze import Maze, MazeError, Problem, cap_problems
+from workbench.sim.maze import Maze, MazeError, Problem, cap_problems, problem_fields
 from workbench.sim.mazefile import format_maze, write_maze
 from workbench.sim.mazeio import format_for_path, load_maze, save_maze
 from workbench.sim.mazeview import render
@@ -78,7 +78,7 @@ def check_report(maze: Maze | None, problems: list[Problem], source: str) -> dic
             shortest_path=maze.shortest_path_length() if not problems else None,
             notes=maze.notes() if not problems else [],
         )
-    report["problems"] = [p.as_dict() for p in problems]
+    report["problems"] = [problem_fields(p) for p in problems]
     return report
 
 

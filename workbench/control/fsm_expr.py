@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from typing import cast
 
 from workbench.files.bounded import digits_problem
+from workbench.files.problems import ExprError
 
 Value = float | int | bool | str
 Env = Mapping[str, Value]
@@ -74,30 +75,6 @@ MAX_DEPTH = 50
 #: the most values, names and operators (AST expression nodes) in one expression
 MAX_TERMS = 200
 _SIMPLER = "split it: keep parts in variables with a set: action"
-#: an expression shown in a message is cut to this many characters
-_SHOWN = 60
-
-
-class ExprError(ValueError):
-    """An expression that cannot be compiled or evaluated; ``column`` is 1-based in ``text``."""
-
-    def __init__(
-        self, message: str, text: str = "", column: int | None = None, hint: str = ""
-    ) -> None:
-        self.message = message
-        self.text = text
-        self.column = column
-        self.hint = hint
-        super().__init__(str(self))
-
-    def __str__(self) -> str:
-        where = ""
-        if self.text:
-            shown = self.text if len(self.text) <= _SHOWN else self.text[: _SHOWN - 3] + "..."
-            where = f" in {shown!r}"
-            if self.column is not None:
-                where += f" at column {self.column}"
-        return f"{self.message}{where}" + (f" ({self.hint})" if self.hint else "")
 
 
 @dataclass(frozen=True, eq=False)
@@ -129,7 +106,7 @@ def compile_expr(
     body = text.lstrip()
     lead = len(text) - len(body)
     if not body.strip():
-        raise ExprError("empty expression", text, None, "write a value or a condition")
+        raise ExprError("empty expression", None, "write a value or a condition", text)
     _prescan(text, lead)
     try:
         with warnings.catch_warnings():
@@ -139,15 +116,15 @@ def compile_expr(
             tree = ast.parse(body, mode="eval")
     except SyntaxError as exc:
         col = (exc.offset or 1) + lead if (exc.lineno or 1) == 1 else exc.offset
-        raise ExprError(f"bad syntax: {exc.msg}", text, col, _syntax_hint(body)) from None
+        raise ExprError(f"bad syntax: {exc.msg}", col, _syntax_hint(body), text) from None
     except (RecursionError, MemoryError):
-        raise ExprError("the expression is too complex to read", text, None, _SIMPLER) from None
+        raise ExprError("the expression is too complex to read", None, _SIMPLER, text) from None
     compiler = _Compiler(text, lead, names, constants or {})
     _check_size(compiler, tree.body)
     try:
         kind, payload = compiler.node(tree.body)
     except (RecursionError, MemoryError):
-        raise ExprError("the expression is too complex to read", text, None, _SIMPLER) from None
+        raise ExprError("the expression is too complex to read", None, _SIMPLER, text) from None
     fn = _as_fn(kind, payload)
     return Expr(text, frozenset(compiler.read), fn, kind == "const")
 
@@ -158,14 +135,14 @@ def _prescan(text: str, lead: int) -> None:
     if len(text) > MAX_LENGTH:
         raise ExprError(
             f"the expression is {len(text):,} characters long; at most {MAX_LENGTH:,}",
-            text,
             MAX_LENGTH + 1,
             _SIMPLER,
+            text,
         )
     nul = text.find("\x00")
     if nul >= 0:
         # Python's parser refuses it too, with another error on some 3.11 releases
-        raise ExprError("a NUL character (code 0)", text, nul + 1, "delete it and type the text")
+        raise ExprError("a NUL character (code 0)", nul + 1, "delete it and type the text", text)
     pending = [0]  # unary operators not yet closed, per open bracket
     operand_before = False
     i = lead
@@ -180,7 +157,7 @@ def _prescan(text: str, lead: int) -> None:
             i = _number_end(text, i)
             reason = digits_problem(text[start:i])
             if reason is not None:
-                raise ExprError(reason, text, start + 1, "write the value with fewer digits")
+                raise ExprError(reason, start + 1, "write the value with fewer digits", text)
             operand_before = True
             continue
         if ch.isalpha() or ch == "_":
@@ -216,9 +193,9 @@ def _prescan(text: str, lead: int) -> None:
         if len(pending) - 1 + sum(pending) > MAX_DEPTH:
             raise ExprError(
                 f"brackets and unary operators nest more than {MAX_DEPTH} deep",
-                text,
                 start + 1,
                 _SIMPLER,
+                text,
             )
 
 
@@ -323,7 +300,7 @@ class _Compiler:
             line = 1
         if col is not None:
             col += 1 + (self.lead if line == 1 else 0)
-        return ExprError(message, self.text, col, hint)
+        return ExprError(message, col, hint, self.text)
 
     def node(self, node: ast.AST) -> _Node:
         method = getattr(self, "_" + type(node).__name__, None)

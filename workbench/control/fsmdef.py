@@ -13,7 +13,9 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 
 from workbench.control.fsm_expr import FUNCTIONS, ExprError, Value, compile_expr
-from workbench.sim.sensors import KINDS, MOUNTS, PORT_RANGE, SensorSpec
+from workbench.files.problems import Problem
+from workbench.sim.sensor_kinds import KINDS, sensor_kind
+from workbench.sim.sensors import MOUNTS, PORT_RANGE, SensorSpec
 
 PROFILES = ("unity", "web", "erobotic")
 EVENTS = ("turn_done", "timer_done")
@@ -36,23 +38,12 @@ class SensorBindingError(FsmError):
     """The robot lacks a sensor the FSM reads."""
 
 
-@dataclass(frozen=True)
-class Problem:
-    """One thing wrong with a definition; ``path`` locates it, e.g. ("states", "Forward", "to")."""
-
-    path: tuple[str | int, ...]
-    message: str
-    hint: str = ""
-    column: int | None = None
-
-    def where(self) -> str:
-        out = ""
-        for part in self.path:
-            out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else str(part))
-        return out
-
-    def __str__(self) -> str:
-        return f"{self.where()}: {self.message}" + (f" ({self.hint})" if self.hint else "")
+def _at(
+    path: tuple[str | int, ...], message: str, hint: str = "", column: int | None = None
+) -> Problem:
+    """A problem of a definition: ``path`` locates it, e.g. ("states", "Forward", "to"), and
+    ``column`` (from 1), when given, is the column inside the value there."""
+    return Problem(message, hint, path=path, column=column or 0)
 
 
 class FsmDefinitionError(FsmError):
@@ -210,14 +201,14 @@ def check_definition(defn: FsmDefinition) -> list[Problem]:
     problems: list[Problem] = []
     add = problems.append
     if not defn.states:
-        add(Problem(("states",), "no states are defined", "add at least one state"))
+        add(_at(("states",), "no states are defined", "add at least one state"))
     names = [s.name for s in defn.states]
     for i, name in enumerate(names):
         if name in names[:i]:
-            add(Problem(("states", name), f"state {name!r} is defined twice", "rename one"))
+            add(_at(("states", name), f"state {name!r} is defined twice", "rename one"))
     if defn.states and defn.initial not in names:
         add(
-            Problem(
+            _at(
                 ("initial",),
                 f"the initial state {defn.initial!r} is not defined"
                 if defn.initial
@@ -250,7 +241,7 @@ def check_definition(defn: FsmDefinition) -> list[Problem]:
             path = (*base, "transitions", j)
             if tr.target not in names:
                 add(
-                    Problem(
+                    _at(
                         (*path, "to"),
                         f"unknown state {tr.target!r} in to:",
                         _choices_hint(tr.target, names, "states"),
@@ -265,11 +256,11 @@ def check_definition(defn: FsmDefinition) -> list[Problem]:
 def _check_name(group: str, name: str, declared: dict[str, str], add: Callable) -> None:
     path = (group, name, "@key")
     if not name.isidentifier() or keyword.iskeyword(name):
-        add(Problem(path, f"{name!r} cannot be used as a name", "use letters, digits and _"))
+        add(_at(path, f"{name!r} cannot be used as a name", "use letters, digits and _"))
     elif name in RESERVED:
-        add(Problem(path, f"{name!r} is reserved", "choose another name"))
+        add(_at(path, f"{name!r} is reserved", "choose another name"))
     elif name in declared:
-        add(Problem(path, f"{name!r} is already declared under {declared[name]}", "rename one"))
+        add(_at(path, f"{name!r} is already declared under {declared[name]}", "rename one"))
     declared.setdefault(name, group)
 
 
@@ -277,13 +268,22 @@ def _check_sensors(defn: FsmDefinition, add: Callable) -> None:
     for s in defn.sensors:
         path = ("sensors", s.name)
         if s.kind not in KINDS:
-            add(Problem((*path, "kind"), f"unknown sensor kind {s.kind!r}", _one_of(KINDS)))
+            add(_at((*path, "kind"), f"unknown sensor kind {s.kind!r}", _one_of(KINDS)))
         if s.mount not in MOUNTS:
-            add(Problem((*path, "mount"), f"unknown mount {s.mount!r}", _one_of(MOUNTS)))
+            add(_at((*path, "mount"), f"unknown mount {s.mount!r}", _one_of(MOUNTS)))
+        elif s.kind in KINDS and s.mount not in sensor_kind(s.kind).mounts:
+            allowed = sensor_kind(s.kind).mounts
+            add(
+                _at(
+                    (*path, "mount"),
+                    f"a {s.kind} sensor cannot be mounted {s.mount}",
+                    _one_of(allowed),
+                )
+            )
         missing = [p for p in PROFILES if s.ports.get(p) is None]
         if missing:
             add(
-                Problem(
+                _at(
                     (*path, "port"),
                     f"no port for profile {', '.join(missing)}",
                     "give one port number, or one per profile",
@@ -298,7 +298,7 @@ def _check_sensors(defn: FsmDefinition, add: Callable) -> None:
                 bad.setdefault(port, []).append(profile)
         for wrong, profiles in bad.items():
             add(
-                Problem(
+                _at(
                     (*path, "port", profiles[0]),
                     f"port {wrong!r} ({', '.join(profiles)}) is not a whole number from "
                     f"{PORT_RANGE.start} to {PORT_RANGE.stop - 1}",
@@ -307,7 +307,7 @@ def _check_sensors(defn: FsmDefinition, add: Callable) -> None:
         for profile in s.ports:
             if profile not in PROFILES:
                 add(
-                    Problem(
+                    _at(
                         (*path, "port", profile, "@key"),
                         f"unknown profile {profile!r}",
                         _one_of(PROFILES),
@@ -324,7 +324,7 @@ def _check_sensors(defn: FsmDefinition, add: Callable) -> None:
                 owner[port] = s.name
     for (name, port, other), profiles in clashes.items():
         add(
-            Problem(
+            _at(
                 ("sensors", name, "port"),
                 f"port {port} ({', '.join(profiles)}) is also used by sensor {other!r}",
                 "give each sensor its own port",
@@ -337,15 +337,15 @@ def _check_parameters(defn: FsmDefinition, add: Callable) -> None:
         path = ("parameters", p.name)
         lo, hi = p.minimum, p.maximum
         if lo is not None and hi is not None and lo > hi:
-            add(Problem((*path, "min"), f"min {lo:g} is above max {hi:g}", "swap them"))
+            add(_at((*path, "min"), f"min {lo:g} is above max {hi:g}", "swap them"))
         for profile, value in p.defaults.items():
             where = (*path, "default", profile)
             if profile not in PROFILES:
-                add(Problem((*where, "@key"), f"unknown profile {profile!r}", _one_of(PROFILES)))
+                add(_at((*where, "@key"), f"unknown profile {profile!r}", _one_of(PROFILES)))
             elif lo is not None and value < lo:
-                add(Problem(where, f"default {value:g} ({profile}) is below min {lo:g}"))
+                add(_at(where, f"default {value:g} ({profile}) is below min {lo:g}"))
             elif hi is not None and value > hi:
-                add(Problem(where, f"default {value:g} ({profile}) is above max {hi:g}"))
+                add(_at(where, f"default {value:g} ({profile}) is above max {hi:g}"))
 
 
 def _check_action(
@@ -357,7 +357,7 @@ def _check_action(
     elif isinstance(action, MotorAction):
         if action.wheel not in ("left", "right"):
             add(
-                Problem(
+                _at(
                     (*path, "motor", "wheel"),
                     f"unknown wheel {action.wheel!r}",
                     "use left or right",
@@ -384,7 +384,7 @@ def _check_assignments(
     for var, text in pairs:
         if var not in variables:
             add(
-                Problem(
+                _at(
                     (*path, var, "@key"),
                     f"{var!r} is not a variable",
                     f"declare it under variables: ({var}: 0)"
@@ -399,7 +399,7 @@ def _check_expr(path: tuple, text: str, names: set[str], add: Callable) -> None:
     try:
         compile_expr(text, names)
     except ExprError as exc:
-        add(Problem(path, exc.message, exc.hint, exc.column))
+        add(_at(path, exc.message, exc.hint, exc.column))
 
 
 def _one_of(options: Iterable[str]) -> str:

@@ -46,7 +46,12 @@ from workbench.files.bounded import (
     read_text,
 )
 from workbench.files.terminal import terminal_problem
-from workbench.files.yamlread import FileProblem, problem_list
+from workbench.files.yamlread import (
+    file_problem,
+    problem_list,
+    refused_problem,
+    syntax_problem,
+)
 
 TOP_KEYS = ("name", "description", "sensors", "parameters", "variables", "initial", "states")
 SENSOR_KEYS = ("kind", "mount", "port")
@@ -79,14 +84,14 @@ class FsmFileError(ValueError):
     """An FSM file that cannot be used; ``problems`` lists every problem found (a long list
     is cut after :data:`~workbench.files.bounded.MAX_PROBLEMS`, saying how many more)."""
 
-    def __init__(self, problems: list[FileProblem]) -> None:
+    def __init__(self, problems: list[Problem]) -> None:
         self.problems = problem_list(problems)
         super().__init__("\n".join(str(p) for p in self.problems))
 
     @classmethod
     def refused(cls, exc: BoundedFileError) -> FsmFileError:
         """The error of a file refused by the bounded reader."""
-        return cls([FileProblem.refused(exc)])
+        return cls([refused_problem(exc)])
 
 
 def load_fsm(path: str | Path) -> FsmDefinition:
@@ -106,15 +111,15 @@ def loads_fsm(text: str, filename: str = "<text>") -> FsmDefinition:
     except BoundedFileError as exc:
         raise FsmFileError.refused(exc) from None
     except yaml.YAMLError as exc:
-        raise FsmFileError([FileProblem.syntax(filename, exc)]) from None
+        raise FsmFileError([syntax_problem(filename, exc)]) from None
     if root is None:
         raise FsmFileError(
-            [FileProblem(filename, 1, 1, "the file is empty", "start with name: and states:")]
+            [file_problem(filename, 1, 1, "the file is empty", "start with name: and states:")]
         )
     if not isinstance(root, MappingNode):
         mark = root.start_mark
         message = "an FSM file must be a mapping with name:, initial: and states:"
-        raise FsmFileError([FileProblem(filename, mark.line + 1, mark.column + 1, message)])
+        raise FsmFileError([file_problem(filename, mark.line + 1, mark.column + 1, message)])
     reader = _Reader(filename)
     definition = reader.definition(root)
     for problem in check_definition(definition):
@@ -174,7 +179,7 @@ class _Reader:
 
     def __init__(self, filename: str) -> None:
         self.filename = filename
-        self.problems: list[FileProblem] = []
+        self.problems: list[Problem] = []
         self.nodes: dict[tuple, Node] = {}
         self.reported: set[tuple] = set()
         self.constructor = SafeConstructor()
@@ -184,7 +189,7 @@ class _Reader:
     def report(self, node: Node, message: str, hint: str = "", path: tuple = ()) -> None:
         mark = node.start_mark
         self.problems.append(
-            FileProblem(self.filename, mark.line + 1, mark.column + 1, message, hint)
+            file_problem(self.filename, mark.line + 1, mark.column + 1, message, hint)
         )
         if path:
             self.reported.add(path)
@@ -202,13 +207,13 @@ class _Reader:
         node = node or self.nodes[()]
         line, col = node.start_mark.line + 1, node.start_mark.column + 1
         if (
-            problem.column is not None
+            problem.column
             and isinstance(node, ScalarNode)
             and node.style in (None, "'", '"')
             and node.start_mark.line == node.end_mark.line
         ):
             col += problem.column - 1 + (1 if node.style else 0)
-        self.problems.append(FileProblem(self.filename, line, col, problem.message, problem.hint))
+        self.problems.append(file_problem(self.filename, line, col, problem.message, problem.hint))
 
     # -- typed access ---------------------------------------------------------------------
 

@@ -21,8 +21,8 @@ from workbench.sim.metrics import Metrics
 from workbench.sim.noise import NoiseSettings
 from workbench.sim.profiles import get_profile
 from workbench.sim.record import RecordStop
+from workbench.sim.sensor_kinds import KINDS, PANEL_KINDS, sensor_kind
 from workbench.sim.sensors import (
-    KINDS,
     MOUNTS,
     PORT_RANGE,
     SensorConfigError,
@@ -45,8 +45,6 @@ PRESETS: dict[str, tuple[SensorSpec, ...]] = {
     "web-wall-following": (SensorSpec("distance", 1, "right"), SensorSpec("touch", 2, "front")),
     "web-two-distance": (SensorSpec("distance", 3, "front"),),
 }
-#: the rows the Web Simulator's sensor panel always offers: two distance sensors and one touch
-PANEL_KINDS = ("distance", "distance", "touch")
 
 
 @dataclass(frozen=True)
@@ -224,6 +222,9 @@ def check_sensor_rows(rows: Sequence[SensorRow]) -> tuple[list[SensorSpec], dict
             continue
         if row.mount not in MOUNTS:
             errors[i] = f"unknown mount {row.mount!r}"
+            continue
+        if row.mount not in sensor_kind(row.kind).mounts:
+            errors[i] = f"a {row.kind} sensor cannot be mounted {row.mount}"
             continue
         if port in owner:
             errors[i] = f"port {port} is already used by row {owner[port] + 1}"
@@ -618,8 +619,9 @@ class LabStation:
     def sensor_rows(self) -> list[SensorRow]:
         """The live sensors as panel rows, padded like the Web Simulator's panel.
 
-        The panel always offers two distance sensors and one touch sensor: kinds the robot
-        lacks are added unmounted, each on the lowest port no other row uses.
+        The panel always offers the rows of ``PANEL_KINDS`` (two distance sensors and one
+        touch sensor, as the sensor kinds' table says): kinds the robot lacks are added
+        unmounted, each on the lowest port no other row uses.
         """
         rows = [SensorRow(s.kind, str(s.port), s.mount) for s in self.sensors]
         used = {s.port for s in self.sensors}

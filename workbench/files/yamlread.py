@@ -11,13 +11,13 @@ raises the file kind's error with every problem found.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass
 from typing import NoReturn, TypeVar
 
 import yaml
 from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
 from .bounded import BoundedFileError, capped, more_problems
+from .problems import Problem
 
 T = TypeVar("T")
 E = TypeVar("E", bound=Exception)
@@ -25,39 +25,31 @@ E = TypeVar("E", bound=Exception)
 _NULL = "tag:yaml.org,2002:null"
 
 
-@dataclass(frozen=True)
-class FileProblem:
-    """One problem of a file: where (line and column from 1; 0 when it is the whole file),
-    what is wrong, and how to fix it."""
+def file_problem(file: str, line: int, column: int, message: str, hint: str = "") -> Problem:
+    """A problem of a file read here: where (line and column from 1; 0 when it is the whole
+    file), what is wrong, and how to fix it, written ``file:line:column: what (hint: fix)``."""
+    return Problem(message, hint, file, line, column, hint_word="hint")
 
-    file: str
-    line: int
-    column: int
-    message: str
-    hint: str = ""
 
-    def __str__(self) -> str:
-        where = f"{self.file}:{self.line}:{self.column}" if self.line else self.file
-        return f"{where}: {self.message}" + (f" (hint: {self.hint})" if self.hint else "")
+def refused_problem(exc: BoundedFileError) -> Problem:
+    """The problem of a file the bounded reader refused."""
+    line, column = exc.line or 0, exc.column or (1 if exc.line else 0)
+    return file_problem(exc.path, line, column, exc.message, exc.hint)
 
-    @classmethod
-    def refused(cls, exc: BoundedFileError) -> FileProblem:
-        """The problem of a file the bounded reader refused."""
-        line, column = exc.line or 0, exc.column or (1 if exc.line else 0)
-        return cls(exc.path, line, column, exc.message, exc.hint)
 
-    @classmethod
-    def syntax(cls, file: str, exc: yaml.YAMLError, hint: str = "") -> FileProblem:
-        """The problem of text that is not valid YAML, at the parser's mark, with a hint for
-        the usual slips (``hint`` when none fits)."""
-        if not isinstance(exc, yaml.MarkedYAMLError):
-            return cls(file, 1, 1, f"YAML syntax: {exc}", hint)
-        mark = exc.problem_mark or exc.context_mark
-        message = exc.problem or "cannot be parsed"
-        if exc.context:
-            message = f"{exc.context}: {message}"
-        line, column = (mark.line + 1, mark.column + 1) if mark is not None else (1, 1)
-        return cls(file, line, column, f"YAML syntax: {message}", _syntax_hint(message) or hint)
+def syntax_problem(file: str, exc: yaml.YAMLError, hint: str = "") -> Problem:
+    """The problem of text that is not valid YAML, at the parser's mark, with a hint for the
+    usual slips (``hint`` when none fits)."""
+    if not isinstance(exc, yaml.MarkedYAMLError):
+        return file_problem(file, 1, 1, f"YAML syntax: {exc}", hint)
+    mark = exc.problem_mark or exc.context_mark
+    message = exc.problem or "cannot be parsed"
+    if exc.context:
+        message = f"{exc.context}: {message}"
+    line, column = (mark.line + 1, mark.column + 1) if mark is not None else (1, 1)
+    return file_problem(
+        file, line, column, f"YAML syntax: {message}", _syntax_hint(message) or hint
+    )
 
 
 def _syntax_hint(message: str) -> str:
@@ -72,13 +64,13 @@ def _syntax_hint(message: str) -> str:
     return ""
 
 
-def problem_list(problems: Iterable[FileProblem]) -> list[FileProblem]:
+def problem_list(problems: Iterable[Problem]) -> list[Problem]:
     """``problems``, cut after :data:`~workbench.files.bounded.MAX_PROBLEMS` saying how many
     more."""
     problems = list(problems)
-    file = problems[0].file if problems else "<text>"
+    file = problems[0].source if problems else "<text>"
     hint = "fix the problems above first"
-    return capped(problems, lambda n: FileProblem(file, 0, 0, more_problems(n), hint))
+    return capped(problems, lambda n: file_problem(file, 0, 0, more_problems(n), hint))
 
 
 class Skip(Exception):
@@ -91,7 +83,7 @@ class NodeReader:
     def __init__(self, source: str) -> None:
         #: the file's name as problems show it
         self.source = source
-        self.problems: list[FileProblem] = []
+        self.problems: list[Problem] = []
 
     # -- problems ------------------------------------------------------------------------------
     def note(self, node: Node | None, where: str, message: str, hint: str = "") -> None:
@@ -100,7 +92,7 @@ class NodeReader:
             (node.start_mark.line + 1, node.start_mark.column + 1) if node is not None else (1, 1)
         )
         prefix = f"{where}: " if where else ""
-        self.problems.append(FileProblem(self.source, line, column, prefix + message, hint))
+        self.problems.append(file_problem(self.source, line, column, prefix + message, hint))
 
     def fail(self, node: Node | None, where: str, message: str, hint: str = "") -> NoReturn:
         """Record a problem and leave the part being read out (see :meth:`each`)."""
@@ -117,7 +109,7 @@ class NodeReader:
                 continue
         return out
 
-    def check(self, error: Callable[[list[FileProblem]], E]) -> None:
+    def check(self, error: Callable[[list[Problem]], E]) -> None:
         """Raise ``error(problems)`` when any problem was found, in the file's order."""
         if self.problems:
             ordered = sorted(self.problems, key=lambda p: (p.line, p.column))

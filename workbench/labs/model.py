@@ -22,7 +22,15 @@ from workbench.control.fsmdef import FsmDefinition
 from workbench.control.fsmfile import FsmFileError, load_fsm
 from workbench.control.manual import DRIVE_KEYS
 from workbench.files.bounded import LAB_LIMITS, BoundedFileError, compose_yaml, read_text
-from workbench.files.yamlread import FileProblem, NodeReader, Skip, problem_list
+from workbench.files.problems import Problem
+from workbench.files.yamlread import (
+    NodeReader,
+    Skip,
+    file_problem,
+    problem_list,
+    refused_problem,
+    syntax_problem,
+)
 from workbench.sim.maze import Maze, MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.profiles import PROFILES
@@ -43,7 +51,7 @@ class LabFileError(ValueError):
     """A lab file that cannot be used; ``problems`` lists every problem found, each as
     ``file:line:column: where: what (hint: fix)``."""
 
-    def __init__(self, problems: list[FileProblem]) -> None:
+    def __init__(self, problems: list[Problem]) -> None:
         self.problems = problem_list(problems)
         super().__init__("\n".join(str(p) for p in self.problems))
 
@@ -337,12 +345,12 @@ def load_lab(path: str | Path) -> Lab:
     try:
         root = compose_yaml(read_text(path, LAB_LIMITS, label), label, LAB_LIMITS)
     except BoundedFileError as exc:
-        raise LabFileError([FileProblem.refused(exc)]) from None
+        raise LabFileError([refused_problem(exc)]) from None
     except yaml.YAMLError as exc:
-        raise LabFileError([FileProblem.syntax(label, exc)]) from None
+        raise LabFileError([syntax_problem(label, exc)]) from None
     if root is None:
         raise LabFileError(
-            [FileProblem(label, 1, 1, "empty file", "a lab needs 'lab', 'title' and 'exercises'")]
+            [file_problem(label, 1, 1, "empty file", "a lab needs 'lab', 'title' and 'exercises'")]
         )
     r = _Reader(path, label)
     try:

@@ -13,7 +13,8 @@ from collections.abc import Sequence
 from dataclasses import replace
 
 from workbench.control.station import LabStation, ProgramChoice
-from workbench.sim.sensors import MOUNTS, SensorSpec
+from workbench.sim.sensor_kinds import sensor_kind
+from workbench.sim.sensors import SensorSpec
 
 from . import kinds as K
 from .compiled import Compiled
@@ -95,7 +96,7 @@ def fit_sensors(
         if have is not None and have.kind in wanted:
             continue
         used = {s.mount for p, s in by_port.items() if p != port}
-        free = [m for m in MOUNTS if m not in used]
+        free = [m for m in sensor_kind(wanted[0]).mounts if m not in used]
         if have is not None and have.mount in free:
             mount = have.mount
         elif free:

@@ -13,7 +13,7 @@ from . import kinds as K
 from .code import CodeRefused, recognise
 from .keys import KEY_NAMES
 from .model import Activity, Program
-from .problems import Problem, ProgramError
+from .problems import Problem, ProgramError, program_problem
 from .viple_expr import ExprError, Expression, Value, literal, parse
 
 #: a Variable's declared type -> the value an unset variable holds
@@ -68,7 +68,9 @@ def compile_program(program: Program) -> Compiled:
 
     def problem(act: Activity, message: str, hint: str = "") -> None:
         problems.append(
-            Problem(program.source, message, hint, act.panel, act.id, act.kind, program.label(act))
+            program_problem(
+                program.source, message, hint, act.panel, act.id, act.kind, program.label(act)
+            )
         )
 
     for var in program.globals:

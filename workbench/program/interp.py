@@ -28,6 +28,7 @@ import itertools
 import json
 import math
 from collections import deque
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from heapq import heappop, heappush
 from typing import Any
@@ -88,6 +89,8 @@ class Limits:
     memory: int = 1_000_000
 
 
+#: activities that run at the start when nothing links into them
+_STARTS = frozenset((K.DATA, K.CALCULATE, K.BLOCK))
 #: activities that pass the message straight on when one arrives
 _PASS_ON = frozenset(
     (
@@ -194,6 +197,11 @@ class ProgramController:
             for aid, act in compiled.program.activities.items()
             if act.kind == K.VARIABLE
         }
+        #: activity kind -> its handler, with the kinds this program's mapping file names
+        self._runs = {
+            **{kind: MAPPED_RUNS[m.activity] for kind, m in compiled.program.kinds.items()},
+            **RUNS,
+        }
         self.reset()
 
     # -- the Controller protocol ----------------------------------------------------------
@@ -224,6 +232,8 @@ class ProgramController:
         self._typed = TypedKeys()
         self._pushed: list[KeyEvent] = []
         self._touch: dict[int, int] = {}
+        #: the report being handed to the sensor activities (a raw sensor's message)
+        self._report: str | None = None
         #: a reading's name ("port 3") -> its port
         self._ports: dict[str, int] = {}
         self._next_report = _NEVER
@@ -254,7 +264,7 @@ class ProgramController:
         main = Frame("Main", {})
         for aid in program.panels["Main"].activities:
             act = program.activities[aid]
-            if act.kind in (K.DATA, K.CALCULATE, K.BLOCK) and aid not in program.inputs:
+            if act.kind in _STARTS and aid not in program.inputs:
                 self._spawn(aid, None, main)
         return self._run()
 
@@ -356,34 +366,41 @@ class ProgramController:
                 self._fire(act.id, "+".join(sorted(wanted)), f"key {'+'.join(sorted(wanted))}")
 
     def _sensors(self, readings: dict[int, Value], report: str | None) -> None:
-        raw = report
+        """One sensor report: each sensor activity, in file order, through the handler of its
+        kind (:data:`SENSES`)."""
+        self._report = report
         for aid, (kind, port) in self.compiled.sensors.items():
-            if kind == K.RAW_SENSOR:
-                if raw is None:  # the simulated robot: a report made from its readings
-                    raw = json.dumps(
-                        {
-                            "sensors": [
-                                {"name": f"sensor{p}", "id": p, "value": readings[p]}
-                                for p in sorted(readings)
-                            ]
-                        }
-                    )
-                self._fire(aid, raw)
-                continue
-            if port not in readings:
-                continue
-            value = sensor_message(readings[port])
-            if kind == K.TOUCH:
-                down = pressed(value)
-                if down is None:
-                    self._error(aid, touch_problem(port, value))
-                    continue
-                before = self._touch.get(aid, 0)
-                self._touch[aid] = int(down)
-                if down and not before:
-                    self._fire(aid, 1, f"touch {port}")
-                continue
-            self._fire(aid, value)
+            SENSES[kind](self, aid, port, readings)
+
+    def _sense_raw(self, aid: int, port: int, readings: dict[int, Value]) -> None:
+        if self._report is None:  # the simulated robot: a report made from its readings
+            self._report = json.dumps(
+                {
+                    "sensors": [
+                        {"name": f"sensor{p}", "id": p, "value": readings[p]}
+                        for p in sorted(readings)
+                    ]
+                }
+            )
+        self._fire(aid, self._report)
+
+    def _sense_value(self, aid: int, port: int, readings: dict[int, Value]) -> None:
+        if port in readings:
+            self._fire(aid, sensor_message(readings[port]))
+
+    def _sense_touch(self, aid: int, port: int, readings: dict[int, Value]) -> None:
+        """A touch sensor fires when it is pressed, not while it stays pressed."""
+        if port not in readings:
+            return
+        value = sensor_message(readings[port])
+        down = pressed(value)
+        if down is None:
+            self._error(aid, touch_problem(port, value))
+            return
+        before = self._touch.get(aid, 0)
+        self._touch[aid] = int(down)
+        if down and not before:
+            self._fire(aid, 1, f"touch {port}")
 
     def _sources(self, kind: int):
         return [a for a in self.program.activities.values() if a.kind == kind]
@@ -521,105 +538,128 @@ class ProgramController:
         )
 
     def _execute(self, flow: Flow, act) -> bool:
-        kind, value, compiled = act.kind, flow.value, self.compiled
-        if kind in _PASS_ON:
-            return self._go(flow, 0, value)
-        if kind == K.DATA:
-            return self._go(flow, 0, compiled.constants[act.id])
-        if kind == K.CALCULATE:
-            return self._go(flow, 0, compiled.expr(act.id, 0)(self._scope(flow)))
-        if kind == K.VARIABLE:
-            key = self._var_keys[act.id]
-            stored = convert(value, compiled.globals[key][1])
-            self.globals[key] = stored
-            self.changes += 1
-            return self._go(flow, 0, stored)
-        if kind == K.IF:
-            scope = self._scope(flow)
-            for index in range(len(act.values)):
-                if _truth(compiled.expr(act.id, index)(scope), index):
-                    return self._go(flow, index, value)
-            return self._go(flow, ELSE, value)
-        if kind == K.SWITCH:
-            scope = self._scope(flow)
-            for index in range(len(act.values)):
-                case = compiled.expr(act.id, index)(scope)
-                if case is True or (not isinstance(case, bool) and case == value):
-                    return self._go(flow, index, value)
-            return self._go(flow, ELSE, value)
-        if kind == K.WHILE:
-            if _truth(compiled.expr(act.id, 0)(self._scope(flow)), 0):
-                mark = (self.changes, _key(value))
-                if flow.loops.get(act.id) == mark:
-                    raise _Park()
-                flow.loops[act.id] = mark
-                return self._go(flow, 0, value)
-            flow.loops.pop(act.id, None)
-            return self._go(flow, 0, value, self.program.loop_end[act.id])
-        if kind == K.END_WHILE:
-            flow.activity = self.program.loop_start[act.id]
-            return True
-        if kind == K.BREAK:
-            loop = self.program.break_loop[act.id]
-            flow.loops.pop(loop, None)
-            return self._go(flow, 0, value, self.program.loop_end[loop])
-        if kind == K.JOIN:
-            return self._join(flow, act)
-        if kind == K.TIMER:
-            if not isinstance(value, int | float) or isinstance(value, bool):
-                raise ValueError(
-                    f"the Timer needs a number of milliseconds, not {type_name(value)}"
-                )
-            if not self._go(flow, 0, value):
-                return False  # nothing waits for the Timer
-            raise _Sleep(max(0.0, float(value)) / 1000.0)
-        if kind == K.PRINT_LINE:
-            self._print(show(value))
-            return self._go(flow, 0, value)
-        if kind == K.DRIVE:
-            scope = self._scope(flow)
-            left = _power(compiled.expr(act.id, 0)(scope), "left")
-            right = _power(compiled.expr(act.id, 1)(scope), "right")
-            self._command(WheelPowers(left, right))
-            return self._go(flow, 0, value)
-        if kind == K.BLOCK:
-            return self._call(flow, act)
-        if kind == K.OUTPUT_PIN:
-            frame = flow.frame
-            if frame.block is None or frame.parent is None:
-                return False
-            flow.frame = frame.parent
-            return self._go(flow, 0, value, frame.block)
-        if kind == K.EVENT_PIN:
-            for aid, block in compiled.event_blocks.items():
-                if block == flow.frame.panel:
-                    self._fired(aid, f"custom event {block}")
-                    for link in self.program.targets(aid):
-                        self._spawn(link.target, value, Frame("Main", {}), link.in_pin)
-            return False
-        if kind == K.CODE:
-            return self._go(flow, 0, first_sensor_value(value))
-        mapped = self.program.kinds.get(kind)
-        if mapped is not None:
-            return self._mapped(flow, act, mapped)
-        return False  # Comment, Robot: never run
+        """Run one activity through the handler of its kind (:data:`RUNS`; a kind named in
+        a mapping file, through :data:`MAPPED_RUNS`)."""
+        return self._runs.get(act.kind, _NEVER_RUNS)(self, flow, act)
 
-    def _mapped(self, flow: Flow, act, mapped) -> bool:
-        if mapped.activity == "custom-event":
-            return self._go(flow, 0, flow.value)
-        if mapped.activity == "ignore":
+    # -- the handlers of the activity kinds: each runs the activity the flow is at and says
+    # -- whether the flow goes on (it has moved the flow to the next activity)
+    def _pass_on(self, flow: Flow, act) -> bool:
+        return self._go(flow, 0, flow.value)
+
+    def _never(self, flow: Flow, act) -> bool:
+        return False  # a Comment, the Robot, a service mapped to "ignore": never run
+
+    def _data(self, flow: Flow, act) -> bool:
+        return self._go(flow, 0, self.compiled.constants[act.id])
+
+    def _calculate(self, flow: Flow, act) -> bool:
+        return self._go(flow, 0, self.compiled.expr(act.id, 0)(self._scope(flow)))
+
+    def _variable(self, flow: Flow, act) -> bool:
+        key = self._var_keys[act.id]
+        stored = convert(flow.value, self.compiled.globals[key][1])
+        self.globals[key] = stored
+        self.changes += 1
+        return self._go(flow, 0, stored)
+
+    def _if(self, flow: Flow, act) -> bool:
+        scope = self._scope(flow)
+        expr = self.compiled.expr
+        for index in range(len(act.values)):
+            if _truth(expr(act.id, index)(scope), index):
+                return self._go(flow, index, flow.value)
+        return self._go(flow, ELSE, flow.value)
+
+    def _switch(self, flow: Flow, act) -> bool:
+        scope = self._scope(flow)
+        value = flow.value
+        expr = self.compiled.expr
+        for index in range(len(act.values)):
+            case = expr(act.id, index)(scope)
+            if case is True or (not isinstance(case, bool) and case == value):
+                return self._go(flow, index, value)
+        return self._go(flow, ELSE, value)
+
+    def _while(self, flow: Flow, act) -> bool:
+        value = flow.value
+        if _truth(self.compiled.expr(act.id, 0)(self._scope(flow)), 0):
+            mark = (self.changes, _key(value))
+            if flow.loops.get(act.id) == mark:
+                raise _Park()
+            flow.loops[act.id] = mark
+            return self._go(flow, 0, value)
+        flow.loops.pop(act.id, None)
+        return self._go(flow, 0, value, self.program.loop_end[act.id])
+
+    def _end_while(self, flow: Flow, act) -> bool:
+        flow.activity = self.program.loop_start[act.id]
+        return True
+
+    def _break(self, flow: Flow, act) -> bool:
+        loop = self.program.break_loop[act.id]
+        flow.loops.pop(loop, None)
+        return self._go(flow, 0, flow.value, self.program.loop_end[loop])
+
+    def _timer(self, flow: Flow, act) -> bool:
+        value = flow.value
+        if not isinstance(value, int | float) or isinstance(value, bool):
+            raise ValueError(f"the Timer needs a number of milliseconds, not {type_name(value)}")
+        if not self._go(flow, 0, value):
+            return False  # nothing waits for the Timer
+        raise _Sleep(max(0.0, float(value)) / 1000.0)
+
+    def _print_line(self, flow: Flow, act) -> bool:
+        self._print(show(flow.value))
+        return self._go(flow, 0, flow.value)
+
+    def _drive(self, flow: Flow, act) -> bool:
+        scope = self._scope(flow)
+        expr = self.compiled.expr
+        left = _power(expr(act.id, 0)(scope), "left")
+        right = _power(expr(act.id, 1)(scope), "right")
+        self._command(WheelPowers(left, right))
+        return self._go(flow, 0, flow.value)
+
+    def _output_pin(self, flow: Flow, act) -> bool:
+        frame = flow.frame
+        if frame.block is None or frame.parent is None:
             return False
-        if mapped.value is not None:
-            arg = self.compiled.expr(act.id, mapped.value)(self._scope(flow))
-        else:
-            arg = flow.value
-        if mapped.activity == "move-at-power":
-            self._command(MoveAtPower(_power(arg, "power")))
-        elif mapped.activity == "turn-by-degrees":
-            self._command(TurnByDegrees(_number(arg, "degrees")))
-        else:
-            wheel = "left" if mapped.activity == "motor-left" else "right"
-            self._command(MotorPower(wheel, _power(arg, wheel)))
+        flow.frame = frame.parent
+        return self._go(flow, 0, flow.value, frame.block)
+
+    def _event_pin(self, flow: Flow, act) -> bool:
+        for aid, block in self.compiled.event_blocks.items():
+            if block == flow.frame.panel:
+                self._fired(aid, f"custom event {block}")
+                for link in self.program.targets(aid):
+                    self._spawn(link.target, flow.value, Frame("Main", {}), link.in_pin)
+        return False
+
+    def _code(self, flow: Flow, act) -> bool:
+        return self._go(flow, 0, first_sensor_value(flow.value))
+
+    # -- kinds a mapping file names (program/kinds.py): the argument, then the command
+    def _argument(self, flow: Flow, act) -> Value:
+        mapped = self.program.kinds[act.kind]
+        if mapped.value is None:
+            return flow.value
+        return self.compiled.expr(act.id, mapped.value)(self._scope(flow))
+
+    def _move_at_power(self, flow: Flow, act) -> bool:
+        self._command(MoveAtPower(_power(self._argument(flow, act), "power")))
+        return self._go(flow, 0, flow.value)
+
+    def _turn_by_degrees(self, flow: Flow, act) -> bool:
+        self._command(TurnByDegrees(_number(self._argument(flow, act), "degrees")))
+        return self._go(flow, 0, flow.value)
+
+    def _motor_left(self, flow: Flow, act) -> bool:
+        self._command(MotorPower("left", _power(self._argument(flow, act), "left")))
+        return self._go(flow, 0, flow.value)
+
+    def _motor_right(self, flow: Flow, act) -> bool:
+        self._command(MotorPower("right", _power(self._argument(flow, act), "right")))
         return self._go(flow, 0, flow.value)
 
     def _call(self, flow: Flow, act) -> bool:
@@ -744,6 +784,48 @@ class ProgramController:
         if len(self.errors) < MAX_ERRORS:
             act = self.program.activities[aid]
             self.errors.append(RunError(self.now, act.panel, aid, self.program.label(act), message))
+
+
+#: activity kind -> its handler (a flow at the activity: does the flow go on?)
+RUNS: dict[int, Callable[[ProgramController, Flow, Any], bool]] = {
+    **dict.fromkeys(_PASS_ON, ProgramController._pass_on),
+    K.DATA: ProgramController._data,
+    K.CALCULATE: ProgramController._calculate,
+    K.VARIABLE: ProgramController._variable,
+    K.IF: ProgramController._if,
+    K.SWITCH: ProgramController._switch,
+    K.WHILE: ProgramController._while,
+    K.END_WHILE: ProgramController._end_while,
+    K.BREAK: ProgramController._break,
+    K.JOIN: ProgramController._join,
+    K.TIMER: ProgramController._timer,
+    K.PRINT_LINE: ProgramController._print_line,
+    K.DRIVE: ProgramController._drive,
+    K.BLOCK: ProgramController._call,
+    K.OUTPUT_PIN: ProgramController._output_pin,
+    K.EVENT_PIN: ProgramController._event_pin,
+    K.CODE: ProgramController._code,
+    K.COMMENT: ProgramController._never,
+    K.ROBOT: ProgramController._never,
+}
+#: what a kind named in a mapping file runs as (``program/kinds.py`` MAPPABLE): its handler
+MAPPED_RUNS: dict[str, Callable[[ProgramController, Flow, Any], bool]] = {
+    "move-at-power": ProgramController._move_at_power,
+    "turn-by-degrees": ProgramController._turn_by_degrees,
+    "motor-left": ProgramController._motor_left,
+    "motor-right": ProgramController._motor_right,
+    "custom-event": ProgramController._pass_on,
+    "ignore": ProgramController._never,
+}
+#: the handler of a kind no table names (the loader refuses such a kind: it never runs)
+_NEVER_RUNS = ProgramController._never
+#: sensor activity kind -> what it does with a report (the activity, its port, the readings)
+SENSES: dict[int, Callable[[ProgramController, int, int, dict[int, Value]], None]] = {
+    K.RAW_SENSOR: ProgramController._sense_raw,
+    K.TOUCH: ProgramController._sense_touch,
+    K.DISTANCE: ProgramController._sense_value,
+    K.OTHER_SENSOR: ProgramController._sense_value,
+}
 
 
 def convert(value: Value, vtype: str) -> Value:

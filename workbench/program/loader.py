@@ -28,7 +28,7 @@ from workbench.files.terminal import terminal_problem
 from . import kinds as K
 from .kinds import KindMap, kind_label
 from .model import ELSE, Activity, Link, Panel, Program, Variable
-from .problems import Problem, ProgramError
+from .problems import Problem, ProgramError, program_problem
 
 #: sizes: the largest real programs are about 35 KB of XML
 LIMITS = Limits("a VIPLE program", max_bytes=4 << 20, max_lines=400_000, max_line_length=200_000)
@@ -214,7 +214,7 @@ def load_program(
         text, digest = read_program_text(path, source)
         root = parse_xml(text, source)
     except BoundedFileError as exc:
-        raise ProgramError([Problem(source, _bounded_message(exc), exc.hint)]) from None
+        raise ProgramError([program_problem(source, _bounded_message(exc), exc.hint)]) from None
     return build_program(root, source, digest, kinds or {})
 
 
@@ -224,7 +224,7 @@ def load_program_text(text: str, source: str, kinds: KindMap | None = None) -> P
     try:
         root = parse_xml(decode_text(text.encode("utf-8"), source, LIMITS), source)
     except BoundedFileError as exc:
-        raise ProgramError([Problem(source, _bounded_message(exc), exc.hint)]) from None
+        raise ProgramError([program_problem(source, _bounded_message(exc), exc.hint)]) from None
     return build_program(root, source, digest, kinds or {})
 
 
@@ -264,10 +264,10 @@ class _Builder:
             if act.name:
                 what += f" {act.name}"
             self.problems.append(
-                Problem(self.source, message, hint, act.panel, act.id, act.kind, what)
+                program_problem(self.source, message, hint, act.panel, act.id, act.kind, what)
             )
         else:
-            self.problems.append(Problem(self.source, message, hint, panel))
+            self.problems.append(program_problem(self.source, message, hint, panel))
 
     # -- elements ------------------------------------------------------------------------
     def number(self, elem: Element | None, what: str, panel: str, owner: str) -> int | None:

@@ -15,6 +15,7 @@ from workbench.control.headless import RunResult, RunSetupError, RunSpec
 from workbench.files.bounded import BoundedFileError
 from workbench.sim.driver import Driver
 from workbench.sim.profiles import Profile, check_report_ms
+from workbench.sim.sensor_kinds import DISTANCE, KINDS, TOUCH, sensor_kind
 from workbench.sim.sensors import SensorSpec
 
 from . import kinds as K
@@ -24,13 +25,14 @@ from .interp import ProgramController
 from .keys import KeyEvent, parse_key_script, typed_events
 from .kinds import load_kind_map
 from .loader import load_program
-from .problems import Problem, ProgramError
+from .problems import Problem, ProgramError, program_problem
 
-#: which simulated sensor kinds answer each VIPLE sensor activity
-SENSOR_NEEDS = {
-    K.DISTANCE: ("distance",),
-    K.TOUCH: ("touch",),
-    K.OTHER_SENSOR: ("distance", "touch"),
+#: which simulated sensor kinds answer each VIPLE sensor activity (the first: the kind a
+#: missing sensor is added as); VIPLE's Robot Sensor reads a sensor of any kind
+SENSOR_NEEDS: dict[int, tuple[str, ...]] = {
+    K.DISTANCE: (DISTANCE.name,),
+    K.TOUCH: (TOUCH.name,),
+    K.OTHER_SENSOR: KINDS,
 }
 
 
@@ -41,7 +43,7 @@ def load_compiled(path: str, kinds: str | None = None) -> Compiled:
         try:
             mapping = load_kind_map(kinds)
         except BoundedFileError as exc:
-            raise ProgramError([Problem(exc.path, str(exc).split(": ", 1)[1])]) from None
+            raise ProgramError([program_problem(exc.path, str(exc).split(": ", 1)[1])]) from None
     return compile_program(load_program(path, mapping))
 
 
@@ -72,14 +74,22 @@ def check_sensors(compiled: Compiled, sensors: list[SensorSpec]) -> list[Problem
                     program,
                     act,
                     f"it reads port {port}, but {have}",
-                    f"add --sensor {wanted[0]}:{port}:MOUNT (MOUNT front, right, back or left)",
+                    f"add --sensor {wanted[0]}:{port}:MOUNT (MOUNT {_either(wanted[0])})",
                 )
             )
     return problems
 
 
+def _either(kind: str) -> str:
+    """The mounts a sensor of ``kind`` allows, as "front, right, back or left"."""
+    *most, last = sensor_kind(kind).mounts
+    return f"{', '.join(most)} or {last}" if most else last
+
+
 def _problem(program, act, message: str, hint: str) -> Problem:
-    return Problem(program.source, message, hint, act.panel, act.id, act.kind, program.label(act))
+    return program_problem(
+        program.source, message, hint, act.panel, act.id, act.kind, program.label(act)
+    )
 
 
 def port_binding(sensors: Sequence[SensorSpec]) -> dict[str, int]:

@@ -2,36 +2,22 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from workbench.files.problems import Problem
 
 
-@dataclass(frozen=True)
-class Problem:
-    """One thing wrong with a program; the fields say where and how to fix it.
-
-    Shown as ``FILE: panel NAME: activity ID (kind K, what): message (hint)``; the parts
-    that do not apply (a problem with the whole file) are left out.
-    """
-
-    source: str
-    message: str
-    hint: str = ""
-    panel: str | None = None
-    activity: int | None = None
-    kind: int | None = None
-    what: str = ""
-
-    def __str__(self) -> str:
-        parts = [self.source]
-        if self.panel is not None:
-            parts.append(f"panel {self.panel}")
-        if self.activity is not None:
-            label = f"activity {self.activity}"
-            if self.kind is not None:
-                label += f" (kind {self.kind}" + (f", {self.what})" if self.what else ")")
-            parts.append(label)
-        text = ": ".join(parts) + f": {self.message}"
-        return text + (f" ({self.hint})" if self.hint else "")
+def program_problem(
+    source: str,
+    message: str,
+    hint: str = "",
+    panel: str | None = None,
+    activity: int | None = None,
+    kind: int | None = None,
+    what: str = "",
+) -> Problem:
+    """One thing wrong with a program, shown as ``FILE: panel NAME: activity ID (kind K,
+    what): message (hint)``; the parts that do not apply (a problem with the whole file) are
+    left out."""
+    return Problem(message, hint, source, panel=panel, activity=activity, kind=kind, what=what)
 
 
 class ProgramError(ValueError):

@@ -17,14 +17,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 from . import kinds as K
 from .compiled import Compiled
 from .interp import Fired, Printed, ProgramController
 from .keys import KeyEvent
-from .problems import Problem, ProgramError
+from .problems import Problem, ProgramError, program_problem
 from .viple_expr import Value
 
 #: the program ticks at least this often between reports (the in-process control rate)
@@ -55,7 +55,7 @@ def robot_settings(compiled: Compiled) -> RobotSettings:
     if not robots:
         raise ProgramError(
             [
-                Problem(
+                program_problem(
                     program.source,
                     "the program has no Robot activity, so it names no robot to connect to",
                     "add one in VIPLE, or give the address: --connect tcp://HOST:PORT",
@@ -64,7 +64,7 @@ def robot_settings(compiled: Compiled) -> RobotSettings:
         )
     act = robots[0]
     host, port, conn = act.value(0).strip(), act.value(1).strip(), act.value(2).strip()
-    where = Problem(program.source, "", "", act.panel, act.id, act.kind, program.label(act))
+    where = program_problem(program.source, "", "", act.panel, act.id, act.kind, program.label(act))
     scheme = CONN_TYPES.get(conn.lower())
     if scheme is None:
         message = f"the connection type {conn[:20]!r} is not WiFi or WSS"
@@ -78,7 +78,7 @@ def robot_settings(compiled: Compiled) -> RobotSettings:
 
 
 def _at(where: Problem, message: str, hint: str) -> Problem:
-    return Problem(where.source, message, hint, where.panel, where.activity, where.kind, where.what)
+    return replace(where, message=message, hint=hint)
 
 
 def wheel_ports(compiled: Compiled) -> tuple[int, int] | None:

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from workbench.files.bounded import digits_problem
+from workbench.files.problems import ExprError
 
 MAX_LENGTH = 2_000
 MAX_TOKENS = 400
@@ -39,20 +40,6 @@ MAX_MESSAGE_PARTS = 20_000
 TEXT_PART = 100
 
 Value = Any
-
-
-class ExprError(ValueError):
-    """An expression that cannot be parsed or evaluated; ``column`` is 1-based."""
-
-    def __init__(self, message: str, column: int | None = None, hint: str = "") -> None:
-        self.message = message
-        self.column = column
-        self.hint = hint
-        super().__init__(str(self))
-
-    def __str__(self) -> str:
-        where = f"column {self.column}: " if self.column is not None else ""
-        return f"{where}{self.message}" + (f" ({self.hint})" if self.hint else "")
 
 
 class LimitError(ExprError):

@@ -47,8 +47,8 @@ class Finding:
 def finding_of(maze: Maze, problem: Problem) -> Finding:
     """A maze problem with its file position turned back into the block it names."""
     cell = None
-    if problem.line is not None and problem.col is not None:
-        x, y = problem.col - 1, problem.line - maze.body_line
+    if problem.line and problem.column:
+        x, y = problem.column - 1, problem.line - maze.body_line
         if maze.in_bounds(x, y):
             cell = (x, y)
     return Finding(problem.message, problem.hint, cell)

@@ -13,6 +13,7 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field, replace
 
 from workbench.files.bounded import BoundedFileError, capped, more_problems
+from workbench.files.problems import Problem
 
 Cell = tuple[int, int]
 
@@ -25,32 +26,15 @@ HEADINGS: dict[str, Cell] = {"up": (0, -1), "right": (1, 0), "down": (0, 1), "le
 PROFILES = ("unity", "web", "erobotic")
 
 
-@dataclass(frozen=True)
-class Problem:
-    """One thing wrong with a maze, at a 1-based file position when it has one."""
-
-    message: str
-    hint: str
-    source: str = "<maze>"
-    line: int | None = None
-    col: int | None = None
-
-    def __str__(self) -> str:
-        where = self.source
-        if self.line is not None:
-            where += f":{self.line}"
-            if self.col is not None:
-                where += f":{self.col}"
-        return f"{where}: {self.message} ({self.hint})"
-
-    def as_dict(self) -> dict[str, object]:
-        return {
-            "source": self.source,
-            "line": self.line,
-            "col": self.col,
-            "message": self.message,
-            "hint": self.hint,
-        }
+def problem_fields(problem: Problem) -> dict[str, object]:
+    """A maze problem as ``workbench maze check --json`` writes it (a place not known: null)."""
+    return {
+        "source": problem.source,
+        "line": problem.line or None,
+        "col": problem.column or None,
+        "message": problem.message,
+        "hint": problem.hint,
+    }
 
 
 class MazeError(ValueError):
@@ -64,7 +48,9 @@ class MazeError(ValueError):
     @classmethod
     def refused(cls, exc: BoundedFileError, hint: str = "") -> MazeError:
         """The error of a file refused by the bounded reader, in maze-problem form."""
-        return cls([Problem(exc.message, hint or exc.hint, exc.path, exc.line, exc.column)])
+        return cls(
+            [Problem(exc.message, hint or exc.hint, exc.path, exc.line or 0, exc.column or 0)]
+        )
 
 
 def cap_problems(problems: list[Problem]) -> list[Problem]:

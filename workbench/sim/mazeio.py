@@ -97,8 +97,8 @@ def _binary(data: bytes, source: str) -> MazeError:
                 f"(256 bytes; this one is {len(data)} bytes){reason}",
                 f"check the file; the formats read are {', '.join(FORMATS)}",
                 source,
-                line,
-                column,
+                line or 0,
+                column or 0,
             )
         ]
     )

@@ -1,12 +1,24 @@
-"""Sensors as VIPLE sees them: a kind, the port number the student chose, and a mount side."""
+"""Sensors as VIPLE sees them: a kind, the port number the student chose, and a mount side.
+
+The kinds, and the mounts each allows, are the table of :mod:`workbench.sim.sensor_kinds`."""
 
 from __future__ import annotations
 
 from collections.abc import Iterable
 from dataclasses import dataclass
 
-KINDS = ("distance", "touch")
-MOUNTS = ("front", "right", "back", "left")
+from .sensor_kinds import KINDS, MOUNTS, is_kind, sensor_kind
+
+__all__ = [
+    "KINDS",
+    "MOUNTS",
+    "MOUNT_ANGLES",
+    "PORT_RANGE",
+    "SensorConfigError",
+    "SensorSpec",
+    "check_ports",
+]
+
 #: mount -> angle in degrees clockwise from the robot's heading
 MOUNT_ANGLES = {"front": 0, "right": 90, "back": 180, "left": 270}
 PORT_RANGE = range(0, 100)
@@ -23,12 +35,18 @@ class SensorSpec:
     mount: str
 
     def __post_init__(self) -> None:
-        if self.kind not in KINDS:
+        if not isinstance(self.kind, str) or not is_kind(self.kind):
             raise SensorConfigError(
                 f"unknown sensor kind {self.kind!r}: use one of {', '.join(KINDS)}"
             )
         if self.mount not in MOUNTS:
             raise SensorConfigError(f"unknown mount {self.mount!r}: use one of {', '.join(MOUNTS)}")
+        allowed = sensor_kind(self.kind).mounts
+        if self.mount not in allowed:
+            raise SensorConfigError(
+                f"a {self.kind} sensor cannot be mounted {self.mount}: "
+                f"use one of {', '.join(allowed)}"
+            )
         if (
             isinstance(self.port, bool)
             or not isinstance(self.port, int)

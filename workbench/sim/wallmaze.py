@@ -26,7 +26,7 @@ OPPOSITE = {"north": "south", "east": "west", "south": "north", "west": "east"}
 MAX_CELLS = (MAX_SIZE - 1) // 2
 
 #: (cell, side) -> (line, col) in the file the wall maze came from, for messages
-Where = Callable[[Cell, str], tuple[int | None, int | None]]
+Where = Callable[[Cell, str], tuple[int, int]]
 
 
 @dataclass(frozen=True)
@@ -79,7 +79,7 @@ def wall_problems(wm: WallMaze, where: Where | None = None) -> list[Problem]:
                     continue
                 walled, open_ = ((x, y), other) if here else (other, (x, y))
                 walled_side = side if here else OPPOSITE[side]
-                line, col = where(walled, walled_side) if where else (None, None)
+                line, col = where(walled, walled_side) if where else (0, 0)
                 problems.append(
                     Problem(
                         f"cell {walled} has a wall on its {walled_side} side but cell {open_} "

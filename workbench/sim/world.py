@@ -46,7 +46,8 @@ from .commands import (
 from .maze import Maze
 from .noise import NoiseSettings, motor_gains, noise_settings, turn_factor
 from .profiles import Profile, get_profile
-from .sensors import MOUNTS, SensorSpec, check_ports
+from .sensor_kinds import MOUNTS, SENSOR_KINDS, sensor_kind
+from .sensors import SensorSpec, check_ports
 
 TURN_DONE = "turn_done"
 COLLISION = "collision"
@@ -219,6 +220,11 @@ class World:
         self._touch_reach = profile.robot_radius + 0.005 * self.cell
         self._tmax = profile.sensor_range / self.cell
         self._inv_cell = 1.0 / self.cell
+        #: each mount's distance from the centre, in MOUNTS order
+        self._offsets = tuple(profile.sensor_offset(m) for m in MOUNTS)
+        #: the mounts' unit vectors and the walls in reach, for the step being read
+        self._dirs: tuple[tuple[float, float], ...] = ()
+        self._contacts_now: list[tuple[float, float]] | None = None
         # the grid padded with one ring of wall: rays and neighbour checks need no bounds test
         w, h = maze.width, maze.height
         self._wp = wp = w + 2
@@ -253,15 +259,17 @@ class World:
                 raise WorldError(f"{spec!r} is not a SensorSpec")
         check_ports(specs)
         self.sensors = tuple(specs)
-        self._distance_plan = tuple(
-            (s.port, MOUNTS.index(s.mount), self.profile.sensor_offset(s.mount))
+        # read kind by kind in the table's order (and each kind's sensors in the order given):
+        # the noise of a run is drawn in that order
+        self._plan = tuple(
+            (s.port, kind.read, MOUNTS.index(s.mount))
+            for kind in SENSOR_KINDS
             for s in specs
-            if s.kind == "distance"
+            if s.kind == kind.name
         )
-        self._touch_plan = tuple(
-            (s.port, MOUNTS.index(s.mount)) for s in specs if s.kind == "touch"
+        self._bumpers = tuple(
+            sorted({MOUNTS.index(s.mount) for s in specs if sensor_kind(s.kind).bumper})
         )
-        self._bumpers = tuple(sorted({mount for _, mount in self._touch_plan}))
         self._readings: dict[int, float | int] | None = None
 
     # -- the run -------------------------------------------------------------------------
@@ -656,7 +664,8 @@ class World:
 
     # -- sensors -------------------------------------------------------------------------
     def read_sensors(self) -> dict[int, float | int]:
-        """Readings by port for the current step: distances in world units, touch 0/1.
+        """Readings by port for the current step, each as its kind reads the world
+        (:mod:`workbench.sim.sensor_kinds`): distances in world units, touch 0/1.
 
         Read twice in one step, the readings (and their noise) are the same: the same dict,
         which callers must not change.
@@ -667,43 +676,44 @@ class World:
         c = math.cos(a)
         s = math.sin(a)
         # unit vectors of the mounts in MOUNTS order: front, right, back, left
-        dirs = ((c, s), (-s, c), (-c, -s), (s, -c))
-        x = self._x
-        y = self._y
+        self._dirs = ((c, s), (-s, c), (-c, -s), (s, -c))
+        self._contacts_now = None
         out: dict[int, float | int] = {}
-        if self._distance_plan:
-            inv = self._inv_cell
-            solid = self._solid
-            wp = self._wp
-            tmax = self._tmax
-            cell = self.cell
-            p = self.profile
-            noise = self.noise
-            rel = noise.distance_relative
-            absolute = noise.distance_absolute
-            gauss = self._rng.gauss
-            for port, mount, offset in self._distance_plan:
-                dx, dy = dirs[mount]
-                t = _march(
-                    solid, wp, (x + offset * dx) * inv + 1.0, (y + offset * dy) * inv + 1.0,
-                    dx, dy, tmax,
-                )  # fmt: skip
-                if t < 0.0:
-                    out[port] = p.no_echo
-                    continue
-                d = t * cell
-                if rel or absolute:
-                    d = min(p.sensor_range, max(0.0, d + gauss(0.0, rel * d + absolute)))
-                out[port] = d
-        if self._touch_plan:
-            contacts = self._wall_contacts()
-            for port, mount in self._touch_plan:
-                ux, uy = dirs[mount]
-                out[port] = int(
-                    any(vx * ux + vy * uy >= _COS45 * math.hypot(vx, vy) for vx, vy in contacts)
-                )
+        for port, read, mount in self._plan:
+            out[port] = read(self, mount)
         self._readings = out
         return out
+
+    # the Probe the sensor kinds read, for the step being read (read_sensors sets it up)
+    def echo(self, mount: int) -> float:
+        """How far the ray of a sensor on ``mount`` (an index of MOUNTS) meets a wall, from
+        the sensor's place on the robot, with the run's distance noise; the profile's no-echo
+        value when it meets none within range."""
+        dx, dy = self._dirs[mount]
+        inv = self._inv_cell
+        offset = self._offsets[mount]
+        t = _march(
+            self._solid, self._wp, (self._x + offset * dx) * inv + 1.0,
+            (self._y + offset * dy) * inv + 1.0, dx, dy, self._tmax,
+        )  # fmt: skip
+        p = self.profile
+        if t < 0.0:
+            return p.no_echo
+        d = t * self.cell
+        noise = self.noise
+        rel = noise.distance_relative
+        absolute = noise.distance_absolute
+        if rel or absolute:
+            d = min(p.sensor_range, max(0.0, d + self._rng.gauss(0.0, rel * d + absolute)))
+        return d
+
+    def pressed(self, mount: int) -> bool:
+        """Whether a wall touches the robot within the arc of ``mount`` (an index of MOUNTS)."""
+        contacts = self._contacts_now
+        if contacts is None:
+            contacts = self._contacts_now = self._wall_contacts()
+        ux, uy = self._dirs[mount]
+        return any(vx * ux + vy * uy >= _COS45 * math.hypot(vx, vy) for vx, vy in contacts)
 
     def _wall_contacts(self) -> list[tuple[float, float]]:
         """Vectors from the centre to the nearest point of each wall block within reach."""

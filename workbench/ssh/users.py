@@ -32,7 +32,15 @@ from workbench.files.bounded import (
     compose_yaml,
     read_text,
 )
-from workbench.files.yamlread import FileProblem, NodeReader, Skip, is_null, problem_list
+from workbench.files.problems import Problem
+from workbench.files.yamlread import (
+    NodeReader,
+    Skip,
+    is_null,
+    problem_list,
+    refused_problem,
+    syntax_problem,
+)
 
 from .passwords import PasswordError, parse_hash, verify_password
 
@@ -51,12 +59,12 @@ class UsersFileError(ValueError):
     """A users file (or a user to add) that cannot be used; for a file, ``problems`` lists
     every problem found, each as ``file:line:column: where: what (hint: fix)``."""
 
-    def __init__(self, message: str, problems: Sequence[FileProblem] = ()) -> None:
+    def __init__(self, message: str, problems: Sequence[Problem] = ()) -> None:
         super().__init__(message)
         self.problems = list(problems)
 
     @classmethod
-    def found(cls, problems: Sequence[FileProblem]) -> UsersFileError:
+    def found(cls, problems: Sequence[Problem]) -> UsersFileError:
         problems = problem_list(problems)
         return cls("\n".join(str(p) for p in problems), problems)
 
@@ -119,7 +127,7 @@ def parse_users(text: str, path: str | os.PathLike = USERS_FILE) -> dict[str, Us
         raise _refused(exc) from None
     except yaml.YAMLError as exc:
         raise UsersFileError.found(
-            [FileProblem.syntax(str(path), exc, "compare with docs/ssh.md")]
+            [syntax_problem(str(path), exc, "compare with docs/ssh.md")]
         ) from None
     if root is None:
         return {}
@@ -234,7 +242,7 @@ def load_users(path: str | os.PathLike) -> dict[str, User]:
 
 def _refused(exc: BoundedFileError) -> UsersFileError:
     """The error of a users file refused by the bounded reader."""
-    return UsersFileError.found([FileProblem.refused(exc)])
+    return UsersFileError.found([refused_problem(exc)])
 
 
 def dump_users(users: Iterable[User]) -> str:

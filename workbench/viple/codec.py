@@ -42,8 +42,10 @@ from workbench.sim.commands import (
     TurnByDegrees,
     WheelPowers,
 )
+from workbench.sim.sensor_kinds import ReportForm, is_kind, sensor_kind
 
-#: sensor names VIPLE understands in a report
+#: sensor names VIPLE understands in a report (the kinds the workbench simulates, and how a
+#: report writes each, are the table of :mod:`workbench.sim.sensor_kinds`)
 REPORT_KINDS = ("distance", "touch", "light", "sound", "color", "motorEncoder")
 #: the ``servoId`` of VIPLE's Robot+ services (Move at Power, Turn by Degree)
 ROBOT_PLUS_ID = -1
@@ -552,19 +554,31 @@ def _check_report_ports(readings: dict[int, float | int], kinds: dict[int, str])
         raise ValueError(f"reading for port {extra[0]}, where no sensor is configured")
 
 
+def report_form(kind: str) -> ReportForm:
+    """How a report writes a sensor of ``kind``: as the sensor kinds' table says for the kinds
+    the workbench simulates, as a number for the other names VIPLE knows."""
+    if is_kind(kind):
+        return sensor_kind(kind).report
+    if kind in REPORT_KINDS:
+        return ReportForm(kind)
+    raise ValueError(f"unknown sensor kind {kind!r}")
+
+
 def _reading_json(port: int, kind: str, value: float | int) -> str:
-    if kind not in REPORT_KINDS:
-        raise ValueError(f"unknown sensor kind {kind!r} on port {port}")
+    try:
+        form = report_form(kind)
+    except ValueError as err:
+        raise ValueError(f"{err} on port {port}") from None
     if isinstance(port, bool) or not isinstance(port, int) or port < 0:
         raise ValueError(f"sensor port must be a whole number >= 0, not {port!r}")
-    if kind == "touch":
+    if form.binary:
         number = "1" if value else "0"
     else:
         try:
-            number = _format_number(value, 3)
+            number = _format_number(value, form.places)
         except ValueError as err:
             raise ValueError(f"{kind} sensor on port {port}: {err}") from None
-    return f'{{"name":"{kind}","id":{port},"value":{number}}}'
+    return f'{{"name":"{form.name}","id":{port},"value":{number}}}'
 
 
 def parse_report(line: str, line_no: int | None = None) -> dict[int, SensorValue]:

@@ -46,7 +46,7 @@ from workbench.sim.profiles import REPORT_MS_MIN as REPORT_MS_MIN
 from workbench.sim.profiles import check_report_ms as check_report_ms
 from workbench.sim.session import Session
 
-from .codec import REPORT_KINDS, CodecError, WheelPorts, encode_report, parse_command
+from .codec import CodecError, WheelPorts, encode_report, parse_command
 
 #: lines (and reads) handled before the loop gets a turn
 BATCH = 64
@@ -333,9 +333,7 @@ class Link:
         """A report carrying every configured sensor, from the session's latest readings."""
         readings = self.session.readings
         kinds = {
-            spec.port: spec.kind
-            for spec in self.session.world.sensors
-            if spec.kind in REPORT_KINDS and spec.port in readings
+            spec.port: spec.kind for spec in self.session.world.sensors if spec.port in readings
         }
         return encode_report({port: readings[port] for port in kinds}, kinds)
 

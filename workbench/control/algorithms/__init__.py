@@ -10,7 +10,8 @@ from functools import cache
 from pathlib import Path
 
 from workbench.control.fsm import FsmDefinition
-from workbench.control.fsmfile import FileProblem, FsmFileError, load_fsm
+from workbench.control.fsmfile import FsmFileError, load_fsm
+from workbench.files.yamlread import file_problem
 
 ALGORITHM_DIR = Path(__file__).resolve().parent
 
@@ -51,7 +52,7 @@ def load_algorithm(
     hint = f"did you mean {close[0]!r}? " if close else ""
     raise FsmFileError(
         [
-            FileProblem(
+            file_problem(
                 text,
                 0,
                 0,

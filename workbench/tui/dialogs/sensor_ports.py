@@ -18,6 +18,7 @@ from textual.widgets import Button, Input, Label, Select, Static
 
 from workbench.control.station import PRESETS, LabStation, SensorRow, check_sensor_rows
 from workbench.sim.profiles import get_profile
+from workbench.sim.sensor_kinds import SENSOR_KINDS
 from workbench.sim.sensors import PORT_RANGE
 from workbench.sim.session import Snapshot
 
@@ -167,7 +168,7 @@ class SensorPortsModal(ShowsSnapshot, ModalScreen[None]):
             return
         used = {r.port.strip() for r in self.rows()}
         port = next((str(p) for p in PORT_RANGE if p > 0 and str(p) not in used), "")
-        editor = SensorRowEditor(len(editors) + 1, SensorRow("distance", port, None))
+        editor = SensorRowEditor(len(editors) + 1, SensorRow(SENSOR_KINDS[0].name, port, None))
         await self.query_one("#ports-rows").mount(editor)
         editor.scroll_visible()
         editor.query_one(".row-port", Input).focus()

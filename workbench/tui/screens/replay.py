@@ -25,6 +25,7 @@ from textual.widgets import Static
 from workbench.files.workspace import LOCAL, FileAccess
 from workbench.sim.maze import Maze
 from workbench.sim.replay import Replay, load_replay, replay_maze
+from workbench.sim.sensor_kinds import sensor_kind
 
 from ..host import FollowsUnicode, ToggleUnicode
 from ..keys import REPLAY_KEY_IDS, REPLAY_LEGEND, bindings, legend_text
@@ -225,7 +226,8 @@ class ReplayScreen(FollowsUnicode, Screen[None]):
         for port, value in sorted(frame.sensors.items()):
             spec = sensors.get(port)
             what = f"{spec.kind} {spec.mount}" if spec else "sensor"
-            shown = ("pressed" if value else "free") if spec and spec.kind == "touch" else value
+            word = sensor_kind(spec.kind).panel.state(value) if spec else None
+            shown = value if word is None else word
             text.append(f"port {port} {what}: {_number(shown)}\n")
         if frame.commands:
             text.append(f"Cmd {', '.join(_command(c) for c in frame.commands)}\n")

@@ -35,6 +35,7 @@ from textual.visual import VisualType
 
 from workbench.sim.maze import WALL, Cell, Maze
 from workbench.sim.mazeview import ARROWS_ASCII, ARROWS_UNICODE, block_text
+from workbench.sim.sensor_kinds import sensor_kind
 from workbench.sim.sensors import MOUNT_ANGLES
 from workbench.sim.session import Snapshot
 
@@ -503,14 +504,15 @@ class MazeView(ScrollView, can_focus=False):
                 continue
             angle = pose.heading + MOUNT_ANGLES[spec.mount]
             label = f"{spec.port:<2}"[:2]
-            if spec.kind == "distance":
+            mark = sensor_kind(spec.kind).panel.mark
+            if mark == "ray":
                 glyph = rays[round(angle / 45.0) % 4]
                 path, hit = self._trace(px, py, angle, value / cell_size)
                 for cell in path:
                     dots[cell] = (glyph, "ray")
                 if hit is not None:
                     marks[hit] = (label, "hit")
-            elif value:
+            elif mark == "contact" and value:
                 dx, dy = _QUARTER_STEPS[round(angle / 90.0) % 4]
                 cell = (robot[0] + dx, robot[1] + dy)
                 if maze.in_bounds(*cell):
@@ -589,7 +591,8 @@ class MazeView(ScrollView, can_focus=False):
             value = snapshot.readings.get(spec.port)
             if value is None:
                 continue
-            shown = f"{value:.3g}" if spec.kind == "distance" else ("pressed" if value else "free")
+            state = sensor_kind(spec.kind).panel.state(value)
+            shown = f"{value:.3g}" if state is None else state
             lines.append(f"port {spec.port} {spec.kind} {spec.mount}: {shown}")
         text = "\n".join(lines)
         if text != self._tooltip_text:

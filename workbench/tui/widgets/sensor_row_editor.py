@@ -9,7 +9,7 @@ from textual.message import Message
 from textual.widgets import Button, Label, Select, Static
 
 from workbench.control.station import SensorRow
-from workbench.sim.sensors import KINDS
+from workbench.sim.sensor_kinds import SENSOR_KINDS
 
 from ..plain import follow_app
 from .field import Field
@@ -72,7 +72,7 @@ class SensorRowEditor(Vertical):
         self.number = number
         self._number = Label(f"{number}.", classes="row-number")
         self._kind = Select(
-            [(k, k) for k in KINDS],
+            [(k.panel.label, k.name) for k in SENSOR_KINDS],
             value=row.kind,
             allow_blank=False,
             compact=True,

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from textual.widget import Widget
 
+from workbench.sim.sensor_kinds import sensor_kind
 from workbench.sim.sensors import SensorSpec
 
 
@@ -38,14 +39,18 @@ def number(value: float | int | None, unit: str = "") -> str:
 
 
 def reading(spec: SensorSpec, value: float | int | None, unit: str, no_echo: float) -> str:
-    """What a sensor reads, as a student would say it."""
+    """What a sensor reads, as a student would say it (in the form its kind's
+    :class:`~workbench.sim.sensor_kinds.PanelForm` gives)."""
     if value is None:
         return "-"
-    if spec.kind == "touch":
-        return "pressed" if value else "free"
-    if value >= no_echo:
-        return f"no echo ({number(value, unit)})"
-    return number(value, unit)
+    form = sensor_kind(spec.kind).panel
+    state = form.state(value)
+    if state is not None:
+        return state
+    shown = number(value, unit if form.unit == "length" else "")
+    if form.echo and value >= no_echo:
+        return f"no echo ({shown})"
+    return shown
 
 
 def speed(value: float | None) -> str:
