@@ -95,10 +95,10 @@ def figure_lines(run: PictureRun) -> list[str]:
         clock += f" | out at {f.exit_time:.1f} s"
         if f.efficiency is not None:
             clock += f" ({f.efficiency:.0%} efficient)"
-    elif not f.complete:
-        clock += " | the record was cut off (no summary line)"
-    else:
+    elif f.complete:
         clock += " | did not get out"
+    if not f.complete:
+        clock += " | the record was cut off (no summary line)"
     travel = f"distance {length(f.distance, unit)} {unit} ({f.blocks:.1f} blocks)"
     turning = f"turned {f.turn_degrees:.0f}°; {_plural(f.turns, 'turn')}"
     hits = f"collisions {f.collisions}" + (f" | touches {f.touches}" if f.touches else "")
