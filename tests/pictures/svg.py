@@ -36,3 +36,14 @@ def texts(svg: bytes) -> str:
     """Every text of the picture, one a line."""
     root = ET.fromstring(svg)
     return "\n".join("".join(t.itertext()) for t in root.iter(f"{SVG}text"))
+
+
+def rectangle_area(svg: bytes, gid: str) -> float:
+    """The area the axis-aligned rectangles of the group ``gid`` cover (SVG units)."""
+    area = 0.0
+    for p in group(svg, gid).iter(f"{SVG}path"):
+        for shape in p.get("d", "").split("M ")[1:]:
+            numbers = [float(v) for v in re.findall(r"-?[0-9.]+", shape)]
+            xs, ys = numbers[0::2], numbers[1::2]
+            area += (max(xs) - min(xs)) * (max(ys) - min(ys))
+    return area

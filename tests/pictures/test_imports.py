@@ -15,6 +15,8 @@ app = app_module.make_app(AppSettings())
 print("after make_app:", "matplotlib" in sys.modules)
 import workbench.pictures.render, workbench.pictures.runs
 print("after pictures:", "matplotlib" in sys.modules)
+import workbench.cli.served, workbench.cli
+print("after the served entry point and the command line:", "matplotlib" in sys.modules)
 """
 
 
@@ -28,10 +30,11 @@ def test_the_app_never_loads_matplotlib(tmp_path):
         timeout=120,
     )
     assert done.returncode == 0, done.stderr
-    assert done.stdout.split("\n")[:3] == [
+    assert done.stdout.split("\n")[:4] == [
         "after import: False",
         "after make_app: False",
         "after pictures: False",
+        "after the served entry point and the command line: False",
     ]
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 import bisect
 import itertools
 import math
+import re
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -26,6 +27,7 @@ if TYPE_CHECKING:
     from matplotlib.figure import Figure
     from matplotlib.path import Path as MplPath
 
+_WALL_RUN = re.compile("#+")
 #: how many pieces of one colour the time-coloured path is drawn in
 TIME_PIECES = 96
 WALL_COLOUR = "#3a3f4b"
@@ -36,24 +38,30 @@ TOUCH_COLOUR = "#ff7f0e"
 BEAM_COLOUR = "#e377c2"
 
 
-def wall_squares(run: PictureRun) -> list[tuple[float, float]]:
-    """The top-left corner of every wall block, in profile units."""
-    maze, cell = run.maze, run.cell
-    return [
-        (x * cell, y * cell)
-        for y, row in enumerate(maze.rows)
-        for x, ch in enumerate(row)
-        if maze.is_wall(x, y)
-    ]
+def wall_rectangles(run: PictureRun) -> list[tuple[int, int, int, int]]:
+    """The maze's wall blocks as few rectangles (x, y, width, height in blocks): each row's
+    runs of wall, a run carried down while the rows below have the same run."""
+    maze = run.maze
+    open_runs: dict[tuple[int, int], int] = {}  # (x, width) -> first row
+    out: list[tuple[int, int, int, int]] = []
+    for y in range(maze.height + 1):
+        row = maze.rows[y] if y < maze.height else ""
+        runs = {(m.start(), m.end() - m.start()) for m in _WALL_RUN.finditer(row)}
+        for key in [k for k in open_runs if k not in runs]:
+            top = open_runs.pop(key)
+            out.append((key[0], top, key[1], y - top))
+        for key in runs:
+            open_runs.setdefault(key, y)
+    return sorted(out, key=lambda r: (r[1], r[0]))
 
 
-def _squares_path(corners: Sequence[tuple[float, float]], size: float) -> MplPath:
+def _rectangles_path(rects: Sequence[tuple[float, float, float, float]]) -> MplPath:
     from matplotlib.path import Path as MplPath
 
     vertices: list[tuple[float, float]] = []
     codes: list[Any] = []
-    for x, y in corners:
-        vertices += [(x, y), (x + size, y), (x + size, y + size), (x, y + size), (x, y)]
+    for x, y, w, h in rects:
+        vertices += [(x, y), (x + w, y), (x + w, y + h), (x, y + h), (x, y)]
         codes += [MplPath.MOVETO, MplPath.LINETO, MplPath.LINETO, MplPath.LINETO, MplPath.CLOSEPOLY]
     return MplPath(vertices or [(0.0, 0.0)], codes or [MplPath.MOVETO])
 
@@ -63,6 +71,7 @@ def draw_maze(ax: Axes, run: PictureRun, *, small: bool = False) -> None:
     from matplotlib.patches import PathPatch, Polygon
 
     maze, cell = run.maze, run.cell
+    rects = wall_rectangles(run)
     width, height = maze.width * cell, maze.height * cell
     ax.set_xlim(0, width)
     ax.set_ylim(height, 0)
@@ -70,19 +79,21 @@ def draw_maze(ax: Axes, run: PictureRun, *, small: bool = False) -> None:
     ax.set_facecolor("white")
     ax.set_xticks([])
     ax.set_yticks([])
+    # (add_artist, not add_patch: the limits are set above, and working them out from
+    # thousands of walls would take seconds)
     walls = PathPatch(
-        _squares_path(wall_squares(run), cell),
+        _rectangles_path([(x * cell, y * cell, w * cell, h * cell) for x, y, w, h in rects]),
         facecolor=WALL_COLOUR,
         edgecolor="none",
         linewidth=0,
         gid="maze-walls",
     )
-    ax.add_patch(walls)
-    exits = [(x * cell, y * cell) for x, y in maze.exits]
+    ax.add_artist(walls)
+    exits = [(x * cell, y * cell, cell, cell) for x, y in maze.exits]
     if exits:
-        ax.add_patch(
+        ax.add_artist(
             PathPatch(
-                _squares_path(exits, cell),
+                _rectangles_path(exits),
                 facecolor=EXIT_COLOUR,
                 alpha=0.35,
                 edgecolor=EXIT_COLOUR,
@@ -100,7 +111,7 @@ def draw_maze(ax: Axes, run: PictureRun, *, small: bool = False) -> None:
             (cx - dx * r * 0.6 - dy * r * 0.7, cy - dy * r * 0.6 + dx * r * 0.7),
             (cx - dx * r * 0.6 + dy * r * 0.7, cy - dy * r * 0.6 - dx * r * 0.7),
         ]
-        ax.add_patch(
+        ax.add_artist(
             Polygon(
                 [tip, *back],
                 closed=True,
@@ -179,7 +190,7 @@ def draw_beams(ax: Axes, run: PictureRun, moments: Sequence[float]) -> None:
         pose = frame.pose
         a = math.radians(pose.heading)
         gid = f"beams-{k + 1}"
-        ax.add_patch(
+        ax.add_artist(
             Circle(
                 (pose.x, pose.y),
                 profile.robot_radius,
@@ -223,7 +234,7 @@ def draw_beams(ax: Axes, run: PictureRun, moments: Sequence[float]) -> None:
                 )
             elif spec.kind == "touch":
                 mid = math.degrees(angle)
-                ax.add_patch(
+                ax.add_artist(
                     Wedge(
                         (pose.x, pose.y),
                         r * 1.25,

@@ -47,6 +47,9 @@ class Kind:
     size: Callable[[Sequence[PictureRun]], tuple[int, int]]
     draw: Callable[[Figure, Sequence[PictureRun], Sequence[float]], None]
     one_run: bool = True
+    #: lines may leave out points that add nothing at the picture's resolution (a long run's
+    #: readings and small paths); False keeps every recorded point (the path picture's)
+    simplify: bool = False
 
 
 def _path(fig: Figure, runs: Sequence[PictureRun], at: Sequence[float]) -> None:
@@ -84,8 +87,11 @@ KINDS: dict[str, Kind] = {
             "the sensors, wheel powers and states over time",
             lambda runs: (1200, 900),
             _time,
+            simplify=True,
         ),
-        Kind("compare", "several runs on one maze side by side", _compare_size, _compare, False),
+        Kind(
+            "compare", "several runs on one maze side by side", _compare_size, _compare, False, True
+        ),
     )
 }
 
@@ -148,7 +154,7 @@ def render(runs: Sequence[PictureRun], spec: PictureSpec) -> bytes:
         "svg.hashsalt": HASH_SALT,
         "svg.fonttype": "none",
         "text.parse_math": False,
-        "path.simplify": False,
+        "path.simplify": kind.simplify,
         "font.family": "DejaVu Sans",
         "figure.dpi": 100,
         "savefig.dpi": 100,
