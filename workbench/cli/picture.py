@@ -1,5 +1,5 @@
 """``workbench picture``: run records drawn as pictures for a lab report, and the
-``--picture FILE`` option that ``run``, ``eval``, ``viple run`` and ``grade`` share."""
+``--picture FILE`` option that ``run``, ``eval`` and ``viple run`` share."""
 
 from __future__ import annotations
 
@@ -11,12 +11,16 @@ import sys
 import tempfile
 from collections.abc import Iterator, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from workbench.control.headless import RunSpec
 from workbench.files.terminal import terminal_safe
-from workbench.pictures.naming import per_maze
-from workbench.pictures.render import KINDS, PictureSpec, format_for, save_picture
-from workbench.pictures.runs import PictureError, load_runs, read_maze
+from workbench.pictures import KIND_NAMES
+
+if TYPE_CHECKING:
+    from workbench.control.headless import RunSpec
+
+# (the pictures' code is imported where a picture is drawn: the command line is imported by
+# the served app's entry point, whose start-up the pictures must not slow)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -30,7 +34,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("-o", "--output", required=True, metavar="FILE.svg|FILE.png")
     p.add_argument(
         "--kind",
-        choices=list(KINDS),
+        choices=list(KIND_NAMES),
         help="default: path for one record, compare for several",
     )
     p.add_argument(
@@ -58,6 +62,8 @@ def picture_option(parser: argparse.ArgumentParser, what: str) -> None:
 
 
 def _size(text: str | None) -> tuple[int, int] | None:
+    from workbench.pictures.runs import PictureError
+
     if not text:
         return None
     width, sep, height = text.lower().partition("x")
@@ -68,6 +74,9 @@ def _size(text: str | None) -> tuple[int, int] | None:
 
 def check_target(target: str | os.PathLike) -> None:
     """Refuse, before a run, a picture file that could not be written after it."""
+    from workbench.pictures.render import format_for
+    from workbench.pictures.runs import PictureError
+
     format_for(target)
     folder = Path(target).parent
     shown = terminal_safe(os.fspath(target))
@@ -88,6 +97,9 @@ def said(path: Path, kind: str) -> str:
 
 
 def cmd_picture(args: argparse.Namespace) -> int:
+    from workbench.pictures.render import PictureSpec, format_for, save_picture
+    from workbench.pictures.runs import PictureError, load_runs, read_maze
+
     try:
         kind = args.kind or ("path" if len(args.records) == 1 else "compare")
         maze = read_maze(args.maze) if args.maze else None
@@ -118,6 +130,9 @@ def recorded(spec: RunSpec) -> Iterator[RunSpec]:
 
 def draw(records: Sequence[str], target: str, kind: str, prog: str) -> int:
     """Draw ``records`` at ``target``; 0, or 2 with the reason on standard error."""
+    from workbench.pictures.render import PictureSpec, format_for, save_picture
+    from workbench.pictures.runs import PictureError, load_runs
+
     try:
         written = save_picture(load_runs(records), target, PictureSpec(kind, format_for(target)))
     except PictureError as exc:
@@ -129,6 +144,8 @@ def draw(records: Sequence[str], target: str, kind: str, prog: str) -> int:
 
 def refused(target: str | None, prog: str) -> bool:
     """Check ``--picture`` before a run; True (with the reason said) when it cannot be used."""
+    from workbench.pictures.runs import PictureError
+
     if not target:
         return False
     try:
@@ -140,4 +157,6 @@ def refused(target: str | None, prog: str) -> bool:
 
 
 def maze_pictures(target: str, mazes: Sequence[str]) -> list[Path]:
+    from workbench.pictures.naming import per_maze
+
     return per_maze(target, mazes)

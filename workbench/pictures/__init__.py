@@ -11,3 +11,7 @@
   and a picture saved whole (:func:`save_picture`).
 - ``naming.py``: the names of pictures saved for a maze or a run.
 """
+
+#: the kinds of picture (``render.KINDS`` holds how each is drawn), here for the command line's
+#: options, which must not load the drawing code when the app starts
+KIND_NAMES = ("path", "time", "compare")

@@ -21,6 +21,7 @@ from workbench.files.atomic import write_bytes_atomic
 from workbench.files.terminal import terminal_safe
 from workbench.files.workspace import LOCAL, FileAccess, OutsideWorkspace
 
+from . import KIND_NAMES
 from .draw_compare import draw_compare_figure
 from .draw_maze import draw_path_figure
 from .draw_time import draw_time_figure
@@ -94,6 +95,9 @@ KINDS: dict[str, Kind] = {
         ),
     )
 }
+
+
+assert tuple(KINDS) == KIND_NAMES
 
 
 @dataclass(frozen=True)
