@@ -217,3 +217,33 @@ def test_eval_draws_one_picture_per_maze(tmp_path, capsys, mazes):
         svg = (tmp_path / name).read_bytes()
         assert path_points(svg, "robot-path-1") > 2 and path_points(svg, "robot-path-2") > 2
         assert "2 runs side by side" in texts(svg)
+
+
+def test_grade_draws_each_mazes_programs_side_by_side(tmp_path, capsys):
+    folder = tmp_path / "handins"
+    for student in ("ana", "ben"):
+        (folder / student).mkdir(parents=True)
+        (folder / student / "wall.viple").write_bytes((PROGRAMS / "right-wall.viple").read_bytes())
+    (folder / "cat").mkdir()
+    (folder / "cat" / "broken.viple").write_text("not a program\n")
+    target = tmp_path / "grade.svg"
+    code = main(["grade", str(folder), "--maze", "web", "web", "--jobs", "1",
+                 "--out", str(tmp_path / "table.csv"), "--picture", str(target)])  # fmt: skip
+    _, err = capsys.readouterr()
+    assert code == 0, err
+    for name in ("grade-web.svg", "grade-web-2.svg"):  # (the same maze twice: numbered)
+        svg = (tmp_path / name).read_bytes()
+        words = texts(svg)
+        assert "2 runs side by side" in words  # cat's program did not load: no run to draw
+        assert "001-ana.jsonl" in words and "002-ben.jsonl" in words
+        assert path_points(svg, "robot-path-1") > 2
+    assert "picture (compare)" in err
+
+
+def test_grade_refuses_a_picture_it_could_not_write(tmp_path, capsys):
+    folder = tmp_path / "handins"
+    folder.mkdir()
+    (folder / "ana.viple").write_bytes((PROGRAMS / "right-wall.viple").read_bytes())
+    code = main(["grade", str(folder), "--maze", "web", "--picture", str(tmp_path / "g.pdf")])
+    _, err = capsys.readouterr()
+    assert code == 2 and "--picture" in err and "g.pdf" in err and ".svg or .png" in err

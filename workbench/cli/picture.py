@@ -1,5 +1,5 @@
 """``workbench picture``: run records drawn as pictures for a lab report, and the
-``--picture FILE`` option that ``run``, ``eval`` and ``viple run`` share."""
+``--picture FILE`` option that ``run``, ``eval``, ``viple run`` and ``grade`` share."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""The names pictures are saved under: one per maze for ``eval``, and the
+"""The names pictures are saved under: one per maze for ``eval`` and ``grade``, and the
 app's names in the workspace's ``pictures/`` folder.
 
 The rule for one picture per maze: with one maze the picture goes to the file given; with

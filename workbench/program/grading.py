@@ -16,6 +16,7 @@ import faulthandler
 import multiprocessing
 import os
 import pickle
+import re
 import resource
 import signal
 import time
@@ -37,6 +38,8 @@ DEFAULT_DEADLINE = 60.0
 DEFAULT_MEMORY = 1024
 #: the longest refusal reason a row keeps (a program's problem can be long)
 MAX_REASON = 300
+#: what of a student's name goes into a record's file name
+_NAME = re.compile(r"[^A-Za-z0-9_.-]+")
 
 
 @dataclass(frozen=True)
@@ -77,13 +80,23 @@ class Plan:
     report_ms: int | None = None
     #: what drives each run: made of the program's path, its key script and the kinds map
     pilot: type[ProgramPilot] = ProgramPilot
+    #: a folder (absolute) where each program's run with seed 0 on each maze is recorded, for
+    #: pictures: ``MAZE_NO/INDEX-STUDENT.jsonl`` (:meth:`record_of`); None records nothing
+    records: str | None = None
+
+    def record_of(self, maze_no: int, index: int, submission: Submission) -> str | None:
+        """Where the ``index``-th submission's seed-0 run on maze ``maze_no`` is recorded."""
+        if self.records is None:
+            return None
+        student = _NAME.sub("-", submission.student).strip("-.")[:40] or "student"
+        return os.path.join(self.records, f"{maze_no + 1:02d}", f"{index + 1:03d}-{student}.jsonl")
 
     @property
     def runs(self) -> list[tuple[str, int]]:
-        """Each run's maze and seed, in the table's order."""
+        """Each run's maze and seed, in the table's order (that of :meth:`specs` too)."""
         return [(maze, seed) for maze in self.mazes for seed in range(self.seeds)]
 
-    def specs(self, submission: Submission) -> list[RunSpec]:
+    def specs(self, submission: Submission, index: int = 0) -> list[RunSpec]:
         pilot = self.pilot(
             submission.path, keys=submission.keys, kinds=self.kinds, report_ms=self.report_ms
         )
@@ -97,8 +110,10 @@ class Plan:
                 noise=self.noise,
                 noise_params=self.noise_params,
                 max_time=self.max_time,
+                record=self.record_of(no, index, submission) if seed == 0 else None,
             )
-            for maze, seed in self.runs
+            for no, maze in enumerate(self.mazes)
+            for seed in range(self.seeds)
         ]
 
 
@@ -216,7 +231,7 @@ class _Child:
         mine, theirs = context.Pipe(duplex=False)
         process = context.Process(
             target=_child_main,
-            args=(theirs, plan.folder, submission.path, plan.kinds, plan.specs(submission)),
+            args=(theirs, plan.folder, submission.path, plan.kinds, plan.specs(submission, index)),
             kwargs={"memory": limits.memory, "deadline": limits.deadline},
             daemon=True,
         )
