@@ -178,6 +178,7 @@ def test_run_draws_its_picture(tmp_path, capsys):
     assert json.loads(out)["reached_exit"] is True  # stdout stays one JSON object
     assert "picture (path)" in err
     assert path_points(target.read_bytes(), "robot-path") > 10
+    assert "run not kept (--record keeps it)" in texts(target.read_bytes())
     assert os.listdir(tmp_path) == sorted(["bend.txt", "run.svg"]) or set(os.listdir(tmp_path)) == {
         "bend.txt",
         "run.svg",

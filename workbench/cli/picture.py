@@ -128,13 +128,20 @@ def recorded(spec: RunSpec) -> Iterator[RunSpec]:
         yield dataclasses.replace(spec, record=str(Path(folder) / "run.jsonl"))
 
 
-def draw(records: Sequence[str], target: str, kind: str, prog: str) -> int:
-    """Draw ``records`` at ``target``; 0, or 2 with the reason on standard error."""
+def draw(records: Sequence[str], target: str, kind: str, prog: str, kept: bool = True) -> int:
+    """Draw ``records`` at ``target``; 0, or 2 with the reason on standard error. A record
+    not ``kept`` (a temporary one) is not named in the caption."""
     from workbench.pictures.render import PictureSpec, format_for, save_picture
     from workbench.pictures.runs import PictureError, load_runs
 
     try:
-        written = save_picture(load_runs(records), target, PictureSpec(kind, format_for(target)))
+        runs = load_runs(records)
+        if not kept:
+            runs = [
+                dataclasses.replace(r, record_words="run not kept (--record keeps it)")
+                for r in runs
+            ]
+        written = save_picture(runs, target, PictureSpec(kind, format_for(target)))
     except PictureError as exc:
         print(f"{prog}: {exc}", file=sys.stderr)
         return 2

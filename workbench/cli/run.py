@@ -144,6 +144,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     )
     if picture_cmd.refused(args.picture, "workbench run"):
         return 2
+    kept = bool(spec.record)
     with picture_cmd.recorded(spec) if args.picture else contextlib.nullcontext(spec) as spec:
         try:
             result = run(spec)
@@ -151,14 +152,14 @@ def cmd_run(args: argparse.Namespace) -> int:
             print(f"workbench run: {exc}", file=sys.stderr)
             return 2
         code = report(result, args.json, describe_run(args.algorithm))
-        return with_picture(code, spec, args.picture, "workbench run")
+        return with_picture(code, spec, args.picture, "workbench run", kept)
 
 
-def with_picture(code: int, spec: RunSpec, target: str | None, prog: str) -> int:
+def with_picture(code: int, spec: RunSpec, target: str | None, prog: str, kept: bool = True) -> int:
     """The run's exit code, or 2 when its ``--picture`` could not be drawn."""
     if not target or spec.record is None:
         return code
-    drawn = picture_cmd.draw([spec.record], target, "path", prog)
+    drawn = picture_cmd.draw([spec.record], target, "path", prog, kept)
     return code if drawn == 0 else drawn
 
 

@@ -166,6 +166,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     )
     if picture_cmd.refused(args.picture, "workbench viple run"):
         return 2
+    kept = bool(spec.record)
     with picture_cmd.recorded(spec) if args.picture else contextlib.nullcontext(spec) as spec:
         try:
             result = run(spec)
@@ -177,7 +178,7 @@ def cmd_run(args: argparse.Namespace) -> int:
             print(f"workbench viple run: {exc}", file=sys.stderr)
             return 2
         code = report(result, args.json, describe_program_run)
-        return with_picture(code, spec, args.picture, "workbench viple run")
+        return with_picture(code, spec, args.picture, "workbench viple run", kept)
 
 
 #: how many printed lines a run's summary shows from the start and from the end

@@ -47,6 +47,8 @@ class PictureRun:
     profile: Profile
     #: what the student should know about the maze (its file changed since the run), or ""
     note: str = ""
+    #: how the caption names the record ("" : ``record NAME``)
+    record_words: str = ""
 
     @property
     def name(self) -> str:

@@ -113,7 +113,7 @@ def heading(run: PictureRun) -> str:
 
 def caption(run: PictureRun) -> str:
     """The caption under a run's picture: heading, figures, and the record's name."""
-    lines = [heading(run), *figure_lines(run), f"record {label(run.name)}"]
+    lines = [heading(run), *figure_lines(run), run.record_words or f"record {label(run.name)}"]
     if run.note:
         lines.append(terminal_safe(run.note))
     return "\n".join(lines)
