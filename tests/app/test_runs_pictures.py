@@ -11,6 +11,7 @@ from tests.pictures.svg import marks, path_points, texts
 from tests.waiting import until
 from workbench.control.station import LabStation
 from workbench.files.workspace import FileAccess
+from workbench.sim.mazeio import load_maze
 from workbench.sim.replay import load_replay
 from workbench.tui.screens.replay import ReplayScreen
 from workbench.tui.screens.runs import RunsScreen
@@ -164,3 +165,19 @@ async def test_the_console_saves_the_evidence_runs_picture(tmp_path, monkeypatch
         )
         svg = picture.read_bytes()
         assert path_points(svg, "robot-path") == len(load_replay(record))
+
+
+@sync
+async def test_a_run_whose_maze_is_gone_says_how_to_draw_it(tmp_path):
+    station = _served(tmp_path)
+    station.load_maze(load_maze("mazes/web.txt"))  # Bend was never a file: only the station had it
+    screen = RunsScreen(station)
+    async with Host(screen).run_test(size=SIZE) as pilot:
+        await pilot.press("a", "p")
+        said = await until(lambda: "no picture" in screen.status and screen.status, "refusal")
+        assert "the maze cannot be drawn" in said
+        assert "load that maze on the workbench (m) and save the picture again" in said
+        assert "--maze" not in said
+    assert not (station.files.workspace / "pictures").exists() or not any(
+        (station.files.workspace / "pictures").iterdir()
+    )

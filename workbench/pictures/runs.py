@@ -33,6 +33,10 @@ MAX_RUNS = 12
 MARGIN_BLOCKS = 2.0
 
 
+#: what to do when a record's maze is not found, on the command line
+MAZE_HINT = "give the run's maze file with --maze FILE"
+
+
 class PictureError(ValueError):
     """A picture that cannot be drawn or saved; the message names the file and the fix."""
 
@@ -98,6 +102,7 @@ def load_run(
     maze: Maze | None = None,
     files: FileAccess = LOCAL,
     known: Sequence[Maze] = (),
+    maze_hint: str = MAZE_HINT,
 ) -> PictureRun:
     """Read the record at ``typed`` and find its maze; with ``maze``, the record must be a run
     on that maze (its layout digest). :class:`PictureError` says why a record cannot be drawn."""
@@ -127,7 +132,7 @@ def load_run(
     else:
         found_or_none, note = replay_maze(replay, path, known, files)
         if found_or_none is None:
-            raise PictureError(f"{shown}: {note}: give the run's maze file with --maze FILE")
+            raise PictureError(f"{shown}: {note}: {maze_hint}")
         found = found_or_none
     profile = PROFILES.get(str(replay.header.get("profile")))
     if profile is None:
@@ -162,6 +167,7 @@ def load_runs(
     maze: Maze | None = None,
     files: FileAccess = LOCAL,
     known: Sequence[Maze] = (),
+    maze_hint: str = MAZE_HINT,
 ) -> list[PictureRun]:
     """The runs of one picture, all on one maze: runs on different mazes are refused."""
     if not paths:
@@ -170,7 +176,7 @@ def load_runs(
         raise PictureError(
             f"{len(paths)} records is more than one picture holds ({MAX_RUNS}): draw them in groups"
         )
-    runs = [load_run(p, maze, files, known) for p in paths]
+    runs = [load_run(p, maze, files, known, maze_hint) for p in paths]
     first = runs[0]
     for run in runs[1:]:
         if run.maze.digest() != first.maze.digest():

@@ -20,6 +20,9 @@ from .naming import app_compare_name, app_picture_name
 from .render import PictureSpec, save_picture
 from .runs import PictureError, load_runs
 
+#: what to do in the app when a record's maze is not found
+APP_MAZE_HINT = "load that maze on the workbench (m) and save the picture again"
+
 
 @dataclass(frozen=True)
 class SavedPicture:
@@ -42,7 +45,7 @@ def save_in_workspace(
 ) -> SavedPicture:
     """Draw ``records`` as a ``kind`` picture into ``pictures/`` (made when missing) and say
     where it went; :class:`PictureError` says why it could not be drawn or saved."""
-    runs = load_runs(records, files=files, known=known)
+    runs = load_runs(records, files=files, known=known, maze_hint=APP_MAZE_HINT)
     if kind == "compare":
         name = app_compare_name(runs[0].maze.name or Path(runs[0].maze.source).stem, len(runs))
     else:
