@@ -118,13 +118,14 @@ def test_the_same_record_gives_the_same_bytes(tmp_path):
 
 def test_another_process_draws_the_same_bytes(tmp_path):
     record = record_of(tmp_path)
-    here = tmp_path / "here.svg"
-    save_picture(load_runs([record]), here)
-    there = tmp_path / "there.svg"
-    code = (
-        "from workbench.pictures.render import save_picture\n"
-        "from workbench.pictures.runs import load_runs\n"
-        f"save_picture(load_runs([{str(record)!r}]), {str(there)!r})\n"
-    )
-    subprocess.run([sys.executable, "-c", code], check=True, timeout=120)
-    assert there.read_bytes() == here.read_bytes()
+    for suffix in (".svg", ".png"):
+        here = tmp_path / f"here{suffix}"
+        save_picture(load_runs([record]), here)
+        there = tmp_path / f"there{suffix}"
+        code = (
+            "from workbench.pictures.render import save_picture\n"
+            "from workbench.pictures.runs import load_runs\n"
+            f"save_picture(load_runs([{str(record)!r}]), {str(there)!r})\n"
+        )
+        subprocess.run([sys.executable, "-c", code], check=True, timeout=120)
+        assert there.read_bytes() == here.read_bytes()

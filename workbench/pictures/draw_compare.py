@@ -80,6 +80,7 @@ def draw_compare_figure(fig: Figure, runs: Sequence[PictureRun]) -> None:
         ax.set_xticks(range(1, n + 1))
         ax.tick_params(labelsize=7)
         ax.margins(y=0.2)
+        ax.set_ylim(bottom=0, top=None if max(values, default=0) > 0 else 1)
     first = runs[0]
     fig.suptitle(
         f"{label(first.maze.name or 'unnamed maze')} ({first.profile.name}): "
