@@ -97,7 +97,7 @@ async def test_the_instructor_signs_a_request_with_their_own_passphrase(tmp_path
         assert "on run 3, as above" in shown and "all objectives pass" in shown
         assert " m;" not in shown and "reached_exit" not in shown
         run_line = str(request.query_one("#request-run", Static).render())
-        assert run_line == f"run 3 is recorded in {record}: p replays it"
+        assert run_line == f"run 3 is recorded in {record}: p replays it, ctrl+g saves its picture"
         # the evidence run replays in the maze view
         request.action_replay()
         await until(pilot, lambda: isinstance(app.screen, ReplayScreen), "the replay")

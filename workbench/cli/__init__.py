@@ -20,6 +20,7 @@ from . import grade as grade_cmd
 from . import instructor as instructor_cmd
 from . import labs as labs_cmd
 from . import maze as maze_cmd
+from . import picture as picture_cmd
 from . import run as run_cmd
 from . import serve as serve_cmd
 from . import signoff as signoff_cmd
@@ -111,6 +112,7 @@ def build_parser() -> argparse.ArgumentParser:
     maze_cmd.register(sub)
     algorithms_cmd.register(sub)
     run_cmd.register(sub)
+    picture_cmd.register(sub)
     grade_cmd.register(sub)
     viple_program_cmd.register(sub)
     labs_cmd.register(sub)

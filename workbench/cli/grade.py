@@ -4,8 +4,11 @@ seeds, in parallel, into one table."""
 from __future__ import annotations
 
 import argparse
+import contextlib
+import dataclasses
 import os
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -24,6 +27,7 @@ from workbench.program.grading import (
 from workbench.program.keys import KeyScriptError
 from workbench.program.submissions import PROGRAM_FILES, FolderError, scan_folder
 
+from . import picture as picture_cmd
 from .common import report_ms_option
 from .run import _simulation_options, common_keys, key_options
 
@@ -108,6 +112,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="write the table to FILE.csv or FILE.json (may be given twice; default: CSV on "
         "standard output)",
     )
+    picture_cmd.picture_option(
+        g,
+        "each maze's runs with seed 0 side by side, one picture per maze (FILE-MAZE.EXT beside "
+        "FILE with several mazes; FILE-MAZE-2.EXT and on for more than 12 programs)",
+    )
     g.set_defaults(func=cmd_grade)
 
 
@@ -131,6 +140,64 @@ def cmd_grade(args: argparse.Namespace) -> int:
         ]
         print("\n".join(lines), file=sys.stderr)
         return 2
+    if picture_cmd.refused(args.picture, NAME):
+        return 2
+    with contextlib.ExitStack() as stack:
+        if args.picture:
+            records = stack.enter_context(tempfile.TemporaryDirectory(prefix="workbench-grade-"))
+            for no in range(len(plan.mazes)):
+                os.mkdir(os.path.join(records, f"{no + 1:02d}"))
+            plan = dataclasses.replace(plan, records=records)
+        code = _graded(args, plan, what, submissions, skipped, limits)
+        if args.picture and code == 0:
+            code = grade_pictures(args.picture, plan, submissions)
+        return code
+
+
+def grade_pictures(target: str, plan: Plan, submissions: list[Submission]) -> int:
+    """One picture per maze of the programs' seed-0 runs side by side (in groups of 12); a
+    record that cannot be drawn (a program that did not run, a record its program made too
+    large) is left out and said."""
+    from workbench.pictures.render import PictureSpec, save_picture
+    from workbench.pictures.runs import MAX_RUNS, PictureError, load_run
+
+    worst = 0
+    for no, path in enumerate(picture_cmd.maze_pictures(target, list(plan.mazes))):
+        runs = []
+        for index, submission in enumerate(submissions):
+            record = plan.record_of(no, index, submission)
+            if record is None or not os.path.isfile(record):
+                continue
+            try:
+                runs.append(load_run(record))
+            except PictureError as exc:
+                print(
+                    f"{NAME}: picture: {submission.student}'s run left out: {exc}", file=sys.stderr
+                )
+        groups = [runs[i : i + MAX_RUNS] for i in range(0, len(runs), MAX_RUNS)]
+        for part, group in enumerate(groups, start=1):
+            name = path if part == 1 else path.with_name(f"{path.stem}-{part}{path.suffix}")
+            try:
+                written = save_picture(group, name, PictureSpec("compare"))
+            except PictureError as exc:
+                print(f"{NAME}: {exc}", file=sys.stderr)
+                worst = 2
+                continue
+            print(picture_cmd.said(written, "compare"), file=sys.stderr)
+        if not groups:
+            print(f"{NAME}: picture: no run on {plan.mazes[no]} to draw", file=sys.stderr)
+    return worst
+
+
+def _graded(
+    args: argparse.Namespace,
+    plan: Plan,
+    what: dict[str, str],
+    submissions: list[Submission],
+    skipped: list,
+    limits: Limits,
+) -> int:
+    """Grade, write the table, say the summary; the exit code."""
     shown = sys.stderr.isatty()
     started = time.monotonic()
     rows = grade(

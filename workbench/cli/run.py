@@ -3,13 +3,19 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
+import dataclasses
 import json
 import os
 import sys
-from collections.abc import Callable
+import tempfile
+from collections.abc import Callable, Sequence
+from pathlib import Path
 
 from workbench.control.evaluate import (
+    Entrant,
     EvalError,
+    algorithm_entrant,
     evaluate,
     format_narrow,
     format_table,
@@ -32,6 +38,7 @@ from workbench.sim.noise import NOISE_LEVELS
 from workbench.sim.profiles import PROFILES
 from workbench.sim.record import stop_words
 
+from . import picture as picture_cmd
 from .common import report_ms_option
 
 
@@ -71,6 +78,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--max-time", type=float, help="simulated seconds (default: from maze size)")
     p.add_argument("--record", metavar="FILE.jsonl", help="write the run record")
     p.add_argument("--json", action="store_true", help="one JSON object")
+    picture_cmd.picture_option(p, "the run's path on its maze")
     p.set_defaults(func=cmd_run)
 
     e = sub.add_parser(
@@ -100,6 +108,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--wide", action="store_true", help="the table in one wide line per entrant (110 columns)"
     )
     e.add_argument("--json", action="store_true", help="one JSON object")
+    picture_cmd.picture_option(
+        e,
+        "each maze's runs (seed 0) side by side, one picture per maze: with several mazes "
+        "FILE-MAZE.svg beside FILE",
+    )
     e.set_defaults(func=cmd_eval)
 
 
@@ -136,12 +149,25 @@ def cmd_run(args: argparse.Namespace) -> int:
         max_time=args.max_time,
         record=args.record,
     )
-    try:
-        result = run(spec)
-    except (RunSetupError, RunFailed) as exc:
-        print(f"workbench run: {exc}", file=sys.stderr)
+    if picture_cmd.refused(args.picture, "workbench run"):
         return 2
-    return report(result, args.json, describe_run(args.algorithm))
+    kept = bool(spec.record)
+    with picture_cmd.recorded(spec) if args.picture else contextlib.nullcontext(spec) as spec:
+        try:
+            result = run(spec)
+        except (RunSetupError, RunFailed) as exc:
+            print(f"workbench run: {exc}", file=sys.stderr)
+            return 2
+        code = report(result, args.json, describe_run(args.algorithm))
+        return with_picture(code, spec, args.picture, "workbench run", kept)
+
+
+def with_picture(code: int, spec: RunSpec, target: str | None, prog: str, kept: bool = True) -> int:
+    """The run's exit code, or 2 when its ``--picture`` could not be drawn."""
+    if not target or spec.record is None:
+        return code
+    drawn = picture_cmd.draw([spec.record], target, "path", prog, kept)
+    return code if drawn == 0 else drawn
 
 
 def report(result: RunResult, as_json: bool, describe: Callable[[RunResult], str]) -> int:
@@ -210,6 +236,8 @@ def describe_measures(result: RunResult) -> list[str]:
 
 
 def cmd_eval(args: argparse.Namespace) -> int:
+    if picture_cmd.refused(args.picture, "workbench eval"):
+        return 2
     if args.seeds < 1 or args.jobs < 1:
         print("workbench eval: --seeds and --jobs must be at least 1", file=sys.stderr)
         return 2
@@ -263,4 +291,30 @@ def cmd_eval(args: argparse.Namespace) -> int:
         print(json.dumps(result.as_dict(), sort_keys=False))
     else:
         print(format_table(result) if args.wide else format_narrow(result))
+    if args.picture:
+        entrants = [
+            *(
+                algorithm_entrant(a, args.profile, args.noise, tuple(args.noise_set), args.max_time)
+                for a in args.algorithm
+            ),
+            *programs,
+        ]
+        return eval_pictures(args.picture, args.maze, entrants, "workbench eval")
     return 0
+
+
+def eval_pictures(target: str, mazes: Sequence[str], entrants: Sequence[Entrant], prog: str) -> int:
+    """One picture per maze of every entrant's run with seed 0 side by side (the run the
+    table's first seed made: the same spec gives the same run)."""
+    worst = 0
+    for maze, path in zip(mazes, picture_cmd.maze_pictures(target, mazes), strict=True):
+        with tempfile.TemporaryDirectory(prefix="workbench-picture-") as folder:
+            records = []
+            for k, entrant in enumerate(entrants):
+                spec = dataclasses.replace(
+                    entrant.spec(maze, 0), record=str(Path(folder) / f"{k + 1:02d}.jsonl")
+                )
+                run(spec)
+                records.append(str(spec.record))
+            worst = max(worst, picture_cmd.draw(records, str(path), "compare", prog))
+    return worst

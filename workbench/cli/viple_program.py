@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import contextlib
 import json
 import os
 import sys
@@ -25,9 +26,10 @@ from workbench.viple.client import (
 )
 from workbench.viple.codec import WheelPorts
 
+from . import picture as picture_cmd
 from .common import report_ms_option
 from .keyboard import QUIT_KEYS, attach_keyboard, raw_terminal
-from .run import _simulation_options, describe_measures, report, run_head
+from .run import _simulation_options, describe_measures, report, run_head, with_picture
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -74,6 +76,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     r.add_argument("--max-time", type=float, help="simulated seconds (default: from maze size)")
     r.add_argument("--record", metavar="FILE.jsonl", help="write the run record")
     r.add_argument("--json", action="store_true", help="one JSON object")
+    picture_cmd.picture_option(r, "the run's path on its maze (not with --connect)")
     r.add_argument(
         "--connect",
         nargs="?",
@@ -130,6 +133,13 @@ def cmd_show(args: argparse.Namespace) -> int:
 
 def cmd_run(args: argparse.Namespace) -> int:
     if args.connect is not None:
+        if args.picture:
+            print(
+                "workbench viple run: --picture draws a simulated run: leave it out with "
+                "--connect, or record the run (--record) and draw it with workbench picture",
+                file=sys.stderr,
+            )
+            return 2
         return cmd_connect(args)
     if not args.maze:
         print("workbench viple run: give --maze M (or --connect for a robot)", file=sys.stderr)
@@ -154,16 +164,21 @@ def cmd_run(args: argparse.Namespace) -> int:
         max_time=args.max_time,
         record=args.record,
     )
-    try:
-        result = run(spec)
-    except ProgramError as exc:
-        for problem in exc.problems:
-            print(problem, file=sys.stderr)
+    if picture_cmd.refused(args.picture, "workbench viple run"):
         return 2
-    except RunSetupError as exc:
-        print(f"workbench viple run: {exc}", file=sys.stderr)
-        return 2
-    return report(result, args.json, describe_program_run)
+    kept = bool(spec.record)
+    with picture_cmd.recorded(spec) if args.picture else contextlib.nullcontext(spec) as spec:
+        try:
+            result = run(spec)
+        except ProgramError as exc:
+            for problem in exc.problems:
+                print(problem, file=sys.stderr)
+            return 2
+        except RunSetupError as exc:
+            print(f"workbench viple run: {exc}", file=sys.stderr)
+            return 2
+        code = report(result, args.json, describe_program_run)
+        return with_picture(code, spec, args.picture, "workbench viple run", kept)
 
 
 #: how many printed lines a run's summary shows from the start and from the end

@@ -14,6 +14,7 @@ not load, crashes, hangs or blows its memory costs its own rows only: the reason
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -39,6 +40,8 @@ DEFAULT_DEADLINE = 60.0
 DEFAULT_MEMORY = 1024
 #: the outer wall around each program's process, unless the command says otherwise
 DEFAULT_LIMITS = Limits(DEFAULT_DEADLINE, DEFAULT_MEMORY)
+#: what of a student's name goes into a record's file name
+_NAME = re.compile(r"[^A-Za-z0-9_.-]+")
 
 
 @dataclass(frozen=True)
@@ -71,13 +74,23 @@ class Plan:
     report_ms: int | None = None
     #: what drives each run: made of the program's path, its key script and the kinds map
     pilot: type[ProgramPilot] = ProgramPilot
+    #: a folder (absolute) where each program's run with seed 0 on each maze is recorded, for
+    #: pictures: ``MAZE_NO/INDEX-STUDENT.jsonl`` (:meth:`record_of`); None records nothing
+    records: str | None = None
+
+    def record_of(self, maze_no: int, index: int, submission: Submission) -> str | None:
+        """Where the ``index``-th submission's seed-0 run on maze ``maze_no`` is recorded."""
+        if self.records is None:
+            return None
+        student = _NAME.sub("-", submission.student).strip("-.")[:40] or "student"
+        return os.path.join(self.records, f"{maze_no + 1:02d}", f"{index + 1:03d}-{student}.jsonl")
 
     @property
     def runs(self) -> list[tuple[str, int]]:
-        """Each run's maze and seed, in the table's order."""
+        """Each run's maze and seed, in the table's order (that of :meth:`specs` too)."""
         return [(maze, seed) for maze in self.mazes for seed in range(self.seeds)]
 
-    def specs(self, submission: Submission) -> list[RunSpec]:
+    def specs(self, submission: Submission, index: int = 0) -> list[RunSpec]:
         pilot = self.pilot(
             submission.path, keys=submission.keys, kinds=self.kinds, report_ms=self.report_ms
         )
@@ -91,8 +104,10 @@ class Plan:
                 noise=self.noise,
                 noise_params=self.noise_params,
                 max_time=self.max_time,
+                record=self.record_of(no, index, submission) if seed == 0 else None,
             )
-            for maze, seed in self.runs
+            for no, maze in enumerate(self.mazes)
+            for seed in range(self.seeds)
         ]
 
 
@@ -142,8 +157,8 @@ def grade(
     in the submissions' order. ``progress(done, total, submission)`` is told of each finished
     submission."""
     work: list[Job] = [
-        Outcome(began=False, stopped=s.refused) if s.refused else _runs(s, plan)
-        for s in submissions
+        Outcome(began=False, stopped=s.refused) if s.refused else _runs(s, index, plan)
+        for index, s in enumerate(submissions)
     ]
     told = (lambda done, total, i: progress(done, total, submissions[i])) if progress else None
     outcomes = run_jobs(work, WORDS, jobs, limits, told)
@@ -153,9 +168,10 @@ def grade(
     return rows
 
 
-def _runs(submission: Submission, plan: Plan) -> Callable[[Reply], None]:
-    """One program's runs, in a process of its own: each result, or why it was refused."""
-    specs = plan.specs(submission)
+def _runs(submission: Submission, index: int, plan: Plan) -> Callable[[Reply], None]:
+    """The ``index``-th program's runs, in a process of its own: each result, or why it was
+    refused."""
+    specs = plan.specs(submission, index)
 
     def work(reply: Reply) -> None:
         os.chdir(plan.folder)

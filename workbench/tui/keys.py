@@ -447,6 +447,33 @@ KEY_TABLE: dict[str, Key] = {
         "u", "unicode", "Unicode", "Runs", "unicode", "Plain ASCII or Unicode marks.", show=False
     ),
     "runs.leave": Key("escape", "leave", "Back", "Runs", "back", "Back to the workbench.", rank=1),
+    "runs.picture": Key(
+        "p",
+        "picture('path')",
+        "Picture",
+        "Runs",
+        "picture of the run",
+        "Save the selected run's path on its maze as a picture (SVG) in pictures/.",
+    ),
+    "runs.plot": Key(
+        "t",
+        "picture('time')",
+        "Plot",
+        "Runs",
+        "plot of the run over time",
+        "Save the selected run's sensors, wheel powers and states over time (SVG) in pictures/.",
+        show=False,
+    ),
+    "runs.compare": Key(
+        "c",
+        "picture('compare')",
+        "Side by side",
+        "Runs",
+        "runs side by side",
+        "Save the recorded runs on this maze (the last 12) side by side with their figures "
+        "(SVG) in pictures/.",
+        show=False,
+    ),
     "replay.step": Key("right", "step(1)", "Step", "Replay", "step", "Forward one control tick."),
     "replay.back": Key("left", "step(-1)", "Back", "Replay", "back", "Back one control tick."),
     "replay.step10": Key(
@@ -481,6 +508,24 @@ KEY_TABLE: dict[str, Key] = {
         show=False,
     ),
     "replay.leave": Key("escape", "leave", "Back", "Replay", "back", "Back to the runs.", rank=1),
+    "replay.picture": Key(
+        "p",
+        "picture('path')",
+        "Picture",
+        "Replay",
+        "picture of the run",
+        "Save the run's path on its maze, with the sensors' beams at this tick, as a picture "
+        "(SVG) in pictures/.",
+    ),
+    "replay.plot": Key(
+        "t",
+        "picture('time')",
+        "Plot",
+        "Replay",
+        "plot of the run over time",
+        "Save the run's sensors, wheel powers and states over time (SVG) in pictures/.",
+        show=False,
+    ),
     "labs.close": Key(
         "escape",
         "close",
@@ -546,6 +591,16 @@ KEY_TABLE: dict[str, Key] = {
         "Console",
         "replay the evidence run",
         "Replay the run the objectives rest on, in the maze view.",
+    ),
+    "console.picture": Key(
+        "ctrl+g",
+        "picture",
+        "Picture",
+        "Console",
+        "picture of the evidence run",
+        "Save the evidence run's path on its maze as a picture (SVG) in pictures/ in the "
+        "current folder.",
+        priority=True,  # (typed into the note or the passphrase otherwise)
     ),
     "console.sign": Key(
         "ctrl+s",
@@ -678,7 +733,16 @@ EDITOR_KEY_IDS = (
     "editor.leave",
 )
 #: the runs screen's keys
-RUNS_KEY_IDS = ("runs.replay", "runs.open", "runs.scope", "runs.unicode", "runs.leave")
+RUNS_KEY_IDS = (
+    "runs.replay",
+    "runs.open",
+    "runs.scope",
+    "runs.unicode",
+    "runs.leave",
+    "runs.picture",
+    "runs.plot",
+    "runs.compare",
+)
 #: the replay screen's keys
 REPLAY_KEY_IDS = (
     "replay.step",
@@ -692,6 +756,8 @@ REPLAY_KEY_IDS = (
     "replay.last",
     "replay.unicode",
     "replay.leave",
+    "replay.picture",
+    "replay.plot",
 )
 #: the labs screen's keys
 LABS_KEY_IDS = ("labs.close", "labs.setup", "labs.ready", "labs.signoff")
@@ -787,5 +853,9 @@ REPLAY_LEGEND: Legend = (
     (
         LegendEntry(("replay.first", "replay.last"), what="first/last"),
         LegendEntry(("replay.leave",)),
+    ),
+    (
+        LegendEntry(("replay.picture",), what="picture"),
+        LegendEntry(("replay.plot",), what="plot"),
     ),
 )

@@ -22,6 +22,7 @@ from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.screen import Screen
 from textual.widgets import Button, Input, Static
 
+from workbench.files.workspace import LOCAL
 from workbench.labs.classview import Request, read_request
 from workbench.labs.copy_hints import CopyHint, hints_for
 from workbench.labs.evidence_text import lines_of_progress, mixed_programs_text, short_digest
@@ -35,6 +36,7 @@ from workbench.sim.record import RecordError
 from workbench.sim.replay import load_replay
 
 from ..keys import bindings
+from ..picture_saving import save_picture_off_the_loop
 from ..plain import follow_app
 from ..widgets.field import Field
 from ..widgets.key_bar import KeyBar
@@ -48,7 +50,8 @@ def record_line(run: dict[str, Any] | None) -> str:
     record = run.get("record")
     if not record:
         return f"run {run.get('run', '?')} was not recorded (no replay)"
-    return f"run {run.get('run', '?')} is recorded in {record}: p replays it"
+    number = run.get("run", "?")
+    return f"run {number} is recorded in {record}: p replays it, ctrl+g saves its picture"
 
 
 def hanging(lines: list[str], width: int) -> list[str]:
@@ -122,7 +125,9 @@ class RequestScreen(Screen[str | None]):
     """
 
     BINDINGS: ClassVar[list[BindingType]] = [
-        *bindings("dialog.close", "console.sign", "console.decline", "console.replay")
+        *bindings(
+            "dialog.close", "console.sign", "console.decline", "console.replay", "console.picture"
+        )
     ]
 
     def __init__(
@@ -366,6 +371,23 @@ class RequestScreen(Screen[str | None]):
             self._say("no recorded run among the evidence: nothing to replay")
             return
         self.run_worker(self._replay(str(record)), group="request", exit_on_error=False)
+
+    def action_picture(self) -> None:
+        """Save the evidence run's picture in pictures/ (the instructor's current folder)."""
+        request = self.request
+        run = request.run if request is not None else None
+        record = run.get("record") if run else None
+        if not record:
+            self._say("no recorded run among the evidence: nothing to draw")
+            return
+        save_picture_off_the_loop(
+            self,
+            [str(record)],
+            "path",
+            LOCAL,
+            lambda text, error: self._say(text),
+            what=f"run {run.get('run', '?') if run else '?'}",
+        )
 
     async def _replay(self, path: str) -> None:
         from .replay import ReplayScreen

@@ -29,6 +29,7 @@ from workbench.sim.sensor_kinds import sensor_kind
 
 from ..host import FollowsUnicode, ToggleUnicode
 from ..keys import REPLAY_KEY_IDS, REPLAY_LEGEND, bindings, legend_text
+from ..picture_saving import save_picture_off_the_loop
 from ..widgets.key_bar import KeyBar
 from ..widgets.maze_view import MazeView
 from ..widgets.text import count
@@ -77,8 +78,16 @@ class ReplayScreen(FollowsUnicode, Screen[None]):
         padding: 0 1;
         color: $text-warning;
     }
-    ReplayScreen #replay-note.-empty {
+    ReplayScreen #replay-note.-empty, ReplayScreen #replay-said.-empty {
         display: none;
+    }
+    ReplayScreen #replay-said {
+        height: auto;
+        padding: 0 1;
+        color: $text-muted;
+    }
+    ReplayScreen #replay-said.-error {
+        color: $text-error;
     }
     ReplayScreen #replay-body {
         height: 1fr;
@@ -135,6 +144,9 @@ class ReplayScreen(FollowsUnicode, Screen[None]):
         self.record_path = os.fspath(record_path)
         self.replay = replay if replay is not None else load_replay(record_path)
         self.maze, self.note = replay_maze(self.replay, record_path, mazes, files)
+        self.files = files
+        #: the last message about a picture (what was saved where, or why not)
+        self.said = ""
         self._unicode = unicode
         self._timer: Timer | None = None
         self._last_time = 0.0
@@ -145,6 +157,7 @@ class ReplayScreen(FollowsUnicode, Screen[None]):
         yield Static(
             self.note, id="replay-note", markup=False, classes="" if self.note else "-empty"
         )
+        yield Static(id="replay-said", markup=False, classes="-empty")
         with Horizontal(id="replay-body"):
             if self.maze is not None:
                 yield MazeView(self.maze, unicode=self._unicode, id="replay-maze")
@@ -176,6 +189,28 @@ class ReplayScreen(FollowsUnicode, Screen[None]):
         if self.is_mounted and self.maze is not None:
             self.query_one(MazeView).set_unicode(unicode)
             self._draw_panel()
+
+    # -- pictures ----------------------------------------------------------------------------
+    def action_picture(self, kind: str) -> None:
+        """Save the run's picture (``path``: with the beams at this tick; ``time``), drawn in
+        a thread."""
+        save_picture_off_the_loop(
+            self,
+            [self.record_path],
+            kind,
+            self.files,
+            self._say,
+            what="this run",
+            at=(self.replay.frame().t,) if kind == "path" else (),
+            known=(self.maze,) if self.maze is not None else (),
+        )
+
+    def _say(self, text: str, error: bool = False) -> None:
+        self.said = text
+        line = self.query_one("#replay-said", Static)
+        line.update(text)
+        line.set_class(not text, "-empty")
+        line.set_class(error, "-error")
 
     # -- drawing -------------------------------------------------------------------------------
     def _draw(self) -> None:

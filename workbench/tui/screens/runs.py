@@ -5,6 +5,8 @@ better on this maze": it shows the runs on the station's maze and profile, and `
 runs on every maze, grouped by maze and profile. The table always keeps the graded measures,
 shortening long names to fit the width; the line under it says the chosen run whole. Enter
 (or a click) on a run with a record opens its replay; ``o`` opens any run record by path.
+``p``, ``t`` and ``c`` save pictures of the chosen run (its path, its plot over time) or of the
+recorded runs on this maze side by side in the workspace's ``pictures/`` folder.
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ from workbench.sim.session import Snapshot
 from ..dialogs.path import PathDialog
 from ..host import FollowsUnicode, ShowsSnapshot, ToggleUnicode
 from ..keys import RUNS_KEY_IDS, bindings
+from ..picture_saving import save_picture_off_the_loop
 from ..widgets.key_bar import KeyBar
 from .replay import ReplayScreen
 from .runs_table import (
@@ -184,7 +187,7 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         if runs:
             return (
                 "Hit/Tch = collisions/touch-sensor bumps. "
-                "Enter replays a recorded run; o opens a record file."
+                "Enter replays a recorded run; o opens a record file; p saves its picture."
             )
         if self.station.runs:
             return "No runs on this maze yet: a shows the runs on other mazes."
@@ -279,6 +282,40 @@ class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
                 note=self.station.files.note(),
             ),
             chosen,
+        )
+
+    # -- pictures ----------------------------------------------------------------------------
+    def action_picture(self, kind: str) -> None:
+        """Save a picture: the chosen run's (``path``, ``time``) or this maze's recorded runs
+        side by side (``compare``), drawn in a thread."""
+        if kind == "compare":
+            digest = self.station.maze.digest()
+            runs = [r for r in self.station.runs if r.record and r.maze_digest == digest][-12:]
+            if not runs:
+                self._status("no recorded run on this maze to put side by side", error=True)
+                return
+            what = f"{len(runs)} run{'' if len(runs) == 1 else 's'} on this maze"
+        else:
+            run = self._selected()
+            if run is None:
+                self._status("no run to draw yet", error=True)
+                return
+            if run.record is None:
+                self._status(
+                    f"run {run.number} was not recorded: start the workbench with a record "
+                    "folder to draw runs",
+                    error=True,
+                )
+                return
+            runs, what = [run], f"run {run.number}"
+        save_picture_off_the_loop(
+            self,
+            [str(r.record) for r in runs],
+            kind,
+            self.station.files,
+            self._status,
+            what=what,
+            known=(self.station.maze,),
         )
 
     def action_unicode(self) -> None:
