@@ -74,7 +74,7 @@ def test_tick_back_and_sign_in_one_packet_signs_with_the_override(tmp_path):
         await burst(pilot, ("tab", "\t"), ("space", " "), ("shift+tab", None), ("enter", "\r"))
         await signing_over(pilot, modal)
         assert modal.signed, str(modal.query_one("#signoff-status", Static).render())
-        (row,) = app.store.signoffs()
+        (row,) = app.store.signoffs.of()
         assert row.override and row.note == "checked at the station"
 
     run(app, body)

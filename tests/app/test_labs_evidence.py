@@ -147,7 +147,7 @@ def test_a_question_out_of_tries_takes_no_answer_and_waits_for_the_instructor(
         assert objective_lines(screen)[-1] == (
             "[ ] question answered: no tries left, waiting for the instructor: tcp-port"
         )
-        saved = app.store.progress("ana")[("unity-simulator", "drive-by-wire")]
+        saved = app.store.progress.of("ana")[("unity-simulator", "drive-by-wire")]
         assert saved["tries"] == {"tcp-port": 2}
         (questions,) = [o for o in saved["objectives"] if o["kind"] == "questions"]
         assert questions["evidence"]["waiting"] == ["tcp-port"]

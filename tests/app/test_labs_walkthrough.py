@@ -527,7 +527,7 @@ def test_a_pair_completes_and_signs_off_every_exercise_in_the_app(tmp_path, lab)
     run(app, body)
 
     with Store.open(data) as store:
-        rows = sorted(store.signoffs(), key=lambda r: r.id)
+        rows = sorted(store.signoffs.of(), key=lambda r: r.id)
         roster = load_roster(roster_path(data))
         verdicts = verify_all(store, roster)
     assert [(r.lab, r.exercise) for r in rows] == [(lab.id, ex.id) for ex in lab.exercises]

@@ -22,7 +22,7 @@ from .test_workspace_app import type_path
 
 def stored(data: Path, db: str, path: str) -> bytes | None:
     with Store.open(data, db=db) as store:
-        got = store.workspace_file("ann", path)
+        got = store.workspaces.file("ann", path)
     return got[1] if got is not None else None
 
 

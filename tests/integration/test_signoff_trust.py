@@ -143,7 +143,7 @@ def test_a_record_inserted_with_another_key_is_found(three, tmp_path, capsys):
     [forged] = read_signoffs(rogue)
     values = {k: v for k, v in forged.__dict__.items() if k not in ("id", "seq")}
     with Store.open(three) as store:
-        store.append_signoff(lambda seq, prev: values)
+        store.signoffs.append(lambda seq, prev: values)
     code, out = verify(capsys, three)
     assert code == 1
     assert "FAIL #4 mallory web-simulator/sensors: the signature does not match" in out
@@ -281,7 +281,7 @@ def test_a_record_by_a_look_alike_instructor_is_not_a_grade(three, tmp_path, cap
         return record.columns(impostor.sign(record.canonical()))
 
     with Store.open(three) as store:
-        store.append_signoff(signed)
+        store.signoffs.append(signed)
     code, out = verify(capsys, three)
     assert code == 1
     assert "FAIL #4 dave web-simulator/sensors: instructor 'Dr Сhen' is not in the trusted" in out

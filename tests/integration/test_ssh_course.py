@@ -65,4 +65,4 @@ async def test_a_student_moves_between_two_servers_sharing_one_database(
     assert not (tmp_path / "one" / "data" / "workbench.sqlite3").exists()
     assert not (tmp_path / "two" / "data" / "workbench.sqlite3").exists()
     with Store.open(tmp_path / "three", db=pg_url) as store:
-        assert ("unity-simulator", "drive-by-wire") in store.progress("ann")
+        assert ("unity-simulator", "drive-by-wire") in store.progress.of("ann")

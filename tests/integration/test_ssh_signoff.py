@@ -73,8 +73,8 @@ async def test_the_instructor_signs_from_their_own_session_and_the_student_sees_
     assert verify.returncode == 0, verify.stdout + verify.stderr
     assert "all 1 record(s) verify" in verify.stdout
     with Store.open(host.data_dir, create=False) as store:
-        (record,) = store.signoffs()
-        assert store.signoff_queue() == []
+        (record,) = store.signoffs.of()
+        assert store.queue.waiting() == []
     assert (record.instructor, record.student) == ("ito", "ann")
     assert (record.lab, record.exercise) == ("unity-simulator", "drive-by-wire")
     assert record.override and record.note == "checked at the console"

@@ -52,7 +52,7 @@ def test_every_digest_is_written_one_way_and_the_run_has_its_measures(store, tmp
     signed(store, "ana", recorded)
     signed(store, "ben", wall_main("ben", digest="cd" * 32))  # no record: the evidence's digest
     signed(store, "cat", drive_by_wire())  # saved before programs and blocks were kept
-    log = verify_log(store.signoffs(), load_roster(roster_path(Path(store.path).parent)))
+    log = verify_log(store.signoffs.of(), load_roster(roster_path(Path(store.path).parent)))
     profiles = {("unity-simulator", "drive-by-wire"): "unity"}
     rows = {r["student"]: r for r in gradebook_rows(log.verified_rows(), log.head, profiles)}
     assert set(rows["ana"]) == set(GRADEBOOK_COLUMNS)

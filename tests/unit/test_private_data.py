@@ -37,7 +37,7 @@ def open_umask() -> Iterator[None]:
 def test_what_the_workbench_makes_in_the_data_folder_is_private(tmp_path, open_umask):
     data = tmp_path / "data"
     with Store.open(data) as store:
-        store.save_progress("ana", "lab", "ex", {"n": 1})
+        store.progress.save("ana", "lab", "ex", {"n": 1})
         companions = [data / f"{DB_NAME}-wal", data / f"{DB_NAME}-shm"]
         assert all(p.exists() for p in companions)
         assert [mode(p) for p in companions] == [0o600, 0o600]

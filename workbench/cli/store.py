@@ -82,7 +82,7 @@ def cmd_info(args: argparse.Namespace) -> int:
         with Store.open(data_dir, db=db, create=bool(db)) as store:
             steps = store.migrations()
             sizes = counts(store)
-            head = log_head(store.signoffs())
+            head = log_head(store.signoffs.of())
             where = store.where
     except StoreError as exc:
         return fail(str(exc))

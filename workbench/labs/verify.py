@@ -223,7 +223,7 @@ def verify_log(
 
 def verify_all(store: Store, roster: dict[str, RosterEntry]) -> list[Verdict]:
     """Every record of an open store, checked with its place in the log."""
-    return list(verify_log(store.signoffs(), roster).verdicts)
+    return list(verify_log(store.signoffs.of(), roster).verdicts)
 
 
 def log_head(rows: list[StoredSignoff]) -> Head:
