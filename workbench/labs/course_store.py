@@ -12,6 +12,9 @@ once everything kept is. A save the database refused is :class:`SaveRefused`. Th
 earlier app kept (:meth:`CourseStore.save_kept`) end in :class:`KeptSaved` or
 :class:`KeptNotSaved`.
 
+It is also the front ends' one door to the store's values (the store, its errors, the sign-off
+queue's entries and states), so no front end reaches into the store's modules.
+
 Listeners are called from the service's threads (and the store's writing thread), or from the
 caller's thread for what a caller reports; a front end hands each event to its own event loop.
 Nothing here imports a user interface.
@@ -28,16 +31,23 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from .pending import pending_path
+from .queue import DECLINED, SIGNED, WAITING, WITHDRAWN, QueueEntry, QueueState
 from .store import Store, StoreError, StoreUnavailable, resolve_data_dir
 from .workspace_sync import WorkspacePusher
 
 __all__ = [
+    "DECLINED",
+    "SIGNED",
+    "WAITING",
+    "WITHDRAWN",
     "Away",
     "Back",
     "CourseStore",
     "KeptNotSaved",
     "KeptSaved",
     "Opened",
+    "QueueEntry",
+    "QueueState",
     "SaveRefused",
     "Store",
     "StoreError",

@@ -24,10 +24,9 @@ from textual.widgets import Button, Input, Static
 
 from workbench.labs.classview import Request, read_request
 from workbench.labs.copy_hints import CopyHint, hints_for
-from workbench.labs.course_store import Store, StoreError
+from workbench.labs.course_store import QueueEntry, Store, StoreError
 from workbench.labs.evidence_text import lines_of_progress, mixed_programs_text, short_digest
 from workbench.labs.model import Lab
-from workbench.labs.queue import QueueEntry
 from workbench.labs.roster import roster_names
 from workbench.labs.signing import sign_off
 from workbench.labs.signoff_errors import SignoffError

@@ -16,8 +16,15 @@ from dataclasses import dataclass
 from textual.message import Message
 from textual.widgets import Static
 
-from workbench.labs.course_store import Store, StoreUnavailable
-from workbench.labs.queue import DECLINED, SIGNED, WAITING, WITHDRAWN, QueueState
+from workbench.labs.course_store import (
+    DECLINED,
+    SIGNED,
+    WAITING,
+    WITHDRAWN,
+    QueueState,
+    Store,
+    StoreUnavailable,
+)
 
 #: seconds between reads of the store
 POLL_SECONDS = 1.0
