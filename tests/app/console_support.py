@@ -11,7 +11,7 @@ from textual.pilot import Pilot
 
 from workbench.labs.checks import ExerciseProgress, ObjectiveState
 from workbench.labs.model import load_labs
-from workbench.labs.store import Store
+from workbench.labs.store.store import Store
 from workbench.sim.record import FORMAT, file_sha256
 
 LAB, EXERCISE = "unity-simulator", "drive-by-wire"

@@ -5,11 +5,11 @@ from __future__ import annotations
 
 from textual.widgets import OptionList, Static
 
-from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.model import load_labs
-from workbench.labs.queue import DECLINED, SIGNED
-from workbench.labs.store import Store
-from workbench.labs.verify import verify_log
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
+from workbench.labs.signoff.verify import verify_log
+from workbench.labs.store.queue import DECLINED, SIGNED
+from workbench.labs.store.store import Store
 from workbench.tui.console_app import ConsoleApp
 from workbench.tui.dialogs.pair import PairDialog
 from workbench.tui.screens.console import ConsoleScreen
@@ -132,7 +132,7 @@ async def test_the_instructor_signs_a_request_with_their_own_passphrase(tmp_path
 
 
 def _public(data):
-    from workbench.labs.roster import load_roster, roster_path
+    from workbench.labs.signoff.roster import load_roster, roster_path
 
     return load_roster(roster_path(data))["Dr Chen"]
 

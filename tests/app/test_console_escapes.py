@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import json
 
-from workbench.labs.instructors import create_instructor
 from workbench.labs.model import load_labs
-from workbench.labs.store import Store
+from workbench.labs.signoff.instructors import create_instructor
+from workbench.labs.store.store import Store
 from workbench.tui.console_app import ConsoleApp
 from workbench.tui.screens.console_request import RequestScreen
 

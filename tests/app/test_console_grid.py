@@ -7,10 +7,10 @@ from textual.widgets import DataTable, Static
 
 from workbench.labs.checks import ObjectiveState
 from workbench.labs.classview import read_request
-from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.model import load_labs
-from workbench.labs.signing import sign_off
-from workbench.labs.store import Store
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
+from workbench.labs.signoff.signing import sign_off
+from workbench.labs.store.store import Store
 from workbench.tui.console_app import ConsoleApp
 from workbench.tui.screens.console import ConsoleScreen
 from workbench.tui.screens.console_grid import GridScreen

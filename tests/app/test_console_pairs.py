@@ -6,8 +6,8 @@ from __future__ import annotations
 
 from textual.widgets import Button
 
-from workbench.labs.instructors import create_instructor
-from workbench.labs.store import Store
+from workbench.labs.signoff.instructors import create_instructor
+from workbench.labs.store.store import Store
 from workbench.tui.dialogs.pair import PairDialog
 from workbench.tui.screens.console_request import RequestScreen
 

@@ -12,7 +12,7 @@ from textual.binding import Binding, BindingType
 from textual.pilot import Pilot
 from textual.widgets import Button, Checkbox, Input, Static
 
-from workbench.labs.instructors import KdfParams, create_instructor
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.signoff import SignoffModal
 from workbench.tui.dialogs.size import SizeDialog

@@ -10,8 +10,8 @@ from textual.pilot import Pilot
 from textual.widgets import Input, OptionList
 
 from tests.waiting import until
-from workbench.labs.pending import pending_path
-from workbench.labs.store import Store
+from workbench.labs.store.pending import pending_path
+from workbench.labs.store.store import Store
 from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
 

@@ -9,8 +9,8 @@ from dataclasses import replace
 from textual.pilot import Pilot
 from textual.widgets import Input
 
-from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.model import load_labs
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
 from workbench.tui.dialogs.generate import GenerateDialog
 from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.dialogs.signoff import SignoffModal

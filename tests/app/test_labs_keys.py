@@ -7,9 +7,9 @@ from textual import events
 from textual.pilot import Pilot
 from textual.widgets import Input, OptionList, Static
 
-from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.model import load_labs
-from workbench.labs.store import Store
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
+from workbench.labs.store.store import Store
 from workbench.tui.dialogs.signoff import SignoffModal
 from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.widgets.choices import Choice, Choices

@@ -9,7 +9,7 @@ from textual.pilot import Pilot
 from textual.widgets import Input, OptionList
 
 from tests.waiting import until
-from workbench.labs.progress_rows import ProgressRows
+from workbench.labs.store.progress_rows import ProgressRows
 from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
 

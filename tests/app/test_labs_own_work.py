@@ -7,9 +7,9 @@ from textual.pilot import Pilot
 from textual.widgets import Input, OptionList
 
 from tests.integration.test_labs_completable import answer
-from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.model import LABS_DIR
-from workbench.labs.store import Store
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
+from workbench.labs.store.store import Store
 from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.dialogs.signoff import SignoffModal
 from workbench.tui.screens.labs import LabsScreen

@@ -11,8 +11,8 @@ from textual.pilot import Pilot
 from textual.widgets import Input
 
 from tests.students_work import own_right_wall
-from workbench.labs.instructors import KdfParams, create_instructor
-from workbench.labs.store import Store
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
+from workbench.labs.store.store import Store
 from workbench.tui.dialogs.algorithm import AlgorithmModal
 from workbench.tui.dialogs.signoff import SignoffModal
 

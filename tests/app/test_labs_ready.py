@@ -7,10 +7,10 @@ from __future__ import annotations
 from textual.widgets import Static
 
 from workbench.files.workspace import workspace_folder
-from workbench.labs.instructors import KdfParams, create_instructor
-from workbench.labs.signing import sign_off
-from workbench.labs.signoff_record import Evidence, RecordFields
-from workbench.labs.store import Store
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
+from workbench.labs.signoff.signing import sign_off
+from workbench.labs.signoff.signoff_record import Evidence, RecordFields
+from workbench.labs.store.store import Store
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.signoff import SignoffModal
 from workbench.tui.settings import AppSettings

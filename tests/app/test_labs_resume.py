@@ -6,7 +6,7 @@ from __future__ import annotations
 from textual.pilot import Pilot
 from textual.widgets import Input, OptionList, Static
 
-from workbench.labs.store import Store
+from workbench.labs.store.store import Store
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.identity import IdentityDialog
 from workbench.tui.screens.main import MainScreen

@@ -10,11 +10,11 @@ from textual.pilot import Pilot
 from textual.widgets import Button, Checkbox, Input, OptionList, Select, Static
 
 from workbench.cli import build_parser
-from workbench.labs.instructors import KdfParams, SealedKey, create_instructor
-from workbench.labs.signing import FAILURE_LIMIT, sign_off
-from workbench.labs.signoff_errors import WrongPassphrase
-from workbench.labs.signoff_record import RecordFields
-from workbench.labs.store import Store
+from workbench.labs.signoff.instructors import KdfParams, SealedKey, create_instructor
+from workbench.labs.signoff.signing import FAILURE_LIMIT, sign_off
+from workbench.labs.signoff.signoff_errors import WrongPassphrase
+from workbench.labs.signoff.signoff_record import RecordFields
+from workbench.labs.store.store import Store
 from workbench.tui.dialogs.signoff import SignoffModal
 from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen

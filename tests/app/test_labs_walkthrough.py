@@ -35,11 +35,11 @@ from workbench.cli import main
 from workbench.control.algorithms import list_algorithms
 from workbench.control.headless import AlgorithmPilot, RunSpec
 from workbench.control.headless import run as headless_run
-from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.model import Exercise, Lab, LabMaze, Objective, load_labs
-from workbench.labs.roster import load_roster, roster_path
-from workbench.labs.store import Store
-from workbench.labs.verify import verify_all
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
+from workbench.labs.signoff.roster import load_roster, roster_path
+from workbench.labs.signoff.verify import verify_all
+from workbench.labs.store.store import Store
 from workbench.sim.mazeio import save_maze
 from workbench.sim.profiles import get_profile
 from workbench.tui.app import WorkbenchApp, make_app

@@ -9,7 +9,7 @@ from textual.widgets import Input
 
 from workbench.labs.checks import MAX_ANSWER, ExerciseProgress
 from workbench.labs.names import MAX_STUDENT_NAME
-from workbench.labs.store import Store
+from workbench.labs.store.store import Store
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.identity import IdentityDialog
 from workbench.tui.settings import AppSettings

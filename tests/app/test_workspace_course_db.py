@@ -11,7 +11,7 @@ from textual.pilot import Pilot
 
 from tests.waiting import until
 from workbench.files.workspace import workspace_folder
-from workbench.labs.store import Store
+from workbench.labs.store.store import Store
 from workbench.tui.app import make_app
 from workbench.tui.screens.editor import EditorScreen
 from workbench.tui.settings import AppSettings

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import pytest
 
-from workbench.labs.queue import DECLINED, SIGNED, WAITING, WITHDRAWN
-from workbench.labs.store import Store, StoreError
+from workbench.labs.store.queue import DECLINED, SIGNED, WAITING, WITHDRAWN
+from workbench.labs.store.store import Store, StoreError
 
 T0 = datetime(2026, 3, 2, 14, 5, 9, tzinfo=UTC)
 

@@ -15,11 +15,11 @@ import pytest
 from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
 
 from workbench.cli import main
-from workbench.labs.instructors import Instructor, create_instructor, key_path
-from workbench.labs.roster import load_roster, roster_path
 from workbench.labs.signlog import GENESIS, entry_hash
-from workbench.labs.signoff_record import record_from_stored
-from workbench.labs.store import DB_NAME, Store, read_signoffs
+from workbench.labs.signoff.instructors import Instructor, create_instructor, key_path
+from workbench.labs.signoff.roster import load_roster, roster_path
+from workbench.labs.signoff.signoff_record import record_from_stored
+from workbench.labs.store.store import DB_NAME, Store, read_signoffs
 
 from .signoff_support import FAST, add_instructor, sign, sql
 

@@ -26,7 +26,7 @@ from tests.app.support import sync
 from tests.sessions import free_port
 from tests.students_work import own_right_wall
 from tests.waiting import until
-from workbench.labs.store import Store
+from workbench.labs.store.store import Store
 from workbench.ssh.balancer import EXAMPLE, LabBackend, haproxy_config
 from workbench.ssh.hostkey import load_or_create_host_key
 from workbench.ssh.users import users_path

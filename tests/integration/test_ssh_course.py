@@ -8,8 +8,8 @@ import pytest
 
 from tests.app.support import sync
 from workbench.files.workspace import workspace_folder
-from workbench.labs.store import Store
-from workbench.labs.workspace_sync import push_file
+from workbench.labs.store.store import Store
+from workbench.labs.store.workspace_sync import push_file
 
 from .ssh_support import Account, lab_host, open_exercise
 

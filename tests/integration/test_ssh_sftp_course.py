@@ -5,8 +5,8 @@ from __future__ import annotations
 
 from tests.app.support import sync
 from tests.waiting import until
-from workbench.labs.store import Store
-from workbench.labs.workspace_sync import sync_at_start
+from workbench.labs.store.store import Store
+from workbench.labs.store.workspace_sync import sync_at_start
 
 from .sftp_support import OpenSSH, files_under, needs_openssh
 from .ssh_support import Account, lab_host

@@ -12,8 +12,8 @@ import sys
 import pytest
 
 from tests.app.support import sync
-from workbench.labs.instructors import KdfParams, create_instructor
-from workbench.labs.store import Store
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
+from workbench.labs.store.store import Store
 
 from .openssh_terminal import OpenSshTerminal
 from .ssh_support import Account, lab_host, open_exercise

@@ -15,18 +15,24 @@ from pathlib import Path
 import pytest
 
 from tests.waiting import wait_until
-from workbench.labs.instructors import KdfParams, create_instructor
-from workbench.labs.roster import RosterEntry, offered_roster
-from workbench.labs.signing import sign_off
-from workbench.labs.signoff_errors import (
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
+from workbench.labs.signoff.roster import RosterEntry, offered_roster
+from workbench.labs.signoff.signing import sign_off
+from workbench.labs.signoff.signoff_errors import (
     LockedOut,
     SignoffError,
     UnknownInstructor,
     WrongPassphrase,
 )
-from workbench.labs.signoff_record import Evidence, RecordFields
-from workbench.labs.store import LogMissing, Store, StoreError, StoreUnavailable, read_signoffs
-from workbench.labs.verify import verify_log
+from workbench.labs.signoff.signoff_record import Evidence, RecordFields
+from workbench.labs.signoff.verify import verify_log
+from workbench.labs.store.store import (
+    LogMissing,
+    Store,
+    StoreError,
+    StoreUnavailable,
+    read_signoffs,
+)
 
 FAST = KdfParams(n=2**10, r=8, p=1)
 PASS = "correct horse battery"
@@ -235,9 +241,9 @@ def test_two_threads_write_at_the_same_time(where):
 
 SIGNER = """
 import os, sys, time
-from workbench.labs.signing import sign_off
-from workbench.labs.signoff_record import RecordFields
-from workbench.labs.store import Store
+from workbench.labs.signoff.signing import sign_off
+from workbench.labs.signoff.signoff_record import RecordFields
+from workbench.labs.store.store import Store
 data_dir, db, who, ready = sys.argv[1], sys.argv[2] or None, sys.argv[3], sys.argv[4]
 fields = RecordFields(student=who, lab="lab", exercise="ex", objectives_passed=True)
 with Store.open(data_dir, db=db) as store:

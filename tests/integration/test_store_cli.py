@@ -12,12 +12,12 @@ from pathlib import Path
 import pytest
 
 from workbench.cli import main
-from workbench.labs.instructors import create_instructor
-from workbench.labs.roster import load_roster
-from workbench.labs.signing import sign_off
-from workbench.labs.signoff_errors import WrongPassphrase
-from workbench.labs.signoff_record import RecordFields
-from workbench.labs.store import Store
+from workbench.labs.signoff.instructors import create_instructor
+from workbench.labs.signoff.roster import load_roster
+from workbench.labs.signoff.signing import sign_off
+from workbench.labs.signoff.signoff_errors import WrongPassphrase
+from workbench.labs.signoff.signoff_record import RecordFields
+from workbench.labs.store.store import Store
 
 from .signoff_support import FAST, PASS, sign
 

@@ -15,21 +15,21 @@ import pytest
 from tests.waiting import wait_until
 from workbench.files.atomic import write_bytes_atomic, write_text_atomic
 from workbench.files.workspace import workspace_folder
-from workbench.labs.instructors import KdfParams, create_instructor
-from workbench.labs.roster import offered_roster
-from workbench.labs.signing import sign_off
-from workbench.labs.signoff_errors import SignoffError
-from workbench.labs.signoff_record import Evidence, RecordFields, record_digest
-from workbench.labs.store import Store, StoreError, read_signoffs
-from workbench.labs.storecopy import copy_store
-from workbench.labs.verify import course_evidence, verify_log
-from workbench.labs.workspace_rows import WorkspaceLimits, WorkspaceRefused
-from workbench.labs.workspace_sync import (
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
+from workbench.labs.signoff.roster import offered_roster
+from workbench.labs.signoff.signing import sign_off
+from workbench.labs.signoff.signoff_errors import SignoffError
+from workbench.labs.signoff.signoff_record import Evidence, RecordFields, record_digest
+from workbench.labs.signoff.verify import course_evidence, verify_log
+from workbench.labs.store.store import Store, StoreError, read_signoffs
+from workbench.labs.store.workspace_rows import WorkspaceLimits, WorkspaceRefused
+from workbench.labs.store.workspace_sync import (
     WorkspacePusher,
     push_file,
     remove_file,
     sync_at_start,
 )
+from workbench.labs.storecopy import copy_store
 from workbench.sim.record import Recorder
 
 FAST = KdfParams(n=2**10, r=8, p=1)

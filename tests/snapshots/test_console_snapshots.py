@@ -19,9 +19,9 @@ from tests.app.console_support import (
     until,
     wall_main,
 )
-from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.model import load_labs
-from workbench.labs.store import Store
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
+from workbench.labs.store.store import Store
 from workbench.tui.console_app import ConsoleApp
 from workbench.tui.screens.console import ConsoleScreen
 

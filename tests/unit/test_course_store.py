@@ -5,7 +5,7 @@ from __future__ import annotations
 import queue
 
 from workbench.labs.course_store import CourseStore, Opened, StoreEvent
-from workbench.labs.store import Store
+from workbench.labs.store.store import Store
 
 
 def opened(course: CourseStore, student: str, partner: str = "", **kw) -> Opened:

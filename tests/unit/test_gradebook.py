@@ -10,13 +10,18 @@ import pytest
 
 from tests.app.console_support import progress as drive_by_wire
 from tests.app.console_support import wall_main, write_record
-from workbench.labs.gradebook import GRADEBOOK_COLUMNS, gradebook_rows, run_cells, sha256_text
-from workbench.labs.instructors import KdfParams, create_instructor
-from workbench.labs.roster import load_roster, roster_path
-from workbench.labs.signing import sign_off
-from workbench.labs.signoff_record import Evidence, RecordFields
-from workbench.labs.store import Store
-from workbench.labs.verify import verify_log
+from workbench.labs.signoff.gradebook import (
+    GRADEBOOK_COLUMNS,
+    gradebook_rows,
+    run_cells,
+    sha256_text,
+)
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
+from workbench.labs.signoff.roster import load_roster, roster_path
+from workbench.labs.signoff.signing import sign_off
+from workbench.labs.signoff.signoff_record import Evidence, RecordFields
+from workbench.labs.signoff.verify import verify_log
+from workbench.labs.store.store import Store
 from workbench.sim.record import file_sha256
 
 FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only

@@ -7,7 +7,7 @@ import pytest
 
 from workbench.labs.checks import ExerciseProgress
 from workbench.labs.progress import LabProgress, read_work
-from workbench.labs.store import Store, StoreUnavailable
+from workbench.labs.store.store import Store, StoreUnavailable
 
 DRIVE = ("unity-simulator", "drive-by-wire")
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from workbench.labs.lastpair import FILE_NAME, read_last_pair, save_last_pair
 from workbench.labs.names import name_key
-from workbench.labs.store import Store
+from workbench.labs.store.store import Store
 
 
 def test_the_last_pair_is_read_back(tmp_path):

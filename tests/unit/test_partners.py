@@ -10,10 +10,10 @@ import pytest
 
 from workbench.labs.checks import ExerciseProgress, ObjectiveState
 from workbench.labs.classview import read_request
-from workbench.labs.gradebook import gradebook_rows
 from workbench.labs.partners import PairNotConfirmed, partner_problem
 from workbench.labs.signlog import Head
-from workbench.labs.store import Store, StoredSignoff
+from workbench.labs.signoff.gradebook import gradebook_rows
+from workbench.labs.store.store import Store, StoredSignoff
 
 
 def signed(seq: int, student: str, partner: str, at: str) -> StoredSignoff:

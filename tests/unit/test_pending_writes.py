@@ -6,8 +6,8 @@ from __future__ import annotations
 import json
 from datetime import UTC, datetime
 
-from workbench.labs.pending import PendingWrite, load_pending, pending_path, save_pending
-from workbench.labs.store import Store
+from workbench.labs.store.pending import PendingWrite, load_pending, pending_path, save_pending
+from workbench.labs.store.store import Store
 
 WHEN = datetime(2026, 3, 2, 10, 0, tzinfo=UTC)
 LATER = datetime(2026, 3, 2, 11, 0, tzinfo=UTC)

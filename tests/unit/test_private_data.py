@@ -14,8 +14,8 @@ from pathlib import Path
 import pytest
 
 from workbench.labs.lastpair import save_last_pair
-from workbench.labs.pending import PendingWrite, pending_path, save_pending
-from workbench.labs.store import DB_NAME, Store, StoreError, read_signoffs
+from workbench.labs.store.pending import PendingWrite, pending_path, save_pending
+from workbench.labs.store.store import DB_NAME, Store, StoreError, read_signoffs
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -15,26 +15,32 @@ from pathlib import Path
 
 import pytest
 
-from workbench.labs.gradebook import gradebook_rows
-from workbench.labs.instructors import KdfParams, create_instructor, key_path, unlock_instructor
-from workbench.labs.roster import RosterEntry, load_roster, roster_path
-from workbench.labs.signing import MAX_NOTE, sign_off
 from workbench.labs.signlog import GENESIS, RECORD_FORMAT
-from workbench.labs.signoff_errors import (
+from workbench.labs.signoff.gradebook import gradebook_rows
+from workbench.labs.signoff.instructors import (
+    KdfParams,
+    create_instructor,
+    key_path,
+    unlock_instructor,
+)
+from workbench.labs.signoff.roster import RosterEntry, load_roster, roster_path
+from workbench.labs.signoff.signing import MAX_NOTE, sign_off
+from workbench.labs.signoff.signoff_errors import (
     LockedOut,
     PassphraseTooShort,
     SignoffError,
     UnknownInstructor,
     WrongPassphrase,
 )
-from workbench.labs.signoff_record import (
+from workbench.labs.signoff.signoff_record import (
     Evidence,
     RecordFields,
     SignoffRecord,
     record_digest,
     record_from_stored,
 )
-from workbench.labs.store import (
+from workbench.labs.signoff.verify import verify_all, verify_log
+from workbench.labs.store.store import (
     DB_NAME,
     SIGNOFF_COLUMNS,
     Store,
@@ -42,7 +48,6 @@ from workbench.labs.store import (
     read_signoffs,
     resolve_data_dir,
 )
-from workbench.labs.verify import verify_all, verify_log
 
 FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only; defaults are untouched
 PASS = "correct horse battery"
@@ -416,7 +421,7 @@ def test_two_connections_can_write_at_the_same_time(data_dir):
 
 WRITER = """
 import sys
-from workbench.labs.store import Store
+from workbench.labs.store.store import Store
 s = Store.open(sys.argv[1])
 i = 0
 while True:
@@ -450,7 +455,7 @@ def test_a_killed_process_keeps_what_it_committed(data_dir):
 def test_evidence_of_an_exercise_points_at_the_run_record_it_rests_on(tmp_path):
     from types import SimpleNamespace
 
-    from workbench.labs.signoff_record import Evidence, record_digest
+    from workbench.labs.signoff.signoff_record import Evidence, record_digest
 
     record = tmp_path / "run-001.jsonl"
     record.write_text('{"type":"header"}\n')
@@ -570,9 +575,9 @@ def test_a_sequence_number_is_taken_once(store):
 SIGNER = """
 import os, sys, time
 from datetime import UTC, datetime
-from workbench.labs.signing import sign_off
-from workbench.labs.signoff_record import RecordFields
-from workbench.labs.store import Store
+from workbench.labs.signoff.signing import sign_off
+from workbench.labs.signoff.signoff_record import RecordFields
+from workbench.labs.store.store import Store
 data_dir, who, ready = sys.argv[1], sys.argv[2], sys.argv[3]
 fields = RecordFields(student=who, lab="lab", exercise="ex", objectives_passed=True)
 with Store.open(data_dir) as store:

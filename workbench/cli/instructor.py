@@ -8,22 +8,22 @@ import shlex
 import sys
 from pathlib import Path
 
-from workbench.labs.instructors import (
+from workbench.labs.signoff.instructors import (
     MIN_PASSPHRASE,
     check_passphrase,
     copy_instructor,
     create_instructor,
     key_path,
 )
-from workbench.labs.roster import (
+from workbench.labs.signoff.roster import (
     ROSTER_NAME,
     check_name,
     config_dir,
     load_roster,
     roster_keys,
 )
-from workbench.labs.signoff_errors import SignoffError
-from workbench.labs.store import Store, StoreError, resolve_data_dir, resolve_db
+from workbench.labs.signoff.signoff_errors import SignoffError
+from workbench.labs.store.store import Store, StoreError, resolve_data_dir, resolve_db
 
 from .common import db_option
 

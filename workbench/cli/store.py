@@ -10,10 +10,10 @@ from __future__ import annotations
 import argparse
 import sys
 
-from workbench.labs.database import StoreError, resolve_db
-from workbench.labs.store import Store, resolve_data_dir
+from workbench.labs.signoff.verify import log_head
+from workbench.labs.store.database import StoreError, resolve_db
+from workbench.labs.store.store import Store, resolve_data_dir
 from workbench.labs.storecopy import copy_store, counts
-from workbench.labs.verify import log_head
 
 from .common import db_option
 from .instructor import data_dir_option

@@ -27,9 +27,9 @@ from .evidence_text import programs_of
 from .model import Lab
 from .partners import PairNotConfirmed, partner_problem
 from .progress import signoff_driver
-from .queue import QueueEntry
-from .signoff_record import Evidence, RecordFields
-from .store import Store
+from .signoff.signoff_record import Evidence, RecordFields
+from .store.queue import QueueEntry
+from .store.store import Store
 
 
 @dataclass(frozen=True)

@@ -30,10 +30,10 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from .pending import pending_path
-from .queue import DECLINED, SIGNED, WAITING, WITHDRAWN, QueueEntry, QueueState
-from .store import Store, StoreError, StoreUnavailable, resolve_data_dir
-from .workspace_sync import WorkspacePusher
+from .store.pending import pending_path
+from .store.queue import DECLINED, SIGNED, WAITING, WITHDRAWN, QueueEntry, QueueState
+from .store.store import Store, StoreError, StoreUnavailable, resolve_data_dir
+from .store.workspace_sync import WorkspacePusher
 
 __all__ = [
     "DECLINED",

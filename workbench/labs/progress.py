@@ -33,7 +33,7 @@ from .checks import (
 )
 from .evidence_text import programs_of
 from .model import Exercise, Lab
-from .store import Store, StoreUnavailable
+from .store.store import Store, StoreUnavailable
 
 #: (lab id, exercise id)
 ExerciseKey = tuple[str, str]

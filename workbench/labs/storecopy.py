@@ -20,13 +20,13 @@ from pathlib import Path
 
 from workbench.files.workspace import workspace_folder
 
-from . import workspace_rows
-from .roster import roster_keys
 from .signlog import Head
-from .store import SIGNOFF_COLUMNS, Store, StoreError, utc_iso
-from .verify import log_head
-from .workspace_rows import WorkspaceRefused
-from .workspace_sync import local_files, read_local
+from .signoff.roster import roster_keys
+from .signoff.verify import log_head
+from .store import workspace_rows
+from .store.store import SIGNOFF_COLUMNS, Store, StoreError, utc_iso
+from .store.workspace_rows import WorkspaceRefused
+from .store.workspace_sync import local_files, read_local
 
 TABLES: dict[str, tuple[str, ...]] = {
     "signoffs": SIGNOFF_COLUMNS,

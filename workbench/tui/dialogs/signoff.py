@@ -23,10 +23,10 @@ from textual.worker import Worker
 from workbench.labs.checks import ExerciseProgress
 from workbench.labs.course_store import Store
 from workbench.labs.progress import signoff_words
-from workbench.labs.roster import roster_keys, roster_names
-from workbench.labs.signing import sign_off
-from workbench.labs.signoff_errors import SignoffError
-from workbench.labs.signoff_record import Evidence, RecordFields, SignoffRecord
+from workbench.labs.signoff.roster import roster_keys, roster_names
+from workbench.labs.signoff.signing import sign_off
+from workbench.labs.signoff.signoff_errors import SignoffError
+from workbench.labs.signoff.signoff_record import Evidence, RecordFields, SignoffRecord
 
 from ..keys import bindings
 from ..plain import follow_app

@@ -27,9 +27,9 @@ from workbench.labs.copy_hints import CopyHint, hints_for
 from workbench.labs.course_store import QueueEntry, Store, StoreError
 from workbench.labs.evidence_text import lines_of_progress, mixed_programs_text, short_digest
 from workbench.labs.model import Lab
-from workbench.labs.roster import roster_names
-from workbench.labs.signing import sign_off
-from workbench.labs.signoff_errors import SignoffError
+from workbench.labs.signoff.roster import roster_names
+from workbench.labs.signoff.signing import sign_off
+from workbench.labs.signoff.signoff_errors import SignoffError
 from workbench.sim.record import RecordError
 from workbench.sim.replay import load_replay
 

@@ -57,7 +57,7 @@ from workbench.labs.progress import (
     read_work,
     shown_values,
 )
-from workbench.labs.signoff_record import SignoffRecord
+from workbench.labs.signoff.signoff_record import SignoffRecord
 from workbench.sim.session import Snapshot
 
 from ..host import FollowsUnicode, SetUpDone, ShowsSnapshot

@@ -20,6 +20,8 @@ from dataclasses import dataclass, replace
 from datetime import UTC, datetime
 from typing import Any
 
+from ..store.store import Store, utc_iso
+from ..store.workspace_rows import EVIDENCE_CAP, evidence_copies
 from .instructors import Instructor, SealedKey, read_key
 from .signoff_errors import LockedOut, SignoffError, WrongPassphrase
 from .signoff_record import (
@@ -30,8 +32,6 @@ from .signoff_record import (
     name_problems,
     record_digest,
 )
-from .store import Store, utc_iso
-from .workspace_rows import EVIDENCE_CAP, evidence_copies
 
 log = logging.getLogger(__name__)
 

@@ -9,11 +9,11 @@ from dataclasses import dataclass, replace
 from datetime import UTC, datetime
 from typing import Any
 
+from ..signlog import entry_hash, next_place, parse_metrics, signed_payload
 from . import workspace_rows
 from .database import StoreError
 from .migrations import RECORD_COLUMNS, SIGNOFF_LOCK
 from .rows import Rows, utc_iso
-from .signlog import entry_hash, next_place, parse_metrics, signed_payload
 
 MAX_SEQ = 2**53  # sequence numbers stay exact wherever the log is kept (JSON, any database)
 

@@ -21,6 +21,7 @@ from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
 from cryptography.hazmat.primitives.ciphers.aead import AESGCM
 from cryptography.hazmat.primitives.kdf.scrypt import Scrypt
 
+from ..store.store import Store, utc_iso
 from .roster import (
     RosterEntry,
     check_name,
@@ -32,7 +33,6 @@ from .roster import (
     to_b64,
 )
 from .signoff_errors import PassphraseTooShort, SignoffError, UnknownInstructor, WrongPassphrase
-from .store import Store, utc_iso
 
 KEY_FORMAT = "workbench-instructor-key/1"
 MIN_PASSPHRASE = 10

@@ -293,7 +293,7 @@ def evidence_copies(
 class WorkspaceRows:
     """The students' workspace files over the store's connection (see
     :mod:`.workspace_sync`). Writes need the database
-    (:class:`~workbench.labs.database.StoreUnavailable` while it is away)."""
+    (:class:`~workbench.labs.store.database.StoreUnavailable` while it is away)."""
 
     def __init__(self, rows: Rows) -> None:
         self.rows = rows

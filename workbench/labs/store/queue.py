@@ -7,7 +7,7 @@ again after a decline puts the exercise back at the end of the queue, asking whi
 keeps its place. Because the queue is in the store, the instructor's console sees the requests
 of students on every lab server that shares a PostgreSQL store.
 
-The functions here take a transaction (:class:`~workbench.labs.database.Tx`) or a read
+The functions here take a transaction (:class:`~workbench.labs.store.database.Tx`) or a read
 function; :class:`QueueRows` (the store's ``queue``) gives them theirs.
 """
 
@@ -226,7 +226,7 @@ def state_of(read: Read, student: str, lab: str, exercise: str) -> QueueState:
 
 class QueueRows:
     """The sign-off queue over the store's connection. Every call needs the database:
-    :class:`~workbench.labs.database.StoreUnavailable` while it is away."""
+    :class:`~workbench.labs.store.database.StoreUnavailable` while it is away."""
 
     def __init__(self, rows: Rows) -> None:
         self.rows = rows

@@ -2,7 +2,7 @@
 had open last (their place) and who of a pair drove an exercise.
 
 Every save here may be kept pending while a course database is away (see
-:class:`~workbench.labs.store.Store`): its return value says whether it reached the database,
+:class:`~workbench.labs.store.store.Store`): its return value says whether it reached the database,
 and every read includes what is still pending.
 """
 
@@ -12,8 +12,8 @@ import json
 from datetime import datetime
 from typing import Any
 
+from ..names import name_key
 from .database import StoreError
-from .names import name_key
 from .pending import PendingWrite
 from .rows import Rows, stamp_of
 

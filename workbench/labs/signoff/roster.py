@@ -28,10 +28,10 @@ from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PublicKey
 
 from workbench.files.atomic import write_text_atomic
 
-from .instructor_rows import InstructorRows
-from .names import NameProblem, clean_name
+from ..names import NameProblem, clean_name
+from ..store.instructor_rows import InstructorRows
+from ..store.store import APP_NAME, Store, StoreError
 from .signoff_errors import SignoffError, UntrustedRoster
-from .store import APP_NAME, Store, StoreError
 
 ROSTER_FORMAT = "workbench-roster/1"
 ROSTER_NAME = "roster.json"

@@ -1,5 +1,5 @@
 """What the store's repositories share: the one connection they work through (:class:`Rows`,
-which :class:`~workbench.labs.store.Store` is) and how they write a moment.
+which :class:`~workbench.labs.store.store.Store` is) and how they write a moment.
 
 Each repository is a small class over one idea's tables: the students' work
 (:mod:`.progress_rows`), the sign-off log, lockouts and events (:mod:`.signoff_rows`), the

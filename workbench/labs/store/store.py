@@ -6,7 +6,7 @@ tool can use it at the same time; given a ``postgresql://`` URL (``--db`` or
 ``$WORKBENCH_DB``), one PostgreSQL database that every lab server of a course shares. Every
 write is one transaction, committed before the call returns, so a process killed afterwards
 loses nothing that was already saved. The schema is built by the numbered steps of
-:mod:`workbench.labs.migrations`.
+:mod:`workbench.labs.store.migrations`.
 
 The sign-off table holds the log of :mod:`workbench.labs.signlog`: each record's fields, its
 signature, its sequence number (unique), the hash of the record before it and its own hash.
@@ -35,6 +35,7 @@ import platformdirs
 
 from workbench.files.private import PRIVATE_FILE, private_dir, tighten
 
+from ..signlog import GENESIS, entry_hash
 from .database import (
     BUSY_TIMEOUT_MS,
     Backend,
@@ -54,7 +55,6 @@ from .pending import FIELDS, PendingWrite, load_pending, save_pending
 from .progress_rows import ProgressRows
 from .queue import QueueRows
 from .rows import utc_iso
-from .signlog import GENESIS, entry_hash
 from .signoff_rows import (
     SIGNOFF_COLUMNS,
     Event,
@@ -132,7 +132,7 @@ class Store:
     drivers), :attr:`signoffs` (the log, lockouts, events), :attr:`queue` (the sign-off
     queue), :attr:`workspaces` (the students' files) and, in a course database only,
     :attr:`instructors` (the roster and sealed keys; ``None`` in SQLite, whose data folder
-    keeps them in files: :func:`workbench.labs.roster.roster_keys`).
+    keeps them in files: :func:`workbench.labs.signoff.roster.roster_keys`).
 
     Saving progress, places and drivers never fails because a PostgreSQL server is down: the
     write is kept pending (the newest per exercise) and written by :meth:`flush`; their return

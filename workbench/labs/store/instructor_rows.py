@@ -1,6 +1,6 @@
 """The instructors' roster and sealed keys as a course database (PostgreSQL) keeps them; a
 data folder's SQLite store keeps them in the folder's files instead
-(:class:`~workbench.labs.roster.FileRosterKeys`)."""
+(:class:`~workbench.labs.signoff.roster.FileRosterKeys`)."""
 
 from __future__ import annotations
 
