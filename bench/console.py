@@ -31,7 +31,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from workbench.labs.checks import ExerciseProgress, ObjectiveState
 from workbench.labs.classview import read_class
 from workbench.labs.model import load_labs
-from workbench.labs.store import Store
+from workbench.labs.store.store import Store
 from workbench.tui.console_app import ConsoleApp
 from workbench.tui.screens.console import ClassRead, ConsoleScreen
 

@@ -11,7 +11,7 @@ from textual.pilot import Pilot
 
 from workbench.labs.checks import ExerciseProgress, ObjectiveState
 from workbench.labs.model import load_labs
-from workbench.labs.store import Store
+from workbench.labs.store.store import Store
 from workbench.sim.record import FORMAT, file_sha256
 
 LAB, EXERCISE = "unity-simulator", "drive-by-wire"
@@ -54,8 +54,8 @@ def progress(passed: bool = True, record: str = "") -> ExerciseProgress:
 
 
 def save_student(store: Store, student: str, passed: bool = True, record: str = "") -> None:
-    store.set_place(student, LAB, EXERCISE)
-    store.save_progress(student, LAB, EXERCISE, json.loads(progress(passed, record).to_json()))
+    store.progress.set_place(student, LAB, EXERCISE)
+    store.progress.save(student, LAB, EXERCISE, json.loads(progress(passed, record).to_json()))
 
 
 async def until(pilot: Pilot, done: Callable[[], object], what: str, seconds: float = 10) -> None:
@@ -128,5 +128,5 @@ def wall_main(
 
 def save_progress(store: Store, student: str, progress: ExerciseProgress) -> None:
     """``student`` at ``progress``'s exercise, with that progress saved."""
-    store.set_place(student, progress.lab, progress.exercise)
-    store.save_progress(student, progress.lab, progress.exercise, json.loads(progress.to_json()))
+    store.progress.set_place(student, progress.lab, progress.exercise)
+    store.progress.save(student, progress.lab, progress.exercise, json.loads(progress.to_json()))

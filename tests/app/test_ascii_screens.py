@@ -16,7 +16,7 @@ from textual.pilot import Pilot
 from textual.widgets import Input
 
 from workbench.files.bundled import MAZE_DIR
-from workbench.labs.instructors import KdfParams, create_instructor
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
 from workbench.tui.app import make_app
 from workbench.tui.screens.replay import ReplayScreen
 from workbench.tui.screens.runs import RunsScreen

@@ -5,11 +5,11 @@ from __future__ import annotations
 
 from textual.widgets import OptionList, Static
 
-from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.model import load_labs
-from workbench.labs.queue import DECLINED, SIGNED
-from workbench.labs.store import Store
-from workbench.labs.verify import verify_log
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
+from workbench.labs.signoff.verify import verify_log
+from workbench.labs.store.queue import DECLINED, SIGNED
+from workbench.labs.store.store import Store
 from workbench.tui.console_app import ConsoleApp
 from workbench.tui.dialogs.pair import PairDialog
 from workbench.tui.screens.console import ConsoleScreen
@@ -65,7 +65,7 @@ async def test_the_class_and_the_queue_follow_the_store(tmp_path):
         assert "nobody has asked" in str(app.screen.query_one("#console-queue-title").render())
         # a student on another app asks: the console shows it without a key pressed
         with Store.open(data) as student_side:
-            student_side.request_signoff("cat", "dan", "dan", LAB, EXERCISE)
+            student_side.queue.request("cat", "dan", "dan", LAB, EXERCISE)
         await until(pilot, lambda: len(queue_lines(app)) == 1, "the request")
         assert queue_lines(app)[0].startswith("1. cat and dan")
         await until(pilot, lambda: "waiting #1" in class_lines(app)[1], "cat's place")
@@ -79,8 +79,8 @@ async def test_the_instructor_signs_a_request_with_their_own_passphrase(tmp_path
     record = write_record(tmp_path / "run-003.jsonl")
     with Store.open(data) as store:
         save_student(store, "ana", record=str(record))
-        store.set_place("ben", LAB, EXERCISE)  # ben is a student of the class
-        store.request_signoff("ana", "ben", "ben", LAB, EXERCISE)
+        store.progress.set_place("ben", LAB, EXERCISE)  # ben is a student of the class
+        store.queue.request("ana", "ben", "ben", LAB, EXERCISE)
     app = console(data)
     async with app.run_test(size=(80, 24)) as pilot:
         await until(pilot, lambda: len(queue_lines(app)) == 1, "the request")
@@ -111,16 +111,16 @@ async def test_the_instructor_signs_a_request_with_their_own_passphrase(tmp_path
         await pilot.press("y")
         await until(pilot, lambda: "wrong passphrase" in status(request), "the refusal")
         with Store.open(data) as store:
-            assert store.lockout("Dr Chen").failures == 1
+            assert store.signoffs.lockout("Dr Chen").failures == 1
         await pilot.press(*PASS, "enter")
         await until(pilot, lambda: "signed off ana and ben" in status(request), "the sign-off")
         await pilot.press("escape")
         await until(pilot, lambda: isinstance(app.screen, ConsoleScreen), "the console")
         await until(pilot, lambda: queue_lines(app) == [], "the queue emptied")
     with Store.open(data) as store:
-        (row,) = store.signoffs()
-        state = store.queue_state("ana", LAB, EXERCISE)
-        log = verify_log(store.signoffs(), {"Dr Chen": _public(data)})
+        (row,) = store.signoffs.of()
+        state = store.queue.state("ana", LAB, EXERCISE)
+        log = verify_log(store.signoffs.of(), {"Dr Chen": _public(data)})
     assert (row.student, row.partner, row.driver, row.instructor) == (
         "ana",
         "ben",
@@ -132,7 +132,7 @@ async def test_the_instructor_signs_a_request_with_their_own_passphrase(tmp_path
 
 
 def _public(data):
-    from workbench.labs.roster import load_roster, roster_path
+    from workbench.labs.signoff.roster import load_roster, roster_path
 
     return load_roster(roster_path(data))["Dr Chen"]
 
@@ -147,7 +147,7 @@ async def test_a_decline_needs_a_note_and_the_student_reads_it(tmp_path):
     create_instructor(data, "Dr Chen", PASS, kdf=FAST)
     with Store.open(data) as store:
         save_student(store, "cat", passed=False)
-        store.request_signoff("cat", "", "cat", LAB, EXERCISE)
+        store.queue.request("cat", "", "cat", LAB, EXERCISE)
     app = console(data)
     async with app.run_test(size=(80, 24)) as pilot:
         await until(pilot, lambda: len(queue_lines(app)) == 1, "the request")
@@ -162,8 +162,8 @@ async def test_a_decline_needs_a_note_and_the_student_reads_it(tmp_path):
         await until(pilot, lambda: queue_lines(app) == [], "the queue emptied")
         assert "declined cat" in str(app.screen.query_one("#console-message").render())
     with Store.open(data) as store:
-        entry = store.queue_state("cat", LAB, EXERCISE).entry
-        assert store.signoffs() == []
+        entry = store.queue.state("cat", LAB, EXERCISE).entry
+        assert store.signoffs.of() == []
     assert entry.state == DECLINED and entry.note == "answer the last question"
     assert entry.instructor == "Dr Chen"
 
@@ -174,7 +174,7 @@ async def test_signing_work_that_does_not_pass_needs_the_override_and_a_note(tmp
     create_instructor(data, "Dr Chen", PASS, kdf=FAST)
     with Store.open(data) as store:
         save_student(store, "cat", passed=False)
-        store.request_signoff("cat", "", "cat", LAB, EXERCISE)
+        store.queue.request("cat", "", "cat", LAB, EXERCISE)
     app = console(data)
     async with app.run_test(size=(80, 24)) as pilot:
         await until(pilot, lambda: len(queue_lines(app)) == 1, "the request")
@@ -184,7 +184,7 @@ async def test_signing_work_that_does_not_pass_needs_the_override_and_a_note(tmp
         await pilot.press(*PASS, "enter")
         await until(pilot, lambda: "override" in status(request), "the refusal")
     with Store.open(data) as store:
-        assert store.signoffs() == [] and len(store.signoff_queue()) == 1
+        assert store.signoffs.of() == [] and len(store.queue.waiting()) == 1
 
 
 def objectives_text(request: RequestScreen) -> str:
@@ -210,7 +210,7 @@ async def test_the_evidence_says_the_run_program_sensors_measures_and_tries(tmp_
     questions.evidence["waiting"] = ["margin"]
     with Store.open(data) as store:
         save_progress(store, "ana", progress)
-        store.request_signoff("ana", "", "ana", WEB_LAB, WALL_MAIN)
+        store.queue.request("ana", "", "ana", WEB_LAB, WALL_MAIN)
     app = console(data)
     async with app.run_test(size=(80, 24)) as pilot:
         request = await open_request(app, pilot)
@@ -237,7 +237,7 @@ async def test_evidence_on_two_programs_and_a_program_two_students_share_are_mar
         save_progress(store, "ana", mixed)
         save_progress(store, "ben", wall_main("ben", attempt="att-2"))
         save_progress(store, "cat", wall_main("cat", digest="ef" * 32, attempt="att-3"))
-        store.request_signoff("ana", "", "ana", WEB_LAB, WALL_MAIN)
+        store.queue.request("ana", "", "ana", WEB_LAB, WALL_MAIN)
     app = console(data)
     async with app.run_test(size=(80, 24)) as pilot:
         await until(pilot, lambda: len(class_lines(app)) == 3, "the class")
@@ -281,8 +281,8 @@ async def test_long_exercise_ids_are_shown_whole_at_80_columns(tmp_path):
     data = tmp_path / "data"
     lab, exercise = LONG_EXERCISE
     with Store.open(data) as store:
-        store.set_place("a-student-with-a-long-name", lab, exercise)
-        store.request_signoff("a-student-with-a-long-name", "her-partner", "her-partner",
+        store.progress.set_place("a-student-with-a-long-name", lab, exercise)
+        store.queue.request("a-student-with-a-long-name", "her-partner", "her-partner",
                               lab, exercise)  # fmt: skip
     app = console(data)
     async with app.run_test(size=(80, 24)) as pilot:
@@ -299,7 +299,7 @@ async def test_the_replay_from_the_console_draws_in_ascii(tmp_path):
     record = write_record(tmp_path / "run-003.jsonl")
     with Store.open(data) as store:
         save_student(store, "ana", record=str(record))
-        store.request_signoff("ana", "", "ana", LAB, EXERCISE)
+        store.queue.request("ana", "", "ana", LAB, EXERCISE)
     app = console(data)
     async with app.run_test(size=(80, 24)) as pilot:
         request = await open_request(app, pilot)

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import json
 
-from workbench.labs.instructors import create_instructor
 from workbench.labs.model import load_labs
-from workbench.labs.store import Store
+from workbench.labs.signoff.instructors import create_instructor
+from workbench.labs.store.store import Store
 from workbench.tui.console_app import ConsoleApp
 from workbench.tui.screens.console_request import RequestScreen
 
@@ -28,8 +28,8 @@ def save_hostile(store: Store, student: str) -> None:
         objective["evidence"]["maze"] = HOSTILE
         objective["evidence"]["driver"] = f"keys{TITLE}"
         objective["reason"] = f"done{CLIPBOARD}"
-    store.set_place(student, LAB, EXERCISE)
-    store.save_progress(student, LAB, EXERCISE, saved)
+    store.progress.set_place(student, LAB, EXERCISE)
+    store.progress.save(student, LAB, EXERCISE, saved)
 
 
 def assert_harmless(app) -> None:
@@ -46,7 +46,7 @@ async def test_hostile_evidence_reaches_the_console_as_text(tmp_path):
     create_instructor(data, "Dr Chen", PASS, kdf=FAST)
     with Store.open(data) as store:
         save_hostile(store, "ana")
-        store.request_signoff("ana", "", f"ana{TITLE}", LAB, EXERCISE)
+        store.queue.request("ana", "", f"ana{TITLE}", LAB, EXERCISE)
     app = ConsoleApp(Store.open(data), load_labs())
     async with app.run_test(size=(80, 24)) as pilot:
         await until(pilot, lambda: "ana" in "".join(emulated_terminal(app).display), "the class")

@@ -7,10 +7,10 @@ from textual.widgets import DataTable, Static
 
 from workbench.labs.checks import ObjectiveState
 from workbench.labs.classview import read_request
-from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.model import load_labs
-from workbench.labs.signing import sign_off
-from workbench.labs.store import Store
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
+from workbench.labs.signoff.signing import sign_off
+from workbench.labs.store.store import Store
 from workbench.tui.console_app import ConsoleApp
 from workbench.tui.screens.console import ConsoleScreen
 from workbench.tui.screens.console_grid import GridScreen
@@ -55,8 +55,8 @@ def a_class(data) -> None:
         save_student(store, "ben", passed=False)
         save_student(store, "cat")
         save_progress(store, "cat", wall_main("cat"))
-        store.set_place("cat", LAB, EXERCISE)
-        store.request_signoff("ana", "", "ana", LAB, EXERCISE)
+        store.progress.set_place("cat", LAB, EXERCISE)
+        store.queue.request("ana", "", "ana", LAB, EXERCISE)
 
 
 async def open_grid(app: ConsoleApp, pilot) -> GridScreen:
@@ -113,10 +113,10 @@ async def test_the_grid_follows_the_store_in_ascii(tmp_path):
         assert grid_rows(grid)["cat"][0] == "ok"
         # ana is signed off (from another console) and a question of ben's waits for you
         with Store.open(data) as store:
-            entry = store.signoff_queue()[0]
+            entry = store.queue.waiting()[0]
             request = read_request(store, entry, load_labs())
             sign_off(store, "Dr Chen", PASS, request.fields())
-            store.mark_signed(entry.id, "Dr Chen")
+            store.queue.mark_signed(entry.id, "Dr Chen")
             waiting = progress(passed=False)
             waiting.objectives[-1] = ObjectiveState(
                 "questions", "question answered", False, "1 of 1 not right yet",

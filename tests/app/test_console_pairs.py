@@ -6,8 +6,8 @@ from __future__ import annotations
 
 from textual.widgets import Button
 
-from workbench.labs.instructors import create_instructor
-from workbench.labs.store import Store
+from workbench.labs.signoff.instructors import create_instructor
+from workbench.labs.store.store import Store
 from workbench.tui.dialogs.pair import PairDialog
 from workbench.tui.screens.console_request import RequestScreen
 
@@ -34,7 +34,7 @@ async def test_a_partner_who_is_not_in_the_class_is_never_signed_for(tmp_path):
     create_instructor(data, "Dr Chen", PASS, kdf=FAST)
     with Store.open(data) as store:
         save_student(store, "ana")
-        store.request_signoff("ana", "zed", "ana", LAB, EXERCISE)
+        store.queue.request("ana", "zed", "ana", LAB, EXERCISE)
     app = console(data)
     async with app.run_test(size=(80, 24)) as pilot:
         request = await open_and_sign(pilot, app)
@@ -48,7 +48,7 @@ async def test_a_partner_who_is_not_in_the_class_is_never_signed_for(tmp_path):
         await until(pilot, lambda: "signed off ana " in status(request), "the sign-off")
         assert "ana and zed" not in status(request)
     with Store.open(data) as store:
-        (row,) = store.signoffs()
+        (row,) = store.signoffs.of()
     assert (row.student, row.partner) == ("ana", "")
 
 
@@ -58,8 +58,8 @@ async def test_the_instructor_signs_for_the_student_alone_when_the_partner_did_n
     create_instructor(data, "Dr Chen", PASS, kdf=FAST)
     with Store.open(data) as store:
         save_student(store, "ana")
-        store.set_place("ben", LAB, EXERCISE)
-        store.request_signoff("ana", "ben", "ana", LAB, EXERCISE)
+        store.progress.set_place("ben", LAB, EXERCISE)
+        store.queue.request("ana", "ben", "ana", LAB, EXERCISE)
     app = console(data)
     async with app.run_test(size=(80, 24)) as pilot:
         request = await open_and_sign(pilot, app)
@@ -73,5 +73,5 @@ async def test_the_instructor_signs_for_the_student_alone_when_the_partner_did_n
         await pilot.press("n")
         await until(pilot, lambda: "signed off ana " in status(request), "the sign-off")
     with Store.open(data) as store:
-        (row,) = store.signoffs()
+        (row,) = store.signoffs.of()
     assert (row.student, row.partner) == ("ana", "")

@@ -12,7 +12,7 @@ from textual.binding import Binding, BindingType
 from textual.pilot import Pilot
 from textual.widgets import Button, Checkbox, Input, Static
 
-from workbench.labs.instructors import KdfParams, create_instructor
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.signoff import SignoffModal
 from workbench.tui.dialogs.size import SizeDialog
@@ -74,7 +74,7 @@ def test_tick_back_and_sign_in_one_packet_signs_with_the_override(tmp_path):
         await burst(pilot, ("tab", "\t"), ("space", " "), ("shift+tab", None), ("enter", "\r"))
         await signing_over(pilot, modal)
         assert modal.signed, str(modal.query_one("#signoff-status", Static).render())
-        (row,) = app.store.signoffs()
+        (row,) = app.store.signoffs.of()
         assert row.override and row.note == "checked at the station"
 
     run(app, body)

@@ -10,8 +10,8 @@ from textual.pilot import Pilot
 from textual.widgets import Input, OptionList
 
 from tests.waiting import until
-from workbench.labs.pending import pending_path
-from workbench.labs.store import Store
+from workbench.labs.store.pending import pending_path
+from workbench.labs.store.store import Store
 from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
 
@@ -75,7 +75,7 @@ def test_the_database_going_away_is_shown_and_the_work_is_saved_when_it_is_back(
 
     run(app, body)
     with Store.open(tmp_path / "elsewhere", db=pg_url) as store:
-        saved = store.progress("ana")[("unity-simulator", "drive-by-wire")]
+        saved = store.progress.of("ana")[("unity-simulator", "drive-by-wire")]
     assert saved["answers"] == {"tcp-port": "1350"}
 
 
@@ -111,12 +111,12 @@ def test_changes_kept_while_the_database_is_down_outlive_the_app_and_are_saved_b
     run(second, resume)
     assert not kept.is_file()
     with Store.open(tmp_path / "elsewhere", db=pg_url) as store:
-        saved = store.progress("ana")[("unity-simulator", "drive-by-wire")]
+        saved = store.progress.of("ana")[("unity-simulator", "drive-by-wire")]
     assert saved["answers"] == {"tcp-port": "4242"}
 
 
 def test_retries_run_beside_the_app_one_at_a_time(tmp_path, pg_server, pg_url, monkeypatch):
-    monkeypatch.setattr("workbench.tui.screens.labs.RETRY_SECONDS", 0.1)
+    monkeypatch.setattr("workbench.labs.course_store.RETRY_SECONDS", 0.1)
     app = lab_app(tmp_path / "data", db=pg_url)
     running, most = 0, 0
 
@@ -237,7 +237,7 @@ def test_a_database_that_hangs_never_freezes_the_app_and_the_work_waits_for_it(
 
     run(app, body)
     with Store.open(tmp_path / "elsewhere", db=pg_url) as store:
-        saved = store.progress("ana")[("unity-simulator", "drive-by-wire")]
+        saved = store.progress.of("ana")[("unity-simulator", "drive-by-wire")]
     assert saved["answers"] == {"tcp-port": "1350"}
 
 

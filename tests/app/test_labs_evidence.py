@@ -9,8 +9,8 @@ from dataclasses import replace
 from textual.pilot import Pilot
 from textual.widgets import Input
 
-from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.model import load_labs
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
 from workbench.tui.dialogs.generate import GenerateDialog
 from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.dialogs.signoff import SignoffModal
@@ -147,7 +147,7 @@ def test_a_question_out_of_tries_takes_no_answer_and_waits_for_the_instructor(
         assert objective_lines(screen)[-1] == (
             "[ ] question answered: no tries left, waiting for the instructor: tcp-port"
         )
-        saved = app.store.progress("ana")[("unity-simulator", "drive-by-wire")]
+        saved = app.store.progress.of("ana")[("unity-simulator", "drive-by-wire")]
         assert saved["tries"] == {"tcp-port": 2}
         (questions,) = [o for o in saved["objectives"] if o["kind"] == "questions"]
         assert questions["evidence"]["waiting"] == ["tcp-port"]

@@ -7,9 +7,9 @@ from textual import events
 from textual.pilot import Pilot
 from textual.widgets import Input, OptionList, Static
 
-from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.model import load_labs
-from workbench.labs.store import Store
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
+from workbench.labs.store.store import Store
 from workbench.tui.dialogs.signoff import SignoffModal
 from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.widgets.choices import Choice, Choices
@@ -77,7 +77,7 @@ def test_reopening_the_labs_focuses_the_list_and_its_keys_leave_the_answers_alon
         await pilot.pause()
         assert field.value == "1350"
         assert reason_of(screen, "tcp-port") == "[X] correct (1 try)"
-        saved = app.store.progress("ana")[("unity-simulator", "drive-by-wire")]
+        saved = app.store.progress.of("ana")[("unity-simulator", "drive-by-wire")]
         assert saved["answers"] == {"tcp-port": "1350"}
 
     run(app, body)
@@ -149,7 +149,7 @@ def test_a_choice_is_picked_with_the_keys_and_saved_as_its_text(tmp_path):
         right = rules_question().choices[right_choice()]
         assert choices.answer == right
         assert reason_of(screen, QUESTION) == "[X] correct (1 try)"
-        saved = app.store.progress("ana")[("maze-algorithms", "erobotic-rules")]
+        saved = app.store.progress.of("ana")[("maze-algorithms", "erobotic-rules")]
         assert saved["answers"][QUESTION] == right
         wrong = (right_choice() + 1) % len(rules_question().choices)
         await pilot.press(*["up"] * right_choice(), *["down"] * wrong, "space")
@@ -181,7 +181,7 @@ def test_a_saved_answer_comes_back_picked(tmp_path):
     data = tmp_path / "data"
     right = rules_question().choices[right_choice()]
     with Store.open(data) as store:
-        store.save_progress(
+        store.progress.save(
             "ana",
             "maze-algorithms",
             "erobotic-rules",

@@ -9,7 +9,7 @@ from textual.pilot import Pilot
 from textual.widgets import Input, OptionList
 
 from tests.waiting import until
-from workbench.labs.store import Store
+from workbench.labs.store.progress_rows import ProgressRows
 from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
 
@@ -31,14 +31,14 @@ def test_the_keys_are_answered_while_the_saved_work_is_read_and_it_shows_once_re
     run(first, work)
     answered = threading.Event()  # the store answers the read of the saved progress
     reading = threading.Event()
-    progress = Store.progress
+    progress = ProgressRows.of
 
-    def slow_progress(store: Store, student: str, lab: str | None = None) -> dict:
+    def slow_progress(rows: ProgressRows, student: str, lab: str | None = None) -> dict:
         reading.set()
         assert answered.wait(60), "the test never let the read go on"
-        return progress(store, student, lab)
+        return progress(rows, student, lab)
 
-    monkeypatch.setattr(Store, "progress", slow_progress)
+    monkeypatch.setattr(ProgressRows, "of", slow_progress)
     again = lab_app(data)
 
     async def resume(pilot: Pilot) -> None:

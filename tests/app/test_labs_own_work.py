@@ -7,9 +7,9 @@ from textual.pilot import Pilot
 from textual.widgets import Input, OptionList
 
 from tests.integration.test_labs_completable import answer
-from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.model import LABS_DIR
-from workbench.labs.store import Store
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
+from workbench.labs.store.store import Store
 from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.dialogs.signoff import SignoffModal
 from workbench.tui.screens.labs import LabsScreen
@@ -65,7 +65,7 @@ def test_the_set_up_of_another_exercise_and_a_loaded_maze_pass_nothing(tmp_path)
         lines = objective_lines(screen)
         assert lines[0] == "[ ] drove with w, a, s, d and space: not used yet: w, a, s, d, space"
         assert lines[1].startswith("[ ] edited the maze and kept it valid: the maze has not been")
-        saved = app.store.progress("ana")[("unity-simulator", "drive-by-wire")]
+        saved = app.store.progress.of("ana")[("unity-simulator", "drive-by-wire")]
         assert [o["passed"] for o in saved["objectives"][:2]] == [False, False]
 
     run(app, body)
@@ -136,7 +136,7 @@ def test_the_sign_off_names_who_did_the_work_and_shows_the_moment_it_is_saved(tm
         assert screen.driver == "ben"  # as chosen, though ana did the work
         await sign(pilot, "ana")
         with Store.open(data) as store:
-            rows = {(r.lab, r.exercise): r for r in store.signoffs(student="ana")}
+            rows = {(r.lab, r.exercise): r for r in store.signoffs.of(student="ana")}
         row = rows[("unity-simulator", "reading-wall-following")]
         assert row.driver == "ana"
         objectives = row.metrics_value()["objectives"]

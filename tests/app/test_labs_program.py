@@ -11,8 +11,8 @@ from textual.pilot import Pilot
 from textual.widgets import Input
 
 from tests.students_work import own_right_wall
-from workbench.labs.instructors import KdfParams, create_instructor
-from workbench.labs.store import Store
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
+from workbench.labs.store.store import Store
 from workbench.tui.dialogs.algorithm import AlgorithmModal
 from workbench.tui.dialogs.signoff import SignoffModal
 
@@ -58,7 +58,7 @@ def test_a_viple_exercise_is_passed_and_signed_off_with_the_students_program(tmp
         objectives = text(screen, "#labs-objectives").splitlines()
         assert objectives[0].startswith("[X] your program got out of the Web maze within 300 s")
         assert "VIPLE program my-right-wall.viple" in objectives[0]
-        progress = app.store.progress("ana")[("web-simulator", "wall-activities")]
+        progress = app.store.progress.of("ana")[("web-simulator", "wall-activities")]
         evidence = progress["objectives"][0]["evidence"]
         assert evidence["program_sha256"] == digest
         assert evidence["driver"] == "VIPLE program my-right-wall.viple"
@@ -80,7 +80,7 @@ def test_a_viple_exercise_is_passed_and_signed_off_with_the_students_program(tmp
         await signing_over(pilot, modal)
         assert "Signed off by Dr Chen" in text(modal, "#signoff-done")
         with Store.open(data) as store:
-            (row,) = store.signoffs(student="ana")
+            (row,) = store.signoffs.of(student="ana")
         assert (row.lab, row.exercise) == ("web-simulator", "wall-activities")
         assert row.evidence_digest == screen.progress.evidence_digest()
         # the signed record names the program the evidence rests on

@@ -7,10 +7,10 @@ from __future__ import annotations
 from textual.widgets import Static
 
 from workbench.files.workspace import workspace_folder
-from workbench.labs.instructors import KdfParams, create_instructor
-from workbench.labs.signing import sign_off
-from workbench.labs.signoff_record import Evidence, RecordFields
-from workbench.labs.store import Store
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
+from workbench.labs.signoff.signing import sign_off
+from workbench.labs.signoff.signoff_record import Evidence, RecordFields
+from workbench.labs.store.store import Store
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.signoff import SignoffModal
 from workbench.tui.settings import AppSettings
@@ -40,7 +40,7 @@ async def test_a_served_student_asks_with_r_and_sees_the_queue_and_the_sign_off(
     data = tmp_path / "data"
     create_instructor(data, "Dr Chen", PASS, kdf=FAST)
     with Store.open(data) as other:
-        other.request_signoff("cat", "", "cat", LAB, "wall-following")
+        other.queue.request("cat", "", "cat", LAB, "wall-following")
     app = served_app(data)
     async with app.run_test(size=(80, 24)) as pilot:
         screen = await open_exercise(pilot, f"{LAB}/{EXERCISE}")
@@ -50,8 +50,8 @@ async def test_a_served_student_asks_with_r_and_sees_the_queue_and_the_sign_off(
         await pilot.press("r")
         await until(pilot, lambda: "2nd in the queue" in status(screen), "the place")
         with Store.open(data) as console:
-            entry = next(e for e in console.signoff_queue() if e.student == "ana")
-            console.decline_request(entry.id, "Dr Chen", "drive it once more")
+            entry = next(e for e in console.queue.waiting() if e.student == "ana")
+            console.queue.decline(entry.id, "Dr Chen", "drive it once more")
         await until(pilot, lambda: "drive it once more" in status(screen), "the decline")
         assert "declined by Dr Chen" in status(screen)
         await pilot.press("r")

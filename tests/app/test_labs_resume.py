@@ -6,7 +6,7 @@ from __future__ import annotations
 from textual.pilot import Pilot
 from textual.widgets import Input, OptionList, Static
 
-from workbench.labs.store import Store
+from workbench.labs.store.store import Store
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.identity import IdentityDialog
 from workbench.tui.screens.main import MainScreen
@@ -32,7 +32,7 @@ def test_an_exercise_is_saved_as_soon_as_it_is_opened(tmp_path):
 
     async def body(pilot: Pilot) -> None:
         await open_exercise(pilot, DRIVE)
-        saved = app.store.progress("ana")[("unity-simulator", "drive-by-wire")]
+        saved = app.store.progress.of("ana")[("unity-simulator", "drive-by-wire")]
         assert saved["passed"] is False
         assert [o["passed"] for o in saved["objectives"]] == [False, False, False]
 
@@ -61,7 +61,7 @@ def test_what_passed_before_a_restart_is_still_passed_after_it(tmp_path):
         assert lines[0] == kept
         assert lines[1].startswith("[ ] edited the maze")
         assert screen.query_one("#q-tcp-port", Input).value == "13"
-        saved = again.store.progress("ana")[("unity-simulator", "drive-by-wire")]
+        saved = again.store.progress.of("ana")[("unity-simulator", "drive-by-wire")]
         assert saved["objectives"][0]["evidence"]["keys_used"] == ["a", "d", "s", "space", "w"]
 
     run(again, resume)
@@ -201,7 +201,7 @@ def test_the_set_up_of_a_tcp_exercise_starts_listening(tmp_path):
 def test_a_store_with_unreadable_progress_says_so_and_starts_that_exercise_afresh(tmp_path):
     data = tmp_path / "data"
     with Store.open(data) as store:
-        store.save_progress("ana", "unity-simulator", "drive-by-wire", {"objectives": 3})
+        store.progress.save("ana", "unity-simulator", "drive-by-wire", {"objectives": 3})
     app = lab_app(data)
 
     async def body(pilot: Pilot) -> None:
@@ -253,8 +253,8 @@ def test_the_labs_reopen_at_the_exercise_the_student_had_open(tmp_path):
 
     run(first, browse)
     with Store.open(data) as store:
-        assert store.place("ana") == ("unity-simulator", "wall-following")
-        assert store.place("ben") is None
+        assert store.progress.place("ana") == ("unity-simulator", "wall-following")
+        assert store.progress.place("ben") is None
     again = lab_app(data)
 
     async def resume(pilot: Pilot) -> None:

@@ -10,11 +10,11 @@ from textual.pilot import Pilot
 from textual.widgets import Button, Checkbox, Input, OptionList, Select, Static
 
 from workbench.cli import build_parser
-from workbench.labs.instructors import KdfParams, SealedKey, create_instructor
-from workbench.labs.signing import FAILURE_LIMIT, sign_off
-from workbench.labs.signoff_errors import WrongPassphrase
-from workbench.labs.signoff_record import RecordFields
-from workbench.labs.store import Store
+from workbench.labs.signoff.instructors import KdfParams, SealedKey, create_instructor
+from workbench.labs.signoff.signing import FAILURE_LIMIT, sign_off
+from workbench.labs.signoff.signoff_errors import WrongPassphrase
+from workbench.labs.signoff.signoff_record import RecordFields
+from workbench.labs.store.store import Store
 from workbench.tui.dialogs.signoff import SignoffModal
 from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
@@ -79,7 +79,7 @@ def test_set_up_then_driving_flips_the_keys_objective_and_saves_progress(tmp_pat
         await pilot.press("escape")
         await pilot.press("w", "a", "s", "d", "space")
         await pilot.pause()
-        progress = app.store.progress("ana")[("unity-simulator", "drive-by-wire")]
+        progress = app.store.progress.of("ana")[("unity-simulator", "drive-by-wire")]
         assert progress["objectives"][0]["passed"] is True  # saved while the labs were closed
         await pilot.press("l")
         await pilot.pause()
@@ -111,7 +111,7 @@ def test_a_question_is_checked_when_an_answer_is_tried_and_every_try_counts(tmp_
         assert str(reason.render()) == "[X] correct (2 tries)"
         assert "[X] question answered" in text(screen, "#labs-objectives")
         assert "  1 of 1 right; tries: tcp-port 2" in text(screen, "#labs-objectives")
-        saved = app.store.progress("ana")[("unity-simulator", "drive-by-wire")]
+        saved = app.store.progress.of("ana")[("unity-simulator", "drive-by-wire")]
         assert saved["answers"] == {"tcp-port": "1350"}
         assert saved["tries"] == {"tcp-port": 2}
 
@@ -145,8 +145,8 @@ def test_sign_off_happy_path_then_the_driver_changes(tmp_path):
         assert screen.driver == "ben"
         assert text(screen, "#labs-message") == "signed off; ben drives next"
         with Store.open(data) as store:
-            (row,) = store.signoffs(student="ana")
-            drivers = store.drivers("ana", "ben")
+            (row,) = store.signoffs.of(student="ana")
+            drivers = store.progress.drivers("ana", "ben")
         assert (row.lab, row.exercise, row.driver, row.override) == (
             "unity-simulator",
             "drive-by-wire",
@@ -200,7 +200,7 @@ def test_a_wrong_passphrase_is_shown_and_nothing_is_signed(tmp_path):
         await signing_over(pilot, modal)
         assert text(modal, "#signoff-status") == "wrong passphrase for Dr Chen"
         assert modal.query_one("#signoff-passphrase", Input).value == ""
-        assert app.store.signoffs() == []
+        assert app.store.signoffs.of() == []
         await pilot.press("escape")
         assert app.screen is screen
 
@@ -236,7 +236,7 @@ def test_a_locked_out_instructor_is_told_for_how_long(tmp_path):
         await pilot.press("enter")
         await signing_over(pilot, modal)
         assert "is locked for" in text(modal, "#signoff-status")
-        assert app.store.signoffs() == []
+        assert app.store.signoffs.of() == []
 
     run(app, body)
 
@@ -286,7 +286,7 @@ def test_the_app_keeps_answering_while_the_key_is_unlocked(tmp_path, monkeypatch
         await signing_over(pilot, modal)
         assert app.screen is screen  # closed once signed, the driver kept
         assert unlocks == ["Dr Chen"]
-        (row,) = app.store.signoffs(student="ana")
+        (row,) = app.store.signoffs.of(student="ana")
         assert row.instructor == "Dr Chen" and not row.note
         assert text(screen, "#labs-message") == "signed off; ana drives next"
 
@@ -327,7 +327,7 @@ def test_an_override_without_a_note_is_refused(tmp_path):
         await pilot.press("enter")
         await signing_over(pilot, modal)
         assert "(override)" in text(modal, "#signoff-done")
-        (row,) = app.store.signoffs()
+        (row,) = app.store.signoffs.of()
         assert row.override and row.note == "showed it on the lab robot"
 
     run(app, body)

@@ -35,11 +35,11 @@ from workbench.cli import main
 from workbench.control.algorithms import list_algorithms
 from workbench.control.headless import AlgorithmPilot, RunSpec
 from workbench.control.headless import run as headless_run
-from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.model import Exercise, Lab, LabMaze, Objective, load_labs
-from workbench.labs.roster import load_roster, roster_path
-from workbench.labs.store import Store
-from workbench.labs.verify import verify_all
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
+from workbench.labs.signoff.roster import load_roster, roster_path
+from workbench.labs.signoff.verify import verify_all
+from workbench.labs.store.store import Store
 from workbench.sim.mazeio import save_maze
 from workbench.sim.profiles import get_profile
 from workbench.tui.app import WorkbenchApp, make_app
@@ -527,7 +527,7 @@ def test_a_pair_completes_and_signs_off_every_exercise_in_the_app(tmp_path, lab)
     run(app, body)
 
     with Store.open(data) as store:
-        rows = sorted(store.signoffs(), key=lambda r: r.id)
+        rows = sorted(store.signoffs.of(), key=lambda r: r.id)
         roster = load_roster(roster_path(data))
         verdicts = verify_all(store, roster)
     assert [(r.lab, r.exercise) for r in rows] == [(lab.id, ex.id) for ex in lab.exercises]

@@ -9,7 +9,7 @@ from textual.widgets import Input
 
 from workbench.labs.checks import MAX_ANSWER, ExerciseProgress
 from workbench.labs.names import MAX_STUDENT_NAME
-from workbench.labs.store import Store
+from workbench.labs.store.store import Store
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.identity import IdentityDialog
 from workbench.tui.settings import AppSettings
@@ -35,7 +35,7 @@ def test_a_pasted_huge_answer_is_cut_to_the_cap_with_a_message(tmp_path):
         )
         await pilot.press("end", "backspace", "backspace", "enter")  # it still edits; tried
         assert len(field.value) == MAX_ANSWER - 2
-        saved = app.store.progress("ana")[("unity-simulator", "drive-by-wire")]
+        saved = app.store.progress.of("ana")[("unity-simulator", "drive-by-wire")]
         assert len(saved["answers"]["tcp-port"]) == MAX_ANSWER - 2
 
     run(app, body)
@@ -44,7 +44,7 @@ def test_a_pasted_huge_answer_is_cut_to_the_cap_with_a_message(tmp_path):
 def test_an_oversized_answer_in_the_store_is_read_back_cut_with_a_notice(tmp_path):
     data = tmp_path / "data"
     with Store.open(data) as store:
-        store.save_progress(
+        store.progress.save(
             "ana",
             "unity-simulator",
             "drive-by-wire",
@@ -68,7 +68,7 @@ def test_an_oversized_answer_in_the_store_is_read_back_cut_with_a_notice(tmp_pat
         field.value = ""
         field.focus()
         await pilot.press("1", "3", "5", "0", "enter")
-        saved = app.store.progress("ana")[("unity-simulator", "drive-by-wire")]
+        saved = app.store.progress.of("ana")[("unity-simulator", "drive-by-wire")]
         assert saved["answers"]["tcp-port"] == "1350"
 
     run(app, body)

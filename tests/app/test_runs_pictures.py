@@ -134,7 +134,7 @@ async def test_the_console_saves_the_evidence_runs_picture(tmp_path, monkeypatch
     from tests.app.console_support import until as console_until
     from tests.pictures.records import record_of
     from workbench.labs.model import load_labs
-    from workbench.labs.store import Store
+    from workbench.labs.store.store import Store
     from workbench.tui.console_app import ConsoleApp
     from workbench.tui.screens.console import ConsoleScreen
     from workbench.tui.screens.console_request import RequestScreen

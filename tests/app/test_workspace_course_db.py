@@ -11,7 +11,7 @@ from textual.pilot import Pilot
 
 from tests.waiting import until
 from workbench.files.workspace import workspace_folder
-from workbench.labs.store import Store
+from workbench.labs.store.store import Store
 from workbench.tui.app import make_app
 from workbench.tui.screens.editor import EditorScreen
 from workbench.tui.settings import AppSettings
@@ -22,7 +22,7 @@ from .test_workspace_app import type_path
 
 def stored(data: Path, db: str, path: str) -> bytes | None:
     with Store.open(data, db=db) as store:
-        got = store.workspace_file("ann", path)
+        got = store.workspaces.file("ann", path)
     return got[1] if got is not None else None
 
 

@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from workbench.labs.instructors import create_instructor
-from workbench.labs.store import Store
+from workbench.labs.signoff.instructors import create_instructor
+from workbench.labs.store.store import Store
 
 from .signoff_support import FAST, PASS
 

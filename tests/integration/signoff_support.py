@@ -9,10 +9,10 @@ from datetime import UTC, datetime
 from pathlib import Path
 
 from workbench.cli import main
-from workbench.labs.instructors import KdfParams
-from workbench.labs.signing import sign_off
-from workbench.labs.signoff_record import Evidence, RecordFields
-from workbench.labs.store import DB_NAME, Store
+from workbench.labs.signoff.instructors import KdfParams
+from workbench.labs.signoff.signing import sign_off
+from workbench.labs.signoff.signoff_record import Evidence, RecordFields
+from workbench.labs.store.store import DB_NAME, Store
 
 PASS = "correct horse battery"
 FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only; defaults are untouched

@@ -10,9 +10,9 @@ from pathlib import Path
 import pytest
 
 from workbench.cli import main
-from workbench.labs.instructors import create_instructor, key_path, unlock_instructor
-from workbench.labs.roster import load_roster, roster_path
-from workbench.labs.store import Store
+from workbench.labs.signoff.instructors import create_instructor, key_path, unlock_instructor
+from workbench.labs.signoff.roster import load_roster, roster_path
+from workbench.labs.store.store import Store
 
 from .signoff_support import FAST, PASS, sign
 

@@ -13,11 +13,11 @@ import sys
 import pytest
 
 from workbench.cli import main
-from workbench.labs.instructors import create_instructor, unlock_instructor
-from workbench.labs.roster import load_roster, roster_path
-from workbench.labs.signing import sign_off
-from workbench.labs.signoff_record import Evidence, RecordFields
-from workbench.labs.store import DB_NAME, Store
+from workbench.labs.signoff.instructors import create_instructor, unlock_instructor
+from workbench.labs.signoff.roster import load_roster, roster_path
+from workbench.labs.signoff.signing import sign_off
+from workbench.labs.signoff.signoff_record import Evidence, RecordFields
+from workbench.labs.store.store import DB_NAME, Store
 
 from .signoff_support import FAST, PASS, add_instructor, sign
 

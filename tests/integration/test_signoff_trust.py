@@ -15,11 +15,11 @@ import pytest
 from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
 
 from workbench.cli import main
-from workbench.labs.instructors import Instructor, create_instructor, key_path
-from workbench.labs.roster import load_roster, roster_path
 from workbench.labs.signlog import GENESIS, entry_hash
-from workbench.labs.signoff_record import record_from_stored
-from workbench.labs.store import DB_NAME, Store, read_signoffs
+from workbench.labs.signoff.instructors import Instructor, create_instructor, key_path
+from workbench.labs.signoff.roster import load_roster, roster_path
+from workbench.labs.signoff.signoff_record import record_from_stored
+from workbench.labs.store.store import DB_NAME, Store, read_signoffs
 
 from .signoff_support import FAST, add_instructor, sign, sql
 
@@ -143,7 +143,7 @@ def test_a_record_inserted_with_another_key_is_found(three, tmp_path, capsys):
     [forged] = read_signoffs(rogue)
     values = {k: v for k, v in forged.__dict__.items() if k not in ("id", "seq")}
     with Store.open(three) as store:
-        store.append_signoff(lambda seq, prev: values)
+        store.signoffs.append(lambda seq, prev: values)
     code, out = verify(capsys, three)
     assert code == 1
     assert "FAIL #4 mallory web-simulator/sensors: the signature does not match" in out
@@ -281,7 +281,7 @@ def test_a_record_by_a_look_alike_instructor_is_not_a_grade(three, tmp_path, cap
         return record.columns(impostor.sign(record.canonical()))
 
     with Store.open(three) as store:
-        store.append_signoff(signed)
+        store.signoffs.append(signed)
     code, out = verify(capsys, three)
     assert code == 1
     assert "FAIL #4 dave web-simulator/sensors: instructor 'Dr Сhen' is not in the trusted" in out

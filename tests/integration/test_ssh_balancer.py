@@ -26,7 +26,7 @@ from tests.app.support import sync
 from tests.sessions import free_port
 from tests.students_work import own_right_wall
 from tests.waiting import until
-from workbench.labs.store import Store
+from workbench.labs.store.store import Store
 from workbench.ssh.balancer import EXAMPLE, LabBackend, haproxy_config
 from workbench.ssh.hostkey import load_or_create_host_key
 from workbench.ssh.users import users_path
@@ -179,7 +179,7 @@ def end_left_over(pids: list[int]) -> None:
 
 def held(reader_dir: Path, db: str) -> dict[str, str]:
     with Store.open(reader_dir, db=db) as store:
-        return {p: r.sha256 for p, r in store.workspace_index("ann").items() if not r.deleted}
+        return {p: r.sha256 for p, r in store.workspaces.index("ann").items() if not r.deleted}
 
 
 def exercise_passed(screen: str) -> bool:
@@ -194,7 +194,7 @@ def exercise_passed(screen: str) -> bool:
 def passed(reader_dir: Path, db: str) -> dict | None:
     """ann's saved progress in the exercise, once it has passed."""
     with Store.open(reader_dir, db=db) as store:
-        progress = store.progress("ann").get(KEY)
+        progress = store.progress.of("ann").get(KEY)
     return progress if progress and progress.get("passed") is True else None
 
 

@@ -8,8 +8,8 @@ import pytest
 
 from tests.app.support import sync
 from workbench.files.workspace import workspace_folder
-from workbench.labs.store import Store
-from workbench.labs.workspace_sync import push_file
+from workbench.labs.store.store import Store
+from workbench.labs.store.workspace_sync import push_file
 
 from .ssh_support import Account, lab_host, open_exercise
 
@@ -65,4 +65,4 @@ async def test_a_student_moves_between_two_servers_sharing_one_database(
     assert not (tmp_path / "one" / "data" / "workbench.sqlite3").exists()
     assert not (tmp_path / "two" / "data" / "workbench.sqlite3").exists()
     with Store.open(tmp_path / "three", db=pg_url) as store:
-        assert ("unity-simulator", "drive-by-wire") in store.progress("ann")
+        assert ("unity-simulator", "drive-by-wire") in store.progress.of("ann")

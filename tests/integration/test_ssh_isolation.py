@@ -14,7 +14,7 @@ import pytest
 
 from tests.app.support import sync
 from workbench.files.workspace import BUNDLED
-from workbench.labs.store import Store
+from workbench.labs.store.store import Store
 
 from .ssh_support import PASSWORD, Account, distance, lab_host, moved
 

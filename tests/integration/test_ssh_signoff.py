@@ -12,8 +12,8 @@ import sys
 import pytest
 
 from tests.app.support import sync
-from workbench.labs.instructors import KdfParams, create_instructor
-from workbench.labs.store import Store
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
+from workbench.labs.store.store import Store
 
 from .openssh_terminal import OpenSshTerminal
 from .ssh_support import Account, lab_host, open_exercise
@@ -73,8 +73,8 @@ async def test_the_instructor_signs_from_their_own_session_and_the_student_sees_
     assert verify.returncode == 0, verify.stdout + verify.stderr
     assert "all 1 record(s) verify" in verify.stdout
     with Store.open(host.data_dir, create=False) as store:
-        (record,) = store.signoffs()
-        assert store.signoff_queue() == []
+        (record,) = store.signoffs.of()
+        assert store.queue.waiting() == []
     assert (record.instructor, record.student) == ("ito", "ann")
     assert (record.lab, record.exercise) == ("unity-simulator", "drive-by-wire")
     assert record.override and record.note == "checked at the console"

@@ -9,7 +9,7 @@ import threading
 
 from tests.app.support import sync
 from tests.waiting import until
-from workbench.labs.workspace_sync import SyncReport
+from workbench.labs.store.workspace_sync import SyncReport
 from workbench.ssh import server as server_module
 from workbench.ssh.limits import SessionLimits
 

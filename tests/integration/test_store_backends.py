@@ -15,18 +15,24 @@ from pathlib import Path
 import pytest
 
 from tests.waiting import wait_until
-from workbench.labs.instructors import KdfParams, create_instructor
-from workbench.labs.roster import RosterEntry, offered_roster
-from workbench.labs.signing import sign_off
-from workbench.labs.signoff_errors import (
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
+from workbench.labs.signoff.roster import RosterEntry, offered_roster
+from workbench.labs.signoff.signing import sign_off
+from workbench.labs.signoff.signoff_errors import (
     LockedOut,
     SignoffError,
     UnknownInstructor,
     WrongPassphrase,
 )
-from workbench.labs.signoff_record import Evidence, RecordFields
-from workbench.labs.store import LogMissing, Store, StoreError, StoreUnavailable, read_signoffs
-from workbench.labs.verify import verify_log
+from workbench.labs.signoff.signoff_record import Evidence, RecordFields
+from workbench.labs.signoff.verify import verify_log
+from workbench.labs.store.store import (
+    LogMissing,
+    Store,
+    StoreError,
+    StoreUnavailable,
+    read_signoffs,
+)
 
 FAST = KdfParams(n=2**10, r=8, p=1)
 PASS = "correct horse battery"
@@ -80,22 +86,22 @@ def fields(student: str = "alice", **kw) -> RecordFields:
 
 def test_progress_places_and_drivers_are_saved_replaced_and_read_back(where):
     with where.open() as s:
-        assert s.save_progress("alice", "web", "ex1", {"objectives": {"keys": True}}, now=T0)
-        s.save_progress("alice", "web", "ex1", {"objectives": {"keys": True, "maze": False}})
-        s.save_progress("alice", "unity", "ex2", {"answers": [1]})
-        s.set_place("alice", "web", "ex1")
-        s.set_place("alice", "unity", "ex2")
-        s.set_driver("alice", "bob", "web", "ex1", "alice")
-        s.set_driver("alice", "bob", "web", "ex1", "bob")
+        assert s.progress.save("alice", "web", "ex1", {"objectives": {"keys": True}}, now=T0)
+        s.progress.save("alice", "web", "ex1", {"objectives": {"keys": True, "maze": False}})
+        s.progress.save("alice", "unity", "ex2", {"answers": [1]})
+        s.progress.set_place("alice", "web", "ex1")
+        s.progress.set_place("alice", "unity", "ex2")
+        s.progress.set_driver("alice", "bob", "web", "ex1", "alice")
+        s.progress.set_driver("alice", "bob", "web", "ex1", "bob")
         with pytest.raises(ValueError):
-            s.save_progress("alice", "web", "ex1", {"t": float("inf")})
+            s.progress.save("alice", "web", "ex1", {"t": float("inf")})
     with where.open() as s:  # another process (or server) opening the same store
-        assert s.progress("alice", "web") == {
+        assert s.progress.of("alice", "web") == {
             ("web", "ex1"): {"objectives": {"keys": True, "maze": False}}
         }
-        assert len(s.progress("alice")) == 2 and s.progress("nobody") == {}
-        assert s.place("alice") == ("unity", "ex2") and s.place("bob") is None
-        assert s.drivers("alice", "bob") == {("web", "ex1"): "bob"}
+        assert len(s.progress.of("alice")) == 2 and s.progress.of("nobody") == {}
+        assert s.progress.place("alice") == ("unity", "ex2") and s.progress.place("bob") is None
+        assert s.progress.drivers("alice", "bob") == {("web", "ex1"): "bob"}
         assert s.pending == 0 and s.available
 
 
@@ -132,17 +138,17 @@ def old_progress(evidence: dict) -> dict:
 
 def test_passes_saved_without_their_work_need_redoing_after_the_upgrade(where):
     with where.open() as s:
-        s.save_progress("ana", "unity-simulator", "drive-by-wire", old_progress({}))
+        s.progress.save("ana", "unity-simulator", "drive-by-wire", old_progress({}))
         kept = old_progress({"attempt": "5eed", "keys_used": ["w"]})
-        s.save_progress("ben", "unity-simulator", "drive-by-wire", kept)
+        s.progress.save("ben", "unity-simulator", "drive-by-wire", kept)
     # as a store before step 5 was: the step not applied, the older schema version
     with where.open() as store, store.backend.write() as tx:
         tx.execute("DELETE FROM schema_migrations WHERE version = 5")
         tx.execute("UPDATE meta SET value = ? WHERE key = 'schema_version'", ("4",))
     with where.open() as s:
         assert (5, "progress evidence") in s.migrations()
-        ana = s.progress("ana")[("unity-simulator", "drive-by-wire")]
-        ben = s.progress("ben")[("unity-simulator", "drive-by-wire")]
+        ana = s.progress.of("ana")[("unity-simulator", "drive-by-wire")]
+        ben = s.progress.of("ben")[("unity-simulator", "drive-by-wire")]
     keys, edited, answered = ana["objectives"]
     assert (keys["passed"], keys["redo"], keys["reason"].startswith("needs redoing")) == (
         False, True, True)  # fmt: skip
@@ -167,8 +173,8 @@ def test_signoffs_form_one_log_that_verifies_and_reads_back_the_same(where):
     with where.open() as s:
         for student in ("alice", "carol", "dave"):
             sign_off(s, "Dr Chen", PASS, fields(student))
-        stored = s.signoffs()
-        assert [r.student for r in s.signoffs(student="bob")] == ["alice", "carol", "dave"]
+        stored = s.signoffs.of()
+        assert [r.student for r in s.signoffs.of(student="bob")] == ["alice", "carol", "dave"]
     assert [r.seq for r in stored] == [1, 2, 3]
     read = read_signoffs(where.data_dir, where.db)
     assert read == stored
@@ -205,7 +211,8 @@ def test_the_lockout_counts_across_a_reopen(where):
     with where.open() as s:
         with pytest.raises(LockedOut, match="60 s more"):
             sign_off(s, "Dr Chen", "wrong wrong wrong", fields(), clock=lambda: T0)
-        assert [e.event for e in s.events("Dr Chen")] == ["wrong-passphrase"] * 5 + ["locked"]
+        events = [e.event for e in s.signoffs.events("Dr Chen")]
+        assert events == ["wrong-passphrase"] * 5 + ["locked"]
 
 
 def test_two_threads_write_at_the_same_time(where):
@@ -216,8 +223,8 @@ def test_two_threads_write_at_the_same_time(where):
         try:
             with where.open() as s:
                 for i in range(30):
-                    s.save_progress(who, "lab", f"ex{i}", {"i": i})
-                    s.log_event(who, "tick", str(i), T0)
+                    s.progress.save(who, "lab", f"ex{i}", {"i": i})
+                    s.signoffs.log_event(who, "tick", str(i), T0)
         except BaseException as exc:
             errors.append(exc)
 
@@ -228,15 +235,15 @@ def test_two_threads_write_at_the_same_time(where):
         t.join()
     assert errors == []
     with where.open() as s:
-        assert len(s.progress("alice")) == 30 and len(s.progress("bob")) == 30
-        assert len(s.events()) == 60
+        assert len(s.progress.of("alice")) == 30 and len(s.progress.of("bob")) == 30
+        assert len(s.signoffs.events()) == 60
 
 
 SIGNER = """
 import os, sys, time
-from workbench.labs.signing import sign_off
-from workbench.labs.signoff_record import RecordFields
-from workbench.labs.store import Store
+from workbench.labs.signoff.signing import sign_off
+from workbench.labs.signoff.signoff_record import RecordFields
+from workbench.labs.store.store import Store
 data_dir, db, who, ready = sys.argv[1], sys.argv[2] or None, sys.argv[3], sys.argv[4]
 fields = RecordFields(student=who, lab="lab", exercise="ex", objectives_passed=True)
 with Store.open(data_dir, db=db) as store:
@@ -279,7 +286,7 @@ def test_a_course_database_holds_the_roster_and_the_keys(pg_url, tmp_path):
     assert not (tmp_path / "one" / "roster.json").exists()
     with two.open() as s:
         assert list(offered_roster(s)) == ["Dr Chen"]
-        assert '"encrypted_private_key"' in (s.instructor_key("Dr Chen") or "")
+        assert '"encrypted_private_key"' in (s.instructors.key_file("Dr Chen") or "")
         sign_off(s, "Dr Chen", PASS, fields())
         with pytest.raises(WrongPassphrase):
             sign_off(s, "Dr Chen", "not the passphrase", fields())
@@ -313,7 +320,7 @@ def test_a_database_host_lost_without_a_word_is_noticed_within_seconds(pg_url, t
 
     def socket_settings(url: str) -> tuple[int, int, int]:
         with Store.open(tmp_path, db=url) as store:
-            store.save_progress("ana", "lab", "exercise", "{}")
+            store.progress.save("ana", "lab", "exercise", "{}")
             sock = socket.socket(fileno=os.dup(store.backend.conn.fileno()))
             with sock:
                 return (
@@ -348,7 +355,7 @@ def test_the_database_stopped_and_restarted_under_a_writer_loses_nothing(
     def writer() -> None:
         i = 0
         while not stop.is_set():
-            outcome[i] = store.save_progress("alice", "lab", f"ex{i % 25}", {"i": i})
+            outcome[i] = store.progress.save("alice", "lab", f"ex{i % 25}", {"i": i})
             i += 1
             time.sleep(0.01)
 
@@ -363,7 +370,7 @@ def test_the_database_stopped_and_restarted_under_a_writer_loses_nothing(
         assert not any(outcome[i] for i in range(down_from + 5, len(outcome)))  # pending
         assert store.pending > 0 and not store.available
         with pytest.raises(StoreError, match=r"cannot be reached|went away"):
-            store.signoffs()  # reads say so; they never wait on a dead server
+            store.signoffs.of()  # reads say so; they never wait on a dead server
     finally:
         pg_server.start()
     # what a front end does now and then, in a thread of its own: flush, while the student
@@ -379,7 +386,7 @@ def test_the_database_stopped_and_restarted_under_a_writer_loses_nothing(
     assert store.pending == 0
     last = len(outcome) - 1
     with Store.open(tmp_path, db=pg_url) as fresh:
-        saved = fresh.progress("alice")
+        saved = fresh.progress.of("alice")
     newest = {f"ex{i % 25}": i for i in range(last + 1)}
     assert {ex: p["i"] for (_, ex), p in saved.items()} == newest
     store.close()
@@ -392,8 +399,8 @@ def test_a_store_opened_while_the_server_is_down_catches_up_when_it_is_back(
     pg_server.stop()
     try:
         store = Store.open(tmp_path, db=pg_url, offline_ok=True)
-        assert store.save_progress("alice", "lab", "ex1", {"i": 1}) is False
-        assert store.set_place("alice", "lab", "ex1") is False
+        assert store.progress.save("alice", "lab", "ex1", {"i": 1}) is False
+        assert store.progress.set_place("alice", "lab", "ex1") is False
         assert store.pending == 2 and not store.available
         with pytest.raises(StoreError, match="cannot be reached"):
             Store.open(tmp_path, db=pg_url)  # without offline_ok it says so at once
@@ -403,8 +410,8 @@ def test_a_store_opened_while_the_server_is_down_catches_up_when_it_is_back(
         store.flush, "the pending saves written", every=0.05
     )  # once past the pause between tries
     with Store.open(tmp_path, db=pg_url) as fresh:
-        assert fresh.progress("alice") == {("lab", "ex1"): {"i": 1}}
-        assert fresh.place("alice") == ("lab", "ex1")
+        assert fresh.progress.of("alice") == {("lab", "ex1"): {"i": 1}}
+        assert fresh.progress.place("alice") == ("lab", "ex1")
     store.close()
 
 
@@ -420,7 +427,7 @@ def test_every_call_to_a_database_that_hangs_is_given_up_and_the_write_kept(
     monkeypatch.setenv("WORKBENCH_DB_TIMEOUT", "1")  # server side 1 s; this side 1 s more
     store = Store.open(tmp_path, db=pg_url)
     create_instructor(tmp_path, "Dr Chen", PASS, kdf=FAST, store=store)
-    store.save_progress("ana", "lab", "ex", {"n": 1})
+    store.progress.save("ana", "lab", "ex", {"n": 1})
     pids: list[int] = []
     locker = None
     if how == "stopped":
@@ -433,8 +440,8 @@ def test_every_call_to_a_database_that_hangs_is_given_up_and_the_write_kept(
     safety.start()
     try:
         for call in (
-            lambda: store.save_progress("ana", "lab", "ex", {"n": 2}),
-            lambda: store.progress("ana"),
+            lambda: store.progress.save("ana", "lab", "ex", {"n": 2}),
+            lambda: store.progress.of("ana"),
             lambda: sign_off(store, "Dr Chen", PASS, fields()),
         ):
             began = time.monotonic()
@@ -452,5 +459,5 @@ def test_every_call_to_a_database_that_hangs_is_given_up_and_the_write_kept(
     deadline = time.monotonic() + 20
     while not store.flush() and time.monotonic() < deadline:
         time.sleep(0.2)
-    assert store.progress("ana")[("lab", "ex")] == {"n": 2}
+    assert store.progress.of("ana")[("lab", "ex")] == {"n": 2}
     store.close()

@@ -12,12 +12,12 @@ from pathlib import Path
 import pytest
 
 from workbench.cli import main
-from workbench.labs.instructors import create_instructor
-from workbench.labs.roster import load_roster
-from workbench.labs.signing import sign_off
-from workbench.labs.signoff_errors import WrongPassphrase
-from workbench.labs.signoff_record import RecordFields
-from workbench.labs.store import Store
+from workbench.labs.signoff.instructors import create_instructor
+from workbench.labs.signoff.roster import load_roster
+from workbench.labs.signoff.signing import sign_off
+from workbench.labs.signoff.signoff_errors import WrongPassphrase
+from workbench.labs.signoff.signoff_record import RecordFields
+from workbench.labs.store.store import Store
 
 from .signoff_support import FAST, PASS, sign
 
@@ -31,9 +31,9 @@ def section(tmp_path, config_dir) -> Path:
     for n, student in enumerate(("ana", "ben", "cy")):
         sign(d, student, f"ex{n}", when=n)
     with Store.open(d) as store:
-        store.save_progress("ana", "web", "ex1", {"answers": {"q1": "3"}})
-        store.set_place("ana", "web", "ex1")
-        store.set_driver("ana", "", "web", "ex2", "ana")
+        store.progress.save("ana", "web", "ex1", {"answers": {"q1": "3"}})
+        store.progress.set_place("ana", "web", "ex1")
+        store.progress.set_driver("ana", "", "web", "ex2", "ana")
         fields = RecordFields(student="ana", lab="web", exercise="ex1", objectives_passed=True)
         with pytest.raises(WrongPassphrase):
             sign_off(store, "Dr Chen", "not the passphrase", fields)
@@ -62,9 +62,9 @@ def test_migrate_copies_a_data_folder_and_checks_the_copy(section, pg_url, capsy
     # a student resumes on any server: progress, place and driver came along
     elsewhere = section.parent / "server-two"
     with Store.open(elsewhere, db=pg_url) as store:
-        assert store.progress("ana") == {("web", "ex1"): {"answers": {"q1": "3"}}}
-        assert store.place("ana") == ("web", "ex1")
-        assert store.drivers("ana") == {("web", "ex2"): "ana"}
+        assert store.progress.of("ana") == {("web", "ex1"): {"answers": {"q1": "3"}}}
+        assert store.progress.place("ana") == ("web", "ex1")
+        assert store.progress.drivers("ana") == {("web", "ex2"): "ana"}
         # the instructor's key came along: signing goes on from the copied head
         _, record = sign_off(
             store,
@@ -72,7 +72,7 @@ def test_migrate_copies_a_data_folder_and_checks_the_copy(section, pg_url, capsy
             PASS,
             RecordFields(student="dee", lab="web", exercise="ex4", objectives_passed=True),
         )
-        assert store.lockout("Dr Chen").failures == 0
+        assert store.signoffs.lockout("Dr Chen").failures == 0
     assert record.seq == 4
     assert main(["signoff", "verify", "--db", pg_url, "--head", head]) == 0
     assert "all 4 record(s) verify" in capsys.readouterr().out

@@ -15,21 +15,21 @@ import pytest
 from tests.waiting import wait_until
 from workbench.files.atomic import write_bytes_atomic, write_text_atomic
 from workbench.files.workspace import workspace_folder
-from workbench.labs.instructors import KdfParams, create_instructor
-from workbench.labs.roster import offered_roster
-from workbench.labs.signing import sign_off
-from workbench.labs.signoff_errors import SignoffError
-from workbench.labs.signoff_record import Evidence, RecordFields, record_digest
-from workbench.labs.store import Store, StoreError, read_signoffs
-from workbench.labs.storecopy import copy_store
-from workbench.labs.verify import course_evidence, verify_log
-from workbench.labs.workspace_rows import WorkspaceLimits, WorkspaceRefused
-from workbench.labs.workspace_sync import (
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
+from workbench.labs.signoff.roster import offered_roster
+from workbench.labs.signoff.signing import sign_off
+from workbench.labs.signoff.signoff_errors import SignoffError
+from workbench.labs.signoff.signoff_record import Evidence, RecordFields, record_digest
+from workbench.labs.signoff.verify import course_evidence, verify_log
+from workbench.labs.store.store import Store, StoreError, read_signoffs
+from workbench.labs.store.workspace_rows import WorkspaceLimits, WorkspaceRefused
+from workbench.labs.store.workspace_sync import (
     WorkspacePusher,
     push_file,
     remove_file,
     sync_at_start,
 )
+from workbench.labs.storecopy import copy_store
 from workbench.sim.record import Recorder
 
 FAST = KdfParams(n=2**10, r=8, p=1)
@@ -45,39 +45,39 @@ def store(request, tmp_path: Path):
 
 
 def test_a_file_is_kept_replaced_and_removed_with_a_growing_revision(store):
-    first = store.put_workspace_file("alice", "mazes/mine.txt", b"one", 100.0)
-    again = store.put_workspace_file("alice", "mazes/mine.txt", b"one", 200.0)
-    second = store.put_workspace_file("alice", "mazes/mine.txt", b"two!", 300.0)
+    first = store.workspaces.put("alice", "mazes/mine.txt", b"one", 100.0)
+    again = store.workspaces.put("alice", "mazes/mine.txt", b"one", 200.0)
+    second = store.workspaces.put("alice", "mazes/mine.txt", b"two!", 300.0)
     assert (first.revision, again.revision, second.revision) == (1, 1, 2)  # same bytes: kept
-    row, data = store.workspace_file("alice", "mazes/mine.txt")
+    row, data = store.workspaces.file("alice", "mazes/mine.txt")
     assert data == b"two!" and row.sha256 == hashlib.sha256(b"two!").hexdigest()
     assert row.size == 4 and row.mtime == 300.0
-    assert store.workspace_file("bob", "mazes/mine.txt") is None  # each student their own
-    gone = store.remove_workspace_file("alice", "mazes/mine.txt")
+    assert store.workspaces.file("bob", "mazes/mine.txt") is None  # each student their own
+    gone = store.workspaces.remove("alice", "mazes/mine.txt")
     assert gone is not None and gone.deleted and gone.revision == 3
-    assert store.workspace_file("alice", "mazes/mine.txt") is None
-    assert store.workspace_index("alice")["mazes/mine.txt"].deleted
-    assert store.remove_workspace_file("alice", "mazes/mine.txt") is None
+    assert store.workspaces.file("alice", "mazes/mine.txt") is None
+    assert store.workspaces.index("alice")["mazes/mine.txt"].deleted
+    assert store.workspaces.remove("alice", "mazes/mine.txt") is None
 
 
 def test_the_bounds_are_kept_and_each_refusal_says_which(store):
     limits = WorkspaceLimits(file_cap=10, quota=25, files=3)
     with pytest.raises(WorkspaceRefused, match=r"more than the .* a file may take"):
-        store.put_workspace_file("alice", "big.txt", b"x" * 11, 1.0, limits)
-    store.put_workspace_file("alice", "a.txt", b"x" * 10, 1.0, limits)
-    store.put_workspace_file("alice", "b.txt", b"x" * 10, 1.0, limits)
+        store.workspaces.put("alice", "big.txt", b"x" * 11, 1.0, limits)
+    store.workspaces.put("alice", "a.txt", b"x" * 10, 1.0, limits)
+    store.workspaces.put("alice", "b.txt", b"x" * 10, 1.0, limits)
     with pytest.raises(WorkspaceRefused, match="more than its quota"):
-        store.put_workspace_file("alice", "c.txt", b"x" * 6, 1.0, limits)
-    store.put_workspace_file("alice", "c.txt", b"x" * 5, 1.0, limits)
+        store.workspaces.put("alice", "c.txt", b"x" * 6, 1.0, limits)
+    store.workspaces.put("alice", "c.txt", b"x" * 5, 1.0, limits)
     with pytest.raises(WorkspaceRefused, match="the most it may keep"):
-        store.put_workspace_file("alice", "d.txt", b"", 1.0, limits)
+        store.workspaces.put("alice", "d.txt", b"", 1.0, limits)
     # replacing a file counts its new size only, and a removed file frees its room
-    store.put_workspace_file("alice", "a.txt", b"y" * 10, 1.0, limits)
-    store.remove_workspace_file("alice", "b.txt")
-    store.put_workspace_file("alice", "d.txt", b"z" * 10, 1.0, limits)
+    store.workspaces.put("alice", "a.txt", b"y" * 10, 1.0, limits)
+    store.workspaces.remove("alice", "b.txt")
+    store.workspaces.put("alice", "d.txt", b"z" * 10, 1.0, limits)
     # another student's workspace has its own room
-    store.put_workspace_file("bob", "a.txt", b"x" * 10, 1.0, limits)
-    kept = {p for p, r in store.workspace_index("alice").items() if not r.deleted}
+    store.workspaces.put("bob", "a.txt", b"x" * 10, 1.0, limits)
+    kept = {p for p, r in store.workspaces.index("alice").items() if not r.deleted}
     assert kept == {"a.txt", "c.txt", "d.txt"}
 
 
@@ -88,8 +88,8 @@ def test_the_bounds_are_kept_and_each_refusal_says_which(store):
 )  # fmt: skip
 def test_names_that_are_not_plain_workspace_paths_are_refused(store, name):
     with pytest.raises(WorkspaceRefused):
-        store.put_workspace_file("alice", name, b"data", 1.0)
-    assert store.workspace_index("alice") == {}
+        store.workspaces.put("alice", name, b"data", 1.0)
+    assert store.workspaces.index("alice") == {}
 
 
 def test_writes_racing_for_the_last_of_a_quota_cannot_both_pass(store, tmp_path):
@@ -102,7 +102,7 @@ def test_writes_racing_for_the_last_of_a_quota_cannot_both_pass(store, tmp_path)
     def add(s: Store, name: str) -> None:
         start.wait()
         try:
-            s.put_workspace_file("alice", name, b"x" * 100, 1.0, limits)
+            s.workspaces.put("alice", name, b"x" * 100, 1.0, limits)
             results.append("kept")
         except WorkspaceRefused:
             results.append("refused")
@@ -244,7 +244,7 @@ def test_a_link_in_the_workspace_is_never_followed_or_sent(servers, tmp_path):
     report = sync_at_start(one.data_dir, one.db, "alice", one.workspace())
     assert report.pushed == []
     with one.store() as s:
-        assert s.workspace_index("alice") == {}
+        assert s.workspaces.index("alice") == {}
         with pytest.raises(WorkspaceRefused, match=r"link\.txt"):
             push_file(s, "alice", "link.txt", one.workspace())
 
@@ -371,7 +371,7 @@ def test_a_pusher_with_nothing_to_send_gives_its_connection_back(servers):
     finally:
         pusher.stop()
     with one.store() as s:
-        assert {"first.txt", "second.txt"} <= set(s.workspace_index("alice"))
+        assert {"first.txt", "second.txt"} <= set(s.workspaces.index("alice"))
     assert told == []
 
 
@@ -404,10 +404,10 @@ def test_store_migrate_copies_the_workspaces(tmp_path, pg_url):
         report = copy_store(source, target)
         assert report.workspaces == {"alice": 2}
         assert any(why.startswith("bob: huge.bin") for why in report.left)
-        assert target.workspace_file("alice", "mine.txt")[1] == MAZE.encode()
-        _row, data_ = target.workspace_file("alice", "runs/20260302/run-1.jsonl")
+        assert target.workspaces.file("alice", "mine.txt")[1] == MAZE.encode()
+        _row, data_ = target.workspaces.file("alice", "runs/20260302/run-1.jsonl")
         assert data_ == b'{"type":"header"}\n'
-        assert set(target.workspace_index("alice")) == {"mine.txt", "runs/20260302/run-1.jsonl"}
+        assert set(target.workspaces.index("alice")) == {"mine.txt", "runs/20260302/run-1.jsonl"}
     # a second copy into the same database is refused: it holds the files already
     with (
         Store.open(data) as source,

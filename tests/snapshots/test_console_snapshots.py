@@ -19,9 +19,9 @@ from tests.app.console_support import (
     until,
     wall_main,
 )
-from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.model import load_labs
-from workbench.labs.store import Store
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
+from workbench.labs.store.store import Store
 from workbench.tui.console_app import ConsoleApp
 from workbench.tui.screens.console import ConsoleScreen
 
@@ -35,8 +35,8 @@ def console(data) -> ConsoleApp:
     with Store.open(data) as store:
         for name, passed in (("ana", True), ("ben", False), ("cat", True), ("dan", False)):
             save_student(store, name, passed=passed)
-        store.request_signoff("cat", "eve", "eve", LAB, EXERCISE, now=T0)
-        store.request_signoff("ana", "", "ana", LAB, EXERCISE, now=T0.replace(minute=7))
+        store.queue.request("cat", "eve", "eve", LAB, EXERCISE, now=T0)
+        store.queue.request("ana", "", "ana", LAB, EXERCISE, now=T0.replace(minute=7))
     return ConsoleApp(Store.open(data), load_labs())
 
 
@@ -82,7 +82,7 @@ def test_console_request_with_a_programs_evidence(snap_compare, tmp_path):
         mixed = wall_main("ana", sensors_program=("other.viple", "cd" * 32))
         save_progress(store, "ana", mixed)
         save_progress(store, "ben", wall_main("ben", attempt="att-2"))
-        store.request_signoff("ana", "", "ana", WEB_LAB, WALL_MAIN, now=T0)
+        store.queue.request("ana", "", "ana", WEB_LAB, WALL_MAIN, now=T0)
 
     async def before(pilot: Pilot) -> None:
         await class_shown(pilot)

@@ -15,8 +15,8 @@ from textual.pilot import Pilot
 from textual.widgets import Checkbox, Input, OptionList
 
 from tests.app.labs_support import open_labs, signing_over
-from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.model import load_labs
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
 from workbench.tui.app import WorkbenchApp, make_app
 from workbench.tui.settings import AppSettings
 
@@ -74,7 +74,7 @@ class SigningTime(datetime):
 
 
 def test_driver_change_prompt_after_an_override(snap_compare, tmp_path, monkeypatch):
-    monkeypatch.setattr("workbench.labs.signing.datetime", SigningTime)
+    monkeypatch.setattr("workbench.labs.signoff.signing.datetime", SigningTime)
 
     async def before(pilot: Pilot) -> None:
         await open_drive_by_wire(pilot)

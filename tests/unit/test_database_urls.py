@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from workbench.labs.database import StoreError, redact, resolve_db
+from workbench.labs.store.database import StoreError, redact, resolve_db
 
 SAFE = st.text(
     st.characters(blacklist_characters="@:/?#", blacklist_categories=("Cs",)), min_size=1

@@ -10,13 +10,18 @@ import pytest
 
 from tests.app.console_support import progress as drive_by_wire
 from tests.app.console_support import wall_main, write_record
-from workbench.labs.gradebook import GRADEBOOK_COLUMNS, gradebook_rows, run_cells, sha256_text
-from workbench.labs.instructors import KdfParams, create_instructor
-from workbench.labs.roster import load_roster, roster_path
-from workbench.labs.signing import sign_off
-from workbench.labs.signoff_record import Evidence, RecordFields
-from workbench.labs.store import Store
-from workbench.labs.verify import verify_log
+from workbench.labs.signoff.gradebook import (
+    GRADEBOOK_COLUMNS,
+    gradebook_rows,
+    run_cells,
+    sha256_text,
+)
+from workbench.labs.signoff.instructors import KdfParams, create_instructor
+from workbench.labs.signoff.roster import load_roster, roster_path
+from workbench.labs.signoff.signing import sign_off
+from workbench.labs.signoff.signoff_record import Evidence, RecordFields
+from workbench.labs.signoff.verify import verify_log
+from workbench.labs.store.store import Store
 from workbench.sim.record import file_sha256
 
 FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
@@ -52,7 +57,7 @@ def test_every_digest_is_written_one_way_and_the_run_has_its_measures(store, tmp
     signed(store, "ana", recorded)
     signed(store, "ben", wall_main("ben", digest="cd" * 32))  # no record: the evidence's digest
     signed(store, "cat", drive_by_wire())  # saved before programs and blocks were kept
-    log = verify_log(store.signoffs(), load_roster(roster_path(Path(store.path).parent)))
+    log = verify_log(store.signoffs.of(), load_roster(roster_path(Path(store.path).parent)))
     profiles = {("unity-simulator", "drive-by-wire"): "unity"}
     rows = {r["student"]: r for r in gradebook_rows(log.verified_rows(), log.head, profiles)}
     assert set(rows["ana"]) == set(GRADEBOOK_COLUMNS)

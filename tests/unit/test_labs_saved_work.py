@@ -7,7 +7,7 @@ import pytest
 
 from workbench.labs.checks import ExerciseProgress
 from workbench.labs.progress import LabProgress, read_work
-from workbench.labs.store import Store, StoreUnavailable
+from workbench.labs.store.store import Store, StoreUnavailable
 
 DRIVE = ("unity-simulator", "drive-by-wire")
 
@@ -20,8 +20,8 @@ def store(tmp_path):
 
 def save_answer(store: Store, answer: str) -> None:
     progress = ExerciseProgress(*DRIVE, objectives=[], answers={"tcp-port": answer})
-    store.save_progress("ana", *DRIVE, progress.as_dict())
-    store.set_place("ana", *DRIVE)
+    store.progress.save("ana", *DRIVE, progress.as_dict())
+    store.progress.set_place("ana", *DRIVE)
 
 
 def test_the_saved_progress_and_the_place_are_read_and_taken(store):
@@ -41,7 +41,7 @@ def test_a_database_that_does_not_answer_in_time_reads_as_away(store, monkeypatc
     def given_up(*args, **kw):
         raise StoreUnavailable("course: the database did not answer within 5 s")
 
-    monkeypatch.setattr(store, "progress", given_up)
+    monkeypatch.setattr(store.progress, "of", given_up)
     work = read_work(store, "ana")
     assert work.away and work.saved is None and work.place is None
     lab_progress = LabProgress("ana", reading=True)
@@ -50,7 +50,7 @@ def test_a_database_that_does_not_answer_in_time_reads_as_away(store, monkeypatc
 
 
 def test_a_damaged_row_is_said_and_a_place_that_cannot_be_read_is_left_out(store, monkeypatch):
-    with store._write() as tx:
+    with store.write() as tx:
         tx.execute(
             "INSERT INTO progress (student, lab, exercise, progress, updated_at) "
             "VALUES (?, ?, ?, ?, ?)",
@@ -62,7 +62,7 @@ def test_a_damaged_row_is_said_and_a_place_that_cannot_be_read_is_left_out(store
     def unreadable(*args, **kw):
         raise StoreUnavailable("course: the database went away")
 
-    monkeypatch.setattr(store, "progress", lambda student, lab=None: {})
-    monkeypatch.setattr(store, "place", unreadable)
+    monkeypatch.setattr(store.progress, "of", lambda student, lab=None: {})
+    monkeypatch.setattr(store.progress, "place", unreadable)
     work = read_work(store, "ana")
     assert work.saved is not None and work.place is None and not work.away

@@ -11,8 +11,8 @@ from workbench.control.station import LabStation
 from workbench.labs.checks import evaluate
 from workbench.labs.model import LabFileError, load_lab, load_labs
 from workbench.labs.progress import LabProgress, evidence_words, read_saved
-from workbench.labs.signoff_record import Evidence
-from workbench.labs.store import Store
+from workbench.labs.signoff.signoff_record import Evidence
+from workbench.labs.store.store import Store
 
 from .test_labs_model import folder, good_text, write  # noqa: F401  (folder: a fixture)
 

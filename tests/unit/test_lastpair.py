@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from workbench.labs.lastpair import FILE_NAME, read_last_pair, save_last_pair
 from workbench.labs.names import name_key
-from workbench.labs.store import Store
+from workbench.labs.store.store import Store
 
 
 def test_the_last_pair_is_read_back(tmp_path):
@@ -29,8 +29,8 @@ def test_names_match_without_case_or_spacing():
 
 def test_the_store_spells_a_known_student_as_it_was_saved(tmp_path):
     with Store.open(tmp_path) as store:
-        store.save_progress("Alice Doe", "lab", "ex", {"answers": {}})
-        assert store.spelling("alice  doe") == "Alice Doe"
-        assert store.spelling("ALICE DOE") == "Alice Doe"
-        assert store.spelling("Alice Doe") == "Alice Doe"
-        assert store.spelling("Bob") == "Bob"
+        store.progress.save("Alice Doe", "lab", "ex", {"answers": {}})
+        assert store.progress.spelling("alice  doe") == "Alice Doe"
+        assert store.progress.spelling("ALICE DOE") == "Alice Doe"
+        assert store.progress.spelling("Alice Doe") == "Alice Doe"
+        assert store.progress.spelling("Bob") == "Bob"

@@ -10,10 +10,10 @@ import pytest
 
 from workbench.labs.checks import ExerciseProgress, ObjectiveState
 from workbench.labs.classview import read_request
-from workbench.labs.gradebook import gradebook_rows
 from workbench.labs.partners import PairNotConfirmed, partner_problem
 from workbench.labs.signlog import Head
-from workbench.labs.store import Store, StoredSignoff
+from workbench.labs.signoff.gradebook import gradebook_rows
+from workbench.labs.store.store import Store, StoredSignoff
 
 
 def signed(seq: int, student: str, partner: str, at: str) -> StoredSignoff:
@@ -52,9 +52,9 @@ def test_a_request_s_partner_is_on_the_sign_off_only_when_the_instructor_confirm
         "lab", "ex", [ObjectiveState("keys", "drive", True, "done", {"person": "ana"})]
     )
     with Store.open(tmp_path / "data") as store:
-        store.set_place("ana", "lab", "ex")
-        store.save_progress("ana", "lab", "ex", json.loads(progress.to_json()))
-        entry = store.request_signoff("ana", "zed", "ana", "lab", "ex").entry
+        store.progress.set_place("ana", "lab", "ex")
+        store.progress.save("ana", "lab", "ex", json.loads(progress.to_json()))
+        entry = store.queue.request("ana", "zed", "ana", "lab", "ex").entry
         assert entry is not None
         request = read_request(store, entry, [])
         assert "zed is not a student of this class" in request.partner_problem
@@ -63,7 +63,7 @@ def test_a_request_s_partner_is_on_the_sign_off_only_when_the_instructor_confirm
         with pytest.raises(ValueError, match="not a student of this class"):
             request.fields(partner_agrees=True)
         assert request.fields(partner_agrees=False).partner == ""
-        store.set_place("zed", "lab", "ex")
+        store.progress.set_place("zed", "lab", "ex")
         request = read_request(store, entry, [])
         assert request.partner_problem == ""
         assert request.fields(partner_agrees=True).partner == "zed"

@@ -6,8 +6,8 @@ from __future__ import annotations
 import json
 from datetime import UTC, datetime
 
-from workbench.labs.pending import PendingWrite, load_pending, pending_path, save_pending
-from workbench.labs.store import Store
+from workbench.labs.store.pending import PendingWrite, load_pending, pending_path, save_pending
+from workbench.labs.store.store import Store
 
 WHEN = datetime(2026, 3, 2, 10, 0, tzinfo=UTC)
 LATER = datetime(2026, 3, 2, 11, 0, tzinfo=UTC)
@@ -63,10 +63,11 @@ def test_kept_writes_are_saved_but_never_over_a_newer_save(tmp_path):
          PendingWrite("place", ("ana", "lab1", "ex9", "2026-03-02T10:00:00Z"))],
     )  # fmt: skip
     with Store.open(tmp_path / "data") as store:
-        store.save_progress("ana", "lab1", "ex1", {"answers": {"q": "new"}}, now=LATER)
+        store.progress.save("ana", "lab1", "ex1", {"answers": {"q": "new"}}, now=LATER)
         assert store.keep_pending_in(kept, "ana") == []
         assert store.pending == 2
         assert store.flush()
-        assert store.progress("ana")[("lab1", "ex1")] == {"answers": {"q": "new"}}
-        assert store.place("ana") == ("lab1", "ex9")  # nothing newer: the kept one is saved
+        assert store.progress.of("ana")[("lab1", "ex1")] == {"answers": {"q": "new"}}
+        # nothing newer: the kept one is saved
+        assert store.progress.place("ana") == ("lab1", "ex9")
     assert not kept.exists()

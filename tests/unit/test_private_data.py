@@ -14,8 +14,8 @@ from pathlib import Path
 import pytest
 
 from workbench.labs.lastpair import save_last_pair
-from workbench.labs.pending import PendingWrite, pending_path, save_pending
-from workbench.labs.store import DB_NAME, Store, StoreError, read_signoffs
+from workbench.labs.store.pending import PendingWrite, pending_path, save_pending
+from workbench.labs.store.store import DB_NAME, Store, StoreError, read_signoffs
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -37,7 +37,7 @@ def open_umask() -> Iterator[None]:
 def test_what_the_workbench_makes_in_the_data_folder_is_private(tmp_path, open_umask):
     data = tmp_path / "data"
     with Store.open(data) as store:
-        store.save_progress("ana", "lab", "ex", {"n": 1})
+        store.progress.save("ana", "lab", "ex", {"n": 1})
         companions = [data / f"{DB_NAME}-wal", data / f"{DB_NAME}-shm"]
         assert all(p.exists() for p in companions)
         assert [mode(p) for p in companions] == [0o600, 0o600]

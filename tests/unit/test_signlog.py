@@ -10,12 +10,12 @@ from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from workbench.labs.instructors import Instructor
-from workbench.labs.roster import RosterEntry
 from workbench.labs.signlog import EMPTY_HEAD, GENESIS, Head, LogError, entry_hash, next_place
-from workbench.labs.signoff_record import Evidence, SignoffRecord
-from workbench.labs.store import StoredSignoff
-from workbench.labs.verify import verify_log
+from workbench.labs.signoff.instructors import Instructor
+from workbench.labs.signoff.roster import RosterEntry
+from workbench.labs.signoff.signoff_record import Evidence, SignoffRecord
+from workbench.labs.signoff.verify import verify_log
+from workbench.labs.store.store import StoredSignoff
 
 CHEN = Instructor("Dr Chen", Ed25519PrivateKey.generate())
 ROGUE = Instructor("Dr Chen", Ed25519PrivateKey.generate())  # same name, another key

@@ -15,26 +15,32 @@ from pathlib import Path
 
 import pytest
 
-from workbench.labs.gradebook import gradebook_rows
-from workbench.labs.instructors import KdfParams, create_instructor, key_path, unlock_instructor
-from workbench.labs.roster import RosterEntry, load_roster, roster_path
-from workbench.labs.signing import MAX_NOTE, sign_off
 from workbench.labs.signlog import GENESIS, RECORD_FORMAT
-from workbench.labs.signoff_errors import (
+from workbench.labs.signoff.gradebook import gradebook_rows
+from workbench.labs.signoff.instructors import (
+    KdfParams,
+    create_instructor,
+    key_path,
+    unlock_instructor,
+)
+from workbench.labs.signoff.roster import RosterEntry, load_roster, roster_path
+from workbench.labs.signoff.signing import MAX_NOTE, sign_off
+from workbench.labs.signoff.signoff_errors import (
     LockedOut,
     PassphraseTooShort,
     SignoffError,
     UnknownInstructor,
     WrongPassphrase,
 )
-from workbench.labs.signoff_record import (
+from workbench.labs.signoff.signoff_record import (
     Evidence,
     RecordFields,
     SignoffRecord,
     record_digest,
     record_from_stored,
 )
-from workbench.labs.store import (
+from workbench.labs.signoff.verify import verify_all, verify_log
+from workbench.labs.store.store import (
     DB_NAME,
     SIGNOFF_COLUMNS,
     Store,
@@ -42,7 +48,6 @@ from workbench.labs.store import (
     read_signoffs,
     resolve_data_dir,
 )
-from workbench.labs.verify import verify_all, verify_log
 
 FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only; defaults are untouched
 PASS = "correct horse battery"
@@ -163,7 +168,7 @@ def test_happy_path_signs_stores_and_verifies(store, data_dir, run_record):
     assert record.signed_at == "2026-03-02T14:05:09Z"
     assert record.evidence.digest == record_digest(run_record)
     assert record.evidence.digest.startswith("sha256:") and not record.override
-    [row] = store.signoffs()
+    [row] = store.signoffs.of()
     assert row.id == row_id and row.student == "alice" and row.partner == "bob"
     assert record_from_stored(row) == record
     assert problems(store, data_dir) == [()]
@@ -192,7 +197,7 @@ def test_signing_needs_passed_objectives_or_an_override_with_a_note(store, data_
         sign_off(store, "Dr Chen", PASS, fields(passed=False))
     with pytest.raises(SignoffError, match="override needs a note"):
         sign_off(store, "Dr Chen", PASS, fields(passed=False), override=True, note="  ")
-    assert store.signoffs() == []
+    assert store.signoffs.of() == []
     _, record = sign_off(
         store, "Dr Chen", PASS, fields(passed=False), override=True, note="timer was off"
     )
@@ -217,7 +222,7 @@ def test_a_bare_hex_digest_of_the_run_record_is_accepted(store, run_record):
     ev = Evidence(str(run_record), bare, {"runs": [{"t": 1.5}]})
     _, record = sign_off(store, "Dr Chen", PASS, replace(fields(), evidence=ev))
     assert record.evidence.digest == f"sha256:{bare}"
-    assert record_from_stored(store.signoffs()[0]) == record
+    assert record_from_stored(store.signoffs.of()[0]) == record
 
 
 def test_a_run_record_changed_before_signing_is_refused(store, run_record):
@@ -232,8 +237,8 @@ def test_a_run_record_changed_before_signing_is_refused(store, run_record):
 def test_wrong_passphrase_is_rejected_and_logged(store):
     with pytest.raises(WrongPassphrase):
         sign_off(store, "Dr Chen", "wrong wrong wrong", fields(), clock=Clock())
-    assert store.signoffs() == []
-    assert [e.event for e in store.events("Dr Chen")] == ["wrong-passphrase"]
+    assert store.signoffs.of() == []
+    assert [e.event for e in store.signoffs.events("Dr Chen")] == ["wrong-passphrase"]
 
 
 def test_five_failures_lock_for_a_minute_even_across_restarts(store, data_dir):
@@ -246,12 +251,12 @@ def test_five_failures_lock_for_a_minute_even_across_restarts(store, data_dir):
     clock.advance(30)
     with Store.open(data_dir) as reopened, pytest.raises(LockedOut, match="30 s more"):
         sign_off(reopened, "Dr Chen", PASS, fields(), clock=clock)
-    assert store.signoffs() == []
-    events = [e.event for e in store.events("Dr Chen")]
+    assert store.signoffs.of() == []
+    events = [e.event for e in store.signoffs.events("Dr Chen")]
     assert events == ["wrong-passphrase"] * 5 + ["locked"]
     clock.advance(31)
     sign_off(store, "Dr Chen", PASS, fields(), clock=clock)
-    assert len(store.signoffs()) == 1
+    assert len(store.signoffs.of()) == 1
 
 
 def test_the_lockout_is_per_instructor_and_a_success_resets_the_count(store, data_dir):
@@ -266,7 +271,7 @@ def test_the_lockout_is_per_instructor_and_a_success_resets_the_count(store, dat
         with pytest.raises(WrongPassphrase):
             sign_off(store, "Dr Chen", "wrong wrong wrong", fields(), clock=clock)
     sign_off(store, "Dr Chen", PASS, fields(), clock=clock)
-    assert store.lockout("Dr Chen").failures == 0
+    assert store.signoffs.lockout("Dr Chen").failures == 0
     with pytest.raises(WrongPassphrase):
         sign_off(store, "Dr Chen", "wrong wrong wrong", fields(), clock=clock)
 
@@ -331,7 +336,7 @@ def test_gradebook_has_one_row_per_student_and_exercise_from_verified_records(st
     sign_off(store, "Dr Chen", PASS, fields(student="dave", partner="", driver=""))
     with sqlite3.connect(store.path) as conn:
         conn.execute("UPDATE signoffs SET note = 'edited' WHERE student = 'dave'")
-    log = verify_log(store.signoffs(), roster(data_dir))
+    log = verify_log(store.signoffs.of(), roster(data_dir))
     rows = gradebook_rows(log.verified_rows(), log.head)
     keys = [(r["student"], r["exercise"]) for r in rows]
     assert keys == [("alice", "wall-following"), ("bob", "wall-following"), ("carol", "x")]
@@ -375,19 +380,19 @@ def test_a_corrupt_or_newer_database_is_named_in_the_error(tmp_path):
 
 def test_progress_and_drivers_are_saved_and_replaced(data_dir):
     with Store.open(data_dir) as s:
-        s.save_progress("alice", "web", "ex1", {"objectives": {"keys": True}}, now=T0)
-        s.save_progress("alice", "web", "ex1", {"objectives": {"keys": True, "maze": False}})
-        s.save_progress("alice", "unity", "ex2", {"answers": [1]})
-        s.set_driver("alice", "bob", "web", "ex1", "alice")
-        s.set_driver("alice", "bob", "web", "ex1", "bob")
+        s.progress.save("alice", "web", "ex1", {"objectives": {"keys": True}}, now=T0)
+        s.progress.save("alice", "web", "ex1", {"objectives": {"keys": True, "maze": False}})
+        s.progress.save("alice", "unity", "ex2", {"answers": [1]})
+        s.progress.set_driver("alice", "bob", "web", "ex1", "alice")
+        s.progress.set_driver("alice", "bob", "web", "ex1", "bob")
     with Store.open(data_dir) as s:
-        assert s.progress("alice", "web") == {
+        assert s.progress.of("alice", "web") == {
             ("web", "ex1"): {"objectives": {"keys": True, "maze": False}}
         }
-        assert len(s.progress("alice")) == 2
-        assert s.drivers("alice", "bob") == {("web", "ex1"): "bob"}
+        assert len(s.progress.of("alice")) == 2
+        assert s.progress.drivers("alice", "bob") == {("web", "ex1"): "bob"}
         with pytest.raises(ValueError):
-            s.save_progress("alice", "web", "ex1", {"t": float("inf")})
+            s.progress.save("alice", "web", "ex1", {"t": float("inf")})
 
 
 def test_two_connections_can_write_at_the_same_time(data_dir):
@@ -398,8 +403,8 @@ def test_two_connections_can_write_at_the_same_time(data_dir):
         try:
             with Store.open(data_dir) as s:
                 for i in range(40):
-                    s.save_progress(who, "lab", f"ex{i}", {"i": i})
-                    s.log_event(who, "tick", str(i), T0)
+                    s.progress.save(who, "lab", f"ex{i}", {"i": i})
+                    s.signoffs.log_event(who, "tick", str(i), T0)
         except BaseException as exc:
             errors.append(exc)
 
@@ -410,17 +415,17 @@ def test_two_connections_can_write_at_the_same_time(data_dir):
         t.join()
     assert errors == []
     with Store.open(data_dir) as s:
-        assert len(s.progress("alice")) == 40 and len(s.progress("bob")) == 40
-        assert len(s.events()) == 80
+        assert len(s.progress.of("alice")) == 40 and len(s.progress.of("bob")) == 40
+        assert len(s.signoffs.events()) == 80
 
 
 WRITER = """
 import sys
-from workbench.labs.store import Store
+from workbench.labs.store.store import Store
 s = Store.open(sys.argv[1])
 i = 0
 while True:
-    s.save_progress("alice", "lab", f"ex{i}", {"i": i})
+    s.progress.save("alice", "lab", f"ex{i}", {"i": i})
     print(i, flush=True)
     i += 1
 """
@@ -442,7 +447,7 @@ def test_a_killed_process_keeps_what_it_committed(data_dir):
     proc.send_signal(signal.SIGKILL)
     proc.wait()
     with Store.open(data_dir) as s:
-        saved = s.progress("alice")
+        saved = s.progress.of("alice")
     assert last >= 30
     assert all(("lab", f"ex{i}") in saved for i in range(last + 1))
 
@@ -450,7 +455,7 @@ def test_a_killed_process_keeps_what_it_committed(data_dir):
 def test_evidence_of_an_exercise_points_at_the_run_record_it_rests_on(tmp_path):
     from types import SimpleNamespace
 
-    from workbench.labs.signoff_record import Evidence, record_digest
+    from workbench.labs.signoff.signoff_record import Evidence, record_digest
 
     record = tmp_path / "run-001.jsonl"
     record.write_text('{"type":"header"}\n')
@@ -491,7 +496,7 @@ def test_the_sign_off_names_the_program_and_older_records_still_verify(store, da
     # a record made before the sign-off named its program (no "programs" in its evidence)
     sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
     _, record = sign_off(store, "Dr Chen", PASS, fields(evidence=evidence), clock=Clock())
-    [_, row] = store.signoffs()
+    [_, row] = store.signoffs.of()
     assert row.metrics_value()["programs"] == {digest: "mine.viple"}
     assert record_from_stored(row) == record
     assert problems(store, data_dir) == [(), ()]
@@ -542,9 +547,9 @@ def test_records_made_before_the_chain_are_read_as_legacy_then_chained_by_the_up
     assert (data_dir / DB_NAME).read_bytes() == before  # reading did not upgrade it
     with Store.open(data_dir) as store:
         assert store.schema_version() == 6
-        assert store.signoffs() == read_signoffs(data_dir)  # upgraded to what was read
+        assert store.signoffs.of() == read_signoffs(data_dir)  # upgraded to what was read
         sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
-        log = verify_log(store.signoffs(), roster(data_dir), kept=read_only.head)
+        log = verify_log(store.signoffs.of(), roster(data_dir), kept=read_only.head)
     assert log.ok and log.legacy == 2 and log.head.seq == 3
     assert [v.row.legacy for v in log.verdicts] == [True, True, False]
     sql_edit = "UPDATE signoffs SET student = 'zed' WHERE seq = 1"
@@ -570,9 +575,9 @@ def test_a_sequence_number_is_taken_once(store):
 SIGNER = """
 import os, sys, time
 from datetime import UTC, datetime
-from workbench.labs.signing import sign_off
-from workbench.labs.signoff_record import RecordFields
-from workbench.labs.store import Store
+from workbench.labs.signoff.signing import sign_off
+from workbench.labs.signoff.signoff_record import RecordFields
+from workbench.labs.store.store import Store
 data_dir, who, ready = sys.argv[1], sys.argv[2], sys.argv[3]
 fields = RecordFields(student=who, lab="lab", exercise="ex", objectives_passed=True)
 with Store.open(data_dir) as store:
@@ -637,6 +642,6 @@ def test_a_planted_row_with_a_huge_sequence_number_is_stepped_over_and_named(sto
 def test_a_note_longer_than_the_cap_is_refused_and_nothing_is_signed(store, run_record):
     with pytest.raises(SignoffError, match=f"keep it to {MAX_NOTE}"):
         sign_off(store, "Dr Chen", PASS, fields(run_record), note="x" * (8 << 20))
-    assert store.signoffs() == []
+    assert store.signoffs.of() == []
     _, record = sign_off(store, "Dr Chen", PASS, fields(run_record), note="y" * MAX_NOTE)
     assert record.note == "y" * MAX_NOTE

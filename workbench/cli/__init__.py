@@ -12,7 +12,7 @@ from typing import TextIO, cast
 from workbench import __version__
 from workbench.files.bundled import default_maze_path
 from workbench.files.terminal import TerminalSafeWriter
-from workbench.labs.store import StoreError, resolve_db
+from workbench.labs.store.store import StoreError, resolve_db
 from workbench.tui.settings import AppSettings
 
 from . import algorithms as algorithms_cmd

@@ -8,23 +8,22 @@ import shlex
 import sys
 from pathlib import Path
 
-from workbench.labs.instructors import (
+from workbench.labs.signoff.instructors import (
     MIN_PASSPHRASE,
     check_passphrase,
     copy_instructor,
     create_instructor,
     key_path,
 )
-from workbench.labs.roster import (
+from workbench.labs.signoff.roster import (
     ROSTER_NAME,
     check_name,
     config_dir,
     load_roster,
-    offered_roster,
-    roster_path,
+    roster_keys,
 )
-from workbench.labs.signoff_errors import SignoffError
-from workbench.labs.store import Store, StoreError, resolve_data_dir, resolve_db
+from workbench.labs.signoff.signoff_errors import SignoffError
+from workbench.labs.store.store import Store, StoreError, resolve_data_dir, resolve_db
 
 from .common import db_option
 
@@ -179,9 +178,8 @@ def cmd_add(args: argparse.Namespace) -> int:
         return fail(str(exc))
     try:
         name = check_name(args.name)
-        where = store.where if store is not None else str(roster_path(data_dir))
-        offered = offered_roster(store) if store is not None else None
-        if name in (offered if offered is not None else load_roster(roster_path(data_dir))):
+        where = roster_keys(store, data_dir).where
+        if name in roster_keys(store, data_dir).entries():
             raise SignoffError(f"{name} is already in the roster {where}")
         if trusted.resolve().is_relative_to(data_dir.resolve()):
             raise SignoffError(
@@ -235,14 +233,10 @@ def cmd_list(args: argparse.Namespace) -> int:
     except StoreError as exc:
         return fail(str(exc))
     try:
-        if store is not None:
-            where = store.where
-            roster = offered_roster(store)
-            keys = {name for name in roster if store.instructor_key(name) is not None}
-        else:
-            where = str(roster_path(data_dir))
-            roster = load_roster(roster_path(data_dir))
-            keys = {name for name in roster if key_path(data_dir, name).exists()}
+        offered = roster_keys(store, data_dir)
+        where = offered.where
+        roster = offered.entries()
+        keys = {name for name in roster if offered.holds_key(name)}
         trusted = load_roster(trusted_path)
     except (SignoffError, StoreError) as exc:
         return fail(str(exc))

@@ -16,7 +16,7 @@ import sys
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
-from workbench.labs.store import StoreError, resolve_db
+from workbench.labs.store.store import StoreError, resolve_db
 from workbench.tui.settings import AppSettings, SettingsError
 
 from .common import error

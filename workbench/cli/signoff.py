@@ -18,12 +18,13 @@ from pathlib import Path
 from workbench.files.atomic import write_text_atomic
 from workbench.files.spreadsheet import spreadsheet_cell
 from workbench.labs.classview import profiles
-from workbench.labs.gradebook import GRADEBOOK_COLUMNS, gradebook_rows, head_from_gradebook
 from workbench.labs.model import LabFileError, load_labs
-from workbench.labs.roster import load_roster, roster_path, trusted_roster_path
 from workbench.labs.signlog import Head, LogError
-from workbench.labs.signoff_errors import SignoffError, UntrustedRoster
-from workbench.labs.store import (
+from workbench.labs.signoff.gradebook import GRADEBOOK_COLUMNS, gradebook_rows, head_from_gradebook
+from workbench.labs.signoff.roster import load_roster, roster_path, trusted_roster_path
+from workbench.labs.signoff.signoff_errors import SignoffError, UntrustedRoster
+from workbench.labs.signoff.verify import LogVerdict, course_evidence, verify_log
+from workbench.labs.store.store import (
     StoreDiskError,
     StoredSignoff,
     StoreError,
@@ -31,7 +32,6 @@ from workbench.labs.store import (
     resolve_data_dir,
     resolve_db,
 )
-from workbench.labs.verify import LogVerdict, course_evidence, verify_log
 
 from .common import db_option
 from .instructor import data_dir_option

@@ -14,8 +14,8 @@ from pathlib import Path
 
 from workbench.control.recording import RecordQuota
 from workbench.files.workspace_files import UploadLimits
-from workbench.labs.database import ENV_DB, redact
-from workbench.labs.store import (
+from workbench.labs.store.database import ENV_DB, redact
+from workbench.labs.store.store import (
     DB_NAME,
     Store,
     StoreError,

@@ -10,10 +10,10 @@ from __future__ import annotations
 import argparse
 import sys
 
-from workbench.labs.database import StoreError, resolve_db
-from workbench.labs.store import Store, resolve_data_dir
+from workbench.labs.signoff.verify import log_head
+from workbench.labs.store.database import StoreError, resolve_db
+from workbench.labs.store.store import Store, resolve_data_dir
 from workbench.labs.storecopy import copy_store, counts
-from workbench.labs.verify import log_head
 
 from .common import db_option
 from .instructor import data_dir_option
@@ -82,7 +82,7 @@ def cmd_info(args: argparse.Namespace) -> int:
         with Store.open(data_dir, db=db, create=bool(db)) as store:
             steps = store.migrations()
             sizes = counts(store)
-            head = log_head(store.signoffs())
+            head = log_head(store.signoffs.of())
             where = store.where
     except StoreError as exc:
         return fail(str(exc))

@@ -2,7 +2,7 @@
 
 The atomic writer (:mod:`.atomic`) calls :func:`committed` once a file has taken its place,
 and a run record calls it once the record is closed. A listener (the workspace's copy in the
-course store, :mod:`workbench.labs.workspace_sync`) must return at once: it only notes the
+course store, :mod:`workbench.labs.store.workspace_sync`) must return at once: it only notes the
 path, and does its own work elsewhere. A listener that fails is logged and never fails the
 write that was already done.
 """

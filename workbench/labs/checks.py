@@ -26,8 +26,8 @@ from workbench.sim.profiles import get_profile
 from workbench.sim.record import file_sha256
 from workbench.sim.sensors import SensorSpec
 
-from .migrations import REDO_REASON
 from .model import Exercise, LabMaze, Objective, Setup
+from .store.migrations import REDO_REASON
 
 ROLE_NAMES = {"tcp": "TCP (the Unity simulator's role)", "ws": "WebSocket (the Web Simulator's)"}
 

@@ -27,9 +27,9 @@ from .evidence_text import programs_of
 from .model import Lab
 from .partners import PairNotConfirmed, partner_problem
 from .progress import signoff_driver
-from .queue import QueueEntry
-from .signoff_record import Evidence, RecordFields
-from .store import Store
+from .signoff.signoff_record import Evidence, RecordFields
+from .store.queue import QueueEntry
+from .store.store import Store
 
 
 @dataclass(frozen=True)
@@ -137,9 +137,9 @@ def _standing(progress: ExerciseProgress | None, asked: bool, signed: bool) -> S
 def read_class(store: Store, labs: list[Lab]) -> ClassView:
     """The class as the store has it now."""
     names = titles(labs)
-    queue = store.signoff_queue()
-    places = store.places()
-    records = store.signoffs()
+    queue = store.queue.waiting()
+    places = store.progress.places()
+    records = store.signoffs.of()
     signed = {(r.student, r.lab, r.exercise) for r in records}
     signed |= {(r.partner, r.lab, r.exercise) for r in records if r.partner}
     waiting = {(e.student, e.lab, e.exercise): n for n, e in enumerate(queue, 1)}
@@ -154,7 +154,7 @@ def read_class(store: Store, labs: list[Lab]) -> ClassView:
     problems: dict[tuple[str, str, str], str] = {}
     uses: list[ProgramUse] = []
     for student in students:
-        for (lab, exercise), data in store.progress(student).items():
+        for (lab, exercise), data in store.progress.of(student).items():
             try:
                 progress = ExerciseProgress.from_dict(data)
             except ValueError as exc:
@@ -302,8 +302,8 @@ def read_request(store: Store, entry: QueueEntry, labs: list[Lab]) -> Request:
     title = safe(titles(labs).get(key, entry.exercise))
     profile = profiles(labs).get(key, "")
     shown = safe_entry(entry)
-    pairing = safe(partner_problem(entry.student, entry.partner, store.places()))
-    saved = store.progress(entry.student, entry.lab).get(key)
+    pairing = safe(partner_problem(entry.student, entry.partner, store.progress.places()))
+    saved = store.progress.of(entry.student, entry.lab).get(key)
     if saved is None:
         return Request(
             shown,

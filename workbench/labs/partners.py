@@ -5,7 +5,7 @@ person named worked on the exercise, or agrees. So the partner of a sign-off is 
 the class (one the course's store knows: they have opened a lab) other than the student, and
 the instructor confirms the pair when signing (the console asks); without that the
 sign-off is for the student alone. The gradebook, in turn, never lets a record that only
-names someone replace a row of their own (:func:`workbench.labs.gradebook.gradebook_rows`).
+names someone replace a row of their own (:func:`workbench.labs.signoff.gradebook.gradebook_rows`).
 """
 
 from __future__ import annotations

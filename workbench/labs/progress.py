@@ -33,7 +33,7 @@ from .checks import (
 )
 from .evidence_text import programs_of
 from .model import Exercise, Lab
-from .store import Store, StoreUnavailable
+from .store.store import Store, StoreUnavailable
 
 #: (lab id, exercise id)
 ExerciseKey = tuple[str, str]
@@ -71,9 +71,9 @@ def read_saved(store: Store, student: str, partner: str = "") -> SavedProgress:
     """The saved progress, sign-offs and drivers of ``student`` (with ``partner``). Passes
     saved without the evidence of their work read as "needs redoing". Raises what the store
     raises (:class:`~.store.StoreUnavailable` while a course database is away)."""
-    rows = store.progress(student)
-    signoffs = store.signoffs(student=student)
-    drivers = store.drivers(student, partner)
+    rows = store.progress.of(student)
+    signoffs = store.signoffs.of(student=student)
+    drivers = store.progress.drivers(student, partner)
     out = SavedProgress(drivers=drivers)
     for key, data in rows.items():
         try:
@@ -113,7 +113,7 @@ def read_work(store: Store, student: str, partner: str = "") -> SavedWork:
     except Exception as exc:  # a damaged database must not stop the lab
         return SavedWork(error=str(exc))
     try:
-        place = store.place(student)
+        place = store.progress.place(student)
     except Exception:  # where the student was is a convenience, never a reason to fail
         place = None
     return SavedWork(saved, place)
@@ -240,7 +240,7 @@ class LabProgress:
         self.saved[(progress.lab, progress.exercise)] = progress
         if store is None:
             return True
-        return store.save_progress(
+        return store.progress.save(
             self.student, progress.lab, progress.exercise, progress.as_dict()
         )
 
@@ -258,7 +258,7 @@ class LabProgress:
     def next_driver(self, lab: Lab, exercise: Exercise, driver: str) -> ExerciseKey | None:
         """``driver`` was chosen to drive next: they drive now, and the exercise after
         ``exercise`` is theirs. Returns that exercise (None after the lab's last) for the
-        caller to record (:meth:`Store.set_driver`)."""
+        caller to record (:meth:`Store.progress.set_driver`)."""
         self.driver = driver
         ids = [ex.id for ex in lab.exercises]
         place = ids.index(exercise.id) + 1

@@ -20,14 +20,13 @@ from pathlib import Path
 
 from workbench.files.workspace import workspace_folder
 
-from . import workspace_rows
-from .instructors import key_path
-from .roster import load_roster, roster_path
 from .signlog import Head
-from .store import SIGNOFF_COLUMNS, Store, StoreError, utc_iso
-from .verify import log_head
-from .workspace_rows import WorkspaceRefused
-from .workspace_sync import local_files, read_local
+from .signoff.roster import roster_keys
+from .signoff.verify import log_head
+from .store import workspace_rows
+from .store.store import SIGNOFF_COLUMNS, Store, StoreError, utc_iso
+from .store.workspace_rows import WorkspaceRefused
+from .store.workspace_sync import local_files, read_local
 
 TABLES: dict[str, tuple[str, ...]] = {
     "signoffs": SIGNOFF_COLUMNS,
@@ -93,16 +92,16 @@ def _workspace_files(
 
 
 def counts(store: Store) -> dict[str, int]:
-    out = {table: int(store._read(f"SELECT count(*) FROM {table}")[0][0]) for table in TABLES}
-    if store.keeps_roster:
-        out["instructors"] = int(store._read("SELECT count(*) FROM instructors")[0][0])
+    out = {table: int(store.read(f"SELECT count(*) FROM {table}")[0][0]) for table in TABLES}
+    if store.instructors is not None:
+        out["instructors"] = store.instructors.count()
     return out
 
 
 def copy_store(source: Store, target: Store) -> CopyReport:
     """Copy the SQLite ``source`` into the empty PostgreSQL ``target``, then check the copy;
     :class:`StoreError` says what is in the way or what differs."""
-    if source.keeps_roster or not target.keeps_roster:
+    if source.postgres or not target.postgres:
         raise StoreError("the copy goes from a data folder's SQLite store to PostgreSQL")
     already = {t: n for t, n in counts(target).items() if n}
     if already:
@@ -111,22 +110,20 @@ def copy_store(source: Store, target: Store) -> CopyReport:
             f"{target.where} already holds {held}: move a data folder into an empty database "
             "(or one made for it with CREATE DATABASE)"
         )
-    roster = load_roster(roster_path(source.data_dir))
-    keys = {}
-    for name in roster:
-        path = key_path(source.data_dir, name)
-        keys[name] = path.read_text(encoding="utf-8") if path.is_file() else None
-    stored_files = int(target._read("SELECT count(*) FROM workspace_files")[0][0])
+    offered = roster_keys(source)  # the data folder's files
+    roster = offered.entries()
+    keys = {name: offered.key_text(name)[0] for name in roster}
+    stored_files = int(target.read("SELECT count(*) FROM workspace_files")[0][0])
     if stored_files:
         raise StoreError(
             f"{target.where} already holds {stored_files} workspace file(s): move a data "
             "folder into an empty database (or one made for it with CREATE DATABASE)"
         )
-    rows = {t: source._read(f"SELECT {', '.join(c)} FROM {t}") for t, c in TABLES.items()}
+    rows = {t: source.read(f"SELECT {', '.join(c)} FROM {t}") for t, c in TABLES.items()}
     files, left = _workspace_files(source.data_dir)
     copied: dict[str, dict[str, str]] = {}
     stamp = utc_iso(datetime.now(UTC))
-    with target._write() as tx:
+    with target.write() as tx:
         for table, columns in TABLES.items():
             sql = (
                 f"INSERT INTO {table} ({', '.join(columns)}) "
@@ -169,7 +166,7 @@ def check_workspaces(target: Store, copied: dict[str, dict[str, str]]) -> None:
     for user, shas in copied.items():
         stored = {
             path: row.sha256
-            for path, row in target.workspace_index(user).items()
+            for path, row in target.workspaces.index(user).items()
             if not row.deleted
         }
         if stored != shas:
@@ -188,7 +185,7 @@ def check_copy(source: Store, target: Store, instructors: int) -> CopyReport:
             )
     if after.get("instructors", 0) != instructors:
         raise StoreError(f"the copy differs: {after.get('instructors')} instructor(s) copied")
-    mine, theirs = source.signoffs(), target.signoffs()
+    mine, theirs = source.signoffs.of(), target.signoffs.of()
     if mine != theirs:
         first = next(
             (a.label() for a, b in zip(mine, theirs, strict=False) if a != b), "the last one"

@@ -3,7 +3,7 @@
 A file a student puts, removes or renames over SFTP changes their workspace folder on this
 server; with ``--db postgresql://...`` the change goes on to the course store, so the next
 session finds it on whichever server it lands. Each student's changes are sent by a
-:class:`~workbench.labs.workspace_sync.WorkspacePusher` of their own (a thread with a store
+:class:`~workbench.labs.store.workspace_sync.WorkspacePusher` of their own (a thread with a store
 connection it gives back when idle), so a database that is slow or away never holds the
 server's event loop or the transfer: what is not sent yet stays on this server's disk and is
 sent again, or at the student's next session start.
@@ -19,8 +19,8 @@ from functools import partial
 from pathlib import Path
 
 from workbench.files.workspace import workspace_folder
-from workbench.labs.store import Store
-from workbench.labs.workspace_sync import WorkspacePusher
+from workbench.labs.store.store import Store
+from workbench.labs.store.workspace_sync import WorkspacePusher
 
 log = logging.getLogger("workbench.ssh")
 

@@ -19,7 +19,7 @@ import asyncssh
 from workbench.control.recording import RecordQuota, shown_size
 from workbench.files.workspace import workspace_folder
 from workbench.files.workspace_files import UploadLimits
-from workbench.labs.workspace_sync import sync_at_start
+from workbench.labs.store.workspace_sync import sync_at_start
 
 from .applog import make_room
 from .appproc import RESTORE_TERMINAL, AppEntry, AppProcess, AppSpec, app_env, forward_hint

@@ -14,7 +14,6 @@ import gc
 import getpass
 import math
 import os
-import threading
 from collections.abc import Callable
 from dataclasses import replace
 from functools import partial
@@ -29,12 +28,19 @@ from textual.screen import ModalScreen, Screen
 from workbench.control.station import LabStation
 from workbench.files.bundled import default_maze_path
 from workbench.files.workspace import LOCAL, FileAccess
+from workbench.labs.course_store import (
+    CourseStore,
+    KeptNotSaved,
+    KeptSaved,
+    Opened,
+    Store,
+    StoreEvent,
+    WorkspacePusher,
+    resolve_data_dir,
+)
 from workbench.labs.lastpair import read_last_pair, save_last_pair
 from workbench.labs.model import Setup
 from workbench.labs.names import NameProblem, check_pair
-from workbench.labs.pending import pending_path
-from workbench.labs.store import Store, StoreError, resolve_data_dir
-from workbench.labs.workspace_sync import WorkspacePusher
 from workbench.sim.maze import Maze, MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.noise import NOISE_LEVELS
@@ -61,7 +67,7 @@ from .host import (
 from .keys import APP_KEY_IDS, bindings
 from .screens.arrival import ArrivalScreen
 from .screens.editor import EditorScreen
-from .screens.labs import LabsScreen, StoreOpened, StoreTrouble
+from .screens.labs import LabsScreen, StoreNews
 from .screens.main import MainScreen
 from .screens.runs import RunsScreen
 from .serving import warmup
@@ -74,8 +80,6 @@ from .settings import AppSettings
 
 #: the smallest terminal the layout is made for (columns, rows)
 MIN_SIZE = (80, 24)
-#: seconds between tries to write what the course database did not get
-STORE_RETRY_SECONDS = 2.0
 #: how long quitting waits for the course database to take what is pending (it is in the
 #: pending file already, for the next app, if it does not)
 STORE_LAST_TRY_SECONDS = 2.0
@@ -126,9 +130,9 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
         self._names_given = names_given
         self.student = settings.student or _login_name()
         self.partner = settings.partner
-        self.store: Store | None = None
-        self._store_lock = threading.Lock()
-        self.store_problem = ""
+        #: the course store's life (opening, retries, the last try): the app only says it
+        self.course = CourseStore(settings.data_dir, settings.db, self.student)
+        self.course.subscribe(self._store_news)
         self._labs: LabsScreen | None = None
         self._viple_configs = viple_configs(settings)
         self.endpoints: Endpoints | None = None
@@ -223,9 +227,8 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
             # each while a student drives) leave it alone from the first screen on
             self.call_after_refresh(gc.freeze)
         self._start_pusher()
-        if self.settings.db and self._pending_file().is_file():
-            # what an earlier app could not save: written as soon as the database answers
-            self.run_worker(self._save_kept(), group="store")
+        # what an earlier app could not save: written as soon as the database answers
+        self.course.save_kept()
         if self._names_given and not self.settings.ask_names:
             self._remember_pair()
         self._check_size(self.size.width, self.size.height)
@@ -508,106 +511,53 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
                 # a served student's terminal is theirs: an instructor never types a
                 # passphrase there (they sign at their own console)
                 signs_here=not self.station.files.confined,
+                course=self.course,
             )
             self.install_screen(self._labs, name="labs")
-            # the screen comes up at once; the store is opened and read beside it
-            self.run_worker(self._open_store_for(self._labs), group="store")
+            # the screen comes up at once; the store is opened and read beside it (a served
+            # student's login name is the only one that is theirs: it is not respelled)
+            self.course.open_for(
+                self.student, self.partner, respell=not self.station.files.confined
+            )
         self.push_screen("labs")
 
-    async def _open_store_for(self, labs: LabsScreen) -> None:
-        """Open the store and spell the pair as it does, in a thread (a course database that
-        hangs makes both wait for its deadline), then hand the store to the labs screen."""
-        names = await asyncio.to_thread(self._stored_names)
-        if names != (self.student, self.partner):
-            self._set_names(*names)
-        labs.post_message(StoreOpened(self.store, self.store_problem, *names))
+    @property
+    def store(self) -> Store | None:
+        """The course store, once open (None before, or when it could not be opened)."""
+        return self.course.store
 
-    def _stored_names(self) -> tuple[str, str]:
-        """The store opened, and the pair as it spells them, so "alice doe" resumes Alice
-        Doe's progress (not for a served student, whose login name is the only one that is
-        theirs). Waits for the store: run off the event loop."""
-        self._open_store()
-        names = (self.student, self.partner)
-        if self.store is None or self.station.files.confined:
-            return names
-        try:
-            student = self.store.spelling(self.student)
-            partner = self.store.spelling(self.partner) if self.partner else ""
-        except Exception:  # the store may be away; the names stay as typed
-            return names
-        return student, partner
+    def _store_news(self, event: StoreEvent) -> None:
+        """What the course store did (called from its threads): handled on the event loop."""
+        self.post_message(StoreNews(event))
 
-    def _open_store(self) -> None:
-        with self._store_lock:  # the labs (here) or the saving of kept changes (a thread)
-            self._open_store_once()
-
-    def _open_store_once(self) -> None:
-        if self.store is not None:
-            return
-        try:
-            # a course database that is down now still gets the work once it is back
-            store = Store.open(self.settings.data_dir, db=self.settings.db, offline_ok=True)
-        except Exception as exc:  # the labs work without saving rather than not at all
-            self.store = None
-            where = "the course database" if self.settings.db else "the data folder"
-            self.store_problem = f"cannot open {where}, so nothing is saved: {exc}"
-            return
-        if self.settings.db:
-            # what waits for the database is kept in a file too: it outlives this app
-            for problem in store.keep_pending_in(self._pending_file(), self.student):
-                self.log.warning(problem)
-            # and a save never waits for it: a database that hangs must not freeze the screen
-            store.write_in_background(self._store_trouble)
-        self.store = store
+    def on_store_news(self, message: StoreNews) -> None:
+        """The pair as the store spells them, and the changes kept by an earlier app; the
+        labs screen hears the rest (and the names too)."""
+        event = message.event
+        if self._labs is not None:
+            self._labs.post_message(StoreNews(event))
+        if isinstance(event, Opened) and (event.student, event.partner) != (
+            self.student,
+            self.partner,
+        ):
+            self._set_names(event.student, event.partner)
+        elif isinstance(event, KeptSaved):
+            self._say("saving resumed: the changes kept while the course database was away "
+                      "are saved")  # fmt: skip
+        elif isinstance(event, KeptNotSaved):
+            self._say(f"changes kept from before were not saved: {event.error}")
 
     def _start_pusher(self) -> None:
         """With a course database, a served student's workspace follows them to any server:
         each file saved here is sent to the database as it is saved, in a thread of its own."""
-        settings = self.settings
-        if not settings.db or settings.workspace is None or self.station.files.workspace is None:
+        workspace = self.station.files.workspace
+        if self.settings.workspace is None or workspace is None:
             return
-        db = settings.db
-
-        def open_store() -> Store:
-            return Store.open(settings.data_dir, db=db, offline_ok=True)
 
         def tell(text: str) -> None:
             self.call_from_thread(self._say, text)
 
-        self.pusher = WorkspacePusher(open_store, self.student, self.station.files.workspace, tell)
-        self.pusher.start()
-
-    def _store_trouble(self, error: StoreError) -> None:
-        """A save failed in the store's thread: the labs screen says so (from that thread)."""
-        labs = self._labs
-        if labs is not None:
-            labs.post_message(StoreTrouble(error))
-
-    def _pending_file(self) -> Path:
-        return pending_path(resolve_data_dir(self.settings.data_dir), self.student)
-
-    async def _save_kept(self) -> None:
-        """Write the changes an earlier app kept because the course database was away: one
-        try at a time, in a thread (a database that does not answer makes a try wait for the
-        connection's timeout), until they are written; then say so."""
-        await asyncio.to_thread(self._open_store)
-        store = self.store
-        if store is None:
-            return
-        while store.pending:
-            try:
-                if store.in_background:
-                    done = await asyncio.wrap_future(store.flush_soon())
-                else:
-                    done = await asyncio.to_thread(store.flush)
-            except Exception as exc:  # written by no retry: say why, keep working
-                self._say(f"changes kept from before were not saved: {exc}")
-                return
-            if done:
-                self._say("saving resumed: the changes kept while the course database was away "
-                          "are saved")  # fmt: skip
-                return
-            await asyncio.sleep(STORE_RETRY_SECONDS)
+        self.pusher = self.course.workspace_pusher(workspace, tell)
 
     def set_up_done(self, setup: Setup | None = None) -> None:
         """A lab's set-up changed the station: follow its maze and profile, and start the VIPLE
@@ -672,21 +622,9 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
             sent = asyncio.ensure_future(
                 asyncio.to_thread(self.pusher.wait_idle, STORE_LAST_TRY_SECONDS)
             )
-        if self.store is not None:
-            # a last try for what the database did not get yet (never shown as saved); while
-            # it is away the pending writes are in their file already, for the next app
-            store = self.store
-            if store.in_background:
-                store.keep_pending_now()  # a write on its way when the database hangs
-                if not store.offline:
-                    with contextlib.suppress(Exception):
-                        await asyncio.wait_for(
-                            asyncio.wrap_future(store.flush_soon()), STORE_LAST_TRY_SECONDS
-                        )
-            elif not store.offline:
-                with contextlib.suppress(Exception):
-                    store.flush()
-            store.close()
+        # a last try for what the database did not get yet (never shown as saved); while it
+        # is away the pending writes are in their file already, for the next app
+        await asyncio.to_thread(self.course.finish, STORE_LAST_TRY_SECONDS)
         if sent is not None and self.pusher is not None:
             await sent
             self.pusher.stop()

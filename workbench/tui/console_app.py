@@ -13,8 +13,8 @@ from typing import ClassVar
 
 from textual.binding import BindingType
 
+from workbench.labs.course_store import Store, StoreError, open_to_read
 from workbench.labs.model import Lab, LabFileError, load_labs
-from workbench.labs.store import Store, StoreError
 
 from .app import FOCUS_BINDINGS
 from .host import ScreenHost
@@ -55,7 +55,7 @@ def make_console(settings: AppSettings) -> ConsoleApp:
     """The console on the store the settings name (a course database, or the SQLite file in
     the data folder); :class:`StoreError` when it cannot be opened, :class:`LabFileError`
     when a lab file is broken."""
-    store = Store.open(settings.data_dir, db=settings.db)
+    store = open_to_read(settings.data_dir, settings.db)
     try:
         labs = load_labs()
     except LabFileError:

@@ -21,12 +21,12 @@ from textual.widgets import Button, Input, Label, Static
 from textual.worker import Worker
 
 from workbench.labs.checks import ExerciseProgress
+from workbench.labs.course_store import Store
 from workbench.labs.progress import signoff_words
-from workbench.labs.roster import roster_names
-from workbench.labs.signing import sign_off
-from workbench.labs.signoff_errors import SignoffError
-from workbench.labs.signoff_record import Evidence, RecordFields, SignoffRecord
-from workbench.labs.store import Store
+from workbench.labs.signoff.roster import roster_keys, roster_names
+from workbench.labs.signoff.signing import sign_off
+from workbench.labs.signoff.signoff_errors import SignoffError
+from workbench.labs.signoff.signoff_record import Evidence, RecordFields, SignoffRecord
 
 from ..keys import bindings
 from ..plain import follow_app
@@ -114,7 +114,7 @@ class SignoffModal(ModalScreen[str | None]):
         #: set once the roster is read: at once from the data folder's files, in a thread
         #: from a course database (which may take its time, or not answer)
         self.roster_read = asyncio.Event()
-        if not store.keeps_roster:
+        if roster_keys(store).reads_at_once:
             self._take_roster(*roster_names(store))
 
     def compose(self) -> ComposeResult:
@@ -263,7 +263,7 @@ class SignoffModal(ModalScreen[str | None]):
         progress = self.progress
         try:
             await asyncio.to_thread(
-                self.store.set_driver,
+                self.store.progress.set_driver,
                 self.student, self.partner, progress.lab, progress.exercise, self.driver,
             )  # fmt: skip
         except Exception as exc:

@@ -27,9 +27,8 @@ from textual.widgets import OptionList, Static
 from textual.widgets.option_list import Option
 
 from workbench.labs.classview import ClassView, StudentRow, read_class
+from workbench.labs.course_store import QueueEntry, Store, StoreUnavailable
 from workbench.labs.model import Lab
-from workbench.labs.queue import QueueEntry
-from workbench.labs.store import Store, StoreUnavailable
 
 from ..host import FollowsUnicode
 from ..keys import bindings

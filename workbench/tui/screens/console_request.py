@@ -25,13 +25,12 @@ from textual.widgets import Button, Input, Static
 from workbench.files.workspace import LOCAL
 from workbench.labs.classview import Request, read_request
 from workbench.labs.copy_hints import CopyHint, hints_for
+from workbench.labs.course_store import QueueEntry, Store, StoreError
 from workbench.labs.evidence_text import lines_of_progress, mixed_programs_text, short_digest
 from workbench.labs.model import Lab
-from workbench.labs.queue import QueueEntry
-from workbench.labs.roster import roster_names
-from workbench.labs.signing import sign_off
-from workbench.labs.signoff_errors import SignoffError
-from workbench.labs.store import Store, StoreError
+from workbench.labs.signoff.roster import roster_names
+from workbench.labs.signoff.signing import sign_off
+from workbench.labs.signoff.signoff_errors import SignoffError
 from workbench.sim.record import RecordError
 from workbench.sim.replay import load_replay
 
@@ -316,12 +315,12 @@ class RequestScreen(Screen[str | None]):
             self.busy = False
         problems = []
         try:
-            await asyncio.to_thread(store.mark_signed, entry.id, instructor)
+            await asyncio.to_thread(store.queue.mark_signed, entry.id, instructor)
         except StoreError as exc:
             problems.append(f"the request stays in the queue: {exc}")
         try:
             await asyncio.to_thread(
-                store.set_driver, entry.student, record.partner, entry.lab, entry.exercise,
+                store.progress.set_driver, entry.student, record.partner, entry.lab, entry.exercise,
                 record.driver,
             )  # fmt: skip
         except StoreError as exc:
@@ -351,7 +350,7 @@ class RequestScreen(Screen[str | None]):
 
     async def _decline(self, instructor: str, note: str) -> None:
         try:
-            await asyncio.to_thread(self.store.decline_request, self.entry.id, instructor, note)
+            await asyncio.to_thread(self.store.queue.decline, self.entry.id, instructor, note)
         except StoreError as exc:
             self._say(f"not declined: {exc}")
             return

@@ -23,7 +23,8 @@ it.
 from __future__ import annotations
 
 import asyncio
-from typing import ClassVar, NamedTuple
+from collections.abc import Callable
+from typing import Any, ClassVar, NamedTuple
 
 from textual import events, on
 from textual.app import ComposeResult
@@ -31,7 +32,6 @@ from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.message import Message
 from textual.screen import Screen
-from textual.timer import Timer
 from textual.widget import Widget
 from textual.widgets import Input, Markdown, OptionList, RadioSet, Static
 from textual.widgets.option_list import Option
@@ -39,6 +39,15 @@ from textual.widgets.option_list import Option
 from workbench.control.station import LabStation
 from workbench.labs.attempt_work import work_at_stake
 from workbench.labs.checks import MAX_ANSWER, ExerciseProgress, SetupChanges
+from workbench.labs.course_store import (
+    Away,
+    Back,
+    CourseStore,
+    Opened,
+    SaveRefused,
+    Store,
+    StoreEvent,
+)
 from workbench.labs.model import Exercise, Lab, LabFileError, Question, Setup, load_labs
 from workbench.labs.progress import (
     LabProgress,
@@ -48,8 +57,7 @@ from workbench.labs.progress import (
     read_work,
     shown_values,
 )
-from workbench.labs.signoff_record import SignoffRecord
-from workbench.labs.store import Store, StoreError, StoreUnavailable
+from workbench.labs.signoff.signoff_record import SignoffRecord
 from workbench.sim.session import Snapshot
 
 from ..host import FollowsUnicode, SetUpDone, ShowsSnapshot
@@ -78,10 +86,17 @@ PASS, FAIL, OPEN, SIGNED = UNICODE_MARKS
 
 
 UNREACHABLE = "the course database cannot be reached"
+BACK = "the course database is back: your progress is saved"
+#: what the screen says of the course store's news that it only says
+NEWS_WORDS: dict[type, Callable[[Any], str]] = {
+    Away: lambda away: (
+        f"{UNREACHABLE}: your progress is kept here ({away.pending} change(s)) and saved as "
+        "soon as it is back"
+    ),
+    SaveRefused: lambda refused: f"progress not saved: {refused.error}",
+}
 #: what the screen shows until the saved work is read
 LOADING = "loading saved work…"
-#: seconds between tries to write what the course database did not get
-RETRY_SECONDS = 2.0
 
 
 def speed_words(speed: float | None) -> str:
@@ -106,25 +121,14 @@ def setup_words(changes: SetupChanges, setup: Setup) -> list[str]:
     return said
 
 
-class StoreOpened(Message):
-    """The app opened the store for the labs (in a thread: a course database may hang): the
-    store (None when it could not be opened, ``problem`` says why) and the pair's names as
-    the store spells them. The screen reads the saved work from it next."""
+class StoreNews(Message, bubble=False):
+    """What the course store did (:mod:`workbench.labs.course_store`), brought by the app
+    (which subscribes to the store's news) from the store's threads to its event loop, and
+    handed on to this screen: it goes to the one it is posted to only."""
 
-    def __init__(self, store: Store | None, problem: str, student: str, partner: str) -> None:
+    def __init__(self, event: StoreEvent) -> None:
         super().__init__()
-        self.store = store
-        self.problem = problem
-        self.student = student
-        self.partner = partner
-
-
-class StoreTrouble(Message):
-    """A save the store wrote in its own thread failed (posted from that thread)."""
-
-    def __init__(self, error: StoreError) -> None:
-        super().__init__()
-        self.error = error
+        self.event = event
 
 
 class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
@@ -192,13 +196,21 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         partner: str = "",
         labs: list[Lab] | None = None,
         signs_here: bool = True,
+        course: CourseStore | None = None,
     ) -> None:
         """The screen shows the labs at once and the saved work once it is read: the store
-        comes with :class:`StoreOpened`. ``signs_here``: an instructor may sign off at this
-        station (``i``); False in a served student's session, where only the ready key asks
-        for sign-off."""
+        comes with the course store's news (:class:`StoreNews`, its ``Opened`` first), which
+        the screen says; it tells ``course`` when a save was kept. ``signs_here``: an
+        instructor may sign off at this station (``i``); False in a served student's session,
+        where only the ready key asks for sign-off."""
         super().__init__()
         self.signs_here = signs_here
+        self.course = course
+        #: what the screen does with the news of the course store that is not only said
+        self._news: dict[type, Callable[[Any], None]] = {
+            Opened: self._store_opened,
+            Back: self._store_back,
+        }
         self.station = station
         self.store: Store | None = None
         self.student = student
@@ -217,11 +229,8 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self._ready = False
         self.selected: tuple[Lab, Exercise] | None = None
         self.progress: ExerciseProgress | None = None
-        self._retry_timer: Timer | None = None
-        self._retrying = False
+        #: the saved work could not be read: it is read again when the database is back
         self._reload_when_back = False
-        #: the student was told the database is away (and so is told when it is back)
-        self._said_away = False
         #: a sign-off seen while another screen was over this one
         self._signed_later: SignoffStatus.Signed | None = None
         self.unicode = False
@@ -237,12 +246,20 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         return self.lab_progress.driver
 
     # -- store ---------------------------------------------------------------------------
-    @on(StoreOpened)
-    def _store_opened(self, message: StoreOpened) -> None:
+    @on(StoreNews)
+    def _store_news(self, message: StoreNews) -> None:
+        event = message.event
+        handler = self._news.get(type(event))
+        if handler is not None:
+            handler(event)
+        elif type(event) in NEWS_WORDS:
+            self.say(NEWS_WORDS[type(event)](event))
+
+    def _store_opened(self, opened: Opened) -> None:
         """The store is open (or could not be): read the saved work from it, in a thread."""
-        self.store = message.store
-        self._store_problem = message.problem
-        self.student, self.partner = message.student, message.partner
+        self.store = opened.store
+        self._store_problem = opened.problem
+        self.student, self.partner = opened.student, opened.partner
         self.lab_progress = LabProgress(self.student, self.partner, reading=True)
         if self.store is None:
             self._take_work(SavedWork())
@@ -250,13 +267,26 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self.query_one(SignoffStatus).use(self.store)
         self.run_worker(self._read_work(), group="labs-read", exit_on_error=False)
 
-    async def _read_work(self) -> None:
+    async def _read_work(self, again: bool = False) -> None:
         """Read the saved work off the event loop (a course database that hangs makes the
-        read wait for the store's deadline; the app answers keys meanwhile), then show it."""
+        read wait for the store's deadline; the app answers keys meanwhile), then show it;
+        ``again``: read once the database is back, after it was away when the screen came up
+        (what this session changed meanwhile was written first, so it reads back as it is
+        here)."""
         store = self.store
         assert store is not None
         work = await asyncio.to_thread(read_work, store, self.student, self.partner)
-        self._take_work(work)
+        if not again:
+            self._take_work(work)
+        elif work.away:  # still away: read again when it is back
+            if self.course is not None:
+                self.course.read_away()
+        else:
+            self._reload_when_back = False
+            self.lab_progress.take_work(work)
+            self._store_problem = self._work_problem(work)
+            self._refresh_list()
+            self.say(BACK)
 
     def _take_work(self, work: SavedWork) -> None:
         """The saved work was read (or could not be): the list, the exercise the student had
@@ -265,8 +295,8 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self._store_problem = self._work_problem(work) or self._store_problem
         if work.away:
             self._reload_when_back = True
-            self._said_away = True
-            self._wait_for_store()
+            if self.course is not None:
+                self.course.read_away()
         if not self._ready:
             return
         self._refresh_list()
@@ -305,70 +335,16 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         except Exception as exc:
             self.say(f"progress not saved: {exc}")
             return
-        if not saved:
-            self._wait_for_store()
+        if not saved and self.course is not None:
+            self.course.kept()
 
-    # -- a course database that went away ------------------------------------------------
-    def _wait_for_store(self) -> None:
-        """Say the database is away and try it again every few seconds until what is kept
-        here is written; the student works on meanwhile."""
-        store = self.store
-        if store is None:
-            return
-        if store.pending:
-            self._said_away = True
-            self.say(
-                f"{UNREACHABLE}: your progress is kept here ({store.pending} change(s)) and "
-                "saved as soon as it is back"
-            )
-        if self._retry_timer is None and self._ready:
-            self._retry_timer = self.set_interval(RETRY_SECONDS, self._retry_store)
-
-    @on(StoreTrouble)
-    def _store_trouble(self, message: StoreTrouble) -> None:
-        if isinstance(message.error, StoreUnavailable):
-            self._wait_for_store()
+    def _store_back(self, back: Back) -> None:
+        """Everything kept here is written (the course store tried it again); saved work that
+        could not be read is read now."""
+        if self._reload_when_back:
+            self.run_worker(self._read_work(again=True), group="labs-read", exit_on_error=False)
         else:
-            self.say(f"progress not saved: {message.error}")
-
-    async def _retry_store(self) -> None:
-        """One try to write what is kept here, in a thread: a database that does not answer
-        makes the try wait for its connection timeout, and the screen must not wait with it.
-        One try at a time."""
-        store = self.store
-        if store is None or self._retrying:
-            return
-        self._retrying = True
-        try:
-            if store.in_background:  # the store's own thread: one write at a time
-                done = await asyncio.wrap_future(store.flush_soon())
-            else:
-                done = await asyncio.to_thread(store.flush)
-            if done and self._reload_when_back:
-                # what this session changed meanwhile was written first, so it reads back as
-                # it is here
-                work = await asyncio.to_thread(read_work, store, self.student, self.partner)
-                if work.away:
-                    return  # still away: the next try reads again
-                self._reload_when_back = False
-                self.lab_progress.take_work(work)
-                self._store_problem = self._work_problem(work)
-                self._refresh_list()
-        except StoreUnavailable:
-            return
-        except Exception as exc:
-            self.say(f"progress not saved: {exc}")
-            done = True
-        finally:
-            self._retrying = False
-        if not done:
-            return
-        if self._retry_timer is not None:
-            self._retry_timer.stop()
-            self._retry_timer = None
-        if self._said_away:  # (a save merely on its way when the screen opened is no news)
-            self._said_away = False
-            self.say("the course database is back: your progress is saved")
+            self.say(BACK)
 
     # -- layout --------------------------------------------------------------------------
     def compose(self) -> ComposeResult:
@@ -419,8 +395,6 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         follow_app(self)
         self._ready = True
         self._refresh_list()
-        if self._reload_when_back or (self.store is not None and self.store.pending):
-            self._retry_timer = self.set_interval(RETRY_SECONDS, self._retry_store)
         listing = self.query_one("#labs-list", OptionList)
         listing.highlighted = self._first_option()
         listing.focus()
@@ -495,8 +469,9 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self.selected = (lab, exercise)
         if self.store is not None:
             try:
-                if not self.store.set_place(self.student, lab.id, exercise.id):
-                    self._wait_for_store()
+                placed = self.store.progress.set_place(self.student, lab.id, exercise.id)
+                if not placed and self.course is not None:
+                    self.course.kept()
             except Exception as exc:
                 self.say(f"cannot save where you are: {exc}")
         driver = self.lab_progress.open((lab.id, exercise.id))
@@ -806,7 +781,7 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self.station.person = driver
         if following is not None and self.store is not None:
             try:
-                self.store.set_driver(self.student, self.partner, *following, driver)
+                self.store.progress.set_driver(self.student, self.partner, *following, driver)
             except Exception as exc:
                 self.say(f"signed off; the next driver was not recorded: {exc}")
                 return

@@ -14,7 +14,7 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical
 from textual.widgets import Input, Label, Select
 
-from workbench.labs.signing import MAX_NOTE
+from workbench.labs.signoff.signing import MAX_NOTE
 
 from .field import Field
 from .tick import Tick

@@ -16,8 +16,15 @@ from dataclasses import dataclass
 from textual.message import Message
 from textual.widgets import Static
 
-from workbench.labs.queue import DECLINED, SIGNED, WAITING, WITHDRAWN, QueueState
-from workbench.labs.store import Store, StoreUnavailable
+from workbench.labs.course_store import (
+    DECLINED,
+    SIGNED,
+    WAITING,
+    WITHDRAWN,
+    QueueState,
+    Store,
+    StoreUnavailable,
+)
 
 #: seconds between reads of the store
 POLL_SECONDS = 1.0
@@ -173,7 +180,7 @@ class SignoffStatus(Static):
     def _request(self, store: Store, target: Target) -> None:
         try:
             asked = self.Asked(
-                store.request_signoff(
+                store.queue.request(
                     target.student, target.partner, target.driver, target.lab, target.exercise
                 )
             )
@@ -188,10 +195,10 @@ class SignoffStatus(Static):
         if store.offline:  # the saving side is waiting for the database: no reads meanwhile
             return Seen(target, None, None, "the course database cannot be reached")
         try:
-            state = store.queue_state(target.student, target.lab, target.exercise)
+            state = store.queue.state(target.student, target.lab, target.exercise)
             rows = [
                 r
-                for r in store.signoffs(student=target.student, lab=target.lab)
+                for r in store.signoffs.of(student=target.student, lab=target.lab)
                 if r.exercise == target.exercise
             ]
         except StoreUnavailable:

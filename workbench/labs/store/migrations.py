@@ -27,9 +27,9 @@ from dataclasses import dataclass
 from datetime import UTC, datetime
 from typing import Any
 
+from ..signlog import GENESIS, entry_hash, parse_metrics, signed_payload
 from . import queue
 from .database import Backend, StoreError, Tx
-from .signlog import GENESIS, entry_hash, parse_metrics, signed_payload
 
 #: the advisory lock key taken while migrating a PostgreSQL store (any fixed number)
 MIGRATION_LOCK = 0x5749_424D_0001

@@ -20,6 +20,8 @@ from dataclasses import dataclass, replace
 from datetime import UTC, datetime
 from typing import Any
 
+from ..store.store import Store, utc_iso
+from ..store.workspace_rows import EVIDENCE_CAP, evidence_copies
 from .instructors import Instructor, SealedKey, read_key
 from .signoff_errors import LockedOut, SignoffError, WrongPassphrase
 from .signoff_record import (
@@ -30,8 +32,6 @@ from .signoff_record import (
     name_problems,
     record_digest,
 )
-from .store import Store, utc_iso
-from .workspace_rows import EVIDENCE_CAP, evidence_copies
 
 log = logging.getLogger(__name__)
 
@@ -103,7 +103,7 @@ def _stored_copy(store: Store, fields: RecordFields, expected: str) -> tuple[str
     one, else the copy at the record's place. :class:`SignoffError` when the store holds no
     copy."""
     record = fields.evidence.run_record
-    copies = evidence_copies(store._read, record, expected, (fields.student, fields.partner))
+    copies = evidence_copies(store.read, record, expected, (fields.student, fields.partner))
     digests = [(f"sha256:{hashlib.sha256(data).hexdigest()}", data) for _, _, data in copies]
     for found in digests:
         if found[0] == expected:
@@ -174,23 +174,23 @@ class PendingSignoff:
         store, record, now = self.store, self.record, self.now
         instructor = record.instructor
         if signer is None:
-            after = store.record_failure(instructor, now, FAILURE_LIMIT, LOCK_SECONDS)
+            after = store.signoffs.record_failure(instructor, now, FAILURE_LIMIT, LOCK_SECONDS)
             where = f"{record.student} {record.lab}/{record.exercise}"
-            store.log_event(instructor, "wrong-passphrase", where, now)
+            store.signoffs.log_event(instructor, "wrong-passphrase", where, now)
             log.info("wrong passphrase for instructor %s at %s", instructor, where)
             if after.locked_until:
-                store.log_event(instructor, "locked", f"for {LOCK_SECONDS:g} s", now)
+                store.signoffs.log_event(instructor, "locked", f"for {LOCK_SECONDS:g} s", now)
                 log.info("sign-off by %s locked for %g s", instructor, LOCK_SECONDS)
                 raise LockedOut(instructor, LOCK_SECONDS, FAILURE_LIMIT)
             raise WrongPassphrase(f"wrong passphrase for {instructor}")
         if self.failures:
-            store.clear_failures(instructor, now)
+            store.signoffs.clear_failures(instructor, now)
 
         def sign_at(seq: int, prev: str) -> dict[str, Any]:
             placed = replace(record, seq=seq, prev=prev)
             return placed.columns(signer.sign(placed.canonical()))
 
-        stored = store.append_signoff(sign_at, self.evidence)
+        stored = store.signoffs.append(sign_at, self.evidence)
         return stored.id, replace(record, seq=stored.seq, prev=stored.prev_hash)
 
 
@@ -217,7 +217,7 @@ def prepare_signoff(
         raise SignoffError("an override needs a note saying why")
     evidence, data = _check_fields(record_fields, store)
     now = clock()
-    state = store.lockout(instructor)
+    state = store.signoffs.lockout(instructor)
     if state.locked_until > now.timestamp():
         raise LockedOut(instructor, state.locked_until - now.timestamp(), FAILURE_LIMIT)
     key = read_key(store.data_dir, instructor, store)

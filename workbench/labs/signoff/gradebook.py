@@ -15,10 +15,10 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-from .evidence_text import measures_of, program_of
-from .signlog import Head, LogError
+from ..evidence_text import measures_of, program_of
+from ..signlog import Head, LogError
+from ..store.store import StoredSignoff
 from .signoff_errors import SignoffError
-from .store import StoredSignoff
 
 #: the columns of the run a sign-off rests on: the program that drove it and its measures
 RUN_COLUMNS = (

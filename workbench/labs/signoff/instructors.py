@@ -9,10 +9,7 @@ front end that must stay responsive can run it off its event loop.
 
 from __future__ import annotations
 
-import hashlib
 import json
-import os
-import re
 import secrets
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
@@ -24,21 +21,20 @@ from cryptography.hazmat.primitives.asymmetric.ed25519 import Ed25519PrivateKey
 from cryptography.hazmat.primitives.ciphers.aead import AESGCM
 from cryptography.hazmat.primitives.kdf.scrypt import Scrypt
 
+from ..store.store import Store, utc_iso
 from .roster import (
     RosterEntry,
     check_name,
     from_b64,
+    key_path,
     load_roster,
-    offered_roster,
-    roster_path,
+    roster_keys,
     save_roster,
     to_b64,
 )
 from .signoff_errors import PassphraseTooShort, SignoffError, UnknownInstructor, WrongPassphrase
-from .store import Store, StoreError, utc_iso
 
 KEY_FORMAT = "workbench-instructor-key/1"
-KEYS_DIR = "instructors"
 MIN_PASSPHRASE = 10
 
 
@@ -54,16 +50,6 @@ class KdfParams:
     def __post_init__(self) -> None:
         if self.n < 2 or self.n & (self.n - 1) or self.r < 1 or self.p < 1:
             raise SignoffError(f"bad scrypt parameters n={self.n} r={self.r} p={self.p}")
-
-
-def _slug(name: str) -> str:
-    slug = re.sub(r"[^a-z0-9]+", "-", name.lower()).strip("-")
-    digest = hashlib.sha256(name.encode("utf-8")).hexdigest()[:8]
-    return f"{slug or 'instructor'}-{digest}"
-
-
-def key_path(data_dir: Path, name: str) -> Path:
-    return data_dir / KEYS_DIR / f"{_slug(name)}.key.json"
 
 
 def check_passphrase(passphrase: str) -> None:
@@ -116,21 +102,17 @@ def create_instructor(
     name = check_name(name)
     check_passphrase(passphrase)
     params = kdf or KdfParams()
-    database = store if store is not None and store.keeps_roster else None
-    roster_file = roster_path(data_dir)
-    roster = offered_roster(database) if database is not None else load_roster(roster_file)
-    if name in roster:
-        where = database.where if database is not None else roster_file
-        raise SignoffError(f"{name} is already in the roster {where}")
+    keys = roster_keys(store, data_dir)
+    if name in keys.entries():
+        raise SignoffError(f"{name} is already in the roster {keys.where}")
     kept = load_roster(trusted) if trusted is not None else {}
     if name in kept:
         raise SignoffError(
             f"{name} is already in your trusted roster {trusted} with another key: choose "
             "another name, or remove the old entry from that file first"
         )
-    target = key_path(data_dir, name)
-    if database is None and target.exists():
-        raise SignoffError(f"{target}: a key for {name} already exists")
+    if keys.holds_key(name):
+        raise SignoffError(f"{keys.key_text(name)[1]}: a key for {name} already exists")
     private = Ed25519PrivateKey.generate()
     instructor = Instructor(name, private)
     public = instructor.public_key_b64()
@@ -155,37 +137,11 @@ def create_instructor(
         "encrypted_private_key": to_b64(sealed),
     }
     entry = RosterEntry(name, public, utc_iso(now or datetime.now(UTC)))
-    _keep(data_dir, database, entry, json.dumps(data, indent=2) + "\n", roster)
+    keys.add(entry, json.dumps(data, indent=2) + "\n")
     if trusted is not None:
         kept[name] = entry
         save_roster(trusted, kept)
     return entry
-
-
-def _keep(
-    data_dir: Path,
-    database: Store | None,
-    entry: RosterEntry,
-    key_text: str,
-    roster: dict[str, RosterEntry],
-) -> None:
-    """Keep an instructor's sealed key and roster entry: in the course ``database``, else as
-    the data folder's key file (never over another) and ``roster`` saved with the entry."""
-    if database is not None:
-        try:
-            database.add_instructor(entry.name, entry.public_key, entry.added, key_text)
-        except StoreError as exc:
-            raise SignoffError(str(exc)) from None
-        return
-    target = key_path(data_dir, entry.name)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd = os.open(target, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
-    with os.fdopen(fd, "w", encoding="utf-8") as fh:
-        fh.write(key_text)
-        fh.flush()
-        os.fsync(fh.fileno())
-    roster[entry.name] = entry
-    save_roster(roster_path(data_dir), roster)
 
 
 def copy_instructor(
@@ -204,12 +160,9 @@ def copy_instructor(
     entry = load_roster(trusted).get(name)
     if entry is None:
         raise SignoffError(f"{name} is not in your trusted roster {trusted}")
-    database = store if store is not None and store.keeps_roster else None
-    roster_file = roster_path(data_dir)
-    roster = offered_roster(database) if database is not None else load_roster(roster_file)
-    if name in roster:
-        where = database.where if database is not None else roster_file
-        raise SignoffError(f"{name} is already in the roster {where}")
+    keys = roster_keys(store, data_dir)
+    if name in keys.entries():
+        raise SignoffError(f"{name} is already in the roster {keys.where}")
     source = key_path(source_dir, name)
     try:
         text = source.read_text(encoding="utf-8")
@@ -225,9 +178,9 @@ def copy_instructor(
         )
     if sealed.unlock(passphrase).public_key_b64() != entry.public_key:
         raise SignoffError(f"{source}: the key does not match its public key; it is not copied")
-    if database is None and key_path(data_dir, name).exists():
-        raise SignoffError(f"{key_path(data_dir, name)}: a key for {name} already exists")
-    _keep(data_dir, database, entry, text, roster)
+    if keys.holds_key(name):
+        raise SignoffError(f"{keys.key_text(name)[1]}: a key for {name} already exists")
+    keys.add(entry, text)
     return entry
 
 
@@ -257,25 +210,14 @@ class SealedKey:
 def read_key(data_dir: Path, name: str, store: Store | None = None) -> SealedKey:
     """An instructor's sealed private key, from the data folder or from the database of a
     PostgreSQL ``store``; :class:`UnknownInstructor` if there is none."""
-    path: Path | str = key_path(data_dir, name)
-    try:
-        if store is not None and store.keeps_roster:
-            path = f"{store.where} (instructors: {name})"
-            text = store.instructor_key(name)
-            if text is None:
-                raise FileNotFoundError(path)
-        else:
-            text = Path(path).read_text(encoding="utf-8")
-    except FileNotFoundError:
-        where = store.where if store is not None and store.keeps_roster else Path(path).parent
+    keys = roster_keys(store, data_dir)
+    text, where = keys.key_text(name)
+    if text is None:
         raise UnknownInstructor(
-            f"no key for instructor {name} in {where} (create it with 'workbench instructor add')"
-        ) from None
-    except StoreError as exc:
-        raise SignoffError(str(exc)) from None
-    except OSError as exc:
-        raise SignoffError(f"{path}: cannot read the key: {exc.strerror}") from None
-    return parse_key(text, name, path)
+            f"no key for instructor {name} in {keys.keys_at} (create it with 'workbench "
+            "instructor add')"
+        )
+    return parse_key(text, name, where)
 
 
 def parse_key(text: str, name: str, path: Path | str) -> SealedKey:

@@ -17,9 +17,11 @@ from __future__ import annotations
 import hashlib
 from collections.abc import Callable
 from dataclasses import dataclass
+from datetime import datetime
 from typing import Any
 
 from .database import StoreError, Tx
+from .rows import Rows, stamp_of
 
 #: the key (first half) of the advisory lock that queues one student's workspace writes
 WORKSPACE_LOCK = 0x5742
@@ -286,3 +288,43 @@ def evidence_copies(
         if got is not None:
             found.append((place[0], place[1], got[1]))
     return found
+
+
+class WorkspaceRows:
+    """The students' workspace files over the store's connection (see
+    :mod:`.workspace_sync`). Writes need the database
+    (:class:`~workbench.labs.store.database.StoreUnavailable` while it is away)."""
+
+    def __init__(self, rows: Rows) -> None:
+        self.rows = rows
+
+    def put(
+        self,
+        student: str,
+        path: str,
+        data: bytes,
+        mtime: float,
+        limits: WorkspaceLimits = LIMITS,
+        now: datetime | None = None,
+    ) -> FileRow:
+        """Keep ``data`` as ``student``'s workspace file ``path`` within ``limits``;
+        :class:`WorkspaceRefused` says which bound it would pass."""
+        with self.rows.write() as tx:
+            return put(tx, student, path, data, mtime, stamp_of(now), limits)
+
+    def remove(self, student: str, path: str, now: datetime | None = None) -> FileRow | None:
+        """Mark ``student``'s workspace file ``path`` removed; None when it was not kept."""
+        with self.rows.write() as tx:
+            return remove(tx, student, path, stamp_of(now))
+
+    def index(self, student: str) -> dict[str, FileRow]:
+        """The workspace files the store holds for ``student`` (removed ones too), by path."""
+        return index(self.rows.read, student)
+
+    def file(self, student: str, path: str) -> tuple[FileRow, bytes] | None:
+        """One workspace file's row and bytes; None when the store does not hold it."""
+        return content(self.rows.read, student, path)
+
+    def by_digest(self, sha256: str, students: tuple[str, ...]) -> list[tuple[str, str, bytes]]:
+        """The files of ``students`` stored with the digest ``sha256`` (hex)."""
+        return by_digest(self.rows.read, sha256, students)

@@ -7,9 +7,8 @@ again after a decline puts the exercise back at the end of the queue, asking whi
 keeps its place. Because the queue is in the store, the instructor's console sees the requests
 of students on every lab server that shares a PostgreSQL store.
 
-The functions here take a transaction (:class:`~workbench.labs.database.Tx`) or a read
-function; :class:`~workbench.labs.store.Store` gives them theirs (``request_signoff``,
-``signoff_queue``, ...).
+The functions here take a transaction (:class:`~workbench.labs.store.database.Tx`) or a read
+function; :class:`QueueRows` (the store's ``queue``) gives them theirs.
 """
 
 from __future__ import annotations
@@ -20,6 +19,7 @@ from datetime import UTC, datetime
 from typing import Any
 
 from .database import StoreError, Tx
+from .rows import Rows
 
 #: the states of a request
 WAITING, SIGNED, DECLINED, WITHDRAWN = "waiting", "signed", "declined", "withdrawn"
@@ -222,3 +222,54 @@ def state_of(read: Read, student: str, lab: str, exercise: str) -> QueueState:
         (WAITING, entry.requested_at, entry.requested_at, entry.id),
     )
     return QueueState(entry, int(ahead[0][0]) + 1, count)
+
+
+class QueueRows:
+    """The sign-off queue over the store's connection. Every call needs the database:
+    :class:`~workbench.labs.store.database.StoreUnavailable` while it is away."""
+
+    def __init__(self, rows: Rows) -> None:
+        self.rows = rows
+
+    def request(
+        self,
+        student: str,
+        partner: str,
+        driver: str,
+        lab: str,
+        exercise: str,
+        now: datetime | None = None,
+    ) -> QueueState:
+        """Ask for an instructor's sign-off of ``lab``/``exercise``; returns where the request
+        stands (its place in the queue)."""
+        with self.rows.write() as tx:
+            request(tx, student, partner, driver, lab, exercise, now or datetime.now(UTC))
+        return self.state(student, lab, exercise)
+
+    def withdraw(self, student: str, lab: str, exercise: str, now: datetime | None = None) -> bool:
+        """Take back a waiting request; False when none waited."""
+        with self.rows.write() as tx:
+            return withdraw(tx, student, lab, exercise, now or datetime.now(UTC))
+
+    def waiting(self) -> list[QueueEntry]:
+        """The requests that wait for an instructor, first asked first."""
+        return waiting(self.rows.read)
+
+    def state(self, student: str, lab: str, exercise: str) -> QueueState:
+        """Where ``student``'s request for ``lab``/``exercise`` stands."""
+        return state_of(self.rows.read, student, lab, exercise)
+
+    def decline(
+        self, entry_id: int, instructor: str, note: str, now: datetime | None = None
+    ) -> QueueEntry:
+        """Decline a waiting request with a note the student sees; refused when it no longer
+        waits or the note is empty."""
+        with self.rows.write() as tx:
+            return decide(tx, entry_id, DECLINED, instructor, note, now or datetime.now(UTC))
+
+    def mark_signed(
+        self, entry_id: int, instructor: str, now: datetime | None = None
+    ) -> QueueEntry:
+        """Close a waiting request once its exercise is signed off."""
+        with self.rows.write() as tx:
+            return decide(tx, entry_id, SIGNED, instructor, "", now or datetime.now(UTC))

@@ -13,11 +13,11 @@ from typing import Any
 
 from workbench.sim.record import file_sha256
 
-from . import signlog
-from .evidence_text import programs_of
-from .names import NameProblem, check_student
+from .. import signlog
+from ..evidence_text import programs_of
+from ..names import NameProblem, check_student
+from ..store.store import StoredSignoff
 from .signoff_errors import SignoffError
-from .store import StoredSignoff
 
 
 @dataclass(frozen=True)

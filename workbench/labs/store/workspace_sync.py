@@ -238,7 +238,7 @@ def push_path(
         _send(store, user, relpath, root, limits, state)
         if not full.exists():
             inside = relpath + "/"
-            for rel, row in store.workspace_index(user).items():
+            for rel, row in store.workspaces.index(user).items():
                 if rel.startswith(inside) and not row.deleted and not (root / rel).exists():
                     _unsend(store, user, rel, state)
 
@@ -264,14 +264,14 @@ def _send(
     if local is None:
         return _unsend(store, user, relpath, state)
     data, info = local
-    row = store.put_workspace_file(user, relpath, data, info.st_mtime, limits)
+    row = store.workspaces.put(user, relpath, data, info.st_mtime, limits)
     state[relpath] = Seen(row.sha256, row.revision, info.st_size, info.st_mtime_ns)
     return row
 
 
 def _unsend(store: Store, user: str, relpath: str, state: dict[str, Seen]) -> FileRow | None:
     check_path(relpath)
-    row = store.remove_workspace_file(user, relpath)
+    row = store.workspaces.remove(user, relpath)
     state.pop(relpath, None)
     return row
 
@@ -339,7 +339,7 @@ def pull_workspace(
     root.mkdir(parents=True, exist_ok=True, mode=0o700)
     report = SyncReport()
     with _state(root) as state:
-        remote = store.workspace_index(user)
+        remote = store.workspaces.index(user)
         local, problems = local_files(root, limits)
         report.problems.extend(problems)
         for rel in sorted(set(remote) | set(local) | set(state)):
@@ -416,7 +416,7 @@ class _Step:
         self.report.removed.append(rel)
 
     def fetch(self, rel: str) -> None:
-        got = self.store.workspace_file(self.user, rel)
+        got = self.store.workspaces.file(self.user, rel)
         if got is None:
             return
         row, data = got

@@ -17,13 +17,14 @@ from dataclasses import dataclass, replace
 
 from cryptography.exceptions import InvalidSignature
 
-from . import signlog, workspace_rows
-from .database import PostgresBackend
+from .. import signlog
+from ..signlog import Head
+from ..store import workspace_rows
+from ..store.database import PostgresBackend
+from ..store.store import Store, StoredSignoff, StoreError
 from .roster import RosterEntry
-from .signlog import Head
 from .signoff_errors import SignoffError
 from .signoff_record import name_problems, record_digest
-from .store import Store, StoredSignoff, StoreError
 
 #: the copies of a record's run record the course store holds: (student, path, bytes) each
 #: (see :func:`.workspace_rows.evidence_copies`); raises StoreError when it cannot be asked
@@ -223,7 +224,7 @@ def verify_log(
 
 def verify_all(store: Store, roster: dict[str, RosterEntry]) -> list[Verdict]:
     """Every record of an open store, checked with its place in the log."""
-    return list(verify_log(store.signoffs(), roster).verdicts)
+    return list(verify_log(store.signoffs.of(), roster).verdicts)
 
 
 def log_head(rows: list[StoredSignoff]) -> Head:

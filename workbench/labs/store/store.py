@@ -6,7 +6,7 @@ tool can use it at the same time; given a ``postgresql://`` URL (``--db`` or
 ``$WORKBENCH_DB``), one PostgreSQL database that every lab server of a course shares. Every
 write is one transaction, committed before the call returns, so a process killed afterwards
 loses nothing that was already saved. The schema is built by the numbered steps of
-:mod:`workbench.labs.migrations`.
+:mod:`workbench.labs.store.migrations`.
 
 The sign-off table holds the log of :mod:`workbench.labs.signlog`: each record's fields, its
 signature, its sequence number (unique), the hash of the record before it and its own hash.
@@ -19,7 +19,6 @@ checking and exporting.
 from __future__ import annotations
 
 import contextlib
-import json
 import logging
 import os
 import sqlite3
@@ -28,8 +27,7 @@ import urllib.request
 from collections.abc import Callable, Iterator
 from concurrent.futures import Future, ThreadPoolExecutor
 from contextlib import contextmanager
-from dataclasses import dataclass, replace
-from datetime import UTC, datetime
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -37,7 +35,7 @@ import platformdirs
 
 from workbench.files.private import PRIVATE_FILE, private_dir, tighten
 
-from . import queue, workspace_rows
+from ..signlog import GENESIS, entry_hash
 from .database import (
     BUSY_TIMEOUT_MS,
     Backend,
@@ -51,14 +49,26 @@ from .database import (
     resolve_db,
     sqlite_failure,
 )
-from .migrations import RECORD_COLUMNS, SIGNOFF_LOCK, check_version, latest, migrate
-from .names import name_key
+from .instructor_rows import InstructorRows
+from .migrations import RECORD_COLUMNS, check_version, latest, migrate
 from .pending import FIELDS, PendingWrite, load_pending, save_pending
-from .queue import QueueEntry, QueueState
-from .signlog import GENESIS, entry_hash, next_place, parse_metrics, signed_payload
-from .workspace_rows import LIMITS, FileRow, WorkspaceLimits
+from .progress_rows import ProgressRows
+from .queue import QueueRows
+from .rows import utc_iso
+from .signoff_rows import (
+    SIGNOFF_COLUMNS,
+    Event,
+    LockoutState,
+    SignoffRows,
+    StoredSignoff,
+    signoff_from_row,
+)
+from .workspace_rows import WorkspaceRows
 
 __all__ = [
+    "SIGNOFF_COLUMNS",
+    "Event",
+    "LockoutState",
     "LogMissing",
     "Store",
     "StoreDiskError",
@@ -68,6 +78,7 @@ __all__ = [
     "read_signoffs",
     "resolve_data_dir",
     "resolve_db",
+    "utc_iso",
 ]
 
 log = logging.getLogger(__name__)
@@ -76,7 +87,6 @@ APP_NAME = "viple-workbench"
 DB_NAME = "workbench.sqlite3"
 ENV_DATA_DIR = "WORKBENCH_DATA"
 SCHEMA_VERSION = latest("sqlite")
-MAX_SEQ = 2**53  # sequence numbers stay exact wherever the log is kept (JSON, any database)
 #: the table of each kind of write that may be kept pending (its columns: pending.FIELDS)
 TABLES = {"progress": "progress", "place": "places", "driver": "drivers"}
 
@@ -113,83 +123,16 @@ def resolve_data_dir(option: str | os.PathLike | None = None) -> Path:
     return default_data_dir()
 
 
-def utc_iso(moment: datetime) -> str:
-    """A moment as UTC ISO 8601 to the second, e.g. ``2026-02-03T14:05:09Z``."""
-    if moment.tzinfo is None:
-        raise ValueError("times must carry a time zone")
-    return moment.astimezone(UTC).isoformat(timespec="seconds").replace("+00:00", "Z")
-
-
-def _now() -> datetime:
-    return datetime.now(UTC)
-
-
-@dataclass(frozen=True)
-class StoredSignoff:
-    """One row of the sign-off table, exactly as stored (it may have been edited since)."""
-
-    id: int
-    student: str
-    partner: str
-    driver: str
-    lab: str
-    exercise: str
-    instructor: str
-    signed_at: str
-    note: str
-    override: bool
-    run_record: str
-    evidence_digest: str
-    metrics: str
-    signature: str
-    seq: int | None = None
-    prev_hash: str = ""
-    entry_hash: str = ""
-    legacy: bool = False
-
-    def metrics_value(self) -> Any:
-        """The metrics as signed (stored as canonical JSON text); text that is not JSON the
-        workbench writes (not JSON, NaN, nested too deep) as ``{"unreadable": text}``."""
-        return parse_metrics(self.metrics)
-
-    def signed_bytes(self) -> bytes:
-        """The bytes the instructor's signature must cover, rebuilt from the columns."""
-        evidence = {
-            "run_record": self.run_record,
-            "digest": self.evidence_digest,
-            "metrics": self.metrics_value(),
-        }
-        chained = not self.legacy
-        return signed_payload(
-            self.__dict__, evidence, self.seq if chained else None, self.prev_hash
-        )
-
-    def label(self) -> str:
-        """``#SEQ`` (the place in the log), or the row id when the row has no place."""
-        return f"#{self.seq}" if self.seq is not None else f"row id {self.id}"
-
-
-SIGNOFF_COLUMNS = tuple(StoredSignoff.__dataclass_fields__)
-assert SIGNOFF_COLUMNS[1:14] == RECORD_COLUMNS  # the fields, evidence and signature of a record
-
-
-@dataclass(frozen=True)
-class LockoutState:
-    failures: int
-    locked_until: float
-
-
-@dataclass(frozen=True)
-class Event:
-    at: str
-    instructor: str
-    event: str
-    detail: str
-
-
 class Store:
     """The store of one data folder (SQLite) or of a whole course (PostgreSQL, ``db``). Use
     :meth:`open`; close it (or use ``with``).
+
+    The store is the one connection, and what waits for it; what is kept is reached through
+    its repositories, each over the same connection: :attr:`progress` (progress, places,
+    drivers), :attr:`signoffs` (the log, lockouts, events), :attr:`queue` (the sign-off
+    queue), :attr:`workspaces` (the students' files) and, in a course database only,
+    :attr:`instructors` (the roster and sealed keys; ``None`` in SQLite, whose data folder
+    keeps them in files: :func:`workbench.labs.signoff.roster.roster_keys`).
 
     Saving progress, places and drivers never fails because a PostgreSQL server is down: the
     write is kept pending (the newest per exercise) and written by :meth:`flush`; their return
@@ -225,6 +168,11 @@ class Store:
         self._on_trouble: Callable[[StoreError], None] | None = None
         #: what opening the store changed (a data folder open to others made private)
         self.notices: list[str] = []
+        self.progress = ProgressRows(self)
+        self.signoffs = SignoffRows(self)
+        self.queue = QueueRows(self)
+        self.workspaces = WorkspaceRows(self)
+        self.instructors = InstructorRows(self) if backend.postgres else None
 
     @classmethod
     def open(
@@ -287,12 +235,6 @@ class Store:
 
     @property
     def postgres(self) -> bool:
-        return self.backend.postgres
-
-    @property
-    def keeps_roster(self) -> bool:
-        """Whether the instructors' roster and keys are in the database (PostgreSQL), not in
-        the data folder's files."""
         return self.backend.postgres
 
     @property
@@ -375,19 +317,24 @@ class Store:
         self.close()
 
     @contextmanager
-    def _write(self) -> Iterator[Tx]:
+    def write(self) -> Iterator[Tx]:
         """One write transaction; on SQLite taken at once (IMMEDIATE) so writers queue."""
         with self._io:
             self._ensure_schema()
             with self.backend.write() as tx:
                 yield tx
 
-    def _read(self, sql: str, params: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
+    def read(self, sql: str, params: tuple[Any, ...] = ()) -> list[tuple[Any, ...]]:
         with self._io:
             self._ensure_schema()
             return self.backend.read(sql, params)
 
-    def _keep(self, write: PendingWrite) -> bool:
+    def waiting(self) -> list[PendingWrite]:
+        """The writes kept until the database can be reached again, oldest first."""
+        with self._lock:
+            return [w for w, _ in self._pending.values()]
+
+    def keep(self, write: PendingWrite) -> bool:
         """Write one upsert, or keep it pending while the database is away; the newest write
         of a key replaces an older pending one. True when it (and all pending) was written,
         or, writing in the background, when it is on its way (the database was answering)."""
@@ -412,7 +359,7 @@ class Store:
                 return True
             batch = dict(self._pending)
         try:
-            with self._write() as tx:
+            with self.write() as tx:
                 for write, earlier in batch.values():
                     tx.execute(upsert(write.kind, only_newer=earlier), write.values)
         except StoreUnavailable:
@@ -465,359 +412,13 @@ class Store:
             self.pending_file_problem = f"cannot keep the pending writes in {path}: {exc}"
 
     def schema_version(self) -> int:
-        rows = self._read("SELECT value FROM meta WHERE key = 'schema_version'")
+        rows = self.read("SELECT value FROM meta WHERE key = 'schema_version'")
         return int(rows[0][0])
 
     def migrations(self) -> list[tuple[int, str]]:
         """The schema steps applied to this store: (version, name)."""
-        rows = self._read("SELECT version, name FROM schema_migrations ORDER BY version")
+        rows = self.read("SELECT version, name FROM schema_migrations ORDER BY version")
         return [(int(v), str(n)) for v, n in rows]
-
-    # sign-off records
-
-    def append_signoff(
-        self, sign: Callable[[int, str], dict[str, Any]], evidence: bytes | None = None
-    ) -> StoredSignoff:
-        """Add a record at the end of the log. ``sign(seq, prev_hash)`` returns the record's
-        columns (those of :data:`RECORD_COLUMNS`) signed for that place; it is called inside
-        the write transaction, which holds the log (SQLite: the write lock; PostgreSQL: an
-        advisory lock), so two processes signing at once queue and never take the same
-        place. A course database keeps ``evidence``, the bytes of the run record the record
-        rests on, with it (a data folder's records stay on its disk). Returns the row as
-        stored."""
-        postgres = self.backend.postgres
-        with self._write() as tx:
-            if postgres:
-                tx.execute("SELECT pg_advisory_xact_lock(?)", (SIGNOFF_LOCK,))
-            # rows whose seq is not a number were tampered with, and so is a row numbered
-            # far beyond the log: verify names them, and the log goes on after the run of
-            # consecutive numbers it grew by (signlog.next_place)
-            numbered = "seq IS NOT NULL" if postgres else "typeof(seq) = 'integer'"
-            rows = tx.execute(
-                f"SELECT seq, entry_hash FROM signoffs WHERE {numbered} ORDER BY seq"
-            ).fetchall()
-            seq, prev = next_place([(int(s), str(h or "")) for s, h in rows])
-            if seq >= MAX_SEQ:
-                raise StoreError(
-                    f"{self.where}: the sign-off log claims {seq - 1} records, more than it "
-                    "can hold; check it with 'workbench signoff verify'"
-                )
-            values = sign(seq, prev)
-            draft = StoredSignoff(
-                id=0,
-                **{c: values[c] for c in RECORD_COLUMNS},
-                seq=seq,
-                prev_hash=prev,
-            )
-            digest = entry_hash(seq, prev, draft.signed_bytes(), draft.signature)
-            columns = (*RECORD_COLUMNS, "seq", "prev_hash", "entry_hash", "legacy")
-            row = (
-                *(int(values[c]) if c == "override" else values[c] for c in RECORD_COLUMNS),
-                seq,
-                prev,
-                digest,
-                0,
-            )
-            new = tx.execute(
-                f"INSERT INTO signoffs ({', '.join(columns)}) "
-                f"VALUES ({', '.join('?' for _ in columns)}) RETURNING id",
-                row,
-            ).fetchone()
-            row_id = int(new[0])
-            if postgres and evidence is not None and draft.evidence_digest:
-                workspace_rows.keep_evidence(tx, draft.evidence_digest, evidence, utc_iso(_now()))
-        return replace(draft, id=row_id, entry_hash=digest)
-
-    def signoffs(self, student: str | None = None, lab: str | None = None) -> list[StoredSignoff]:
-        """Records in the order they were signed; ``student`` matches either member of a pair."""
-        sql = f"SELECT {', '.join(SIGNOFF_COLUMNS)} FROM signoffs"
-        where: list[str] = []
-        params: list[Any] = []
-        if student:
-            where.append("(student = ? OR partner = ?)")
-            params += [student, student]
-        if lab:
-            where.append("lab = ?")
-            params.append(lab)
-        if where:
-            sql += " WHERE " + " AND ".join(where)
-        sql += " ORDER BY seq IS NULL, seq, id"
-        rows = self._read(sql, tuple(params))
-        return [_signoff_from_row(r, SIGNOFF_COLUMNS) for r in rows]
-
-    # exercise progress
-
-    def save_progress(
-        self,
-        student: str,
-        lab: str,
-        exercise: str,
-        progress: dict[str, Any],
-        now: datetime | None = None,
-    ) -> bool:
-        """Replace the saved progress of one student in one exercise (any JSON object).
-        True when written; False when kept pending (the database is away)."""
-        text = json.dumps(progress, sort_keys=True, allow_nan=False)
-        stamp = utc_iso(now or _now())
-        return self._keep(PendingWrite("progress", (student, lab, exercise, text, stamp)))
-
-    def progress(self, student: str, lab: str | None = None) -> dict[tuple[str, str], dict]:
-        """Saved progress by (lab, exercise), including what is still pending."""
-        sql = "SELECT lab, exercise, progress FROM progress WHERE student = ?"
-        params: tuple[Any, ...] = (student,)
-        if lab:
-            sql += " AND lab = ?"
-            params += (lab,)
-        out: dict[tuple[str, str], dict] = {}
-        for lab_id, exercise, text in self._read(sql, params):
-            try:
-                out[(lab_id, exercise)] = json.loads(text)
-            except json.JSONDecodeError:
-                raise StoreError(
-                    f"{self.where}: the saved progress of {student} in {lab_id}/{exercise} "
-                    "is not JSON"
-                ) from None
-        with self._lock:
-            waiting = [w for w, _ in self._pending.values()]
-        for write in waiting:
-            key = write.key
-            if key[0] == "progress" and key[1] == student and (not lab or key[2] == lab):
-                out[(key[2], key[3])] = json.loads(write.values[3])
-        return out
-
-    def spelling(self, name: str) -> str:
-        """``name`` as the store already spells it when it holds progress, a place or a
-        sign-off of that student with other case or spacing (``alice  doe`` finds
-        ``Alice Doe``); else ``name`` itself."""
-        key = name_key(name)
-        sql = (
-            "SELECT student FROM progress UNION SELECT student FROM places "
-            "UNION SELECT student FROM signoffs"
-        )
-        known = sorted({str(row[0]) for row in self._read(sql, ())})
-        known += sorted({key_[1] for key_ in self._pending if key_[0] in ("progress", "place")})
-        if name in known:
-            return name
-        return next((k for k in known if name_key(k) == key), name)
-
-    # where each student was
-
-    def set_place(self, student: str, lab: str, exercise: str, now: datetime | None = None) -> bool:
-        """Remember the exercise ``student`` has open (the labs reopen there)."""
-        stamp = utc_iso(now or _now())
-        return self._keep(PendingWrite("place", (student, lab, exercise, stamp)))
-
-    def place(self, student: str) -> tuple[str, str] | None:
-        """The (lab, exercise) ``student`` had open last, if any."""
-        pending = self._pending.get(("place", student))
-        if pending is not None:
-            return (pending[0].values[1], pending[0].values[2])
-        rows = self._read("SELECT lab, exercise FROM places WHERE student = ?", (student,))
-        return (rows[0][0], rows[0][1]) if rows else None
-
-    # drivers
-
-    def set_driver(
-        self,
-        student: str,
-        partner: str,
-        lab: str,
-        exercise: str,
-        driver: str,
-        now: datetime | None = None,
-    ) -> bool:
-        """Record who drove (did the typing in) an exercise for a student or a pair."""
-        stamp = utc_iso(now or _now())
-        return self._keep(PendingWrite("driver", (student, partner, lab, exercise, driver, stamp)))
-
-    def drivers(self, student: str, partner: str = "") -> dict[tuple[str, str], str]:
-        rows = self._read(
-            "SELECT lab, exercise, driver FROM drivers WHERE student = ? AND partner = ?",
-            (student, partner),
-        )
-        return {(lab, exercise): driver for lab, exercise, driver in rows}
-
-    # the sign-off queue (see queue.py)
-
-    def request_signoff(
-        self,
-        student: str,
-        partner: str,
-        driver: str,
-        lab: str,
-        exercise: str,
-        now: datetime | None = None,
-    ) -> QueueState:
-        """Ask for an instructor's sign-off of ``lab``/``exercise``; returns where the request
-        stands (its place in the queue). Needs the database: :class:`StoreUnavailable` while
-        it is away."""
-        with self._write() as tx:
-            queue.request(tx, student, partner, driver, lab, exercise, now or _now())
-        return self.queue_state(student, lab, exercise)
-
-    def withdraw_request(
-        self, student: str, lab: str, exercise: str, now: datetime | None = None
-    ) -> bool:
-        """Take back a waiting request; False when none waited."""
-        with self._write() as tx:
-            return queue.withdraw(tx, student, lab, exercise, now or _now())
-
-    def signoff_queue(self) -> list[QueueEntry]:
-        """The requests that wait for an instructor, first asked first."""
-        return queue.waiting(self._read)
-
-    def queue_state(self, student: str, lab: str, exercise: str) -> QueueState:
-        """Where ``student``'s request for ``lab``/``exercise`` stands."""
-        return queue.state_of(self._read, student, lab, exercise)
-
-    def decline_request(
-        self, entry_id: int, instructor: str, note: str, now: datetime | None = None
-    ) -> QueueEntry:
-        """Decline a waiting request with a note the student sees; refused when it no longer
-        waits or the note is empty."""
-        with self._write() as tx:
-            return queue.decide(tx, entry_id, queue.DECLINED, instructor, note, now or _now())
-
-    def mark_signed(
-        self, entry_id: int, instructor: str, now: datetime | None = None
-    ) -> QueueEntry:
-        """Close a waiting request once its exercise is signed off."""
-        with self._write() as tx:
-            return queue.decide(tx, entry_id, queue.SIGNED, instructor, "", now or _now())
-
-    def places(self) -> dict[str, tuple[str, str]]:
-        """The (lab, exercise) every student who has opened one had open last."""
-        rows = self._read("SELECT student, lab, exercise FROM places ORDER BY student")
-        return {str(s): (str(lab), str(ex)) for s, lab, ex in rows}
-
-    # passphrase lockout
-
-    def lockout(self, instructor: str) -> LockoutState:
-        rows = self._read(
-            "SELECT failures, locked_until FROM lockouts WHERE instructor = ?", (instructor,)
-        )
-        if not rows:
-            return LockoutState(0, 0.0)
-        return LockoutState(int(rows[0][0]), float(rows[0][1]))
-
-    def record_failure(
-        self, instructor: str, now: datetime, limit: int, lock_seconds: float
-    ) -> LockoutState:
-        """Count a wrong passphrase; the ``limit``-th in a row locks until now + lock_seconds."""
-        with self._write() as tx:
-            if self.backend.postgres:  # two servers counting one instructor's failures queue
-                tx.execute("SELECT pg_advisory_xact_lock(?)", (SIGNOFF_LOCK + 1,))
-            row = tx.execute(
-                "SELECT failures FROM lockouts WHERE instructor = ?", (instructor,)
-            ).fetchone()
-            failures = (int(row[0]) if row else 0) + 1
-            locked_until = 0.0
-            if failures >= limit:
-                locked_until = now.timestamp() + lock_seconds
-                failures = 0
-            tx.execute(
-                "INSERT INTO lockouts (instructor, failures, locked_until, updated_at) "
-                "VALUES (?, ?, ?, ?) ON CONFLICT (instructor) DO UPDATE SET "
-                "failures = excluded.failures, locked_until = excluded.locked_until, "
-                "updated_at = excluded.updated_at",
-                (instructor, failures, locked_until, utc_iso(now)),
-            )
-        return LockoutState(failures, locked_until)
-
-    def clear_failures(self, instructor: str, now: datetime) -> None:
-        with self._write() as tx:
-            tx.execute(
-                "UPDATE lockouts SET failures = 0, locked_until = 0, updated_at = ? "
-                "WHERE instructor = ?",
-                (utc_iso(now), instructor),
-            )
-
-    def log_event(self, instructor: str, event: str, detail: str, now: datetime) -> None:
-        with self._write() as tx:
-            tx.execute(
-                "INSERT INTO events (at, instructor, event, detail) VALUES (?, ?, ?, ?)",
-                (utc_iso(now), instructor, event, detail),
-            )
-
-    def events(self, instructor: str | None = None) -> list[Event]:
-        sql = "SELECT at, instructor, event, detail FROM events"
-        params: tuple[Any, ...] = ()
-        if instructor:
-            sql += " WHERE instructor = ?"
-            params = (instructor,)
-        return [Event(*r) for r in self._read(sql + " ORDER BY id", params)]
-
-    # the students' workspace files (see workspace_rows.py and workspace_sync.py)
-
-    def put_workspace_file(
-        self,
-        student: str,
-        path: str,
-        data: bytes,
-        mtime: float,
-        limits: WorkspaceLimits = LIMITS,
-        now: datetime | None = None,
-    ) -> FileRow:
-        """Keep ``data`` as ``student``'s workspace file ``path`` within ``limits``;
-        :class:`~.workspace_rows.WorkspaceRefused` says which bound it would pass. Needs the
-        database (:class:`StoreUnavailable` while it is away)."""
-        with self._write() as tx:
-            return workspace_rows.put(tx, student, path, data, mtime, utc_iso(now or _now()),
-                                      limits)  # fmt: skip
-
-    def remove_workspace_file(
-        self, student: str, path: str, now: datetime | None = None
-    ) -> FileRow | None:
-        """Mark ``student``'s workspace file ``path`` removed; None when it was not kept."""
-        with self._write() as tx:
-            return workspace_rows.remove(tx, student, path, utc_iso(now or _now()))
-
-    def workspace_index(self, student: str) -> dict[str, FileRow]:
-        """The workspace files the store holds for ``student`` (removed ones too), by path."""
-        return workspace_rows.index(self._read, student)
-
-    def workspace_file(self, student: str, path: str) -> tuple[FileRow, bytes] | None:
-        """One workspace file's row and bytes; None when the store does not hold it."""
-        return workspace_rows.content(self._read, student, path)
-
-    def workspace_files_by_digest(
-        self, sha256: str, students: tuple[str, ...]
-    ) -> list[tuple[str, str, bytes]]:
-        """The files of ``students`` stored with the digest ``sha256`` (hex)."""
-        return workspace_rows.by_digest(self._read, sha256, students)
-
-    # the instructors' roster (PostgreSQL; a SQLite store keeps it in the data folder)
-
-    def roster_rows(self) -> list[tuple[str, str, str]]:
-        """(name, public key, added) of each instructor in the database's roster."""
-        self._need_roster()
-        rows = self._read("SELECT name, public_key, added FROM instructors ORDER BY added, name")
-        return [(str(n), str(k), str(a)) for n, k, a in rows]
-
-    def instructor_key(self, name: str) -> str | None:
-        """The encrypted key file (JSON text) of an instructor, if the database holds it."""
-        self._need_roster()
-        rows = self._read("SELECT key_file FROM instructors WHERE name = ?", (name,))
-        return str(rows[0][0]) if rows and rows[0][0] is not None else None
-
-    def add_instructor(self, name: str, public_key: str, added: str, key_file: str | None) -> None:
-        """Add an instructor (refused if the name is taken: a roster entry is never replaced)."""
-        self._need_roster()
-        with self._write() as tx:
-            taken = tx.execute("SELECT 1 FROM instructors WHERE name = ?", (name,)).fetchone()
-            if taken:
-                raise StoreError(f"{name} is already in the roster in {self.where}")
-            tx.execute(
-                "INSERT INTO instructors (name, public_key, added, key_file) VALUES (?, ?, ?, ?)",
-                (name, public_key, added, key_file),
-            )
-
-    def _need_roster(self) -> None:
-        if not self.keeps_roster:
-            raise StoreError(
-                f"{self.where}: a SQLite store keeps the roster in the data folder's files"
-            )
-
 
 def _create_database(path: Path) -> None:
     """Make a new, empty workbench database at ``path``, private to the account: built under
@@ -858,19 +459,6 @@ def refuse_empty(path: Path) -> None:
             f"{path}: an empty file (0 bytes), not a workbench database; if the store was "
             f"lost, restore it from a backup, or move the file aside to start a new one"
         )
-
-
-def _signoff_from_row(row: tuple[Any, ...], names: tuple[str, ...]) -> StoredSignoff:
-    data = dict(zip(names, row, strict=True))
-    for name in names:
-        value = data[name]
-        if name in ("override", "legacy"):
-            data[name] = bool(value)
-        elif name == "seq":
-            data[name] = value if isinstance(value, int) else None
-        elif name != "id":
-            data[name] = "" if value is None else str(value)
-    return StoredSignoff(**data)
 
 
 def legacy_chain(rows: list[StoredSignoff]) -> list[StoredSignoff]:
@@ -959,7 +547,7 @@ def _read_log(
     if "seq" in columns:
         sql = f"SELECT {', '.join(SIGNOFF_COLUMNS)} FROM signoffs"
         rows = read(sql + " ORDER BY seq IS NULL, seq, id")
-        return [_signoff_from_row(r, SIGNOFF_COLUMNS) for r in rows]
+        return [signoff_from_row(r, SIGNOFF_COLUMNS) for r in rows]
     names = ("id", *RECORD_COLUMNS)
     rows = read(f"SELECT {', '.join(names)} FROM signoffs ORDER BY id")
-    return legacy_chain([_signoff_from_row(r, names) for r in rows])
+    return legacy_chain([signoff_from_row(r, names) for r in rows])

@@ -1,0 +1,2 @@
+"""Signing off: the record, the instructors' keys and roster, signing, checking the log,
+and the gradebook."""
