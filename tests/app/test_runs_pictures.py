@@ -130,6 +130,8 @@ async def test_the_replay_saves_the_picture_with_the_beams_at_this_tick(tmp_path
 
 @sync
 async def test_the_console_saves_the_evidence_runs_picture(tmp_path, monkeypatch):
+    from textual.widgets import OptionList
+
     from tests.app.console_support import EXERCISE, LAB, save_student
     from tests.app.console_support import until as console_until
     from tests.pictures.records import record_of
@@ -145,12 +147,13 @@ async def test_the_console_saves_the_evidence_runs_picture(tmp_path, monkeypatch
     data = tmp_path / "data"
     with Store.open(data) as store:
         save_student(store, "ana", record=str(record))
-        store.set_place("ben", LAB, EXERCISE)
-        store.request_signoff("ana", "ben", "ben", LAB, EXERCISE)
+        store.progress.set_place("ben", LAB, EXERCISE)
+        store.queue.request("ana", "ben", "ben", LAB, EXERCISE)
     app = ConsoleApp(Store.open(data), load_labs())
     async with app.run_test(size=SIZE) as pilot:
         await console_until(pilot, lambda: isinstance(app.screen, ConsoleScreen), "the console")
-        await console_until(pilot, lambda: app.screen.query("OptionList"), "the queue")
+        queue = lambda: app.screen.query_one("#console-queue", OptionList).options  # noqa: E731
+        await console_until(pilot, lambda: len(queue()) == 1, "the request")
         await pilot.press("enter")
         request = app.screen
         assert isinstance(request, RequestScreen)
