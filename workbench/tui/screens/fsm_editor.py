@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import asyncio
 from collections.abc import Callable
+from pathlib import Path
 from typing import ClassVar
 
 from rich.text import Text
@@ -176,7 +177,8 @@ class FsmEditorScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
                 text = draft.saved
                 if not station.files.allows_writing(draft.path):
                     # a built-in or a starter: its text to start from, saved under a new name
-                    self._status(f"{draft.shown} is shipped: ctrl+s saves your own copy")
+                    name = Path(draft.path).name
+                    self._status(f"{name} comes with the workbench: ctrl+s saves your own copy")
                     draft = FsmDraft(station.files)
             self.draft = draft
         if not text:
