@@ -281,8 +281,21 @@ def evidence_lines(state: ObjectiveState, profile: str = "", unicode: bool = Fal
     if not isinstance(evidence, Mapping) or not evidence:
         return []
     if "run" in evidence and "metrics" in evidence:
-        return run_lines(evidence, profile, unicode)
+        lines = run_lines(evidence, profile, unicode)
+        return lines + _behaved(evidence) if state.kind == "fsm-behaviour" else lines
     return BY_KIND.get(state.kind, _other)(evidence, profile, unicode)
+
+
+def _behaved(evidence: Mapping[str, Any]) -> list[str]:
+    """An ``fsm-behaviour`` pass: what the run's machine was compared with, and where."""
+    trials = [t for t in evidence.get("trials") or [] if isinstance(t, Mapping)]
+    where = ", ".join(
+        f"{t.get('maze', '?')}" + (f" seed {t['seed']}" if t.get("seed") else "") for t in trials
+    )
+    return [
+        f"behaved as {evidence.get('reference', '?')}: {evidence.get('compared', '?')} moves "
+        f"and turns alike on {where or '-'}"
+    ]
 
 
 # -- the programs an exercise's evidence rests on ------------------------------------------
