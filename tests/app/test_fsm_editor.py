@@ -38,6 +38,8 @@ TRANSITIONS = [
     ("Settle", "Left", "front < 50"),
     ("Settle", "Ahead", "timer_done or right <= 100"),
 ]
+#: the one transition the first test types by hand
+LAST = ("Left", "Ahead", "turn_done")
 
 
 def served(tmp_path: Path):
@@ -67,13 +69,14 @@ async def type_text(pilot: Pilot, text: str) -> None:
     await pilot.press(*["space" if c == " " else c for c in text])
 
 
-async def write_right_wall(pilot: Pilot, editor: FsmEditorScreen) -> None:
+async def write_right_wall(pilot: Pilot, editor: FsmEditorScreen, whole: bool = False) -> None:
+    """The right-wall machine through the forms (``whole``: with :data:`LAST` too)."""
     for name, actions in STATES:
         await pilot.press("ctrl+n")
         assert isinstance(pilot.app.screen, StateDialog)
         await fill(pilot, {"state-name": name, "state-actions": actions})
         assert pilot.app.screen is editor, editor.status
-    for source, target, when in TRANSITIONS:
+    for source, target, when in [*TRANSITIONS, *([LAST] if whole else [])]:
         await pilot.press("ctrl+b")
         assert isinstance(pilot.app.screen, TransitionDialog)
         await fill(pilot, {"tr-from": source, "tr-to": target, "tr-when": when})

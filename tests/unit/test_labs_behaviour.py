@@ -67,8 +67,8 @@ def test_a_renamed_reordered_machine_of_the_students_passes(tmp_path):
 
 def test_one_wrong_transition_fails_with_the_first_difference(tmp_path):
     station = station_in(tmp_path)
-    wrong = renamed_and_reordered().replace("front < front_blocked\n        to: Left",
-                                            "front < front_blocked\n        to: Right", 1)  # fmt: skip
+    blocked = "front < front_blocked\n        to: "
+    wrong = renamed_and_reordered().replace(blocked + "Left", blocked + "Right", 1)
     run_file(station, "mine.yaml", wrong)
     state = judged(station)
     assert not state.passed
