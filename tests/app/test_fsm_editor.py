@@ -4,18 +4,21 @@ workspace (undo kept), runs it to the exit and watches the diagram light the sta
 
 from __future__ import annotations
 
+import threading
 from pathlib import Path
 
 from rich.text import Text
 from textual.pilot import Pilot
 from textual.widgets import Input, Static, TextArea
 
-from tests.waiting import until
+from tests.waiting import DEADLINE, until
+from workbench.control.fsm_editing import check
 from workbench.files.workspace import workspace_folder
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.algorithm import AlgorithmModal
 from workbench.tui.dialogs.fsm_form import StateDialog, TransitionDialog
 from workbench.tui.dialogs.path import PathDialog
+from workbench.tui.screens import fsm_editor
 from workbench.tui.screens.fsm_editor import FsmEditorScreen
 from workbench.tui.settings import AppSettings
 
@@ -208,5 +211,55 @@ def test_the_algorithm_dialog_opens_the_chosen_file_in_the_editor(tmp_path):
         assert isinstance(editor, FsmEditorScreen)
         assert editor.text == "initial: A\nstates:\n  A: {}\n"
         assert editor.draft.shown == "~/mine.yaml"
+
+    run(app, body)
+
+
+def test_a_hostile_file_never_holds_the_editor(tmp_path, monkeypatch):
+    """The check runs beside the screen: keys are answered while it works; a file past the
+    limits is one problem and is not saved; a machine of thousands of states is drawn in
+    part."""
+    app, workspace = served(tmp_path)
+    n = 3000
+    big = "initial: S0\nstates:\n" + "".join(
+        f"  S{i}:\n    transitions: [{{to: S{(i + 1) % n}, when: timer_done}}]\n" for i in range(n)
+    )
+    (workspace / "big.yaml").write_text(big)
+    release = threading.Event()
+    started = threading.Event()
+
+    def slow_check(text: str, filename: str):
+        started.set()
+        release.wait(DEADLINE)
+        return check(text, filename)
+
+    monkeypatch.setattr(fsm_editor, "check", slow_check)
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.press("g")
+        app.screen.query_one("#alg-path", Input).value = "big.yaml"
+        await pilot.click("#alg-edit")
+        editor = app.screen
+        assert isinstance(editor, FsmEditorScreen)
+        await until(started.is_set, "the check under way")
+        await pilot.press("ctrl+t")  # answered while the check works
+        assert editor.has_class("-diagram") and editor.checked is None
+        release.set()
+        await checked(pilot, editor)
+        assert problems(editor).startswith(f"No problems: {n} states")
+        assert editor.diagram is not None
+        assert editor.diagram.lines[-1] == f"... and {n - 200} more states, not drawn"
+
+        area = editor.query_one(TextArea)
+        deep = "(" * 60 + "1" + ")" * 60
+        area.load_text(f"initial: A\nstates:\n  A:\n    transitions: [{{to: A, when: '{deep}'}}]\n")
+        await checked(pilot, editor)
+        assert "nest more than 50 deep" in problems(editor)
+        area.load_text("x: 1\n" * 300_000)
+        await checked(pilot, editor)
+        assert "over the 1,048,576 bytes an FSM file may hold" in problems(editor)
+        await pilot.press("ctrl+s")
+        assert "not saved" in editor.status
+        assert (workspace / "big.yaml").read_text() == big
 
     run(app, body)

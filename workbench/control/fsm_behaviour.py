@@ -33,7 +33,7 @@ from .headless import RunResult, RunSetupError, RunSpec, prepare
 #: two command times closer than this are the same control tick, seconds
 _SAME_TICK = 1e-6
 #: the longest a whole comparison may take on the wall clock, seconds
-DEFAULT_DEADLINE = 60.0
+DEFAULT_DEADLINE = 20.0
 
 
 class OutOfTime(Exception):

@@ -38,6 +38,8 @@ _ASCII = {"tl": "+", "tr": "+", "bl": "+", "br": "+", "h": "-", "v": "|",
           "branch": "+", "last": "`", "arrow": "->", "dots": "..."}  # fmt: skip
 #: the narrowest drawing: a box name and an arrow need this much
 MIN_WIDTH = 20
+#: the most states drawn (a file may hold thousands; nobody reads a diagram of them)
+MAX_STATES = 200
 
 
 @dataclass(frozen=True)
@@ -103,6 +105,8 @@ def layout(
     width = max(MIN_WIDTH, width)
     placed = layers_of(definition)
     layer = dict(placed)
+    left_out = len(placed) - MAX_STATES
+    placed = placed[:MAX_STATES]
     states = {s.name: s for s in definition.states}
     lines: list[str] = []
     boxes: dict[str, tuple[int, int]] = {}
@@ -148,6 +152,8 @@ def layout(
                 lines.append(_cut(f"{lead}{guard}", width, ch["dots"]))
                 lines.append(_cut(f"    {ch['arrow']} {tr.target}{mark}", width, ch["dots"]))
             arrows[(name, j)] = (start, len(lines) - 1)
+    if left_out > 0:
+        lines += ["", _cut(f"... and {left_out} more states, not drawn", width, ch["dots"])]
     return Diagram(tuple(lines), boxes, arrows, tuple(placed))
 
 

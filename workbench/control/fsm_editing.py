@@ -40,6 +40,13 @@ class Checked:
 
 def check(text: str, filename: str = NEW_NAME) -> Checked:
     """``text`` read as an FSM file (the FSM limits hold: a text past them is one problem)."""
+    size = len(text.encode("utf-8", "surrogatepass"))
+    if size > FSM_LIMITS.max_bytes:
+        problem = FileProblem(
+            filename, 1, 1, f"the text is {size:,} bytes, over the {FSM_LIMITS.max_bytes:,} "
+            "bytes an FSM file may hold", "keep the machine smaller",
+        )  # fmt: skip
+        return Checked(None, (problem,))
     try:
         return Checked(loads_fsm(text, filename))
     except FsmFileError as exc:

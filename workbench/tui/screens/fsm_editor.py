@@ -142,6 +142,7 @@ class FsmEditorScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         self.lit: tuple[str | None, tuple[str, int] | None] = (None, None)
         self.status = ""
         self._timer: Timer | None = None
+        self._checking = False
         self._opened_text = ""
 
     # -- layout ----------------------------------------------------------------------------
@@ -218,13 +219,20 @@ class FsmEditorScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             self._start_check()
 
     def _start_check(self) -> None:
-        self.run_worker(self._check(self.text), exclusive=True, group="fsm-check")
+        if self._checking:
+            return  # one check at a time: the one under way looks again when it is done
+        self._checking = True
+        self.run_worker(self._check(self.text), group="fsm-check")
 
     async def _check(self, text: str) -> None:
         name = self.draft.shown if self.draft.path else "my-fsm.yaml"
-        checked = await asyncio.to_thread(check, text, name)
+        try:
+            checked = await asyncio.to_thread(check, text, name)
+        finally:
+            self._checking = False
         if text != self.text:
-            return  # typed on meanwhile: the next check has it
+            self._start_check()  # typed on meanwhile: check the text as it is now
+            return
         self.checked = checked
         self.checked_text = text
         self.checks += 1
