@@ -16,7 +16,7 @@ from workbench.control.fsm_editing import check
 from workbench.files.workspace import workspace_folder
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.algorithm import AlgorithmModal
-from workbench.tui.dialogs.fsm_form import StateDialog, TransitionDialog
+from workbench.tui.dialogs.fsm_form import STATE, TRANSITION, FormDialog
 from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.screens import fsm_editor
 from workbench.tui.screens.fsm_editor import FsmEditorScreen
@@ -76,12 +76,13 @@ async def write_right_wall(pilot: Pilot, editor: FsmEditorScreen, whole: bool = 
     """The right-wall machine through the forms (``whole``: with :data:`LAST` too)."""
     for name, actions in STATES:
         await pilot.press("ctrl+n")
-        assert isinstance(pilot.app.screen, StateDialog)
+        assert isinstance(pilot.app.screen, FormDialog) and pilot.app.screen.form is STATE
         await fill(pilot, {"state-name": name, "state-actions": actions})
         assert pilot.app.screen is editor, editor.status
     for source, target, when in [*TRANSITIONS, *([LAST] if whole else [])]:
         await pilot.press("ctrl+b")
-        assert isinstance(pilot.app.screen, TransitionDialog)
+        assert isinstance(pilot.app.screen, FormDialog)
+        assert pilot.app.screen.form is TRANSITION
         await fill(pilot, {"tr-from": source, "tr-to": target, "tr-when": when})
         assert pilot.app.screen is editor, editor.status
 
@@ -95,6 +96,13 @@ def test_write_save_and_run_a_right_wall_machine(tmp_path):
         assert isinstance(editor, FsmEditorScreen)
         await checked(pilot, editor)
         assert "states" in problems(editor)  # a new file has none yet
+        await pilot.press("ctrl+b")  # a transition before its states: refused, saying why
+        await fill(pilot, {"tr-from": "Ahead", "tr-to": "Left"})
+        form = app.screen
+        assert isinstance(form, FormDialog)
+        assert "no state 'Ahead' yet: add it first" in str(form.query_one("#error").render())
+        await pilot.press("escape")
+        assert app.screen is editor
         await write_right_wall(pilot, editor)
 
         # the last transition typed by hand, with a slip first
@@ -206,8 +214,7 @@ def test_the_algorithm_dialog_opens_the_chosen_file_in_the_editor(tmp_path):
         assert isinstance(app.screen, AlgorithmModal)
         app.screen.query_one("#alg-path", Input).value = "mine.yaml"
         await pilot.click("#alg-edit")
-        await pilot.pause()
-        editor = app.screen
+        editor = await until(lambda: isinstance(app.screen, FsmEditorScreen) and app.screen)
         assert isinstance(editor, FsmEditorScreen)
         assert editor.text == "initial: A\nstates:\n  A: {}\n"
         assert editor.draft.shown == "~/mine.yaml"
@@ -239,7 +246,7 @@ def test_a_hostile_file_never_holds_the_editor(tmp_path, monkeypatch):
         await pilot.press("g")
         app.screen.query_one("#alg-path", Input).value = "big.yaml"
         await pilot.click("#alg-edit")
-        editor = app.screen
+        editor = await until(lambda: isinstance(app.screen, FsmEditorScreen) and app.screen)
         assert isinstance(editor, FsmEditorScreen)
         await until(started.is_set, "the check under way")
         await pilot.press("ctrl+t")  # answered while the check works

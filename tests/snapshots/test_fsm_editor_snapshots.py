@@ -37,6 +37,7 @@ def checked_then(*keys: str):
         assert isinstance(screen, FsmEditorScreen)
         await until(lambda: screen.checked_text == screen.text, "the text checked")
         screen.query_one(TextArea).cursor_blink = False
+        screen.set_focus(None)  # no text cursor (blinking or not) in the picture
         await pilot.press(*keys)
         await pilot.pause()
 

@@ -58,7 +58,10 @@ class BehaviourJudge:
     caller's thread, for headless uses)."""
 
     def __init__(
-        self, files: FileAccess | None = None, deadline: float = DEFAULT_DEADLINE, inline=False
+        self,
+        files: FileAccess | None = None,
+        deadline: float = DEFAULT_DEADLINE,
+        inline: bool = False,
     ) -> None:
         self.files = files or FileAccess()
         self.deadline = deadline

@@ -233,7 +233,8 @@ def _edited(evidence: Mapping[str, Any], profile: str, unicode: bool) -> list[st
 
 def _compare(evidence: Mapping[str, Any], profile: str, unicode: bool) -> list[str]:
     lines = []
-    for row in evidence.get("runs") or []:
+    rows = evidence.get("runs")
+    for row in rows if isinstance(rows, list) else []:
         if not isinstance(row, Mapping):
             continue
         m = measures_of(row, profile)
@@ -288,7 +289,8 @@ def evidence_lines(state: ObjectiveState, profile: str = "", unicode: bool = Fal
 
 def _behaved(evidence: Mapping[str, Any]) -> list[str]:
     """An ``fsm-behaviour`` pass: what the run's machine was compared with, and where."""
-    trials = [t for t in evidence.get("trials") or [] if isinstance(t, Mapping)]
+    given = evidence.get("trials")
+    trials = [t for t in given if isinstance(t, Mapping)] if isinstance(given, list) else []
     where = ", ".join(
         f"{t.get('maze', '?')}" + (f" seed {t['seed']}" if t.get("seed") else "") for t in trials
     )

@@ -1,10 +1,11 @@
-"""The FSM editor's forms: add a state, add a transition. Each dismisses with the edited text
-(the edit itself is :mod:`workbench.control.fsm_forms`'), or None when cancelled; an entry
-that cannot be written keeps the dialog open with the reason."""
+"""The FSM editor's forms: add a state, add a transition. A form dismisses with the edited
+text (the edit itself is :mod:`workbench.control.fsm_forms`'), or None when cancelled; an
+entry that cannot be written keeps the dialog open with the reason."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
 
 from textual import on
 from textual.app import ComposeResult
@@ -16,102 +17,74 @@ from workbench.control.fsm_forms import Edited, FormError, add_state, add_transi
 from ..widgets.field import Field
 from .frame import Dialog
 
-STATE_HELP = (
+
+@dataclass(frozen=True)
+class Form:
+    """One form: its title, its help, its fields (id, label, placeholder) and the edit it
+    makes of the text with the values typed."""
+
+    title: str
+    help: str
+    fields: tuple[tuple[str, str, str], ...]
+    edit: Callable[[str, Mapping[str, str]], Edited]
+
+
+STATE = Form(
+    "Add a state",
     "A state and what the robot does on entering it. Actions, separated by ';': "
-    "move: 1 | turn: -90 | wheels: 0.5, 0.5 | stop | timer: 2 | set: turns = turns + 1"
+    "move: 1 | turn: -90 | wheels: 0.5, 0.5 | stop | timer: 2 | set: turns = turns + 1",
+    (("state-name", "Name", "e.g. Forward"), ("state-actions", "Actions", "e.g. move: 1")),
+    lambda text, v: add_state(text, v["state-name"], v["state-actions"]),
 )
-TRANSITION_HELP = (
+TRANSITION = Form(
+    "Add a transition",
     "When the condition holds in the 'from' state, the machine goes to the 'to' state (the "
     "first true one of a state wins; empty: at the next tick). Set: assignments made on the "
-    "way, e.g. turns = turns + 1."
+    "way, e.g. turns = turns + 1.",
+    (
+        ("tr-from", "From", "a state"),
+        ("tr-to", "To", "a state"),
+        ("tr-when", "When", "e.g. front < 50"),
+        ("tr-set", "Set", "e.g. turns = turns + 1"),
+    ),
+    lambda text, v: add_transition(text, v["tr-from"], v["tr-to"], v["tr-when"], v["tr-set"]),
 )
+#: the FSM editor's forms by name
+FORMS = {"state": STATE, "transition": TRANSITION}
 
 
-class _FormDialog(Dialog[Edited | None]):
-    """A titled form of labelled fields; OK runs the edit, which may refuse."""
+class FormDialog(Dialog[Edited | None]):
+    """A form of labelled fields over the FSM text; Add makes its edit, which may refuse."""
 
-    TITLE_TEXT = ""
-    HELP = ""
-    #: (field id, label, placeholder)
-    FIELDS: tuple[tuple[str, str, str], ...] = ()
-
-    def __init__(self, text: str, values: dict[str, str] | None = None) -> None:
+    def __init__(self, form: Form, text: str) -> None:
         super().__init__()
+        self.form = form
         self._text = text
-        self._values = values or {}
 
     def compose(self) -> ComposeResult:
         with Vertical(id="dialog") as box:
-            box.border_title = self.TITLE_TEXT
-            yield Static(self.HELP, classes="help", markup=False)
-            for field_id, label, placeholder in self.FIELDS:
+            box.border_title = self.form.title
+            yield Static(self.form.help, classes="help", markup=False)
+            for field_id, label, placeholder in self.form.fields:
                 with Horizontal(classes="field"):
                     yield Label(label)
-                    yield Field(
-                        self._values.get(field_id, ""),
-                        placeholder=placeholder,
-                        id=field_id,
-                        compact=True,
-                    )
+                    yield Field(placeholder=placeholder, id=field_id, compact=True)
             yield Static("", id="error", classes="-empty", markup=False)
             with Horizontal(id="buttons"):
                 yield Button("Add", id="ok", variant="primary", compact=True)
                 yield Button("Cancel", id="cancel", compact=True)
 
     def on_mount(self) -> None:
-        self.query_one(f"#{self.FIELDS[0][0]}", Input).focus()
-
-    def value(self, field_id: str) -> str:
-        return self.query_one(f"#{field_id}", Input).value
-
-    def edit(self) -> Edited:
-        raise NotImplementedError
+        self.query_one(f"#{self.form.fields[0][0]}", Input).focus()
 
     @on(Input.Submitted)
     @on(Button.Pressed, "#ok")
     def submit(self, event: Input.Submitted | Button.Pressed) -> None:
         event.stop()
+        values = {f[0]: self.query_one(f"#{f[0]}", Input).value for f in self.form.fields}
         try:
-            edited = self.edit()
+            edited = self.form.edit(self._text, values)
         except FormError as exc:
             self.show_error(str(exc))
             return
         self.dismiss(edited)
-
-
-class StateDialog(_FormDialog):
-    TITLE_TEXT = "Add a state"
-    HELP = STATE_HELP
-    FIELDS = (
-        ("state-name", "Name", "e.g. Forward"),
-        ("state-actions", "Actions", "e.g. move: 1"),
-    )
-
-    def edit(self) -> Edited:
-        return add_state(self._text, self.value("state-name"), self.value("state-actions"))
-
-
-class TransitionDialog(_FormDialog):
-    TITLE_TEXT = "Add a transition"
-    HELP = TRANSITION_HELP
-    FIELDS = (
-        ("tr-from", "From", "a state"),
-        ("tr-to", "To", "a state"),
-        ("tr-when", "When", "e.g. front < 50"),
-        ("tr-set", "Set", "e.g. turns = turns + 1"),
-    )
-
-    def edit(self) -> Edited:
-        return add_transition(
-            self._text,
-            self.value("tr-from"),
-            self.value("tr-to"),
-            self.value("tr-when"),
-            self.value("tr-set"),
-        )
-
-
-FORMS: dict[str, Callable[[str, dict[str, str]], _FormDialog]] = {
-    "state": StateDialog,
-    "transition": TransitionDialog,
-}

@@ -35,7 +35,7 @@ from workbench.control.station import LabStation
 from workbench.files.workspace import OutsideWorkspace
 from workbench.sim.session import Snapshot
 
-from ..dialogs.fsm_form import FORMS
+from ..dialogs.fsm_form import FORMS, FormDialog
 from ..dialogs.path import PathDialog
 from ..dialogs.unsaved import Choice, UnsavedDialog
 from ..host import FollowsUnicode, ShowsSnapshot, StationChanged
@@ -253,6 +253,9 @@ class FsmEditorScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             return
         definition = checked.definition
         box = self.query_one("#fsm-diagram-box")
+        if box.display and not box.size.width:
+            self.call_after_refresh(self._draw_diagram)  # not laid out yet: once it is
+            return
         width = max(20, (box.size.width or DIAGRAM_WIDTH) - 2)
         self.diagram = layout(definition, width, self._unicode, state_notes(definition))
         self._light()
@@ -307,10 +310,8 @@ class FsmEditorScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         return (controller.state, arrow)
 
     def on_resize(self, event: Resize) -> None:
-        narrow = event.size.width < SIDE_BY_SIDE
-        if narrow != self.has_class("-narrow"):
-            self.set_class(narrow, "-narrow")
-            self.call_after_refresh(self._draw_diagram)
+        self.set_class(event.size.width < SIDE_BY_SIDE, "-narrow")
+        self.call_after_refresh(self._draw_diagram)  # laid out again for the new width
 
     def action_toggle_diagram(self) -> None:
         showing = not self.has_class("-diagram")
@@ -355,7 +356,7 @@ class FsmEditorScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             area.focus()
             self._status(f"added: line {edited.line + 1}; ctrl+z takes it back")
 
-        self.app.push_screen(FORMS[kind](self.text, {}), done)
+        self.app.push_screen(FormDialog(FORMS[kind], self.text), done)
 
     # -- saving and running -------------------------------------------------------------------
     def _save(self, typed: str | None) -> bool:
