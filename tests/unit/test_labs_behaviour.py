@@ -104,3 +104,14 @@ def test_the_judge_works_beside_the_caller_and_keeps_its_verdict(tmp_path):
     (then,) = evaluate(LAB.id, EXERCISE, station, judge=judge).objectives
     assert then.passed and not judge.busy
     judge.close()
+
+
+def test_a_closed_judge_compares_nothing_more(tmp_path):
+    station = station_in(tmp_path)
+    run_file(station, "mine.yaml", renamed_and_reordered())
+    judge = BehaviourJudge(station.files)
+    judge.close()
+    evaluate(LAB.id, EXERCISE, station, judge=judge)
+    judge.wait(60)
+    (state,) = evaluate(LAB.id, EXERCISE, station, judge=judge).objectives
+    assert not state.passed and "the workbench is closing" in state.reason

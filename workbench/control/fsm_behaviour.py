@@ -148,8 +148,10 @@ class _Watch:
         deadline: float,
         where: tuple[str, int],
         expected: Sequence[Act] | None = None,
+        clock: Callable[[], float] = time.monotonic,
     ) -> None:
         self.inner = inner
+        self.clock = clock
         self.mounts = mounts
         self.deadline = deadline
         self.where = where
@@ -170,7 +172,7 @@ class _Watch:
         return self._note(t, {}, self.inner.start(t))
 
     def tick(self, t: float, readings: dict[str, float], events: frozenset[str]) -> list[Any]:
-        if time.monotonic() > self.deadline:
+        if self.clock() > self.deadline:
             raise OutOfTime
         return self._note(t, readings, self.inner.tick(t, readings, events))
 
@@ -241,6 +243,7 @@ def _run(
     max_time: float | None,
     deadline: float,
     expected: Sequence[Act] | None,
+    clock: Callable[[], float] = time.monotonic,
 ) -> list[Act]:
     spec = RunSpec(
         maze=trial.maze,
@@ -252,9 +255,8 @@ def _run(
     )
     ready = prepare(spec)
     session = ready.session
-    watch = _Watch(
-        ready.driving.controller, _mounts(definition), deadline, (trial.shown, trial.seed), expected
-    )
+    where = (trial.shown, trial.seed)
+    watch = _Watch(ready.driving.controller, _mounts(definition), deadline, where, expected, clock)
     session.attach(watch, dict(session.binding), session.driver)
     try:
         session.run(ready.max_time)
@@ -281,20 +283,20 @@ def compare(
 
     ``sensors`` are the robot's (``KIND:PORT:MOUNT``; none: the reference's own), ``max_time``
     the simulated limit of each run (None: the runner's default for the maze), ``deadline``
-    the wall-clock seconds the whole comparison may take."""
+    the wall-clock seconds the whole comparison may take (by ``clock``, read every tick)."""
     until = clock() + deadline
     shown = tuple(t.shown for t in trials)
     compared = 0
     for trial in trials:
         try:
-            expected = _run(reference, trial, profile, tuple(sensors), max_time, until, None)
+            expected = _run(reference, trial, profile, tuple(sensors), max_time, until, None, clock)
         except OutOfTime:
             return Verdict(False, 0, compared, problem=_slow(deadline), mazes=shown)
         except (RunSetupError, FsmError) as exc:
             return Verdict(False, 0, compared, problem=f"the reference cannot run: {exc}",
                            mazes=shown)  # fmt: skip
         try:
-            _run(student, trial, profile, tuple(sensors), max_time, until, expected)
+            _run(student, trial, profile, tuple(sensors), max_time, until, expected, clock)
         except _Diverged as exc:
             return Verdict(False, len(trials), compared, exc.difference, mazes=shown)
         except OutOfTime:

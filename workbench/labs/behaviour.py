@@ -11,9 +11,11 @@ recent :data:`KEPT` of them), so the same file is judged once.
 
 from __future__ import annotations
 
+import math
+import queue
 import threading
+import time
 from collections import OrderedDict
-from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass
 
 from workbench.control.fsm import FsmDefinition
@@ -68,8 +70,11 @@ class BehaviourJudge:
         self.inline = inline
         self._lock = threading.Lock()
         self._done: OrderedDict[tuple[object, ...], Judged] = OrderedDict()
-        self._pending: dict[tuple[object, ...], Future[Judged]] = {}
-        self._pool: ThreadPoolExecutor | None = None
+        self._pending: dict[tuple[object, ...], Task] = {}
+        self._queue: queue.SimpleQueue[tuple[tuple[object, ...], Task]] = queue.SimpleQueue()
+        self._worker: threading.Thread | None = None
+        self._closed = threading.Event()
+        self._idle = threading.Condition(self._lock)
 
     @property
     def busy(self) -> bool:
@@ -89,30 +94,36 @@ class BehaviourJudge:
             self._keep(key, self.judge(task))
             return self._done[key]
         with self._lock:
-            if self._pool is None:
-                self._pool = ThreadPoolExecutor(1, thread_name_prefix="fsm-behaviour")
-            future = self._pool.submit(self.judge, task)
-            self._pending[key] = future
-        future.add_done_callback(lambda f: self._finished(key, f))
+            self._pending[key] = task
+            if self._worker is None:
+                # a daemon: a comparison under way never holds the app's exit
+                self._worker = threading.Thread(
+                    target=self._work, name="fsm-behaviour", daemon=True
+                )
+                self._worker.start()
+        self._queue.put((key, task))
         return None
 
     def wait(self, timeout: float | None = None) -> None:
-        """Until every pending task is judged (tests, and closing)."""
-        with self._lock:
-            pending = list(self._pending.values())
-        for future in pending:
-            future.result(timeout)
+        """Until every pending task is judged (tests)."""
+        with self._idle:
+            self._idle.wait_for(lambda: not self._pending, timeout)
 
     def close(self) -> None:
-        if self._pool is not None:
-            self._pool.shutdown(wait=False, cancel_futures=True)
+        """No more judging: a comparison under way stops at its next tick (out of time)."""
+        self._closed.set()
 
-    def _finished(self, key: tuple[object, ...], future: Future[Judged]) -> None:
-        try:
-            outcome = future.result()
-        except Exception as exc:  # a bug must not leave the objective checking for ever
-            outcome = Judged(problem=f"could not be compared: {type(exc).__name__}")
-        self._keep(key, outcome)
+    def _clock(self) -> float:
+        return math.inf if self._closed.is_set() else time.monotonic()
+
+    def _work(self) -> None:
+        while True:  # a daemon thread: it ends with the process
+            key, task = self._queue.get()
+            try:
+                outcome = self.judge(task)
+            except Exception as exc:  # a bug must not leave the objective checking for ever
+                outcome = Judged(problem=f"could not be compared: {type(exc).__name__}")
+            self._keep(key, outcome)
 
     def _keep(self, key: tuple[object, ...], outcome: Judged) -> None:
         with self._lock:
@@ -120,9 +131,12 @@ class BehaviourJudge:
             self._done[key] = outcome
             while len(self._done) > KEPT:
                 self._done.popitem(last=False)
+            self._idle.notify_all()
 
     def judge(self, task: Task) -> Judged:
         """Read the student's file (it must still be the one that ran) and compare it."""
+        if self._closed.is_set():
+            return Judged(problem="not compared: the workbench is closing")
         try:
             definition = load_fsm(self.files.for_reading(task.source))
         except (FsmFileError, OutsideWorkspace, OSError):
@@ -140,5 +154,6 @@ class BehaviourJudge:
             task.sensors,
             task.max_time,
             self.deadline,
+            self._clock,
         )
         return Judged(verdict)
