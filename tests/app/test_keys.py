@@ -22,6 +22,7 @@ from workbench.tui.keys import (
     legend_text,
 )
 from workbench.tui.screens.editor import EditorScreen
+from workbench.tui.screens.fsm_editor import FsmEditorScreen
 from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
 from workbench.tui.screens.replay import ReplayScreen
@@ -95,6 +96,7 @@ def test_the_help_explains_the_keys_each_screen_answers():
             "Workbench": MainScreen,
             "Labs (l)": LabsScreen,
             "Maze editor (e)": EditorScreen,
+            "FSM editor (F)": FsmEditorScreen,
             "Runs (R)": RunsScreen,
             "Replay (enter on a run)": ReplayScreen,
         }[heading]

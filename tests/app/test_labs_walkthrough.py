@@ -28,6 +28,7 @@ from textual.widgets import Input, Markdown, OptionList, Select, Static
 from websockets.asyncio.server import serve
 
 from tests.app.labs_support import objective_lines, open_labs, signing_over, try_answer
+from tests.app.test_fsm_editor import write_right_wall
 from tests.integration.test_labs_completable import DRIVE, SOLUTIONS, answer
 from tests.sessions import free_port
 from tests.waiting import DEADLINE, until
@@ -49,6 +50,7 @@ from workbench.tui.dialogs.sensor_ports import SensorPortsModal
 from workbench.tui.dialogs.signoff import SignoffModal
 from workbench.tui.plain import prose
 from workbench.tui.screens.editor import EditorScreen
+from workbench.tui.screens.fsm_editor import FsmEditorScreen
 from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
 from workbench.tui.settings import AppSettings
@@ -264,7 +266,8 @@ class Walkthrough:
             runs.extend(state.evidence.get("runs", []))
         kinds = [o.kind for o in ex.objectives]
         compared = sum(len(o.mazes) * len(o.algorithms) for o in ex.objectives)
-        assert len(runs) == kinds.count("exit") + kinds.count("sensors") + compared, runs
+        judged = kinds.count("fsm-behaviour")
+        assert len(runs) == kinds.count("exit") + kinds.count("sensors") + compared + judged, runs
         for evidence in runs:
             if evidence["driver"] == "keys":  # a drive with the sensors: no run to repeat
                 continue
@@ -287,6 +290,25 @@ class Walkthrough:
             await self.load_maze(lab_maze)
             for name in obj.algorithms:
                 await self.run_builtin(name)
+
+    async def draw_fsm(self) -> None:
+        """The FSM editor (F): the machine drawn through its forms, saved, run to the exit
+        (ctrl+r); the labs screen then waits for the comparison with the reference."""
+        await self.main_screen()
+        await self.press("F")
+        editor = self.app.screen
+        assert isinstance(editor, FsmEditorScreen)
+        await write_right_wall(self.pilot, editor, whole=True)
+        await self.press("ctrl+r")
+        assert isinstance(self.app.screen, PathDialog)
+        self.app.screen.query_one("#path", Input).value = str(self.tmp / "drawn.yaml")
+        await self.press("enter")
+        assert self.station.driving is not None, editor.status
+        await self.run_to_exit()
+        await self.press("escape")
+        screen = await self.labs()
+        await until(lambda: screen.lab_progress.judge is not None and
+                    not screen.lab_progress.judge.busy, "the machine compared")  # fmt: skip
 
     async def drive_keys(self, obj: Objective) -> None:
         await self.main_screen()
@@ -374,6 +396,8 @@ class Walkthrough:
                 await self.reach_exit(ex, obj)
             elif obj.kind == "compare":
                 await self.compare(obj)
+            elif obj.kind == "fsm-behaviour":
+                await self.draw_fsm()
         if {"keys", "maze-edited"} & set(kinds):  # those work on the exercise's own maze
             await self.load_maze(ex.setup.maze)
         for obj in ex.objectives:

@@ -5,14 +5,18 @@ scripted VIPLE program over the real endpoints. Wrong set-ups show the expected 
 from __future__ import annotations
 
 import asyncio
+import tempfile
 from decimal import Decimal
+from pathlib import Path
 
 import pytest
 from websockets.asyncio.server import serve
 
 from tests.sessions import free_port
+from tests.unit.test_labs_behaviour import renamed_and_reordered
 from tests.waiting import DEADLINE, until
 from workbench.control.station import LabStation
+from workbench.labs.behaviour import BehaviourJudge
 from workbench.labs.checks import ExerciseProgress, apply_setup, evaluate
 from workbench.labs.model import Exercise, LabMaze, Objective, Question, load_labs
 from workbench.sim.editing import MazeEditor
@@ -138,11 +142,19 @@ def answer(q: Question) -> str:
     raise AssertionError(f"no answer to {q.id} in the searched range")
 
 
-def complete(station: LabStation, ex: Exercise) -> dict[str, str]:
+def complete(station: LabStation, ex: Exercise, folder: Path | None = None) -> dict[str, str]:
+    """Every objective's work done on ``station`` (a drawn machine is written in ``folder``,
+    else in a temporary folder of its own); the answers to its questions."""
     kinds = {o.kind for o in ex.objectives}
     for obj in ex.objectives:
         if obj.kind == "exit":
             reach_exit(station, ex, obj)
+        elif obj.kind == "fsm-behaviour":
+            drawn = Path(folder or tempfile.mkdtemp()) / "drawn.yaml"  # drawn their own way
+            drawn.write_text(renamed_and_reordered())
+            station.select_algorithm(drawn)
+            station.start()
+            station.step(60)
         elif obj.kind == "compare":
             for maze in obj.mazes:
                 for name in obj.algorithms:
@@ -175,12 +187,13 @@ def complete(station: LabStation, ex: Exercise) -> dict[str, str]:
 
 
 @pytest.mark.parametrize(("lab_id", "ex"), EXERCISES, ids=[f"{lab}/{e.id}" for lab, e in EXERCISES])
-def test_every_exercise_can_be_completed(lab_id, ex):
+def test_every_exercise_can_be_completed(lab_id, ex, tmp_path):
     station = fresh_station(ex)
-    before = evaluate(lab_id, ex, station)
+    judge = BehaviourJudge(station.files, inline=True)
+    before = evaluate(lab_id, ex, station, judge=judge)
     assert not before.passed
-    answers = complete(station, ex)
-    progress = evaluate(lab_id, ex, station, answers)
+    answers = complete(station, ex, tmp_path)
+    progress = evaluate(lab_id, ex, station, answers, judge=judge)
     failed = [(o.text, o.reason) for o in progress.objectives if not o.passed]
     assert failed == [], failed
     assert progress.passed

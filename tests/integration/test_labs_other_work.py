@@ -7,6 +7,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from workbench.control.station import LabStation
+from workbench.labs.behaviour import BehaviourJudge
 from workbench.labs.progress import LabProgress
 
 from .test_labs_completable import EXERCISES, LABS, complete
@@ -20,6 +21,7 @@ def test_the_work_of_one_exercise_never_passes_another(pair, other_set_up_first)
     (lab_id, ex), (other_lab, other) = pair
     station = LabStation.open(ex.setup.maze.maze, ex.setup.profile, noise="off")
     progress = LabProgress("ana", "ben")
+    progress.judge = BehaviourJudge(station.files, inline=True)  # a drawn machine judged at once
     if other_set_up_first:
         progress.set_up(station, LABS[other_lab], other)
     progress.set_up(station, LABS[lab_id], ex)

@@ -170,13 +170,26 @@ KEYS = st.sampled_from(
         "profile",
         "correct",
         "edit",
+        "trials",
+        "reference",
+        "compared",
     ]
 )
 
 
 @given(
     kind=st.sampled_from(
-        ["exit", "sensors", "questions", "keys", "viple", "maze-edited", "compare", "other"]
+        [
+            "exit",
+            "sensors",
+            "questions",
+            "keys",
+            "viple",
+            "maze-edited",
+            "compare",
+            "fsm-behaviour",
+            "other",
+        ]
     ),
     evidence=st.dictionaries(KEYS | st.text(max_size=6), JSON, max_size=6)
     | st.lists(JSON, max_size=2),

@@ -160,7 +160,7 @@ def test_unknown_objective_kind_lists_the_kinds_and_the_exact_line(folder):
         load_lab(path)
     assert str(err.value).endswith(
         ":14:15: exercise 'drive': unknown objective kind 'drive-keys' (hint: use one of keys, "
-        "sensors, viple, exit, maze-edited, compare, questions)"
+        "sensors, viple, exit, maze-edited, compare, questions, fsm-behaviour)"
     )
 
 

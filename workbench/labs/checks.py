@@ -20,12 +20,14 @@ from pathlib import Path
 from typing import Any
 
 from workbench.control.algorithms import ALGORITHM_DIR
+from workbench.control.fsm_behaviour import Trial
 from workbench.control.manual import KEY_NAMES
 from workbench.control.station import UNDER_WAY, Attempt, LabStation, RunEntry
 from workbench.sim.profiles import get_profile
 from workbench.sim.record import file_sha256
 from workbench.sim.sensors import SensorSpec
 
+from .behaviour import BehaviourJudge, Task
 from .model import Exercise, LabMaze, Objective, Setup
 from .store.migrations import REDO_REASON
 
@@ -59,7 +61,12 @@ REDO = REDO_REASON
 #: what a pass of these kinds keeps since it rests on the student's own run or hand edit: a
 #: pass saved without it was judged by the rules before (the set-up's sensors, a shipped
 #: program, Generate) and needs redoing
-OWN_WORK_KEYS = {"sensors": "run", "exit": "sensors", "maze-edited": "hand_blocks"}
+OWN_WORK_KEYS = {
+    "sensors": "run",
+    "exit": "sensors",
+    "maze-edited": "hand_blocks",
+    "fsm-behaviour": "compared",
+}
 
 
 def proven(state: ObjectiveState) -> bool:
@@ -577,6 +584,72 @@ def check_compare(
     return Check(True, f"{len(table)} runs to compare", {ATTEMPT: attempt.id, "runs": table})
 
 
+#: what an ``fsm-behaviour`` objective says while its comparison is under way
+COMPARING = "comparing"
+
+
+def check_fsm_behaviour(
+    obj: Objective,
+    exercise: Exercise,
+    station: LabStation,
+    attempt: Attempt,
+    judge: BehaviourJudge | None,
+) -> Check:
+    """The student's own FSM file, as their latest run of the attempt ran it, behaves as the
+    reference on the objective's mazes and seeds: the same moves and turns at the same
+    times (see :mod:`workbench.control.fsm_behaviour`). A shipped FSM, even renamed, is not
+    the student's; the comparison runs on the judge's thread and the check says so meanwhile."""
+    assert obj.reference is not None
+    profile = exercise.setup.profile
+    reference = obj.reference.name
+    runs = [r for r in attempt_runs(station, attempt) if r.profile == profile and r.source
+            and r.driver.kind == "algorithm"]  # fmt: skip
+    own = [r for r in runs if "fsm" in driver_kinds(r)]
+    if not own:
+        shipped = [r for r in runs if r.bundled]
+        if shipped:
+            last = shipped[-1]
+            return Check(False, f"run {last.number} was {last.bundled}, which comes with the "
+                         "workbench: write your own machine (F) and run it (ctrl+r)")  # fmt: skip
+        return Check(False, f"write your own machine in the FSM editor (F) and run it (ctrl+r): "
+                     f"it is then compared with {reference}")  # fmt: skip
+    run = own[-1]
+    if judge is None:
+        return Check(False, "judged in the app: open the exercise there")
+    sensors = tuple(str(s) for s in (exercise.setup.sensors or get_profile(profile).sensors))
+    trials = tuple(
+        Trial(str(maze.path), maze.name, seed) for maze in obj.mazes for seed in range(obj.seeds)
+    )
+    task = Task(run.source or "", run.program_sha256, obj.reference, trials, profile, sensors,
+                obj.max_time)  # fmt: skip
+    judged = judge.judged(task)
+    if judged is None:
+        return Check(False, f"{COMPARING} run {run.number}'s machine with {reference}...")
+    if judged.problem:
+        return Check(False, f"run {run.number}: {judged.problem}")
+    verdict = judged.verdict
+    assert verdict is not None
+    if verdict.problem:
+        return Check(False, verdict.problem)
+    if not verdict.same:
+        assert verdict.difference is not None
+        unit = get_profile(profile).unit
+        return Check(False, f"run {run.number}'s machine differs from {reference}: "
+                     f"{verdict.difference.words(unit)}")  # fmt: skip
+    evidence = {
+        **run_evidence(run),
+        "reference": reference,
+        "compared": verdict.commands,
+        "trials": [{"maze": t.shown, "seed": t.seed} for t in trials],
+    }
+    return Check(
+        True,
+        f"run {run.number}'s machine did as {reference} did: {verdict.commands} moves and "
+        f"turns alike on {len(trials)} run{'s' * (len(trials) != 1)}",
+        evidence,
+    )
+
+
 def waiting_questions(
     exercise: Exercise, answers: Mapping[str, str], tries: Mapping[str, int]
 ) -> list[str]:
@@ -627,9 +700,11 @@ def check_objective(
     answers: Mapping[str, str] | None = None,
     attempt: Attempt | None = None,
     tries: Mapping[str, int] | None = None,
+    judge: BehaviourJudge | None = None,
 ) -> Check:
     """``obj`` checked against the work of ``attempt`` (the exercise's latest attempt on the
-    station), and the answers given in the exercise (with how often each was tried)."""
+    station), and the answers given in the exercise (with how often each was tried);
+    ``judge`` compares machines for ``fsm-behaviour``."""
     if obj.kind == "questions":
         return check_questions(exercise, answers or {}, tries)
     if attempt is None:
@@ -641,6 +716,7 @@ def check_objective(
         "exit": lambda a: check_exit(obj, exercise, station, a),
         "maze-edited": lambda a: check_maze_edited(exercise, station, a),
         "compare": lambda a: check_compare(obj, exercise, station, a),
+        "fsm-behaviour": lambda a: check_fsm_behaviour(obj, exercise, station, a, judge),
     }
     return by_kind[obj.kind](attempt)
 
@@ -651,14 +727,15 @@ def evaluate(
     station: LabStation,
     answers: Mapping[str, str] | None = None,
     tries: Mapping[str, int] | None = None,
+    judge: BehaviourJudge | None = None,
 ) -> ExerciseProgress:
     """Every objective of ``exercise`` checked against its own work on the station now: the
     work of its latest attempt, and its answers (``tries``: how many times each question was
-    answered)."""
+    answered; ``judge``: compares machines for ``fsm-behaviour``)."""
     attempt = attempt_of(station, lab_id, exercise)
     states = []
     for obj in exercise.objectives:
-        check = check_objective(obj, exercise, station, answers, attempt, tries)
+        check = check_objective(obj, exercise, station, answers, attempt, tries, judge)
         states.append(
             ObjectiveState(obj.kind, obj.text, check.passed, check.reason, check.evidence)
         )

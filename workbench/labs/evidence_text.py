@@ -233,7 +233,8 @@ def _edited(evidence: Mapping[str, Any], profile: str, unicode: bool) -> list[st
 
 def _compare(evidence: Mapping[str, Any], profile: str, unicode: bool) -> list[str]:
     lines = []
-    for row in evidence.get("runs") or []:
+    rows = evidence.get("runs")
+    for row in rows if isinstance(rows, list) else []:
         if not isinstance(row, Mapping):
             continue
         m = measures_of(row, profile)
@@ -281,8 +282,22 @@ def evidence_lines(state: ObjectiveState, profile: str = "", unicode: bool = Fal
     if not isinstance(evidence, Mapping) or not evidence:
         return []
     if "run" in evidence and "metrics" in evidence:
-        return run_lines(evidence, profile, unicode)
+        lines = run_lines(evidence, profile, unicode)
+        return lines + _behaved(evidence) if state.kind == "fsm-behaviour" else lines
     return BY_KIND.get(state.kind, _other)(evidence, profile, unicode)
+
+
+def _behaved(evidence: Mapping[str, Any]) -> list[str]:
+    """An ``fsm-behaviour`` pass: what the run's machine was compared with, and where."""
+    given = evidence.get("trials")
+    trials = [t for t in given if isinstance(t, Mapping)] if isinstance(given, list) else []
+    where = ", ".join(
+        f"{t.get('maze', '?')}" + (f" seed {t['seed']}" if t.get("seed") else "") for t in trials
+    )
+    return [
+        f"behaved as {evidence.get('reference', '?')}: {evidence.get('compared', '?')} moves "
+        f"and turns alike on {where or '-'}"
+    ]
 
 
 # -- the programs an exercise's evidence rests on ------------------------------------------

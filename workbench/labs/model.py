@@ -17,7 +17,7 @@ from typing import Any
 
 import yaml
 
-from workbench.control.algorithms import list_algorithms
+from workbench.control.algorithms import list_algorithms, load_algorithm
 from workbench.control.fsmdef import FsmDefinition
 from workbench.control.fsmfile import FsmFileError, load_fsm
 from workbench.control.manual import DRIVE_KEYS
@@ -38,7 +38,16 @@ from workbench.sim.sensors import SensorConfigError, SensorSpec, check_ports
 
 #: the folder of the bundled labs (next to ``mazes/``)
 LABS_DIR = Path(__file__).resolve().parents[2] / "labs"
-OBJECTIVE_KINDS = ("keys", "sensors", "viple", "exit", "maze-edited", "compare", "questions")
+OBJECTIVE_KINDS = (
+    "keys",
+    "sensors",
+    "viple",
+    "exit",
+    "maze-edited",
+    "compare",
+    "questions",
+    "fsm-behaviour",
+)
 CONTROLLER_KINDS = ("keys", "algorithm", "starter", "viple")
 #: the speeds a set-up may ask for (the app's speed key steps through the same)
 SETUP_SPEEDS: dict[str, float | None] = {"1": 1.0, "2": 2.0, "4": 4.0, "10": 10.0, "max": None}
@@ -226,6 +235,10 @@ class Objective:
     #: ``sensors:``, else the exercise's ``sensors`` objective's, else the set-up's; None:
     #: any, when the exercise names none)
     run_sensors: tuple[SensorSpec, ...] | None = None
+    #: ``fsm-behaviour``: the built-in machine the student's must behave as (as read when the
+    #: lab was loaded), on ``mazes`` with seeds 0..seeds-1
+    reference: FsmDefinition | None = field(default=None, compare=False)
+    seeds: int = 1
 
 
 @dataclass(frozen=True)
@@ -427,7 +440,7 @@ def _exercise(r: _Reader, node: yaml.Node) -> Exercise:
         r.text(keys["title"], where),
         r.text(keys["instructions"], where),
         setup,
-        _with_run_sensors(objectives, setup),
+        _with_mazes(_with_run_sensors(objectives, setup), setup),
         questions,
         grading=_grading(r, keys["grading"], where) if "grading" in keys else None,
     )
@@ -448,6 +461,15 @@ def _max_tries(r: _Reader, node: yaml.Node, where: str) -> int:
             "write how many answers a student may try, e.g. 'max_tries: 3'",
         )
     return int(value)
+
+
+def _with_mazes(objectives: tuple[Objective, ...], setup: Setup) -> tuple[Objective, ...]:
+    """The exercise's ``fsm-behaviour`` objectives with the set-up's maze where they name
+    none."""
+    return tuple(
+        replace(o, mazes=(setup.maze,)) if o.kind == "fsm-behaviour" and not o.mazes else o
+        for o in objectives
+    )
 
 
 def _with_run_sensors(objectives: tuple[Objective, ...], setup: Setup) -> tuple[Objective, ...]:
@@ -539,6 +561,7 @@ _OBJECTIVE_KEYS: dict[str, tuple[tuple[str, ...], tuple[str, ...]]] = {
     "maze-edited": ((), ()),
     "compare": (("algorithms", "mazes"), ()),
     "questions": ((), ()),
+    "fsm-behaviour": (("reference",), ("mazes", "seeds", "max_time")),
 }
 
 
@@ -585,7 +608,51 @@ def _objective(r: _Reader, node: yaml.Node, where: str) -> Objective:
     if kind == "compare":
         mazes = tuple(r.maze(n, here) for n in r.items(keys["mazes"], here))
         return Objective(kind, text, algorithms=r.texts(keys["algorithms"], here), mazes=mazes)
+    if kind == "fsm-behaviour":
+        return _behaviour(r, keys, kind, text, here)
     return Objective(kind, text)
+
+
+#: the most simulated seconds one run of an ``fsm-behaviour`` comparison may take
+MAX_BEHAVIOUR_TIME = 600.0
+#: the most seeds and mazes one comparison runs (each run is two machines' runs)
+MAX_BEHAVIOUR_RUNS = 10
+
+
+def _behaviour(
+    r: _Reader, keys: dict[str, yaml.Node], kind: str, text: str, here: str
+) -> Objective:
+    """An ``fsm-behaviour`` objective: the reference is a built-in algorithm's name; the
+    mazes default to the set-up's (filled in by :func:`_exercise`)."""
+    name = r.text(keys["reference"], here)
+    if name not in list_algorithms():
+        r.fail(keys["reference"], here, f"no built-in algorithm {name!r}",
+               f"use one of {', '.join(list_algorithms())}")  # fmt: skip
+    reference = load_algorithm(name)
+    mazes = tuple(r.maze(n, here) for n in r.items(keys["mazes"], here)) if "mazes" in keys else ()
+    seeds = 1
+    if "seeds" in keys:
+        value = r.number(keys["seeds"], f"{here}: seeds", minimum=1)
+        if value != int(value) or value > MAX_BEHAVIOUR_RUNS:
+            r.fail(keys["seeds"], here, f"seeds must be a whole number from 1 to "
+                   f"{MAX_BEHAVIOUR_RUNS}", "write e.g. 'seeds: 2'")  # fmt: skip
+        seeds = int(value)
+    if len(mazes or (None,)) * seeds > MAX_BEHAVIOUR_RUNS:
+        r.fail(keys["seeds"] if "seeds" in keys else keys["mazes"], here,
+               f"mazes times seeds is over {MAX_BEHAVIOUR_RUNS} runs",
+               "compare on fewer mazes or seeds")  # fmt: skip
+    max_time = None
+    if "max_time" in keys:
+        max_time = r.number(keys["max_time"], f"{here}: max_time")
+        if not 0 < max_time <= MAX_BEHAVIOUR_TIME:
+            r.fail(
+                keys["max_time"],
+                here,
+                f"max_time must be above 0 and at most {MAX_BEHAVIOUR_TIME:g}",
+                "write simulated seconds, e.g. 'max_time: 120'",
+            )
+    return Objective(kind, text, mazes=mazes, reference=reference, seeds=seeds,
+                     max_time=max_time)  # fmt: skip
 
 
 def _question(r: _Reader, node: yaml.Node, where: str, max_tries: int | None = None) -> Question:

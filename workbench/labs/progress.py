@@ -23,6 +23,7 @@ from typing import Any, Literal
 from workbench.control.station import LabStation
 from workbench.sim.profiles import PROFILES
 
+from .behaviour import BehaviourJudge
 from .checks import (
     ExerciseProgress,
     ObjectiveState,
@@ -144,6 +145,9 @@ class LabProgress:
     #: the saved work is being read (:func:`read_work`): a front end opens no exercise (so
     #: checks and saves nothing over that work) until :meth:`take_work` has it
     reading: bool = False
+    #: compares a student's machine with an exercise's reference (``fsm-behaviour``), made
+    #: at the first check with the station's file rules
+    judge: BehaviourJudge | None = field(default=None, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         self.driver = self.driver or self.student
@@ -213,8 +217,15 @@ class LabProgress:
         saved before kept (and every pass saved without evidence still needing redoing)."""
         key = (lab_id, exercise.id)
         exercise = exercise.with_shown(shown_values(station))
+        if self.judge is None:
+            self.judge = BehaviourJudge(station.files)
         live = evaluate(
-            lab_id, exercise, station, self.answers.get(key, {}), self.tries.get(key, {})
+            lab_id,
+            exercise,
+            station,
+            self.answers.get(key, {}),
+            self.tries.get(key, {}),
+            self.judge,
         )
         return keep_passed(self.saved.get(key), live)
 

@@ -67,6 +67,7 @@ from .host import (
 from .keys import APP_KEY_IDS, bindings
 from .screens.arrival import ArrivalScreen
 from .screens.editor import EditorScreen
+from .screens.fsm_editor import FsmEditorScreen
 from .screens.labs import LabsScreen, StoreNews
 from .screens.main import MainScreen
 from .screens.runs import RunsScreen
@@ -165,11 +166,14 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
         #: the maze the message line last named
         self._maze_named = station.maze
         #: the screens a screen may ask for (OpenScreen), each with the way it opens
+        #: the file the FSM editor is asked to open ("" its own choice)
+        self._fsm_path = ""
         self._screens: dict[ScreenName, Callable[[], None]] = {
             "main": self._open_main,
             "editor": self._open_editor,
             "runs": self._open_runs,
             "labs": self._open_labs,
+            "fsm": self._open_fsm_editor,
         }
 
     def who(self) -> str:
@@ -459,6 +463,7 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
         self.set_up_done(message.setup)
 
     def on_open_screen(self, message: OpenScreen) -> None:
+        self._fsm_path = message.path
         self._screens[message.screen]()
 
     def on_start_endpoint(self, message: StartEndpoint) -> None:
@@ -476,6 +481,15 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
         writable = path is not None and self.station.files.allows_writing(path)
         saves_to = str(path) if writable else None
         self.push_screen(EditorScreen(self.station, saves_to, unicode=self.unicode), self._edited)
+
+    def _open_fsm_editor(self) -> None:
+        """The FSM editor on the file asked for, else the chosen algorithm's file (a built-in
+        opens as the text of a copy to save), else a new machine."""
+        path = self._fsm_path
+        algorithm = self.station.algorithm
+        if not path and algorithm is not None and algorithm.source:
+            path = algorithm.source
+        self.push_screen(FsmEditorScreen(self.station, path, unicode=self.unicode))
 
     def _edited(self, maze: Maze | None) -> None:
         self.maze_changed()
@@ -606,7 +620,11 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
 
     async def action_quit(self) -> None:
         """Quit; an editor with unsaved changes asks first (save / discard / cancel)."""
-        editors = [s for s in self.screen_stack if isinstance(s, EditorScreen) and s.dirty]
+        editors = [
+            s
+            for s in self.screen_stack
+            if isinstance(s, EditorScreen | FsmEditorScreen) and s.dirty
+        ]
         if editors:
             editors[-1].ask_before(lambda: self.run_worker(self._shut_down()))
         else:

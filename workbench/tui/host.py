@@ -28,7 +28,7 @@ from .plain import PlainCommandPalette, follow
 
 ReturnType = TypeVar("ReturnType")
 #: the screens a screen may ask the app to open
-ScreenName = Literal["editor", "runs", "labs", "main"]
+ScreenName = Literal["editor", "runs", "labs", "main", "fsm"]
 
 
 class ShowsSnapshot:
@@ -109,11 +109,13 @@ class SetUpDone(Message):
 
 
 class OpenScreen(Message):
-    """Open one of the app's screens over the current one."""
+    """Open one of the app's screens over the current one (``path``: the file it opens, for
+    the FSM editor; "" its own choice)."""
 
-    def __init__(self, screen: ScreenName) -> None:
+    def __init__(self, screen: ScreenName, path: str = "") -> None:
         super().__init__()
         self.screen = screen
+        self.path = path
 
 
 class StartEndpoint(Message):

@@ -31,7 +31,7 @@ from workbench.program.problems import ProgramError
 from workbench.sim.sensors import SensorConfigError
 from workbench.sim.session import Snapshot
 
-from ..host import Say, ShowsSnapshot, StationChanged
+from ..host import OpenScreen, Say, ShowsSnapshot, StationChanged
 from ..keys import bindings
 from ..plain import drawn_in_unicode, prose
 from ..widgets.field import Field
@@ -88,6 +88,12 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
     AlgorithmModal #alg-path {
         margin: 0;
     }
+    AlgorithmModal #alg-file-buttons {
+        height: 1;
+    }
+    AlgorithmModal #alg-file-buttons Button {
+        margin-right: 1;
+    }
     AlgorithmModal Button {
         min-width: 0;
         width: auto;
@@ -138,7 +144,7 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
     """
 
     BINDINGS: ClassVar[list[BindingType]] = [
-        *bindings("dialog.close", "algorithm.fix", "algorithm.defaults")
+        *bindings("dialog.close", "algorithm.fix", "algorithm.defaults", "algorithm.edit")
     ]
 
     def __init__(self, station: LabStation) -> None:
@@ -150,7 +156,7 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
     def compose(self) -> ComposeResult:
         dialog = Vertical(id="alg-dialog")
         dialog.border_title = "Algorithm"
-        dialog.border_subtitle = "enter picks, f fits sensors, escape closes"
+        dialog.border_subtitle = "enter picks, f fits sensors, E edits, escape closes"
         names = list_algorithms()
         with dialog:
             with Horizontal(id="alg-top"):
@@ -161,7 +167,9 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
                     files = self.station.files
                     example = "~/my.yaml or ~/my.viple" if files.confined else "fsm.yaml, x.viple"
                     yield Field(placeholder=example, compact=True, id="alg-path")
-                    yield Button("Load file", compact=True, id="alg-load")
+                    with Horizontal(id="alg-file-buttons"):
+                        yield Button("Load file", compact=True, id="alg-load")
+                        yield Button("Edit", compact=True, id="alg-edit")
                 with VerticalScroll(id="alg-details"):
                     yield Static(id="alg-title", markup=False)
                     yield Static(id="alg-problems", markup=False)
@@ -370,6 +378,19 @@ class AlgorithmModal(ShowsSnapshot, ModalScreen[None]):
         if await self.choose(text):
             # the path is done with: the dialog's keys (f fits the sensors) act on the dialog
             self.query_one("#alg-start", Button).focus()
+
+    @on(Button.Pressed, "#alg-edit")
+    def _edit_file(self) -> None:
+        """The FSM editor on the file typed (else the chosen algorithm's, else a new one)."""
+        self.action_edit_fsm()
+
+    def action_edit_fsm(self) -> None:
+        typed = self.query_one("#alg-path", Input).value.strip()
+        if typed and is_program_path(typed):
+            self._error("a VIPLE program is edited in VIPLE: the FSM editor takes YAML files")
+            return
+        self.dismiss()
+        self.post_message(OpenScreen("fsm", typed))
 
     @on(ParamEditor.Edited)
     def _param_edited(self, event: ParamEditor.Edited) -> None:

@@ -32,6 +32,7 @@ from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical, VerticalScroll
 from textual.message import Message
 from textual.screen import Screen
+from textual.timer import Timer
 from textual.widget import Widget
 from textual.widgets import Input, Markdown, OptionList, RadioSet, Static
 from textual.widgets.option_list import Option
@@ -97,6 +98,8 @@ NEWS_WORDS: dict[type, Callable[[Any], str]] = {
 }
 #: what the screen shows until the saved work is read
 LOADING = "loading saved work…"
+#: how often the screen looks again while an FSM is compared with its reference, seconds
+JUDGING_POLL = 0.25
 
 
 def speed_words(speed: float | None) -> str:
@@ -218,6 +221,8 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
         #: what the student (or pair) has done in the labs (read from the store first)
         self.lab_progress = LabProgress(student, partner, reading=True)
         self._problem = ""
+        #: the timer that looks again while a machine is compared (None: none waiting)
+        self._judging: Timer | None = None
         if labs is None:
             try:
                 labs = load_labs()
@@ -628,7 +633,16 @@ class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             if self._ready and self.lab_progress.mark(key) != mark:
                 self._refresh_list()
         self.progress = progress
+        judge = self.lab_progress.judge
+        if judge is not None and judge.busy and self._judging is None:
+            # a machine is being compared beside the screen: look again until it is done
+            self._judging = self.set_timer(JUDGING_POLL, self._judged)
         return progress
+
+    def _judged(self) -> None:
+        self._judging = None
+        if self.is_mounted:
+            self.show_snapshot(self.station.snapshot())
 
     def show_snapshot(self, snapshot: Snapshot) -> None:
         if not self._ready:

@@ -464,6 +464,9 @@ class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, Quick
     def action_runs(self) -> None:
         self.post_message(OpenScreen("runs"))
 
+    def action_fsm_editor(self) -> None:
+        self.post_message(OpenScreen("fsm"))
+
     def action_labs(self) -> None:
         self.post_message(OpenScreen("labs"))
 
