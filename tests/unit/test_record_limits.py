@@ -201,7 +201,7 @@ def test_serve_ssh_hands_its_record_caps_to_every_session_s_app(tmp_path):
     from workbench.cli import build_parser
     from workbench.control.recording import RecordQuota
     from workbench.ssh.appproc import AppSpec
-    from workbench.tui.settings import AppSettings
+    from workbench.wire.settings import AppSettings
 
     parser = build_parser()
     args = parser.parse_args(["serve-ssh", "--record-cap", "5M", "--runs-quota", "0"])

@@ -26,8 +26,8 @@ from workbench.ssh.passwords import (
     verify_password,
 )
 from workbench.ssh.ports import PoolExhausted, PortPool, parse_range, port_is_free
-from workbench.tui.serving import packets
-from workbench.tui.settings import AppSettings
+from workbench.wire import packets
+from workbench.wire.settings import AppSettings
 
 
 # -- passwords ------------------------------------------------------------------------------

@@ -13,7 +13,7 @@ from workbench import __version__
 from workbench.files.bundled import default_maze_path
 from workbench.files.terminal import TerminalSafeWriter
 from workbench.labs.store import StoreError, resolve_db
-from workbench.tui.settings import AppSettings
+from workbench.wire.settings import AppSettings
 
 from . import algorithms as algorithms_cmd
 from . import grade as grade_cmd

@@ -22,8 +22,8 @@ from typing import TYPE_CHECKING
 
 from workbench.control.recording import RecordQuota
 from workbench.files.workspace_files import UploadLimits
-from workbench.tui.serving import packets
-from workbench.tui.settings import AppSettings
+from workbench.wire import packets
+from workbench.wire.settings import AppSettings
 
 from .applog import AppLog, ErrorPipe, read_errors
 

@@ -63,6 +63,7 @@ PRELOAD_PACKAGES = (
     "workbench.control",
     "workbench.viple",
     "workbench.labs",
+    "workbench.wire",
     "workbench.tui",
 )
 MAX_MESSAGE = 1 << 20

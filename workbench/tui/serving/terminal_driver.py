@@ -40,8 +40,9 @@ from textual._xterm_parser import XTermParser
 from textual.app import App
 from textual.drivers.web_driver import WebDriver, _ExitInput
 
+from workbench.wire.packets import DATA, PacketReader
+
 from .key_budget import KeyBudget, dropped_message
-from .packets import DATA, PacketReader
 
 #: how long to wait while the parser's own time limit cannot be read (Textual's interval)
 FALLBACK_WAIT = 0.1

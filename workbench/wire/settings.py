@@ -8,7 +8,8 @@ command line of a new process, and the app reads it back with :meth:`AppSettings
 :func:`workbench.tui.app.make_app` takes it and checks what only the app can check (the maze
 file, the names, the profile and noise level).
 
-This module imports no Textual (an import-linter contract keeps it so): the lab server reads it.
+It is part of the wire (``workbench/wire/``), which imports no Textual (an import-linter
+contract keeps it so): the lab server reads it without importing the app.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Textual's web-driver packets, the protocol between the server and an app process.
 
-The app (run with Textual's web driver, :class:`.terminal_driver.ServedTerminalDriver`) writes
+The app (run with Textual's web driver, ``workbench.tui.serving.terminal_driver``) writes
 the line ``__GANGLION__`` on its standard output, then packets: one type byte (``D`` terminal
 output, ``M`` JSON meta data, ``P`` binary-encoded data), a 4-byte big-endian length and the
 payload.
