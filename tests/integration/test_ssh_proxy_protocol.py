@@ -14,7 +14,7 @@ import asyncssh
 
 from tests.app.support import sync
 from tests.waiting import until
-from workbench.ssh.logins import LoginPolicy
+from workbench.door.logins import LoginPolicy
 from workbench.ssh.proxy_protocol import parse_networks
 
 from ..unit.test_proxy_protocol import v2

@@ -11,7 +11,7 @@ import pytest
 
 from workbench.cli import app_settings, build_parser
 from workbench.cli.served import run
-from workbench.ssh.appproc import AppSpec
+from workbench.door.appproc import AppSpec
 from workbench.wire.settings import AppSettings, SettingsError
 
 

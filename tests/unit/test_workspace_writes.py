@@ -8,9 +8,9 @@ from pathlib import Path
 
 import pytest
 
+from workbench.door.appproc import AppSpec
 from workbench.files.workspace import FileAccess, NoRoom, OutsideWorkspace
 from workbench.files.workspace_files import UploadLimits, WorkspaceError, WorkspaceFiles
-from workbench.ssh.appproc import AppSpec
 from workbench.wire.settings import AppSettings
 
 

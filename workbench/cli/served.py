@@ -1,6 +1,6 @@
 """The app of one SSH session, started from the settings the lab server made for it.
 
-The lab server (``workbench/ssh/appproc.py``) hands a session's app its settings as one JSON
+The lab server (``workbench/door/appproc.py``) hands a session's app its settings as one JSON
 object (:meth:`workbench.wire.settings.AppSettings.to_json`), the workbench for a student and
 the instructor's console (:mod:`workbench.tui.console_app`) for an instructor: to :func:`main`
 in a process forked from the fork server, or as the one argument of

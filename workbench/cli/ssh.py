@@ -13,6 +13,9 @@ import sys
 from pathlib import Path
 
 from workbench.control.recording import RecordQuota
+from workbench.door.appproc import AppEntry
+from workbench.door.limits import SessionLimits
+from workbench.door.serverlog import SERVER_LOG_SIZE
 from workbench.files.workspace_files import UploadLimits
 from workbench.labs.database import ENV_DB, redact
 from workbench.labs.store import (
@@ -23,9 +26,6 @@ from workbench.labs.store import (
     resolve_data_dir,
     resolve_db,
 )
-from workbench.ssh.appproc import AppEntry
-from workbench.ssh.limits import SessionLimits
-from workbench.ssh.serverlog import SERVER_LOG_SIZE
 
 from .common import db_option, record_quota_options, size, upload_options
 
@@ -211,7 +211,7 @@ def fail(command: str, message: str) -> int:
 
 
 def _users_file(args: argparse.Namespace) -> Path:
-    from workbench.ssh.users import users_path
+    from workbench.door.users import users_path
 
     return Path(args.users) if args.users else users_path(resolve_data_dir(args.data_dir))
 
@@ -220,7 +220,7 @@ def _users_file(args: argparse.Namespace) -> Path:
 def read_new_password() -> str:
     """Asked twice on a terminal; without one, the first line of standard input (for scripts;
     a second line, if given, must repeat it)."""
-    from workbench.ssh.passwords import MIN_PASSWORD, PasswordError, check_password
+    from workbench.door.passwords import MIN_PASSWORD, PasswordError, check_password
 
     if not sys.stdin.isatty():
         lines = sys.stdin.read().splitlines()
@@ -237,8 +237,8 @@ def read_new_password() -> str:
 
 
 def cmd_add_user(args: argparse.Namespace) -> int:
-    from workbench.ssh.passwords import PasswordError, hash_password
-    from workbench.ssh.users import UsersFileError, add_user, parse_public_key
+    from workbench.door.passwords import PasswordError, hash_password
+    from workbench.door.users import UsersFileError, add_user, parse_public_key
 
     path = _users_file(args)
     keys: list[str] = []
@@ -272,7 +272,7 @@ def cmd_add_user(args: argparse.Namespace) -> int:
 
 
 def cmd_list_users(args: argparse.Namespace) -> int:
-    from workbench.ssh.users import UsersFileError, load_users
+    from workbench.door.users import UsersFileError, load_users
 
     path = _users_file(args)
     try:
@@ -294,12 +294,12 @@ def cmd_list_users(args: argparse.Namespace) -> int:
 
 # -- the server -------------------------------------------------------------------------------
 def cmd_serve(args: argparse.Namespace) -> int:
+    from workbench.door.logins import LoginPolicy
+    from workbench.door.ports import parse_range
+    from workbench.door.serverlog import setup_logging
+    from workbench.door.users import UsersFileError
     from workbench.ssh.hostkey import HostKeyError
-    from workbench.ssh.logins import LoginPolicy
-    from workbench.ssh.ports import parse_range
     from workbench.ssh.server import LabServer, ServerConfig
-    from workbench.ssh.serverlog import setup_logging
-    from workbench.ssh.users import UsersFileError
 
     if not 0 <= args.port <= 65535:
         return fail(

@@ -17,19 +17,31 @@ from pathlib import Path
 import asyncssh
 
 from workbench.control.recording import RecordQuota, shown_size
+from workbench.door.applog import make_room
+from workbench.door.appproc import (
+    RESTORE_TERMINAL,
+    AppEntry,
+    AppProcess,
+    AppSpec,
+    app_env,
+    forward_hint,
+)
+from workbench.door.forkserver import ForkServer, ForkServerError
+from workbench.door.limits import SessionLimits, describe_duration, describe_memory
+from workbench.door.logins import ConnectionGate, Eviction, LoginGuard, LoginPolicy, QuietLog, Stage
+from workbench.door.memory import SHORT_OF_MEMORY, MemoryWatch
+from workbench.door.passwords import hash_password, verify_password
+from workbench.door.ports import PoolExhausted, PortPool
+from workbench.door.serverlog import shown
+from workbench.door.sources import source_of
+from workbench.door.users import User, UsersFile, users_path
 from workbench.files.workspace import workspace_folder
 from workbench.files.workspace_files import UploadLimits
 from workbench.labs.workspace_sync import sync_at_start
 
-from .applog import make_room
-from .appproc import RESTORE_TERMINAL, AppEntry, AppProcess, AppSpec, app_env, forward_hint
 from .course_files import CourseWorkspaces
-from .forkserver import ForkServer, ForkServerError
 from .forwarding import forward, local_forward_refusal, remote_forward_refusal
 from .hostkey import host_key_path, load_or_create_host_key
-from .limits import SessionLimits, describe_duration, describe_memory
-from .logins import ConnectionGate, Eviction, LoginGuard, LoginPolicy, QuietLog, Stage
-from .memory import SHORT_OF_MEMORY, MemoryWatch
 from .openfiles import (
     Handler,
     near_the_limit,
@@ -37,14 +49,9 @@ from .openfiles import (
     raise_file_limit,
     room_for_a_file,
 )
-from .passwords import hash_password, verify_password
-from .ports import PoolExhausted, PortPool
 from .proxy_protocol import Network, ProxyAcceptor, accept_behind_balancer
 from .refusals import ASKED_NOTHING, refusal_message
-from .serverlog import shown
 from .sftp import SFTPChannel, SFTPService
-from .sources import source_of
-from .users import User, UsersFile, users_path
 from .workers import PASSWORDS, STORE, in_pool
 
 log = logging.getLogger("workbench.ssh")

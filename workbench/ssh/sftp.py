@@ -41,6 +41,7 @@ from asyncssh.sftp import (
 )
 from asyncssh.stream import SSHReader, SSHServerStreamSession, SSHWriter
 
+from workbench.door.users import User
 from workbench.files.names import (
     MAX_NAME_BYTES,
     BadPath,
@@ -58,7 +59,6 @@ from workbench.files.workspace_files import (
     WorkspaceFiles,
 )
 
-from .users import User
 from .workers import FILES, in_pool
 
 log = logging.getLogger("workbench.ssh")

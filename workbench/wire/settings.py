@@ -2,7 +2,7 @@
 to the app.
 
 The command line builds :class:`AppSettings` from its options (``workbench/cli/__init__.py``);
-the SSH lab server builds one for each session (``workbench/ssh/appproc.py``) and hands it to the
+the SSH lab server builds one for each session (``workbench/door/appproc.py``) and hands it to the
 session's app as a JSON object (:meth:`AppSettings.to_json`), through the fork server or on the
 command line of a new process, and the app reads it back with :meth:`AppSettings.from_json`.
 :func:`workbench.tui.app.make_app` takes it and checks what only the app can check (the maze
