@@ -26,15 +26,16 @@ from workbench.door.appproc import (
     app_env,
     forward_hint,
 )
+from workbench.door.checking import PasswordDesk
 from workbench.door.forkserver import ForkServer, ForkServerError
 from workbench.door.limits import SessionLimits, describe_duration, describe_memory
 from workbench.door.logins import ConnectionGate, Eviction, LoginGuard, LoginPolicy, QuietLog, Stage
 from workbench.door.memory import SHORT_OF_MEMORY, MemoryWatch
-from workbench.door.passwords import hash_password, verify_password
 from workbench.door.ports import PoolExhausted, PortPool
 from workbench.door.serverlog import shown
 from workbench.door.sources import source_of
 from workbench.door.users import User, UsersFile, users_path
+from workbench.door.workers import STORE, in_pool
 from workbench.files.workspace import workspace_folder
 from workbench.files.workspace_files import UploadLimits
 from workbench.labs.workspace_sync import sync_at_start
@@ -52,7 +53,6 @@ from .openfiles import (
 from .proxy_protocol import Network, ProxyAcceptor, accept_behind_balancer
 from .refusals import ASKED_NOTHING, refusal_message
 from .sftp import SFTPChannel, SFTPService
-from .workers import PASSWORDS, STORE, in_pool
 
 log = logging.getLogger("workbench.ssh")
 
@@ -89,8 +89,6 @@ MACS = (
     "hmac-sha2-256",
     "hmac-sha2-512",
 )
-#: checked against when a user is unknown, so a wrong name costs the same time as a wrong password
-_DUMMY_HASH = hash_password("not a real password")
 
 
 @dataclass
@@ -149,11 +147,9 @@ class LabServer:
         self.remote_listens: dict[str, Counter[int]] = {}
         self.guard = LoginGuard(config.logins)
         self.gate: ConnectionGate[LabConnection] = ConnectionGate(config.logins)
+        self.desk = PasswordDesk(self.users, self.guard, self.gate)
         self.quiet_log = QuietLog()
         self.memory = MemoryWatch(config.limits.server_memory)
-        #: password checks for one account take turns, so parallel guesses wait in line
-        self._account_turns: dict[str, asyncio.Lock] = {}
-        self._account_queue: Counter[str] = Counter()
         self._ids = itertools.count(1)
         self._acceptor: asyncssh.SSHAcceptor | ProxyAcceptor | None = None
         self._sweeper: asyncio.Task[None] | None = None
@@ -339,19 +335,6 @@ class LabServer:
         )  # fmt: skip
         return True
 
-    @contextlib.asynccontextmanager
-    async def account_turn(self, account: str):
-        """Wait for the account's turn to have a password checked."""
-        lock = self._account_turns.setdefault(account, asyncio.Lock())
-        self._account_queue[account] += 1
-        try:
-            async with lock:
-                yield
-        finally:
-            self._account_queue[account] -= 1
-            if not self._account_queue[account]:
-                del self._account_queue[account], self._account_turns[account]
-
     # -- sessions ----------------------------------------------------------------------------
     def live(self, user: str) -> list[LabSession]:
         return [s for s in self.sessions.values() if s.user.name == user and s.running]
@@ -516,11 +499,7 @@ class LabConnection(asyncssh.SSHServer):
         return True
 
     def _known(self, username: str) -> User | None:
-        users = self.server.users
-        user = users.get(username)
-        if users.problem:
-            log.error("users file not read again, the earlier users stay: %s", users.problem)
-        return user
+        return self.server.desk.known(username)
 
     def _refused(self, username: str, why: str, *, checked: bool = True) -> None:
         """Log a refused password; unchecked ones (which cost nothing) at most once per 10 s."""
@@ -580,45 +559,19 @@ class LabConnection(asyncssh.SSHServer):
         return True
 
     async def validate_password(self, username: str, password: str) -> bool:
-        server, peer = self.server, self.peer
-        if not server.gate.start_waiting(peer):
-            why = "too many password attempts at once, not checked"
-            self._refused(username, why, checked=False)
-            return False
+        server = self.server
         server.gate.progressed(self, Stage.CHECKING)
         try:
-            async with server.account_turn(username):
-                return await self._check_password(username, password)
+            verdict = await server.desk.check(username, password, self.peer)
         finally:
-            server.gate.stop_waiting(peer)
             server.gate.progressed(self, Stage.AUTHENTICATING)
-
-    async def _check_password(self, username: str, password: str) -> bool:
-        guard = self.server.guard
-        locked = guard.locked_for(username)
-        if locked:
-            why = f"passwords locked for another {describe_duration(round(locked))}"
-            self._refused(username, why, checked=False)
-            return False
-        delay = guard.delay(username, self.peer)
-        if delay:
-            await asyncio.sleep(delay)
-        user = self._known(username)
-        stored = user.password if user is not None and user.password else _DUMMY_HASH
-        ok = await in_pool(PASSWORDS, verify_password, password, stored)
-        if user is not None and ok and user.password:
-            guard.password_succeeded(username)
-            self._login = (user, "password")
+        if verdict.user is not None:
+            self._login = (verdict.user, "password")
             return True
-        locks = guard.password_failed(username, self.peer)
-        self._refused(username, "unknown user" if user is None else "wrong password")
-        if locks:
-            policy = guard.policy
+        self._refused(username, verdict.why, checked=verdict.checked)
+        if verdict.locked:
             log.warning(
-                "passwords of %s locked for %s after %d failures (keys still work)",
-                shown(username),
-                describe_duration(policy.lock_for),
-                policy.lock_after,
+                "passwords of %s %s (keys still work)", shown(username), server.desk.lock_words()
             )
         return False
 
