@@ -27,6 +27,7 @@ from . import ssh as ssh_cmd
 from . import store as store_cmd
 from . import viple_client as viple_client_cmd
 from . import viple_program as viple_program_cmd
+from . import web as web_cmd
 from .common import (
     db_option,
     error,
@@ -119,6 +120,7 @@ def build_parser() -> argparse.ArgumentParser:
     instructor_cmd.register(sub)
     signoff_cmd.register(sub)
     ssh_cmd.register(sub)
+    web_cmd.register(sub)
     store_cmd.register(sub)
     return parser
 

@@ -252,6 +252,10 @@ class AppProcess:
         if width > 0 and height > 0:
             self._write(packets.resize(width, height))
 
+    def redraw(self) -> None:
+        """Ask the app for its whole screen again (a new terminal shows it)."""
+        self._write(packets.redraw())
+
     # -- output ------------------------------------------------------------------------------
     def pause_output(self) -> None:
         """Stop reading the app's screen output (the client is behind); the app then waits."""

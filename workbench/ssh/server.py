@@ -31,6 +31,7 @@ from workbench.door.forkserver import ForkServer, ForkServerError
 from workbench.door.limits import SessionLimits, describe_duration, describe_memory
 from workbench.door.logins import ConnectionGate, Eviction, LoginGuard, LoginPolicy, QuietLog, Stage
 from workbench.door.memory import SHORT_OF_MEMORY, MemoryWatch
+from workbench.door.networks import Network
 from workbench.door.ports import PoolExhausted, PortPool
 from workbench.door.serverlog import shown
 from workbench.door.sources import source_of
@@ -50,7 +51,7 @@ from .openfiles import (
     raise_file_limit,
     room_for_a_file,
 )
-from .proxy_protocol import Network, ProxyAcceptor, accept_behind_balancer
+from .proxy_protocol import ProxyAcceptor, accept_behind_balancer
 from .refusals import ASKED_NOTHING, refusal_message
 from .sftp import SFTPChannel, SFTPService
 
