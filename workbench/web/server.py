@@ -42,14 +42,16 @@ from .relay import Notice, StudentApp, background
 log = logging.getLogger("workbench.web")
 
 STATIC = Path(__file__).resolve().parent / "static"
-#: the page may load and connect to this server only; no frames, no inline script
+#: the page may load and connect to this server only; no frames, no inline script (styles
+#: inline are allowed: xterm.js sets its theme's colours in a style element of its own)
 SECURITY_HEADERS = {
     "Content-Security-Policy": (
-        "default-src 'self'; script-src 'self'; style-src 'self'; img-src 'self' data:; "
-        "connect-src 'self'; frame-ancestors 'none'; base-uri 'none'; form-action 'self'"
+        "default-src 'self'; script-src 'self'; style-src 'self' 'unsafe-inline'; "
+        "img-src 'self' data:; connect-src 'self'; frame-ancestors 'none'; base-uri 'none'; "
+        "form-action 'self'"
     ),
     "X-Content-Type-Options": "nosniff",
-    "Referrer-Policy": "no-referrer",
+    "Referrer-Policy": "same-origin",
     "Cache-Control": "no-store",
 }
 #: the form token a script sends with an upload, when not in the form
@@ -96,6 +98,7 @@ class WebServer:
         app.add_routes(
             [
                 web.get("/", self.index),
+                web.get("/favicon.ico", self.no_icon),
                 web.get("/login", self.login_form),
                 web.post("/login", self.login),
                 web.post("/logout", self.logout),
@@ -277,6 +280,9 @@ class WebServer:
         if "new_login" in request:
             self._set_login_cookie(response, request["new_login"], self.origin(request).secure)
         return response
+
+    async def no_icon(self, request: web.Request) -> web.Response:
+        return web.Response(status=204)
 
     async def login_form(self, request: web.Request, message: str = "", status: int = 200
                          ) -> web.Response:  # fmt: skip
