@@ -15,6 +15,7 @@ from pathlib import Path
 
 import aiohttp
 import pyte
+import yarl
 
 from workbench.cli.ssh import WORKBENCH_APP
 from workbench.door.limits import SessionLimits
@@ -77,6 +78,26 @@ class Browser:
             max_msg_size=0,
         )
         return WebTerminal(socket, size)
+
+    async def upload(
+        self, name: str, data: bytes, *, folder: str = "", csrf: str | None = None
+    ) -> tuple[int, dict]:
+        """Send a file with the files panel's form (into ``folder``); the status and the
+        JSON answer."""
+        form = aiohttp.FormData()
+        form.add_field("csrf", self.csrf if csrf is None else csrf)
+        form.add_field("folder", folder)
+        form.add_field("file", data, filename=name, content_type="application/octet-stream")
+        async with self.session.post(
+            f"{self.host.url}/files", data=form, headers={"Origin": self.host.url}
+        ) as answer:
+            return answer.status, await answer.json()
+
+    async def get(self, path: str) -> tuple[int, bytes]:
+        """GET ``path`` as written (its dots and escapes kept, as an attacker sends them)."""
+        url = yarl.URL(f"{self.host.url}{path}", encoded=True)
+        async with self.session.get(url) as answer:
+            return answer.status, await answer.read()
 
     async def close(self) -> None:
         await self.session.close()

@@ -636,8 +636,10 @@ class WebServer:
         if not isinstance(sent, web.FileField):
             return web.json_response({"error": "choose a file to send"}, status=400)
         data = sent.file.read()
+        folder = form.get("folder")
+        name = f"{folder}/{sent.filename}" if isinstance(folder, str) and folder else sent.filename
         try:
-            path = transfer.upload(self._files(login.user), sent.filename, data)
+            path = transfer.upload(self._files(login.user), name, data)
         except transfer.TransferError as exc:
             log.warning("upload refused: %s from %s: %s", login.user, where.address, exc)
             return web.json_response({"error": str(exc)}, status=400)

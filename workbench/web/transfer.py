@@ -36,7 +36,8 @@ def files_of(root, limits: UploadLimits) -> WorkspaceFiles:
 
 
 def upload(files: WorkspaceFiles, name: str, data: bytes) -> str:
-    """Write ``data`` as ``name`` in the workspace; the path written, as shown."""
+    """Write ``data`` as ``name`` (a path in the workspace: the folder the files panel shows,
+    then the file's name) in the workspace; the path written, as shown."""
     try:
         parts = path_parts(name)
     except BadPath as exc:

@@ -112,6 +112,7 @@
   document.getElementById("upload").onsubmit = async (event) => {
     event.preventDefault();
     const form = new FormData(event.target);
+    form.append("folder", folder);
     const reply = await fetch("/files", { method: "POST", body: form,
       credentials: "same-origin", headers: { "X-Workbench-Form": body.dataset.csrf } });
     const data = await reply.json();
