@@ -8,6 +8,8 @@ from the fork server with the session's settings, as the SSH server starts it:
   * ``config``: what the server is started with (the options of ``serve-web``);
   * ``cookies``: the logins of browsers, known by random ids kept on the server, and the
     CSRF tokens of their forms;
+  * ``gate``: connections that have sent no request yet, under the SSH server's caps and
+    early drop for connections not logged in;
   * ``proxy``: the trusted-header mode (an authenticating proxy names the user) and the
     client's address behind a proxy;
   * ``relay``: one student's app and the page attached to it, kept through a reload for a

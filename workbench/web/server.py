@@ -35,6 +35,7 @@ from workbench.files.workspace import workspace_folder
 from . import transfer
 from .config import WebConfig
 from .cookies import CSRF_COOKIE, SESSION_COOKIE, Login, Logins, new_token, same_token
+from .gate import RequestGate
 from .pages import login_page, terminal_page
 from .proxy import Origin, header_login, origin_of
 from .relay import Notice, StudentApp, background
@@ -75,6 +76,12 @@ class WebServer:
         self.guard = LoginGuard(config.logins)
         self.gate: ConnectionGate[object] = ConnectionGate(config.logins)
         self.desk = PasswordDesk(self.users, self.guard, self.gate)
+        self.requests = RequestGate(
+            self.gate,
+            config.logins.login_timeout,
+            config.trusted_proxies,
+            lambda key, line: self.say_now_and_then(key, "%s", line),
+        )
         self.logins = Logins(config.login_lifetime)
         self.pool = PortPool(*config.port_range)
         self.apps: dict[str, StudentApp] = {}
@@ -125,8 +132,15 @@ class WebServer:
             context = ssl.create_default_context(ssl.Purpose.CLIENT_AUTH)
             context.minimum_version = ssl.TLSVersion.TLSv1_2
             context.load_cert_chain(config.tls_cert, config.tls_key)
-        self._runner = web.AppRunner(self.application(), access_log=None, handle_signals=False)
+        self._runner = web.AppRunner(
+            self.application(),
+            access_log=None,
+            handle_signals=False,
+            keepalive_timeout=config.logins.login_timeout,
+        )
         await self._runner.setup()
+        assert self._runner.server is not None
+        self.requests.watch(self._runner.server)
         self._site = web.TCPSite(
             self._runner, config.bind or None, config.port, ssl_context=context
         )
@@ -196,6 +210,7 @@ class WebServer:
     # -- what every answer carries ------------------------------------------------------------
     @web.middleware
     async def _headers(self, request: web.Request, handler: Any) -> web.StreamResponse:
+        self.requests.asked(request)
         response = await handler(request)
         if not response.prepared:
             response.headers.update(SECURITY_HEADERS)
@@ -451,7 +466,7 @@ class WebServer:
                     f"ws error {user}", "page of %s from %s closed: %s",
                     user, address, socket.exception(),
                 )  # fmt: skip
-                break
+                return
         if socket.close_code not in (None, 1000, 1001):
             self.say_now_and_then(
                 f"ws close {user}", "page of %s from %s closed with code %s",
