@@ -37,7 +37,8 @@ class WebHost:
 
     @property
     def url(self) -> str:
-        return f"http://127.0.0.1:{self.server.port}"
+        scheme = "https" if self.server.config.tls else "http"
+        return f"{scheme}://127.0.0.1:{self.server.port}"
 
     def browser(self, **options) -> Browser:
         return Browser(self, **options)
@@ -49,7 +50,9 @@ class Browser:
     def __init__(self, host: WebHost, headers: dict[str, str] | None = None) -> None:
         self.host = host
         self.session = aiohttp.ClientSession(
-            cookie_jar=aiohttp.CookieJar(unsafe=True), headers=headers or {}
+            cookie_jar=aiohttp.CookieJar(unsafe=True),
+            headers=headers or {},
+            connector=aiohttp.TCPConnector(ssl=False),  # the tests' own certificate
         )
         self.csrf = ""
 
