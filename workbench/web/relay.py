@@ -142,6 +142,7 @@ class StudentApp:
         grace: float,
         resize_every: float,
         on_end: Callable[[StudentApp], Coroutine[Any, Any, None]],
+        size: tuple[int, int] = (80, 24),
     ) -> None:
         self.user = user
         self.app = app
@@ -149,13 +150,17 @@ class StudentApp:
         self.resize_every = resize_every
         self._on_end = on_end
         self.page: Page | None = None
-        self.size = (0, 0)
+        #: the size the app has (it starts at its first page's)
+        self.size = size
+        self._shown = False
+        #: what the app wrote before its first page was attached
+        self._early = bytearray()
         self.last_input = time.monotonic()
         self.started_at = time.monotonic()
         self._waiting: asyncio.TimerHandle | None = None
         self._resize: asyncio.TimerHandle | None = None
         self._resized_at = 0.0
-        self._wanted = (0, 0)
+        self._wanted = size
         self.ending = False
         #: the VIPLE ports the app was given (released when it ends)
         self.ports: tuple[int, ...] = ()
@@ -169,10 +174,17 @@ class StudentApp:
             self._waiting = None
         before = self.page
         page = self.page = Page(socket, address, self._drained)
+        first = not self._shown
+        self._shown = True
         if before is not None:
             log.info("%s's workbench taken over by a page from %s", self.user, address)
             background(before.close(TAKEN_OVER))
         self.app.resume_output()
+        if first:
+            page.push(bytes(self._early))
+            self._early.clear()
+        if first and size == self.size:
+            return page  # a new app draws its first screen at this size by itself
         self._redraw(size)
         return page
 
@@ -196,6 +208,8 @@ class StudentApp:
     def output(self, data: bytes) -> None:
         page = self.page
         if page is None:
+            if not self._shown and len(self._early) < BACKLOG_HIGH:
+                self._early += data  # drawn before the first page came: it gets it all
             return  # nobody to show it to: the next page gets the screen redrawn
         page.push(data)
         if page.backlog > BACKLOG_HIGH:

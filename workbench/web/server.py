@@ -429,7 +429,7 @@ class WebServer:
         if self.short_of_memory("session", login.user):
             raise web.HTTPServiceUnavailable(text=SHORT_OF_MEMORY + "\n")
         size = self._page_size(request)
-        student = await self.app_of(login)
+        student = await self.app_of(login, size)
         if isinstance(student, str):
             socket = web.WebSocketResponse()
             await socket.prepare(request)
@@ -491,7 +491,7 @@ class WebServer:
             student.resize(self.clamped(cols, rows, user))
 
     # -- the student's app -------------------------------------------------------------------
-    async def app_of(self, login: Login) -> StudentApp | str:
+    async def app_of(self, login: Login, size: tuple[int, int]) -> StudentApp | str:
         """The login's user's running app, started if there is none; a message instead when
         none may start."""
         running = self.apps.get(login.user)
@@ -499,11 +499,13 @@ class WebServer:
             return running
         starting = self._starting.get(login.user)
         if starting is None:
-            starting = self._starting[login.user] = asyncio.create_task(self._start_app(login))
+            starting = self._starting[login.user] = asyncio.create_task(
+                self._start_app(login, size)
+            )
             starting.add_done_callback(lambda _: self._starting.pop(login.user, None))
         return await asyncio.shield(starting)
 
-    async def _start_app(self, login: Login) -> StudentApp | str:
+    async def _start_app(self, login: Login, size: tuple[int, int]) -> StudentApp | str:
         config = self.config
         user = login.user
         why = config.limits.refusal(0, len(self.apps))
@@ -523,7 +525,7 @@ class WebServer:
             record_dir = workspace / "runs" / f"{stamp}-web"
         spec = AppSpec(
             user, login.role, tcp_port, ws_port, WEB_HINT, config.data_dir, record_dir,
-            workspace, 80, 24, "xterm-256color", config.record_quota, uploads=config.uploads,
+            workspace, *size, "xterm-256color", config.record_quota, uploads=config.uploads,
         )  # fmt: skip
         log_path = config.data_dir / "logs" / user / f"{stamp}-web.log"
         holder: list[StudentApp] = []
@@ -539,7 +541,7 @@ class WebServer:
         )
         student = StudentApp(
             user, process, grace=config.reattach_grace,
-            resize_every=config.limits.resize_every, on_end=self.end,
+            resize_every=config.limits.resize_every, on_end=self.end, size=size,
         )  # fmt: skip
         holder.append(student)
         student.ports = ports
