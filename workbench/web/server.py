@@ -640,7 +640,7 @@ class WebServer:
             form = await request.post()
         except web.HTTPRequestEntityTooLarge:
             log.warning("upload refused: %s from %s: larger than %d bytes", login.user,
-                        where.address, request.app._client_max_size)  # fmt: skip
+                        where.address, request.client_max_size)  # fmt: skip
             return web.json_response({"error": "the file is too large"}, status=413)
         token = form.get("csrf") or request.headers.get(FORM_HEADER)
         if not same_token(token if isinstance(token, str) else None, login.csrf):
