@@ -12,6 +12,8 @@ browser door (``workbench.web``) let the same students in the same way and start
     forked from the fork server with the session's settings, its error log, and the server's
     watch on free memory;
   * ``ports``: the VIPLE ports each session is given;
+  * ``course_files``: with a course database, a student's workspace brought in step at a
+    session's start, and their uploads sent on;
   * ``serverlog``: the server's own log; ``workers``: the thread pools (store, passwords,
     files) so one kind of work stuck holds up no other.
 

@@ -27,6 +27,7 @@ from workbench.door.appproc import (
     forward_hint,
 )
 from workbench.door.checking import PasswordDesk
+from workbench.door.course_files import CourseWorkspaces, bring_workspace
 from workbench.door.forkserver import ForkServer, ForkServerError
 from workbench.door.limits import SessionLimits, describe_duration, describe_memory
 from workbench.door.logins import ConnectionGate, Eviction, LoginGuard, LoginPolicy, QuietLog, Stage
@@ -41,7 +42,6 @@ from workbench.files.workspace import workspace_folder
 from workbench.files.workspace_files import UploadLimits
 from workbench.labs.workspace_sync import sync_at_start
 
-from .course_files import CourseWorkspaces
 from .forwarding import forward, local_forward_refusal, remote_forward_refusal
 from .hostkey import host_key_path, load_or_create_host_key
 from .openfiles import (
@@ -70,8 +70,6 @@ MADE_ROOM = (
 )
 #: seconds a connection from a balancer has to send its PROXY header
 PROXY_HEADER_WAIT = 5.0
-#: seconds a session's start waits for the student's files from the course store
-WORKSPACE_SYNC_WAIT = 20.0
 #: the ciphers the server takes, AES only: a client picks the first of its own list the server
 #: has, and OpenSSH's list starts with chacha20-poly1305, which asyncssh does per packet in
 #: several Python calls (about five times the CPU of AES-GCM, measured in bench/startup.py);
@@ -901,27 +899,11 @@ class LabSession(asyncssh.SSHServerSession):
             await self._finish(message, code)
 
     async def _bring_workspace(self, user: str, workspace: Path) -> None:
-        """Bring the student's files from the course store before their app starts (in a
-        thread; a store that does not answer within :data:`WORKSPACE_SYNC_WAIT` lets the
-        session start with the files this server has)."""
         config = self.server.config
         assert config.db is not None
-        sync = in_pool(STORE, sync_at_start, config.data_dir, config.db, user, workspace)
-        try:
-            report = await asyncio.wait_for(sync, WORKSPACE_SYNC_WAIT)
-        except TimeoutError:
-            log.warning("session %d: %s's workspace: the course store did not answer within "
-                        "%g s: starting with this server's files", self.id, user,
-                        WORKSPACE_SYNC_WAIT)  # fmt: skip
-            return
-        if report.fetched or report.removed or report.pushed:
-            log.info(
-                "session %d: %s's workspace: %d file(s) brought, %d removed, %d sent",
-                self.id, user, len(report.fetched), len(report.removed), len(report.pushed),
-            )  # fmt: skip
-        for problem in report.problems[:20]:
-            text = "".join(c if c.isprintable() else "?" for c in problem[:300])
-            log.warning("session %d: %s's workspace: %s", self.id, user, text)
+        await bring_workspace(
+            config.data_dir, config.db, user, workspace, f"session {self.id}", sync_at_start
+        )
 
     def _make_log_room(self, log_path: Path) -> None:
         """Remove the user's oldest logs until their folder has room for this session's."""

@@ -23,6 +23,7 @@ from aiohttp import WSMsgType, web
 
 from workbench.door.appproc import AppProcess, AppSpec, app_env
 from workbench.door.checking import PasswordDesk
+from workbench.door.course_files import CourseWorkspaces, bring_workspace
 from workbench.door.forkserver import ForkServer, ForkServerError
 from workbench.door.limits import describe_duration, describe_memory
 from workbench.door.logins import ConnectionGate, LoginGuard, QuietLog
@@ -30,6 +31,7 @@ from workbench.door.memory import SHORT_OF_MEMORY, MemoryWatch
 from workbench.door.ports import PoolExhausted, PortPool
 from workbench.door.serverlog import shown
 from workbench.door.users import UsersFile
+from workbench.door.workers import STORE, in_pool
 from workbench.files.workspace import workspace_folder
 
 from . import transfer
@@ -88,6 +90,8 @@ class WebServer:
         self.quiet_log = QuietLog()
         self.memory = MemoryWatch(config.limits.server_memory)
         self.forkserver: ForkServer | None = None
+        #: with a course database, uploads go on to it (and so to every server of the course)
+        self.course_files = CourseWorkspaces(config.data_dir, config.db) if config.db else None
         self.pages_open: Counter[str] = Counter()
         self._runner: web.AppRunner | None = None
         self._site: web.TCPSite | None = None
@@ -199,6 +203,12 @@ class WebServer:
             await self._runner.cleanup()
         if self.forkserver is not None:
             await self.forkserver.close()
+        if self.course_files is not None:
+            unsent = await in_pool(STORE, self.course_files.close, 5.0)
+            if unsent:
+                log.warning("stopping: %d uploaded file(s) not in the course store yet (sent "
+                            "at each student's next session start): %s", len(unsent),
+                            ", ".join(unsent[:10]))  # fmt: skip
 
     async def __aenter__(self) -> WebServer:
         await self.start()
@@ -520,6 +530,8 @@ class WebServer:
         tcp_port, ws_port = ports
         stamp = time.strftime("%Y%m%d-%H%M%S")
         workspace = workspace_folder(config.data_dir, user)
+        if config.db:
+            await bring_workspace(config.data_dir, config.db, user, workspace, f"web {user}")
         record_dir = workspace / "runs" / stamp
         if record_dir.exists():
             record_dir = workspace / "runs" / f"{stamp}-web"
@@ -615,7 +627,12 @@ class WebServer:
         return login
 
     def _files(self, user: str) -> transfer.WorkspaceFiles:
-        return transfer.files_of(workspace_folder(self.config.data_dir, user), self.config.uploads)
+        course = self.course_files
+        return transfer.files_of(
+            workspace_folder(self.config.data_dir, user),
+            self.config.uploads,
+            (lambda path: course.changed(user, path)) if course is not None else None,
+        )
 
     async def list_files(self, request: web.Request) -> web.StreamResponse:
         login = self._files_login(request)

@@ -13,7 +13,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from workbench.files.names import BadPath, path_parts, shown_path
-from workbench.files.workspace_files import Entry, UploadLimits, WorkspaceError, WorkspaceFiles
+from workbench.files.workspace_files import (
+    ChangeHook,
+    Entry,
+    UploadLimits,
+    WorkspaceError,
+    WorkspaceFiles,
+)
 
 #: how a download is named to the browser: its last part, with only these characters kept
 _SAFE = frozenset("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789._-")
@@ -29,10 +35,11 @@ class Listing:
     entries: tuple[Entry, ...]
 
 
-def files_of(root, limits: UploadLimits) -> WorkspaceFiles:
+def files_of(root, limits: UploadLimits, on_change: ChangeHook | None = None) -> WorkspaceFiles:
     """The workspace's files as the browser door uses them (the app may be writing there at
-    the same time: the room is counted afresh for each upload)."""
-    return WorkspaceFiles(root, limits, shared=True)
+    the same time: the room is counted afresh for each upload); ``on_change`` hears of each
+    file written (to send it on to the course store)."""
+    return WorkspaceFiles(root, limits, shared=True, on_change=on_change)
 
 
 def upload(files: WorkspaceFiles, name: str, data: bytes) -> str:
