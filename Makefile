@@ -4,7 +4,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 TEST_STAMP := $(VENV)/.installed-test
 
-.PHONY: run test lint bench clean haproxy
+.PHONY: run test lint bench clean haproxy chromium
 
 $(BIN)/python:
 	@command -v $(PYTHON) >/dev/null 2>&1 || { echo "Python 3.11 is needed: install it or run 'make PYTHON=/path/to/python3.11 ...'"; exit 1; }
@@ -22,7 +22,7 @@ $(TEST_STAMP): $(BIN)/python pyproject.toml
 run: $(STAMP)
 	$(BIN)/workbench
 
-test: $(TEST_STAMP) haproxy
+test: $(TEST_STAMP) haproxy chromium
 	$(BIN)/ruff check .
 	$(BIN)/lint-imports
 	$(BIN)/mypy
@@ -41,6 +41,21 @@ haproxy:
 	      echo "haproxy could not be installed: the balancer test will be skipped"; \
 	  else \
 	    echo "no haproxy: the balancer test will be skipped (install the haproxy package)"; \
+	  fi; \
+	}
+
+# the browser test drives Debian's Chromium with Playwright: installed here as root where
+# apt-get is, else that test is skipped (never a reason for the build to fail)
+chromium:
+	@command -v chromium >/dev/null 2>&1 || { \
+	  if [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+	    echo "installing Debian's chromium for the browser test"; \
+	    export DEBIAN_FRONTEND=noninteractive; \
+	    apt-get install -y -q chromium >/dev/null 2>&1 || \
+	      { apt-get update -q >/dev/null 2>&1 && apt-get install -y -q chromium >/dev/null 2>&1; } || \
+	      echo "chromium could not be installed: the browser test will be skipped"; \
+	  else \
+	    echo "no chromium: the browser test will be skipped (install the chromium package)"; \
 	  fi; \
 	}
 

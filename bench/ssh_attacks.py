@@ -68,8 +68,8 @@ from ssh_load import Result, Student, free_port, pct, start_server, student_addr
 from tests.integration.sftp_support import raw_sftp_open, sftp_read  # noqa: E402
 from tests.integration.ssh_support import open_bare_channel  # noqa: E402
 from tests.program import hostile  # noqa: E402
+from workbench.door.users import add_user  # noqa: E402
 from workbench.files.workspace import workspace_folder  # noqa: E402
-from workbench.ssh.users import add_user  # noqa: E402
 
 PROGRAMS = ("merge_spin", "join_nesting", "join_doubling", "number_doubling", "record_flood")
 PHASES = (

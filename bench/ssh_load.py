@@ -56,7 +56,7 @@ sys.path.insert(0, str(ROOT))
 
 from procfs import children_by_parent  # noqa: E402
 
-from workbench.ssh.users import add_user  # noqa: E402
+from workbench.door.users import add_user  # noqa: E402
 
 PATTERN = "wwwwawwwwdww wwwwdwwwwaww "
 PROBE_EVERY = 2.0  # seconds between latency probes of one session
@@ -123,7 +123,7 @@ def descendants(pid: int) -> list[int]:
 
 def is_forkserver(pid: int) -> bool:
     try:
-        return b"workbench.ssh.forkserver" in Path(f"/proc/{pid}/cmdline").read_bytes()
+        return b"workbench.door.forkserver" in Path(f"/proc/{pid}/cmdline").read_bytes()
     except OSError:
         return False
 

@@ -29,10 +29,10 @@ import asyncssh
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from workbench.ssh.logins import LoginPolicy  # noqa: E402
-from workbench.ssh.passwords import hash_password  # noqa: E402
+from workbench.door.logins import LoginPolicy  # noqa: E402
+from workbench.door.passwords import hash_password  # noqa: E402
+from workbench.door.users import add_user, users_path  # noqa: E402
 from workbench.ssh.server import LabServer, ServerConfig  # noqa: E402
-from workbench.ssh.users import add_user, users_path  # noqa: E402
 
 PASSWORD = "rivera-secret-1"
 

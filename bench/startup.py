@@ -51,7 +51,7 @@ sys.path.insert(0, str(ROOT))
 from gitrev import export  # noqa: E402
 from procfs import children  # noqa: E402
 
-from workbench.ssh.users import add_user  # noqa: E402
+from workbench.door.users import add_user  # noqa: E402
 
 NAMES_DIALOG = b"Who is at this robot"
 MAIN_SCREEN = b"running"
@@ -325,8 +325,8 @@ def report(name: str, f: Figures) -> dict[str, float]:
 async def profile_app(prefix: str) -> None:
     """One app forked from a fork server, profiled from its fork to its first screen."""
     from workbench.cli.ssh import WORKBENCH_APP
-    from workbench.ssh.appproc import AppProcess, AppSpec, app_env
-    from workbench.ssh.forkserver import ForkServer
+    from workbench.door.appproc import AppProcess, AppSpec, app_env
+    from workbench.door.forkserver import ForkServer
 
     stats = Path(f"{prefix}-app.prof").resolve()
     env = app_env()

@@ -27,7 +27,7 @@ keys). Each of --runs runs is a fresh process; the medians are printed last.
 in the same run, alternating with this tree, and prints both medians and their ratios (app CPU,
 and the server's part): a before/after taken under the same load from other processes on the
 machine. The older revision's app is read with that revision's own server code
-(``workbench/ssh/appproc.py``, with the packets module it imports), so a change there is measured
+(``workbench/door/appproc.py``, with the packets module it imports), so a change there is measured
 too.
 
 ``--profile PREFIX`` runs the app under cProfile, switched on only for the measured stretch of
@@ -58,7 +58,7 @@ sys.path.insert(0, str(ROOT))
 
 from gitrev import export  # noqa: E402
 
-from workbench.ssh.appproc import AppProcess, AppSpec  # noqa: E402
+from workbench.door.appproc import AppProcess, AppSpec  # noqa: E402
 
 CLK_TCK = os.sysconf("SC_CLK_TCK")
 SSH_PATTERN = "wwwwawwwwdww wwwwdwwwwaww "

@@ -37,8 +37,8 @@ from workbench.sim.maze import Maze
 from workbench.sim.mazefile import write_maze
 from workbench.sim.session import Session
 from workbench.tui.app import make_app
-from workbench.tui.settings import AppSettings
 from workbench.tui.widgets import MazeView
+from workbench.wire.settings import AppSettings
 
 SIZE = (80, 24)
 PROFILE = "unity"

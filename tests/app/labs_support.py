@@ -11,7 +11,7 @@ from tests.waiting import until
 from workbench.tui.app import WorkbenchApp, make_app
 from workbench.tui.dialogs.signoff import SignoffModal
 from workbench.tui.screens.labs import LabsScreen
-from workbench.tui.settings import AppSettings
+from workbench.wire.settings import AppSettings
 
 DRIVE = "unity-simulator/drive-by-wire"
 

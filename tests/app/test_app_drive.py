@@ -25,10 +25,10 @@ from workbench.tui.keys import KEY_TABLE
 from workbench.tui.screens.editor import EditorScreen
 from workbench.tui.screens.main import MainScreen
 from workbench.tui.screens.runs import RunsScreen
-from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.key_legend import KeyLegend
 from workbench.tui.widgets.maze_view import MazeView
 from workbench.tui.widgets.run_status import RunStatus
+from workbench.wire.settings import AppSettings
 
 ROOM = "#######\n#.....#\n#..S..#\n#.....#\n#######\n"
 CORRIDOR = "##########\n#S......E#\n##########\n"

@@ -12,12 +12,12 @@ from workbench.tui.app import WorkbenchApp, make_app
 from workbench.tui.dialogs.algorithm import AlgorithmModal
 from workbench.tui.dialogs.sensor_ports import SensorPortsModal
 from workbench.tui.screens.main import MainScreen
-from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.algorithm_state import AlgorithmState
 from workbench.tui.widgets.param_editor import ParamEditor
 from workbench.tui.widgets.sensor_readings import SensorReadings
 from workbench.tui.widgets.sensor_row_editor import SensorRowEditor
 from workbench.tui.widgets.transition_log import TransitionLog
+from workbench.wire.settings import AppSettings
 
 ROOM = "#######\n#.....#\n#..S..#\n#.....#\n#######\n"
 

@@ -11,9 +11,9 @@ from tests.program.builder import ProgramBuilder
 from workbench.program.keys import RELEASE_GAP
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.algorithm import AlgorithmModal
-from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.algorithm_state import AlgorithmState
 from workbench.tui.widgets.program_state import ProgramState
+from workbench.wire.settings import AppSettings
 
 ROOM = "#########\n#.......#\n#...S...#\n#.......#\n#########\n"
 

@@ -13,8 +13,8 @@ from tests.waiting import until
 from workbench.tui.app import WorkbenchApp, make_app
 from workbench.tui.dialogs.identity import IdentityDialog
 from workbench.tui.screens.main import MainScreen
-from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.run_status import RunStatus
+from workbench.wire.settings import AppSettings
 
 from .support import run, run_panel, said
 

@@ -20,7 +20,7 @@ from workbench.labs.signoff.instructors import KdfParams, create_instructor
 from workbench.tui.app import make_app
 from workbench.tui.screens.replay import ReplayScreen
 from workbench.tui.screens.runs import RunsScreen
-from workbench.tui.settings import AppSettings
+from workbench.wire.settings import AppSettings
 
 from .labs_support import open_exercise
 from .support import run, screen_lines

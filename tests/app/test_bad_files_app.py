@@ -13,7 +13,7 @@ from workbench.tui.dialogs.algorithm import AlgorithmModal
 from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.screens import labs as labs_screen
 from workbench.tui.screens.main import MainScreen
-from workbench.tui.settings import AppSettings
+from workbench.wire.settings import AppSettings
 
 from .labs_support import lab_app, open_labs, text
 from .support import run

@@ -7,7 +7,7 @@ from textual.widgets import Input
 
 from workbench.tui.app import make_app
 from workbench.tui.screens.editor import EditorScreen
-from workbench.tui.settings import AppSettings
+from workbench.wire.settings import AppSettings
 
 from .support import run, screen_lines
 

@@ -13,7 +13,7 @@ from workbench.files.workspace import workspace_folder
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.screens.editor import EditorScreen
-from workbench.tui.settings import AppSettings
+from workbench.wire.settings import AppSettings
 
 from .support import run, screen_lines
 from .test_workspace_app import type_path

@@ -13,8 +13,8 @@ from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
 from workbench.tui.screens.replay import ReplayScreen
 from workbench.tui.screens.runs import RunsScreen
-from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.key_bar import KeyBar
+from workbench.wire.settings import AppSettings
 
 from .support import run, screen_lines
 

@@ -17,7 +17,7 @@ from workbench.tui.app import make_app
 from workbench.tui.dialogs.signoff import SignoffModal
 from workbench.tui.dialogs.size import SizeDialog
 from workbench.tui.serving.ordered_keys import OrderedKeys
-from workbench.tui.settings import AppSettings
+from workbench.wire.settings import AppSettings
 
 from .labs_support import lab_app, open_exercise, signing_over
 from .support import run

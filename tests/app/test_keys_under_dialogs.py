@@ -11,8 +11,8 @@ from textual.widgets._footer import FooterKey
 
 from workbench.tui.app import make_app
 from workbench.tui.serving.internals import bindings_of
-from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.key_bar import KeyBar
+from workbench.wire.settings import AppSettings
 
 from .support import run, screen_lines
 

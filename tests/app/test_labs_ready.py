@@ -13,7 +13,7 @@ from workbench.labs.signoff.signoff_record import Evidence, RecordFields
 from workbench.labs.store.store import Store
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.signoff import SignoffModal
-from workbench.tui.settings import AppSettings
+from workbench.wire.settings import AppSettings
 
 from .console_support import EXERCISE, LAB, progress, until
 from .labs_support import open_exercise, text

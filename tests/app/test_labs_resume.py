@@ -10,8 +10,8 @@ from workbench.labs.store.store import Store
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.identity import IdentityDialog
 from workbench.tui.screens.main import MainScreen
-from workbench.tui.settings import AppSettings
 from workbench.viple.tcp_server import TcpConfig
+from workbench.wire.settings import AppSettings
 
 from .labs_support import (
     DRIVE,

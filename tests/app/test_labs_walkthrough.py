@@ -53,13 +53,13 @@ from workbench.tui.screens.editor import EditorScreen
 from workbench.tui.screens.fsm_editor import FsmEditorScreen
 from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.screens.main import MainScreen
-from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.choices import Choices
 from workbench.tui.widgets.param_editor import ParamEditor
 from workbench.tui.widgets.sensor_row_editor import SensorRowEditor
 from workbench.tui.widgets.text import degrees, number
 from workbench.viple.tcp_server import TcpConfig
 from workbench.viple.ws_client import WsConfig
+from workbench.wire.settings import AppSettings
 
 from .support import run, run_panel, said, screen_lines
 

@@ -12,7 +12,7 @@ from workbench.labs.names import MAX_STUDENT_NAME
 from workbench.labs.store.store import Store
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.identity import IdentityDialog
-from workbench.tui.settings import AppSettings
+from workbench.wire.settings import AppSettings
 
 from .labs_support import DRIVE, lab_app, open_exercise, text
 from .support import run

@@ -22,8 +22,8 @@ from tests.waiting import until
 from workbench.tui.app import WorkbenchApp, make_app
 from workbench.tui.screens.main import MainScreen
 from workbench.tui.serving.compositor import GroupedUpdate, LiveCompositor
-from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.maze_view import MazeView
+from workbench.wire.settings import AppSettings
 
 Cell = tuple[str, Style | None]
 

@@ -10,7 +10,7 @@ from workbench.sim.mazeio import load_maze
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.screens.main import MainScreen
-from workbench.tui.settings import AppSettings
+from workbench.wire.settings import AppSettings
 
 from .support import run
 

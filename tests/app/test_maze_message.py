@@ -9,8 +9,8 @@ from textual.widgets import Input
 from workbench.files.bundled import MAZE_DIR
 from workbench.labs.model import load_labs
 from workbench.tui.app import make_app
-from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.message_bar import MessageBar
+from workbench.wire.settings import AppSettings
 
 from .labs_support import open_exercise
 from .support import run, screen_lines

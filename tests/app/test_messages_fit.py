@@ -10,7 +10,7 @@ from textual.pilot import Pilot
 from workbench.tui.app import make_app
 from workbench.tui.screens.labs import UNREACHABLE
 from workbench.tui.screens.main import MainScreen
-from workbench.tui.settings import AppSettings
+from workbench.wire.settings import AppSettings
 
 from .labs_support import lab_app, open_exercise, open_labs
 from .support import run, screen_lines

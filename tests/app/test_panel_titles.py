@@ -7,8 +7,8 @@ import pytest
 from textual.pilot import Pilot
 
 from workbench.tui.app import make_app
-from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.algorithm_state import AlgorithmState
+from workbench.wire.settings import AppSettings
 
 from .support import run, screen_lines
 

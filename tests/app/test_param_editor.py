@@ -9,8 +9,8 @@ from workbench.labs.checks import apply_setup
 from workbench.labs.model import load_labs
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.algorithm import AlgorithmModal
-from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.param_editor import ParamEditor
+from workbench.wire.settings import AppSettings
 
 from .support import run, screen_lines
 

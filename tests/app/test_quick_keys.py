@@ -17,8 +17,8 @@ from tests.waiting import until
 from workbench.tui.app import WorkbenchApp, make_app
 from workbench.tui.dialogs.help import HelpScreen
 from workbench.tui.screens.main import MainScreen
-from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.run_status import RunStatus
+from workbench.wire.settings import AppSettings
 
 ROOM = "#######\n#.....#\n#..S..#\n#.....#\n#######\n"
 

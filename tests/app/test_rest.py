@@ -15,8 +15,8 @@ from textual.screen import ModalScreen
 from tests.app.support import run
 from tests.waiting import until
 from workbench.tui.app import REST_HZ, make_app
-from workbench.tui.settings import AppSettings
 from workbench.tui.widgets.run_status import RunStatus
+from workbench.wire.settings import AppSettings
 
 ROOM = "#########\n#.......#\n#...S...#\n#.......#\n#########\n"
 

@@ -9,7 +9,7 @@ from textual.widgets import Input
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.dialogs.size import SizeDialog
-from workbench.tui.settings import AppSettings
+from workbench.wire.settings import AppSettings
 
 from .support import run
 

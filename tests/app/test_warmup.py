@@ -8,10 +8,10 @@ import pytest
 import textual.css.stylesheet as stylesheet_module
 from textual.css.stylesheet import Stylesheet
 
-from workbench.ssh.forkserver import preload
+from workbench.door.forkserver import preload
 from workbench.tui.app import make_app, warm_up
 from workbench.tui.serving import warmup
-from workbench.tui.settings import AppSettings
+from workbench.wire.settings import AppSettings
 
 from .support import run, screen_lines
 

@@ -12,7 +12,7 @@ from textual.widgets import Input
 from workbench.labs.lastpair import save_last_pair
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.identity import IdentityDialog
-from workbench.tui.settings import AppSettings
+from workbench.wire.settings import AppSettings
 
 from .labs_support import DRIVE, open_exercise, text
 from .support import run

@@ -15,7 +15,7 @@ from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.screens.editor import EditorScreen
 from workbench.tui.screens.main import MainScreen
 from workbench.tui.screens.runs import RunsScreen
-from workbench.tui.settings import AppSettings
+from workbench.wire.settings import AppSettings
 
 from .support import run
 

@@ -14,7 +14,7 @@ from workbench.files.workspace import workspace_folder
 from workbench.labs.store.store import Store
 from workbench.tui.app import make_app
 from workbench.tui.screens.editor import EditorScreen
-from workbench.tui.settings import AppSettings
+from workbench.wire.settings import AppSettings
 
 from .support import run, said
 from .test_workspace_app import type_path

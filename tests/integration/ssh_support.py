@@ -15,11 +15,11 @@ import asyncssh
 import pyte
 
 from workbench.cli.ssh import WORKBENCH_APP
-from workbench.ssh.limits import SessionLimits
-from workbench.ssh.logins import LoginPolicy
-from workbench.ssh.passwords import hash_password
+from workbench.door.limits import SessionLimits
+from workbench.door.logins import LoginPolicy
+from workbench.door.passwords import hash_password
+from workbench.door.users import add_user, users_path
 from workbench.ssh.server import LabServer, ServerConfig
-from workbench.ssh.users import add_user, users_path
 
 from .openssh_terminal import pass_the_names
 

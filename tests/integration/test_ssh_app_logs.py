@@ -11,8 +11,8 @@ import sys
 import pytest
 
 from tests.app.support import sync
-from workbench.ssh.appproc import AppEntry
-from workbench.ssh.limits import SessionLimits
+from workbench.door.appproc import AppEntry
+from workbench.door.limits import SessionLimits
 
 from .error_flood import LAST, LINES
 from .ssh_support import Account, lab_host

@@ -26,10 +26,10 @@ from tests.app.support import sync
 from tests.sessions import free_port
 from tests.students_work import own_right_wall
 from tests.waiting import until
+from workbench.door.users import users_path
 from workbench.labs.store.store import Store
 from workbench.ssh.balancer import EXAMPLE, LabBackend, haproxy_config
 from workbench.ssh.hostkey import load_or_create_host_key
-from workbench.ssh.users import users_path
 
 from .sftp_support import OpenSSH, files_under, needs_openssh
 from .ssh_support import Account, Terminal, make_accounts, open_exercise, port_range

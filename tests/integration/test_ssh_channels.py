@@ -13,8 +13,8 @@ import pytest
 
 from tests.app.support import sync
 from tests.waiting import until
-from workbench.ssh.limits import SessionLimits
-from workbench.ssh.memory import SHORT_OF_MEMORY
+from workbench.door.limits import SessionLimits
+from workbench.door.memory import SHORT_OF_MEMORY
 from workbench.ssh.server import LabSession
 
 from .ssh_support import Account, lab_host, moved, open_bare_channel

@@ -14,8 +14,8 @@ import time
 import asyncssh
 import pytest
 
+from workbench.door.users import load_users
 from workbench.ssh.server import ServerConfig
-from workbench.ssh.users import load_users
 
 
 def workbench(*args: str, stdin: str = "", timeout: float = 60) -> subprocess.CompletedProcess:

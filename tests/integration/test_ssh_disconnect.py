@@ -8,7 +8,7 @@ import os
 
 from tests.app.support import sync
 from tests.waiting import until
-from workbench.ssh.ports import port_is_free
+from workbench.door.ports import port_is_free
 
 from .ssh_support import Account, lab_host, open_exercise
 

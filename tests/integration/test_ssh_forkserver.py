@@ -16,9 +16,9 @@ import pytest
 from tests.app.support import sync
 from tests.waiting import until
 from workbench.cli.ssh import WORKBENCH_APP
-from workbench.ssh import forkserver as forkserver_module
-from workbench.ssh.appproc import app_env
-from workbench.ssh.forkserver import APP_NICENESS, ForkServer, ForkServerError
+from workbench.door import forkserver as forkserver_module
+from workbench.door.appproc import app_env
+from workbench.door.forkserver import APP_NICENESS, ForkServer, ForkServerError
 
 from .ssh_support import Account, lab_host, moved
 

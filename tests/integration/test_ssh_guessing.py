@@ -15,7 +15,7 @@ import pytest
 
 from tests.app.support import sync
 from tests.waiting import until
-from workbench.ssh.logins import LoginPolicy
+from workbench.door.logins import LoginPolicy
 
 from .ssh_support import PASSWORD, Account, lab_host
 

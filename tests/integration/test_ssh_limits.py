@@ -19,9 +19,9 @@ import asyncssh
 import pytest
 
 from tests.app.support import sync
-from workbench.ssh.appproc import AppEntry, AppProcess
-from workbench.ssh.limits import SessionLimits
-from workbench.ssh.logins import LoginPolicy
+from workbench.door.appproc import AppEntry, AppProcess
+from workbench.door.limits import SessionLimits
+from workbench.door.logins import LoginPolicy
 
 from .ssh_support import Account, Terminal, lab_host, make_accounts
 from .test_ssh_guessing import closed_within

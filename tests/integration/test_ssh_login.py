@@ -10,7 +10,7 @@ import asyncssh
 import pytest
 
 from tests.app.support import sync
-from workbench.ssh.logins import LoginPolicy
+from workbench.door.logins import LoginPolicy
 
 from .ssh_support import PASSWORD, Account, lab_host, moved
 

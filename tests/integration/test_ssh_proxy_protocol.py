@@ -14,8 +14,8 @@ import asyncssh
 
 from tests.app.support import sync
 from tests.waiting import until
-from workbench.ssh.logins import LoginPolicy
-from workbench.ssh.proxy_protocol import parse_networks
+from workbench.door.logins import LoginPolicy
+from workbench.door.networks import parse_networks
 
 from ..unit.test_proxy_protocol import v2
 from .ssh_support import Account, lab_host

@@ -10,7 +10,7 @@ import pytest
 
 from tests.app.support import sync
 from tests.waiting import until
-from workbench.ssh.limits import SessionLimits
+from workbench.door.limits import SessionLimits
 
 from .ssh_support import Account, lab_host
 

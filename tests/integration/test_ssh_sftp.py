@@ -216,7 +216,7 @@ async def test_an_instructor_reads_every_workspace_and_changes_none(tmp_path):
 
 @sync
 async def test_file_transfers_count_against_the_users_connection_limit(tmp_path, caplog):
-    from workbench.ssh.limits import SessionLimits
+    from workbench.door.limits import SessionLimits
 
     limits = SessionLimits(connections_per_user=2)
     async with lab_host(tmp_path, [Account("ann")], limits=limits, fork_server=False) as host:

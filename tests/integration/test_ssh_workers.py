@@ -9,9 +9,9 @@ import threading
 
 from tests.app.support import sync
 from tests.waiting import until
+from workbench.door.limits import SessionLimits
 from workbench.labs.store.workspace_sync import SyncReport
 from workbench.ssh import server as server_module
-from workbench.ssh.limits import SessionLimits
 
 from .ssh_support import PASSWORD, Account, lab_host
 

@@ -12,7 +12,7 @@ from textual.pilot import Pilot
 from textual.widgets import Input, Select
 
 from workbench.tui.app import WorkbenchApp, make_app
-from workbench.tui.settings import AppSettings
+from workbench.wire.settings import AppSettings
 
 SIZES = {"80x24": (80, 24), "120x40": (120, 40)}
 MODES = {"ascii": False, "unicode": True}

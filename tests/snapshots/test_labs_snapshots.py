@@ -18,7 +18,7 @@ from tests.app.labs_support import open_labs, signing_over
 from workbench.labs.model import load_labs
 from workbench.labs.signoff.instructors import KdfParams, create_instructor
 from workbench.tui.app import WorkbenchApp, make_app
-from workbench.tui.settings import AppSettings
+from workbench.wire.settings import AppSettings
 
 FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
 PASS = "correct horse battery"

@@ -7,7 +7,7 @@ from __future__ import annotations
 import os
 
 from tests.full_disk import FakeDisk
-from workbench.ssh.applog import KEPT, AppLog, make_room
+from workbench.door.applog import KEPT, AppLog, make_room
 
 
 def lines(first: int, count: int) -> bytes:

@@ -11,8 +11,8 @@ import pytest
 
 from workbench.cli import app_settings, build_parser
 from workbench.cli.served import run
-from workbench.ssh.appproc import AppSpec
-from workbench.tui.settings import AppSettings, SettingsError
+from workbench.door.appproc import AppSpec
+from workbench.wire.settings import AppSettings, SettingsError
 
 
 def test_the_command_line_gives_the_app_its_settings(monkeypatch):

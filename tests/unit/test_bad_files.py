@@ -7,12 +7,12 @@ import pytest
 
 from tests.bad_files import GOOD_FSM, GOOD_LAB, GOOD_MAZE, GOOD_USERS, SECRET, corpus, write_corpus
 from workbench.control.fsmfile import FsmFileError, load_fsm
+from workbench.door.passwords import hash_password
+from workbench.door.users import UsersFileError, load_users
 from workbench.files.bounded import MAX_PROBLEMS
 from workbench.labs.model import LabFileError, load_lab
 from workbench.sim.maze import MazeError
 from workbench.sim.mazeio import load_maze
-from workbench.ssh.passwords import hash_password
-from workbench.ssh.users import UsersFileError, load_users
 
 LOADERS = {
     "maze": (load_maze, MazeError),

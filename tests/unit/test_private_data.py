@@ -93,7 +93,7 @@ def test_the_database_the_workbench_makes_is_never_an_empty_file(tmp_path):
 LOGGING = """
 import logging, os, sys
 from pathlib import Path
-from workbench.ssh.serverlog import setup_logging
+from workbench.door.serverlog import setup_logging
 os.umask(0o022)
 setup_logging(Path(sys.argv[1]), stream=False)
 logging.getLogger("workbench.ssh.server").info("a line")

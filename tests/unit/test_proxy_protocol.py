@@ -11,6 +11,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
+from workbench.door.networks import parse_networks, trusted
 from workbench.ssh.proxy_protocol import (
     V2_MAX_BODY,
     V2_SIGNATURE,
@@ -18,8 +19,6 @@ from workbench.ssh.proxy_protocol import (
     ProxyHeaderError,
     bytes_wanted,
     parse_header,
-    parse_networks,
-    trusted,
 )
 
 

@@ -200,8 +200,8 @@ def test_outside_a_workspace_a_file_in_the_way_is_left_alone(tmp_path):
 def test_serve_ssh_hands_its_record_caps_to_every_session_s_app(tmp_path):
     from workbench.cli import build_parser
     from workbench.control.recording import RecordQuota
-    from workbench.ssh.appproc import AppSpec
-    from workbench.tui.settings import AppSettings
+    from workbench.door.appproc import AppSpec
+    from workbench.wire.settings import AppSettings
 
     parser = build_parser()
     args = parser.parse_args(["serve-ssh", "--record-cap", "5M", "--runs-quota", "0"])

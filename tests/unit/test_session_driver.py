@@ -17,7 +17,6 @@ from textual import events, messages
 from textual.drivers import web_driver
 
 from tests.waiting import until
-from workbench.tui.serving import packets
 from workbench.tui.serving.terminal_driver import (
     SYNC_END,
     SYNC_START,
@@ -27,6 +26,7 @@ from workbench.tui.serving.terminal_driver import (
     parser_wait,
     plain_keys,
 )
+from workbench.wire import packets
 
 
 class UnusedReader:

@@ -6,8 +6,8 @@ from __future__ import annotations
 import asyncio
 import logging
 
+from workbench.door.serverlog import setup_logging
 from workbench.ssh.openfiles import quiet_accept_errors
-from workbench.ssh.serverlog import setup_logging
 from workbench.tui.serving.key_budget import KeyBudget, dropped_message
 
 

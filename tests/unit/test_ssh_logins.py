@@ -3,7 +3,7 @@ connections that have not logged in (all on an injected clock)."""
 
 from __future__ import annotations
 
-from workbench.ssh.logins import ConnectionGate, LoginGuard, LoginPolicy, QuietLog
+from workbench.door.logins import ConnectionGate, LoginGuard, LoginPolicy, QuietLog
 
 STUDENT_PC = "10.0.0.7"
 
@@ -121,7 +121,7 @@ def test_a_repeated_warning_is_said_once_per_period_with_the_count_held_back():
 
 
 def test_sources_are_ipv4_addresses_and_ipv6_networks_of_64():
-    from workbench.ssh.sources import source_of
+    from workbench.door.sources import source_of
 
     assert source_of("10.0.0.7") == "10.0.0.7"
     assert source_of("::ffff:10.0.0.7") == "10.0.0.7"

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from workbench.ssh.logins import Admission, ConnectionGate, LoginPolicy, Stage
+from workbench.door.logins import Admission, ConnectionGate, LoginPolicy, Stage
 
 
 class Clock:

@@ -14,20 +14,20 @@ from pathlib import Path
 import pytest
 
 from tests.waiting import wait_until
-from workbench.ssh.appproc import AppProcess, AppSpec, forward_hint
-from workbench.ssh.forkserver import APP_NICENESS
-from workbench.ssh.forwarding import local_forward_refusal, remote_forward_refusal
-from workbench.ssh.limits import SessionLimits, describe_duration
-from workbench.ssh.passwords import (
+from workbench.door.appproc import AppProcess, AppSpec, forward_hint
+from workbench.door.forkserver import APP_NICENESS
+from workbench.door.limits import SessionLimits, describe_duration
+from workbench.door.passwords import (
     PasswordError,
     check_password,
     hash_password,
     parse_hash,
     verify_password,
 )
-from workbench.ssh.ports import PoolExhausted, PortPool, parse_range, port_is_free
-from workbench.tui.serving import packets
-from workbench.tui.settings import AppSettings
+from workbench.door.ports import PoolExhausted, PortPool, parse_range, port_is_free
+from workbench.ssh.forwarding import local_forward_refusal, remote_forward_refusal
+from workbench.wire import packets
+from workbench.wire.settings import AppSettings
 
 
 # -- passwords ------------------------------------------------------------------------------
@@ -225,7 +225,7 @@ def test_a_group_niceness_the_kernel_asks_to_wait_for_is_set_a_moment_later(tmp_
     """An unprivileged server may change one scheduling group's niceness every 0.1 s; a class
     logging in at once asks for more, and each app's group is set all the same, a moment
     later, while the app goes on starting."""
-    from workbench.ssh import forkserver
+    from workbench.door import forkserver
 
     written = tmp_path / "autogroup"
     refusals = [BlockingIOError(11, "Resource temporarily unavailable")] * 3

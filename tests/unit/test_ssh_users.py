@@ -8,8 +8,8 @@ import stat
 import asyncssh
 import pytest
 
-from workbench.ssh.passwords import hash_password
-from workbench.ssh.users import UsersFile, UsersFileError, add_user, load_users, parse_users
+from workbench.door.passwords import hash_password
+from workbench.door.users import UsersFile, UsersFileError, add_user, load_users, parse_users
 
 KEY = asyncssh.generate_private_key("ssh-ed25519")
 PUB = KEY.export_public_key().decode().strip()

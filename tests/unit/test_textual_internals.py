@@ -159,6 +159,12 @@ METHODS = {
     ("textual._compositor", "Compositor", "render_partial_update"): ["self"],
     ("textual._compositor", "ChopsUpdate", "__init__"): ["self", "chops", "spans", "chop_ends"],
     ("textual._compositor", "CompositorUpdate", "render_segments"): ["self", "console"],
+    ("textual._compositor", "Compositor", "render_update"): [
+        "self", "full", "screen_stack", "simplify"
+    ],
+    ("textual.app", "App", "_display"): ["self", "screen", "renderable"],
+    ("textual.drivers.web_driver", "WebDriver", "_enable_mouse_support"): ["self"],
+    ("textual.drivers.web_driver", "WebDriver", "_enable_bracketed_paste"): ["self"],
     ("textual._xterm_parser", "XTermParser", "__init__"): ["self", "debug"],
     ("textual._xterm_parser", "XTermParser", "feed"): ["self", "data"],
     ("textual._xterm_parser", "XTermParser", "tick"): ["self"],
@@ -232,6 +238,7 @@ def test_a_new_app_has_the_state_the_serving_code_reads():
     assert app._driver is None
     assert isinstance(app._keymap, dict)
     assert app._batch_count == 0
+    assert app._screen_stack == []
     assert isinstance(DOMNode()._bindings, BindingsMap)
 
 

@@ -8,10 +8,10 @@ from pathlib import Path
 
 import pytest
 
+from workbench.door.appproc import AppSpec
 from workbench.files.workspace import FileAccess, NoRoom, OutsideWorkspace
 from workbench.files.workspace_files import UploadLimits, WorkspaceError, WorkspaceFiles
-from workbench.ssh.appproc import AppSpec
-from workbench.tui.settings import AppSettings
+from workbench.wire.settings import AppSettings
 
 
 def test_the_server_hands_its_upload_limits_to_each_session_s_app(tmp_path):

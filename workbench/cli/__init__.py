@@ -13,7 +13,7 @@ from workbench import __version__
 from workbench.files.bundled import default_maze_path
 from workbench.files.terminal import TerminalSafeWriter
 from workbench.labs.store.store import StoreError, resolve_db
-from workbench.tui.settings import AppSettings
+from workbench.wire.settings import AppSettings
 
 from . import algorithms as algorithms_cmd
 from . import grade as grade_cmd
@@ -28,6 +28,7 @@ from . import ssh as ssh_cmd
 from . import store as store_cmd
 from . import viple_client as viple_client_cmd
 from . import viple_program as viple_program_cmd
+from . import web as web_cmd
 from .common import (
     db_option,
     error,
@@ -121,6 +122,7 @@ def build_parser() -> argparse.ArgumentParser:
     instructor_cmd.register(sub)
     signoff_cmd.register(sub)
     ssh_cmd.register(sub)
+    web_cmd.register(sub)
     store_cmd.register(sub)
     return parser
 

@@ -209,7 +209,7 @@ def cmd_add(args: argparse.Namespace) -> int:
 def cmd_console(args: argparse.Namespace) -> int:
     from workbench.labs.model import LabFileError
     from workbench.tui.console_app import make_console
-    from workbench.tui.settings import AppSettings
+    from workbench.wire.settings import AppSettings
 
     try:
         settings = AppSettings(

@@ -1,7 +1,7 @@
 """The app of one SSH session, started from the settings the lab server made for it.
 
-The lab server (``workbench/ssh/appproc.py``) hands a session's app its settings as one JSON
-object (:meth:`workbench.tui.settings.AppSettings.to_json`), the workbench for a student and
+The lab server (``workbench/door/appproc.py``) hands a session's app its settings as one JSON
+object (:meth:`workbench.wire.settings.AppSettings.to_json`), the workbench for a student and
 the instructor's console (:mod:`workbench.tui.console_app`) for an instructor: to :func:`main`
 in a process forked from the fork server, or as the one argument of
 ``python -m workbench.cli.served`` when it starts the app as a new process. The course
@@ -17,7 +17,7 @@ from dataclasses import replace
 from typing import TYPE_CHECKING
 
 from workbench.labs.store.store import StoreError, resolve_db
-from workbench.tui.settings import AppSettings, SettingsError
+from workbench.wire.settings import AppSettings, SettingsError
 
 from .common import error
 

@@ -13,6 +13,8 @@ import sys
 from pathlib import Path
 
 from workbench.control.recording import RecordQuota
+from workbench.door.appproc import AppEntry
+from workbench.door.limits import SessionLimits
 from workbench.files.workspace_files import UploadLimits
 from workbench.labs.store.database import ENV_DB, redact
 from workbench.labs.store.store import (
@@ -23,11 +25,9 @@ from workbench.labs.store.store import (
     resolve_data_dir,
     resolve_db,
 )
-from workbench.ssh.appproc import AppEntry
-from workbench.ssh.limits import SessionLimits
-from workbench.ssh.serverlog import SERVER_LOG_SIZE
 
-from .common import db_option, record_quota_options, size, upload_options
+from .common import db_option, record_quota_options, upload_options
+from .doors import door_options
 
 #: the app every SSH session runs, given the session's settings as JSON (see
 #: :mod:`workbench.cli.served`): this Python's ``-m workbench.cli.served``, or forked from the
@@ -61,7 +61,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "made on first start)"
     )  # fmt: skip
     serve.add_argument("--users", help="users file (default <data-dir>/ssh-users.yaml)")
-    _data_dir(serve)
+    data_dir_option(serve)
     db_option(serve)
     serve.add_argument(
         "--port-range", default="41000-41999",
@@ -73,11 +73,6 @@ def register(sub: argparse._SubParsersAction) -> None:
         "app (default: this machine's full name)",
     )  # fmt: skip
     serve.add_argument("--max-per-user", type=int, default=2, help="sessions per user (default 2)")
-    serve.add_argument("--max-sessions", type=int, default=60, help="sessions in all (default 60)")
-    serve.add_argument(
-        "--idle-timeout", type=float, default=7200,
-        help="seconds without input before a session is closed (default 7200)",
-    )  # fmt: skip
     serve.add_argument(
         "--max-connections-per-user", type=int, default=10,
         help="connections one user may hold logged in, with or without a session (default 10)",
@@ -92,35 +87,6 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--channel-grace", type=float, default=SessionLimits.channel_grace, metavar="SECONDS",
         help="seconds a session channel has to ask for a terminal, a command or a file "
         "transfer before it is closed (default 10)",
-    )  # fmt: skip
-    serve.add_argument(
-        "--server-memory", type=int, default=SessionLimits.server_memory, metavar="MIB",
-        help="the server process's own memory, in MiB, past which it takes no new connections, "
-        "channels or sessions while the live ones go on (default 1024; 0: not watched)",
-    )  # fmt: skip
-    serve.add_argument(
-        "--server-log-size", type=size, default=SERVER_LOG_SIZE, metavar="SIZE",
-        help="the largest ssh.log grows; a full one is kept as ssh.log.1 and a new one begun "
-        "(e.g. 20M; 0: no limit; default 20 MB)",
-    )  # fmt: skip
-    serve.add_argument(
-        "--max-terminal", default="500x200", metavar="COLSxROWS",
-        help="the largest terminal an app is given; larger ones are clamped (default 500x200)",
-    )  # fmt: skip
-    serve.add_argument(
-        "--app-memory", type=int, default=512, metavar="MIB",
-        help="memory each session's app may use, in MiB; an app past it is ended with a "
-        "message (default 512; 0: no cap)",
-    )  # fmt: skip
-    serve.add_argument(
-        "--app-log-size", type=size, default=SessionLimits.app_log, metavar="SIZE",
-        help="the largest one session's error log grows; a full one is kept as .log.1 and a "
-        "new one begun (e.g. 1M; 0: no limit; default 1 MB)",
-    )  # fmt: skip
-    serve.add_argument(
-        "--user-logs-quota", type=size, default=SessionLimits.user_logs, metavar="SIZE",
-        help="the most one user's error logs (<data-dir>/logs/USER) may take; the oldest are "
-        "removed at a session's start (0: no limit; default 20 MB)",
     )  # fmt: skip
     serve.add_argument(
         "--login-timeout", type=float, default=30,
@@ -156,21 +122,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--penalty-max", type=float, default=600,
         help="the longest an address is refused for that (default 600; 0: no penalties)",
     )  # fmt: skip
-    serve.add_argument(
-        "--password-lock-after", type=int, default=10,
-        help="wrong passwords for one account before its passwords are locked (default 10)",
-    )  # fmt: skip
-    serve.add_argument(
-        "--password-lock-for", type=float, default=900,
-        help="seconds an account takes no passwords once locked; keys still work (default 900)",
-    )  # fmt: skip
     record_quota_options(serve)
     upload_options(serve)
-    serve.add_argument(
-        "--no-fork-server", action="store_true",
-        help="start each session's app as a new Python process instead of forking it from a "
-        "fork server that has the app imported (slower to start, more memory)",
-    )  # fmt: skip
+    door_options(serve)
     serve.set_defaults(func=cmd_serve)
 
     users = sub.add_parser("ssh", help="users of the SSH lab server")
@@ -189,16 +143,16 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="set a password (asked twice; without a terminal: read from standard input)",
     )  # fmt: skip
     add.add_argument("--users", help="users file (default <data-dir>/ssh-users.yaml)")
-    _data_dir(add)
+    data_dir_option(add)
     add.set_defaults(func=cmd_add_user)
 
     ls = inner.add_parser("list-users", help="list the users, their roles and credentials")
     ls.add_argument("--users", help="users file (default <data-dir>/ssh-users.yaml)")
-    _data_dir(ls)
+    data_dir_option(ls)
     ls.set_defaults(func=cmd_list_users)
 
 
-def _data_dir(parser: argparse.ArgumentParser) -> None:
+def data_dir_option(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--data-dir",
         help="the workbench's data folder (default: $WORKBENCH_DATA, else the user data folder)",
@@ -211,7 +165,7 @@ def fail(command: str, message: str) -> int:
 
 
 def _users_file(args: argparse.Namespace) -> Path:
-    from workbench.ssh.users import users_path
+    from workbench.door.users import users_path
 
     return Path(args.users) if args.users else users_path(resolve_data_dir(args.data_dir))
 
@@ -220,7 +174,7 @@ def _users_file(args: argparse.Namespace) -> Path:
 def read_new_password() -> str:
     """Asked twice on a terminal; without one, the first line of standard input (for scripts;
     a second line, if given, must repeat it)."""
-    from workbench.ssh.passwords import MIN_PASSWORD, PasswordError, check_password
+    from workbench.door.passwords import MIN_PASSWORD, PasswordError, check_password
 
     if not sys.stdin.isatty():
         lines = sys.stdin.read().splitlines()
@@ -237,8 +191,8 @@ def read_new_password() -> str:
 
 
 def cmd_add_user(args: argparse.Namespace) -> int:
-    from workbench.ssh.passwords import PasswordError, hash_password
-    from workbench.ssh.users import UsersFileError, add_user, parse_public_key
+    from workbench.door.passwords import PasswordError, hash_password
+    from workbench.door.users import UsersFileError, add_user, parse_public_key
 
     path = _users_file(args)
     keys: list[str] = []
@@ -272,7 +226,7 @@ def cmd_add_user(args: argparse.Namespace) -> int:
 
 
 def cmd_list_users(args: argparse.Namespace) -> int:
-    from workbench.ssh.users import UsersFileError, load_users
+    from workbench.door.users import UsersFileError, load_users
 
     path = _users_file(args)
     try:
@@ -294,12 +248,12 @@ def cmd_list_users(args: argparse.Namespace) -> int:
 
 # -- the server -------------------------------------------------------------------------------
 def cmd_serve(args: argparse.Namespace) -> int:
+    from workbench.door.logins import LoginPolicy
+    from workbench.door.ports import parse_range
+    from workbench.door.serverlog import setup_logging
+    from workbench.door.users import UsersFileError
     from workbench.ssh.hostkey import HostKeyError
-    from workbench.ssh.logins import LoginPolicy
-    from workbench.ssh.ports import parse_range
     from workbench.ssh.server import LabServer, ServerConfig
-    from workbench.ssh.serverlog import setup_logging
-    from workbench.ssh.users import UsersFileError
 
     if not 0 <= args.port <= 65535:
         return fail(
@@ -315,7 +269,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
             f"--port {args.port} lies inside --port-range {args.port_range}, which is kept for "
             "the sessions' VIPLE ports: choose a port outside it",
         )
-    from workbench.ssh.proxy_protocol import parse_networks
+    from workbench.door.networks import parse_networks
 
     try:
         proxy_from = parse_networks(args.proxy_protocol) if args.proxy_protocol else ()
@@ -394,7 +348,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
     except StoreError as exc:
         return fail("serve-ssh", str(exc))
     if db:
-        problem = _prepare_course_store(data_dir, db)
+        problem = prepare_course_store(data_dir, db)
         if problem:
             return fail("serve-ssh", f"{problem}\nthe server did not start")
         os.environ[ENV_DB] = db  # every session's app inherits it (never on a command line)
@@ -444,7 +398,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
     print(f"workbench serve-ssh: logging to {log_path}", file=sys.stderr)
     logging.getLogger("workbench.ssh").info("course store: %s", store_words(data_dir, db))
     try:
-        return asyncio.run(_serve(server))
+        return asyncio.run(serve_until_stopped(server))
     except OSError as exc:
         return fail("serve-ssh", f"cannot listen on port {args.port}: {exc.strerror or exc}")
 
@@ -468,7 +422,7 @@ def store_words(data_dir: Path, db: str | None) -> str:
     return f"SQLite in the data folder, {data_dir / DB_NAME}"
 
 
-def _prepare_course_store(data_dir: Path, db: str) -> str:
+def prepare_course_store(data_dir: Path, db: str) -> str:
     """Bring the course database's schema up to date once, before any session opens it.
     A server that is down only warns: the apps keep students' work until it is back."""
     try:
@@ -484,7 +438,7 @@ def _prepare_course_store(data_dir: Path, db: str) -> str:
     return ""
 
 
-async def _serve(server) -> int:
+async def serve_until_stopped(server) -> int:
     stop = asyncio.Event()
     loop = asyncio.get_running_loop()
     for sig in (signal.SIGINT, signal.SIGTERM):

@@ -20,15 +20,14 @@ from typing import Any
 
 import asyncssh
 
+from workbench.door.networks import Network, trusted
+
 #: the 12 bytes every version 2 header starts with
 V2_SIGNATURE = b"\r\n\r\n\x00\r\nQUIT\n"
 #: what follows the fixed 16 bytes of a version 2 header may be at most this long
 V2_MAX_BODY = 512
 #: the longest version 1 (text) header, its CRLF included
 V1_MAX = 107
-
-Network = ipaddress.IPv4Network | ipaddress.IPv6Network
-
 
 class ProxyHeaderError(ValueError):
     """The bytes are not a PROXY protocol header this server takes."""
@@ -43,33 +42,6 @@ class ProxyHeader:
     client: str | None
     length: int
     local: bool = False
-
-
-def parse_networks(text: str) -> tuple[Network, ...]:
-    """``"127.0.0.1,10.0.0.0/24"`` as networks; ValueError naming the bad part."""
-    parts = [part.strip() for part in text.split(",")]
-    if not text.strip() or not all(parts):
-        raise ValueError(f"{text!r}: give the balancer's addresses, comma-separated")
-    networks = []
-    for part in parts:
-        try:
-            networks.append(ipaddress.ip_network(part, strict=False))
-        except ValueError:
-            raise ValueError(
-                f"{part!r} is not an address or network (such as 10.0.0.5 or 10.0.0.0/24)"
-            ) from None
-    return tuple(networks)
-
-
-def trusted(address: str, networks: Sequence[Network]) -> bool:
-    """Whether the connection from ``address`` comes from a balancer."""
-    try:
-        ip = ipaddress.ip_address(address)
-    except ValueError:
-        return False
-    if isinstance(ip, ipaddress.IPv6Address) and ip.ipv4_mapped is not None:
-        ip = ip.ipv4_mapped
-    return any(ip.version == net.version and ip in net for net in networks)
 
 
 def bytes_wanted(data: bytes) -> int:

@@ -17,19 +17,33 @@ from pathlib import Path
 import asyncssh
 
 from workbench.control.recording import RecordQuota, shown_size
+from workbench.door.applog import make_room
+from workbench.door.appproc import (
+    RESTORE_TERMINAL,
+    AppEntry,
+    AppProcess,
+    AppSpec,
+    app_env,
+    forward_hint,
+)
+from workbench.door.checking import PasswordDesk
+from workbench.door.course_files import CourseWorkspaces, bring_workspace
+from workbench.door.forkserver import ForkServer, ForkServerError
+from workbench.door.limits import SessionLimits, describe_duration, describe_memory
+from workbench.door.logins import ConnectionGate, Eviction, LoginGuard, LoginPolicy, QuietLog, Stage
+from workbench.door.memory import SHORT_OF_MEMORY, MemoryWatch
+from workbench.door.networks import Network
+from workbench.door.ports import PoolExhausted, PortPool
+from workbench.door.serverlog import shown
+from workbench.door.sources import source_of
+from workbench.door.users import User, UsersFile, users_path
+from workbench.door.workers import STORE, in_pool
 from workbench.files.workspace import workspace_folder
 from workbench.files.workspace_files import UploadLimits
 from workbench.labs.store.workspace_sync import sync_at_start
 
-from .applog import make_room
-from .appproc import RESTORE_TERMINAL, AppEntry, AppProcess, AppSpec, app_env, forward_hint
-from .course_files import CourseWorkspaces
-from .forkserver import ForkServer, ForkServerError
 from .forwarding import forward, local_forward_refusal, remote_forward_refusal
 from .hostkey import host_key_path, load_or_create_host_key
-from .limits import SessionLimits, describe_duration, describe_memory
-from .logins import ConnectionGate, Eviction, LoginGuard, LoginPolicy, QuietLog, Stage
-from .memory import SHORT_OF_MEMORY, MemoryWatch
 from .openfiles import (
     Handler,
     near_the_limit,
@@ -37,15 +51,9 @@ from .openfiles import (
     raise_file_limit,
     room_for_a_file,
 )
-from .passwords import hash_password, verify_password
-from .ports import PoolExhausted, PortPool
-from .proxy_protocol import Network, ProxyAcceptor, accept_behind_balancer
+from .proxy_protocol import ProxyAcceptor, accept_behind_balancer
 from .refusals import ASKED_NOTHING, refusal_message
-from .serverlog import shown
 from .sftp import SFTPChannel, SFTPService
-from .sources import source_of
-from .users import User, UsersFile, users_path
-from .workers import PASSWORDS, STORE, in_pool
 
 log = logging.getLogger("workbench.ssh")
 
@@ -62,8 +70,6 @@ MADE_ROOM = (
 )
 #: seconds a connection from a balancer has to send its PROXY header
 PROXY_HEADER_WAIT = 5.0
-#: seconds a session's start waits for the student's files from the course store
-WORKSPACE_SYNC_WAIT = 20.0
 #: the ciphers the server takes, AES only: a client picks the first of its own list the server
 #: has, and OpenSSH's list starts with chacha20-poly1305, which asyncssh does per packet in
 #: several Python calls (about five times the CPU of AES-GCM, measured in bench/startup.py);
@@ -82,8 +88,6 @@ MACS = (
     "hmac-sha2-256",
     "hmac-sha2-512",
 )
-#: checked against when a user is unknown, so a wrong name costs the same time as a wrong password
-_DUMMY_HASH = hash_password("not a real password")
 
 
 @dataclass
@@ -142,11 +146,9 @@ class LabServer:
         self.remote_listens: dict[str, Counter[int]] = {}
         self.guard = LoginGuard(config.logins)
         self.gate: ConnectionGate[LabConnection] = ConnectionGate(config.logins)
+        self.desk = PasswordDesk(self.users, self.guard, self.gate)
         self.quiet_log = QuietLog()
         self.memory = MemoryWatch(config.limits.server_memory)
-        #: password checks for one account take turns, so parallel guesses wait in line
-        self._account_turns: dict[str, asyncio.Lock] = {}
-        self._account_queue: Counter[str] = Counter()
         self._ids = itertools.count(1)
         self._acceptor: asyncssh.SSHAcceptor | ProxyAcceptor | None = None
         self._sweeper: asyncio.Task[None] | None = None
@@ -332,19 +334,6 @@ class LabServer:
         )  # fmt: skip
         return True
 
-    @contextlib.asynccontextmanager
-    async def account_turn(self, account: str):
-        """Wait for the account's turn to have a password checked."""
-        lock = self._account_turns.setdefault(account, asyncio.Lock())
-        self._account_queue[account] += 1
-        try:
-            async with lock:
-                yield
-        finally:
-            self._account_queue[account] -= 1
-            if not self._account_queue[account]:
-                del self._account_queue[account], self._account_turns[account]
-
     # -- sessions ----------------------------------------------------------------------------
     def live(self, user: str) -> list[LabSession]:
         return [s for s in self.sessions.values() if s.user.name == user and s.running]
@@ -509,11 +498,7 @@ class LabConnection(asyncssh.SSHServer):
         return True
 
     def _known(self, username: str) -> User | None:
-        users = self.server.users
-        user = users.get(username)
-        if users.problem:
-            log.error("users file not read again, the earlier users stay: %s", users.problem)
-        return user
+        return self.server.desk.known(username)
 
     def _refused(self, username: str, why: str, *, checked: bool = True) -> None:
         """Log a refused password; unchecked ones (which cost nothing) at most once per 10 s."""
@@ -573,45 +558,19 @@ class LabConnection(asyncssh.SSHServer):
         return True
 
     async def validate_password(self, username: str, password: str) -> bool:
-        server, peer = self.server, self.peer
-        if not server.gate.start_waiting(peer):
-            why = "too many password attempts at once, not checked"
-            self._refused(username, why, checked=False)
-            return False
+        server = self.server
         server.gate.progressed(self, Stage.CHECKING)
         try:
-            async with server.account_turn(username):
-                return await self._check_password(username, password)
+            verdict = await server.desk.check(username, password, self.peer)
         finally:
-            server.gate.stop_waiting(peer)
             server.gate.progressed(self, Stage.AUTHENTICATING)
-
-    async def _check_password(self, username: str, password: str) -> bool:
-        guard = self.server.guard
-        locked = guard.locked_for(username)
-        if locked:
-            why = f"passwords locked for another {describe_duration(round(locked))}"
-            self._refused(username, why, checked=False)
-            return False
-        delay = guard.delay(username, self.peer)
-        if delay:
-            await asyncio.sleep(delay)
-        user = self._known(username)
-        stored = user.password if user is not None and user.password else _DUMMY_HASH
-        ok = await in_pool(PASSWORDS, verify_password, password, stored)
-        if user is not None and ok and user.password:
-            guard.password_succeeded(username)
-            self._login = (user, "password")
+        if verdict.user is not None:
+            self._login = (verdict.user, "password")
             return True
-        locks = guard.password_failed(username, self.peer)
-        self._refused(username, "unknown user" if user is None else "wrong password")
-        if locks:
-            policy = guard.policy
+        self._refused(username, verdict.why, checked=verdict.checked)
+        if verdict.locked:
             log.warning(
-                "passwords of %s locked for %s after %d failures (keys still work)",
-                shown(username),
-                describe_duration(policy.lock_for),
-                policy.lock_after,
+                "passwords of %s %s (keys still work)", shown(username), server.desk.lock_words()
             )
         return False
 
@@ -940,27 +899,11 @@ class LabSession(asyncssh.SSHServerSession):
             await self._finish(message, code)
 
     async def _bring_workspace(self, user: str, workspace: Path) -> None:
-        """Bring the student's files from the course store before their app starts (in a
-        thread; a store that does not answer within :data:`WORKSPACE_SYNC_WAIT` lets the
-        session start with the files this server has)."""
         config = self.server.config
         assert config.db is not None
-        sync = in_pool(STORE, sync_at_start, config.data_dir, config.db, user, workspace)
-        try:
-            report = await asyncio.wait_for(sync, WORKSPACE_SYNC_WAIT)
-        except TimeoutError:
-            log.warning("session %d: %s's workspace: the course store did not answer within "
-                        "%g s: starting with this server's files", self.id, user,
-                        WORKSPACE_SYNC_WAIT)  # fmt: skip
-            return
-        if report.fetched or report.removed or report.pushed:
-            log.info(
-                "session %d: %s's workspace: %d file(s) brought, %d removed, %d sent",
-                self.id, user, len(report.fetched), len(report.removed), len(report.pushed),
-            )  # fmt: skip
-        for problem in report.problems[:20]:
-            text = "".join(c if c.isprintable() else "?" for c in problem[:300])
-            log.warning("session %d: %s's workspace: %s", self.id, user, text)
+        await bring_workspace(
+            config.data_dir, config.db, user, workspace, f"session {self.id}", sync_at_start
+        )
 
     def _make_log_room(self, log_path: Path) -> None:
         """Remove the user's oldest logs until their folder has room for this session's."""

@@ -41,6 +41,8 @@ from asyncssh.sftp import (
 )
 from asyncssh.stream import SSHReader, SSHServerStreamSession, SSHWriter
 
+from workbench.door.users import User
+from workbench.door.workers import FILES, in_pool
 from workbench.files.names import (
     MAX_NAME_BYTES,
     BadPath,
@@ -57,9 +59,6 @@ from workbench.files.workspace_files import (
     WorkspaceError,
     WorkspaceFiles,
 )
-
-from .users import User
-from .workers import FILES, in_pool
 
 log = logging.getLogger("workbench.ssh")
 

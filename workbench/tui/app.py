@@ -48,6 +48,7 @@ from workbench.sim.profiles import PROFILES, check_report_ms
 from workbench.viple.hosting import Endpoints
 from workbench.viple.tcp_server import TcpConfig
 from workbench.viple.ws_client import WsConfig
+from workbench.wire.settings import AppSettings
 
 from .commands import WorkbenchCommands
 from .dialogs.help import HelpScreen
@@ -77,7 +78,6 @@ from .serving.loop_clock import LoopClock
 from .serving.ordered_keys import OrderedKeys
 from .serving.quick_keys import QuickKeys, as_key_press
 from .serving.terminal_driver import serves
-from .settings import AppSettings
 
 #: the smallest terminal the layout is made for (columns, rows)
 MIN_SIZE = (80, 24)

@@ -15,12 +15,12 @@ from textual.binding import BindingType
 
 from workbench.labs.course_store import Store, StoreError, open_to_read
 from workbench.labs.model import Lab, LabFileError, load_labs
+from workbench.wire.settings import AppSettings
 
 from .app import FOCUS_BINDINGS
 from .host import ScreenHost
 from .keys import APP_KEY_IDS, bindings
 from .screens.console import ConsoleScreen
-from .settings import AppSettings
 
 
 class ConsoleApp(ScreenHost[None]):

@@ -4,8 +4,8 @@ A lab server runs one app process per student, and a student driving sends some 
 second; the modules here cut what each key, tick and frame costs the server (measured with
 ``bench/tui_cpu.py``, see ``docs/ssh.md``):
 
-  * ``terminal_driver``: Textual's web driver reading the session's input on the event loop;
-    ``packets``: the web driver's packet protocol, shared with the SSH server;
+  * ``terminal_driver``: Textual's web driver reading the session's input on the event loop
+    (the packets it speaks with the server are the wire's, ``workbench/wire/packets.py``);
   * ``quick_keys`` and ``binding_chain``: a driving key runs its action without a key event,
     and a screen's binding chain is built only when it changed;
   * ``prompt_frames`` and ``compositor``: a change is drawn in the wake that made it, rendering

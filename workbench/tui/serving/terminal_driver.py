@@ -2,7 +2,7 @@
 event loop instead of in a thread.
 
 The lab server runs each session's app with Textual's web driver (packets over a pipe, see
-``packets.py`` beside this module). That driver reads them in a thread of its own that wakes ten
+``workbench/wire/packets.py``). That driver reads them in a thread of its own that wakes ten
 times a second, key or no key (to look for a lone Escape whose sequence never finished), and hands
 each key to the app's loop wrapped in a coroutine, a task and a pair of futures. With twenty
 keys a second from a student driving, that thread and the hand-over were a fifth of what the app
@@ -21,6 +21,10 @@ key goes the usual way, the rest of that text follows it, so keys stay in the or
 A synchronized update (the terminal's begin-update, the frame and end-update: three writes when
 the student's terminal supports them) leaves the app as one packet, so the server reads and
 forwards a frame in one piece.
+
+A ``redraw`` meta packet (a browser's page that came back to its app) sets the terminal's modes
+as at the start and writes the whole screen as it is (:meth:`ServedTerminalDriver.redraw`):
+a resize to the size the app has already draws nothing.
 """
 
 from __future__ import annotations
@@ -40,11 +44,14 @@ from textual._xterm_parser import XTermParser
 from textual.app import App
 from textual.drivers.web_driver import WebDriver, _ExitInput
 
+from workbench.wire.packets import DATA, PacketReader
+
 from .key_budget import KeyBudget, dropped_message
-from .packets import DATA, PacketReader
 
 #: how long to wait while the parser's own time limit cannot be read (Textual's interval)
 FALLBACK_WAIT = 0.1
+#: seconds a redraw waits while the app holds its frames back
+REDRAW_WAIT = 0.02
 #: the most bytes taken from the pipe at once
 READ_SIZE = 65536
 _UNKNOWN = object()
@@ -263,6 +270,28 @@ class ServedTerminalDriver(WebDriver):
         self._input_reader = reading  # type: ignore[assignment]
         #: the writes of a synchronized update so far (None: no update is open)
         self._frame: list[str] | None = None
+
+    def on_meta(self, packet_type: str, payload: dict[str, object]) -> None:
+        if packet_type == "redraw":
+            self._app.call_later(self.redraw)
+            return
+        super().on_meta(packet_type, payload)
+
+    def redraw(self) -> None:
+        """Write the app's whole screen for a new terminal: the modes set at the start (the
+        alternate screen, mouse reports, hidden cursor, bracketed paste), then every line.
+        While the app holds its frames back (a batch of changes under way, no screen yet) it
+        waits for them: a frame dropped then would leave the new terminal blank."""
+        app = self._app
+        if app._batch_count or not app._screen_stack or not app.screen.is_attached:
+            app.set_timer(REDRAW_WAIT, self.redraw)
+            return
+        self.write("\x1b[?1049h")
+        self._enable_mouse_support()
+        self.write("\x1b[?25l")
+        self._enable_bracketed_paste()
+        screen = app.screen
+        app._display(screen, screen._compositor.render_update(full=True))
 
     def send_message(self, message: messages.Message) -> None:
         """Hand a message to the app (on its loop: straight into its queue)."""

@@ -2,13 +2,14 @@
 to the app.
 
 The command line builds :class:`AppSettings` from its options (``workbench/cli/__init__.py``);
-the SSH lab server builds one for each session (``workbench/ssh/appproc.py``) and hands it to the
+the SSH lab server builds one for each session (``workbench/door/appproc.py``) and hands it to the
 session's app as a JSON object (:meth:`AppSettings.to_json`), through the fork server or on the
 command line of a new process, and the app reads it back with :meth:`AppSettings.from_json`.
 :func:`workbench.tui.app.make_app` takes it and checks what only the app can check (the maze
 file, the names, the profile and noise level).
 
-This module imports no Textual (an import-linter contract keeps it so): the lab server reads it.
+It is part of the wire (``workbench/wire/``), which imports no Textual (an import-linter
+contract keeps it so): the lab server reads it without importing the app.
 """
 
 from __future__ import annotations

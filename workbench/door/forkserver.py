@@ -4,7 +4,7 @@ a fresh ``python -m workbench`` takes.
 
 Two halves live here:
 
-- the fork server process (``python -m workbench.ssh.forkserver FD MAIN [MODULE...]``): started
+- the fork server process (``python -m workbench.door.forkserver FD MAIN [MODULE...]``): started
   by the lab server with the apps' environment and the app's entry point (``MAIN``, as
   ``module:function``, handed down by whoever starts the lab server), it imports the modules it
   is given, the :data:`PRELOAD` list and every module of the workbench packages the app uses;
@@ -63,6 +63,7 @@ PRELOAD_PACKAGES = (
     "workbench.control",
     "workbench.viple",
     "workbench.labs",
+    "workbench.wire",
     "workbench.tui",
 )
 MAX_MESSAGE = 1 << 20
@@ -396,7 +397,7 @@ class ForkServer:
         ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_SEQPACKET)
         try:
             self.process = await asyncio.create_subprocess_exec(
-                sys.executable, "-m", "workbench.ssh.forkserver", str(theirs.fileno()),
+                sys.executable, "-m", "workbench.door.forkserver", str(theirs.fileno()),
                 self.main, *self.preload,
                 pass_fds=[theirs.fileno()], stdin=asyncio.subprocess.DEVNULL,
                 stdout=asyncio.subprocess.DEVNULL, env=self.env, start_new_session=True,

@@ -23,15 +23,23 @@ def shown(name: str) -> str:
     return "".join(c if c.isprintable() else "?" for c in name[:64])
 
 
-def setup_logging(data_dir: Path, stream: bool = True, size: int = SERVER_LOG_SIZE) -> Path:
-    """Log the server's events to ``<data-dir>/ssh.log`` (and stderr), the log kept within
-    ``size`` bytes and one older log (0: no limit); returns the log's path.
+def setup_logging(
+    data_dir: Path,
+    stream: bool = True,
+    size: int = SERVER_LOG_SIZE,
+    *,
+    file_name: str = "ssh.log",
+    also: tuple[str, ...] = (),
+) -> Path:
+    """Log the server's events to ``<data-dir>/ssh.log`` (the browser door's to
+    ``web.log``, with its own logger among ``also``) and stderr, the log kept within ``size``
+    bytes and one older log (0: no limit); returns the log's path.
     The data folder and everything in it are made private to the server's account first, and
     so is all the server and its apps make from now on (a umask of 077): they hold students'
     progress and login addresses."""
     os.umask(0o077)
     changed = [n for n in (private_dir(data_dir), *tighten_tree(data_dir)) if n]
-    path = data_dir / "ssh.log"
+    path = data_dir / file_name
     formatter = logging.Formatter("%(asctime)s %(levelname)s %(message)s")
     handlers: list[logging.Handler] = [
         logging.handlers.RotatingFileHandler(
@@ -40,10 +48,13 @@ def setup_logging(data_dir: Path, stream: bool = True, size: int = SERVER_LOG_SI
     ]
     if stream:
         handlers.append(logging.StreamHandler(sys.stderr))
+    loggers = [log, *(logging.getLogger(name) for name in also)]
     for handler in handlers:
         handler.setFormatter(formatter)
-        log.addHandler(handler)
-    log.setLevel(logging.INFO)
+        for logger in loggers:
+            logger.addHandler(handler)
+    for logger in loggers:
+        logger.setLevel(logging.INFO)
     logging.getLogger("asyncssh").setLevel(logging.WARNING)
     if changed:
         log.warning(

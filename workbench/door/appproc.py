@@ -22,8 +22,8 @@ from typing import TYPE_CHECKING
 
 from workbench.control.recording import RecordQuota
 from workbench.files.workspace_files import UploadLimits
-from workbench.tui.serving import packets
-from workbench.tui.settings import AppSettings
+from workbench.wire import packets
+from workbench.wire.settings import AppSettings
 
 from .applog import AppLog, ErrorPipe, read_errors
 
@@ -251,6 +251,10 @@ class AppProcess:
     def resize(self, width: int, height: int) -> None:
         if width > 0 and height > 0:
             self._write(packets.resize(width, height))
+
+    def redraw(self) -> None:
+        """Ask the app for its whole screen again (a new terminal shows it)."""
+        self._write(packets.redraw())
 
     # -- output ------------------------------------------------------------------------------
     def pause_output(self) -> None:

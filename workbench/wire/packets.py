@@ -1,11 +1,12 @@
 """Textual's web-driver packets, the protocol between the server and an app process.
 
-The app (run with Textual's web driver, :class:`.terminal_driver.ServedTerminalDriver`) writes
+The app (run with Textual's web driver, ``workbench.tui.serving.terminal_driver``) writes
 the line ``__GANGLION__`` on its standard output, then packets: one type byte (``D`` terminal
 output, ``M`` JSON meta data, ``P`` binary-encoded data), a 4-byte big-endian length and the
 payload.
 The server writes packets of the same form to the app's standard input: ``D`` with the raw
-bytes the user typed, ``M`` with ``{"type": "resize", ...}`` or ``{"type": "quit"}``.
+bytes the user typed, ``M`` with ``{"type": "resize", ...}``, ``{"type": "redraw"}`` (write
+the whole screen again, for a new terminal) or ``{"type": "quit"}``.
 """
 
 from __future__ import annotations
@@ -44,6 +45,10 @@ def meta(message: dict[str, Any]) -> bytes:
 
 def resize(width: int, height: int) -> bytes:
     return meta({"type": "resize", "width": int(width), "height": int(height)})
+
+
+def redraw() -> bytes:
+    return meta({"type": "redraw"})
 
 
 def quit_message() -> bytes:
