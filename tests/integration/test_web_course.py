@@ -18,7 +18,7 @@ PROGRAM = b"ann's program\n"
 def held(data_dir, db: str) -> dict[str, str]:
     """The course store's live files of ann, path -> sha256."""
     with Store.open(data_dir, db=db) as store:
-        return {p: r.sha256 for p, r in store.workspace_index("ann").items() if not r.deleted}
+        return {p: r.sha256 for p, r in store.workspaces.index("ann").items() if not r.deleted}
 
 
 @sync

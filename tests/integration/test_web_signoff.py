@@ -53,5 +53,5 @@ async def test_the_instructor_signs_in_their_own_page_and_the_students_page_show
             await browser.close()
 
     with Store.open(host.data_dir, create=False) as store:
-        (record,) = store.signoffs()
+        (record,) = store.signoffs.of()
     assert (record.instructor, record.student, record.override) == ("ito", "ann", True)
