@@ -3,7 +3,7 @@ lab, at 80x24, in Unicode and in ASCII, following the store and scrolling."""
 
 from __future__ import annotations
 
-from textual.widgets import DataTable, Static
+from textual.widgets import DataTable
 
 from workbench.labs.checks import ObjectiveState
 from workbench.labs.classview import read_request
@@ -26,14 +26,11 @@ from .console_support import (
     until,
     wall_main,
 )
+from .labs_support import text
 from .support import screen_lines, sync
 
 FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
 PASS = "correct horse battery"
-
-
-def text(screen, selector: str) -> str:
-    return str(screen.query_one(selector, Static).render())
 
 
 def grid_rows(screen: GridScreen) -> dict[str, list[str]]:

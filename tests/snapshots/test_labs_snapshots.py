@@ -15,6 +15,7 @@ from textual.pilot import Pilot
 from textual.widgets import Checkbox, Input, OptionList
 
 from tests.app.labs_support import open_labs, signing_over
+from tests.app.support import still
 from workbench.labs.instructors import KdfParams, create_instructor
 from workbench.labs.model import load_labs
 from workbench.tui.app import WorkbenchApp, make_app
@@ -29,11 +30,6 @@ def lab_app(data_dir: Path, instructor: bool = True) -> WorkbenchApp:
     if instructor:
         create_instructor(data_dir, "Dr Chen", PASS, kdf=FAST)
     return make_app(AppSettings(paused=True, student="ana", partner="ben", data_dir=data_dir))
-
-
-def still(pilot: Pilot) -> None:
-    for field in pilot.app.screen.query(Input):
-        field.cursor_blink = False
 
 
 async def open_drive_by_wire(pilot: Pilot) -> None:
