@@ -6,6 +6,7 @@ from __future__ import annotations
 import asyncio
 import functools
 from collections.abc import Awaitable, Callable, Coroutine
+from pathlib import Path
 from typing import Any
 
 from textual import events
@@ -78,6 +79,14 @@ def still(pilot: Pilot) -> None:
     """No blinking text cursors in the picture (for a snapshot)."""
     for field in pilot.app.screen.query(Input):
         field.cursor_blink = False
+
+
+def maze_file(folder: Path, rows: str, profile: str = "unity", name: str = "room") -> str:
+    """The maze ``rows`` saved as ``name``.txt in ``folder``, named ``name`` and made for
+    ``profile``; its path, as the command line takes it."""
+    path = folder / f"{name}.txt"
+    path.write_text(f"---\nname: {name}\nprofile: {profile}\n---\n{rows}")
+    return str(path)
 
 
 def said(app: App) -> str:

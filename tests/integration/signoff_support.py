@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import re
 import sqlite3
 import sys
 from datetime import UTC, datetime
@@ -57,3 +58,10 @@ def sql(data_dir: Path, *statements: str, params: tuple = ()) -> list[tuple]:
         return rows
     finally:
         conn.close()
+
+
+def head_of(out: str) -> str:
+    """The head of the sign-off log (``SEQ:SHA256``) a command printed."""
+    found = re.search(r"\bhead (\d+:[0-9a-f]{64})", out)
+    assert found is not None, f"no head of the log in:\n{out}"
+    return found.group(1)

@@ -17,7 +17,7 @@ from tests.app.support import sync
 from tests.waiting import until
 from workbench.ssh.logins import LoginPolicy
 
-from .ssh_support import PASSWORD, Account, lab_host
+from .ssh_support import PASSWORD, Account, idle_socket, lab_host
 
 FAST = {"first_delay": 0.2, "max_delay": 0.8}
 
@@ -86,11 +86,6 @@ async def test_too_many_wrong_passwords_lock_the_account_s_passwords_but_not_its
         conn = await host.connect("rivera")  # by key
         conn.close()
         assert "login: rivera (instructor) from 127.0.0.1 with key" in caplog.text
-
-
-async def idle_socket(port: int) -> tuple[asyncio.StreamReader, asyncio.StreamWriter]:
-    reader, writer = await asyncio.open_connection("127.0.0.1", port)
-    return reader, writer
 
 
 async def closed_within(reader: asyncio.StreamReader, seconds: float) -> bool:

@@ -5,19 +5,12 @@ from __future__ import annotations
 
 from tests.app.support import sync
 from tests.waiting import until
-from workbench.labs.store import Store
 from workbench.labs.workspace_sync import sync_at_start
 
-from .sftp_support import OpenSSH, files_under, needs_openssh
+from .sftp_support import OpenSSH, files_under, held, needs_openssh
 from .ssh_support import Account, lab_host
 
 pytestmark = needs_openssh
-
-
-def held(data_dir, db: str) -> dict[str, str]:
-    """The course store's live files of ann, path -> sha256."""
-    with Store.open(data_dir, db=db) as store:
-        return {p: r.sha256 for p, r in store.workspace_index("ann").items() if not r.deleted}
 
 
 @sync
