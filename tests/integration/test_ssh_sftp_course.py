@@ -19,8 +19,8 @@ async def test_uploads_renames_and_removals_reach_the_other_server(tmp_path, pg_
     (tmp_path / "prog.viple").write_bytes(b"ann's program\n")
     (tmp_path / "maze.txt").write_bytes(b"ann's maze\n")
     async with (
-        lab_host(tmp_path / "one", [ann], db=pg_url) as one,
-        lab_host(tmp_path / "two", [ann], db=pg_url) as two,
+        lab_host(tmp_path / "one", [ann], db=pg_url, fork_server=False) as one,
+        lab_host(tmp_path / "two", [ann], db=pg_url, fork_server=False) as two,
     ):
         done = await OpenSSH(one, tmp_path).sftp(
             "ann",

@@ -8,7 +8,6 @@ import signal
 import sqlite3
 import subprocess
 import sys
-import threading
 from dataclasses import replace
 from datetime import UTC, datetime
 from pathlib import Path
@@ -378,30 +377,6 @@ def test_progress_and_drivers_are_saved_and_replaced(data_dir):
         assert s.drivers("alice", "bob") == {("web", "ex1"): "bob"}
         with pytest.raises(ValueError):
             s.save_progress("alice", "web", "ex1", {"t": float("inf")})
-
-
-def test_two_connections_can_write_at_the_same_time(data_dir):
-    Store.open(data_dir).close()
-    errors: list[BaseException] = []
-
-    def writer(who: str) -> None:
-        try:
-            with Store.open(data_dir) as s:
-                for i in range(40):
-                    s.save_progress(who, "lab", f"ex{i}", {"i": i})
-                    s.log_event(who, "tick", str(i), T0)
-        except BaseException as exc:
-            errors.append(exc)
-
-    threads = [threading.Thread(target=writer, args=(w,)) for w in ("alice", "bob")]
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join()
-    assert errors == []
-    with Store.open(data_dir) as s:
-        assert len(s.progress("alice")) == 40 and len(s.progress("bob")) == 40
-        assert len(s.events()) == 80
 
 
 WRITER = """
