@@ -15,6 +15,7 @@ from pathlib import Path
 import pytest
 
 from tests.clocks import Clock
+from tests.integration.signoff_support import fields
 from workbench.labs.gradebook import gradebook_rows
 from workbench.labs.instructors import KdfParams, create_instructor, key_path, unlock_instructor
 from workbench.labs.roster import RosterEntry, load_roster, roster_path
@@ -29,7 +30,6 @@ from workbench.labs.signoff_errors import (
 )
 from workbench.labs.signoff_record import (
     Evidence,
-    RecordFields,
     SignoffRecord,
     record_digest,
     record_from_stored,
@@ -66,23 +66,6 @@ def run_record(tmp_path: Path) -> Path:
     p = tmp_path / "run.jsonl"
     p.write_text('{"type":"header","format":"workbench-run/1"}\n{"type":"summary"}\n')
     return p
-
-
-def fields(run_record: Path | None = None, passed: bool = True, **kw) -> RecordFields:
-    evidence = Evidence(
-        str(run_record) if run_record else "", "", {"exit_time": 41.5, "collisions": 0}
-    )
-    base = dict(
-        student="alice",
-        partner="bob",
-        driver="alice",
-        lab="unity-simulator",
-        exercise="wall-following",
-        evidence=evidence,
-        objectives_passed=passed,
-    )
-    base.update(kw)
-    return RecordFields(**base)
 
 
 def roster(data_dir: Path) -> dict[str, RosterEntry]:
