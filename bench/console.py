@@ -60,8 +60,8 @@ class Class:
         self.lock = threading.Lock()
         self.stop = threading.Event()
         for name in self.names:
-            self.store.set_place(name, self.lab, self.exercise.id)
-            self.store.save_progress(name, self.lab, self.exercise.id, self.progress(0))
+            self.store.progress.set_place(name, self.lab, self.exercise.id)
+            self.store.progress.save(name, self.lab, self.exercise.id, self.progress(0))
 
     def progress(self, turn: int) -> dict:
         return progress(self.lab, self.exercise, turn)
@@ -72,18 +72,18 @@ class Class:
         while not self.stop.is_set():
             turn += 1
             name = self.names[turn % len(self.names)]
-            self.store.save_progress(name, self.lab, self.exercise.id, self.progress(turn))
+            self.store.progress.save(name, self.lab, self.exercise.id, self.progress(turn))
             with self.lock:
                 seen, self.seen = self.seen, []
             for entry_id in seen:
-                self.store.decline_request(entry_id, "bench", "seen")
+                self.store.queue.decline(entry_id, "bench", "seen")
             if time.monotonic() >= next_ask:
                 who = self.names[asker % len(self.names)]
                 asker += 1
                 with self.lock:
                     if who not in self.asked:
                         self.asked[who] = time.monotonic()
-                        self.store.request_signoff(who, "", who, self.lab, self.exercise.id)
+                        self.store.queue.request(who, "", who, self.lab, self.exercise.id)
                 next_ask += self.interval
             self.stop.wait(per_save)
 

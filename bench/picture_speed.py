@@ -49,7 +49,7 @@ import json, sys, time
 t0 = time.process_time()
 import workbench.cli.served
 from workbench.tui.app import make_app
-from workbench.tui.settings import AppSettings
+from workbench.wire.settings import AppSettings
 app = make_app(AppSettings(paused=True, student="ana"))
 took = time.process_time() - t0
 print(json.dumps({

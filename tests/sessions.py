@@ -1,5 +1,5 @@
 """What the tests of the VIPLE endpoints share: a simulation stepped by the test, free ports on
-loopback, and reports counted as they arrive."""
+loopback, many sensors, and reports counted as they arrive."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ from collections.abc import Awaitable, Callable
 
 from workbench.sim.maze import Maze
 from workbench.sim.mazefile import parse_maze
+from workbench.sim.sensors import SensorSpec
 from workbench.sim.session import Session
 
 # a corridor facing east, the far wall 7 blocks ahead; unity blocks are 2 units
@@ -26,11 +27,15 @@ def steps(session: Session, n: int) -> None:
         session.step()
 
 
-def free_port() -> int:
-    """A port on loopback that nothing listens on now."""
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return sock.getsockname()[1]
+def free_port(outside: tuple[int, int] | None = None) -> int:
+    """A port on loopback that nothing listens on now; given ``outside`` (low, high), one not
+    in that range (a lab server refuses its sessions' own VIPLE ports for itself)."""
+    while True:
+        with socket.socket() as sock:
+            sock.bind(("127.0.0.1", 0))
+            port = sock.getsockname()[1]
+        if outside is None or not outside[0] <= port <= outside[1]:
+            return port
 
 
 async def pushes_keep_their_interval(
@@ -53,3 +58,9 @@ async def pushes_keep_their_interval(
         await receive()
         # a hundredth of the interval for the clock's granularity
         assert now() - start >= n * interval - interval / 100, f"push {n} came early"
+
+
+def many_sensors() -> list[SensorSpec]:
+    """Forty sensors: reports of about 2 KB fill the socket buffers in a few dozen reports."""
+    mounts = ("front", "left", "right", "back")
+    return [SensorSpec("distance", port, mounts[port % 4]) for port in range(1, 41)]

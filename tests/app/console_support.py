@@ -3,11 +3,7 @@
 from __future__ import annotations
 
 import json
-import time
-from collections.abc import Callable
 from pathlib import Path
-
-from textual.pilot import Pilot
 
 from workbench.labs.checks import ExerciseProgress, ObjectiveState
 from workbench.labs.model import load_labs
@@ -56,14 +52,6 @@ def progress(passed: bool = True, record: str = "") -> ExerciseProgress:
 def save_student(store: Store, student: str, passed: bool = True, record: str = "") -> None:
     store.progress.set_place(student, LAB, EXERCISE)
     store.progress.save(student, LAB, EXERCISE, json.loads(progress(passed, record).to_json()))
-
-
-async def until(pilot: Pilot, done: Callable[[], object], what: str, seconds: float = 10) -> None:
-    """Let the app run until ``done()`` holds (the event the test waits for)."""
-    deadline = time.monotonic() + seconds
-    while not done():
-        assert time.monotonic() < deadline, f"waited {seconds} s for {what}"
-        await pilot.pause(0.05)
 
 
 WEB_LAB, WALL_MAIN = "web-simulator", "wall-main"

@@ -6,6 +6,7 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
+from tests.stations import run_once
 from workbench.control.station import LabStation
 from workbench.program.choice import choose_program
 from workbench.sim.mazefile import parse_maze
@@ -21,24 +22,14 @@ def run_algorithms(station: LabStation, *names: str) -> LabStation:
     for name in names:
         station.select_algorithm(name)
         station.apply_algorithm_preset()
-        station.start()
-        before = len(station.runs)
-        for _ in range(200):
-            station.step(60)
-            if len(station.runs) > before:
-                break
+        run_once(station, limit_s=200)
     return station
 
 
 def run_program(station: LabStation, path) -> None:
     """Run the VIPLE program file at ``path`` from the start block until its run ends."""
     station.use_program(choose_program(station, str(path)))
-    station.start()
-    before = len(station.runs)
-    for _ in range(400):
-        station.step(60)
-        if len(station.runs) > before:
-            break
+    run_once(station, limit_s=400)
 
 
 def runs_with_long_driver_names(tmp_path) -> LabStation:

@@ -1,15 +1,21 @@
-"""What the app tests share: running async test bodies and driving an app with a Pilot."""
+"""What the app tests share: running async test bodies, driving an app with a Pilot, an app
+that hosts one screen, and reading what the screens show."""
 
 from __future__ import annotations
 
 import asyncio
 import functools
 from collections.abc import Awaitable, Callable, Coroutine
+from pathlib import Path
 from typing import Any
 
+from textual import events
 from textual.app import App
 from textual.pilot import Pilot
+from textual.screen import Screen
+from textual.widgets import Input
 
+from workbench.tui.host import ScreenHost
 from workbench.tui.screens.main import MainScreen
 from workbench.tui.widgets.run_status import RunStatus
 
@@ -37,6 +43,50 @@ def run(
             await body(pilot)
 
     asyncio.run(go())
+
+
+class Host(ScreenHost):
+    """An app that pushes one screen (``under_test``) over an empty default screen, keeps what
+    the screen was dismissed with (``results``) and what was said on the message line
+    (``said``). It draws in plain ASCII unless ``follow_unicode``: then as the screen does (its
+    footer, scroll bars and dialogs too), as the workbench app would."""
+
+    def __init__(self, screen: Screen, follow_unicode: bool = False) -> None:
+        super().__init__()
+        self.under_test = screen
+        self.results: list[object] = []
+        self.said: list[str] = []
+        if follow_unicode:
+            self.set_reactive(ScreenHost.unicode, bool(getattr(screen, "unicode", False)))
+
+    def say(self, text: str) -> None:
+        self.said.append(text)
+        super().say(text)
+
+    def on_mount(self) -> None:
+        self.push_screen(self.under_test, self.results.append)
+
+
+async def burst(pilot: Pilot, *keys: tuple[str, str | None]) -> None:
+    """Post ``keys`` to the app in one go, as a packet's keys come, then let them settle."""
+    for key, char in keys:
+        pilot.app.post_message(events.Key(key, char))
+    for _ in range(3):
+        await pilot.pause()
+
+
+def still(pilot: Pilot) -> None:
+    """No blinking text cursors in the picture (for a snapshot)."""
+    for field in pilot.app.screen.query(Input):
+        field.cursor_blink = False
+
+
+def maze_file(folder: Path, rows: str, profile: str = "unity", name: str = "room") -> str:
+    """The maze ``rows`` saved as ``name``.txt in ``folder``, named ``name`` and made for
+    ``profile``; its path, as the command line takes it."""
+    path = folder / f"{name}.txt"
+    path.write_text(f"---\nname: {name}\nprofile: {profile}\n---\n{rows}")
+    return str(path)
 
 
 def said(app: App) -> str:

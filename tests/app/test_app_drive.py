@@ -13,7 +13,7 @@ from textual.command import CommandList
 from textual.pilot import Pilot
 from textual.widgets import Static
 
-from tests.app.support import run
+from tests.app.support import maze_file, run, run_panel
 from workbench.cli import main
 from workbench.control.manual import key_legend
 from workbench.tui.app import FOCUS_BINDINGS, AppSetupError, WorkbenchApp, make_app
@@ -32,16 +32,6 @@ from workbench.wire.settings import AppSettings
 
 ROOM = "#######\n#.....#\n#..S..#\n#.....#\n#######\n"
 CORRIDOR = "##########\n#S......E#\n##########\n"
-
-
-def maze_file(tmp_path, text: str, profile: str) -> str:
-    path = tmp_path / f"{profile}.txt"
-    path.write_text(f"---\nname: test {profile}\nprofile: {profile}\n---\n{text}")
-    return str(path)
-
-
-def status(app: WorkbenchApp) -> str:
-    return "\n".join(app.screen.query_one(RunStatus).lines)
 
 
 # -- drive-by-wire ------------------------------------------------------------------------------
@@ -64,7 +54,7 @@ def test_unity_keys_turn_by_degree_and_move_at_power(tmp_path):
         pose = app.station.snapshot().pose
         assert pose.y > start.y + 0.5 and pose.x == pytest.approx(start.x, abs=0.05)
         assert app.screen.query_one(MazeView).robot_cell == app.station.snapshot().block
-        assert "driver: keys" in status(app)
+        assert "driver: keys" in run_panel(app)
         assert app.station.keys_used == {"d", "w", "space"}
 
     run(app, body)
@@ -128,7 +118,7 @@ def test_pause_step_speed_and_reset(tmp_path):
         await pilot.pause(0.3)
         assert station.snapshot().time > 0  # the interval runs the simulation in real time
         await pilot.press("p")
-        assert station.pacer.paused and "PAUSED" in status(app)
+        assert station.pacer.paused and "PAUSED" in run_panel(app)
         t = station.snapshot().time
         await pilot.pause(0.2)
         assert station.snapshot().time == t
@@ -138,14 +128,14 @@ def test_pause_step_speed_and_reset(tmp_path):
         seen = []
         for _ in range(5):
             await pilot.press("plus")
-            seen.append(status(app).splitlines()[1].split(" at ")[1].split()[0])
+            seen.append(run_panel(app).splitlines()[1].split(" at ")[1].split()[0])
         assert seen == ["2x", "4x", "10x", "max", "1x"]
         await pilot.press("r")
         snap = station.snapshot()
         assert snap.time == 0 and snap.block == station.maze.start
         assert station.runs[-1].ended == "reset"
         await pilot.press("p")
-        assert not station.pacer.paused and "running" in status(app)
+        assert not station.pacer.paused and "running" in run_panel(app)
 
     run(app, body)
 
@@ -349,7 +339,7 @@ def test_e_opens_the_maze_editor_and_capital_r_the_runs(tmp_path):
         assert isinstance(app.screen, MainScreen)
         view = app.screen.query_one(MazeView)
         assert view.maze is edited and view.robot_cell == edited.start
-        assert app.sub_title == "test unity (unity)"
+        assert app.sub_title == "room (unity)"
         await pilot.press("R")
         assert isinstance(app.screen, RunsScreen)
         await pilot.press("escape")

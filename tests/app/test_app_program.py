@@ -6,7 +6,7 @@ from __future__ import annotations
 from textual.pilot import Pilot
 from textual.widgets import Input, Static
 
-from tests.app.support import run
+from tests.app.support import maze_file, run
 from tests.program.builder import ProgramBuilder
 from workbench.program.keys import RELEASE_GAP
 from workbench.tui.app import make_app
@@ -16,12 +16,6 @@ from workbench.tui.widgets.program_state import ProgramState
 from workbench.wire.settings import AppSettings
 
 ROOM = "#########\n#.......#\n#...S...#\n#.......#\n#########\n"
-
-
-def maze_file(tmp_path) -> str:
-    path = tmp_path / "room.txt"
-    path.write_text(f"---\nname: room\nprofile: unity\n---\n{ROOM}")
-    return str(path)
 
 
 def drive_by_wire(tmp_path, name: str = "wire.viple") -> str:
@@ -66,7 +60,7 @@ async def load(pilot: Pilot, path: str) -> AlgorithmModal:
 
 
 def test_a_program_loads_drives_answers_keys_and_prints(tmp_path):
-    app = make_app(AppSettings(maze_file(tmp_path), paused=True, noise="off"))
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM), paused=True, noise="off"))
     path = drive_by_wire(tmp_path)
 
     async def body(pilot: Pilot) -> None:
@@ -115,7 +109,7 @@ def test_a_program_loads_drives_answers_keys_and_prints(tmp_path):
 
 
 def test_a_held_key_repeating_stays_held(tmp_path):
-    app = make_app(AppSettings(maze_file(tmp_path), paused=True, noise="off"))
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM), paused=True, noise="off"))
     path = drive_by_wire(tmp_path)
 
     async def body(pilot: Pilot) -> None:
@@ -137,7 +131,7 @@ def test_a_held_key_repeating_stays_held(tmp_path):
 
 
 def test_a_bad_program_lists_every_problem_and_the_app_goes_on(tmp_path):
-    app = make_app(AppSettings(maze_file(tmp_path), paused=True, noise="off"))
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM), paused=True, noise="off"))
     path = bad_program(tmp_path)
 
     async def body(pilot: Pilot) -> None:
@@ -161,7 +155,9 @@ def test_a_served_student_loads_programs_only_from_the_workspace(tmp_path):
     workspace.mkdir()
     drive_by_wire(workspace, "mine.viple")
     outside = drive_by_wire(tmp_path, "theirs.viple")
-    app = make_app(AppSettings(maze_file(tmp_path), paused=True, noise="off", workspace=workspace))
+    app = make_app(
+        AppSettings(maze_file(tmp_path, ROOM), paused=True, noise="off", workspace=workspace)
+    )
 
     async def body(pilot: Pilot) -> None:
         dialog = await load(pilot, outside)
@@ -176,7 +172,7 @@ def test_a_served_student_loads_programs_only_from_the_workspace(tmp_path):
 
 
 def test_a_program_lacking_a_sensor_cannot_start_and_says_which(tmp_path):
-    app = make_app(AppSettings(maze_file(tmp_path), paused=True, noise="off"))
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM), paused=True, noise="off"))
     b = ProgramBuilder()
     main = b.panel("Main")
     b.robot(main)
@@ -212,7 +208,7 @@ def active_actions(app) -> set[str]:
 
 
 def test_ctrl_k_sends_every_key_to_the_program_until_pressed_again(tmp_path):
-    app = make_app(AppSettings(maze_file(tmp_path), paused=True, noise="off"))
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM), paused=True, noise="off"))
     path = screen_keys("keys.viple", tmp_path)
 
     async def body(pilot: Pilot) -> None:
@@ -252,7 +248,7 @@ def test_ctrl_k_sends_every_key_to_the_program_until_pressed_again(tmp_path):
 
 
 def test_all_keys_end_when_the_program_stops(tmp_path):
-    app = make_app(AppSettings(maze_file(tmp_path), paused=True, noise="off"))
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM), paused=True, noise="off"))
     path = screen_keys("keys.viple", tmp_path)
 
     async def body(pilot: Pilot) -> None:
@@ -275,7 +271,7 @@ def test_all_keys_end_when_the_program_stops(tmp_path):
 def test_after_loading_a_program_f_fits_the_sensors_its_diagram_reads(tmp_path):
     from workbench.sim.sensors import SensorSpec
 
-    app = make_app(AppSettings(maze_file(tmp_path), paused=True, noise="off"))
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM), paused=True, noise="off"))
     path = drive_by_wire(tmp_path)
 
     async def body(pilot: Pilot) -> None:
@@ -308,7 +304,7 @@ def test_a_program_is_read_and_checked_beside_the_event_loop(tmp_path, monkeypat
 
     import workbench.tui.dialogs.algorithm as dialog_module
 
-    app = make_app(AppSettings(maze_file(tmp_path), paused=True, noise="off"))
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM), paused=True, noise="off"))
     path = drive_by_wire(tmp_path)
     release = threading.Event()
     checking = threading.Event()
@@ -343,7 +339,7 @@ def test_f_on_the_main_screen_fits_the_chosen_program_not_the_algorithm_before_i
     from tests.app.support import said
     from workbench.sim.sensors import SensorSpec
 
-    app = make_app(AppSettings(maze_file(tmp_path), paused=True, noise="off"))
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM), paused=True, noise="off"))
     path = drive_by_wire(tmp_path)
 
     async def body(pilot: Pilot) -> None:

@@ -13,32 +13,23 @@ from tests.waiting import until
 from workbench.tui.app import WorkbenchApp, make_app
 from workbench.tui.dialogs.identity import IdentityDialog
 from workbench.tui.screens.main import MainScreen
-from workbench.tui.widgets.run_status import RunStatus
 from workbench.wire.settings import AppSettings
 
-from .support import run, run_panel, said
+from .support import maze_file, run, run_panel, said
 
 ROOM = "#########\n#.......#\n#...S...#\n#.......#\n#########\n"
 
 
-def maze(tmp_path) -> str:
-    path = tmp_path / "room.txt"
-    path.write_text(f"---\nname: room\nprofile: erobotic\n---\n{ROOM}")
-    return str(path)
-
-
-def status(app: WorkbenchApp) -> str:
-    return "\n".join(app.screen.query_one(RunStatus).lines)
-
-
 def test_a_viple_program_drives_the_robot_the_app_shows(tmp_path):
     port = free_port()
-    app = make_app(AppSettings(maze(tmp_path), tcp_port=port, noise="off", tick_hz=50))
+    app = make_app(
+        AppSettings(maze_file(tmp_path, ROOM, "erobotic"), tcp_port=port, noise="off", tick_hz=50)
+    )
 
     async def go() -> None:
         async with app.run_test(size=(80, 24)) as pilot:
             await pilot.pause(0.1)
-            assert f"VIPLE tcp listening on 127.0.0.1:{port}" in status(app)
+            assert f"VIPLE tcp listening on 127.0.0.1:{port}" in run_panel(app)
             reader, writer = await asyncio.open_connection("127.0.0.1", port)
             report = await asyncio.wait_for(reader.readline(), 2)
             assert report.startswith(b'{"sensors":[')
@@ -49,11 +40,11 @@ def test_a_viple_program_drives_the_robot_the_app_shows(tmp_path):
             snap = app.station.snapshot()
             assert snap.pose.x > x0 + 20  # heading right at 120 px/s
             assert str(snap.driver).startswith("VIPLE tcp 127.0.0.1:")
-            assert "in 1 out" in status(app)
+            assert "in 1 out" in run_panel(app)
             writer.write(b"not json\r\n")
             await writer.drain()
             await pilot.pause(0.2)
-            assert "1 rejected (last: line 2: not JSON" in status(app)
+            assert "1 rejected (last: line 2: not JSON" in run_panel(app)
             writer.close()
             await pilot.pause(0.3)
             x1 = app.station.snapshot().pose.x
@@ -69,12 +60,16 @@ def test_a_port_in_use_is_shown_and_the_app_keeps_working(tmp_path):
         taken.bind(("127.0.0.1", 0))
         taken.listen()
         port = taken.getsockname()[1]
-        app = make_app(AppSettings(maze(tmp_path), tcp_port=port, noise="off", paused=True))
+        app = make_app(
+            AppSettings(
+                maze_file(tmp_path, ROOM, "erobotic"), tcp_port=port, noise="off", paused=True
+            )
+        )
 
         async def go() -> None:
             async with app.run_test(size=(80, 24)) as pilot:
                 await pilot.pause(0.1)
-                assert f"VIPLE tcp not listening: port {port} is in use" in status(app)
+                assert f"VIPLE tcp not listening: port {port} is in use" in run_panel(app)
                 await pilot.press("d")
                 await pilot.press("n")
                 assert app.station.keys_used == {"d"}
@@ -110,7 +105,7 @@ async def palette_runs(pilot, words: str) -> None:
 
 def test_a_live_program_runs_at_1x_and_the_speed_keys_say_why_they_are_held(tmp_path):
     port = free_port()
-    app = make_app(AppSettings(maze(tmp_path), tcp_port=port, noise="off"))
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM, "erobotic"), tcp_port=port, noise="off"))
 
     async def body(pilot) -> None:
         await pilot.press("+", "+", "+", "+")  # 2x, 4x, 10x, max: left from before
@@ -136,7 +131,7 @@ def test_a_live_program_runs_at_1x_and_the_speed_keys_say_why_they_are_held(tmp_
 
 def test_a_paused_station_says_the_programs_commands_are_held_and_counts_on(tmp_path):
     port = free_port()
-    app = make_app(AppSettings(maze(tmp_path), tcp_port=port, noise="off"))
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM, "erobotic"), tcp_port=port, noise="off"))
 
     async def body(pilot) -> None:
         reader, writer = await connected(app, port)
@@ -161,7 +156,7 @@ def test_a_paused_station_says_the_programs_commands_are_held_and_counts_on(tmp_
 
 
 def test_a_reset_and_the_end_of_a_run_put_the_speed_back_to_1x(tmp_path):
-    app = make_app(AppSettings(maze(tmp_path), noise="off", paused=True))
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM, "erobotic"), noise="off", paused=True))
 
     async def body(pilot) -> None:
         await pilot.press("+", "+", "+", "+")
@@ -182,7 +177,8 @@ def test_a_reset_and_the_end_of_a_run_put_the_speed_back_to_1x(tmp_path):
 
 
 def test_no_time_passes_while_the_names_are_asked(tmp_path):
-    app = make_app(AppSettings(maze(tmp_path), noise="off", ask_names=True, student="ann",
+    maze = maze_file(tmp_path, ROOM, "erobotic")
+    app = make_app(AppSettings(maze, noise="off", ask_names=True, student="ann",
                                data_dir=tmp_path / "data"))  # fmt: skip
 
     async def body(pilot) -> None:
@@ -202,7 +198,9 @@ def test_no_time_passes_while_the_names_are_asked(tmp_path):
 
 def test_a_program_that_connects_to_a_paused_station_is_told_its_commands_wait(tmp_path):
     port = free_port()
-    app = make_app(AppSettings(maze(tmp_path), tcp_port=port, noise="off", paused=True))
+    app = make_app(
+        AppSettings(maze_file(tmp_path, ROOM, "erobotic"), tcp_port=port, noise="off", paused=True)
+    )
 
     async def body(pilot) -> None:
         reader, writer = await connected(app, port)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from textual.widgets import OptionList, Static
 
+from tests.waiting import until
 from workbench.labs.model import load_labs
 from workbench.labs.signoff.instructors import KdfParams, create_instructor
 from workbench.labs.signoff.verify import verify_log
@@ -24,7 +25,6 @@ from .console_support import (
     WEB_LAB,
     save_progress,
     save_student,
-    until,
     wall_main,
     write_record,
 )
@@ -55,8 +55,8 @@ async def test_the_class_and_the_queue_follow_the_store(tmp_path):
         save_student(store, "ana")
         save_student(store, "cat", passed=False)
     app = console(data)
-    async with app.run_test(size=(80, 24)) as pilot:
-        await until(pilot, lambda: len(class_lines(app)) == 2, "the class")
+    async with app.run_test(size=(80, 24)):
+        await until(lambda: len(class_lines(app)) == 2, "the class")
         ana, cat = class_lines(app)
         # one mark per objective: X passed, . not yet (ASCII)
         assert ana.startswith("ana") and f"{LAB}/{EXERCISE}" in ana and "X" * 3 in ana
@@ -66,9 +66,9 @@ async def test_the_class_and_the_queue_follow_the_store(tmp_path):
         # a student on another app asks: the console shows it without a key pressed
         with Store.open(data) as student_side:
             student_side.queue.request("cat", "dan", "dan", LAB, EXERCISE)
-        await until(pilot, lambda: len(queue_lines(app)) == 1, "the request")
+        await until(lambda: len(queue_lines(app)) == 1, "the request")
         assert queue_lines(app)[0].startswith("1. cat and dan")
-        await until(pilot, lambda: "waiting #1" in class_lines(app)[1], "cat's place")
+        await until(lambda: "waiting #1" in class_lines(app)[1], "cat's place")
         assert any("Sign-off queue: 1 waiting" in line for line in screen_lines(app))
 
 
@@ -83,11 +83,11 @@ async def test_the_instructor_signs_a_request_with_their_own_passphrase(tmp_path
         store.queue.request("ana", "ben", "ben", LAB, EXERCISE)
     app = console(data)
     async with app.run_test(size=(80, 24)) as pilot:
-        await until(pilot, lambda: len(queue_lines(app)) == 1, "the request")
+        await until(lambda: len(queue_lines(app)) == 1, "the request")
         await pilot.press("enter")
         request = app.screen
         assert isinstance(request, RequestScreen)
-        await until(pilot, lambda: request.request is not None, "the saved progress")
+        await until(lambda: request.request is not None, "the saved progress")
         shown = "\n".join(screen_lines(app))
         assert "ana and ben ask for sign-off" in shown and "driver ben" in shown
         # evidence saved before runs kept their sensors and programs still reads whole,
@@ -100,23 +100,23 @@ async def test_the_instructor_signs_a_request_with_their_own_passphrase(tmp_path
         assert run_line == f"run 3 is recorded in {record}: p replays it, ctrl+g saves its picture"
         # the evidence run replays in the maze view
         request.action_replay()
-        await until(pilot, lambda: isinstance(app.screen, ReplayScreen), "the replay")
+        await until(lambda: isinstance(app.screen, ReplayScreen), "the replay")
         await pilot.press("escape")
-        await until(pilot, lambda: app.screen is request, "back from the replay")
+        await until(lambda: app.screen is request, "back from the replay")
         # a wrong passphrase is refused and counted
         await pilot.click("#request-passphrase")
         await pilot.press(*"not the one!", "enter")
         # the pair is the instructor's to confirm: ben worked on it and agrees
-        await until(pilot, lambda: isinstance(app.screen, PairDialog), "the pair's question")
+        await until(lambda: isinstance(app.screen, PairDialog), "the pair's question")
         await pilot.press("y")
-        await until(pilot, lambda: "wrong passphrase" in status(request), "the refusal")
+        await until(lambda: "wrong passphrase" in status(request), "the refusal")
         with Store.open(data) as store:
             assert store.signoffs.lockout("Dr Chen").failures == 1
         await pilot.press(*PASS, "enter")
-        await until(pilot, lambda: "signed off ana and ben" in status(request), "the sign-off")
+        await until(lambda: "signed off ana and ben" in status(request), "the sign-off")
         await pilot.press("escape")
-        await until(pilot, lambda: isinstance(app.screen, ConsoleScreen), "the console")
-        await until(pilot, lambda: queue_lines(app) == [], "the queue emptied")
+        await until(lambda: isinstance(app.screen, ConsoleScreen), "the console")
+        await until(lambda: queue_lines(app) == [], "the queue emptied")
     with Store.open(data) as store:
         (row,) = store.signoffs.of()
         state = store.queue.state("ana", LAB, EXERCISE)
@@ -150,16 +150,16 @@ async def test_a_decline_needs_a_note_and_the_student_reads_it(tmp_path):
         store.queue.request("cat", "", "cat", LAB, EXERCISE)
     app = console(data)
     async with app.run_test(size=(80, 24)) as pilot:
-        await until(pilot, lambda: len(queue_lines(app)) == 1, "the request")
+        await until(lambda: len(queue_lines(app)) == 1, "the request")
         await pilot.press("enter")
         request = app.screen
-        await until(pilot, lambda: request.request is not None, "the saved progress")
+        await until(lambda: request.request is not None, "the saved progress")
         assert "2 of 3 objectives pass" in "\n".join(screen_lines(app))
         await pilot.press("ctrl+d")
         assert "write a note first" in status(request)
         await pilot.press(*"answer the last question", "ctrl+d")
-        await until(pilot, lambda: isinstance(app.screen, ConsoleScreen), "the console")
-        await until(pilot, lambda: queue_lines(app) == [], "the queue emptied")
+        await until(lambda: isinstance(app.screen, ConsoleScreen), "the console")
+        await until(lambda: queue_lines(app) == [], "the queue emptied")
         assert "declined cat" in str(app.screen.query_one("#console-message").render())
     with Store.open(data) as store:
         entry = store.queue.state("cat", LAB, EXERCISE).entry
@@ -177,12 +177,12 @@ async def test_signing_work_that_does_not_pass_needs_the_override_and_a_note(tmp
         store.queue.request("cat", "", "cat", LAB, EXERCISE)
     app = console(data)
     async with app.run_test(size=(80, 24)) as pilot:
-        await until(pilot, lambda: len(queue_lines(app)) == 1, "the request")
+        await until(lambda: len(queue_lines(app)) == 1, "the request")
         await pilot.press("enter")
         request = app.screen
-        await until(pilot, lambda: request.request is not None, "the saved progress")
+        await until(lambda: request.request is not None, "the saved progress")
         await pilot.press(*PASS, "enter")
-        await until(pilot, lambda: "override" in status(request), "the refusal")
+        await until(lambda: "override" in status(request), "the refusal")
     with Store.open(data) as store:
         assert store.signoffs.of() == [] and len(store.queue.waiting()) == 1
 
@@ -193,11 +193,11 @@ def objectives_text(request: RequestScreen) -> str:
 
 
 async def open_request(app: ConsoleApp, pilot) -> RequestScreen:
-    await until(pilot, lambda: len(queue_lines(app)) == 1, "the request")
+    await until(lambda: len(queue_lines(app)) == 1, "the request")
     await pilot.press("enter")
     request = app.screen
     assert isinstance(request, RequestScreen)
-    await until(pilot, lambda: request.request is not None, "the saved progress")
+    await until(lambda: request.request is not None, "the saved progress")
     await pilot.pause()
     return request
 
@@ -240,7 +240,7 @@ async def test_evidence_on_two_programs_and_a_program_two_students_share_are_mar
         store.queue.request("ana", "", "ana", WEB_LAB, WALL_MAIN)
     app = console(data)
     async with app.run_test(size=(80, 24)) as pilot:
-        await until(pilot, lambda: len(class_lines(app)) == 3, "the class")
+        await until(lambda: len(class_lines(app)) == 3, "the class")
         ana, ben, cat = class_lines(app)
         assert "! evidence mixes 2 programs; same program as ben" in ana
         assert ben.endswith("! same program as ana") and "!" not in cat
@@ -270,8 +270,8 @@ async def test_a_pair_and_the_bundled_programs_are_no_copy_hint(tmp_path):
             shipped = wall_main(name, "web-wall-following.viple", bundled, f"att-{name}")
             save_progress(store, name, shipped)
     app = console(data)
-    async with app.run_test(size=(80, 24)) as pilot:
-        await until(pilot, lambda: len(class_lines(app)) == 4, "the class")
+    async with app.run_test(size=(80, 24)):
+        await until(lambda: len(class_lines(app)) == 4, "the class")
         assert not any("!" in line for line in class_lines(app))
         assert app.screen.view.hints == ()
 
@@ -285,8 +285,8 @@ async def test_long_exercise_ids_are_shown_whole_at_80_columns(tmp_path):
         store.queue.request("a-student-with-a-long-name", "her-partner", "her-partner",
                               lab, exercise)  # fmt: skip
     app = console(data)
-    async with app.run_test(size=(80, 24)) as pilot:
-        await until(pilot, lambda: len(queue_lines(app)) == 1, "the request")
+    async with app.run_test(size=(80, 24)):
+        await until(lambda: len(queue_lines(app)) == 1, "the request")
         shown = "\n".join(screen_lines(app))
         assert f"{lab}/{exercise}" in shown  # not "reading-wall-f"
         assert "a-student-with-a-long-name and her-partner" in shown
@@ -304,10 +304,10 @@ async def test_the_replay_from_the_console_draws_in_ascii(tmp_path):
     async with app.run_test(size=(80, 24)) as pilot:
         request = await open_request(app, pilot)
         await pilot.click("#request-replay")
-        await until(pilot, lambda: isinstance(app.screen, ReplayScreen), "the replay")
+        await until(lambda: isinstance(app.screen, ReplayScreen), "the replay")
         await pilot.pause()
         lines = screen_lines(app)
         assert any("left/right step" in line for line in lines)
         assert all(line.isascii() for line in lines), [x for x in lines if not x.isascii()]
         await pilot.press("escape")
-        await until(pilot, lambda: app.screen is request, "back from the replay")
+        await until(lambda: app.screen is request, "back from the replay")

@@ -5,13 +5,14 @@ from __future__ import annotations
 
 import json
 
+from tests.waiting import until
 from workbench.labs.model import load_labs
 from workbench.labs.signoff.instructors import create_instructor
 from workbench.labs.store.store import Store
 from workbench.tui.console_app import ConsoleApp
 from workbench.tui.screens.console_request import RequestScreen
 
-from .console_support import EXERCISE, LAB, progress, until
+from .console_support import EXERCISE, LAB, progress
 from .support import emulated_terminal, sync, terminal_output
 from .test_console import FAST, PASS, status
 
@@ -49,12 +50,12 @@ async def test_hostile_evidence_reaches_the_console_as_text(tmp_path):
         store.queue.request("ana", "", f"ana{TITLE}", LAB, EXERCISE)
     app = ConsoleApp(Store.open(data), load_labs())
     async with app.run_test(size=(80, 24)) as pilot:
-        await until(pilot, lambda: "ana" in "".join(emulated_terminal(app).display), "the class")
+        await until(lambda: "ana" in "".join(emulated_terminal(app).display), "the class")
         assert_harmless(app)
         await pilot.press("enter")
         request = app.screen
         assert isinstance(request, RequestScreen)
-        await until(pilot, lambda: request.request is not None, "the saved progress")
+        await until(lambda: request.request is not None, "the saved progress")
         await pilot.pause()
         assert_harmless(app)
         shown = "\n".join(emulated_terminal(app).display)
@@ -64,6 +65,6 @@ async def test_hostile_evidence_reaches_the_console_as_text(tmp_path):
         # says why, with the place, and nothing raw
         await pilot.click("#request-passphrase")
         await pilot.press(*PASS, "enter")
-        await until(pilot, lambda: "cannot be signed" in status(request), "the refusal")
+        await until(lambda: "cannot be signed" in status(request), "the refusal")
         assert "objectives[0].reason holds an escape character" in status(request)
         assert_harmless(app)

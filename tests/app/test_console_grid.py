@@ -3,8 +3,9 @@ lab, at 80x24, in Unicode and in ASCII, following the store and scrolling."""
 
 from __future__ import annotations
 
-from textual.widgets import DataTable, Static
+from textual.widgets import DataTable
 
+from tests.waiting import until
 from workbench.labs.checks import ObjectiveState
 from workbench.labs.classview import read_request
 from workbench.labs.model import load_labs
@@ -23,17 +24,13 @@ from .console_support import (
     progress,
     save_progress,
     save_student,
-    until,
     wall_main,
 )
+from .labs_support import text
 from .support import screen_lines, sync
 
 FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
 PASS = "correct horse battery"
-
-
-def text(screen, selector: str) -> str:
-    return str(screen.query_one(selector, Static).render())
 
 
 def grid_rows(screen: GridScreen) -> dict[str, list[str]]:
@@ -62,7 +59,7 @@ def a_class(data) -> None:
 async def open_grid(app: ConsoleApp, pilot) -> GridScreen:
     console = app.screen
     assert isinstance(console, ConsoleScreen)
-    await until(pilot, lambda: console.view is not None, "the class")
+    await until(lambda: console.view is not None, "the class")
     await pilot.press("g")
     grid = app.screen
     assert isinstance(grid, GridScreen)
@@ -99,7 +96,7 @@ async def test_g_opens_the_grid_of_students_by_exercises(tmp_path):
         assert text(grid, "#grid-title").startswith("Class by exercise, lab web-simulator")
         assert grid_rows(grid)["cat"][headings(grid).index("wall-main") - 1] == "✓"
         await pilot.press("escape")
-        await until(pilot, lambda: isinstance(app.screen, ConsoleScreen), "back at the console")
+        await until(lambda: isinstance(app.screen, ConsoleScreen), "back at the console")
 
 
 @sync
@@ -124,7 +121,7 @@ async def test_the_grid_follows_the_store_in_ascii(tmp_path):
             )  # fmt: skip
             save_progress(store, "ben", waiting)
         grid.console.read_now()
-        await until(pilot, lambda: grid_rows(grid)["ana"][0] == "signed", "the sign-off")
+        await until(lambda: grid_rows(grid)["ana"][0] == "signed", "the sign-off")
         assert grid_rows(grid)["ben"][0] == "2/3?"
         assert "?: a question waits for you" in text(grid, "#grid-legend")
         assert all(line.isascii() for line in screen_lines(app))

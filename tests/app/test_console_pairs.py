@@ -6,25 +6,26 @@ from __future__ import annotations
 
 from textual.widgets import Button
 
+from tests.waiting import until
 from workbench.labs.signoff.instructors import create_instructor
 from workbench.labs.store.store import Store
 from workbench.tui.dialogs.pair import PairDialog
 from workbench.tui.screens.console_request import RequestScreen
 
-from .console_support import EXERCISE, LAB, save_student, until
+from .console_support import EXERCISE, LAB, save_student
 from .support import screen_lines, sync
 from .test_console import FAST, PASS, console, queue_lines, status
 
 
 async def open_and_sign(pilot, app) -> RequestScreen:
-    await until(pilot, lambda: len(queue_lines(app)) == 1, "the request")
+    await until(lambda: len(queue_lines(app)) == 1, "the request")
     await pilot.press("enter")
     request = app.screen
     assert isinstance(request, RequestScreen)
-    await until(pilot, lambda: request.request is not None, "the saved progress")
+    await until(lambda: request.request is not None, "the saved progress")
     await pilot.click("#request-passphrase")
     await pilot.press(*PASS, "enter")
-    await until(pilot, lambda: isinstance(app.screen, PairDialog), "the pair's question")
+    await until(lambda: isinstance(app.screen, PairDialog), "the pair's question")
     return request
 
 
@@ -45,7 +46,7 @@ async def test_a_partner_who_is_not_in_the_class_is_never_signed_for(tmp_path):
         await pilot.press("y")
         assert app.screen is dialog
         await pilot.press("n")
-        await until(pilot, lambda: "signed off ana " in status(request), "the sign-off")
+        await until(lambda: "signed off ana " in status(request), "the sign-off")
         assert "ana and zed" not in status(request)
     with Store.open(data) as store:
         (row,) = store.signoffs.of()
@@ -65,13 +66,13 @@ async def test_the_instructor_signs_for_the_student_alone_when_the_partner_did_n
         request = await open_and_sign(pilot, app)
         assert app.screen.query_one("#pair", Button)  # ben is in the class: the pair is offered
         await pilot.press("escape")  # not yet: nothing signed
-        await until(pilot, lambda: app.screen is request, "back to the request")
+        await until(lambda: app.screen is request, "back to the request")
         assert "not signed" in status(request)
         await pilot.click("#request-passphrase")
         await pilot.press("enter")  # the passphrase is still typed in
-        await until(pilot, lambda: isinstance(app.screen, PairDialog), "the question again")
+        await until(lambda: isinstance(app.screen, PairDialog), "the question again")
         await pilot.press("n")
-        await until(pilot, lambda: "signed off ana " in status(request), "the sign-off")
+        await until(lambda: "signed off ana " in status(request), "the sign-off")
     with Store.open(data) as store:
         (row,) = store.signoffs.of()
     assert (row.student, row.partner) == ("ana", "")

@@ -2,10 +2,9 @@
 
 from __future__ import annotations
 
-from textual.screen import Screen
 from textual.widgets import Input, OptionList, Select
 
-from tests.app.support import sync
+from tests.app.support import Host, sync
 from workbench.control.station import LabStation
 from workbench.sim.mazefile import write_maze
 from workbench.sim.mazeio import load_maze
@@ -13,29 +12,11 @@ from workbench.tui.dialogs.generate import GenerateDialog
 from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.dialogs.size import SizeDialog
 from workbench.tui.dialogs.unsaved import UnsavedDialog
-from workbench.tui.host import ScreenHost
 from workbench.tui.screens.editor import EditorScreen
 from workbench.tui.widgets import MazeView
 
 ROOM_TEXT = "#######\n#S....#\n#.....#\n#....E#\n#######\n"
 SIZE = (80, 24)
-
-
-class Host(ScreenHost):
-    """Pushes one screen and keeps what it was dismissed with."""
-
-    def __init__(self, screen: Screen) -> None:
-        super().__init__()
-        self.under_test = screen
-        self.results: list[object] = []
-        #: what the screens said on the message line
-        self.said: list[str] = []
-
-    def say(self, text: str) -> None:
-        self.said.append(text)
-
-    def on_mount(self) -> None:
-        self.push_screen(self.under_test, self.results.append)
 
 
 def room(tmp_path, name="room.txt"):

@@ -7,6 +7,7 @@ import pytest
 from textual.pilot import Pilot
 from textual.widgets._footer import FooterKey
 
+from tests.waiting import until
 from workbench.tui.app import make_app
 from workbench.tui.screens.editor import EditorScreen
 from workbench.tui.screens.labs import LabsScreen
@@ -22,12 +23,18 @@ from .support import run, screen_lines
 NEWCOMER = ("l Labs", "e Editor", "R Runs", "m Maze", "? Help")
 
 
-def bar_keys(pilot: Pilot) -> list[str]:
+async def bar_keys(pilot: Pilot) -> list[str]:
     """The keys the bar shows, as "key label", checked against the terminal's last row: each
-    drawn whole, in order, none over another, all inside the width."""
+    drawn whole, in order, none over another, all inside the width. (Once the bar is laid
+    out: on a busy machine the screen may not have had its first layout yet.)"""
     app = pilot.app
     bar = app.screen.query_one(KeyBar)
-    keys = list(bar.query(FooterKey))
+
+    def laid_out() -> list[FooterKey]:
+        keys = list(bar.query(FooterKey))
+        return keys if keys and all(k.region.height for k in keys) else []
+
+    keys = await until(laid_out, "the key bar laid out")
     row = screen_lines(app)[-1]
     assert len(row) <= app.size.width
     texts = [f"{k.key_display} {k.description}" for k in keys]
@@ -53,7 +60,7 @@ def test_every_screens_key_bar_fits_whole(tmp_path, width):
         station.step(60)
         station.stop()  # one recorded run, for the replay
         assert isinstance(app.screen, MainScreen)
-        shown = bar_keys(pilot)
+        shown = await bar_keys(pilot)
         assert all(key in shown for key in NEWCOMER), shown
         walked = []
         for key, screen in (("l", LabsScreen), ("e", EditorScreen), ("R", RunsScreen)):
@@ -62,13 +69,13 @@ def test_every_screens_key_bar_fits_whole(tmp_path, width):
             await pilot.press(key)
             await pilot.pause()
             assert isinstance(app.screen, screen)
-            shown = bar_keys(pilot)
+            shown = await bar_keys(pilot)
             assert any(k.endswith(("Back", "Close")) for k in shown), shown
             walked.append(screen)
         await pilot.press("enter")
         await pilot.pause()
         assert isinstance(app.screen, ReplayScreen)
-        assert "esc Back" in bar_keys(pilot)
+        assert "esc Back" in await bar_keys(pilot)
 
     run(app, body, size=(width, 24))
 
@@ -77,12 +84,12 @@ def test_the_bar_follows_the_terminals_width(tmp_path):
     app = make_app(AppSettings(paused=True, student="ana"))
 
     async def body(pilot: Pilot) -> None:
-        wide = bar_keys(pilot)
+        wide = await bar_keys(pilot)
         assert "n Step" in wide
         await pilot.resize_terminal(80, 24)
         await pilot.pause()
         await pilot.pause()
-        narrow = bar_keys(pilot)
+        narrow = await bar_keys(pilot)
         assert "n Step" not in narrow and all(key in narrow for key in NEWCOMER)
 
     run(app, body, size=(160, 24))

@@ -20,7 +20,7 @@ from workbench.tui.dialogs.fsm_form import STATE, TRANSITION, FormDialog
 from workbench.tui.dialogs.path import PathDialog
 from workbench.tui.screens import fsm_editor
 from workbench.tui.screens.fsm_editor import FsmEditorScreen
-from workbench.tui.settings import AppSettings
+from workbench.wire.settings import AppSettings
 
 from .support import run
 

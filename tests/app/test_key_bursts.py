@@ -20,17 +20,9 @@ from workbench.tui.serving.ordered_keys import OrderedKeys
 from workbench.wire.settings import AppSettings
 
 from .labs_support import lab_app, open_exercise, signing_over
-from .support import run
+from .support import burst, run
 
 FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
-
-
-async def burst(pilot: Pilot, *keys: tuple[str, str | None]) -> None:
-    """Post ``keys`` to the app in one go, as a packet's keys come, then let them settle."""
-    for key, char in keys:
-        pilot.app.post_message(events.Key(key, char))
-    for _ in range(3):
-        await pilot.pause()
 
 
 def test_space_then_shift_tab_ticks_the_override_and_moves_back(tmp_path):

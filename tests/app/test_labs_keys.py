@@ -3,7 +3,6 @@ it, a multiple-choice answer is picked (keys or mouse), and keys typed together 
 
 from __future__ import annotations
 
-from textual import events
 from textual.pilot import Pilot
 from textual.widgets import Input, OptionList, Static
 
@@ -15,7 +14,7 @@ from workbench.tui.screens.labs import LabsScreen
 from workbench.tui.widgets.choices import Choice, Choices
 
 from .labs_support import lab_app, open_exercise, text
-from .support import run
+from .support import burst, run
 
 FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
 RULES = "maze-algorithms/erobotic-rules"
@@ -31,14 +30,6 @@ def right_choice() -> int:
     """The index of the right answer among the question's choices."""
     question = rules_question()
     return next(i for i, c in enumerate(question.choices) if question.check(c)[0])
-
-
-async def burst(pilot: Pilot, *keys: tuple[str, str | None]) -> None:
-    """Post ``keys`` to the app in one go, as a packet's keys come, then let them settle."""
-    for key, char in keys:
-        pilot.app.post_message(events.Key(key, char))
-    for _ in range(3):
-        await pilot.pause()
 
 
 def reason_of(screen: LabsScreen, question: str) -> str:

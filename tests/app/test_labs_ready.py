@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from textual.widgets import Static
 
+from tests.waiting import until
 from workbench.files.workspace import workspace_folder
 from workbench.labs.signoff.instructors import KdfParams, create_instructor
 from workbench.labs.signoff.signing import sign_off
@@ -15,7 +16,7 @@ from workbench.tui.app import make_app
 from workbench.tui.dialogs.signoff import SignoffModal
 from workbench.wire.settings import AppSettings
 
-from .console_support import EXERCISE, LAB, progress, until
+from .console_support import EXERCISE, LAB, progress
 from .labs_support import open_exercise, text
 from .support import sync
 
@@ -48,19 +49,19 @@ async def test_a_served_student_asks_with_r_and_sees_the_queue_and_the_sign_off(
         await pilot.press("i")
         assert not isinstance(app.screen, SignoffModal)
         await pilot.press("r")
-        await until(pilot, lambda: "2nd in the queue" in status(screen), "the place")
+        await until(lambda: "2nd in the queue" in status(screen), "the place")
         with Store.open(data) as console:
             entry = next(e for e in console.queue.waiting() if e.student == "ana")
             console.queue.decline(entry.id, "Dr Chen", "drive it once more")
-        await until(pilot, lambda: "drive it once more" in status(screen), "the decline")
+        await until(lambda: "drive it once more" in status(screen), "the decline")
         assert "declined by Dr Chen" in status(screen)
         await pilot.press("r")
-        await until(pilot, lambda: "in the queue" in status(screen), "asked again")
+        await until(lambda: "in the queue" in status(screen), "asked again")
         evidence = Evidence.of_progress(progress())
         with Store.open(data) as console:  # a sign-off made elsewhere, as at the console
             fields = RecordFields("ana", LAB, EXERCISE, "ana", "", evidence, True)
             sign_off(console, "Dr Chen", PASS, fields)
-        await until(pilot, lambda: "signed off by Dr Chen" in text(screen, "#labs-title"),
+        await until(lambda: "signed off by Dr Chen" in text(screen, "#labs-title"),
                     "the sign-off on the student's screen")  # fmt: skip
         assert "Drive by wire" in text(screen, "#labs-title")
 

@@ -12,7 +12,7 @@ from textual import events
 from textual.pilot import Pilot
 from textual.widgets import Tooltip
 
-from tests.app.support import run
+from tests.app.support import maze_file, run, run_panel
 from tests.waiting import until
 from workbench.tui.app import WorkbenchApp, make_app
 from workbench.tui.dialogs.help import HelpScreen
@@ -21,12 +21,6 @@ from workbench.tui.widgets.run_status import RunStatus
 from workbench.wire.settings import AppSettings
 
 ROOM = "#######\n#.....#\n#..S..#\n#.....#\n#######\n"
-
-
-def room(tmp_path) -> str:
-    path = tmp_path / "room.txt"
-    path.write_text(f"---\nname: room\nprofile: unity\n---\n{ROOM}")
-    return str(path)
 
 
 def heading(app: WorkbenchApp) -> float:
@@ -40,12 +34,8 @@ def main_screen(app: WorkbenchApp) -> MainScreen:
     return screen
 
 
-def status(app: WorkbenchApp) -> str:
-    return "\n".join(app.screen.query_one(RunStatus).lines)
-
-
 def test_a_driving_key_taken_at_once_drives_as_its_key_event_does(tmp_path):
-    app = make_app(AppSettings(room(tmp_path), paused=True, noise="off"))
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM), paused=True, noise="off"))
 
     async def body(pilot: Pilot) -> None:
         assert app.take_typed_key("d")
@@ -54,16 +44,16 @@ def test_a_driving_key_taken_at_once_drives_as_its_key_event_does(tmp_path):
         assert heading(app) == pytest.approx(180, abs=0.5)
         assert app.take_typed_key("p")  # resume: the clock runs the robot in real time
         await pilot.pause()
-        assert "running" in status(app)
+        assert "running" in run_panel(app)
         assert app.take_typed_key("p")
         await pilot.pause()
-        assert "PAUSED" in status(app)
+        assert "PAUSED" in run_panel(app)
 
     run(app, body)
 
 
 def test_keys_whose_binding_is_not_a_quick_action_come_as_key_events(tmp_path):
-    app = make_app(AppSettings(room(tmp_path), paused=True, noise="off"))
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM), paused=True, noise="off"))
     assert not app.take_typed_key("w")  # no screen yet (as while the app starts or ends)
 
     async def body(pilot: Pilot) -> None:
@@ -81,7 +71,7 @@ def test_keys_whose_binding_is_not_a_quick_action_come_as_key_events(tmp_path):
 
 
 def test_no_key_is_taken_at_once_over_a_dialog_or_while_a_key_before_it_is_on_its_way(tmp_path):
-    app = make_app(AppSettings(room(tmp_path), paused=True, noise="off"))
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM), paused=True, noise="off"))
 
     async def body(pilot: Pilot) -> None:
         await pilot.press("question_mark")
@@ -102,7 +92,7 @@ def test_no_key_is_taken_at_once_over_a_dialog_or_while_a_key_before_it_is_on_it
 
 
 def test_a_quick_key_is_refused_where_the_screen_refuses_its_action(tmp_path):
-    app = make_app(AppSettings(room(tmp_path), paused=True, noise="off"))
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM), paused=True, noise="off"))
 
     async def body(pilot: Pilot) -> None:
         screen = main_screen(app)
@@ -118,7 +108,7 @@ def test_a_quick_key_is_refused_where_the_screen_refuses_its_action(tmp_path):
 
 
 def test_a_change_is_drawn_at_once_and_the_next_within_a_frame_waits_for_the_timer(tmp_path):
-    app = make_app(AppSettings(room(tmp_path), paused=True, noise="off"))
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM), paused=True, noise="off"))
 
     async def body(pilot: Pilot) -> None:
         screen = main_screen(app)
@@ -141,7 +131,7 @@ def test_a_change_is_drawn_at_once_and_the_next_within_a_frame_waits_for_the_tim
 
 
 def test_a_quick_key_clears_a_tooltip_as_a_key_event_does(tmp_path):
-    app = make_app(AppSettings(room(tmp_path), paused=True, noise="off"))
+    app = make_app(AppSettings(maze_file(tmp_path, ROOM), paused=True, noise="off"))
 
     async def go() -> None:
         async with app.run_test(size=(80, 24), tooltips=True) as pilot:

@@ -4,11 +4,11 @@ and recording comes back."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from pathlib import Path
 
 from textual.pilot import Pilot
 
+from tests.waiting import until
 from workbench.files.workspace import workspace_folder
 from workbench.sim.record import read_record
 from workbench.tui.app import make_app
@@ -22,15 +22,6 @@ from .test_workspace_app import type_path
 ROOM = "---\nname: room\nprofile: erobotic\n---\n#######\n#.....#\n#..S..#\n#.....#\n#######\n"
 
 
-async def until(pilot: Pilot, done: Callable[[], bool], what: str, polls: int = 400) -> None:
-    """Let the app run until ``done`` holds (its clock and messages go on meanwhile)."""
-    for _ in range(polls):
-        if done():
-            return
-        await pilot.pause(0.02)
-    raise AssertionError(f"the app never got to: {what}")
-
-
 def test_a_full_disk_leaves_the_app_driving_and_recording_comes_back(tmp_path, disk):
     maze = tmp_path / "room.txt"
     maze.write_text(ROOM)
@@ -41,20 +32,20 @@ def test_a_full_disk_leaves_the_app_driving_and_recording_comes_back(tmp_path, d
     async def body(pilot: Pilot) -> None:
         await pilot.press("a")  # the robot spins: a run, recorded
         started = station.snapshot().time
-        await until(pilot, lambda: station.snapshot().time > started + 1.5, "a second recorded")
+        await until(lambda: station.snapshot().time > started + 1.5, "a second recorded")
         disk.full = True
-        await until(pilot, lambda: "no room on the disk" in said(app), "the disk-full message")
+        await until(lambda: "no room on the disk" in said(app), "the disk-full message")
         assert "the run goes on unrecorded" in said(app)
         full_at = station.snapshot().time
-        await until(pilot, lambda: station.snapshot().time > full_at + 1, "the clock going on")
+        await until(lambda: station.snapshot().time > full_at + 1, "the clock going on")
         heading = station.snapshot().pose.heading
         await pilot.press("d")  # the keys still drive
-        await until(pilot, lambda: station.snapshot().pose.heading != heading, "the robot turning")
+        await until(lambda: station.snapshot().pose.heading != heading, "the robot turning")
         disk.full = False
         await pilot.press("r", "a")  # a new run: recorded again
-        await until(pilot, lambda: station.snapshot().time > 1.2, "the new run going")
+        await until(lambda: station.snapshot().time > 1.2, "the new run going")
         await pilot.press("r")
-        await until(pilot, lambda: len(station.runs) == 2, "the second run ending")
+        await until(lambda: len(station.runs) == 2, "the second run ending")
 
     run(app, body)
     first, second = app.station.runs
@@ -73,7 +64,7 @@ def test_a_file_named_runs_is_moved_aside_on_the_first_drive_key(tmp_path):
 
     async def body(pilot: Pilot) -> None:
         await pilot.press("w")
-        await until(pilot, lambda: "runs.taken-1" in said(app), "the moved-aside message")
+        await until(lambda: "runs.taken-1" in said(app), "the moved-aside message")
         assert said(app).startswith("your file ~/runs was in the way of your run records")
         await pilot.press("n", "n", "space")
 

@@ -6,16 +6,14 @@ import json
 from dataclasses import replace
 
 import pytest
-from textual.screen import Screen
 from textual.widgets import DataTable, Input, Static
 
 from tests.app.runs_support import BEND, run_algorithms, runs_with_long_driver_names
-from tests.app.support import screen_lines, sync
+from tests.app.support import Host, screen_lines, sync
 from workbench.control.station import LabStation
 from workbench.sim.mazeio import load_maze
 from workbench.sim.record import FORMAT
 from workbench.tui.dialogs.path import PathDialog
-from workbench.tui.host import ScreenHost
 from workbench.tui.screens.replay import ReplayScreen
 from workbench.tui.screens.runs import RunsScreen
 from workbench.tui.screens.runs_table import (
@@ -30,17 +28,6 @@ from workbench.tui.widgets import MazeView
 SIZE = (80, 24)
 #: the headings of the graded measures, which every view keeps at any width
 GRADED = ("Out", "Time s", "Blocks", "Turn deg", "Turns", "Hit/Tch")
-
-
-class Host(ScreenHost):
-    def __init__(self, screen: Screen) -> None:
-        super().__init__()
-        self.under_test = screen
-        # the app draws as the screen does (its footer, scroll bars and dialogs too)
-        self.set_reactive(ScreenHost.unicode, bool(getattr(screen, "unicode", False)))
-
-    def on_mount(self) -> None:
-        self.push_screen(self.under_test)
 
 
 def two_runs(tmp_path) -> LabStation:
@@ -59,7 +46,7 @@ def table_rows(table: DataTable) -> list[list[str]]:
 @sync
 async def test_the_table_shows_each_run_with_its_measures(tmp_path):
     station = two_runs(tmp_path)
-    app = Host(RunsScreen(station, unicode=False))
+    app = Host(RunsScreen(station, unicode=False), follow_unicode=True)
     async with app.run_test(size=(132, 24)) as pilot:
         await pilot.pause()
         table = app.screen.query_one(DataTable)
@@ -120,7 +107,7 @@ def check_no_column_is_cut(app: Host) -> list[str]:
 async def test_no_column_is_cut_and_the_rest_is_on_the_detail_line(tmp_path, width):
     station = runs_on_two_mazes(tmp_path)
     screen = RunsScreen(station, unicode=False)
-    app = Host(screen)
+    app = Host(screen, follow_unicode=True)
     async with app.run_test(size=(width, 24)) as pilot:
         await pilot.pause()
         # the station's maze only: the one run on the web maze
@@ -172,7 +159,7 @@ async def test_touches_show_apart_from_collisions_in_the_table_and_the_replay(tm
     run = run_algorithms(station, "web-wall-following").runs[0]
     m = run.metrics
     assert run.ended == "exit" and m.collisions == 0 and m.touches >= 5
-    app = Host(RunsScreen(station, unicode=False))
+    app = Host(RunsScreen(station, unicode=False), follow_unicode=True)
     async with app.run_test(size=SIZE) as pilot:
         await pilot.pause()
         table = app.screen.query_one(DataTable)
@@ -197,7 +184,7 @@ async def test_touches_show_apart_from_collisions_in_the_table_and_the_replay(tm
 async def test_new_runs_appear_when_the_screen_comes_back(tmp_path):
     station = two_runs(tmp_path)
     screen = RunsScreen(station)
-    app = Host(screen)
+    app = Host(screen, follow_unicode=True)
     async with app.run_test(size=SIZE) as pilot:
         await pilot.press("enter")
         await pilot.pause()
@@ -212,7 +199,7 @@ async def test_new_runs_appear_when_the_screen_comes_back(tmp_path):
 async def test_no_runs_yet_and_a_run_without_a_record(tmp_path):
     station = LabStation.open(BEND, "erobotic", noise="off")
     screen = RunsScreen(station)
-    app = Host(screen)
+    app = Host(screen, follow_unicode=True)
     async with app.run_test(size=SIZE) as pilot:
         await pilot.pause()
         assert text(screen.query_one("#runs-help")).startswith("No runs yet")
@@ -228,7 +215,7 @@ async def test_no_runs_yet_and_a_run_without_a_record(tmp_path):
 @sync
 async def test_replay_steps_through_the_recorded_run(tmp_path):
     station = two_runs(tmp_path)
-    app = Host(RunsScreen(station, unicode=False))
+    app = Host(RunsScreen(station, unicode=False), follow_unicode=True)
     async with app.run_test(size=SIZE) as pilot:
         await pilot.press("down", "enter")
         await pilot.pause()
@@ -263,7 +250,7 @@ async def test_replay_steps_through_the_recorded_run(tmp_path):
 @sync
 async def test_replay_plays_at_a_speed_and_pauses(tmp_path):
     station = two_runs(tmp_path)
-    app = Host(RunsScreen(station))
+    app = Host(RunsScreen(station), follow_unicode=True)
     async with app.run_test(size=SIZE) as pilot:
         await pilot.press("enter")
         await pilot.pause()
@@ -292,7 +279,7 @@ async def test_replay_plays_at_a_speed_and_pauses(tmp_path):
 async def test_open_a_record_by_path_and_a_malformed_one(tmp_path):
     station = two_runs(tmp_path)
     screen = RunsScreen(station)
-    app = Host(screen)
+    app = Host(screen, follow_unicode=True)
     bad = tmp_path / "bad.jsonl"
     bad.write_text(
         json.dumps({"type": "header", "format": FORMAT})
@@ -324,7 +311,7 @@ async def test_open_a_record_by_path_and_a_malformed_one(tmp_path):
 async def test_replay_of_a_run_whose_maze_cannot_be_found(tmp_path):
     station = two_runs(tmp_path)
     record = station.runs[0].record
-    app = Host(ReplayScreen(record))  # no known mazes; bend.txt is nowhere
+    app = Host(ReplayScreen(record), follow_unicode=True)  # no known mazes; bend.txt is nowhere
     async with app.run_test(size=SIZE) as pilot:
         await pilot.pause()
         screen = app.screen
@@ -338,7 +325,7 @@ async def test_replay_of_a_run_whose_maze_cannot_be_found(tmp_path):
 async def test_runs_that_end_while_the_screen_is_open_appear(tmp_path):
     station = two_runs(tmp_path)
     screen = RunsScreen(station)
-    app = Host(screen)
+    app = Host(screen, follow_unicode=True)
     async with app.run_test(size=SIZE) as pilot:
         run_algorithms(station, "right-wall")
         screen.show_snapshot(station.snapshot())
@@ -353,7 +340,7 @@ async def test_both_views_keep_every_graded_measure_at_80x24_with_long_driver_na
 ):
     station = runs_with_long_driver_names(tmp_path)
     screen = RunsScreen(station, unicode=unicode)
-    app = Host(screen)
+    app = Host(screen, follow_unicode=True)
     turn = "Turn °" if unicode else "Turn deg"
     graded = [turn if g == "Turn deg" else g for g in GRADED]
     cut = "…" if unicode else "~"

@@ -1,4 +1,4 @@
-"""Fixtures of the sign-off and store command tests."""
+"""Fixtures of the sign-off, store and course-store tests."""
 
 from __future__ import annotations
 
@@ -20,3 +20,12 @@ def data_dir(tmp_path, config_dir) -> Path:
     create_instructor(d, "Dr Chen", PASS, kdf=FAST, trusted=config_dir / "roster.json")
     Store.open(d).close()
     return d
+
+
+@pytest.fixture(params=["sqlite", "postgresql"])
+def store(request, tmp_path: Path):
+    """An empty course store, once on the SQLite file in a data folder and once on a database
+    of its own on the PostgreSQL server."""
+    db = request.getfixturevalue("pg_url") if request.param == "postgresql" else None
+    with Store.open(tmp_path / "data", db=db) as opened:
+        yield opened

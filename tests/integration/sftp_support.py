@@ -14,6 +14,7 @@ import asyncssh
 import pytest
 
 from tests.waiting import until
+from workbench.labs.store.store import Store
 
 from .ssh_support import LabHost
 
@@ -148,3 +149,9 @@ async def raw_sftp_open(
     kind, body = await client.reply(2)
     assert kind == FXP_HANDLE, body
     return chan, client, body[8 : 8 + struct.unpack(">I", body[4:8])[0]]
+
+
+def held(data_dir, db: str) -> dict[str, str]:
+    """The course store's live files of ann, path -> sha256."""
+    with Store.open(data_dir, db=db) as store:
+        return {p: r.sha256 for p, r in store.workspaces.index("ann").items() if not r.deleted}

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import re
 import sqlite3
 import sys
 from datetime import UTC, datetime
@@ -57,3 +58,30 @@ def sql(data_dir: Path, *statements: str, params: tuple = ()) -> list[tuple]:
         return rows
     finally:
         conn.close()
+
+
+def head_of(out: str) -> str:
+    """The head of the sign-off log (``SEQ:SHA256``) a command printed."""
+    found = re.search(r"\bhead (\d+:[0-9a-f]{64})", out)
+    assert found is not None, f"no head of the log in:\n{out}"
+    return found.group(1)
+
+
+def fields(run_record: Path | None = None, passed: bool = True, **kw) -> RecordFields:
+    """What a sign-off records: alice, driving, with bob on the Unity wall-following exercise;
+    as evidence the run record ``run_record`` (none) and an exit in 41.5 s without a collision.
+    ``kw`` replaces any of them."""
+    evidence = Evidence(
+        str(run_record) if run_record else "", "", {"exit_time": 41.5, "collisions": 0}
+    )
+    base = dict(
+        student="alice",
+        partner="bob",
+        driver="alice",
+        lab="unity-simulator",
+        exercise="wall-following",
+        evidence=evidence,
+        objectives_passed=passed,
+    )
+    base.update(kw)
+    return RecordFields(**base)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import os
 import random
 import time
 from collections.abc import AsyncIterator, Callable
@@ -260,3 +261,17 @@ async def open_bare_channel(
     session.connection_made(chan)
     chan.resume_reading()  # a new channel holds what it receives until it is started
     return chan, session
+
+
+def gone(pid: int) -> bool:
+    """Whether no process ``pid`` is left (a zombie, not yet reaped, would still answer)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return True
+    return False
+
+
+async def idle_socket(port: int, address: str = "127.0.0.1"):
+    """A connection from ``address`` that never says a word."""
+    return await asyncio.open_connection("127.0.0.1", port, local_addr=(address, 0))

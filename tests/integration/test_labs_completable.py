@@ -13,6 +13,7 @@ import pytest
 from websockets.asyncio.server import serve
 
 from tests.sessions import free_port
+from tests.stations import run_to_exit
 from tests.unit.test_labs_behaviour import renamed_and_reordered
 from tests.waiting import DEADLINE, until
 from workbench.control.station import LabStation
@@ -51,17 +52,6 @@ def fresh_station(ex: Exercise) -> LabStation:
     station = LabStation.open(ex.setup.maze.maze, ex.setup.profile, noise="off")
     apply_setup(station, ex.setup, lab=lab_of(ex), exercise=ex.id)
     return station
-
-
-def run_to_exit(station: LabStation, limit_s: int = 600) -> None:
-    station.start()
-    done = len(station.runs)
-    for _ in range(limit_s):
-        station.step(60)
-        if len(station.runs) > done:
-            assert station.runs[-1].ended == "exit", station.runs[-1]
-            return
-    raise AssertionError(f"{station.algorithm.name} did not get out of {station.maze.name}")
 
 
 def run_on(

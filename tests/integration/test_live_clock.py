@@ -139,7 +139,7 @@ def test_keys_taken_while_paused_drop_what_the_program_sent():
     asyncio.run(scenario())
 
 
-def run_to_exit(b: LabStation) -> None:
+def advance_to_exit(b: LabStation) -> None:
     while not b.runs or b.runs[-1].ended != "exit":
         b.advance(1.0)  # at max: as many steps as the budget allows
 
@@ -151,7 +151,7 @@ def test_a_run_ends_at_1x_and_a_reset_and_a_new_maze_start_at_1x():
     assert b.set_speed(None)
     b.start()
     assert b.pacer.speed is None  # the speed chosen before the run is the run's
-    run_to_exit(b)
+    advance_to_exit(b)
     assert b.pacer.speed == 1.0  # not max after the run
     for again in (b.reset_robot, lambda: b.load_maze(CORRIDOR)):
         b.set_speed(10.0)
@@ -172,7 +172,7 @@ def test_a_run_gives_the_same_numbers_at_any_speed():
         b.apply_algorithm_preset()
         b.set_speed(speed)
         b.start()
-        run_to_exit(b)
+        advance_to_exit(b)
         return b.runs[-1].metrics
 
     assert metrics(None) == metrics(1.0) == metrics(4.0)

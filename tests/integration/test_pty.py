@@ -16,6 +16,8 @@ import pexpect
 import pyte
 import pytest
 
+from .ssh_support import line_with
+
 ROOT = Path(__file__).resolve().parents[2]
 COLUMNS, LINES = 80, 24
 
@@ -91,10 +93,6 @@ class Terminal:
             raise AssertionError(f"still running {timeout} s after ctrl+q:\n{self.text()}")
         self.child.close()
         return self.child.exitstatus
-
-
-def line_with(text: str, needle: str) -> str:
-    return next(line for line in text.splitlines() if needle in line)
 
 
 def test_workbench_opens_the_app_drives_and_quits_with_ctrl_q():

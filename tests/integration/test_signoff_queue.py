@@ -4,7 +4,6 @@ session starts): students ask, wait in order, and an instructor signs or decline
 from __future__ import annotations
 
 from datetime import UTC, datetime, timedelta
-from pathlib import Path
 
 import pytest
 
@@ -16,13 +15,6 @@ T0 = datetime(2026, 3, 2, 14, 5, 9, tzinfo=UTC)
 
 def at(seconds: float) -> datetime:
     return T0 + timedelta(seconds=seconds)
-
-
-@pytest.fixture(params=["sqlite", "postgresql"])
-def store(request, tmp_path: Path):
-    db = request.getfixturevalue("pg_url") if request.param == "postgresql" else None
-    with Store.open(tmp_path / "data", db=db) as opened:
-        yield opened
 
 
 def test_requests_wait_in_the_order_asked_and_each_sees_its_place(store):

@@ -21,7 +21,7 @@ from workbench.labs.signoff.roster import load_roster, roster_path
 from workbench.labs.signoff.signoff_record import record_from_stored
 from workbench.labs.store.store import DB_NAME, Store, read_signoffs
 
-from .signoff_support import FAST, add_instructor, sign, sql
+from .signoff_support import FAST, add_instructor, head_of, sign, sql
 
 
 @pytest.fixture
@@ -39,11 +39,6 @@ def run(capsys, *args: str) -> tuple[int, str]:
 
 def verify(capsys, data_dir: Path, *extra: str) -> tuple[int, str]:
     return run(capsys, "signoff", "verify", *extra, "--data-dir", str(data_dir))
-
-
-def head_of(out: str) -> str:
-    [line] = [line for line in out.splitlines() if line.startswith("head ")]
-    return line.split()[1]
 
 
 def relink(data_dir: Path) -> None:

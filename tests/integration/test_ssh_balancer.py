@@ -31,7 +31,7 @@ from workbench.labs.store.store import Store
 from workbench.ssh.balancer import EXAMPLE, LabBackend, haproxy_config
 from workbench.ssh.hostkey import load_or_create_host_key
 
-from .sftp_support import OpenSSH, files_under, needs_openssh
+from .sftp_support import OpenSSH, files_under, held, needs_openssh
 from .ssh_support import Account, Terminal, make_accounts, open_exercise, port_range
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -175,11 +175,6 @@ def end_left_over(pids: list[int]) -> None:
         with contextlib.suppress(OSError):
             if Path(f"/proc/{pid}/cmdline").read_bytes().startswith(sys.executable.encode()):
                 os.killpg(pid, signal.SIGKILL)
-
-
-def held(reader_dir: Path, db: str) -> dict[str, str]:
-    with Store.open(reader_dir, db=db) as store:
-        return {p: r.sha256 for p, r in store.workspaces.index("ann").items() if not r.deleted}
 
 
 def exercise_passed(screen: str) -> bool:

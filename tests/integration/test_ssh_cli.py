@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import os
 import signal
-import socket
 import stat
 import subprocess
 import sys
@@ -14,6 +13,7 @@ import time
 import asyncssh
 import pytest
 
+from tests.sessions import free_port
 from workbench.door.users import load_users
 from workbench.ssh.server import ServerConfig
 
@@ -112,20 +112,9 @@ def test_serve_ssh_refuses_bad_options_before_it_starts(tmp_path, options, messa
     assert not (tmp_path / "d").exists()  # nothing made: no host key, no log
 
 
-def free_port() -> int:
-    """A free port outside the sessions' default VIPLE range (which the server refuses)."""
-    low, high = ServerConfig.port_range
-    while True:
-        with socket.socket() as sock:
-            sock.bind(("127.0.0.1", 0))
-            port = sock.getsockname()[1]
-        if not low <= port <= high:
-            return port
-
-
 def test_serve_ssh_makes_a_private_host_key_logs_and_stops_on_sigterm(tmp_path):
     data = tmp_path / "data"
-    port = free_port()
+    port = free_port(ServerConfig.port_range)
     server = subprocess.Popen(
         [
             sys.executable,

@@ -4,24 +4,15 @@ free again, and logging in again shows the lab progress saved before."""
 from __future__ import annotations
 
 import asyncio
-import os
 
 from tests.app.support import sync
 from tests.waiting import until
 from workbench.door.ports import port_is_free
 
-from .ssh_support import Account, lab_host, open_exercise
+from .ssh_support import Account, gone, lab_host, open_exercise
 
 DRIVE = "Unity simulator: Drive by wire"
 KEYS_DONE = "[X] drove with w, a, s, d and space"
-
-
-def gone(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)  # a zombie (not yet reaped) would still answer
-    except ProcessLookupError:
-        return True
-    return False
 
 
 @sync

@@ -20,19 +20,11 @@ from workbench.door import forkserver as forkserver_module
 from workbench.door.appproc import app_env
 from workbench.door.forkserver import APP_NICENESS, ForkServer, ForkServerError
 
-from .ssh_support import Account, lab_host, moved
+from .ssh_support import Account, gone, lab_host, moved
 
 
 def parent_of(pid: int) -> int:
     return int(Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[1])
-
-
-def gone(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return True
-    return False
 
 
 @sync

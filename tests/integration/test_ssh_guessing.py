@@ -17,7 +17,7 @@ from tests.app.support import sync
 from tests.waiting import until
 from workbench.door.logins import LoginPolicy
 
-from .ssh_support import PASSWORD, Account, lab_host
+from .ssh_support import PASSWORD, Account, idle_socket, lab_host
 
 FAST = {"first_delay": 0.2, "max_delay": 0.8}
 
@@ -36,7 +36,7 @@ async def test_the_guesser_s_own_logins_between_guesses_do_not_speed_the_guessin
     caplog.set_level(logging.INFO, logger="workbench.ssh")
     accounts = [Account("mallory"), Account("rivera", role="instructor", password=PASSWORD)]
     policy = LoginPolicy(**FAST, lock_after=50)
-    async with lab_host(tmp_path, accounts, logins=policy) as host:
+    async with lab_host(tmp_path, accounts, logins=policy, fork_server=False) as host:
         guard = host.server.guard
         delays: list[float] = []  # the wait the server put before each password check
         delay = guard.delay
@@ -57,7 +57,7 @@ async def test_the_guesser_s_own_logins_between_guesses_do_not_speed_the_guessin
 async def test_parallel_guesses_at_one_account_wait_their_turn(tmp_path):
     accounts = [Account("rivera", role="instructor", password=PASSWORD)]
     policy = LoginPolicy(first_delay=0.2, max_delay=0.2, lock_after=50, address_allowance=50)
-    async with lab_host(tmp_path, accounts, logins=policy) as host:
+    async with lab_host(tmp_path, accounts, logins=policy, fork_server=False) as host:
         await refused_after(host, "rivera", "first-guess")
         start = time.monotonic()
         results = await asyncio.gather(
@@ -75,7 +75,7 @@ async def test_too_many_wrong_passwords_lock_the_account_s_passwords_but_not_its
     accounts = [Account("rivera", role="instructor", password=PASSWORD)]
     accounts[0].key = asyncssh.generate_private_key("ssh-ed25519")
     policy = LoginPolicy(first_delay=0.01, max_delay=0.02, lock_after=3, lock_for=60)
-    async with lab_host(tmp_path, accounts, logins=policy) as host:
+    async with lab_host(tmp_path, accounts, logins=policy, fork_server=False) as host:
         for n in range(3):
             await refused_after(host, "rivera", f"guess-{n}")
         assert "passwords of rivera locked for 1 min after 3 failures (keys still work)" in (
@@ -86,11 +86,6 @@ async def test_too_many_wrong_passwords_lock_the_account_s_passwords_but_not_its
         conn = await host.connect("rivera")  # by key
         conn.close()
         assert "login: rivera (instructor) from 127.0.0.1 with key" in caplog.text
-
-
-async def idle_socket(port: int) -> tuple[asyncio.StreamReader, asyncio.StreamWriter]:
-    reader, writer = await asyncio.open_connection("127.0.0.1", port)
-    return reader, writer
 
 
 async def closed_within(reader: asyncio.StreamReader, seconds: float) -> bool:
@@ -110,7 +105,7 @@ async def test_idle_connections_that_never_log_in_are_capped_and_a_real_login_st
 ):
     caplog.set_level(logging.INFO, logger="workbench.ssh")
     policy = LoginPolicy(max_unauthenticated=40, max_unauthenticated_per_address=10)
-    async with lab_host(tmp_path, [Account("ann")], logins=policy) as host:
+    async with lab_host(tmp_path, [Account("ann")], logins=policy, fork_server=False) as host:
         flood = [await idle_socket(host.port) for _ in range(300)]
         closed = await asyncio.gather(*(closed_within(r, 1.0) for r, _ in flood))
         assert closed.count(False) == 10  # held: the first ten, not yet timed out
@@ -125,7 +120,9 @@ async def test_idle_connections_that_never_log_in_are_capped_and_a_real_login_st
 
 @sync
 async def test_a_connection_that_does_not_log_in_in_time_is_closed(tmp_path):
-    async with lab_host(tmp_path, [Account("ann")], logins=LoginPolicy(login_timeout=0.5)) as host:
+    async with lab_host(
+        tmp_path, [Account("ann")], logins=LoginPolicy(login_timeout=0.5), fork_server=False
+    ) as host:
         reader, writer = await idle_socket(host.port)
         assert await closed_within(reader, 3.0)
         writer.close()
@@ -134,7 +131,7 @@ async def test_a_connection_that_does_not_log_in_in_time_is_closed(tmp_path):
 @sync
 async def test_agent_and_tunnel_requests_are_refused_and_logged(tmp_path, caplog):
     caplog.set_level(logging.INFO, logger="workbench.ssh")
-    async with lab_host(tmp_path, [Account("ann")]) as host:
+    async with lab_host(tmp_path, [Account("ann")], fork_server=False) as host:
         conn = await host.connect("ann", agent_forwarding=True, agent_path="/nonexistent/agent")
         result = await conn.run("ls", check=False)  # the agent request comes with the session
         assert result.exit_status == 1
@@ -152,7 +149,7 @@ async def test_agent_and_tunnel_requests_are_refused_and_logged(tmp_path, caplog
 @sync
 async def test_x11_and_agent_forwarding_asked_by_openssh_are_logged(tmp_path, caplog):
     caplog.set_level(logging.INFO, logger="workbench.ssh")
-    async with lab_host(tmp_path, [Account("ann")]) as host:
+    async with lab_host(tmp_path, [Account("ann")], fork_server=False) as host:
         key = tmp_path / "id_ann"
         key.write_bytes(host.accounts["ann"].key.export_private_key())
         key.chmod(0o600)

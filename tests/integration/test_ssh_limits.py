@@ -23,13 +23,8 @@ from workbench.door.appproc import AppEntry, AppProcess
 from workbench.door.limits import SessionLimits
 from workbench.door.logins import LoginPolicy
 
-from .ssh_support import Account, Terminal, lab_host, make_accounts
+from .ssh_support import Account, Terminal, idle_socket, lab_host, make_accounts
 from .test_ssh_guessing import closed_within
-
-
-async def idle_socket(port: int, address: str = "127.0.0.1"):
-    """A connection from ``address`` that never says a word."""
-    return await asyncio.open_connection("127.0.0.1", port, local_addr=(address, 0))
 
 
 class Watcher(asyncssh.SSHClient):

@@ -60,7 +60,7 @@ async def test_a_student_behind_the_balancer_logs_in_under_the_address_its_heade
     tmp_path, caplog
 ):
     caplog.set_level(logging.INFO, logger="workbench.ssh")
-    async with lab_host(tmp_path, [Account("ana")], proxy_from=BALANCER) as host:
+    async with lab_host(tmp_path, [Account("ana")], proxy_from=BALANCER, fork_server=False) as host:
         conn = await login_as(host, "ana", await through_balancer(host.port, v2("192.0.2.7")))
         assert "login: ana (student) from 192.0.2.7 with key" in caplog.text
         assert host.server.user_connections["ana"] == 1
@@ -77,7 +77,9 @@ async def test_the_per_address_cap_counts_the_address_in_the_header_not_the_bala
         max_unauthenticated_per_address=1, unauthenticated_grace=60, login_timeout=60
     )
     accounts = [Account("ana")]
-    async with lab_host(tmp_path, accounts, logins=policy, proxy_from=BALANCER) as host:
+    async with lab_host(
+        tmp_path, accounts, logins=policy, proxy_from=BALANCER, fork_server=False
+    ) as host:
         gate = host.server.gate
         idle = await through_balancer(host.port, v2("192.0.2.7"))  # holds 192.0.2.7's place
         await until(lambda: gate.unauthenticated["192.0.2.7"] == 1, "the idle connection held")
@@ -97,7 +99,7 @@ async def test_a_connection_from_the_balancer_without_a_header_is_closed_with_on
     tmp_path, caplog
 ):
     caplog.set_level(logging.INFO, logger="workbench.ssh")
-    async with lab_host(tmp_path, [Account("ana")], proxy_from=BALANCER) as host:
+    async with lab_host(tmp_path, [Account("ana")], proxy_from=BALANCER, fork_server=False) as host:
         garbage = await through_balancer(host.port, b"SSH-2.0-OpenSSH_9.6\r\n")
         assert await what_it_reads(garbage) == b""  # closed before the server said anything
         line = "connection from 127.0.0.1 closed: it did not start with a PROXY protocol header"
@@ -124,7 +126,9 @@ async def test_a_header_that_never_comes_closes_the_connection_after_the_login_t
 ):
     caplog.set_level(logging.INFO, logger="workbench.ssh")
     policy = LoginPolicy(login_timeout=0.5)
-    async with lab_host(tmp_path, [Account("ana")], logins=policy, proxy_from=BALANCER) as host:
+    async with lab_host(
+        tmp_path, [Account("ana")], logins=policy, proxy_from=BALANCER, fork_server=False
+    ) as host:
         silent = await through_balancer(host.port, v2("192.0.2.7")[:10])
         assert await what_it_reads(silent) == b""
         assert "connection from 127.0.0.1 closed: no PROXY header within 0.5 s" in caplog.text
@@ -135,7 +139,9 @@ async def test_a_header_that_never_comes_closes_the_connection_after_the_login_t
 async def test_a_client_not_from_the_balancer_is_not_read_for_a_header(tmp_path, caplog):
     caplog.set_level(logging.INFO, logger="workbench.ssh")
     elsewhere = parse_networks("10.0.0.0/24")
-    async with lab_host(tmp_path, [Account("ana")], proxy_from=elsewhere) as host:
+    async with lab_host(
+        tmp_path, [Account("ana")], proxy_from=elsewhere, fork_server=False
+    ) as host:
         conn = await host.connect("ana")
         conn.close()
         assert "login: ana (student) from 127.0.0.1" in caplog.text

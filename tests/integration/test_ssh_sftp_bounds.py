@@ -51,7 +51,7 @@ def sftp_sessions() -> list[LabSession]:
 
 @sync
 async def test_reads_never_read_back_stop_the_channel_s_requests_not_grow_its_buffer(tmp_path):
-    async with lab_host(tmp_path, [Account("mallory")]) as host:
+    async with lab_host(tmp_path, [Account("mallory")], fork_server=False) as host:
         folder = workspace_folder(host.data_dir, "mallory")
         folder.mkdir(parents=True, exist_ok=True)
         (folder / "big.viple").write_bytes(os.urandom(FILE_SIZE))
@@ -110,7 +110,7 @@ async def test_a_listing_is_made_off_the_event_loop(tmp_path, monkeypatch):
         return listed(self, parts)
 
     monkeypatch.setattr(WorkspaceFiles, "list", list_)
-    async with lab_host(tmp_path, [Account("mallory")]) as host:
+    async with lab_host(tmp_path, [Account("mallory")], fork_server=False) as host:
         folder = workspace_folder(host.data_dir, "mallory")
         folder.mkdir(parents=True, exist_ok=True)
         for n in range(50):
@@ -125,7 +125,7 @@ async def test_a_listing_is_made_off_the_event_loop(tmp_path, monkeypatch):
 
 @sync
 async def test_files_are_not_opened_into_the_descriptors_kept_for_live_sessions(tmp_path):
-    async with lab_host(tmp_path, [Account("mallory")]) as host:
+    async with lab_host(tmp_path, [Account("mallory")], fork_server=False) as host:
         conn = await host.connect("mallory")
         async with conn.start_sftp_client() as sftp:
             probe = os.open(os.devnull, os.O_RDONLY)
@@ -147,7 +147,7 @@ async def test_files_are_not_opened_into_the_descriptors_kept_for_live_sessions(
 
 @sync
 async def test_a_student_s_open_files_are_capped_over_all_their_transfers(tmp_path):
-    async with lab_host(tmp_path, [Account("mallory")]) as host:
+    async with lab_host(tmp_path, [Account("mallory")], fork_server=False) as host:
         folder = workspace_folder(host.data_dir, "mallory")
         folder.mkdir(parents=True, exist_ok=True)
         (folder / "a.txt").write_text("a")

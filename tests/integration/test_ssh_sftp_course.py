@@ -5,19 +5,12 @@ from __future__ import annotations
 
 from tests.app.support import sync
 from tests.waiting import until
-from workbench.labs.store.store import Store
 from workbench.labs.store.workspace_sync import sync_at_start
 
-from .sftp_support import OpenSSH, files_under, needs_openssh
+from .sftp_support import OpenSSH, files_under, held, needs_openssh
 from .ssh_support import Account, lab_host
 
 pytestmark = needs_openssh
-
-
-def held(data_dir, db: str) -> dict[str, str]:
-    """The course store's live files of ann, path -> sha256."""
-    with Store.open(data_dir, db=db) as store:
-        return {p: r.sha256 for p, r in store.workspaces.index("ann").items() if not r.deleted}
 
 
 @sync
@@ -26,8 +19,8 @@ async def test_uploads_renames_and_removals_reach_the_other_server(tmp_path, pg_
     (tmp_path / "prog.viple").write_bytes(b"ann's program\n")
     (tmp_path / "maze.txt").write_bytes(b"ann's maze\n")
     async with (
-        lab_host(tmp_path / "one", [ann], db=pg_url) as one,
-        lab_host(tmp_path / "two", [ann], db=pg_url) as two,
+        lab_host(tmp_path / "one", [ann], db=pg_url, fork_server=False) as one,
+        lab_host(tmp_path / "two", [ann], db=pg_url, fork_server=False) as two,
     ):
         done = await OpenSSH(one, tmp_path).sftp(
             "ann",

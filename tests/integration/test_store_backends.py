@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pytest
 
+from tests.integration.signoff_support import fields
 from tests.waiting import wait_until
 from workbench.labs.signoff.instructors import KdfParams, create_instructor
 from workbench.labs.signoff.roster import RosterEntry, offered_roster
@@ -24,7 +25,6 @@ from workbench.labs.signoff.signoff_errors import (
     UnknownInstructor,
     WrongPassphrase,
 )
-from workbench.labs.signoff.signoff_record import Evidence, RecordFields
 from workbench.labs.signoff.verify import verify_log
 from workbench.labs.store.store import (
     LogMissing,
@@ -68,20 +68,6 @@ class Where:
 def where(request, tmp_path: Path) -> Where:
     db = request.getfixturevalue("pg_url") if request.param == "postgresql" else None
     return Where(tmp_path / "data", db)
-
-
-def fields(student: str = "alice", **kw) -> RecordFields:
-    base = dict(
-        student=student,
-        partner="bob",
-        driver=student,
-        lab="unity-simulator",
-        exercise="wall-following",
-        evidence=Evidence("", "", {"exit_time": 41.5}),
-        objectives_passed=True,
-    )
-    base.update(kw)
-    return RecordFields(**base)
 
 
 def test_progress_places_and_drivers_are_saved_replaced_and_read_back(where):
@@ -172,7 +158,7 @@ def test_signoffs_form_one_log_that_verifies_and_reads_back_the_same(where):
     assert list(roster) == ["Dr Chen"]
     with where.open() as s:
         for student in ("alice", "carol", "dave"):
-            sign_off(s, "Dr Chen", PASS, fields(student))
+            sign_off(s, "Dr Chen", PASS, fields(student=student, driver=student))
         stored = s.signoffs.of()
         assert [r.student for r in s.signoffs.of(student="bob")] == ["alice", "carol", "dave"]
     assert [r.seq for r in stored] == [1, 2, 3]

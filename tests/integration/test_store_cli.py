@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 import io
-import re
 import sys
 from datetime import UTC, datetime
 from pathlib import Path
@@ -19,7 +18,7 @@ from workbench.labs.signoff.signoff_errors import WrongPassphrase
 from workbench.labs.signoff.signoff_record import RecordFields
 from workbench.labs.store.store import Store
 
-from .signoff_support import FAST, PASS, sign
+from .signoff_support import FAST, PASS, head_of, sign
 
 
 @pytest.fixture
@@ -38,10 +37,6 @@ def section(tmp_path, config_dir) -> Path:
         with pytest.raises(WrongPassphrase):
             sign_off(store, "Dr Chen", "not the passphrase", fields)
     return d
-
-
-def head_of(out: str) -> str:
-    return re.search(r"head (\d+:[0-9a-f]{64})", out).group(1)
 
 
 def test_migrate_copies_a_data_folder_and_checks_the_copy(section, pg_url, capsys):

@@ -16,7 +16,14 @@ import socket
 
 import pytest
 
-from tests.sessions import CORRIDOR, ROOM, pushes_keep_their_interval, session_for, steps
+from tests.sessions import (
+    CORRIDOR,
+    ROOM,
+    many_sensors,
+    pushes_keep_their_interval,
+    session_for,
+    steps,
+)
 from tests.waiting import until
 from workbench.sim.sensors import SensorSpec
 from workbench.sim.session import Session
@@ -507,12 +514,6 @@ async def not_reading_client(port: int) -> tuple[asyncio.StreamReader, asyncio.S
 async def read_everything(reader: asyncio.StreamReader) -> None:
     while await reader.read(65536):
         pass
-
-
-def many_sensors() -> list[SensorSpec]:
-    """Forty sensors: reports of about 2 KB fill the socket buffers in a few dozen reports."""
-    mounts = ("front", "left", "right", "back")
-    return [SensorSpec("distance", port, mounts[port % 4]) for port in range(1, 41)]
 
 
 def test_a_driver_that_stops_sending_and_reading_loses_the_seat_and_the_robot_stops(caplog):

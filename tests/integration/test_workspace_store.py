@@ -37,13 +37,6 @@ PASS = "correct horse battery"
 MAZE = "5 4\n#####\n#S..#\n#..E#\n#####\n"
 
 
-@pytest.fixture(params=["sqlite", "postgresql"])
-def store(request, tmp_path: Path):
-    db = request.getfixturevalue("pg_url") if request.param == "postgresql" else None
-    with Store.open(tmp_path / "data", db=db) as opened:
-        yield opened
-
-
 def test_a_file_is_kept_replaced_and_removed_with_a_growing_revision(store):
     first = store.workspaces.put("alice", "mazes/mine.txt", b"one", 100.0)
     again = store.workspaces.put("alice", "mazes/mine.txt", b"one", 200.0)

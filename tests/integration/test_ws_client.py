@@ -11,9 +11,15 @@ import pytest
 from websockets.asyncio.server import ServerConnection, serve
 from websockets.exceptions import ConnectionClosed
 
-from tests.sessions import CORRIDOR, free_port, pushes_keep_their_interval, session_for, steps
+from tests.sessions import (
+    CORRIDOR,
+    free_port,
+    many_sensors,
+    pushes_keep_their_interval,
+    session_for,
+    steps,
+)
 from tests.waiting import until
-from workbench.sim.sensors import SensorSpec
 from workbench.sim.session import Session
 from workbench.viple import ws_client
 from workbench.viple.codec import parse_report
@@ -348,12 +354,6 @@ class DeafViple(FakeViple):
             self.commanded = True
             await ws.send(MOVE)
         await ws.wait_closed()
-
-
-def many_sensors() -> list[SensorSpec]:
-    """Forty sensors: reports of about 2 KB fill the socket buffers in a few dozen reports."""
-    mounts = ("front", "left", "right", "back")
-    return [SensorSpec("distance", port, mounts[port % 4]) for port in range(1, 41)]
 
 
 def test_a_driver_that_stops_sending_and_reading_loses_the_seat_and_the_robot_stops(caplog):

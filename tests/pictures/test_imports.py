@@ -10,7 +10,7 @@ CHECK = """
 import sys
 import workbench.tui.app as app_module
 print("after import:", "matplotlib" in sys.modules)
-from workbench.tui.settings import AppSettings
+from workbench.wire.settings import AppSettings
 app = app_module.make_app(AppSettings())
 print("after make_app:", "matplotlib" in sys.modules)
 import workbench.pictures.render, workbench.pictures.runs

@@ -9,6 +9,7 @@ import pytest
 
 from tests.program import hostile
 from tests.program.builder import ProgramBuilder
+from tests.program.ticking import run
 from workbench.cli import main
 from workbench.program.compiled import compile_program
 from workbench.program.interp import Limits, ProgramController
@@ -18,7 +19,6 @@ from workbench.program.viple_expr import MAX_MESSAGE_DEPTH, JoinMessage, show
 from workbench.sim.commands import Stop
 from workbench.sim.record import read_record
 
-TICK = 0.05
 WEB_MAZE = "mazes/web.txt"
 
 
@@ -26,13 +26,6 @@ def controller(text: str, tmp_path, limits: Limits | None = None) -> ProgramCont
     path = tmp_path / "hostile.viple"
     path.write_text(text)
     return ProgramController(compile_program(load_program(path)), limits=limits or Limits())
-
-
-def run(c: ProgramController, seconds: float) -> list:
-    commands = list(c.start(0.0))
-    for i in range(1, round(seconds / TICK) + 1):
-        commands += c.tick(i * TICK, {}, frozenset())
-    return commands
 
 
 def problems(text: str, tmp_path) -> list[str]:

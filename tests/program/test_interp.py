@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 
 from tests.program.builder import ProgramBuilder
+from tests.program.ticking import TICK, run
 from workbench.program import kinds as K
 from workbench.program.compiled import compile_program
 from workbench.program.interp import MAPPED_RUNS, RUNS, SENSES, ProgramController
@@ -15,20 +16,10 @@ from workbench.program.model import ELSE
 from workbench.program.problems import ProgramError
 from workbench.sim.commands import MotorPower, MoveAtPower, TurnByDegrees, WheelPowers
 
-TICK = 0.05
-
 
 def controller(b: ProgramBuilder, tmp_path, keys: str = "", kinds=None) -> ProgramController:
     path = b.write(tmp_path / "p.viple")
     return ProgramController(compile_program(load_program(path, kinds)), parse_key_script(keys))
-
-
-def run(c: ProgramController, seconds: float, readings=None) -> list:
-    commands = list(c.start(0.0))
-    for i in range(1, round(seconds / TICK) + 1):
-        r = readings(i * TICK) if callable(readings) else (readings or {})
-        commands += c.tick(i * TICK, {f"port {p}": v for p, v in r.items()}, frozenset())
-    return commands
 
 
 def texts(c: ProgramController) -> list[str]:

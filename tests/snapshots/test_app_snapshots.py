@@ -11,6 +11,7 @@ import pytest
 from textual.pilot import Pilot
 from textual.widgets import Input, Select
 
+from tests.app.support import still
 from workbench.tui.app import WorkbenchApp, make_app
 from workbench.wire.settings import AppSettings
 
@@ -25,12 +26,6 @@ grid = pytest.mark.parametrize(
 
 def app(unicode: bool, **kw) -> WorkbenchApp:
     return make_app(AppSettings(paused=True, unicode=unicode, **kw))
-
-
-def still(pilot: Pilot) -> None:
-    """No blinking cursors in the picture."""
-    for field in pilot.app.screen.query(Input):
-        field.cursor_blink = False
 
 
 async def drive_a_little(pilot: Pilot) -> None:

@@ -16,9 +16,9 @@ from tests.app.console_support import (
     WEB_LAB,
     save_progress,
     save_student,
-    until,
     wall_main,
 )
+from tests.waiting import until
 from workbench.labs.model import load_labs
 from workbench.labs.signoff.instructors import KdfParams, create_instructor
 from workbench.labs.store.store import Store
@@ -43,7 +43,7 @@ def console(data) -> ConsoleApp:
 async def class_shown(pilot: Pilot) -> None:
     screen = pilot.app.screen
     assert isinstance(screen, ConsoleScreen)
-    await until(pilot, lambda: screen.view is not None, "the class")
+    await until(lambda: screen.view is not None, "the class")
     await pilot.pause()
 
 
@@ -56,7 +56,7 @@ def test_console_request_opened(snap_compare, tmp_path):
         await class_shown(pilot)
         await pilot.press("enter")
         screen = pilot.app.screen
-        await until(pilot, lambda: getattr(screen, "request", None) is not None, "the request")
+        await until(lambda: getattr(screen, "request", None) is not None, "the request")
         for field in screen.query(Input):
             field.cursor_blink = False
         await pilot.pause()
@@ -88,7 +88,7 @@ def test_console_request_with_a_programs_evidence(snap_compare, tmp_path):
         await class_shown(pilot)
         await pilot.press("enter")
         screen = pilot.app.screen
-        await until(pilot, lambda: getattr(screen, "request", None) is not None, "the request")
+        await until(lambda: getattr(screen, "request", None) is not None, "the request")
         for field in screen.query(Input):
             field.cursor_blink = False
         await pilot.pause()

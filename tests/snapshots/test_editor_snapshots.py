@@ -10,14 +10,13 @@ from pathlib import Path
 
 import pytest
 from textual.pilot import Pilot
-from textual.screen import Screen
-from textual.widgets import Input
 
 from tests.app.runs_support import runs_with_long_driver_names
+from tests.app.support import Host, still
+from tests.stations import run_to_exit
 from workbench.control.station import LabStation
 from workbench.sim.generate import generate
 from workbench.sim.mazeio import load_maze
-from workbench.tui.host import ScreenHost
 from workbench.tui.screens.editor import EditorScreen
 from workbench.tui.screens.replay import ReplayScreen
 from workbench.tui.screens.runs import RunsScreen
@@ -28,25 +27,8 @@ SMALL = (80, 24)
 LARGE = (120, 40)
 
 
-class Host(ScreenHost):
-    """Pushes the screen under test over an empty default screen."""
-
-    def __init__(self, screen: Screen) -> None:
-        super().__init__()
-        self.under_test = screen
-
-    def on_mount(self) -> None:
-        self.push_screen(self.under_test)
-
-
 def web_station(**kwargs) -> LabStation:
     return LabStation.open(load_maze(ROOT / WEB), "web", noise="off", **kwargs)
-
-
-def still_inputs(pilot: Pilot) -> None:
-    """No blinking text cursor in the picture."""
-    for field in pilot.app.screen.query(Input):
-        field.cursor_blink = False
 
 
 def press_then_still(*keys: str):
@@ -54,7 +36,7 @@ def press_then_still(*keys: str):
         await pilot.pause()
         await pilot.press(*keys)
         await pilot.pause()
-        still_inputs(pilot)
+        still(pilot)
 
     return run_before
 
@@ -66,12 +48,7 @@ def web_runs(tmp_path_factory) -> LabStation:
     for name in ("web-wall-following", "two-distance-local-best"):
         station.select_algorithm(name)
         station.apply_algorithm_preset()
-        station.start()
-        before = len(station.runs)
-        for _ in range(400):
-            station.step(60)
-            if len(station.runs) > before:
-                break
+        run_to_exit(station)
     assert [r.ended for r in station.runs] == ["exit", "exit"]
     return station
 

@@ -8,32 +8,21 @@ on every run.
 from __future__ import annotations
 
 from datetime import UTC, datetime
-from pathlib import Path
 
 import pytest
 from textual.pilot import Pilot
 from textual.widgets import Checkbox, Input, OptionList
 
-from tests.app.labs_support import open_labs, signing_over
+from tests.app.labs_support import lab_app, open_labs, signing_over
+from tests.app.support import still
 from workbench.labs.model import load_labs
 from workbench.labs.signoff.instructors import KdfParams, create_instructor
-from workbench.tui.app import WorkbenchApp, make_app
+from workbench.tui.app import make_app
 from workbench.wire.settings import AppSettings
 
 FAST = KdfParams(n=2**10, r=8, p=1)  # cheap scrypt for tests only
 PASS = "correct horse battery"
 SIZE = (80, 24)
-
-
-def lab_app(data_dir: Path, instructor: bool = True) -> WorkbenchApp:
-    if instructor:
-        create_instructor(data_dir, "Dr Chen", PASS, kdf=FAST)
-    return make_app(AppSettings(paused=True, student="ana", partner="ben", data_dir=data_dir))
-
-
-def still(pilot: Pilot) -> None:
-    for field in pilot.app.screen.query(Input):
-        field.cursor_blink = False
 
 
 async def open_drive_by_wire(pilot: Pilot) -> None:
@@ -49,7 +38,7 @@ async def open_drive_by_wire(pilot: Pilot) -> None:
 
 
 def test_labs_exercise_with_objectives_in_both_states(snap_compare, tmp_path):
-    app = lab_app(tmp_path / "data", instructor=False)
+    app = lab_app(tmp_path / "data")
     assert snap_compare(app, terminal_size=SIZE, run_before=open_drive_by_wire)
 
 
@@ -61,6 +50,7 @@ def test_signoff_dialog(snap_compare, tmp_path):
         still(pilot)
         await pilot.pause()
 
+    create_instructor(tmp_path / "data", "Dr Chen", PASS, kdf=FAST)
     assert snap_compare(lab_app(tmp_path / "data"), terminal_size=SIZE, run_before=before)
 
 
@@ -91,6 +81,7 @@ def test_driver_change_prompt_after_an_override(snap_compare, tmp_path, monkeypa
         still(pilot)
         await pilot.pause()
 
+    create_instructor(tmp_path / "data", "Dr Chen", PASS, kdf=FAST)
     assert snap_compare(lab_app(tmp_path / "data"), terminal_size=SIZE, run_before=before)
 
 
@@ -124,7 +115,7 @@ def test_every_lab_exercise_at_80x24(snap_compare, tmp_path, option_id):
         still(pilot)
         await pilot.pause()
 
-    app = lab_app(tmp_path / "data", instructor=False)
+    app = lab_app(tmp_path / "data")
     assert snap_compare(app, terminal_size=SIZE, run_before=before)
 
 
@@ -147,5 +138,5 @@ def test_multiple_choice_question_at_80x24(snap_compare, tmp_path):
         still(pilot)
         await pilot.pause()
 
-    app = lab_app(tmp_path / "data", instructor=False)
+    app = lab_app(tmp_path / "data")
     assert snap_compare(app, terminal_size=SIZE, run_before=before)

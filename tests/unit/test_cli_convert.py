@@ -1,5 +1,6 @@
 """`workbench maze convert`, as a user runs it."""
 
+from tests.files import write
 from workbench.cli import main
 from workbench.sim.mazeio import load_maze
 
@@ -20,12 +21,6 @@ name: tiny
 #^#...#
 #######
 """
-
-
-def write(tmp_path, name, text):
-    path = tmp_path / name
-    path.write_text(text)
-    return str(path)
 
 
 def classic_16x16() -> str:

@@ -2,16 +2,11 @@
 
 import json
 
+from tests.files import write
 from workbench.cli import main
 
 VALID = "---\nname: Tiny\n---\n#####\n#S.E#\n#####\n"
 BROKEN = "#####\n#S.X#\n#...\n"
-
-
-def write(tmp_path, name, text):
-    path = tmp_path / name
-    path.write_text(text)
-    return str(path)
 
 
 def test_check_valid_file_prints_summary_and_exits_0(tmp_path, capsys):

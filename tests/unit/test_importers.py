@@ -2,6 +2,7 @@
 
 import pytest
 
+from tests.files import write
 from workbench.sim.maz import format_maz, parse_maz
 from workbench.sim.maze import Maze, MazeError
 from workbench.sim.mazefile import parse_maze
@@ -42,15 +43,6 @@ BLOCKS = (
 
 def problems(exc_info) -> list[str]:
     return [str(p) for p in exc_info.value.problems]
-
-
-def write(tmp_path, name, content):
-    path = tmp_path / name
-    if isinstance(content, bytes):
-        path.write_bytes(content)
-    else:
-        path.write_text(content)
-    return path
 
 
 # -- micromouseonline text -------------------------------------------------------------------

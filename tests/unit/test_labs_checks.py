@@ -5,6 +5,7 @@ from pathlib import Path
 
 import pytest
 
+from tests.stations import run_to_exit
 from workbench.control.fsmfile import load_fsm
 from workbench.control.station import LabStation
 from workbench.labs.checks import (
@@ -55,16 +56,6 @@ def check(obj, ex, b, answers=None):
 
 def evidence_of(obj, ex, b):
     return check_objective(obj, ex, b, None, attempt_of(b, "lab", ex)).evidence
-
-
-def run_to_exit(b, limit_s=400):
-    b.start()
-    done = len(b.runs)
-    for _ in range(limit_s):
-        b.step(60)
-        if len(b.runs) > done and b.runs[-1].ended == "exit":
-            return b.runs[-1]
-    raise AssertionError("the run did not get out")
 
 
 def test_keys_objective_names_the_keys_still_to_use():

@@ -6,6 +6,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+from tests.stations import run_to_exit
 from workbench.control.station import LabStation
 from workbench.labs.checks import REDO, ExerciseProgress, apply_setup, evaluate, keep_passed
 from workbench.labs.model import Controller, Exercise, LabMaze, Objective, Question, Setup
@@ -49,19 +50,6 @@ def station() -> LabStation:
     return LabStation.open(EROBOTIC.maze, "unity", noise="off")
 
 
-def run_to_exit(b: LabStation) -> None:
-    b.select_algorithm("right-wall")
-    b.apply_algorithm_preset()
-    b.start()
-    done = len(b.runs)
-    for _ in range(400):
-        b.step(60)
-        if len(b.runs) > done:
-            assert b.runs[-1].ended == "exit"
-            return
-    raise AssertionError("the run did not get out")
-
-
 def do_the_work(b: LabStation, kind: str) -> None:
     """What passes an objective of ``kind`` in the exercise set up on ``b``."""
     if kind == "keys":
@@ -80,6 +68,8 @@ def do_the_work(b: LabStation, kind: str) -> None:
         b.step(30)
     elif kind in ("exit", "compare"):
         b.load_maze(RANK.maze)
+        b.select_algorithm("right-wall")
+        b.apply_algorithm_preset()
         run_to_exit(b)
     elif kind == "maze-edited":
         maze = b.maze

@@ -6,6 +6,7 @@ from pathlib import Path
 
 import pytest
 
+from tests.stations import run_to_exit
 from workbench.control.station import LabStation
 from workbench.labs.checks import apply_setup, attempt_of, check_objective
 from workbench.labs.model import LabFileError, load_lab
@@ -40,16 +41,6 @@ def lab_in(tmp_path, controller="algorithm right-wall", driver="algorithm right-
     path = tmp_path / "pinned.yaml"
     path.write_text(LAB.format(controller=controller, driver=driver))
     return load_lab(path).exercises[0]
-
-
-def run_to_exit(b, limit_s=200):
-    b.start()
-    done = len(b.runs)
-    for _ in range(limit_s):
-        b.step(60)
-        if len(b.runs) > done and b.runs[-1].ended == "exit":
-            return b.runs[-1]
-    raise AssertionError("the run did not get out")
 
 
 def check(obj, ex, b):

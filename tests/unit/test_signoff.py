@@ -8,13 +8,14 @@ import signal
 import sqlite3
 import subprocess
 import sys
-import threading
 from dataclasses import replace
-from datetime import UTC, datetime, timedelta
+from datetime import UTC, datetime
 from pathlib import Path
 
 import pytest
 
+from tests.clocks import Clock
+from tests.integration.signoff_support import fields
 from workbench.labs.signlog import GENESIS, RECORD_FORMAT
 from workbench.labs.signoff.gradebook import gradebook_rows
 from workbench.labs.signoff.instructors import (
@@ -34,7 +35,6 @@ from workbench.labs.signoff.signoff_errors import (
 )
 from workbench.labs.signoff.signoff_record import (
     Evidence,
-    RecordFields,
     SignoffRecord,
     record_digest,
     record_from_stored,
@@ -54,17 +54,6 @@ PASS = "correct horse battery"
 T0 = datetime(2026, 3, 2, 14, 5, 9, tzinfo=UTC)
 
 
-class Clock:
-    def __init__(self, start: datetime = T0):
-        self.now = start
-
-    def __call__(self) -> datetime:
-        return self.now
-
-    def advance(self, seconds: float) -> None:
-        self.now += timedelta(seconds=seconds)
-
-
 @pytest.fixture
 def data_dir(tmp_path: Path) -> Path:
     return tmp_path / "data"
@@ -82,23 +71,6 @@ def run_record(tmp_path: Path) -> Path:
     p = tmp_path / "run.jsonl"
     p.write_text('{"type":"header","format":"workbench-run/1"}\n{"type":"summary"}\n')
     return p
-
-
-def fields(run_record: Path | None = None, passed: bool = True, **kw) -> RecordFields:
-    evidence = Evidence(
-        str(run_record) if run_record else "", "", {"exit_time": 41.5, "collisions": 0}
-    )
-    base = dict(
-        student="alice",
-        partner="bob",
-        driver="alice",
-        lab="unity-simulator",
-        exercise="wall-following",
-        evidence=evidence,
-        objectives_passed=passed,
-    )
-    base.update(kw)
-    return RecordFields(**base)
 
 
 def roster(data_dir: Path) -> dict[str, RosterEntry]:
@@ -163,7 +135,7 @@ def test_a_damaged_roster_is_reported_with_its_file(data_dir):
 
 
 def test_happy_path_signs_stores_and_verifies(store, data_dir, run_record):
-    clock = Clock()
+    clock = Clock(T0)
     row_id, record = sign_off(store, "Dr Chen", PASS, fields(run_record), clock=clock)
     assert record.signed_at == "2026-03-02T14:05:09Z"
     assert record.evidence.digest == record_digest(run_record)
@@ -236,13 +208,13 @@ def test_a_run_record_changed_before_signing_is_refused(store, run_record):
 
 def test_wrong_passphrase_is_rejected_and_logged(store):
     with pytest.raises(WrongPassphrase):
-        sign_off(store, "Dr Chen", "wrong wrong wrong", fields(), clock=Clock())
+        sign_off(store, "Dr Chen", "wrong wrong wrong", fields(), clock=Clock(T0))
     assert store.signoffs.of() == []
     assert [e.event for e in store.signoffs.events("Dr Chen")] == ["wrong-passphrase"]
 
 
 def test_five_failures_lock_for_a_minute_even_across_restarts(store, data_dir):
-    clock = Clock()
+    clock = Clock(T0)
     for _ in range(4):
         with pytest.raises(WrongPassphrase):
             sign_off(store, "Dr Chen", "wrong wrong wrong", fields(), clock=clock)
@@ -261,7 +233,7 @@ def test_five_failures_lock_for_a_minute_even_across_restarts(store, data_dir):
 
 def test_the_lockout_is_per_instructor_and_a_success_resets_the_count(store, data_dir):
     create_instructor(data_dir, "Dr Lee", "another long passphrase", kdf=FAST)
-    clock = Clock()
+    clock = Clock(T0)
     for _ in range(5):
         with pytest.raises(SignoffError):
             sign_off(store, "Dr Chen", "wrong wrong wrong", fields(), clock=clock)
@@ -296,7 +268,7 @@ def test_the_lockout_is_per_instructor_and_a_success_resets_the_count(store, dat
 )
 def test_a_record_edited_in_the_database_fails_verify(store, data_dir, column, value):
     create_instructor(data_dir, "Dr Lee", "another long passphrase", kdf=FAST)
-    sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+    sign_off(store, "Dr Chen", PASS, fields(), clock=Clock(T0))
     assert problems(store, data_dir) == [()]
     with sqlite3.connect(store.path) as conn:
         conn.execute(f"UPDATE signoffs SET {column} = ?", (value,))
@@ -305,7 +277,7 @@ def test_a_record_edited_in_the_database_fails_verify(store, data_dir, column, v
 
 
 def test_a_changed_run_record_fails_and_a_missing_one_is_only_noted(store, data_dir, run_record):
-    sign_off(store, "Dr Chen", PASS, fields(run_record), clock=Clock())
+    sign_off(store, "Dr Chen", PASS, fields(run_record), clock=Clock(T0))
     run_record.write_text(run_record.read_text() + '{"t":1}\n')
     [verdict] = verify_all(store, roster(data_dir))
     assert not verdict.ok and "no longer has the signed digest" in verdict.problems[0]
@@ -319,8 +291,8 @@ def test_a_key_not_in_the_roster_fails(store, data_dir, tmp_path):
     create_instructor(other, "Dr Fake", PASS, kdf=FAST)
     create_instructor(other, "Dr Chen", PASS, kdf=FAST)
     with Store.open(other) as rogue:
-        sign_off(rogue, "Dr Fake", PASS, fields(), clock=Clock())
-        sign_off(rogue, "Dr Chen", PASS, fields(), clock=Clock())
+        sign_off(rogue, "Dr Fake", PASS, fields(), clock=Clock(T0))
+        sign_off(rogue, "Dr Chen", PASS, fields(), clock=Clock(T0))
     rogue_log = verify_log(read_signoffs(other), roster(data_dir))  # chain and all
     found = [v.problems for v in rogue_log.verdicts]
     assert found[0] == ("instructor 'Dr Fake' is not in the trusted roster",)
@@ -328,7 +300,7 @@ def test_a_key_not_in_the_roster_fails(store, data_dir, tmp_path):
 
 
 def test_gradebook_has_one_row_per_student_and_exercise_from_verified_records(store, data_dir):
-    clock = Clock()
+    clock = Clock(T0)
     sign_off(store, "Dr Chen", PASS, fields(), clock=clock)
     clock.advance(60)
     sign_off(store, "Dr Chen", PASS, fields(), clock=clock)
@@ -393,30 +365,6 @@ def test_progress_and_drivers_are_saved_and_replaced(data_dir):
         assert s.progress.drivers("alice", "bob") == {("web", "ex1"): "bob"}
         with pytest.raises(ValueError):
             s.progress.save("alice", "web", "ex1", {"t": float("inf")})
-
-
-def test_two_connections_can_write_at_the_same_time(data_dir):
-    Store.open(data_dir).close()
-    errors: list[BaseException] = []
-
-    def writer(who: str) -> None:
-        try:
-            with Store.open(data_dir) as s:
-                for i in range(40):
-                    s.progress.save(who, "lab", f"ex{i}", {"i": i})
-                    s.signoffs.log_event(who, "tick", str(i), T0)
-        except BaseException as exc:
-            errors.append(exc)
-
-    threads = [threading.Thread(target=writer, args=(w,)) for w in ("alice", "bob")]
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join()
-    assert errors == []
-    with Store.open(data_dir) as s:
-        assert len(s.progress.of("alice")) == 40 and len(s.progress.of("bob")) == 40
-        assert len(s.signoffs.events()) == 80
 
 
 WRITER = """
@@ -494,8 +442,8 @@ def test_the_sign_off_names_the_program_and_older_records_still_verify(store, da
     evidence = Evidence.of_progress(progress)
     assert evidence.metrics["programs"] == {digest: "mine.viple"}
     # a record made before the sign-off named its program (no "programs" in its evidence)
-    sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
-    _, record = sign_off(store, "Dr Chen", PASS, fields(evidence=evidence), clock=Clock())
+    sign_off(store, "Dr Chen", PASS, fields(), clock=Clock(T0))
+    _, record = sign_off(store, "Dr Chen", PASS, fields(evidence=evidence), clock=Clock(T0))
     [_, row] = store.signoffs.of()
     assert row.metrics_value()["programs"] == {digest: "mine.viple"}
     assert record_from_stored(row) == record
@@ -548,7 +496,7 @@ def test_records_made_before_the_chain_are_read_as_legacy_then_chained_by_the_up
     with Store.open(data_dir) as store:
         assert store.schema_version() == 6
         assert store.signoffs.of() == read_signoffs(data_dir)  # upgraded to what was read
-        sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+        sign_off(store, "Dr Chen", PASS, fields(), clock=Clock(T0))
         log = verify_log(store.signoffs.of(), roster(data_dir), kept=read_only.head)
     assert log.ok and log.legacy == 2 and log.head.seq == 3
     assert [v.row.legacy for v in log.verdicts] == [True, True, False]
@@ -561,7 +509,7 @@ def test_records_made_before_the_chain_are_read_as_legacy_then_chained_by_the_up
 
 
 def test_a_sequence_number_is_taken_once(store):
-    sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+    sign_off(store, "Dr Chen", PASS, fields(), clock=Clock(T0))
     with sqlite3.connect(store.path) as conn, pytest.raises(sqlite3.IntegrityError):
         conn.execute(
             "INSERT INTO signoffs (student, partner, driver, lab, exercise, instructor, "
@@ -606,25 +554,25 @@ def test_two_processes_signing_at_once_never_fork_the_chain(store, data_dir, tmp
 
 
 def test_signing_after_a_tampered_sequence_number_goes_on_or_says_why(store, data_dir):
-    sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
-    sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+    sign_off(store, "Dr Chen", PASS, fields(), clock=Clock(T0))
+    sign_off(store, "Dr Chen", PASS, fields(), clock=Clock(T0))
     with sqlite3.connect(store.path) as conn:
         conn.execute("UPDATE signoffs SET seq = 'last' WHERE seq = 2")
     conn.close()
-    _, record = sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+    _, record = sign_off(store, "Dr Chen", PASS, fields(), clock=Clock(T0))
     assert record.seq == 2  # after the last numbered record; verify names the damaged one
     log = verify_log(read_signoffs(data_dir), roster(data_dir))
     assert [v.row.label() for v in log.verdicts if not v.ok] == ["row id 2"]
     with sqlite3.connect(store.path) as conn:
         conn.execute("UPDATE signoffs SET seq = ? WHERE id = 3", (2**62,))
     conn.close()
-    _, record = sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+    _, record = sign_off(store, "Dr Chen", PASS, fields(), clock=Clock(T0))
     assert record.seq == 2  # the far-off number is stepped over, not followed
 
 
 def test_a_planted_row_with_a_huge_sequence_number_is_stepped_over_and_named(store, data_dir):
     for _ in range(3):
-        sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())
+        sign_off(store, "Dr Chen", PASS, fields(), clock=Clock(T0))
     with sqlite3.connect(store.path) as conn:  # a copy of record 3, planted far beyond the log
         columns = ", ".join(c for c in SIGNOFF_COLUMNS if c not in ("id", "seq"))
         conn.execute(
@@ -632,7 +580,7 @@ def test_a_planted_row_with_a_huge_sequence_number_is_stepped_over_and_named(sto
             "FROM signoffs WHERE seq = 3"
         )
     conn.close()
-    signed = [sign_off(store, "Dr Chen", PASS, fields(), clock=Clock())[1] for _ in range(2)]
+    signed = [sign_off(store, "Dr Chen", PASS, fields(), clock=Clock(T0))[1] for _ in range(2)]
     assert [r.seq for r in signed] == [4, 5]
     log = verify_log(read_signoffs(data_dir), roster(data_dir))
     assert [v.row.seq for v in log.verdicts if not v.ok] == [999999999999999999]

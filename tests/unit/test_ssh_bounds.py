@@ -6,17 +6,10 @@ from __future__ import annotations
 import asyncio
 import logging
 
+from tests.clocks import Clock
 from workbench.door.serverlog import setup_logging
 from workbench.ssh.openfiles import quiet_accept_errors
 from workbench.tui.serving.key_budget import KeyBudget, dropped_message
-
-
-class Clock:
-    def __init__(self) -> None:
-        self.now = 0.0
-
-    def __call__(self) -> float:
-        return self.now
 
 
 def test_typed_keys_past_the_burst_are_dropped_and_the_rate_lets_more_through_later():

@@ -3,17 +3,10 @@ connections that have not logged in (all on an injected clock)."""
 
 from __future__ import annotations
 
+from tests.clocks import Clock
 from workbench.door.logins import ConnectionGate, LoginGuard, LoginPolicy, QuietLog
 
 STUDENT_PC = "10.0.0.7"
-
-
-class Clock:
-    def __init__(self) -> None:
-        self.now = 0.0
-
-    def __call__(self) -> float:
-        return self.now
 
 
 def arrive(gate: ConnectionGate, address: str) -> tuple[object, str | None]:

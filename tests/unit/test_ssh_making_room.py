@@ -6,15 +6,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from tests.clocks import Clock
 from workbench.door.logins import Admission, ConnectionGate, LoginPolicy, Stage
-
-
-class Clock:
-    def __init__(self) -> None:
-        self.now = 0.0
-
-    def __call__(self) -> float:
-        return self.now
 
 
 @dataclass(eq=False)

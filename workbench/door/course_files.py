@@ -4,7 +4,7 @@ step at a session's start (:func:`bring_workspace`), and the uploads sent on.
 A file a student puts, removes or renames over SFTP (or sends through the browser door) changes
 their workspace folder on this server; with ``--db postgresql://...`` the change goes on to the
 course store, so the next session finds it on whichever server it lands. Each student's changes
-are sent by a :class:`~workbench.labs.workspace_sync.WorkspacePusher` of their own (a thread
+are sent by a :class:`~workbench.labs.store.workspace_sync.WorkspacePusher` of their own (a thread
 with a store connection it gives back when idle), so a database that is slow or away never
 holds the server's event loop or the transfer: what is not sent yet stays on this server's disk
 and is sent again, or at the student's next session start.
