@@ -133,7 +133,6 @@ async def test_the_console_saves_the_evidence_runs_picture(tmp_path, monkeypatch
     from textual.widgets import OptionList
 
     from tests.app.console_support import EXERCISE, LAB, save_student
-    from tests.app.console_support import until as console_until
     from tests.pictures.records import record_of
     from workbench.labs.model import load_labs
     from workbench.labs.store.store import Store
@@ -151,18 +150,17 @@ async def test_the_console_saves_the_evidence_runs_picture(tmp_path, monkeypatch
         store.queue.request("ana", "ben", "ben", LAB, EXERCISE)
     app = ConsoleApp(Store.open(data), load_labs())
     async with app.run_test(size=SIZE) as pilot:
-        await console_until(pilot, lambda: isinstance(app.screen, ConsoleScreen), "the console")
+        await until(lambda: isinstance(app.screen, ConsoleScreen), "the console")
         queue = lambda: app.screen.query_one("#console-queue", OptionList).options  # noqa: E731
-        await console_until(pilot, lambda: len(queue()) == 1, "the request")
+        await until(lambda: len(queue()) == 1, "the request")
         await pilot.press("enter")
         request = app.screen
         assert isinstance(request, RequestScreen)
-        await console_until(pilot, lambda: request.request is not None, "the saved progress")
+        await until(lambda: request.request is not None, "the saved progress")
         await pilot.press("ctrl+g")
         picture = tmp_path / "pictures" / f"{record.stem}-path.svg"
-        await console_until(pilot, picture.is_file, "the picture")
-        await console_until(
-            pilot,
+        await until(picture.is_file, "the picture")
+        await until(
             lambda: "saved the path of run 3" in str(request.query_one("#request-status").render()),
             "the message",
         )
