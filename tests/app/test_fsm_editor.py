@@ -79,6 +79,9 @@ async def write_right_wall(pilot: Pilot, editor: FsmEditorScreen, whole: bool = 
         assert isinstance(pilot.app.screen, FormDialog) and pilot.app.screen.form is STATE
         await fill(pilot, {"state-name": name, "state-actions": actions})
         assert pilot.app.screen is editor, editor.status
+        if name == STATES[0][0]:  # one state alone is a machine already, and said as one
+            await checked(pilot, editor)
+            assert problems(editor).startswith("No problems: 1 state. "), problems(editor)
     for source, target, when in [*TRANSITIONS, *([LAST] if whole else [])]:
         await pilot.press("ctrl+b")
         assert isinstance(pilot.app.screen, FormDialog)
@@ -268,5 +271,26 @@ def test_a_hostile_file_never_holds_the_editor(tmp_path, monkeypatch):
         await pilot.press("ctrl+s")
         assert "not saved" in editor.status
         assert (workspace / "big.yaml").read_text() == big
+
+    run(app, body)
+
+
+def test_leaving_a_new_machine_with_changes_asks_about_this_new_fsm(tmp_path):
+    from workbench.tui.dialogs.unsaved import UnsavedDialog
+
+    app, _ = served(tmp_path)
+
+    async def body(pilot: Pilot) -> None:
+        await pilot.press("F")
+        editor = app.screen
+        assert isinstance(editor, FsmEditorScreen)
+        await pilot.press("ctrl+n")
+        await fill(pilot, {"state-name": "Forward", "state-actions": "move: 1"})
+        await pilot.press("escape")
+        await until(lambda: isinstance(app.screen, UnsavedDialog), "the unsaved question")
+        said = " ".join(str(s.render()) for s in app.screen.query(Static))
+        assert "This new FSM has changes that are not saved." in said, said
+        await pilot.press("d")
+        await until(lambda: app.screen is not editor and not isinstance(app.screen, UnsavedDialog))
 
     run(app, body)

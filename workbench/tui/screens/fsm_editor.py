@@ -59,7 +59,9 @@ HIGHLIGHT_ARROW = "bold underline"
 def _problem_text(checked: Checked) -> str:
     if checked.definition is not None:
         d = checked.definition
-        return f"No problems: {len(d.states)} states. ctrl+r saves and runs it."
+        count = len(d.states)
+        states = "1 state" if count == 1 else f"{count} states"
+        return f"No problems: {states}. ctrl+r saves and runs it."
     lines = []
     for p in checked.problems:
         where = f"{p.line}:{p.column} " if p.line else ""
@@ -451,7 +453,8 @@ class FsmEditorScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
             elif choice == "discard":
                 action()
 
-        self.app.push_screen(UnsavedDialog(f"The FSM {self.draft.shown}"), chosen)
+        title = f"The FSM {self.draft.shown}" if self.draft.path else "This new FSM"
+        self.app.push_screen(UnsavedDialog(title), chosen)
 
     def action_leave(self) -> None:
         self.ask_before(self._leave)
