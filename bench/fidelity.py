@@ -42,9 +42,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from workbench.control.algorithms import load_algorithm  # noqa: E402
-from workbench.control.fsm import FsmController, bind_sensors, preset_sensors  # noqa: E402
 from workbench.control.headless import default_max_time  # noqa: E402
+from workbench.fsm.algorithms import load_algorithm  # noqa: E402
+from workbench.fsm.machine import FsmController, bind_sensors, preset_sensors  # noqa: E402
 from workbench.sim.commands import MoveAtPower, WheelPowers  # noqa: E402
 from workbench.sim.driver import Driver  # noqa: E402
 from workbench.sim.generate import generate  # noqa: E402

@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import time
 
-from workbench.control.algorithms import load_algorithm
-from workbench.control.fsm import FsmController
+from workbench.fsm.algorithms import load_algorithm
+from workbench.fsm.machine import FsmController
 
 DT = 1 / 60
 TICKS = 20_000

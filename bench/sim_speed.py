@@ -17,9 +17,9 @@ import os
 import tempfile
 import time
 
-from workbench.control.algorithms import load_algorithm
 from workbench.control.evaluate import evaluate
-from workbench.control.fsm import FsmController, bind_sensors
+from workbench.fsm.algorithms import load_algorithm
+from workbench.fsm.machine import FsmController, bind_sensors
 from workbench.sim.commands import MoveAtPower, Stop, TurnByDegrees, WheelPowers
 from workbench.sim.generate import generate
 from workbench.sim.mazefile import write_maze

@@ -29,8 +29,8 @@ from textual.app import App, ComposeResult
 from textual.drivers.headless_driver import HeadlessDriver
 from textual.screen import Screen
 
-from workbench.control.algorithms import load_algorithm
-from workbench.control.fsm import FsmController, bind_sensors, preset_sensors
+from workbench.fsm.algorithms import load_algorithm
+from workbench.fsm.machine import FsmController, bind_sensors, preset_sensors
 from workbench.sim.clock import Pacer
 from workbench.sim.generate import generate
 from workbench.sim.maze import Maze

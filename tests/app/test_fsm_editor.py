@@ -12,8 +12,8 @@ from textual.pilot import Pilot
 from textual.widgets import Input, Static, TextArea
 
 from tests.waiting import DEADLINE, until
-from workbench.control.fsm_editing import check
 from workbench.files.workspace import workspace_folder
+from workbench.fsm.editing import check
 from workbench.tui.app import make_app
 from workbench.tui.dialogs.algorithm import AlgorithmModal
 from workbench.tui.dialogs.fsm_form import STATE, TRANSITION, FormDialog

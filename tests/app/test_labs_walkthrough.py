@@ -33,9 +33,9 @@ from tests.integration.test_labs_completable import DRIVE, SOLUTIONS, answer
 from tests.sessions import free_port
 from tests.waiting import DEADLINE, until
 from workbench.cli import main
-from workbench.control.algorithms import list_algorithms
 from workbench.control.headless import AlgorithmPilot, RunSpec
 from workbench.control.headless import run as headless_run
+from workbench.fsm.algorithms import list_algorithms
 from workbench.labs.model import Exercise, Lab, LabMaze, Objective, load_labs
 from workbench.labs.signoff.instructors import KdfParams, create_instructor
 from workbench.labs.signoff.roster import load_roster, roster_path

@@ -6,10 +6,10 @@ import json
 import pytest
 
 from workbench.cli import main
-from workbench.control.algorithms import load_algorithm
 from workbench.control.evaluate import evaluate, format_table
-from workbench.control.fsm import FsmController, bind_sensors, preset_sensors
 from workbench.control.headless import AlgorithmPilot, RunSpec, run
+from workbench.fsm.algorithms import load_algorithm
+from workbench.fsm.machine import FsmController, bind_sensors, preset_sensors
 from workbench.sim.driver import Driver
 from workbench.sim.generate import generate
 from workbench.sim.session import Session

@@ -12,8 +12,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from tests.students_work import example_copy, own_right_wall
-from workbench.control.algorithms import ALGORITHM_DIR, list_algorithms
 from workbench.control.station import LabStation
+from workbench.fsm.algorithms import ALGORITHM_DIR, list_algorithms
 from workbench.labs.checks import evaluate
 from workbench.labs.evidence_text import programs_of
 from workbench.labs.model import Exercise

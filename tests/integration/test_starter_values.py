@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import pytest
 
-from workbench.control.algorithms import load_algorithm
-from workbench.control.fsm import resolve_params
 from workbench.control.headless import AlgorithmPilot, RunSpec
+from workbench.fsm.algorithms import load_algorithm
+from workbench.fsm.machine import resolve_params
 from workbench.labs.model import load_labs
 from workbench.tui.widgets.param_editor import fill_in_hint
 

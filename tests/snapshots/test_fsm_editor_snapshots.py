@@ -18,7 +18,7 @@ from workbench.sim.mazeio import load_maze
 from workbench.tui.screens.fsm_editor import FsmEditorScreen
 
 ROOT = Path(__file__).resolve().parents[2]
-RIGHT_WALL = str(ROOT / "workbench" / "control" / "algorithms" / "right-wall.yaml")
+RIGHT_WALL = str(ROOT / "workbench" / "fsm" / "algorithms" / "right-wall.yaml")
 BAD = "initial: Ahead\nstates:\n  Ahead:\n    on_enter: [{move: 1}]\n    transitions:\n" \
       "      - {when: frnt < 50, to: Ahead}\n"  # fmt: skip
 

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from textual.app import App, ComposeResult
 
-from workbench.control.algorithms import load_algorithm
-from workbench.control.fsm import FsmController, bind_sensors, preset_sensors
+from workbench.fsm.algorithms import load_algorithm
+from workbench.fsm.machine import FsmController, bind_sensors, preset_sensors
 from workbench.sim.generate import generate
 from workbench.sim.session import Session
 from workbench.tui.widgets import MazeView

@@ -6,9 +6,9 @@ import json
 import pytest
 
 from workbench.cli import main
-from workbench.control.algorithms import list_algorithms, load_algorithm
-from workbench.control.fsm import PROFILES, FsmController, bind_sensors, preset_sensors
-from workbench.control.fsmfile import FsmFileError
+from workbench.fsm.algorithms import list_algorithms, load_algorithm
+from workbench.fsm.machine import PROFILES, FsmController, bind_sensors, preset_sensors
+from workbench.fsm.yaml_file import FsmFileError
 from workbench.sim.commands import MoveAtPower, Stop, TurnByDegrees, WheelPowers
 from workbench.sim.mazefile import parse_maze
 from workbench.sim.session import Session

@@ -6,10 +6,10 @@ from __future__ import annotations
 import pytest
 
 from tests.bad_files import GOOD_FSM, GOOD_LAB, GOOD_MAZE, GOOD_USERS, SECRET, corpus, write_corpus
-from workbench.control.fsmfile import FsmFileError, load_fsm
 from workbench.door.passwords import hash_password
 from workbench.door.users import UsersFileError, load_users
 from workbench.files.bounded import MAX_PROBLEMS
+from workbench.fsm.yaml_file import FsmFileError, load_fsm
 from workbench.labs.model import LabFileError, load_lab
 from workbench.sim.maze import MazeError
 from workbench.sim.mazeio import load_maze

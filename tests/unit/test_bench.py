@@ -2,7 +2,6 @@
 
 import pytest
 
-from workbench.control.fsm import SensorBindingError
 from workbench.control.station import (
     ALGORITHM_FAILED,
     OUT,
@@ -11,6 +10,7 @@ from workbench.control.station import (
     SensorRow,
     check_sensor_rows,
 )
+from workbench.fsm.machine import SensorBindingError
 from workbench.sim.driver import Driver
 from workbench.sim.mazefile import parse_maze
 from workbench.sim.mazeio import load_maze

@@ -120,7 +120,7 @@ def test_evidence_on_two_programs_is_said_and_bundled_files_are_no_program_of_th
     assert mixed_programs_text(programs_of(wall_main("ana"))) == ""
     assert programs_of(mixed, frozenset({"cd" * 32})) == {"ab" * 32: "wall.viple"}
     files = ("programs/right-wall.viple", "labs/starters/web-two-distance.yaml",
-             "workbench/control/algorithms/right-wall.yaml")  # fmt: skip
+             "workbench/fsm/algorithms/right-wall.yaml")  # fmt: skip
     shipped = {file_sha256(p) for p in files}
     assert shipped <= bundled_digests()
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from workbench.control.fsm_expr import MAX_DEPTH, ExprError, compile_expr
+from workbench.fsm.expr import MAX_DEPTH, ExprError, compile_expr
 
 
 def refused(text: str) -> ExprError:

@@ -4,8 +4,8 @@ import time
 
 import pytest
 
-from workbench.control.algorithms import load_algorithm
-from workbench.control.fsm import (
+from workbench.fsm.algorithms import load_algorithm
+from workbench.fsm.machine import (
     FsmController,
     FsmDefinition,
     FsmDefinitionError,

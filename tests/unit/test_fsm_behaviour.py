@@ -6,9 +6,9 @@ import re
 from pathlib import Path
 
 from workbench.control.fsm_behaviour import Trial, compare
-from workbench.control.fsmfile import load_fsm, loads_fsm
+from workbench.fsm.yaml_file import load_fsm, loads_fsm
 
-ALGORITHMS = Path(__file__).resolve().parents[2] / "workbench" / "control" / "algorithms"
+ALGORITHMS = Path(__file__).resolve().parents[2] / "workbench" / "fsm" / "algorithms"
 REFERENCE = ALGORITHMS / "right-wall.yaml"
 TRIALS = [Trial("mazes/erobotic.txt", "erobotic", 0)]
 SENSORS = ["distance:1:front", "distance:2:left", "distance:3:right"]

@@ -3,10 +3,10 @@ where the front end highlights them, within the width asked for, in ASCII or Uni
 
 from pathlib import Path
 
-from workbench.control.fsm_diagram import layers_of, layout, state_notes
-from workbench.control.fsmfile import load_fsm, loads_fsm
+from workbench.fsm.diagram import layers_of, layout, state_notes
+from workbench.fsm.yaml_file import load_fsm, loads_fsm
 
-RIGHT_WALL = Path(__file__).resolve().parents[2] / "workbench/control/algorithms/right-wall.yaml"
+RIGHT_WALL = Path(__file__).resolve().parents[2] / "workbench/fsm/algorithms/right-wall.yaml"
 
 SMALL = """\
 initial: A

@@ -2,7 +2,7 @@
 
 import pytest
 
-from workbench.control.fsm_expr import ExprError, compile_expr
+from workbench.fsm.expr import ExprError, compile_expr
 
 
 def value(text, **env):

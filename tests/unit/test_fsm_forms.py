@@ -3,10 +3,10 @@ the student's text as it was."""
 
 import pytest
 
-from workbench.control.fsm_editing import FsmDraft, FsmEditError, check
-from workbench.control.fsm_forms import FormError, add_state, add_transition, new_text
-from workbench.control.fsmfile import loads_fsm
 from workbench.files.workspace import FileAccess
+from workbench.fsm.editing import FsmDraft, FsmEditError, check
+from workbench.fsm.forms import FormError, add_state, add_transition, new_text
+from workbench.fsm.yaml_file import loads_fsm
 from workbench.sim.sensors import SensorSpec
 
 SENSORS = [SensorSpec("distance", 1, "front"), SensorSpec("distance", 3, "right")]

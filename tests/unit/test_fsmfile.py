@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from workbench.control.fsm import FsmController, ParameterError, StopAction
-from workbench.control.fsmfile import FsmFileError, load_fsm, loads_fsm, parse_param_overrides
+from workbench.fsm.machine import FsmController, ParameterError, StopAction
+from workbench.fsm.yaml_file import FsmFileError, load_fsm, loads_fsm, parse_param_overrides
 from workbench.sim.commands import MoveAtPower, TurnByDegrees
 
 DOCS = Path(__file__).resolve().parents[2] / "docs" / "fsm-format.md"

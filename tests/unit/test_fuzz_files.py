@@ -8,9 +8,9 @@ import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from workbench.control.fsm_expr import ExprError, compile_expr
-from workbench.control.fsmfile import FsmFileError, loads_fsm
 from workbench.files.bounded import BoundedFileError, Limits, compose_yaml, decode_text
+from workbench.fsm.expr import ExprError, compile_expr
+from workbench.fsm.yaml_file import FsmFileError, loads_fsm
 from workbench.sim.maze import MazeError
 from workbench.sim.mazefile import parse_maze
 from workbench.sim.micromouse import parse_micromouse, parse_mms_map, parse_mms_num

@@ -15,7 +15,7 @@ from workbench.labs.checks import apply_setup, evaluate, proven
 from workbench.labs.model import load_lab
 
 ROOT = Path(__file__).resolve().parents[2]
-REFERENCE = ROOT / "workbench" / "control" / "algorithms" / "right-wall.yaml"
+REFERENCE = ROOT / "workbench" / "fsm" / "algorithms" / "right-wall.yaml"
 LAB = load_lab(ROOT / "labs" / "maze-algorithms.yaml")
 EXERCISE = LAB.exercise("draw-right-wall")
 

@@ -6,8 +6,8 @@ from pathlib import Path
 import pytest
 
 from tests.stations import run_to_exit
-from workbench.control.fsmfile import load_fsm
 from workbench.control.station import LabStation
+from workbench.fsm.yaml_file import load_fsm
 from workbench.labs.checks import (
     ExerciseProgress,
     apply_setup,

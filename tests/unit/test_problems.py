@@ -6,9 +6,9 @@ from __future__ import annotations
 import pytest
 
 from workbench.cli.maze import check_report
-from workbench.control.fsm_expr import compile_expr
-from workbench.control.fsmfile import FsmFileError, loads_fsm
 from workbench.files.problems import ExprError, Problem
+from workbench.fsm.expr import compile_expr
+from workbench.fsm.yaml_file import FsmFileError, loads_fsm
 from workbench.program import viple_expr
 from workbench.program.problems import program_problem
 from workbench.sim.maze import MazeError

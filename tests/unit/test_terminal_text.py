@@ -13,8 +13,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from workbench.cli import main
-from workbench.control.fsmfile import FsmFileError, loads_fsm
 from workbench.files.terminal import terminal_problem, terminal_safe, terminal_safe_data
+from workbench.fsm.yaml_file import FsmFileError, loads_fsm
 from workbench.labs.model import LabFileError, load_lab
 from workbench.program.loader import load_program_text
 from workbench.program.problems import ProgramError

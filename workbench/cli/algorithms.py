@@ -7,9 +7,9 @@ import json
 import sys
 import textwrap
 
-from workbench.control.algorithms import list_algorithms, load_algorithm
-from workbench.control.fsm import PROFILES, FsmDefinition, Parameter, SensorNeed
-from workbench.control.fsmfile import FsmFileError
+from workbench.fsm.algorithms import list_algorithms, load_algorithm
+from workbench.fsm.machine import PROFILES, FsmDefinition, Parameter, SensorNeed
+from workbench.fsm.yaml_file import FsmFileError
 
 
 def register(sub: argparse._SubParsersAction) -> None:

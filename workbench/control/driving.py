@@ -13,12 +13,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from workbench.fsm.bundled import bundled_fsm, fsm_digest
+from workbench.fsm.machine import FsmController, FsmDefinition, bind_sensors
 from workbench.sim.driver import Driver
 from workbench.sim.sensors import SensorSpec
 from workbench.sim.session import Controller
-
-from .bundled import bundled_fsm, fsm_digest
-from .fsm import FsmController, FsmDefinition, bind_sensors
 
 
 @dataclass(frozen=True, eq=False)

@@ -22,12 +22,12 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
+from workbench.fsm.machine import FsmDefinition, FsmError, bind_sensors, preset_sensors
 from workbench.sim.commands import MotorPower, MoveAtPower, Stop, TurnByDegrees, WheelPowers
 from workbench.sim.profiles import Profile
 from workbench.sim.sensors import SensorSpec
 
 from .driving import Driving, algorithm_driving
-from .fsm import FsmDefinition, FsmError, bind_sensors, preset_sensors
 from .headless import RunResult, RunSetupError, RunSpec, prepare
 
 #: two command times closer than this are the same control tick, seconds

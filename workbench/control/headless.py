@@ -13,6 +13,9 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 from workbench.files.bundled import maze_path
+from workbench.fsm.algorithms import load_algorithm
+from workbench.fsm.machine import FsmRuntimeError, bind_sensors, preset_sensors
+from workbench.fsm.yaml_file import parse_param_overrides
 from workbench.sim.maze import Maze, MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.noise import noise_settings
@@ -21,10 +24,7 @@ from workbench.sim.record import RecordStop
 from workbench.sim.sensors import SensorSpec, check_ports
 from workbench.sim.session import Session
 
-from .algorithms import load_algorithm
 from .driving import Driving, algorithm_driving, record_fields
-from .fsm import FsmRuntimeError, bind_sensors, preset_sensors
-from .fsmfile import parse_param_overrides
 from .lifecycle import Run, ending, record_file
 
 #: keys of `workbench run --json`, in this order

@@ -13,6 +13,15 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from workbench.files.workspace import LOCAL, FileAccess
+from workbench.fsm.algorithms import load_algorithm
+from workbench.fsm.machine import (
+    FsmController,
+    FsmDefinition,
+    FsmRuntimeError,
+    bind_sensors,
+    preset_sensors,
+)
+from workbench.fsm.yaml_file import parse_param_overrides
 from workbench.sim.clock import Pacer
 from workbench.sim.commands import Command, MotorPower, Stop, motion_of
 from workbench.sim.driver import BY_KEYS, NOBODY, Driver
@@ -31,10 +40,7 @@ from workbench.sim.sensors import (
 )
 from workbench.sim.session import Session, Snapshot
 
-from .algorithms import load_algorithm
 from .driving import Driving, algorithm_driving, record_fields
-from .fsm import FsmController, FsmDefinition, FsmRuntimeError, bind_sensors, preset_sensors
-from .fsmfile import parse_param_overrides
 from .lifecycle import ERROR, EXIT, MAZE_CHANGED, RESET, STOPPED, Run, ending
 from .manual import exact_move, key_command
 from .recording import RecordQuota, RecordTrouble, record_stopped

@@ -26,7 +26,7 @@ _PACKAGE = Path(workbench.__file__).resolve().parent
 BUNDLED = (
     MAZE_DIR,
     _PACKAGE.parent / "labs",
-    _PACKAGE / "control" / "algorithms",
+    _PACKAGE / "fsm" / "algorithms",
 )
 #: a login name as a folder name: what the users file allows, nothing that walks
 _FOLDER_NAME = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,63}")

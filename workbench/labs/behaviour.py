@@ -18,10 +18,10 @@ import time
 from collections import OrderedDict
 from dataclasses import dataclass
 
-from workbench.control.fsm import FsmDefinition
 from workbench.control.fsm_behaviour import DEFAULT_DEADLINE, Trial, Verdict, compare
-from workbench.control.fsmfile import FsmFileError, load_fsm
 from workbench.files.workspace import FileAccess, OutsideWorkspace
+from workbench.fsm.machine import FsmDefinition
+from workbench.fsm.yaml_file import FsmFileError, load_fsm
 
 #: how many verdicts a judge keeps
 KEPT = 64

@@ -19,10 +19,10 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from workbench.control.algorithms import ALGORITHM_DIR
 from workbench.control.fsm_behaviour import Trial
 from workbench.control.manual import KEY_NAMES
 from workbench.control.station import UNDER_WAY, Attempt, LabStation, RunEntry
+from workbench.fsm.algorithms import ALGORITHM_DIR
 from workbench.sim.profiles import get_profile
 from workbench.sim.record import file_sha256
 from workbench.sim.sensors import SensorSpec

@@ -14,7 +14,7 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
-from workbench.control.algorithms import ALGORITHM_DIR
+from workbench.fsm.algorithms import ALGORITHM_DIR
 from workbench.sim.record import file_sha256
 
 from .checks import ATTEMPT, ExerciseProgress

@@ -17,9 +17,6 @@ from typing import Any
 
 import yaml
 
-from workbench.control.algorithms import list_algorithms, load_algorithm
-from workbench.control.fsmdef import FsmDefinition
-from workbench.control.fsmfile import FsmFileError, load_fsm
 from workbench.control.manual import DRIVE_KEYS
 from workbench.files.bounded import LAB_LIMITS, BoundedFileError, compose_yaml, read_text
 from workbench.files.problems import Problem
@@ -31,6 +28,9 @@ from workbench.files.yamlread import (
     refused_problem,
     syntax_problem,
 )
+from workbench.fsm.algorithms import list_algorithms, load_algorithm
+from workbench.fsm.definition import FsmDefinition
+from workbench.fsm.yaml_file import FsmFileError, load_fsm
 from workbench.sim.maze import Maze, MazeError
 from workbench.sim.mazeio import load_maze
 from workbench.sim.profiles import PROFILES

@@ -60,8 +60,8 @@ from urllib.parse import urlsplit
 from websockets.asyncio.server import ServerConnection, serve
 from websockets.exceptions import ConnectionClosed
 
-from workbench.control.algorithms import load_algorithm
-from workbench.control.fsm import (
+from workbench.fsm.algorithms import load_algorithm
+from workbench.fsm.machine import (
     FsmController,
     FsmDefinition,
     FsmError,
@@ -70,7 +70,7 @@ from workbench.control.fsm import (
     bind_sensors,
     preset_sensors,
 )
-from workbench.control.fsmfile import FsmFileError, parse_param_overrides
+from workbench.fsm.yaml_file import FsmFileError, parse_param_overrides
 from workbench.sim.commands import Command, Stop, TurnByDegrees
 from workbench.sim.profiles import Profile, get_profile
 from workbench.sim.sensors import SensorConfigError, SensorSpec, check_ports

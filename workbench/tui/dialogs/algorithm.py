@@ -21,11 +21,11 @@ from textual.screen import ModalScreen
 from textual.widgets import Button, Input, Label, OptionList, Static
 from textual.widgets.option_list import Option
 
-from workbench.control.algorithms import ALGORITHM_DIR, list_algorithms
-from workbench.control.fsm import FsmError, resolve_params
-from workbench.control.fsmfile import FsmFileError
 from workbench.control.station import LabStation, ProgramChoice
 from workbench.files.workspace import OutsideWorkspace
+from workbench.fsm.algorithms import ALGORITHM_DIR, list_algorithms
+from workbench.fsm.machine import FsmError, resolve_params
+from workbench.fsm.yaml_file import FsmFileError
 from workbench.program.choice import is_program_path, load_choice
 from workbench.program.problems import ProgramError
 from workbench.sim.sensors import SensorConfigError

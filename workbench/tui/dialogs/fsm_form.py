@@ -1,5 +1,5 @@
 """The FSM editor's forms: add a state, add a transition. A form dismisses with the edited
-text (the edit itself is :mod:`workbench.control.fsm_forms`'), or None when cancelled; an
+text (the edit itself is :mod:`workbench.fsm.forms`'), or None when cancelled; an
 entry that cannot be written keeps the dialog open with the reason."""
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ from textual.app import ComposeResult
 from textual.containers import Horizontal, Vertical
 from textual.widgets import Button, Input, Label, Static
 
-from workbench.control.fsm_forms import Edited, FormError, add_state, add_transition
+from workbench.fsm.forms import Edited, FormError, add_state, add_transition
 
 from ..widgets.field import Field
 from .frame import Dialog

@@ -3,8 +3,8 @@ diagram beside it, forms for beginners, save, and run it at once on the station.
 
 The text is the ``TextArea``'s (with its undo history, kept across saves); the file, the
 checks, the forms' edits and the diagram's layout are the core's
-(:mod:`workbench.control.fsm_editing`, :mod:`~workbench.control.fsm_forms`,
-:mod:`~workbench.control.fsm_diagram`). Every change is checked a moment after the typing
+(:mod:`workbench.fsm.editing`, :mod:`~workbench.fsm.forms`,
+:mod:`~workbench.fsm.diagram`). Every change is checked a moment after the typing
 stops, in a thread, so a large file never holds the screen. Below 100 columns the text and
 the diagram share the space: ctrl+t shows one or the other.
 """
@@ -26,13 +26,13 @@ from textual.screen import Screen
 from textual.timer import Timer
 from textual.widgets import Static, TextArea
 
-from workbench.control.fsm import FsmController, FsmError
-from workbench.control.fsm_diagram import Diagram, layout, state_notes
-from workbench.control.fsm_editing import Checked, FsmDraft, FsmEditError, check
-from workbench.control.fsm_forms import Edited, new_text
-from workbench.control.fsmfile import FsmFileError
 from workbench.control.station import LabStation
 from workbench.files.workspace import OutsideWorkspace
+from workbench.fsm.diagram import Diagram, layout, state_notes
+from workbench.fsm.editing import Checked, FsmDraft, FsmEditError, check
+from workbench.fsm.forms import Edited, new_text
+from workbench.fsm.machine import FsmController, FsmError
+from workbench.fsm.yaml_file import FsmFileError
 from workbench.sim.session import Snapshot
 
 from ..dialogs.fsm_form import FORMS, FormDialog

@@ -18,9 +18,9 @@ from textual.app import ComposeResult
 from textual.binding import BindingType
 from textual.containers import Horizontal, Vertical
 
-from workbench.control.fsm import FsmError
 from workbench.control.station import ALGORITHM_FAILED, PROGRAM_STOPPED, LabStation, Notice
 from workbench.files.workspace import OutsideWorkspace
+from workbench.fsm.machine import FsmError
 from workbench.program.choice import ProgramChoice
 from workbench.program.keys import known_key
 from workbench.sim.driver import Driver

@@ -10,8 +10,8 @@ from textual.content import Content
 from textual.reactive import var
 from textual.widgets import Static
 
-from workbench.control.fsm import FsmController
 from workbench.control.station import LabStation
+from workbench.fsm.machine import FsmController
 from workbench.sim.profiles import get_profile
 
 from .text import arrow, named_title, number, set_border_title

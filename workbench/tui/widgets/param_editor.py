@@ -13,7 +13,7 @@ from textual.containers import Horizontal, Vertical
 from textual.message import Message
 from textual.widgets import Input, Label, Static
 
-from workbench.control.fsm import Parameter
+from workbench.fsm.machine import Parameter
 
 from .field import Field
 

@@ -8,7 +8,7 @@ from collections.abc import Iterable
 from textual.widget import Widget
 from textual.widgets import Log
 
-from workbench.control.fsm import Transition
+from workbench.fsm.machine import Transition
 
 from .text import arrow, number
 

@@ -9,9 +9,9 @@ from collections.abc import Callable
 from functools import cache
 from pathlib import Path
 
-from workbench.control.fsm import FsmDefinition
-from workbench.control.fsmfile import FsmFileError, load_fsm
 from workbench.files.yamlread import file_problem
+from workbench.fsm.machine import FsmDefinition
+from workbench.fsm.yaml_file import FsmFileError, load_fsm
 
 ALGORITHM_DIR = Path(__file__).resolve().parent
 

@@ -21,7 +21,7 @@ from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 from workbench.files.bounded import FSM_LIMITS, BoundedFileError, check_text, compose_yaml
 from workbench.sim.sensors import SensorSpec
 
-from .fsmfile import ACTIONS
+from .yaml_file import ACTIONS
 
 _NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 #: the top-level key a line starts, at column 0

@@ -20,7 +20,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from .fsmdef import (
+from .definition import (
     FsmDefinition,
     MotorAction,
     MoveAction,

@@ -3,7 +3,7 @@
 Entering a state runs its ``on_enter`` actions (motor commands, timers, variable assignments).
 Every control tick the current state's transitions are checked top to bottom and the first whose
 guard holds fires; at most one transition fires per tick. Timers run on simulated time. The
-definition dataclasses, checks and sensor binding live in :mod:`workbench.control.fsmdef` and
+definition dataclasses, checks and sensor binding live in :mod:`workbench.fsm.definition` and
 are re-exported here.
 """
 
@@ -13,8 +13,7 @@ from collections import deque
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 
-from workbench.control.fsm_expr import Expr, Fn, Value, compile_expr
-from workbench.control.fsmdef import (
+from workbench.fsm.definition import (
     EVENTS,
     PROFILES,
     RESERVED,
@@ -44,6 +43,7 @@ from workbench.control.fsmdef import (
     preset_sensors,
     resolve_params,
 )
+from workbench.fsm.expr import Expr, Fn, Value, compile_expr
 from workbench.sim.commands import (
     Command,
     MotorPower,

@@ -1,8 +1,8 @@
 """FSM definitions: the dataclasses, their checks, parameter values and sensor binding.
 
-A definition (usually loaded from YAML by :mod:`workbench.control.fsmfile`) names the sensors it
+A definition (usually loaded from YAML by :mod:`workbench.fsm.yaml_file`) names the sensors it
 reads, tunable parameters with per-profile defaults, variables, and states; the engine in
-:mod:`workbench.control.fsm` runs it. Import these names from ``workbench.control.fsm``.
+:mod:`workbench.fsm.machine` runs it. Import these names from ``workbench.fsm.machine``.
 """
 
 from __future__ import annotations
@@ -12,8 +12,8 @@ import keyword
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 
-from workbench.control.fsm_expr import FUNCTIONS, ExprError, Value, compile_expr
 from workbench.files.problems import Problem
+from workbench.fsm.expr import FUNCTIONS, ExprError, Value, compile_expr
 from workbench.sim.sensor_kinds import KINDS, sensor_kind
 from workbench.sim.sensors import MOUNTS, PORT_RANGE, SensorSpec
 

@@ -7,7 +7,7 @@ and parameter ranges are equal once names, descriptions and the order of the par
 no order (sensors, parameters, variables, states other than the initial one) are set aside,
 and the parameters in force have the same values.
 
-- A built-in algorithm (``control/algorithms``) is matched on every parameter's value for the
+- A built-in algorithm (``fsm/algorithms``) is matched on every parameter's value for the
   profile the run is on.
 - A lab's starter (``labs/starters``) is matched on its ``FILL IN`` parameters only: a starter
   whose FILL IN values are as shipped is the starter, whatever else was tuned; one whose FILL
@@ -28,8 +28,8 @@ from pathlib import Path
 from workbench.files.bundled import STARTER_DIR
 
 from .algorithms import ALGORITHM_DIR
-from .fsmdef import FsmDefinition, Parameter, resolve_params
-from .fsmfile import FsmFileError, load_fsm
+from .definition import FsmDefinition, Parameter, resolve_params
+from .yaml_file import FsmFileError, load_fsm
 
 #: a starter's parameter for the student to set says so at the start of its description
 FILL_IN = "FILL IN"

@@ -1,4 +1,4 @@
-"""FSM files in YAML: read one into an :class:`~workbench.control.fsm.FsmDefinition`.
+"""FSM files in YAML: read one into an :class:`~workbench.fsm.machine.FsmDefinition`.
 
 The YAML is composed into a node tree (not loaded into plain Python objects) so every problem
 can be reported as ``file:line:column`` with a hint. All problems of a file are reported at once.
@@ -18,7 +18,21 @@ import yaml
 from yaml.constructor import SafeConstructor
 from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
-from workbench.control.fsm import (
+from workbench.files.bounded import (
+    FSM_LIMITS,
+    BoundedFileError,
+    check_text,
+    compose_yaml,
+    read_text,
+)
+from workbench.files.terminal import terminal_problem
+from workbench.files.yamlread import (
+    file_problem,
+    problem_list,
+    refused_problem,
+    syntax_problem,
+)
+from workbench.fsm.machine import (
     PROFILES,
     Action,
     FsmDefinition,
@@ -37,20 +51,6 @@ from workbench.control.fsm import (
     Variable,
     WheelsAction,
     check_definition,
-)
-from workbench.files.bounded import (
-    FSM_LIMITS,
-    BoundedFileError,
-    check_text,
-    compose_yaml,
-    read_text,
-)
-from workbench.files.terminal import terminal_problem
-from workbench.files.yamlread import (
-    file_problem,
-    problem_list,
-    refused_problem,
-    syntax_problem,
 )
 
 TOP_KEYS = ("name", "description", "sensors", "parameters", "variables", "initial", "states")

@@ -19,8 +19,8 @@ from workbench.files.problems import Problem
 from workbench.files.workspace import FileAccess, OutsideWorkspace
 from workbench.files.yamlread import file_problem, refused_problem
 
-from .fsm import FsmDefinition
-from .fsmfile import FsmFileError, loads_fsm
+from .machine import FsmDefinition
+from .yaml_file import FsmFileError, loads_fsm
 
 #: the file name a new FSM is offered under
 NEW_NAME = "my-fsm.yaml"
