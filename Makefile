@@ -3,6 +3,9 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 TEST_STAMP := $(VENV)/.installed-test
+# two test workers per core, at least four: many tests wait on a served app, a database or a
+# browser, so a core is idle while its one worker waits (5 min 17 s against 7 min 9 s on 2 cores)
+TEST_WORKERS ?= $(shell n=$$(nproc 2>/dev/null || echo 2); [ $$((n * 2)) -lt 4 ] && echo 4 || echo $$((n * 2)))
 
 .PHONY: run test lint bench clean haproxy chromium
 
@@ -26,7 +29,7 @@ test: $(TEST_STAMP) haproxy chromium
 	$(BIN)/ruff check .
 	$(BIN)/lint-imports
 	$(BIN)/mypy
-	$(BIN)/python -m pytest -n auto
+	$(BIN)/python -m pytest -n $(TEST_WORKERS)
 
 # the balancer test needs HAProxy: installed here as root where apt-get is, else skipped
 # (never a reason for the build to fail)
