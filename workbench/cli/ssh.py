@@ -10,6 +10,7 @@ import math
 import os
 import signal
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 from workbench.control.recording import RecordQuota
@@ -389,18 +390,34 @@ def cmd_serve(args: argparse.Namespace) -> int:
         return fail("serve-ssh", f"{exc}\nthe server did not start")
     except OSError as exc:
         return fail("serve-ssh", f"cannot use the data folder {data_dir}: {exc}")
-    if not server.users.users:
-        print(
-            f"workbench serve-ssh: no users yet in {config.users_file}: add one with "
-            "'workbench ssh add-user NAME --role student --key FILE.pub'",
-            file=sys.stderr,
-        )
-    print(f"workbench serve-ssh: logging to {log_path}", file=sys.stderr)
-    logging.getLogger("workbench.ssh").info("course store: %s", store_words(data_dir, db))
-    try:
-        return asyncio.run(serve_until_stopped(server))
-    except OSError as exc:
-        return fail("serve-ssh", f"cannot listen on port {args.port}: {exc.strerror or exc}")
+    door = Door("serve-ssh", "workbench.ssh", "--role student --key FILE.pub")
+    return door.serve(server, log_path, data_dir, db, args.port)
+
+
+@dataclass(frozen=True)
+class Door:
+    """What a door's command says as its server starts: its name, its log, and how to add
+    the first user."""
+
+    command: str
+    logger: str
+    add_user: str
+
+    def serve(self, server, log_path: Path, data_dir: Path, db: str | None, port: int) -> int:
+        """Say the start (no users yet, where the log goes, which course store) and serve
+        until stopped; the exit code."""
+        if not server.users.users:
+            print(
+                f"workbench {self.command}: no users yet in {server.users.path}: add one with "
+                f"'workbench ssh add-user NAME {self.add_user}'",
+                file=sys.stderr,
+            )
+        print(f"workbench {self.command}: logging to {log_path}", file=sys.stderr)
+        logging.getLogger(self.logger).info("course store: %s", store_words(data_dir, db))
+        try:
+            return asyncio.run(serve_until_stopped(server))
+        except OSError as exc:
+            return fail(self.command, f"cannot listen on port {port}: {exc.strerror or exc}")
 
 
 def parse_terminal(text: str) -> tuple[int, int]:

@@ -3,11 +3,8 @@
 from __future__ import annotations
 
 import argparse
-import asyncio
-import logging
 import math
 import os
-import sys
 from pathlib import Path
 
 from workbench.control.recording import RecordQuota
@@ -20,12 +17,11 @@ from .common import db_option, record_quota_options, upload_options
 from .doors import door_options
 from .ssh import (
     WORKBENCH_APP,
+    Door,
     data_dir_option,
     fail,
     parse_terminal,
     prepare_course_store,
-    serve_until_stopped,
-    store_words,
 )
 
 
@@ -165,15 +161,5 @@ def cmd_serve_web(args: argparse.Namespace) -> int:
         return fail(command, f"{exc}\nthe server did not start")
     except OSError as exc:
         return fail(command, f"cannot use the data folder {data_dir}: {exc}")
-    if not server.users.users:
-        print(
-            f"workbench serve-web: no users yet in {config.users_file}: add one with "
-            "'workbench ssh add-user NAME --role student'",
-            file=sys.stderr,
-        )
-    print(f"workbench serve-web: logging to {log_path}", file=sys.stderr)
-    logging.getLogger("workbench.web").info("course store: %s", store_words(data_dir, db))
-    try:
-        return asyncio.run(serve_until_stopped(server))
-    except OSError as exc:
-        return fail(command, f"cannot listen on port {args.port}: {exc.strerror or exc}")
+    door = Door(command, "workbench.web", "--role student")
+    return door.serve(server, log_path, data_dir, db, args.port)

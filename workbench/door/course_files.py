@@ -79,6 +79,15 @@ class CourseWorkspaces:
             left += [f"{user}: {path}" for path in pusher.waiting]
         return left
 
+    async def close_at_stop(self, said: logging.Logger, wait: float = 5.0) -> None:
+        """Stop sending as a server stops (off its event loop, at most ``wait`` seconds), and
+        log the files not sent yet, which each student's next session start sends."""
+        unsent = await in_pool(STORE, self.close, wait)
+        if unsent:
+            said.warning("stopping: %d uploaded file(s) not in the course store yet (sent at "
+                         "each student's next session start): %s", len(unsent),
+                         ", ".join(unsent[:10]))  # fmt: skip
+
 
 async def bring_workspace(
     data_dir: Path,

@@ -37,7 +37,6 @@ from workbench.door.ports import PoolExhausted, PortPool
 from workbench.door.serverlog import shown
 from workbench.door.sources import source_of
 from workbench.door.users import User, UsersFile, users_path
-from workbench.door.workers import STORE, in_pool
 from workbench.files.workspace import workspace_folder
 from workbench.files.workspace_files import UploadLimits
 from workbench.labs.store.workspace_sync import sync_at_start
@@ -289,11 +288,7 @@ class LabServer:
         if self.forkserver is not None:
             await self.forkserver.close()
         if self.course_files is not None:
-            unsent = await in_pool(STORE, self.course_files.close, 5.0)
-            if unsent:
-                log.warning("stopping: %d uploaded file(s) not in the course store yet (sent "
-                            "at each student's next session start): %s", len(unsent),
-                            ", ".join(unsent[:10]))  # fmt: skip
+            await self.course_files.close_at_stop(log)
         asyncio.get_running_loop().set_exception_handler(self._previous_handler)
 
     async def __aenter__(self) -> LabServer:

@@ -31,7 +31,6 @@ from workbench.door.memory import SHORT_OF_MEMORY, MemoryWatch
 from workbench.door.ports import PoolExhausted, PortPool
 from workbench.door.serverlog import shown
 from workbench.door.users import UsersFile
-from workbench.door.workers import STORE, in_pool
 from workbench.files.workspace import workspace_folder
 
 from . import transfer
@@ -204,11 +203,7 @@ class WebServer:
         if self.forkserver is not None:
             await self.forkserver.close()
         if self.course_files is not None:
-            unsent = await in_pool(STORE, self.course_files.close, 5.0)
-            if unsent:
-                log.warning("stopping: %d uploaded file(s) not in the course store yet (sent "
-                            "at each student's next session start): %s", len(unsent),
-                            ", ".join(unsent[:10]))  # fmt: skip
+            await self.course_files.close_at_stop(log)
 
     async def __aenter__(self) -> WebServer:
         await self.start()
