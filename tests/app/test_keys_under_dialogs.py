@@ -10,7 +10,7 @@ from textual.screen import ModalScreen
 from textual.widgets._footer import FooterKey
 
 from workbench.tui.app import make_app
-from workbench.tui.serving.internals import bindings_of
+from workbench.tui.textual_private import bindings_of
 from workbench.tui.widgets.key_bar import KeyBar
 from workbench.wire.settings import AppSettings
 

@@ -73,11 +73,11 @@ from .screens.labs import LabsScreen, StoreNews
 from .screens.main import MainScreen
 from .screens.runs import RunsScreen
 from .serving import warmup
-from .serving.internals import end_with_error, handled_size
 from .serving.loop_clock import LoopClock
 from .serving.ordered_keys import OrderedKeys
 from .serving.quick_keys import QuickKeys, as_key_press
 from .serving.terminal_driver import serves
+from .textual_private import end_with_error, handled_size
 
 #: the smallest terminal the layout is made for (columns, rows)
 MIN_SIZE = (80, 24)

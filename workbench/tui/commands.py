@@ -13,7 +13,7 @@ from textual.command import DiscoveryHit, Hit, Hits, Provider
 from textual.dom import DOMNode
 
 from .keys import KEY_TABLE
-from .serving.internals import bindings_of
+from .textual_private import bindings_of
 
 
 def key_display(node: DOMNode, binding: Binding) -> str:

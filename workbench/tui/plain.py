@@ -16,7 +16,7 @@ from textual.dom import DOMNode
 from textual.scrollbar import ScrollBar, ScrollBarRender
 from textual.widgets import Markdown, Static
 
-from .serving.internals import current_app
+from .textual_private import current_app
 
 #: typographic characters of prose (lab texts, algorithm descriptions) and their ASCII spelling
 PROSE = str.maketrans(

@@ -19,9 +19,9 @@ only once the key before it has gone its whole way, bindings and all.
 ``key_budget`` bounds what a flood of typed keys costs the app: past a burst and a rate the
 keys are dropped and the student told how many.
 
-These reach into Textual beyond its public interface, and so does ``internals``, the few
-private parts the rest of the TUI needs (each behind a name that says what it gives). Nothing
-outside this package touches Textual's private modules or attributes, and
+These reach into Textual beyond its public interface, and so does ``tui/textual_private.py``
+beside this package, the few private parts the rest of the TUI needs (each behind a name that
+says what it gives). Nothing else touches Textual's private modules or attributes, and
 ``tests/unit/test_textual_internals.py`` checks that each part relied on here is still there,
 with the shape relied on, in the Textual installed.
 """

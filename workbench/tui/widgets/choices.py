@@ -17,7 +17,7 @@ from textual.widgets import RadioSet
 
 from workbench.labs.model import normalise_choice
 
-from ..serving.internals import DrawnRadioButton
+from ..textual_private import DrawnRadioButton
 
 #: the cells before a choice's text: its box and a space
 INDENT = 4

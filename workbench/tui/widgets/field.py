@@ -16,7 +16,7 @@ from textual.binding import Binding
 from textual.message import Message
 from textual.widgets import Input
 
-from ..serving.internals import KeyFirstInput
+from ..textual_private import KeyFirstInput
 
 #: every key Input binds, and the action it runs
 _EDITING = {

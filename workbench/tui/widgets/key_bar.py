@@ -26,7 +26,7 @@ from textual.app import ComposeResult
 from textual.widgets import Footer
 
 from ..keys import KEY_TABLE
-from ..serving.internals import FooterKey, bindings_of, footer_ready
+from ..textual_private import FooterKey, bindings_of, footer_ready
 from .under_dialog import DialogWatch
 
 #: the rank of a key that is not in the workbench's table (Textual's own)

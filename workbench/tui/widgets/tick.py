@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from textual.content import Content
 
-from ..serving.internals import DrawnCheckbox
+from ..textual_private import DrawnCheckbox
 
 
 class Tick(DrawnCheckbox):
