@@ -42,6 +42,8 @@ from .proxy import Origin, header_login, origin_of
 from .relay import Notice, StudentApp, background
 
 log = logging.getLogger("workbench.web")
+#: the login a sign-on header opened while this request was handled, for its cookie
+NEW_LOGIN = web.RequestKey("new_login", str)
 
 STATIC = Path(__file__).resolve().parent / "static"
 #: the page may load and connect to this server only; no frames, no inline script (styles
@@ -277,7 +279,7 @@ class WebServer:
         if user is None:
             return f"{config.user_header} names {shown(said.user)}, who is not in the users file"
         login_id, login = self.logins.open(user.name, user.role, config.user_header)
-        request["new_login"] = login_id
+        request[NEW_LOGIN] = login_id
         log.info("login: %s (%s) from %s by the %s header", user.name, user.role,
                  self.origin(request).address, config.user_header)  # fmt: skip
         return login
@@ -297,8 +299,8 @@ class WebServer:
         response = web.Response(
             text=terminal_page(login.user, login.role, login.csrf), content_type="text/html"
         )
-        if "new_login" in request:
-            self._set_login_cookie(response, request["new_login"], self.origin(request).secure)
+        if NEW_LOGIN in request:
+            self._set_login_cookie(response, request[NEW_LOGIN], self.origin(request).secure)
         return response
 
     async def no_icon(self, request: web.Request) -> web.Response:
