@@ -91,3 +91,41 @@ async def test_a_traversal_download_is_refused_with_one_log_line(tmp_path, caplo
         status, _ = await browser.upload("x.txt", b"x", csrf="forged")
         assert status == 403
         await browser.close()
+
+
+@sync
+async def test_a_download_held_up_on_the_disk_leaves_the_server_answering(tmp_path, monkeypatch):
+    """File work runs in the file threads, as SFTP's does: one student's download stuck on a
+    slow disk never holds the event loop every other student is served from."""
+    import asyncio
+    import threading
+
+    from workbench.web import transfer
+
+    held, release, done = threading.Event(), threading.Event(), threading.Event()
+    read = transfer.read
+
+    def slow_read(files, path, limit):
+        held.set()
+        release.wait(10)  # on the event loop, this would hold every request for 10 s
+        done.set()
+        return read(files, path, limit)
+
+    monkeypatch.setattr(transfer, "read", slow_read)
+    accounts = [Account("ann", password=PASSWORD), Account("bob", password=PASSWORD)]
+    async with web_host(tmp_path, accounts) as host:
+        ann, bob = host.browser(), host.browser()
+        await ann.login("ann")
+        await ann.upload("corridor.txt", MAZE)
+        stuck = asyncio.ensure_future(ann.get("/files/corridor.txt"))
+        await until(held.is_set, "ann's download reading")
+        try:
+            await bob.login("bob")  # the server answers bob while ann's read is held
+            status, listing = await bob.get("/files?folder=")
+            assert status == 200 and json.loads(listing)["entries"] == []
+            assert not done.is_set(), "bob was answered only once ann's read had ended"
+        finally:
+            release.set()
+        assert await stuck == (200, MAZE)
+        await ann.close()
+        await bob.close()

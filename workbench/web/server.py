@@ -31,6 +31,7 @@ from workbench.door.memory import SHORT_OF_MEMORY, MemoryWatch
 from workbench.door.ports import PoolExhausted, PortPool
 from workbench.door.serverlog import shown
 from workbench.door.users import UsersFile
+from workbench.door.workers import FILES, in_pool
 from workbench.files.workspace import workspace_folder
 
 from . import transfer
@@ -634,7 +635,9 @@ class WebServer:
     async def list_files(self, request: web.Request) -> web.StreamResponse:
         login = self._files_login(request)
         try:
-            found = transfer.listing(self._files(login.user), request.query.get("folder", ""))
+            found = await in_pool(
+                FILES, transfer.listing, self._files(login.user), request.query.get("folder", "")
+            )
         except transfer.TransferError as exc:
             return web.json_response({"error": str(exc)}, status=400)
         return web.json_response({
@@ -666,11 +669,11 @@ class WebServer:
         sent = form.get("file")
         if not isinstance(sent, web.FileField):
             return web.json_response({"error": "choose a file to send"}, status=400)
-        data = sent.file.read()
+        data = await in_pool(FILES, sent.file.read)
         folder = form.get("folder")
         name = f"{folder}/{sent.filename}" if isinstance(folder, str) and folder else sent.filename
         try:
-            path = transfer.upload(self._files(login.user), name, data)
+            path = await in_pool(FILES, transfer.upload, self._files(login.user), name, data)
         except transfer.TransferError as exc:
             log.warning("upload refused: %s from %s: %s", login.user, where.address, exc)
             return web.json_response({"error": str(exc)}, status=400)
@@ -684,7 +687,7 @@ class WebServer:
             64 << 20
         )
         try:
-            name, data = transfer.read(self._files(login.user), path, limit)
+            name, data = await in_pool(FILES, transfer.read, self._files(login.user), path, limit)
         except transfer.TransferError as exc:
             log.warning("download refused: %s from %s: %s", login.user,
                         self.origin(request).address, exc)  # fmt: skip
