@@ -8,6 +8,8 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+import yaml
+
 from workbench.control.station import LabStation
 from workbench.files.workspace import FileAccess
 from workbench.labs.behaviour import BehaviourJudge
@@ -21,15 +23,29 @@ EXERCISE = LAB.exercise("draw-right-wall")
 
 
 def renamed_and_reordered() -> str:
-    text = REFERENCE.read_text()
-    head, states = text.split("states:\n", 1)
-    blocks = re.split(r"\n(?=  [A-Za-z]+:\n)", states.strip("\n"))
-    text = head + "states:\n" + "\n".join(reversed(blocks)) + "\n"
-    for old, new in (("TurningLeft", "Left"), ("TurningRight", "Right"),
-                     ("BesideOpening", "Waiting"), ("TurnedRight", "Settle"),
-                     ("Forward", "Ahead"), ("name: right-wall", "name: mine")):  # fmt: skip
-        text = text.replace(old, new)
-    return text
+    """The right-wall machine as a student might write it for the eRobotic profile: the
+    states renamed and written in another order, and the numbers in its guards and actions
+    instead of parameters. It behaves as the built-in, and it is not the built-in's file."""
+    machine = yaml.safe_load(REFERENCE.read_text())
+    values = {name: p["default"]["erobotic"] for name, p in machine.pop("parameters").items()}
+    names = {"TurningLeft": "Left", "TurningRight": "Right", "BesideOpening": "Waiting",
+             "TurnedRight": "Settle", "Forward": "Ahead"}  # fmt: skip
+
+    def literal(value):
+        if isinstance(value, str):
+            for name, number in values.items():
+                value = re.sub(rf"\b{name}\b", repr(number), value)
+            return names.get(value, value)
+        if isinstance(value, list):
+            return [literal(v) for v in value]
+        if isinstance(value, dict):
+            return {names.get(k, k): literal(v) for k, v in value.items() if k != "description"}
+        return value
+
+    mine = literal(machine)
+    mine["name"] = "mine"
+    mine["states"] = dict(reversed(list(mine["states"].items())))
+    return yaml.safe_dump(mine, sort_keys=False)
 
 
 def station_in(tmp_path: Path) -> LabStation:
@@ -67,8 +83,10 @@ def test_a_renamed_reordered_machine_of_the_students_passes(tmp_path):
 
 def test_one_wrong_transition_fails_with_the_first_difference(tmp_path):
     station = station_in(tmp_path)
-    blocked = "front < front_blocked\n        to: "
-    wrong = renamed_and_reordered().replace(blocked + "Left", blocked + "Right", 1)
+    blocked = "- when: front < 50\n      to: "
+    mine = renamed_and_reordered()
+    assert blocked + "Left" in mine
+    wrong = mine.replace(blocked + "Left", blocked + "Right", 1)
     run_file(station, "mine.yaml", wrong)
     state = judged(station)
     assert not state.passed
@@ -82,6 +100,15 @@ def test_the_shipped_machine_or_a_changed_file_does_not_count(tmp_path):
     run_file(station, str(REFERENCE))
     assert "comes with the workbench" in judged(station).reason
     run_file(station, "copy.yaml", REFERENCE.read_text())  # a copy is still the shipped one
+    assert "comes with the workbench" in judged(station).reason
+    # so is a copy with its states renamed and written in another order
+    text = REFERENCE.read_text()
+    head, states = text.split("states:\n", 1)
+    blocks = re.split(r"\n(?=  [A-Za-z]+:\n)", states.strip("\n"))
+    renamed = head + "states:\n" + "\n".join(reversed(blocks)) + "\n"
+    for old, new in (("TurningLeft", "Left"), ("Forward", "Ahead"), ("BesideOpening", "Wait")):
+        renamed = renamed.replace(old, new)
+    run_file(station, "renamed.yaml", renamed)
     assert "comes with the workbench" in judged(station).reason
     run_file(station, "mine.yaml", renamed_and_reordered())
     assert station.files.workspace is not None

@@ -3,9 +3,10 @@
 A lab's "your program" objectives must rest on the student's own work, so a run by an FSM
 that is one the workbench ships is not theirs, whatever the file is called. Two FSMs are the
 same here when they behave the same: their states, actions, transitions, sensors, variables
-and parameter ranges are equal once names, descriptions and the order of the parts that have
-no order (sensors, parameters, variables, states other than the initial one) are set aside,
-and the parameters in force have the same values.
+and parameter ranges are equal once names (the states' too: they are named in the order a run
+reaches them), descriptions and the order of the parts that have no order (sensors,
+parameters, variables, states other than the initial one) are set aside, and the parameters
+in force have the same values.
 
 - A built-in algorithm (``fsm/algorithms``) is matched on every parameter's value for the
   profile the run is on.
@@ -35,19 +36,50 @@ from .yaml_file import FsmFileError, load_fsm
 FILL_IN = "FILL IN"
 
 
+def canonical_names(definition: FsmDefinition) -> dict[str, str]:
+    """Each state's name in the order a run could reach it: the initial state ``S0``, then
+    the targets of each state's transitions in the order they are written, breadth first;
+    states no transition reaches follow in their names' order. Two machines that differ only
+    in what their states are called, or in the order the states are written, get the same
+    names."""
+    by_name = {s.name: s for s in definition.states}
+    order: list[str] = []
+    queue = [definition.initial]
+    while queue:
+        name = queue.pop(0)
+        if name in order or name not in by_name:
+            continue
+        order.append(name)
+        queue += [t.target for t in by_name[name].transitions]
+    order += sorted(n for n in by_name if n not in order)
+    return {name: f"S{i}" for i, name in enumerate(order)}
+
+
 def shape(definition: FsmDefinition) -> str:
-    """What an FSM does, without what does not change its behaviour (names, descriptions,
-    the order of its unordered parts and the parameters' values)."""
+    """What an FSM does, without what does not change its behaviour (names, descriptions
+    and the states' names among them, the order of its unordered parts and the parameters'
+    values)."""
+    names = canonical_names(definition)
     states = sorted(
-        (replace(s, description="") for s in definition.states),
-        key=lambda s: (s.name != definition.initial, s.name),
+        (
+            replace(
+                s,
+                name=names[s.name],
+                description="",
+                transitions=tuple(
+                    replace(t, target=names.get(t.target, t.target)) for t in s.transitions
+                ),
+            )
+            for s in definition.states
+        ),
+        key=lambda s: int(s.name[1:]),
     )
     sensors = sorted(
         (n.name, n.kind, n.mount, tuple(sorted(n.ports.items()))) for n in definition.sensors
     )
     params = sorted((p.name, p.minimum, p.maximum) for p in definition.parameters)
     variables = sorted((v.name, v.initial) for v in definition.variables)
-    return repr((definition.initial, states, sensors, params, variables))
+    return repr((names.get(definition.initial), states, sensors, params, variables))
 
 
 def declared(definition: FsmDefinition) -> str:
