@@ -4,7 +4,7 @@ the console shows, from evidence dicts as the checks save them, old and new."""
 from __future__ import annotations
 
 import pytest
-from hypothesis import given
+from hypothesis import example, given
 from hypothesis import strategies as st
 
 from tests.app.console_support import progress, wall_main, wall_run
@@ -195,6 +195,8 @@ KEYS = st.sampled_from(
     | st.lists(JSON, max_size=2),
     profile=st.sampled_from(["unity", "web", "erobotic", "", "nonsense"]),
 )
+@example(kind="fsm-behaviour", evidence={"\n": False}, profile="unity")
+@example(kind="other", evidence={"note": "two\nlines"}, profile="")
 def test_any_saved_evidence_is_said_without_an_error(kind, evidence, profile):
     """Evidence read back from a store may be old, odd or edited: it is said, never a crash."""
     state = ObjectiveState(kind, "t", True, "r", evidence)

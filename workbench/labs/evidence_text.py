@@ -283,8 +283,13 @@ def evidence_lines(state: ObjectiveState, profile: str = "", unicode: bool = Fal
         return []
     if "run" in evidence and "metrics" in evidence:
         lines = run_lines(evidence, profile, unicode)
-        return lines + _behaved(evidence) if state.kind == "fsm-behaviour" else lines
-    return BY_KIND.get(state.kind, _other)(evidence, profile, unicode)
+        if state.kind == "fsm-behaviour":
+            lines += _behaved(evidence)
+    else:
+        lines = BY_KIND.get(state.kind, _other)(evidence, profile, unicode)
+    # saved evidence may hold any text (an edited store, a key with a line break in it):
+    # each line said stays one line
+    return [" ".join(line.splitlines()) for line in lines]
 
 
 def _behaved(evidence: Mapping[str, Any]) -> list[str]:
