@@ -11,7 +11,7 @@ import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from tests.students_work import example_copy, own_right_wall
+from tests.students_work import example_copy, example_renumbered, own_right_wall
 from workbench.control.station import LabStation
 from workbench.fsm.algorithms import ALGORITHM_DIR, list_algorithms
 from workbench.labs.checks import evaluate
@@ -108,10 +108,11 @@ def test_the_exit_evidence_names_the_sensors_program_and_driver(tmp_path):
 
 def test_the_example_programs_never_pass_the_exercises_they_solve(tmp_path):
     moved = example_copy(tmp_path, "web-wall-following.viple", "mine.viple")
+    renumbered = example_renumbered(tmp_path, "web-wall-following.viple", "renumbered.viple")
     for ex_id in ("wall-main", "wall-activities"):
         ex = LABS["web-simulator"].exercise(ex_id)
         for path, name in ((EXAMPLES / "web-wall-following.viple", "web-wall-following.viple"),
-                           (moved, "mine.viple")):  # fmt: skip
+                           (moved, "mine.viple"), (renumbered, "renumbered.viple")):  # fmt: skip
             station = fresh_station(ex)
             program_to_exit(station, path)
             (out,) = [o for o in ex.objectives if o.kind == "exit"]
