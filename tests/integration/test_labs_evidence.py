@@ -5,6 +5,7 @@ or a run on other sensors passes nothing."""
 from __future__ import annotations
 
 import hashlib
+import re
 from pathlib import Path
 
 import yaml
@@ -131,6 +132,47 @@ def test_a_built_in_fsm_renamed_is_still_the_built_in(tmp_path):
     data["description"] = "all my own work"
     copy = tmp_path / "mine.yaml"
     copy.write_text(yaml.safe_dump(data, sort_keys=True))
+    station = fresh_station(ex)
+    station.select_algorithm(str(copy))
+    run_to_exit(station)
+    assert states("web-simulator", ex, station)["your program got out of the Web maze"] == (
+        False,
+        "run 1 (algorithm my-wall-follower) is the built-in algorithm "
+        "algorithms/web-wall-following.yaml, which comes with the workbench, not your own "
+        "program: complete it or write yours, and run that",
+    )
+
+
+def _renamed_everywhere(node, names):
+    """``node`` (YAML data) with each of ``names`` (old to new) replaced wherever it is a
+    whole word: in keys, expressions and descriptions alike."""
+    pattern = re.compile(r"\b(" + "|".join(map(re.escape, names)) + r")\b")
+    if isinstance(node, dict):
+        return {
+            names.get(k, k) if isinstance(k, str) else k: _renamed_everywhere(v, names)
+            for k, v in node.items()
+        }
+    if isinstance(node, list):
+        return [_renamed_everywhere(v, names) for v in node]
+    if isinstance(node, str):
+        return pattern.sub(lambda found: names[found[1]], node)
+    return node
+
+
+def test_a_built_in_fsm_with_its_parameters_variables_and_sensors_renamed_is_the_built_in(
+    tmp_path,
+):
+    ex = LABS["web-simulator"].exercise("wall-main")
+    data = yaml.safe_load((ALGORITHM_DIR / "web-wall-following.yaml").read_text())
+    names = {p: f"my_{p}_{i}" for i, p in enumerate(data["parameters"])}
+    names |= {v: f"{v}Mine" for v in data["variables"]}
+    data = _renamed_everywhere(data, names)
+    # the sensor named as its kind is renamed where a machine reads it, not where its kind is
+    data["sensors"]["bumper"] = data["sensors"].pop("touch")
+    data["states"] = _renamed_everywhere(data["states"], {"touch": "bumper"})
+    data["name"] = "my-wall-follower"
+    copy = tmp_path / "mine.yaml"
+    copy.write_text(yaml.safe_dump(data, sort_keys=False))
     station = fresh_station(ex)
     station.select_algorithm(str(copy))
     run_to_exit(station)

@@ -3,10 +3,13 @@
 A lab's "your program" objectives must rest on the student's own work, so a run by an FSM
 that is one the workbench ships is not theirs, whatever the file is called. Two FSMs are the
 same here when they behave the same: their states, actions, transitions, sensors, variables
-and parameter ranges are equal once names (the states' too: they are named in the order a run
-reaches them), descriptions and the order of the parts that have no order (sensors,
-parameters, variables, states other than the initial one) are set aside, and the parameters
-in force have the same values.
+and parameter ranges are equal once names, descriptions and the order of the parts that have
+no order (sensors, parameters, variables, states other than the initial one) are set aside,
+and the parameters in force have the same values. Names are set aside by naming things
+afresh: the states in the order a run reaches them, and the sensors, parameters and variables
+in the order the machine's expressions first read them (each expression is rewritten with the
+new names, the way Python writes it back, so spacing and brackets that change nothing are set
+aside too).
 
 - A built-in algorithm (``fsm/algorithms``) is matched on every parameter's value for the
   profile the run is on.
@@ -20,8 +23,9 @@ in force have the same values.
 
 from __future__ import annotations
 
+import ast
 import hashlib
-from collections.abc import Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, replace
 from functools import cache
 from pathlib import Path
@@ -29,7 +33,20 @@ from pathlib import Path
 from workbench.files.bundled import STARTER_DIR
 
 from .algorithms import ALGORITHM_DIR
-from .definition import FsmDefinition, Parameter, resolve_params
+from .definition import (
+    Action,
+    FsmDefinition,
+    MotorAction,
+    MoveAction,
+    Parameter,
+    SetAction,
+    State,
+    TimerAction,
+    TransitionDef,
+    TurnAction,
+    WheelsAction,
+    resolve_params,
+)
 from .yaml_file import FsmFileError, load_fsm
 
 #: a starter's parameter for the student to set says so at the start of its description
@@ -55,36 +72,139 @@ def canonical_names(definition: FsmDefinition) -> dict[str, str]:
     return {name: f"S{i}" for i, name in enumerate(order)}
 
 
+#: the fields of each kind of action that hold an expression
+EXPRESSIONS: dict[type, tuple[str, ...]] = {
+    WheelsAction: ("left", "right"),
+    MotorAction: ("power",),
+    MoveAction: ("power",),
+    TurnAction: ("degrees",),
+    TimerAction: ("seconds",),
+}
+
+
+def _ordered_states(definition: FsmDefinition) -> list[State]:
+    names = canonical_names(definition)
+    return sorted(definition.states, key=lambda s: int(names[s.name][1:]))
+
+
+def _texts(definition: FsmDefinition) -> Iterator[str]:
+    """Every expression and assigned name of the machine, in the order a reader meets them
+    going through the states as a run reaches them."""
+    for state in _ordered_states(definition):
+        for action in state.on_enter:
+            if isinstance(action, SetAction):
+                for name, text in action.assignments:
+                    yield name
+                    yield text
+            for field_name in EXPRESSIONS.get(type(action), ()):
+                yield getattr(action, field_name)
+        for transition in state.transitions:
+            yield transition.when
+            for name, text in transition.set:
+                yield name
+                yield text
+    for variable in definition.variables:
+        yield variable.initial
+
+
+def _read_names(text: str) -> list[str]:
+    try:
+        tree = ast.parse(text.strip(), mode="eval")
+    except (SyntaxError, ValueError, RecursionError, MemoryError):
+        return []
+    return [node.id for node in ast.walk(tree) if isinstance(node, ast.Name)]
+
+
+def fresh_names(definition: FsmDefinition) -> dict[str, str]:
+    """A new name for each sensor (``s0``...), parameter (``p0``...) and variable (``v0``...),
+    numbered in the order the expressions first read them; those no expression reads follow,
+    in the order of what they hold, not of what they are called."""
+    sensors = {n.name: repr((n.kind, n.mount, sorted(n.ports.items()))) for n in definition.sensors}
+    params = {
+        p.name: repr((p.minimum, p.maximum, sorted(p.defaults.items())))
+        for p in definition.parameters
+    }
+    variables = {v.name: repr(v.initial) for v in definition.variables}
+    kinds = (("s", sensors), ("p", params), ("v", variables))
+    met: list[str] = []
+    for text in _texts(definition):
+        for name in _read_names(text):
+            if name not in met:
+                met.append(name)
+    fresh: dict[str, str] = {}
+    for prefix, held in kinds:
+        order = [n for n in met if n in held]
+        order += sorted((n for n in held if n not in order), key=lambda n: (held[n], n))
+        fresh.update({name: f"{prefix}{i}" for i, name in enumerate(order)})
+    return fresh
+
+
+def _renamer(fresh: Mapping[str, str]) -> Callable[[str], str]:
+    def rename(text: str) -> str:
+        if text in fresh:
+            return fresh[text]
+        try:
+            tree = ast.parse(text.strip(), mode="eval")
+        except (SyntaxError, ValueError, RecursionError, MemoryError):
+            return text
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Name) and node.id in fresh:
+                node.id = fresh[node.id]
+        try:
+            return ast.unparse(tree)
+        except (RecursionError, ValueError):
+            return text
+
+    return rename
+
+
+def _renamed_action(action: Action, rename: Callable[[str], str]) -> Action:
+    if isinstance(action, SetAction):
+        return SetAction(tuple((rename(n), rename(t)) for n, t in action.assignments))
+    fields = EXPRESSIONS.get(type(action), ())
+    return replace(action, **{f: rename(getattr(action, f)) for f in fields})  # type: ignore[arg-type]
+
+
+def _renamed_transition(
+    transition: TransitionDef, states: Mapping[str, str], rename: Callable[[str], str]
+) -> TransitionDef:
+    return replace(
+        transition,
+        target=states.get(transition.target, transition.target),
+        when=rename(transition.when) if transition.when else "",
+        set=tuple((rename(n), rename(t)) for n, t in transition.set),
+    )
+
+
 def shape(definition: FsmDefinition) -> str:
     """What an FSM does, without what does not change its behaviour (names, descriptions
     and the states' names among them, the order of its unordered parts and the parameters'
     values)."""
     names = canonical_names(definition)
-    states = sorted(
-        (
-            replace(
-                s,
-                name=names[s.name],
-                description="",
-                transitions=tuple(
-                    replace(t, target=names.get(t.target, t.target)) for t in s.transitions
-                ),
-            )
-            for s in definition.states
-        ),
-        key=lambda s: int(s.name[1:]),
-    )
+    fresh = fresh_names(definition)
+    rename = _renamer(fresh)
+    states = [
+        replace(
+            s,
+            name=names[s.name],
+            description="",
+            on_enter=tuple(_renamed_action(a, rename) for a in s.on_enter),
+            transitions=tuple(_renamed_transition(t, names, rename) for t in s.transitions),
+        )
+        for s in _ordered_states(definition)
+    ]
     sensors = sorted(
-        (n.name, n.kind, n.mount, tuple(sorted(n.ports.items()))) for n in definition.sensors
+        (fresh[n.name], n.kind, n.mount, tuple(sorted(n.ports.items()))) for n in definition.sensors
     )
-    params = sorted((p.name, p.minimum, p.maximum) for p in definition.parameters)
-    variables = sorted((v.name, v.initial) for v in definition.variables)
+    params = sorted((fresh[p.name], p.minimum, p.maximum) for p in definition.parameters)
+    variables = sorted((fresh[v.name], rename(v.initial)) for v in definition.variables)
     return repr((names.get(definition.initial), states, sensors, params, variables))
 
 
 def declared(definition: FsmDefinition) -> str:
-    """The parameter defaults an FSM file declares, every profile's."""
-    return repr(sorted((p.name, sorted(p.defaults.items())) for p in definition.parameters))
+    """The parameter defaults an FSM file declares, every profile's, under their fresh names."""
+    fresh = fresh_names(definition)
+    return repr(sorted((fresh[p.name], sorted(p.defaults.items())) for p in definition.parameters))
 
 
 @dataclass(frozen=True)
@@ -99,8 +219,12 @@ class BundledFsm:
     defaults: str
     #: None: every parameter; else only these (a starter's FILL IN parameters)
     pinned: frozenset[str] | None
+    #: its names and their fresh names (:func:`fresh_names`)
+    fresh: Mapping[str, str]
 
     def matches(self, run_shape: str, values: Mapping[str, float], profile: str) -> bool:
+        """Whether a run of this shape, with ``values`` (by the fresh names of
+        :func:`fresh_names`) in force, is this file's."""
         if run_shape != self.shape:
             return False
         try:
@@ -108,7 +232,7 @@ class BundledFsm:
         except ValueError:
             return False
         names = own.keys() if self.pinned is None else self.pinned
-        return all(values.get(name) == own.get(name) for name in names)
+        return all(values.get(self.fresh[name]) == own.get(name) for name in names)
 
 
 def _fill_ins(parameters: tuple[Parameter, ...]) -> frozenset[str]:
@@ -131,7 +255,14 @@ def bundled_fsms() -> tuple[BundledFsm, ...]:
             pinned = _fill_ins(definition.parameters) if starters else None
             shown = f"the {label} {path.parent.name}/{path.name}"
             found.append(
-                BundledFsm(shown, shape(definition), definition, declared(definition), pinned)
+                BundledFsm(
+                    shown,
+                    shape(definition),
+                    definition,
+                    declared(definition),
+                    pinned,
+                    fresh_names(definition),
+                )
             )
     return tuple(found)
 
@@ -140,6 +271,8 @@ def bundled_fsm(definition: FsmDefinition, values: Mapping[str, float], profile:
     """Which shipped FSM ``definition`` with the parameters ``values`` in force is, in words
     ("the built-in algorithm algorithms/right-wall.yaml"); "" when it is none of them."""
     run_shape, run_defaults = shape(definition), declared(definition)
+    fresh = fresh_names(definition)
+    values = {fresh.get(name, name): value for name, value in values.items()}
     known = bundled_fsms()
     copied = [
         b for b in known
