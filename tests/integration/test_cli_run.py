@@ -132,6 +132,31 @@ def test_eval_bad_algorithm_exits_2(capsys):
     assert "nope on mazes/web.txt" in capsys.readouterr().err
 
 
+@pytest.mark.parametrize(
+    ("option", "said"),
+    [
+        (["--deadline", "0"], "--deadline must be above 0 and at most a day (seconds)"),
+        (["--deadline", "100000"], "--deadline must be above 0 and at most a day (seconds)"),
+        (["--memory", "10"], "--memory must be at least 256 (MiB)"),
+    ],
+)
+def test_eval_refuses_limits_it_cannot_run_under(option, said, capsys):
+    code = main(["eval", "--maze", "mazes/web.txt", "--algorithm", "right-wall", *option])
+    assert code == 2
+    assert capsys.readouterr().err == f"workbench eval: {said}\n"
+
+
+def test_eval_stops_a_run_at_the_deadline_it_is_given(capsys):
+    """right-wall never leaves the trap loop, and 100,000 simulated s take far longer than
+    0.5 s: the run is stopped there, and the error names the run and the option."""
+    code = main(["eval", "--maze", "mazes/trap-loop.txt", "--algorithm", "right-wall",
+                 "--seeds", "1", "--max-time", "100000", "--deadline", "0.5",
+                 "--jobs", "1"])  # fmt: skip
+    assert code == 2
+    err = capsys.readouterr().err
+    assert "stopped after 0.5 s of wall-clock time, the limit for one run (--deadline)" in err
+
+
 def test_eval_fits_80_columns_and_wide_keeps_one_line_per_entrant(tmp_path, capsys):
     # two programs of one name: each is named by its whole (long) path
     source = Path("programs/right-wall.viple").read_text(encoding="utf-8")

@@ -73,8 +73,8 @@ def _entrant(name: str, attack: str) -> Entrant:
     ("attack", "deadline", "reason"),
     [
         ("crash", 60, "the run's process was ended by SIGSEGV"),
-        ("hog", 60, "used more than 300 MiB of memory, the cap for one run"),
-        ("sleeper", 3, "stopped after 3 s of wall-clock time, the limit for one run"),
+        ("hog", 60, "used more than 300 MiB of memory, the cap for one run (--memory)"),
+        ("sleeper", 3, "stopped after 3 s of wall-clock time, the limit for one run (--deadline)"),
     ],
 )
 def test_a_run_that_attacks_its_process_ends_the_evaluation_naming_it(attack, deadline, reason):

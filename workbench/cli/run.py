@@ -13,6 +13,8 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from workbench.control.evaluate import (
+    EVAL_LIMITS,
+    MIN_EVAL_MEMORY,
     Entrant,
     EvalError,
     algorithm_entrant,
@@ -29,6 +31,7 @@ from workbench.control.headless import (
     RunSpec,
     run,
 )
+from workbench.control.parallel import Limits
 from workbench.program.interp import ProgramController
 from workbench.program.keyfiles import program_keys, read_key_file
 from workbench.program.keys import KeyScriptError, parse_key_script
@@ -103,6 +106,22 @@ def register(sub: argparse._SubParsersAction) -> None:
     e.add_argument("--seeds", type=int, default=3, help="seeds 0..N-1 (default 3)")
     e.add_argument("--max-time", type=float, help="simulated seconds per run")
     e.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="parallel processes")
+    e.add_argument(
+        "--deadline",
+        type=float,
+        default=EVAL_LIMITS.deadline,
+        metavar="S",
+        help="wall-clock seconds one run may take before it is stopped "
+        f"(default {EVAL_LIMITS.deadline:g})",
+    )
+    e.add_argument(
+        "--memory",
+        type=int,
+        default=EVAL_LIMITS.memory,
+        metavar="MIB",
+        help="address space one run's process may map beyond the evaluator's, in MiB "
+        f"(default {EVAL_LIMITS.memory})",
+    )
     e.add_argument("--csv", metavar="FILE", help="also write the matrix as CSV")
     e.add_argument(
         "--wide", action="store_true", help="the table in one wide line per entrant (110 columns)"
@@ -241,6 +260,15 @@ def cmd_eval(args: argparse.Namespace) -> int:
     if args.seeds < 1 or args.jobs < 1:
         print("workbench eval: --seeds and --jobs must be at least 1", file=sys.stderr)
         return 2
+    if not 0 < args.deadline <= 24 * 3600:
+        print(
+            "workbench eval: --deadline must be above 0 and at most a day (seconds)",
+            file=sys.stderr,
+        )
+        return 2
+    if args.memory < MIN_EVAL_MEMORY:
+        print(f"workbench eval: --memory must be at least {MIN_EVAL_MEMORY} (MiB)", file=sys.stderr)
+        return 2
     if not args.algorithm and not args.program:
         print(
             "workbench eval: give --algorithm A ... or --program FILE ... (or both)",
@@ -280,6 +308,7 @@ def cmd_eval(args: argparse.Namespace) -> int:
             noise_params=tuple(args.noise_set),
             max_time=args.max_time,
             jobs=args.jobs,
+            limits=Limits(deadline=args.deadline, memory=args.memory),
             progress=not args.json and sys.stderr.isatty(),
         )
     except (EvalError, RunSetupError) as exc:

@@ -26,12 +26,14 @@ MEASURES = ("distance_cells", "turn_degrees", "sim_time", "collisions", "touches
 #: the outer wall around each run's process: a run is bounded in simulated time already, so
 #: the deadline only catches one that hangs (the largest bundled maze takes a few seconds)
 EVAL_LIMITS = Limits(deadline=600.0, memory=1024)
+#: the least address space (MiB) a run's process may be given: less cannot load the simulator
+MIN_EVAL_MEMORY = 256
 #: how a run's process is said to have stopped
 WORDS = Words(
-    deadline="stopped after {deadline:g} s of wall-clock time, the limit for one run",
-    memory="used more than {memory} MiB of memory, the cap for one run",
+    deadline="stopped after {deadline:g} s of wall-clock time, the limit for one run (--deadline)",
+    memory="used more than {memory} MiB of memory, the cap for one run (--memory)",
     no_result="the run's process ended without a result (exit status {code}); it may have "
-    "run out of its {memory} MiB of memory",
+    "run out of its {memory} MiB of memory (--memory)",
     killed="the run's process was ended by {signal}",
     interrupted="the evaluation was interrupted",
 )
