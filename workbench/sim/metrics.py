@@ -41,6 +41,8 @@ class TurnCounter:
         self._sweep = 0.0
 
     def update(self, signed_degrees: float, seconds: float) -> None:
+        if not signed_degrees and not self._sweep:
+            return  # not rotating, and no sweep to end: nothing changes
         rotating = seconds > 0 and abs(signed_degrees) / seconds > ROTATING_ABOVE
         if rotating and (self._sweep == 0.0 or (signed_degrees > 0) == (self._sweep > 0)):
             self._sweep += signed_degrees

@@ -34,8 +34,10 @@ class Probe(Protocol):
         ...
 
 
-#: how a kind reads the world: from the probe of a step and the mount's index, the reading
-Read = Callable[[Probe, int], float | int]
+#: how a kind reads the world: given a probe, the function that reads a sensor of this kind on
+#: a mount (an index of MOUNTS) at the probe's current step; made once per sensor set-up, so
+#: the reading itself is one call
+Read = Callable[[Probe], Callable[[int], float | int]]
 
 #: a reading's unit: the profile's length unit ("length"), or none (a count or a state)
 Unit = Literal["length", "none"]
@@ -87,12 +89,13 @@ class SensorKind:
     bumper: bool = False
 
 
-def _echo(probe: Probe, mount: int) -> float:
-    return probe.echo(mount)
+def _echo(probe: Probe) -> Callable[[int], float]:
+    return probe.echo
 
 
-def _pressed(probe: Probe, mount: int) -> int:
-    return int(probe.pressed(mount))
+def _pressed(probe: Probe) -> Callable[[int], int]:
+    pressed = probe.pressed
+    return lambda mount: int(pressed(mount))
 
 
 DISTANCE = SensorKind(

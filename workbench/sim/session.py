@@ -78,6 +78,8 @@ class Session:
     ) -> None:
         self.world = World(maze, profile, sensors, noise, seed, dt)
         self._world_step = self.world.step
+        #: the world's step, which a new maze keeps
+        self._dt = self.world.dt
         self.maze = maze
         self.profile = self.world.profile
         self.recorder = recorder
@@ -188,15 +190,18 @@ class Session:
     def step(self) -> tuple[str, ...]:
         """One physics step (and a control tick every ``every`` steps); a controller with
         something due inside the step is woken at that time."""
-        early: tuple[str, ...] = ()
-        if self._due < (self._steps + 1) * self.world.dt - _SAME:
+        n = self._steps + 1
+        due = self._due
+        if due < n * self._dt - _SAME:
             early = self._wake_within()
-        events = self._world_step()
-        if early:
-            events = early + events
+            events = self._world_step()
+            if early:
+                events = early + events
+        else:
+            events = self._world_step()
         if events:
             self._events.extend(events)
-        self._steps = n = self._steps + 1
+        self._steps = n
         if self._scheduled is not None and n >= self._scheduled[0]:
             cmd = self._scheduled[1]
             self._scheduled = None

@@ -205,6 +205,13 @@ class World:
         self.maze = maze
         self.profile = profile
         self.noise = noise
+        #: the distance noise (relative, absolute), or () for none
+        self._distance_noise = (
+            (noise.distance_relative, noise.distance_absolute)
+            if noise.distance_relative or noise.distance_absolute
+            else ()
+        )
+        self._no_echo = profile.no_echo
         self.seed = seed
         self.dt = float(dt)
         # a maze's own block size counts when it was written for this profile
@@ -224,6 +231,8 @@ class World:
         self._offsets = tuple(profile.sensor_offset(m) for m in MOUNTS)
         #: the mounts' unit vectors and the walls in reach, for the step being read
         self._dirs: tuple[tuple[float, float], ...] = ()
+        #: the angle ``_dirs`` were made for
+        self._dirs_angle = math.nan
         self._contacts_now: list[tuple[float, float]] | None = None
         # the grid padded with one ring of wall: rays and neighbour checks need no bounds test
         w, h = maze.width, maze.height
@@ -262,7 +271,7 @@ class World:
         # read kind by kind in the table's order (and each kind's sensors in the order given):
         # the noise of a run is drawn in that order
         self._plan = tuple(
-            (s.port, kind.read, MOUNTS.index(s.mount))
+            (s.port, kind.read(self), MOUNTS.index(s.mount))
             for kind in SENSOR_KINDS
             for s in specs
             if s.kind == kind.name
@@ -307,7 +316,7 @@ class World:
         self._physics_stale = False
         self._step_angle = self._step_v = math.nan  # the cached step of straight driving
         self._step_dt = self.dt
-        self._step_dx = self._step_dy = 0.0
+        self._step_dx = self._step_dy = self._step_moved = 0.0
         self._box = (math.inf, -math.inf, math.inf, -math.inf)
 
     def _build_space(self) -> None:
@@ -483,22 +492,24 @@ class World:
                     self._step_v = v
                     self._step_dx = v * math.cos(a0) * dt
                     self._step_dy = v * math.sin(a0) * dt
+                    self._step_moved = abs(v) * dt
                 x = x0 + self._step_dx
                 y = y0 + self._step_dy
+                moved = self._step_moved
             else:
                 x = x0
                 y = y0
-            box = self._box
-            if not (box[0] <= x0 <= box[1] and box[2] <= y0 <= box[3]):
-                box = self._box = self._free_box(x0, y0)
-            if box[0] <= x <= box[1] and box[2] <= y <= box[3]:
+                moved = 0.0
+            xmin, xmax, ymin, ymax = self._box
+            if not (xmin <= x0 <= xmax and ymin <= y0 <= ymax):
+                xmin, xmax, ymin, ymax = self._box = self._free_box(x0, y0)
+            if xmin <= x <= xmax and ymin <= y <= ymax:
                 # free motion: no wall within reach, so no contact can start this step
                 free = True
                 self._free_w = w
                 self._physics_stale = True
                 a = a0 + w * dt
-                moved = abs(v) * dt
-                turned = abs(w) * dt
+                turned = abs(w) * dt if w else 0.0
         if not free:
             x, y, a = self._physics_step(target, a0, dt)
             moved = math.hypot(x - x0, y - y0)
@@ -673,14 +684,16 @@ class World:
         if self._readings is not None:
             return self._readings
         a = self._angle
-        c = math.cos(a)
-        s = math.sin(a)
-        # unit vectors of the mounts in MOUNTS order: front, right, back, left
-        self._dirs = ((c, s), (-s, c), (-c, -s), (s, -c))
+        if a != self._dirs_angle:
+            c = math.cos(a)
+            s = math.sin(a)
+            # unit vectors of the mounts in MOUNTS order: front, right, back, left
+            self._dirs = ((c, s), (-s, c), (-c, -s), (s, -c))
+            self._dirs_angle = a
         self._contacts_now = None
         out: dict[int, float | int] = {}
         for port, read, mount in self._plan:
-            out[port] = read(self, mount)
+            out[port] = read(mount)
         self._readings = out
         return out
 
@@ -696,15 +709,13 @@ class World:
             self._solid, self._wp, (self._x + offset * dx) * inv + 1.0,
             (self._y + offset * dy) * inv + 1.0, dx, dy, self._tmax,
         )  # fmt: skip
-        p = self.profile
         if t < 0.0:
-            return p.no_echo
+            return self._no_echo
         d = t * self.cell
-        noise = self.noise
-        rel = noise.distance_relative
-        absolute = noise.distance_absolute
-        if rel or absolute:
-            d = min(p.sensor_range, max(0.0, d + self._rng.gauss(0.0, rel * d + absolute)))
+        if self._distance_noise:
+            rel, absolute = self._distance_noise
+            gauss = self._rng.gauss(0.0, rel * d + absolute)
+            d = min(self.profile.sensor_range, max(0.0, d + gauss))
         return d
 
     def pressed(self, mount: int) -> bool:
