@@ -240,6 +240,8 @@ class ProgramController:
         self.flows_dropped = 0
         self.steps = 0
         self.state: str | None = None
+        #: how many flows ``state`` counts
+        self._busy = -1
         #: why and where the program was stopped (None while it may run)
         self.stopped: RunError | None = None
         #: the activities run at each run of the last simulated second, and their sum
@@ -458,6 +460,7 @@ class ProgramController:
         total = 0
         budget = min(self.limits.tick, self.limits.second - self._second_steps)
         hot = self._hot
+        ran: list[Flow] = []  # the flows that took steps in this pass (their count restarts)
         while ready and total < budget and self.stopped is None:
             flow = ready.popleft()
             if flow.steps >= FLOW_TICK_STEPS:
@@ -483,6 +486,7 @@ class ProgramController:
                 self._parked.append(flow)
             if not ended:
                 flow.steps += done
+                ran.append(flow)
                 hot[flow.activity] = hot.get(flow.activity, 0) + done
             total += done
         self.steps += total
@@ -497,12 +501,12 @@ class ProgramController:
             self._check_memory()
         if self.stopped is not None:
             return self._halted()
-        for flow in itertools.chain(ready, self._parked):
-            flow.steps = 0
-        for _, _, flow in self._sleeping:
+        for flow in ran:
             flow.steps = 0
         busy = len(ready) + len(self._parked) + len(self._sleeping)
-        self.state = f"{busy} flow{'s' if busy != 1 else ''}"
+        if busy != self._busy or self.state is None:
+            self._busy = busy
+            self.state = f"{busy} flow{'s' if busy != 1 else ''}"
         commands, self.commands = self.commands, []
         return commands
 

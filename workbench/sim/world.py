@@ -72,6 +72,10 @@ _space_step = _cp.cpSpaceStep
 _get_position = _cp.cpBodyGetPosition
 _get_angle = _cp.cpBodyGetAngle
 _get_angular_velocity = _cp.cpBodyGetAngularVelocity
+_set_position = _cp.cpBodySetPosition
+_set_angle = _cp.cpBodySetAngle
+_set_velocity = _cp.cpBodySetVelocity
+_set_angular_velocity = _cp.cpBodySetAngularVelocity
 
 
 class WorldError(ValueError):
@@ -357,6 +361,7 @@ class World:
         self._body = body
         self._body_ptr = body._body
         self._control = control
+        self._control_ptr = control._body
 
     def _contact_begin(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: object) -> None:
         if space is not self._space:
@@ -545,10 +550,10 @@ class World:
             ahead = a0 + _get_angular_velocity(self._body_ptr) * dt
             rate = self._turn_rate
             w = (target - ahead) / dt
-            self._control.angular_velocity = max(-rate, min(rate, w))
+            _set_angular_velocity(self._control_ptr, max(-rate, min(rate, w)))
         elif self._reaim:
             v = self._v
-            self._control.velocity = (v * math.cos(a0), v * math.sin(a0))
+            _set_velocity(self._control_ptr, (v * math.cos(a0), v * math.sin(a0)))
         # the C step directly: the wrapper's bookkeeping (deferred adds and removals, first-step
         # mass checks) has nothing to do for this space after it is built
         _space_step(self._space_ptr, dt)
@@ -613,16 +618,17 @@ class World:
 
     def _sync_body(self) -> None:
         """Hand the directly integrated pose and motion back to pymunk before it steps again."""
-        body = self._body
         a = self._angle
         v = self._v if self._turn_target is None else 0.0
         velocity = (v * math.cos(a), v * math.sin(a))
-        body.position = (self._x, self._y)
-        body.angle = a
-        body.velocity = velocity
-        body.angular_velocity = self._free_w
-        self._control.velocity = velocity
-        self._control.angular_velocity = self._free_w
+        ptr = self._body_ptr
+        _set_position(ptr, (self._x, self._y))
+        _set_angle(ptr, a)
+        _set_velocity(ptr, velocity)
+        _set_angular_velocity(ptr, self._free_w)
+        control = self._control_ptr
+        _set_velocity(control, velocity)
+        _set_angular_velocity(control, self._free_w)
         self._physics_stale = False
 
     def run(self, seconds: float) -> list[tuple[float, str]]:
@@ -734,18 +740,26 @@ class World:
         inv = self._inv_cell
         bx = int(x * inv)
         by = int(y * inv)
-        reach2 = self._touch_reach**2
+        reach = self._touch_reach
+        fx = x - bx * cell
+        fy = y - by * cell
+        if reach < fx < cell - reach and reach < fy < cell - reach:
+            return []  # every other block is farther than the reach: none can touch
+        reach2 = reach**2
         wp = self._wp
         solid = self._solid
         found = []
         for j in (by - 1, by, by + 1):
             row = (j + 1) * wp + 1
             y0 = j * cell
-            ny = min(max(y, y0), y0 + cell) - y
+            y1 = y0 + cell
+            # to the block's nearest point: the same numbers as min(max(y, y0), y1) - y
+            ny = y0 - y if y < y0 else y1 - y if y > y1 else 0.0
             for i in (bx - 1, bx, bx + 1):
                 if solid[row + i]:
                     x0 = i * cell
-                    nx = min(max(x, x0), x0 + cell) - x
+                    x1 = x0 + cell
+                    nx = x0 - x if x < x0 else x1 - x if x > x1 else 0.0
                     if nx * nx + ny * ny <= reach2:
                         found.append((nx, ny))
         return found
