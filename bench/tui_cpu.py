@@ -234,12 +234,18 @@ def app_options(spec: AppSpec) -> list[str]:
     ]  # fmt: skip
 
 
+def _appproc_folder(tree: Path) -> Path:
+    """Where ``tree`` keeps ``appproc.py``: ``workbench/door`` now, ``workbench/ssh`` before."""
+    door = tree / "workbench" / "door"
+    return door if (door / "appproc.py").is_file() else tree / "workbench" / "ssh"
+
+
 def tree_app_process(tree: Path) -> type[AppProcess]:
     """The server side of a session (``AppProcess``) as the workbench in ``tree`` has it."""
     if tree == ROOT:
         return AppProcess
-    folder = tree / "workbench" / "ssh"
-    name = f"_ssh_of_{len(sys.modules)}"
+    folder = _appproc_folder(tree)
+    name = f"_{folder.name}_of_{len(sys.modules)}"
     found = importlib.util.spec_from_file_location(
         name, folder / "__init__.py", submodule_search_locations=[str(folder)]
     )
@@ -252,7 +258,7 @@ def tree_app_process(tree: Path) -> type[AppProcess]:
 
 def tree_driver(tree: Path) -> str:
     """The Textual driver the lab server of ``tree`` runs its apps with."""
-    source = (tree / "workbench" / "ssh" / "appproc.py").read_text()
+    source = (_appproc_folder(tree) / "appproc.py").read_text()
     found = re.search(r'^DRIVER = "([^"]+)"', source, re.MULTILINE)
     return found.group(1) if found else "textual.drivers.web_driver:WebDriver"
 
