@@ -25,6 +25,7 @@ from workbench.door.appproc import AppProcess, AppSpec, app_env
 from workbench.door.checking import PasswordDesk
 from workbench.door.course_files import CourseWorkspaces, bring_workspace
 from workbench.door.forkserver import ForkServer, ForkServerError
+from workbench.door.leases import Lease, SessionLeases
 from workbench.door.limits import describe_duration, describe_memory
 from workbench.door.logins import ConnectionGate, LoginGuard, QuietLog
 from workbench.door.memory import SHORT_OF_MEMORY, MemoryWatch
@@ -89,6 +90,8 @@ class WebServer:
         self.logins = Logins(config.login_lifetime)
         self.pool = PortPool(*config.port_range)
         self.apps: dict[str, StudentApp] = {}
+        #: every door's sessions in this data folder, for the per-user cap
+        self.leases = SessionLeases(config.data_dir, "web")
         self.quiet_log = QuietLog()
         self.memory = MemoryWatch(config.limits.server_memory)
         self.forkserver: ForkServer | None = None
@@ -377,8 +380,10 @@ class WebServer:
         login_id, login = self.current_login(request)
         form = await request.post()
         token = form.get("csrf")
-        if login is None or not self.same_site(request) or not same_token(
-            token if isinstance(token, str) else None, login.csrf
+        if (
+            login is None
+            or not self.same_site(request)
+            or not same_token(token if isinstance(token, str) else None, login.csrf)
         ):
             self.say_now_and_then(f"logout {self.origin(request).address}",
                                   "logout refused from %s: no login or not its form",
@@ -495,8 +500,11 @@ class WebServer:
             self.say_now_and_then(f"page said {user}", "a page of %s sent %r: not a message "
                                   "of the page", user, text[:60])  # fmt: skip
             return
-        if cols > 0 and rows > 0:
-            student.resize(self.clamped(cols, rows, user))
+        if cols > 0 and rows > 0 and not student.resize(self.clamped(cols, rows, user)):
+            self.say_now_and_then(
+                f"resizes {user}", "resizes from a page of %s come faster than one per %g s: "
+                "the app is given the latest", user, self.config.limits.resize_every,
+            )  # fmt: skip
 
     # -- the student's app -------------------------------------------------------------------
     async def app_of(self, login: Login, size: tuple[int, int]) -> StudentApp | str:
@@ -516,10 +524,34 @@ class WebServer:
     async def _start_app(self, login: Login, size: tuple[int, int]) -> StudentApp | str:
         config = self.config
         user = login.user
-        why = config.limits.refusal(0, len(self.apps))
+        limits = config.limits
+        why = limits.refusal(0, len(self.apps))
+        lease = None
+        if why is None:
+            try:
+                lease, held = self.leases.take(user, limits.per_user, "a browser's page")
+            except OSError as exc:
+                log.error("session refused: %s: its lease could not be made: %s", user, exc)
+                return "The workbench could not be started; tell the instructor."
+            if lease is None:
+                why = limits.refusal(held, 0)
         if why is not None:
             log.warning("session refused: %s: %s", user, why)
             return why
+        assert lease is not None
+        try:
+            started = await self._start_leased(login, size, lease)
+        except BaseException:
+            lease.release()
+            raise
+        if isinstance(started, str):
+            lease.release()
+        return started
+
+    async def _start_leased(
+        self, login: Login, size: tuple[int, int], lease: Lease
+    ) -> StudentApp | str:
+        config, user = self.config, login.user
         try:
             ports = self.pool.allocate(user, 2)
         except PoolExhausted as exc:
@@ -555,6 +587,7 @@ class WebServer:
         )  # fmt: skip
         holder.append(student)
         student.ports = ports
+        student.lease = lease
         try:
             await process.start()
         except OSError as exc:
@@ -573,8 +606,10 @@ class WebServer:
     async def _watch(self, student: StudentApp) -> None:
         code = await student.app.wait()
         if not student.ending:
-            message = "The workbench ended." if code == 0 else (
-                f"The workbench ended with an error ({code})."
+            message = (
+                "The workbench ended."
+                if code == 0
+                else (f"The workbench ended with an error ({code}).")
             )
             if code and student.app.ran_out_of_memory():
                 message = self.config.limits.memory_message()
@@ -591,6 +626,9 @@ class WebServer:
         if self.apps.get(student.user) is student:
             del self.apps[student.user]
         self.pool.release(student.ports)
+        if student.lease is not None:
+            student.lease.release()
+            student.lease = None
         lines = student.app.errors.report()
         if lines:
             log.warning("%s's app log %s", student.user, "\n  ".join(lines))
@@ -663,9 +701,7 @@ class WebServer:
         if not same_token(token if isinstance(token, str) else None, login.csrf):
             self.say_now_and_then(f"upload token {login.user}", "upload refused: %s from %s: "
                                   "not its form's token", login.user, where.address)  # fmt: skip
-            return web.json_response(
-                {"error": "the form was not this page's: reload"}, status=403
-            )
+            return web.json_response({"error": "the form was not this page's: reload"}, status=403)
         sent = form.get("file")
         if not isinstance(sent, web.FileField):
             return web.json_response({"error": "choose a file to send"}, status=400)
@@ -697,4 +733,3 @@ class WebServer:
             content_type="application/octet-stream",
             headers={"Content-Disposition": f'attachment; filename="{name}"'},
         )
-
