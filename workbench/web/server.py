@@ -37,7 +37,15 @@ from workbench.files.workspace import workspace_folder
 
 from . import transfer
 from .config import WebConfig
-from .cookies import CSRF_COOKIE, SESSION_COOKIE, Login, Logins, new_token, same_token
+from .cookies import (
+    CSRF_COOKIE,
+    LOGINS_FOLDER,
+    SESSION_COOKIE,
+    Login,
+    Logins,
+    new_token,
+    same_token,
+)
 from .gate import RequestGate
 from .pages import login_page, terminal_page
 from .proxy import Origin, header_login, origin_of
@@ -87,7 +95,8 @@ class WebServer:
             config.trusted_proxies,
             lambda key, line: self.say_now_and_then(key, "%s", line),
         )
-        self.logins = Logins(config.login_lifetime)
+        #: kept in the data folder, so a restart logs no one out
+        self.logins = Logins(config.login_lifetime, folder=config.data_dir / LOGINS_FOLDER)
         self.pool = PortPool(*config.port_range)
         self.apps: dict[str, StudentApp] = {}
         #: every door's sessions in this data folder, for the per-user cap
@@ -256,7 +265,16 @@ class WebServer:
 
     def current_login(self, request: web.Request) -> tuple[str | None, Login | None]:
         login_id = request.cookies.get(SESSION_COOKIE)
-        return login_id, self.logins.get(login_id)
+        login = self.logins.get(login_id)
+        if login is None:
+            return login_id, None
+        user = self.desk.known(login.user)
+        if user is None:  # taken out of the users file since: logged out
+            self.logins.close(login_id)
+            log.info("logout: %s is no longer in the users file", shown(login.user))
+            return login_id, None
+        login.role = user.role
+        return login_id, login
 
     def _set_login_cookie(self, response: web.StreamResponse, login_id: str, secure: bool) -> None:
         response.set_cookie(
