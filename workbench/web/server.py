@@ -182,11 +182,19 @@ class WebServer:
                 "logins by the %s header from %s only (passwords are not taken)",
                 config.user_header, ", ".join(map(str, config.trusted_proxies)),
             )  # fmt: skip
+        logins = config.logins
+        log.info(
+            "logins: %g s to send a request; at most %d connections without one (%d per "
+            "address); passwords locked for %s after %d failures; %d logins kept from before",
+            logins.login_timeout, logins.max_unauthenticated,
+            logins.max_unauthenticated_per_address, describe_duration(logins.lock_for),
+            logins.lock_after, len(self.logins),
+        )  # fmt: skip
         limits = config.limits
         log.info(
-            "limits: %d sessions in all; terminals at most %dx%d; app memory %s; messages "
-            "from a page at most %d bytes",
-            limits.total, limits.max_columns, limits.max_rows,
+            "limits: %d sessions in all, %d per user (over both doors); terminals at most "
+            "%dx%d; app memory %s; messages from a page at most %d bytes",
+            limits.total, limits.per_user, limits.max_columns, limits.max_rows,
             describe_memory(limits.app_memory) if limits.app_memory else "not capped",
             config.max_message,
         )  # fmt: skip
