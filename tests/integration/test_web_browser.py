@@ -88,3 +88,124 @@ async def test_a_student_drives_in_chromium_and_a_reload_finds_the_same_workbenc
             assert problems == []
         finally:
             await browser.close()
+
+
+#: what a test's key string is as Playwright's key names (the rest is typed as it is)
+KEY_NAMES = {"\r": "Enter", "\t": "Tab", " ": "Space", "\x13": "Control+s", "\x1b[B": "ArrowDown"}
+
+
+class ChromiumTerminal:
+    """A Chromium page's terminal with the waits and keys of ``ssh_support.Terminal``, so
+    the lab helpers drive it: keys go through Playwright's keyboard one after another, in the
+    order sent; the screen is read from xterm.js's buffer."""
+
+    def __init__(self, page) -> None:
+        self.page = page
+        self._keys: asyncio.Task[None] | None = None
+        self._last = ""
+
+    def send(self, keys: str) -> None:
+        before = self._keys
+
+        async def press() -> None:
+            if before is not None:
+                await before
+            name = KEY_NAMES.get(keys)
+            if name is not None:
+                await self.page.keyboard.press(name)
+            else:
+                await self.page.keyboard.type(keys)
+
+        self._keys = asyncio.get_running_loop().create_task(press())
+
+    def text(self) -> str:
+        return self._last
+
+    async def wait_until(self, check, what: str, timeout: float = 20.0) -> str:
+        if self._keys is not None:
+            await self._keys
+        loop = asyncio.get_running_loop()
+        end = loop.time() + timeout
+        while not check(text := await screen_text(self.page)):
+            if loop.time() > end:
+                raise AssertionError(f"{what}: not on the page after {timeout:g} s:\n{text}")
+            await asyncio.sleep(0.1)
+        self._last = text
+        return text
+
+    async def wait_for(self, *needles: str, timeout: float = 20.0) -> str:
+        return await self.wait_until(
+            lambda text: all(n in text for n in needles), f"{list(needles)}", timeout
+        )
+
+
+async def log_in(page, url: str, name: str) -> None:
+    await page.goto(f"{url}/")
+    await page.fill("input[name=user]", name)
+    await page.fill("input[name=password]", PASSWORD)
+    await page.click("button[type=submit]")
+    await page.wait_for_url(f"{url}/")
+
+
+@sync
+async def test_an_instructor_signs_in_their_own_chromium_and_the_students_page_shows_it(tmp_path):
+    """Two browsers (contexts: cookies of their own): the student asks for sign-off on
+    theirs; the instructor logs in on the other, types the passphrase there and signs; the
+    student's page shows the sign-off."""
+    from workbench.labs.signoff.instructors import KdfParams, create_instructor
+    from workbench.labs.store.store import Store
+
+    from .ssh_support import open_exercise
+
+    passphrase = "correct horse battery"
+    accounts = [Account("ann", password=PASSWORD), Account("ito", "instructor", password=PASSWORD)]
+    async with (
+        web_host(tmp_path, accounts) as host,
+        playwright.async_playwright() as driver,
+    ):
+        create_instructor(host.data_dir, "ito", passphrase, kdf=KdfParams(n=2**10, r=8, p=1))
+        browser = await driver.chromium.launch(
+            executable_path=CHROMIUM, args=["--no-sandbox", "--disable-gpu"]
+        )
+        try:
+            viewport = {"width": 1000, "height": 640}
+            anns, itos = [await browser.new_context(viewport=viewport) for _ in range(2)]
+            problems: list[str] = []
+            pages = [await anns.new_page(), await itos.new_page()]
+            for page in pages:
+                page.on("pageerror", lambda error: problems.append(str(error)))
+            student_page, instructor_page = pages
+            await log_in(student_page, host.url, "ann")
+            student = ChromiumTerminal(student_page)
+            await student.wait_for("Who is at this robot?", timeout=90)
+            student.send("\r")
+            await student.wait_for("distance 0.00 unit")
+            await open_exercise(student, "Unity simulator: Drive by wire")
+            student.send("i")
+            student.send("r")
+            await student.wait_for("1st in the queue")
+
+            await log_in(instructor_page, host.url, "ito")
+            instructor = ChromiumTerminal(instructor_page)
+            await instructor.wait_for("Sign-off queue: 1 waiting", "1. ann", timeout=90)
+            instructor.send("\r")
+            await instructor.wait_for("ann ask for sign-off", "objectives pass")
+            instructor.send(passphrase)  # typed on the instructor's own page
+            await instructor.wait_for("•" * len(passphrase))
+            instructor.send("\t")
+            instructor.send("checked at the console")
+            await instructor.wait_for("at the console")
+            instructor.send("\t")
+            instructor.send(" ")
+            await instructor.wait_for("[X] Override")
+            instructor.send("\x13")  # ctrl+s signs
+            await instructor.wait_for("signed off ann unity-simulator/drive-by-wire as ito")
+            await student.wait_for("[*] Drive by wire", "signed off by ito on")
+            assert sorted(host.server.apps) == ["ann", "ito"]
+            assert problems == []
+        finally:
+            await browser.close()
+
+    with Store.open(host.data_dir, create=False) as store:
+        (record,) = store.signoffs.of()
+    assert (record.instructor, record.student, record.override) == ("ito", "ann", True)

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import asyncio
 import logging
+import re
 import socket
 
 import aiohttp
@@ -72,14 +73,28 @@ async def test_websockets_without_a_login_with_a_forged_cookie_or_another_origin
 async def test_a_login_without_the_form_token_or_from_another_site_is_refused(tmp_path, caplog):
     caplog.set_level(logging.INFO, "workbench.web")
     async with web_host(tmp_path, ACCOUNTS) as host:
+        bob, bobs_page = await working(host)
         browser = host.browser()
         form = {"user": "ann", "password": PASSWORD, "csrf": "forged"}
         async with browser.session.post(f"{host.url}/login", data=form) as answer:
             assert answer.status == 403 and SESSION_COOKIE not in answer.cookies
         assert len(lines(caplog, "the form's token or origin is not this server's")) == 1
+        # the form's own token, posted by another site's page
+        async with browser.session.get(f"{host.url}/login") as page:
+            token = re.search(r'name="csrf" value="([^"]+)"', await page.text())
+        assert token is not None
+        form["csrf"] = token.group(1)
+        async with browser.session.post(
+            f"{host.url}/login", data=form, headers={"Origin": "https://evil.example"}
+        ) as answer:
+            assert answer.status == 403 and SESSION_COOKIE not in answer.cookies
+        # said once: the same refusal from one address again within 10 s is held back
+        assert len(lines(caplog, "the form's token or origin is not this server's")) == 1
         answer = await browser.login("ann")  # the form itself, with its token: let in
         assert answer.status == 200 and answer.url.path == "/"
+        await still_working(bobs_page)
         await browser.close()
+        await bob.close()
 
 
 @sync
@@ -140,8 +155,10 @@ async def test_a_huge_resize_is_clamped_and_a_flood_of_them_passes_on_few(tmp_pa
         page.resize(100, 30)
         page.screen.resize(30, 100)
         await until(lambda: student.size == (100, 30), "the last size passed on")
-        # at most one size per resize_every (0.1 s) went to the app, not five hundred
+        # at most one size per resize_every (0.1 s) went to the app, not five hundred, and
+        # the flood is said in one line
         assert len(passed) < 100
+        assert len(lines(caplog, "resizes from a page of ann come faster than one per")) == 1
         page.send("w")
         await page.wait_until(moved, "ann's app still answering")
         await still_working(bobs_page)

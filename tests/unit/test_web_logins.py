@@ -4,7 +4,7 @@ trusted header believed from the proxy's addresses only."""
 from __future__ import annotations
 
 from workbench.door.networks import parse_networks
-from workbench.web.cookies import MAX_LOGINS, Logins, same_token
+from workbench.web.cookies import MAX_LOGINS, Logins, digest, same_token
 from workbench.web.proxy import header_login, origin_of
 
 
@@ -54,3 +54,36 @@ def test_the_user_header_and_forwarded_address_are_believed_from_the_proxy_only(
     secure = origin_of("10.0.0.5", {"X-Forwarded-Proto": "https"}, proxy, tls=False)
     assert secure.secure and not origin_of("10.0.0.6", {"X-Forwarded-Proto": "https"}, proxy,
                                            tls=False).secure  # fmt: skip
+
+
+def test_logins_kept_in_a_folder_outlive_the_server_as_digests_until_they_expire(tmp_path):
+    now = [1000.0]
+    folder = tmp_path / "web-logins"
+    before = Logins(lifetime=60, clock=lambda: now[0], folder=folder)
+    login_id, login = before.open("ann", "student", "password")
+    gone_id, _ = before.open("bob", "student", "password")
+    before.close(gone_id)  # logged out: nothing kept
+    (kept,) = folder.iterdir()
+    assert kept.name == digest(login_id) and login_id not in kept.read_text()
+    assert (kept.stat().st_mode & 0o777) == 0o600
+    # a restart: a new server's logins from the same folder
+    after = Logins(lifetime=60, clock=lambda: now[0], folder=folder)
+    again = after.get(login_id)
+    assert again is not None and (again.user, again.role, again.csrf) == (
+        "ann", "student", login.csrf,
+    )  # fmt: skip
+    assert after.get(gone_id) is None and after.get("A" * 43) is None
+    now[0] += 60
+    assert after.get(login_id) is None and list(folder.iterdir()) == []
+
+
+def test_an_expired_login_in_the_folder_is_removed_as_the_server_starts(tmp_path):
+    now = [1000.0]
+    folder = tmp_path / "web-logins"
+    login_id, _ = Logins(lifetime=60, clock=lambda: now[0], folder=folder).open(
+        "ann", "student", "password"
+    )
+    (folder / ("0" * 64)).write_text("not a login")
+    now[0] += 61
+    later = Logins(lifetime=60, clock=lambda: now[0], folder=folder)
+    assert len(later) == 0 and later.get(login_id) is None and list(folder.iterdir()) == []

@@ -28,7 +28,7 @@ from workbench.labs.store.store import (
 )
 
 from .common import db_option, record_quota_options, upload_options
-from .doors import door_options
+from .doors import door_options, login_policy
 
 #: the app every SSH session runs, given the session's settings as JSON (see
 #: :mod:`workbench.cli.served`): this Python's ``-m workbench.cli.served``, or forked from the
@@ -73,7 +73,6 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="the server's name as students type it, for the forwarding command shown in the "
         "app (default: this machine's full name)",
     )  # fmt: skip
-    serve.add_argument("--max-per-user", type=int, default=2, help="sessions per user (default 2)")
     serve.add_argument(
         "--max-connections-per-user", type=int, default=10,
         help="connections one user may hold logged in, with or without a session (default 10)",
@@ -88,40 +87,6 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--channel-grace", type=float, default=SessionLimits.channel_grace, metavar="SECONDS",
         help="seconds a session channel has to ask for a terminal, a command or a file "
         "transfer before it is closed (default 10)",
-    )  # fmt: skip
-    serve.add_argument(
-        "--login-timeout", type=float, default=30,
-        help="seconds a connection has to log in (default 30)",
-    )  # fmt: skip
-    serve.add_argument(
-        "--max-unauthenticated", type=int, default=100,
-        help="connections not logged in yet, in all (default 100)",
-    )  # fmt: skip
-    serve.add_argument(
-        "--max-unauthenticated-per-address", type=int, default=10,
-        help="connections not logged in yet from one address (default 10)",
-    )  # fmt: skip
-    serve.add_argument(
-        "--unauthenticated-start", type=int, default=50,
-        help="from this many connections not logged in yet, new ones are dropped at random, "
-        "more often the nearer --max-unauthenticated (default 50)",
-    )  # fmt: skip
-    serve.add_argument(
-        "--unauthenticated-grace", type=float, default=5,
-        help="seconds a connection not logged in keeps its place for sure; past them it is "
-        "closed to make room when a new connection finds the places full or would be dropped "
-        "at random, from the address holding the most places first (default 5; at or above "
-        "--login-timeout: never)",
-    )  # fmt: skip
-    serve.add_argument(
-        "--penalty-min", type=float, default=90,
-        help="seconds of places at the login held by connections that went without logging "
-        "in, beyond what time has paid back, before their address (IPv6: /64) is refused "
-        "(default 90)",
-    )  # fmt: skip
-    serve.add_argument(
-        "--penalty-max", type=float, default=600,
-        help="the longest an address is refused for that (default 600; 0: no penalties)",
     )  # fmt: skip
     record_quota_options(serve)
     upload_options(serve)
@@ -249,7 +214,6 @@ def cmd_list_users(args: argparse.Namespace) -> int:
 
 # -- the server -------------------------------------------------------------------------------
 def cmd_serve(args: argparse.Namespace) -> int:
-    from workbench.door.logins import LoginPolicy
     from workbench.door.ports import parse_range
     from workbench.door.serverlog import setup_logging
     from workbench.door.users import UsersFileError
@@ -310,39 +274,9 @@ def cmd_serve(args: argparse.Namespace) -> int:
             f"--app-memory {args.app_memory}: give at least 64 (MiB; an app needs about 50) or "
             "0 for no cap (default 512)",
         )
-    penalties = (args.penalty_min, args.penalty_max)
-    if not all(math.isfinite(x) and x >= 0 for x in penalties) or args.unauthenticated_start < 1:
-        return fail(
-            "serve-ssh",
-            "--penalty-min and --penalty-max must be 0 or more (0: no penalties), and "
-            "--unauthenticated-start at least 1",
-        )
-    login_numbers = (
-        args.login_timeout,
-        args.unauthenticated_grace,
-        args.max_unauthenticated,
-        args.max_unauthenticated_per_address,
-        args.password_lock_after,
-        args.password_lock_for,
-    )
-    if not all(math.isfinite(x) and x > 0 for x in login_numbers):
-        return fail(
-            "serve-ssh",
-            "--login-timeout, --unauthenticated-grace, --max-unauthenticated, "
-            "--max-unauthenticated-per-address, --password-lock-after and --password-lock-for "
-            "must be > 0",
-        )
-    logins = LoginPolicy(
-        login_timeout=args.login_timeout,
-        max_unauthenticated=args.max_unauthenticated,
-        max_unauthenticated_per_address=args.max_unauthenticated_per_address,
-        lock_after=args.password_lock_after,
-        lock_for=args.password_lock_for,
-        unauthenticated_start=args.unauthenticated_start,
-        unauthenticated_grace=args.unauthenticated_grace,
-        penalty_least=args.penalty_min,
-        penalty_longest=args.penalty_max,
-    )
+    logins = login_policy(args)
+    if isinstance(logins, str):
+        return fail("serve-ssh", logins)
     data_dir = resolve_data_dir(args.data_dir)
     try:
         db = resolve_db(args.db)

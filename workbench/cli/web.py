@@ -14,7 +14,7 @@ from workbench.labs.store.database import ENV_DB
 from workbench.labs.store.store import StoreError, resolve_data_dir, resolve_db
 
 from .common import db_option, record_quota_options, upload_options
-from .doors import door_options
+from .doors import door_options, login_policy
 from .ssh import (
     WORKBENCH_APP,
     Door,
@@ -72,7 +72,6 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def cmd_serve_web(args: argparse.Namespace) -> int:
-    from workbench.door.logins import LoginPolicy
     from workbench.door.networks import parse_networks
     from workbench.door.ports import parse_range
     from workbench.door.serverlog import setup_logging
@@ -101,15 +100,20 @@ def cmd_serve_web(args: argparse.Namespace) -> int:
             "proxy that sets it (the header from anywhere else is refused)",
         )
     numbers = (args.reattach_grace, args.login_hours, args.idle_timeout)
-    if not all(math.isfinite(x) and x > 0 for x in numbers) or args.max_sessions < 1:
+    if (
+        not all(math.isfinite(x) and x > 0 for x in numbers)
+        or min(args.max_sessions, args.max_per_user) < 1
+    ):
         return fail(
             command,
-            "--reattach-grace, --login-hours, --idle-timeout and --max-sessions must be > 0",
+            "--reattach-grace, --login-hours, --idle-timeout, --max-sessions and --max-per-user "
+            "must be > 0",
         )
     if args.app_memory < 0 or 0 < args.app_memory < 64:
         return fail(command, f"--app-memory {args.app_memory}: give at least 64 (MiB) or 0")
-    if not (args.password_lock_after > 0 and args.password_lock_for > 0):
-        return fail(command, "--password-lock-after and --password-lock-for must be > 0")
+    logins = login_policy(args)
+    if isinstance(logins, str):
+        return fail(command, logins)
     data_dir = resolve_data_dir(args.data_dir)
     try:
         db = resolve_db(args.db)
@@ -127,6 +131,7 @@ def cmd_serve_web(args: argparse.Namespace) -> int:
         users_file=Path(args.users) if args.users else None,
         port_range=port_range,
         limits=SessionLimits(
+            per_user=args.max_per_user,
             total=args.max_sessions,
             idle_timeout=args.idle_timeout,
             max_columns=columns,
@@ -136,9 +141,7 @@ def cmd_serve_web(args: argparse.Namespace) -> int:
             user_logs=args.user_logs_quota or 0,
             server_memory=args.server_memory,
         ),
-        logins=LoginPolicy(
-            lock_after=args.password_lock_after, lock_for=args.password_lock_for
-        ),
+        logins=logins,
         fork_server=not args.no_fork_server,
         reattach_grace=args.reattach_grace,
         login_lifetime=args.login_hours * 3600,

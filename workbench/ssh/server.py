@@ -29,6 +29,7 @@ from workbench.door.appproc import (
 from workbench.door.checking import PasswordDesk
 from workbench.door.course_files import CourseWorkspaces, bring_workspace
 from workbench.door.forkserver import ForkServer, ForkServerError
+from workbench.door.leases import Lease, SessionLeases
 from workbench.door.limits import SessionLimits, describe_duration, describe_memory
 from workbench.door.logins import ConnectionGate, Eviction, LoginGuard, LoginPolicy, QuietLog, Stage
 from workbench.door.memory import SHORT_OF_MEMORY, MemoryWatch
@@ -138,6 +139,8 @@ class LabServer:
         self.host_key = load_or_create_host_key(config.host_key)
         self.pool = PortPool(*config.port_range)
         self.sessions: dict[int, LabSession] = {}
+        #: every door's sessions in this data folder, for the per-user cap
+        self.leases = SessionLeases(config.data_dir, "ssh")
         self.connections: set[LabConnection] = set()
         #: connections logged in, per user
         self.user_connections: Counter[str] = Counter()
@@ -668,6 +671,8 @@ class LabSession(asyncssh.SSHServerSession):
         self.spec: AppSpec | None = None
         self.app: AppProcess | None = None
         self.ports: tuple[int, ...] = ()
+        #: the session's place among the user's sessions of every door (see door/leases.py)
+        self.lease: Lease | None = None
         self.last_input = time.monotonic()
         self.started_at = time.monotonic()
         self._ending: asyncio.Task[None] | None = None
@@ -769,10 +774,7 @@ class LabSession(asyncssh.SSHServerSession):
         if self.request != "shell" or not self.has_pty:
             self._refuse_request()
             return
-        why = self.server.config.limits.refusal(
-            len([s for s in self.server.sessions.values() if s.user.name == self.user.name]),
-            len(self.server.sessions),
-        )
+        why = self._take_lease()
         if why is not None:
             log.warning(
                 "session refused: %s from %s: %s", self.user.name, self.connection.peer, why
@@ -781,6 +783,30 @@ class LabSession(asyncssh.SSHServerSession):
             return
         self.server.sessions[self.id] = self
         self._runner = asyncio.create_task(self._run(), name=f"ssh-session-{self.id}")
+
+    def _take_lease(self) -> str | None:
+        """Take this session's place among the user's sessions of every door (the lease),
+        or say why it may not open: the server full, or the user at their cap."""
+        server, user = self.server, self.user.name
+        limits = server.config.limits
+        why = limits.refusal(0, len(server.sessions))
+        if why is not None:
+            return why
+        try:
+            self.lease, held = server.leases.take(
+                user, limits.per_user, f"session {self.id} from {self.connection.peer}"
+            )
+        except OSError as exc:
+            log.error("session refused: %s: its lease could not be made: %s", user, exc)
+            return "The workbench could not be started; tell the instructor."
+        return None if self.lease is not None else limits.refusal(held, 0)
+
+    def _forget(self) -> bool:
+        """Leave the server's sessions and let go of the lease; whether it was one of them."""
+        if self.lease is not None:
+            self.lease.release()
+            self.lease = None
+        return self.server.sessions.pop(self.id, None) is not None
 
     def _refuse_request(self) -> None:
         config = self.server.config
@@ -814,7 +840,7 @@ class LabSession(asyncssh.SSHServerSession):
             self.ports = server.pool.allocate(user, 2, owned=server.held_remote_ports(user))
         except PoolExhausted as exc:
             log.error("session refused: %s: %s", user, exc)
-            server.sessions.pop(self.id, None)
+            self._forget()
             self._say_and_exit(
                 "The lab server has no free VIPLE ports left; try again in a few minutes.", 1
             )
@@ -945,7 +971,7 @@ class LabSession(asyncssh.SSHServerSession):
                     "session %d: %s's app log %s",
                     self.id, self.user.name, "\n  ".join(lines),
                 )  # fmt: skip
-        if server.sessions.pop(self.id, None) is not None and self.app is not None:
+        if self._forget() and self.app is not None:
             log.info(
                 "session %d: %s ended (exit %s) after %.0f s",
                 self.id,
@@ -1039,4 +1065,4 @@ class LabSession(asyncssh.SSHServerSession):
             log.info("session %d: %s: %s", self.id, self.user.name, why)
             self._ending = asyncio.create_task(self._stop(""))
         elif self._runner is None:
-            self.server.sessions.pop(self.id, None)
+            self._forget()

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 from workbench.door.appproc import AppProcess
+from workbench.door.leases import Lease
 
 log = logging.getLogger("workbench.web")
 
@@ -164,6 +165,8 @@ class StudentApp:
         self.ending = False
         #: the VIPLE ports the app was given (released when it ends)
         self.ports: tuple[int, ...] = ()
+        #: its place among the user's sessions of every door (released when it ends)
+        self.lease: Lease | None = None
 
     # -- pages -------------------------------------------------------------------------------
     def attach(self, socket: Socket, address: str, size: tuple[int, int]) -> Page:
@@ -225,17 +228,18 @@ class StudentApp:
         self.last_input = time.monotonic()
         self.app.send_keys(data)
 
-    def resize(self, size: tuple[int, int]) -> None:
+    def resize(self, size: tuple[int, int]) -> bool:
         """Pass a new size on, at most once per ``resize_every`` seconds (of a storm of
-        resizes the app gets the latest)."""
+        resizes the app gets the latest); False when it came while one was held back."""
         self._wanted = size
         if self._resize is not None:
-            return
+            return False
         wait = self._resized_at + self.resize_every - time.monotonic()
         if wait <= 0:
             self._pass_size_on()
         else:
             self._resize = asyncio.get_running_loop().call_later(wait, self._pass_size_on)
+        return True
 
     def _pass_size_on(self) -> None:
         self._resize = None

@@ -25,6 +25,7 @@ from workbench.door.appproc import AppProcess, AppSpec, app_env
 from workbench.door.checking import PasswordDesk
 from workbench.door.course_files import CourseWorkspaces, bring_workspace
 from workbench.door.forkserver import ForkServer, ForkServerError
+from workbench.door.leases import Lease, SessionLeases
 from workbench.door.limits import describe_duration, describe_memory
 from workbench.door.logins import ConnectionGate, LoginGuard, QuietLog
 from workbench.door.memory import SHORT_OF_MEMORY, MemoryWatch
@@ -36,7 +37,15 @@ from workbench.files.workspace import workspace_folder
 
 from . import transfer
 from .config import WebConfig
-from .cookies import CSRF_COOKIE, SESSION_COOKIE, Login, Logins, new_token, same_token
+from .cookies import (
+    CSRF_COOKIE,
+    LOGINS_FOLDER,
+    SESSION_COOKIE,
+    Login,
+    Logins,
+    new_token,
+    same_token,
+)
 from .gate import RequestGate
 from .pages import login_page, terminal_page
 from .proxy import Origin, header_login, origin_of
@@ -86,9 +95,12 @@ class WebServer:
             config.trusted_proxies,
             lambda key, line: self.say_now_and_then(key, "%s", line),
         )
-        self.logins = Logins(config.login_lifetime)
+        #: kept in the data folder, so a restart logs no one out
+        self.logins = Logins(config.login_lifetime, folder=config.data_dir / LOGINS_FOLDER)
         self.pool = PortPool(*config.port_range)
         self.apps: dict[str, StudentApp] = {}
+        #: every door's sessions in this data folder, for the per-user cap
+        self.leases = SessionLeases(config.data_dir, "web")
         self.quiet_log = QuietLog()
         self.memory = MemoryWatch(config.limits.server_memory)
         self.forkserver: ForkServer | None = None
@@ -170,11 +182,19 @@ class WebServer:
                 "logins by the %s header from %s only (passwords are not taken)",
                 config.user_header, ", ".join(map(str, config.trusted_proxies)),
             )  # fmt: skip
+        logins = config.logins
+        log.info(
+            "logins: %g s to send a request; at most %d connections without one (%d per "
+            "address); passwords locked for %s after %d failures; %d logins kept from before",
+            logins.login_timeout, logins.max_unauthenticated,
+            logins.max_unauthenticated_per_address, describe_duration(logins.lock_for),
+            logins.lock_after, len(self.logins),
+        )  # fmt: skip
         limits = config.limits
         log.info(
-            "limits: %d sessions in all; terminals at most %dx%d; app memory %s; messages "
-            "from a page at most %d bytes",
-            limits.total, limits.max_columns, limits.max_rows,
+            "limits: %d sessions in all, %d per user (over both doors); terminals at most "
+            "%dx%d; app memory %s; messages from a page at most %d bytes",
+            limits.total, limits.per_user, limits.max_columns, limits.max_rows,
             describe_memory(limits.app_memory) if limits.app_memory else "not capped",
             config.max_message,
         )  # fmt: skip
@@ -253,7 +273,16 @@ class WebServer:
 
     def current_login(self, request: web.Request) -> tuple[str | None, Login | None]:
         login_id = request.cookies.get(SESSION_COOKIE)
-        return login_id, self.logins.get(login_id)
+        login = self.logins.get(login_id)
+        if login is None:
+            return login_id, None
+        user = self.desk.known(login.user)
+        if user is None:  # taken out of the users file since: logged out
+            self.logins.close(login_id)
+            log.info("logout: %s is no longer in the users file", shown(login.user))
+            return login_id, None
+        login.role = user.role
+        return login_id, login
 
     def _set_login_cookie(self, response: web.StreamResponse, login_id: str, secure: bool) -> None:
         response.set_cookie(
@@ -377,8 +406,10 @@ class WebServer:
         login_id, login = self.current_login(request)
         form = await request.post()
         token = form.get("csrf")
-        if login is None or not self.same_site(request) or not same_token(
-            token if isinstance(token, str) else None, login.csrf
+        if (
+            login is None
+            or not self.same_site(request)
+            or not same_token(token if isinstance(token, str) else None, login.csrf)
         ):
             self.say_now_and_then(f"logout {self.origin(request).address}",
                                   "logout refused from %s: no login or not its form",
@@ -495,8 +526,11 @@ class WebServer:
             self.say_now_and_then(f"page said {user}", "a page of %s sent %r: not a message "
                                   "of the page", user, text[:60])  # fmt: skip
             return
-        if cols > 0 and rows > 0:
-            student.resize(self.clamped(cols, rows, user))
+        if cols > 0 and rows > 0 and not student.resize(self.clamped(cols, rows, user)):
+            self.say_now_and_then(
+                f"resizes {user}", "resizes from a page of %s come faster than one per %g s: "
+                "the app is given the latest", user, self.config.limits.resize_every,
+            )  # fmt: skip
 
     # -- the student's app -------------------------------------------------------------------
     async def app_of(self, login: Login, size: tuple[int, int]) -> StudentApp | str:
@@ -516,10 +550,34 @@ class WebServer:
     async def _start_app(self, login: Login, size: tuple[int, int]) -> StudentApp | str:
         config = self.config
         user = login.user
-        why = config.limits.refusal(0, len(self.apps))
+        limits = config.limits
+        why = limits.refusal(0, len(self.apps))
+        lease = None
+        if why is None:
+            try:
+                lease, held = self.leases.take(user, limits.per_user, "a browser's page")
+            except OSError as exc:
+                log.error("session refused: %s: its lease could not be made: %s", user, exc)
+                return "The workbench could not be started; tell the instructor."
+            if lease is None:
+                why = limits.refusal(held, 0)
         if why is not None:
             log.warning("session refused: %s: %s", user, why)
             return why
+        assert lease is not None
+        try:
+            started = await self._start_leased(login, size, lease)
+        except BaseException:
+            lease.release()
+            raise
+        if isinstance(started, str):
+            lease.release()
+        return started
+
+    async def _start_leased(
+        self, login: Login, size: tuple[int, int], lease: Lease
+    ) -> StudentApp | str:
+        config, user = self.config, login.user
         try:
             ports = self.pool.allocate(user, 2)
         except PoolExhausted as exc:
@@ -555,6 +613,7 @@ class WebServer:
         )  # fmt: skip
         holder.append(student)
         student.ports = ports
+        student.lease = lease
         try:
             await process.start()
         except OSError as exc:
@@ -573,8 +632,10 @@ class WebServer:
     async def _watch(self, student: StudentApp) -> None:
         code = await student.app.wait()
         if not student.ending:
-            message = "The workbench ended." if code == 0 else (
-                f"The workbench ended with an error ({code})."
+            message = (
+                "The workbench ended."
+                if code == 0
+                else (f"The workbench ended with an error ({code}).")
             )
             if code and student.app.ran_out_of_memory():
                 message = self.config.limits.memory_message()
@@ -591,6 +652,9 @@ class WebServer:
         if self.apps.get(student.user) is student:
             del self.apps[student.user]
         self.pool.release(student.ports)
+        if student.lease is not None:
+            student.lease.release()
+            student.lease = None
         lines = student.app.errors.report()
         if lines:
             log.warning("%s's app log %s", student.user, "\n  ".join(lines))
@@ -663,9 +727,7 @@ class WebServer:
         if not same_token(token if isinstance(token, str) else None, login.csrf):
             self.say_now_and_then(f"upload token {login.user}", "upload refused: %s from %s: "
                                   "not its form's token", login.user, where.address)  # fmt: skip
-            return web.json_response(
-                {"error": "the form was not this page's: reload"}, status=403
-            )
+            return web.json_response({"error": "the form was not this page's: reload"}, status=403)
         sent = form.get("file")
         if not isinstance(sent, web.FileField):
             return web.json_response({"error": "choose a file to send"}, status=400)
@@ -697,4 +759,3 @@ class WebServer:
             content_type="application/octet-stream",
             headers={"Content-Disposition": f'attachment; filename="{name}"'},
         )
-
