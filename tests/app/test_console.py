@@ -3,12 +3,14 @@ or declining a request from the instructor's own app."""
 
 from __future__ import annotations
 
+import pytest
 from textual.widgets import OptionList, Static
 
 from tests.waiting import until
 from workbench.labs.model import load_labs
 from workbench.labs.signoff.instructors import KdfParams, create_instructor
 from workbench.labs.signoff.verify import verify_log
+from workbench.labs.store import changes
 from workbench.labs.store.queue import DECLINED, SIGNED
 from workbench.labs.store.store import Store
 from workbench.tui.console_app import ConsoleApp
@@ -70,6 +72,33 @@ async def test_the_class_and_the_queue_follow_the_store(tmp_path):
         assert queue_lines(app)[0].startswith("1. cat and dan")
         await until(lambda: "waiting #1" in class_lines(app)[1], "cat's place")
         assert any("Sign-off queue: 1 waiting" in line for line in screen_lines(app))
+
+
+@pytest.mark.parametrize("kind", ["sqlite", "postgresql"])
+def test_a_request_shows_at_word_of_the_commit_not_at_a_clock(kind, tmp_path, request, monkeypatch):
+    """The console reads again when the store says another connection committed: with the
+    read without word an hour away, a student's request still shows within moments."""
+    monkeypatch.setattr(changes, "EVEN_WITHOUT_WORD", 3600.0)
+    url = request.getfixturevalue("pg_url") if kind == "postgresql" else None
+    data = tmp_path / "data"
+
+    def opened(folder):
+        return Store.open(folder, db=url) if url else Store.open(folder)
+
+    with opened(data) as store:
+        save_student(store, "cat", passed=False)
+
+    @sync
+    async def watch() -> None:
+        app = ConsoleApp(opened(data), load_labs())
+        async with app.run_test(size=(80, 24)):
+            await until(lambda: len(class_lines(app)) == 1, "the class")
+            with opened(tmp_path / "student" if url else data) as student_side:
+                student_side.queue.request("cat", "dan", "dan", LAB, EXERCISE)
+            await until(lambda: len(queue_lines(app)) == 1, "the request, at word of it")
+            assert queue_lines(app)[0].startswith("1. cat and dan")
+
+    watch()
 
 
 @sync

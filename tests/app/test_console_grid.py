@@ -121,8 +121,11 @@ async def test_the_grid_follows_the_store_in_ascii(tmp_path):
             )  # fmt: skip
             save_progress(store, "ben", waiting)
         grid.console.read_now()
-        await until(lambda: grid_rows(grid)["ana"][0] == "signed", "the sign-off")
-        assert grid_rows(grid)["ben"][0] == "2/3?"
+        # word of each write may come before the next is made: wait for the read after both
+        await until(
+            lambda: grid_rows(grid)["ana"][0] == "signed" and grid_rows(grid)["ben"][0] == "2/3?",
+            "the sign-off and the question",
+        )
         assert "?: a question waits for you" in text(grid, "#grid-legend")
         assert all(line.isascii() for line in screen_lines(app))
 

@@ -2,10 +2,10 @@
 its objectives and who waits for sign-off; every student's standing in every exercise (the
 grid); and the programs two students' evidence share (the copy hints), read from the store.
 
-:func:`read_class` reads it all in one go (the console calls it about once a second, in a
-thread); :func:`read_request` reads what one request rests on: the exercise's saved progress,
-the objectives' evidence and the run they rest on, and the sign-off fields an instructor signs.
-Nothing here imports Textual.
+:func:`read_class` reads it all in one go (the console calls it in a thread, at word of a
+change to the store: ``labs/store/changes.py``); :func:`read_request` reads what one request
+rests on: the exercise's saved progress, the objectives' evidence and the run they rest on,
+and the sign-off fields an instructor signs. Nothing here imports Textual.
 
 Everything read here reaches the instructor's terminal, and much of it was written by a
 student's app (the evidence, the driver, the partner's name) or read from their files (a

@@ -30,6 +30,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from .store.changes import ChangeWaiter
 from .store.pending import pending_path
 from .store.queue import DECLINED, SIGNED, WAITING, WITHDRAWN, QueueEntry, QueueState
 from .store.store import Store, StoreError, StoreUnavailable, resolve_data_dir
@@ -42,6 +43,7 @@ __all__ = [
     "WITHDRAWN",
     "Away",
     "Back",
+    "ChangeWaiter",
     "CourseStore",
     "KeptNotSaved",
     "KeptSaved",

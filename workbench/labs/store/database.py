@@ -54,6 +54,10 @@ MAX_URL = 2048
 POSTGRES_SCHEMES = ("postgresql://", "postgres://")
 
 
+#: the channel every PostgreSQL write transaction notifies (``labs/store/changes.py``)
+CHANGES_CHANNEL = "workbench_store"
+
+
 class StoreError(Exception):
     """The database cannot be opened, read or written; the message names it."""
 
@@ -441,6 +445,9 @@ class PostgresBackend(Backend):
                     with suppress(psycopg.Error):
                         tx.execute("ROLLBACK")
                     raise
+                # word for the readers that show the store live (labs/store/changes.py): the
+                # server sends it at the commit, and never for a write rolled back
+                tx.execute(f"NOTIFY {CHANGES_CHANNEL}")
                 tx.execute("COMMIT")
         except psycopg.Error as exc:
             raise self._failed(exc, "write") from None

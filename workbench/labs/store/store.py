@@ -36,6 +36,7 @@ import platformdirs
 from workbench.files.private import PRIVATE_FILE, private_dir, tighten
 
 from ..signlog import GENESIS, entry_hash
+from .changes import Changes, watch
 from .database import (
     BUSY_TIMEOUT_MS,
     Backend,
@@ -236,6 +237,12 @@ class Store:
     @property
     def postgres(self) -> bool:
         return self.backend.postgres
+
+    def watch_changes(self) -> Changes:
+        """A watcher of commits to this store by other connections (``changes.py``), with a
+        connection of its own: for one reading thread. :class:`StoreUnavailable` when it cannot
+        be made now."""
+        return watch(self.backend)
 
     @property
     def available(self) -> bool:

@@ -27,7 +27,7 @@ from textual.widgets import OptionList, Static
 from textual.widgets.option_list import Option
 
 from workbench.labs.classview import ClassView, StudentRow, read_class
-from workbench.labs.course_store import QueueEntry, Store, StoreUnavailable
+from workbench.labs.course_store import ChangeWaiter, QueueEntry, Store, StoreUnavailable
 from workbench.labs.model import Lab
 
 from ..host import FollowsUnicode
@@ -36,7 +36,8 @@ from ..plain import follow_app
 from ..widgets.key_bar import KeyBar
 
 #: seconds between reads of the store
-POLL_SECONDS = 1.0
+#: while the store is away, how often the console tries to read it again (seconds)
+AWAY_SECONDS = 1.0
 
 
 class ClassRead(Message):
@@ -177,16 +178,21 @@ class ConsoleScreen(FollowsUnicode, Screen[None]):
 
     # -- the reading thread --------------------------------------------------------------
     def _poll(self) -> None:
-        while not self._stop.is_set():
-            try:
-                read = ClassRead(read_class(self.store, self.labs))
-            except StoreUnavailable:
-                read = ClassRead(None, "the course database cannot be reached: trying again")
-            except Exception as exc:
-                read = ClassRead(None, f"cannot read the class: {exc}")
-            self.post_message(read)
-            self._wake.wait(POLL_SECONDS)
-            self._wake.clear()
+        """Read the class, then again at word of a change to the store (another connection's
+        commit: a student's progress or request), at ``read_now``, or after a while anyway."""
+        waiter = ChangeWaiter(self.store.watch_changes, self._wake, self._stop, away=AWAY_SECONDS)
+        try:
+            while not self._stop.is_set():
+                try:
+                    read = ClassRead(read_class(self.store, self.labs))
+                except StoreUnavailable:
+                    read = ClassRead(None, "the course database cannot be reached: trying again")
+                except Exception as exc:
+                    read = ClassRead(None, f"cannot read the class: {exc}")
+                self.post_message(read)
+                waiter.wait()
+        finally:
+            waiter.close()
 
     # -- on the event loop ---------------------------------------------------------------
     @on(ClassRead)

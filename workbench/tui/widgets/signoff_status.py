@@ -21,13 +21,17 @@ from workbench.labs.course_store import (
     SIGNED,
     WAITING,
     WITHDRAWN,
+    ChangeWaiter,
     QueueState,
     Store,
     StoreUnavailable,
 )
 
-#: seconds between reads of the store
-POLL_SECONDS = 1.0
+#: how often a SQLite store's data version is asked (seconds): a student's status may take
+#: this long to show a sign-off; PostgreSQL's word comes at once
+CHECK_SECONDS = 0.25
+#: while the store is away, how often the status tries to read it again (seconds)
+AWAY_SECONDS = 1.0
 
 
 @dataclass(frozen=True)
@@ -161,21 +165,28 @@ class SignoffStatus(Static):
 
     # -- the reading thread ------------------------------------------------------------------
     def _poll(self) -> None:
+        """Ask and read in this thread: again at word of a change to the store (an instructor
+        signed or declined), when asked to at once, or after a while anyway."""
         store = self.store
         assert store is not None
-        while not self._stop.is_set():
-            with self._lock:
-                target, asks, self._asks = self._target, self._asks, []
-            for asked in asks:
-                self._request(store, asked)
-            if target is not None:
-                seen = self._read(store, target)
-                try:
-                    self.app.call_from_thread(self._take, seen)
-                except RuntimeError:  # the app is ending
-                    return
-            self._wake.wait(POLL_SECONDS)
-            self._wake.clear()
+        waiter = ChangeWaiter(
+            store.watch_changes, self._wake, self._stop, check=CHECK_SECONDS, away=AWAY_SECONDS
+        )
+        try:
+            while not self._stop.is_set():
+                with self._lock:
+                    target, asks, self._asks = self._target, self._asks, []
+                for asked in asks:
+                    self._request(store, asked)
+                if target is not None:
+                    seen = self._read(store, target)
+                    try:
+                        self.app.call_from_thread(self._take, seen)
+                    except RuntimeError:  # the app is ending
+                        return
+                waiter.wait()
+        finally:
+            waiter.close()
 
     def _request(self, store: Store, target: Target) -> None:
         try:
