@@ -11,7 +11,8 @@ FSM and the program taking turns (best of REPEATS each, so a busy machine slows 
   the two trajectories, and the physics they cost, differ).
 
 Prints simulated seconds per wall second for each, the interpreter's activity count, and the
-program's speed as a share of the FSM's (target: >= 0.7 for the same algorithm). Then runs
+program's speed as a share of the FSM's, with a target line for each pair (>= 0.85 for
+web-wall-following, the same algorithm; >= 0.70 for right-wall, whose robot differs). Then runs
 ``workbench viple run`` as its own process for 600 simulated s (a copy of the maze without its
 exit, so the run is not cut short) and prints its real-time factor, start-up included.
 """
@@ -36,6 +37,8 @@ PAIRS = (
     ("web-wall-following", str(ROOT / "programs" / "web-wall-following.viple")),
     ("right-wall", str(ROOT / "programs" / "right-wall.viple")),
 )
+#: the share of its FSM's speed each program should reach
+TARGETS = {"web-wall-following": 0.85, "right-wall": 0.70}
 SECONDS = 600.0
 REPEATS = 5
 
@@ -90,8 +93,12 @@ def main() -> None:
         print(f"    FSM          {fsm:7.0f}x real time")
         print(f"    program      {prog:7.0f}x real time ({steps:,} activities run)")
         print(f"    program/FSM  {prog / fsm:7.2f}")
-    met = shares[PAIRS[0][0]] >= 0.7
-    print(f"  target: program >= 0.7 of the same algorithm's FSM: {'met' if met else 'NOT met'}")
+    for algorithm, target in TARGETS.items():
+        met = shares[algorithm] >= target
+        print(
+            f"  target {algorithm}: program >= {target:.2f} of its FSM: "
+            f"{'met' if met else 'NOT met'} ({shares[algorithm]:.2f})"
+        )
     for _, program in PAIRS:
         wall, cpu = whole_process(program)
         print(
