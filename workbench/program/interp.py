@@ -202,6 +202,21 @@ class ProgramController:
             **{kind: MAPPED_RUNS[m.activity] for kind, m in compiled.program.kinds.items()},
             **RUNS,
         }
+        self._activities = compiled.program.activities
+        #: activity id -> (its handler, the activity), looked up once instead of every step
+        self._handlers = {
+            aid: (self._runs.get(act.kind, _NEVER_RUNS), act)
+            for aid, act in compiled.program.activities.items()
+        }
+        #: activity id -> its compiled expressions in value order (If and Switch walk them)
+        exprs: dict[int, list[Any]] = {}
+        for (aid, index), expression in sorted(compiled.expressions.items()):
+            exprs.setdefault(aid, []).append((index, expression))
+        self._exprs = {
+            aid: tuple(e.run for _, e in pairs)
+            for aid, pairs in exprs.items()
+            if [i for i, _ in pairs] == list(range(len(pairs)))
+        }
         self.reset()
 
     # -- the Controller protocol ----------------------------------------------------------
@@ -289,8 +304,13 @@ class ProgramController:
         if self._parked:
             self._ready.extend(self._parked)
             self._parked = []
-        self._keys(t)
-        if (readings or report is not None) and self._report_due(t):
+        if self._pushed or self._next_key < len(self.key_script) or self._typed.held:
+            self._keys(t)
+        if (
+            (readings or report is not None)
+            and (self.report_period is None or t + _SAME >= self._next_report)
+            and self._report_due(t)
+        ):
             # a tick between two reports (of a remote robot, or of the paced simulator) fires
             # no sensor
             ports = self._ports
@@ -512,10 +532,12 @@ class ProgramController:
 
     # -- one activity ----------------------------------------------------------------------
     def _step(self, flow: Flow) -> bool:
-        """Run the activity the flow is at; False when the flow has ended."""
-        act = self.program.activities[flow.activity]
+        """Run the activity the flow is at, through the handler of its kind (:data:`RUNS`; a
+        kind named in a mapping file, through :data:`MAPPED_RUNS`); False when the flow has
+        ended."""
+        handler, act = self._handlers[flow.activity]
         try:
-            return self._execute(flow, act)
+            return handler(self, flow, act)
         except LimitError as exc:
             self._stop(act.id, str(exc))
             return False
@@ -541,10 +563,12 @@ class ProgramController:
             value, self.globals, flow.frame.instance, value if isinstance(value, dict) else None
         )
 
-    def _execute(self, flow: Flow, act) -> bool:
-        """Run one activity through the handler of its kind (:data:`RUNS`; a kind named in
-        a mapping file, through :data:`MAPPED_RUNS`)."""
-        return self._runs.get(act.kind, _NEVER_RUNS)(self, flow, act)
+    def _expr(self, aid: int, index: int) -> Callable[[Scope], Value]:
+        """The compiled expression ``index`` of activity ``aid``, as the function it runs."""
+        exprs = self._exprs.get(aid)
+        if exprs is not None and index < len(exprs):
+            return exprs[index]
+        return self.compiled.expr(aid, index).run
 
     # -- the handlers of the activity kinds: each runs the activity the flow is at and says
     # -- whether the flow goes on (it has moved the flow to the next activity)
@@ -558,7 +582,7 @@ class ProgramController:
         return self._go(flow, 0, self.compiled.constants[act.id])
 
     def _calculate(self, flow: Flow, act) -> bool:
-        return self._go(flow, 0, self.compiled.expr(act.id, 0)(self._scope(flow)))
+        return self._go(flow, 0, self._expr(act.id, 0)(self._scope(flow)))
 
     def _variable(self, flow: Flow, act) -> bool:
         key = self._var_keys[act.id]
@@ -569,9 +593,12 @@ class ProgramController:
 
     def _if(self, flow: Flow, act) -> bool:
         scope = self._scope(flow)
-        expr = self.compiled.expr
-        for index in range(len(act.values)):
-            if _truth(expr(act.id, index)(scope), index):
+        exprs = self._exprs.get(act.id)
+        if exprs is None or len(exprs) != len(act.values):
+            expr = self.compiled.expr
+            exprs = tuple(expr(act.id, index).run for index in range(len(act.values)))
+        for index, condition in enumerate(exprs):
+            if _truth(condition(scope), index):
                 return self._go(flow, index, flow.value)
         return self._go(flow, ELSE, flow.value)
 
@@ -587,7 +614,7 @@ class ProgramController:
 
     def _while(self, flow: Flow, act) -> bool:
         value = flow.value
-        if _truth(self.compiled.expr(act.id, 0)(self._scope(flow)), 0):
+        if _truth(self._expr(act.id, 0)(self._scope(flow)), 0):
             mark = (self.changes, _key(value))
             if flow.loops.get(act.id) == mark:
                 raise _Park()
@@ -619,9 +646,8 @@ class ProgramController:
 
     def _drive(self, flow: Flow, act) -> bool:
         scope = self._scope(flow)
-        expr = self.compiled.expr
-        left = _power(expr(act.id, 0)(scope), "left")
-        right = _power(expr(act.id, 1)(scope), "right")
+        left = _power(self._expr(act.id, 0)(scope), "left")
+        right = _power(self._expr(act.id, 1)(scope), "right")
         self._command(WheelPowers(left, right))
         return self._go(flow, 0, flow.value)
 
