@@ -13,11 +13,17 @@ import os
 from pathlib import Path
 
 import pytest
+from hypothesis import settings
 
 import workbench.sim.record
 
 from .full_disk import FakeDisk
 from .pgserver import NoServer, PgServer
+
+# hypothesis's own per-example deadline (200 ms) is a wall-clock rate: on a loaded machine a
+# case that passes takes longer and fails as "unreliable". Tests assert behaviour, never speed.
+settings.register_profile("workbench", deadline=None)
+settings.load_profile("workbench")
 
 _names = itertools.count(1)
 
