@@ -10,6 +10,7 @@ import math
 from workbench.door.limits import SessionLimits
 from workbench.door.logins import LoginPolicy
 from workbench.door.serverlog import SERVER_LOG_SIZE
+from workbench.door.spares import MAX_SPARES
 
 from .common import size
 
@@ -98,10 +99,23 @@ def door_options(parser: argparse.ArgumentParser) -> None:
         help="seconds an account takes no passwords once locked; keys still work (default 900)",
     )  # fmt: skip
     parser.add_argument(
+        "--spare-apps", type=int, default=0, metavar="N",
+        help="keep N students' apps started ahead of their sessions, each waiting at the names "
+        "dialog, so that a class logging in at once sees its first screens sooner (each spare "
+        "holds an app's memory while it waits; default 0: each app starts with its session)",
+    )  # fmt: skip
+    parser.add_argument(
         "--no-fork-server", action="store_true",
         help="start each session's app as a new Python process instead of forking it from a "
         "fork server that has the app imported (slower to start, more memory)",
     )  # fmt: skip
+
+
+def spares_problem(count: int) -> str | None:
+    """What is wrong with ``--spare-apps COUNT`` (None: nothing)."""
+    if 0 <= count <= MAX_SPARES:
+        return None
+    return f"--spare-apps {count}: give 0 (no spares) to {MAX_SPARES}"
 
 
 def login_policy(args: argparse.Namespace) -> LoginPolicy | str:

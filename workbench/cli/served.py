@@ -12,12 +12,13 @@ as the command line does without ``--db``.
 from __future__ import annotations
 
 import json
+import socket
 import sys
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
 from workbench.labs.store.store import StoreError, resolve_db
-from workbench.wire.settings import AppSettings, SettingsError
+from workbench.wire.settings import SESSION_FIELDS, AppSettings, SettingsError
 
 from .common import error
 
@@ -43,6 +44,35 @@ def main(settings: object) -> int:
         return 2
     app.run()
     return app.return_code or 0
+
+
+def spare(template: object, control: socket.socket) -> int:
+    """A spare app (``workbench/door/spares.py``): the workbench started from the settings
+    every session shares (``template``, a JSON object; what is a session's own is left out),
+    waiting at the names dialog for its session on ``control``
+    (:mod:`workbench.tui.serving.seat`); then as :func:`main` with the session's settings."""
+    from workbench.labs.model import LabFileError
+    from workbench.tui.app import AppSetupError, make_app
+    from workbench.tui.serving.seat import Seat
+
+    try:
+        if not isinstance(template, dict):
+            raise SettingsError("the spare's settings are not a JSON object")
+        shared = {k: v for k, v in template.items() if k not in SESSION_FIELDS}
+        given = AppSettings.from_json(shared)
+        if given.role != "student":
+            raise SettingsError("a spare app is a student's workbench")
+        app = make_app(given, Seat(control, _with_db))
+    except (SettingsError, StoreError, AppSetupError, LabFileError) as exc:
+        error(f"no spare app: {exc}")
+        return 2
+    app.run()
+    return app.return_code or 0
+
+
+def _with_db(settings: AppSettings) -> AppSettings:
+    """A session's settings with the course database its environment names."""
+    return replace(settings, db=resolve_db(None))
 
 
 def run(argv: list[str]) -> int:

@@ -28,7 +28,7 @@ from workbench.labs.store.store import (
 )
 
 from .common import db_option, record_quota_options, upload_options
-from .doors import door_options, login_policy
+from .doors import door_options, login_policy, spares_problem
 
 #: the app every SSH session runs, given the session's settings as JSON (see
 #: :mod:`workbench.cli.served`): this Python's ``-m workbench.cli.served``, or forked from the
@@ -38,6 +38,7 @@ WORKBENCH_APP = AppEntry(
     command=(sys.executable, "-m", "workbench.cli.served"),
     main="workbench.cli.served:main",
     preload=("workbench.tui.app:warm_up",),
+    spare="workbench.cli.served:spare",
 )
 
 
@@ -242,6 +243,8 @@ def cmd_serve(args: argparse.Namespace) -> int:
         return fail("serve-ssh", f"--proxy-protocol {exc}")
     if args.max_per_user < 1 or args.max_sessions < 1 or not args.idle_timeout > 0:
         return fail("serve-ssh", "--max-per-user, --max-sessions and --idle-timeout must be > 0")
+    if (problem := spares_problem(args.spare_apps)) is not None:
+        return fail("serve-ssh", problem)
     if args.max_connections_per_user < 1:
         return fail(
             "serve-ssh",
@@ -311,6 +314,7 @@ def cmd_serve(args: argparse.Namespace) -> int:
         ),
         logins=logins,
         fork_server=not args.no_fork_server,
+        spare_apps=args.spare_apps,
         app=WORKBENCH_APP,
         record_quota=RecordQuota(args.record_cap, args.runs_quota),
         uploads=UploadLimits(args.upload_cap or 0, args.workspace_quota or 0, args.workspace_files),

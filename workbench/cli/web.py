@@ -14,7 +14,7 @@ from workbench.labs.store.database import ENV_DB
 from workbench.labs.store.store import StoreError, resolve_data_dir, resolve_db
 
 from .common import db_option, record_quota_options, upload_options
-from .doors import door_options, login_policy
+from .doors import door_options, login_policy, spares_problem
 from .ssh import (
     WORKBENCH_APP,
     Door,
@@ -109,6 +109,8 @@ def cmd_serve_web(args: argparse.Namespace) -> int:
             "--reattach-grace, --login-hours, --idle-timeout, --max-sessions and --max-per-user "
             "must be > 0",
         )
+    if (problem := spares_problem(args.spare_apps)) is not None:
+        return fail(command, problem)
     if args.app_memory < 0 or 0 < args.app_memory < 64:
         return fail(command, f"--app-memory {args.app_memory}: give at least 64 (MiB) or 0")
     logins = login_policy(args)
@@ -143,6 +145,7 @@ def cmd_serve_web(args: argparse.Namespace) -> int:
         ),
         logins=logins,
         fork_server=not args.no_fork_server,
+        spare_apps=args.spare_apps,
         reattach_grace=args.reattach_grace,
         login_lifetime=args.login_hours * 3600,
         tls_cert=Path(args.tls_cert) if args.tls_cert else None,

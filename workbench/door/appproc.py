@@ -60,6 +60,10 @@ class AppEntry:
     #: modules the fork server imports before it forks (the app's own), and functions
     #: (``module:function``) it calls once they are imported
     preload: tuple[str, ...] = ()
+    #: the app as a spare for the fork server to start ahead (``workbench/door/spares.py``):
+    #: ``module:function`` taking the settings every session shares and a control socket
+    #: ("": the app has no spares)
+    spare: str = ""
 
 
 @dataclass(frozen=True)
@@ -119,6 +123,47 @@ class AppSpec:
             TERM=self.term or "xterm-256color",
         )
         return env
+
+
+def spare_template(
+    data_dir: Path,
+    record_quota: RecordQuota,
+    uploads: UploadLimits,
+    term: str = "xterm-256color",
+) -> tuple[dict[str, object], dict[str, str]]:
+    """The settings and environment a student's session has before it is anybody's (what
+    is each session's own, ``SESSION_FIELDS``, is the spare's to take): a spare app's."""
+    spec = AppSpec("student", "student", 0, 0, "", data_dir, data_dir, data_dir,
+                   term=term, record_quota=record_quota, uploads=uploads)  # fmt: skip
+    return spec.settings().to_json(), spec.env()
+
+
+def keep_spares(
+    forkserver: ForkServer,
+    count: int,
+    app: AppEntry,
+    data_dir: Path,
+    record_quota: RecordQuota,
+    uploads: UploadLimits,
+) -> None:
+    """Have ``forkserver`` keep ``count`` students' apps started ahead (none when the app has
+    no spare entry), and say so in the log."""
+    if count <= 0:
+        return
+    if not app.spare:
+        log.warning("--spare-apps %d: this app has no spares; each session's app is forked", count)
+        return
+    from workbench.wire.settings import SESSION_FIELDS
+
+    from .forkserver import ForkServerError
+
+    settings, env = spare_template(data_dir, record_quota, uploads)
+    try:
+        forkserver.keep_spares(count, app.spare, settings, env, SESSION_FIELDS)
+    except ForkServerError as exc:
+        log.error("no spare apps: %s", exc)
+        return
+    log.info("the fork server keeps %d students' apps started ahead of their sessions", count)
 
 
 def app_env(base: dict[str, str] | None = None) -> dict[str, str]:

@@ -53,6 +53,8 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
+from .spares import SparePool, SpareSpec, SpareSpecError
+
 log = logging.getLogger("workbench.ssh")
 
 #: modules the app imports, loaded once in the fork server
@@ -129,6 +131,8 @@ class _Zygote:
     def __init__(self, control: socket.socket, main: Callable[[object], int]) -> None:
         self.control = control
         self.main = main
+        #: apps started ahead of their sessions (once the lab server asks for them)
+        self.spares: SparePool | None = None
 
     def serve(self) -> Callable[[], int] | None:
         """Serve until the lab server goes (``None``); in a forked child, return its app."""
@@ -138,26 +142,35 @@ class _Zygote:
         selector = selectors.DefaultSelector()
         selector.register(self.control, selectors.EVENT_READ)
         selector.register(wake_r, selectors.EVENT_READ)
+
+        def child(app: Callable[[], int]) -> Callable[[], int]:
+            selector.close()
+            for fd in (wake_r, wake_w):
+                os.close(fd)
+            self.control.close()
+            signal.set_wakeup_fd(-1)
+            return app
+
         try:
             while True:
-                for key, _ in selector.select():
+                spares = self.spares
+                for key, _ in selector.select(None if spares is None else spares.wait_time()):
                     if key.fileobj is self.control:
                         message, fds, _, _ = socket.recv_fds(self.control, MAX_MESSAGE, 4)
                         if not message:
+                            if self.spares is not None:
+                                self.spares.close()
                             return None  # the lab server closed its end: stop
                         app = self._fork(message, fds)
                         if app is not None:  # this is the child
-                            selector.close()
-                            for fd in (wake_r, wake_w):
-                                os.close(fd)
-                            self.control.close()
-                            signal.set_wakeup_fd(-1)
-                            return app
+                            return child(app)
                     else:
                         with contextlib.suppress(BlockingIOError):
                             while os.read(wake_r, 512):
                                 pass
                 self._reap()
+                if self.spares is not None and (app := self.spares.refill()) is not None:
+                    return child(app)
         finally:
             with contextlib.suppress(ValueError, OSError):
                 signal.signal(signal.SIGCHLD, signal.SIG_DFL)
@@ -165,6 +178,9 @@ class _Zygote:
     def _fork(self, message: bytes, fds: list[int]) -> Callable[[], int] | None:
         try:
             request = json.loads(message)
+            if isinstance(request, dict) and "spares" in request:
+                self._keep_spares(request["spares"], fds)
+                return None
             settings = request["settings"]
             if not isinstance(settings, dict):
                 raise TypeError("the settings are not a JSON object")
@@ -177,6 +193,13 @@ class _Zygote:
                 os.close(fd)
             _send(self.control, {"error": f"bad request: {exc}"})
             return None
+        if self.spares is not None:
+            spare = self.spares.take(request, fds, limit_memory)
+            if spare is not None:
+                for fd in fds:
+                    os.close(fd)  # the spare has its own copies
+                _send(self.control, {"pid": spare})
+                return None
         ready_r, ready_w = os.pipe()
         try:
             pid = os.fork()
@@ -198,6 +221,19 @@ class _Zygote:
         _send(self.control, {"pid": pid})
         return None
 
+    def _keep_spares(self, message: object, fds: list[int]) -> None:
+        for fd in fds:
+            os.close(fd)
+        try:
+            spec = SpareSpec.from_message(message)
+            entry = entry_point(spec.main)
+        except (SpareSpecError, ValueError, ImportError) as exc:
+            print(f"fork server: no spare apps: {exc}", file=sys.stderr)
+            return
+        if self.spares is not None:
+            self.spares.close()
+        self.spares = SparePool(spec, lambda spec, control: _run_spare(entry, spec, control))
+
     def _reap(self) -> None:
         while True:
             try:
@@ -206,6 +242,8 @@ class _Zygote:
                 return
             if pid == 0:
                 return
+            if self.spares is not None and self.spares.ended(pid):
+                continue  # a spare nobody had taken: the lab server never heard of it
             _send(self.control, {"exit": pid, "code": os.waitstatus_to_exitcode(status)})
 
 
@@ -295,6 +333,26 @@ def _run_app(
             os.chdir(cwd)
     sys.argv = ["workbench"]
     return main(settings)
+
+
+def _run_spare(main: Callable[..., int], spec: SpareSpec, control: socket.socket) -> int:
+    """In a forked spare: start the app from the template and let it wait for its session
+    (:mod:`.spares`). Until then it reads a pipe nobody writes and writes to nothing."""
+    idle_r, _open = os.pipe()  # its write end stays open: the input never ends while it waits
+    nothing = os.open(os.devnull, os.O_WRONLY)
+    os.dup2(idle_r, 0)
+    os.dup2(nothing, 1)
+    os.close(idle_r)
+    os.close(nothing)
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    lower_priority(APP_NICENESS)
+    os.environ.clear()
+    os.environ.update(spec.env)
+    if spec.cwd:
+        with contextlib.suppress(OSError):
+            os.chdir(spec.cwd)
+    sys.argv = ["workbench"]
+    return main(spec.settings, control)
 
 
 def serve_main(argv: list[str] | None = None) -> int:
@@ -510,6 +568,27 @@ class ForkServer:
             return
         self._watching[pid] = fd
         loop.add_reader(fd, gone)
+
+    def keep_spares(
+        self,
+        count: int,
+        main: str,
+        settings: dict,
+        env: dict[str, str],
+        personal: frozenset[str],
+        cwd: str | None = None,
+    ) -> None:
+        """Have the fork server keep ``count`` spare apps (:mod:`.spares`): started ahead with
+        the entry point ``main`` from ``settings`` and ``env``, each handed to a session whose
+        own differ from them only in ``personal`` settings (and the terminal's size)."""
+        if not self._running or self._sock is None:
+            raise ForkServerError("the fork server is not running")
+        spec = {"count": count, "main": main, "settings": settings, "env": env,
+                "personal": sorted(personal), "cwd": cwd or os.getcwd()}  # fmt: skip
+        try:
+            self._sock.send(json.dumps({"spares": spec}).encode())
+        except OSError as exc:
+            raise ForkServerError(f"the spares request was not sent: {exc}") from exc
 
     async def spawn(
         self,

@@ -25,6 +25,7 @@ from workbench.door.appproc import (
     AppSpec,
     app_env,
     forward_hint,
+    keep_spares,
 )
 from workbench.door.checking import PasswordDesk
 from workbench.door.course_files import CourseWorkspaces, bring_workspace
@@ -104,6 +105,8 @@ class ServerConfig:
     app_command: tuple[str, ...] | None = None
     #: fork each app from a fork server that has the app imported (not with ``app_command``)
     fork_server: bool = True
+    #: students' apps the fork server keeps started ahead of their sessions (0: none)
+    spare_apps: int = 0
     #: seconds between the stop steps of an app (quit, SIGTERM, SIGKILL)
     stop_grace: float = 2.0
     logins: LoginPolicy = field(default_factory=LoginPolicy)
@@ -268,6 +271,8 @@ class LabServer:
             forkserver.modules,
             forkserver.seconds,
         )
+        keep_spares(forkserver, config.spare_apps, config.app, config.data_dir,
+                    config.record_quota, config.uploads)  # fmt: skip
 
     async def close(self) -> None:
         """End every session (their apps stopped and reaped), then stop listening."""

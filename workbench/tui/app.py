@@ -14,6 +14,7 @@ import gc
 import getpass
 import math
 import os
+import sys
 from collections.abc import Callable
 from dataclasses import replace
 from functools import partial
@@ -76,6 +77,7 @@ from .serving import warmup
 from .serving.loop_clock import LoopClock
 from .serving.ordered_keys import OrderedKeys
 from .serving.quick_keys import QuickKeys, as_key_press
+from .serving.seat import Seat
 from .serving.terminal_driver import serves
 from .textual_private import end_with_error, handled_size
 
@@ -121,28 +123,27 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
     frames: int = 0
 
     def __init__(
-        self, station: LabStation, settings: AppSettings, *, names_given: bool = False
+        self,
+        station: LabStation,
+        settings: AppSettings,
+        *,
+        names_given: bool = False,
+        seat: Seat | None = None,
     ) -> None:
         """The app on ``station`` with ``settings`` as :func:`make_app` completes them (the
         maze file and the pair named); ``names_given``: whoever started the app named the pair
-        (it is kept as the last pair at this workbench)."""
+        (it is kept as the last pair at this workbench). With a ``seat`` the app is a spare:
+        it shows the names dialog and waits there for its session (:meth:`take_seat`)."""
         super().__init__()
-        self.settings = settings
-        self._names_given = names_given
-        self.student = settings.student or _login_name()
-        self.partner = settings.partner
-        #: the course store's life (opening, retries, the last try): the app only says it
-        self.course = CourseStore(settings.data_dir, settings.db, self.student)
-        self.course.subscribe(self._store_news)
+        #: a spare's wait for its session (None once it has one, or was never a spare)
+        self.seat = seat
         self._labs: LabsScreen | None = None
-        self._viple_configs = viple_configs(settings)
         self.endpoints: Endpoints | None = None
         #: sends the files saved in a served student's workspace to the course database
         self.pusher: WorkspacePusher | None = None
         #: the endpoints' status line as last handed to the screens
         self._connection = ""
-        self.station = station
-        self.maze_path = settings.maze_path
+        self._sit(station, settings, names_given)
         self.set_reactive(WorkbenchApp.unicode, settings.unicode)
         self.mark_ascii(update=False)
         # the stylesheets as the fork server parsed them (a served app), else parsed here
@@ -163,8 +164,6 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
         #: a key or a click has come from the terminal
         self._input_seen = False
         self._last_said = ""
-        #: the maze the message line last named
-        self._maze_named = station.maze
         #: the screens a screen may ask for (OpenScreen), each with the way it opens
         #: the file the FSM editor is asked to open ("" its own choice)
         self._fsm_path = ""
@@ -175,6 +174,41 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
             "labs": self._open_labs,
             "fsm": self._open_fsm_editor,
         }
+
+    def _sit(self, station: LabStation, settings: AppSettings, names_given: bool) -> None:
+        """What is the session's own: the settings, the pair, the course store, the station."""
+        self.settings = settings
+        self._names_given = names_given
+        self.student = settings.student or _login_name()
+        self.partner = settings.partner
+        #: the course store's life (opening, retries, the last try): the app only says it
+        self.course = CourseStore(settings.data_dir, settings.db, self.student)
+        self.course.subscribe(self._store_news)
+        self._viple_configs = viple_configs(settings)
+        self.station = station
+        self.maze_path = settings.maze_path
+        #: the maze the message line last named
+        self._maze_named = station.maze
+
+    async def take_seat(self, settings: AppSettings) -> None:
+        """A spare app becomes its session's: the session's settings (those every session
+        shares are the spare's already), a station of its own, the names dialog showing the
+        student's name, and the session's start (:meth:`_start_session`). Settings the app
+        cannot start with end it with status 2 and the reason in its error output."""
+        self.seat = None
+        try:
+            station, named, given = open_station(settings)
+        except AppSetupError as exc:
+            print(f"workbench: {exc}", file=sys.stderr)
+            self.exit(return_code=2)
+            return
+        self._sit(station, named, given)
+        from .dialogs.identity import IdentityDialog
+
+        for screen in self.screen_stack:
+            if isinstance(screen, IdentityDialog):
+                screen.show_student(self.student)
+        await self._start_session()
 
     def who(self) -> str:
         """Who is at the robot, for the message line ("" when nobody was named)."""
@@ -211,6 +245,15 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
 
     # Textual runs each class's on_mount in turn (the host's too): a handler, not an override
     async def on_mount(self) -> None:  # type: ignore[override]
+        if self.seat is not None:
+            self.seat.wait(self)  # a spare: its session starts when it comes
+        else:
+            await self._start_session()
+        self._check_size(self.size.width, self.size.height)
+        self._ask_for_names()
+
+    async def _start_session(self) -> None:
+        """The session's start: its VIPLE endpoints, the clock, the course store's work."""
         tcp, ws = self._viple_configs
         if not self.settings.ws_at_start:
             ws = None  # later: a WebSocket exercise's set-up or the v key starts it
@@ -235,8 +278,6 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
         self.course.save_kept()
         if self._names_given and not self.settings.ask_names:
             self._remember_pair()
-        self._check_size(self.size.width, self.size.height)
-        self._ask_for_names()
 
     def on_unmount(self) -> None:
         """However the app ends (quitting, or its session closing), its workspace sends stop:
@@ -651,8 +692,9 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
         self.exit()
 
 
-def make_app(settings: AppSettings) -> WorkbenchApp:
-    """The workbench app with ``settings`` (the maze default: the bundled Unity maze).
+def make_app(settings: AppSettings, seat: Seat | None = None) -> WorkbenchApp:
+    """The workbench app with ``settings`` (the maze default: the bundled Unity maze); with a
+    ``seat``, a spare app waiting for its session (:meth:`WorkbenchApp.take_seat`).
 
     Neither VIPLE endpoint runs unless the settings ask for it (a lab exercise's set-up starts
     the one it needs). The student (default: the pair last at this workbench, else the login
@@ -662,6 +704,14 @@ def make_app(settings: AppSettings) -> WorkbenchApp:
     Raises :class:`AppSetupError` with a message for the user when the maze cannot be read or
     a setting is not one the workbench knows.
     """
+    station, named, names_given = open_station(settings)
+    return WorkbenchApp(station, named, names_given=names_given, seat=seat)
+
+
+def open_station(settings: AppSettings) -> tuple[LabStation, AppSettings, bool]:
+    """The station ``settings`` ask for, the settings completed (the maze file and the pair
+    named), and whether whoever started the app named the pair; AppSetupError as for
+    :func:`make_app`."""
     path = settings.maze_path or default_maze_path()
     profile, noise, role = settings.profile, settings.noise, settings.role
     if profile is not None and profile not in PROFILES:
@@ -722,7 +772,7 @@ def make_app(settings: AppSettings) -> WorkbenchApp:
     # max speed may use at most 60 % of each frame, so keys and drawing stay responsive
     station.pacer.budget = 0.6 / tick_hz
     named = replace(settings, maze_path=path, student=student, partner=partner)
-    return WorkbenchApp(station, named, names_given=bool(settings.student))
+    return station, named, bool(settings.student)
 
 
 def viple_configs(settings: AppSettings) -> tuple[TcpConfig | None, WsConfig | None]:

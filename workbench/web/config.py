@@ -28,6 +28,8 @@ class WebConfig:
     #: the app's command before its settings, instead of the entry's (no fork server then)
     app_command: tuple[str, ...] | None = None
     fork_server: bool = True
+    #: students' apps the fork server keeps started ahead of their sessions (0: none)
+    spare_apps: int = 0
     stop_grace: float = 2.0
     #: seconds an app waits for its page to come back after the page's WebSocket closed
     reattach_grace: float = 60.0

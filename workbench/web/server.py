@@ -21,7 +21,7 @@ from urllib.parse import urlsplit
 
 from aiohttp import WSMsgType, web
 
-from workbench.door.appproc import AppProcess, AppSpec, app_env
+from workbench.door.appproc import AppProcess, AppSpec, app_env, keep_spares
 from workbench.door.checking import PasswordDesk
 from workbench.door.course_files import CourseWorkspaces, bring_workspace
 from workbench.door.forkserver import ForkServer, ForkServerError
@@ -212,6 +212,8 @@ class WebServer:
             return
         self.forkserver = forkserver
         log.info("apps are forked from a fork server (pid %s)", forkserver.pid)
+        keep_spares(forkserver, config.spare_apps, config.app, config.data_dir,
+                    config.record_quota, config.uploads)  # fmt: skip
 
     async def close(self) -> None:
         self._closing = True

@@ -23,6 +23,13 @@ from typing import Any, Union, get_args, get_origin, get_type_hints
 from workbench.control.recording import RECORD_CAP, RUNS_QUOTA, RecordQuota
 from workbench.files.workspace_files import UploadLimits
 
+#: the settings that are each served session's own (who, their ports and folders): a spare app
+#: (``workbench/door/spares.py``) starts without them and takes them from its session
+SESSION_FIELDS = frozenset(
+    {"student", "partner", "tcp_port", "ws_url", "connect_hint", "record_dir", "runs_counted",
+     "workspace"}
+)  # fmt: skip
+
 
 class SettingsError(ValueError):
     """Settings that are not the app's (an unknown name, a value of the wrong kind)."""

@@ -61,6 +61,11 @@ class IdentityDialog(Dialog[tuple[str, str] | None]):
             with Horizontal(id="buttons"):
                 yield Button("Start", id="ok", variant="primary", compact=True)
 
+    def show_student(self, student: str) -> None:
+        """The student at the robot is ``student`` (a spare app given its session)."""
+        self._student = student
+        self.query_one("#student", Input).value = student
+
     def on_mount(self) -> None:
         self.query_one("#partner" if self._fixed else "#student", Input).focus()
 

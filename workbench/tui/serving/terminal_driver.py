@@ -44,7 +44,7 @@ from textual._xterm_parser import XTermParser
 from textual.app import App
 from textual.drivers.web_driver import WebDriver, _ExitInput
 
-from workbench.wire.packets import DATA, PacketReader
+from workbench.wire.packets import DATA, GANGLION, PacketReader
 
 from .key_budget import KeyBudget, dropped_message
 
@@ -292,6 +292,23 @@ class ServedTerminalDriver(WebDriver):
         self._enable_bracketed_paste()
         screen = app.screen
         app._display(screen, screen._compositor.render_update(full=True))
+
+    def take_terminal(self, fd: int, size: tuple[int, int]) -> None:
+        """A spare app's terminal has come (``seat.py``): read and write on ``fd`` from now on
+        (it becomes the standard input and output), announce the app on it as a start does,
+        ask the terminal what a start asks, take its ``size`` and draw the whole screen."""
+        reading = self._input_reader
+        if isinstance(reading, LoopInput):
+            reading.close()
+        os.dup2(fd, 0)
+        os.dup2(fd, 1)
+        self._write(GANGLION)
+        if isinstance(reading, LoopInput):
+            reading.start()
+        if size != self._size:
+            self.on_meta("resize", {"width": size[0], "height": size[1]})
+        self._request_terminal_sync_mode_support()
+        self._app.call_later(self.redraw)
 
     def send_message(self, message: messages.Message) -> None:
         """Hand a message to the app (on its loop: straight into its queue)."""
