@@ -169,9 +169,7 @@ class SparePool:
             return None
         if not self.spec.fits(settings, env):
             return None
-        message = json.dumps(
-            {"settings": settings, "env": env, "cwd": request.get("cwd")}
-        ).encode()
+        message = json.dumps({"settings": settings, "env": env, "cwd": request.get("cwd")}).encode()
         while self.waiting:
             spare = self.waiting.popleft()
             try:
