@@ -62,6 +62,16 @@ _CSRF = re.compile(r'name="csrf" value="([^"]+)"')
 class WebStudent(Student):
     """A student through the browser door: the login form, then the page's WebSocket."""
 
+    async def log_in(self, session: aiohttp.ClientSession, url: str) -> None:
+        async with session.get(f"{url}/login") as form:
+            token = _CSRF.search(await form.text())
+        assert token is not None
+        fields = {"csrf": token.group(1), "user": self.name, "password": PASSWORD}
+        async with session.post(f"{url}/login", data=fields,
+                                headers={"Origin": url}) as answer:  # fmt: skip
+            if answer.url.path != "/":
+                raise OSError(f"login refused ({answer.status})")
+
     @contextlib.asynccontextmanager
     async def terminal(self) -> AsyncIterator[Callable[[bytes], None] | None]:
         url = f"http://127.0.0.1:{self.port}"
@@ -71,14 +81,12 @@ class WebStudent(Student):
         ) as session:
             began = time.perf_counter()
             try:
-                async with session.get(f"{url}/login") as form:
-                    token = _CSRF.search(await form.text())
-                assert token is not None
-                fields = {"csrf": token.group(1), "user": self.name, "password": PASSWORD}
-                async with session.post(f"{url}/login", data=fields,
-                                        headers={"Origin": url}) as answer:  # fmt: skip
-                    if answer.url.path != "/":
-                        raise OSError(f"login refused ({answer.status})")
+                if SIGN_ON:  # the sign-on proxy in front names the student
+                    async with session.get(f"{url}/", headers={SIGN_ON: self.name}) as page:
+                        if page.status != 200:
+                            raise OSError(f"sign-on refused ({page.status})")
+                else:
+                    await self.log_in(session, url)
                 LOGINS.append(time.perf_counter() - began)
                 socket = await session.ws_connect(f"{url}/ws?cols=80&rows=24", origin=url)
             except (OSError, aiohttp.ClientError, AssertionError) as exc:
@@ -105,7 +113,8 @@ def start_web_server(data: Path, port: int, sessions: int, spares: int = 0) -> s
          "--port", str(port), "--data-dir", str(data),
          "--port-range", f"{first}-{first + 2 * sessions + 40}",
          "--max-sessions", str(max(60, sessions)),
-         *(["--spare-apps", str(spares)] if spares else [])],
+         *(["--spare-apps", str(spares)] if spares else []),
+         *(["--user-header", SIGN_ON, "--trusted-proxy", "127.0.0.0/8"] if SIGN_ON else [])],
         cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
     )  # fmt: skip
     log = data / "web.log"
@@ -158,6 +167,8 @@ async def one_door(
     return result, spans
 
 
+#: the header a sign-on proxy names the student in (--sign-on; "": logins by password)
+SIGN_ON = ""
 #: the browser round's bytes per second per session, for the SSH round's comparison
 WEB_RATES: list[float] = []
 
@@ -173,9 +184,11 @@ def report(door: str, n: int, result: Result, rates: list[float], spares: int) -
         f"p95 {1000 * pct(result.latency, 0.95):.0f} ms   ({len(result.latency)} presses)"
     )
     if door == "web" and LOGINS:
+        how = ("named by the sign-on header" if SIGN_ON else
+               "a password checked with scrypt; the SSH round logs in with keys")  # fmt: skip
         print(
             f"  of which login   p50 {pct(LOGINS, 0.5):.2f} s   p95 {pct(LOGINS, 0.95):.2f} s"
-            "   (a password checked with scrypt; the SSH round logs in with keys)"
+            f"   ({how})"
         )
     if rates:
         print(f"  bytes/s/session  mean {statistics.mean(rates):.0f}   max {max(rates):.0f}")
@@ -199,7 +212,15 @@ def main() -> None:
         help="each server keeps N apps started ahead (--spare-apps), at rest before the "
         "students come (default 0)",
     )  # fmt: skip
+    parser.add_argument(
+        "--sign-on", action="store_true",
+        help="the browser door behind a sign-on proxy (--user-header X-Forwarded-User, trusted "
+        "from loopback): the students come named by the proxy, no password checked",
+    )  # fmt: skip
     args = parser.parse_args()
+    if args.sign_on:
+        global SIGN_ON
+        SIGN_ON = "X-Forwarded-User"
     print(f"load average before: {os.getloadavg()[0]:.2f}")
     for door in ("web",) if args.web_only else ("web", "ssh"):
         result, rates = asyncio.run(
