@@ -88,7 +88,7 @@ MIN_SIZE = (80, 24)
 STORE_LAST_TRY_SECONDS = 2.0
 #: how often the clock ticks while the station is at rest (paused, or the robot standing with
 #: nobody driving it): time passes as before, in larger steps, and nothing else needs drawing
-REST_HZ = 0.5
+REST_HZ = 0.25
 ROLES = ("student", "instructor")
 
 
