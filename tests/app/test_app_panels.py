@@ -240,6 +240,32 @@ def test_start_and_the_state_display_follows_the_engine():
     run(app, body)
 
 
+def test_the_last_transition_takes_the_rows_its_text_needs_as_it_grows_and_shrinks():
+    """The algorithm panel's lines are laid out again only when one takes another number of
+    rows; a line that grows onto a second row still shows whole, and gives the row back."""
+    app = unity_app()
+
+    async def body(pilot: Pilot) -> None:
+        state = app.screen.query_one(AlgorithmState)
+        last = state.query_one("#algorithm-last", Static)
+        state.last = "1.0 s a -> b"
+        await pilot.pause()
+        assert last.size.height == 1
+        width = last.content_region.width
+        long = "2.0 s forward -> turn when " + " ".join(f"d{i}<0.5" for i in range(width // 3))
+        state.last = long
+        await pilot.pause()
+        rows = last.size.height
+        assert rows >= 2
+        shown = " ".join(line.strip() for line in screen_lines(app) if line.strip())
+        assert "d0<0.5" in shown and f"d{width // 3 - 1}<0.5" in shown  # nothing cut
+        state.last = "3.0 s turn -> forward"  # the same rows again: no new layout needed
+        await pilot.pause()
+        assert last.size.height == 1
+
+    run(app, body)
+
+
 def test_the_transition_log_follows_the_newest_transitions():
     """However many transitions there are, and however the panel above the log grows or shrinks
     (the last transition's lines come and go), the log shows the newest one at its bottom."""

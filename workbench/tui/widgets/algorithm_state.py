@@ -61,9 +61,9 @@ class AlgorithmState(Vertical):
         yield self._log
 
     def on_mount(self) -> None:
-        self.watch_summary("", self.summary)
+        self.watch_summary(self.summary)
         self.watch_states(self.states)
-        self.watch_variables("", self.variables)
+        self.watch_variables(self.variables)
         self.watch_last(self.last)
 
     @property
@@ -124,9 +124,9 @@ class AlgorithmState(Vertical):
         log.display = True
         log.show(controller, history, unit, unicode)
 
-    def watch_summary(self, old: str, text: str) -> None:
-        # the timer counts down every tick: lay out again only when the length changes
-        self._summary.update(text, layout=len(old) != len(text))
+    def watch_summary(self, text: str) -> None:
+        # the timer counts down every tick: lay out again only when the height changes
+        update_in_place(self._summary, text)
 
     def watch_states(self, value: tuple[tuple[str, ...], str | None]) -> None:
         names, current = value
@@ -135,15 +135,29 @@ class AlgorithmState(Vertical):
             for name in names
         ]
         widget = self._states
-        widget.update(Content("").join(parts))
+        update_in_place(widget, Content("").join(parts))
         widget.display = bool(names)
 
-    def watch_variables(self, old: str, text: str) -> None:
+    def watch_variables(self, text: str) -> None:
         widget = self._vars
-        widget.update(f"vars: {text}" if text else "", layout=len(old) != len(text))
+        update_in_place(widget, f"vars: {text}" if text else "")
         widget.display = bool(text)
 
     def watch_last(self, text: str) -> None:
         widget = self._last
-        widget.update(text)
+        update_in_place(widget, text)
         widget.display = bool(text)
+
+
+def update_in_place(widget: Static, content: str | Content) -> None:
+    """Show ``content`` in ``widget``, laying the panel out again only when it takes another
+    number of rows at the widget's width (a new layout is most of a frame's work; the state
+    highlighted, the timer and the last transition change many times a minute)."""
+    region = widget.content_region
+    if not widget.is_mounted or not widget.display or region.width <= 0:
+        widget.update(content)
+        return
+    widget.update(content, layout=False)
+    size = widget.size
+    if widget.get_content_height(size, size, region.width) != region.height:
+        widget.refresh(layout=True)
