@@ -37,6 +37,10 @@ def test_a_session_fits_a_spare_when_only_its_own_settings_and_size_differ():
     assert not spec().fits(mine | {"role": "instructor"}, ENV)  # a setting of its own
     assert not spec().fits({k: v for k, v in mine.items() if k != "ask_names"}, ENV)
     assert not spec().fits(mine, ENV | {"TERM": "vt100"})  # another terminal type
+    for alike in ("screen-256color", "tmux-256color", "XTERM-256COLOR", "xterm-kitty"):
+        assert spec().fits(mine, ENV | {"TERM": alike})  # draws in the same 256 colours
+    for unlike in ("xterm", "linux", "dumb", "xterm-16color"):
+        assert not spec().fits(mine, ENV | {"TERM": unlike})
     assert not spec().fits(mine, ENV | {"WORKBENCH_DB": "postgresql://x/y"})
 
 

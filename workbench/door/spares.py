@@ -33,7 +33,8 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
-#: the terminal's size: the session's own in the environment
+#: the terminal's size: the session's own in the environment (and ``TERM``, as far as
+#: :func:`term_colours` says it draws alike)
 SESSION_ENV = frozenset({"COLUMNS", "ROWS"})
 #: seconds without a new session before spares are started again
 REFILL_QUIET = 1.0
@@ -93,7 +94,21 @@ class SpareSpec:
 
 
 def _shared(env: dict[str, str]) -> dict[str, str]:
-    return {k: v for k, v in env.items() if k not in SESSION_ENV}
+    shared = {k: v for k, v in env.items() if k not in SESSION_ENV}
+    if "TERM" in shared:
+        shared["TERM"] = term_colours(shared["TERM"])
+    return shared
+
+
+def term_colours(term: str) -> str:
+    """What a terminal type changes in an app: the colours it draws in, which Rich (under
+    Textual) takes from the end of ``TERM`` (``xterm-256color``, ``screen-256color`` and
+    ``tmux-256color`` all draw in 256 colours; ``xterm`` in 16; ``dumb`` in none). Sessions
+    whose terminals draw alike may have the same spare; each gets its own ``TERM``."""
+    term = term.strip().lower()
+    if term in ("dumb", "unknown"):
+        return "none"
+    return "256" if term.rpartition("-")[2] in ("256color", "kitty") else "16"
 
 
 @dataclass
