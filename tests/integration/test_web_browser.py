@@ -17,6 +17,7 @@ from tests.app.support import sync
 from tests.waiting import until
 
 from .ssh_support import Account, moved
+from .test_spare_apps import children
 from .web_support import PASSWORD, web_host
 
 CHROMIUM = os.environ.get("WORKBENCH_CHROMIUM") or shutil.which("chromium") or "/usr/bin/chromium"
@@ -54,12 +55,19 @@ async def wait_for_screen(page, check, what: str, timeout: float = 90.0) -> str:
     return text
 
 
+@pytest.mark.parametrize("spares", [0, 1], ids=["forked", "spare app"])
 @sync
-async def test_a_student_drives_in_chromium_and_a_reload_finds_the_same_workbench(tmp_path):
+async def test_a_student_drives_in_chromium_and_a_reload_finds_the_same_workbench(tmp_path, spares):
     async with (
-        web_host(tmp_path, [Account("ann", password=PASSWORD)]) as host,
+        web_host(tmp_path, [Account("ann", password=PASSWORD)], spare_apps=spares) as host,
         playwright.async_playwright() as driver,
     ):
+        waiting: set[int] = set()
+        if spares:  # the app started ahead is the one ann gets
+            forkserver = host.server.forkserver
+            assert forkserver is not None
+            await until(lambda: len(children(forkserver.pid)) == 1, "a spare app waiting", 60)
+            waiting = children(forkserver.pid)
         browser = await driver.chromium.launch(
             executable_path=CHROMIUM, args=["--no-sandbox", "--disable-gpu"]
         )
@@ -80,6 +88,7 @@ async def test_a_student_drives_in_chromium_and_a_reload_finds_the_same_workbenc
             await page.keyboard.press("w")
             await wait_for_screen(page, moved, "the robot moving")
             pid = host.server.apps["ann"].app.pid
+            assert (pid in waiting) == bool(spares)
             await page.reload()
             again = await wait_for_screen(page, moved, "the same workbench after a reload")
             assert "Who is at this robot?" not in again

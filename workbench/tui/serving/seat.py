@@ -9,7 +9,7 @@ session's environment, folder and descriptors in place, hands the terminal to th
 (:meth:`ServedTerminalDriver.take_terminal`: the app's start announced on it, the terminal's
 size, the whole screen drawn) and the settings to the app (``take_seat``), whose session then
 starts as a new app's would. A control socket that closes with no session (the fork server
-stopping) ends the app.
+stopping) ends the process at once: a spare has nothing of anyone's to save.
 """
 
 from __future__ import annotations
@@ -67,11 +67,11 @@ class Seat:
             message, fds = b"", []
         asyncio.get_running_loop().remove_reader(self.control.fileno())
         self.control.close()
-        if not message or len(fds) != 2:  # the fork server stopped: no student will come
-            for fd in fds:
-                os.close(fd)
-            app.exit()
-            return
+        if not message or len(fds) != 2:
+            # the fork server stopped: no student will come, and a spare holds nothing of
+            # anyone's, so it ends at once (an exit in the middle of its start would leave
+            # its names dialog half mounted and a traceback in the server's log)
+            os._exit(0)
         io, errors = fds
         os.dup2(errors, 2)
         os.close(errors)
