@@ -90,3 +90,25 @@ def test_a_served_student_is_never_offered_another_pair(tmp_path):
     # nor when no name is given: the app's own login name, not the pair kept in the data folder
     unnamed = make_app(replace(served, student=None, ask_names=False, student_fixed=False))
     assert unnamed.student != "Alice Doe" and unnamed.partner == ""
+
+
+def test_a_spare_apps_dialog_shows_the_student_it_is_given_before_or_after_its_fields(tmp_path):
+    """A spare app (started ahead) learns its student while its names dialog is still being
+    made, or once it is up: either way the fixed name shown is theirs, and Enter keeps it."""
+    app = make_app(AppSettings(paused=True, data_dir=tmp_path, ask_names=True, student_fixed=True))
+
+    async def body(pilot: Pilot) -> None:
+        early = IdentityDialog("spare", student_fixed=True)
+        early.show_student("ann")  # before it has its fields
+        answers: list[object] = []
+        app.push_screen(early, answers.append)
+        await pilot.pause()
+        assert early.query_one("#student", Input).value == "ann"
+        early.show_student("ben")  # once it is up
+        await pilot.pause()
+        assert early.query_one("#student", Input).value == "ben"
+        await pilot.press("enter")
+        await pilot.pause()
+        assert answers and answers[-1][0] == "ben"
+
+    run(app, body)

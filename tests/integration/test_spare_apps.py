@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import asyncio
 import os
+import signal
 from pathlib import Path
 
 from tests.app.support import sync
@@ -97,3 +98,24 @@ async def test_sessions_beyond_the_spares_are_forked_and_all_work(tmp_path):
             await term.close()
         await until(lambda: all(gone(pid) for pid in pids.values()), "the apps gone")
         assert os.getpid() not in pids.values()
+
+
+@sync
+async def test_spares_end_when_their_fork_server_is_killed_with_forked_apps_running(tmp_path):
+    """An app forked while spares wait holds none of their control sockets: a fork server
+    killed outright still leaves every spare its end of file, and none is left running."""
+    async with lab_host(tmp_path, [Account("ann")], spare_apps=2) as host:
+        forkserver = host.server.forkserver
+        assert forkserver is not None
+        await until(lambda: len(children(forkserver.pid)) == 2, "two spare apps waiting", 60)
+        spares = children(forkserver.pid)
+        conn = await host.connect("ann")  # a 16-colour terminal: an app of its own
+        process = await conn.create_process(term_type="xterm", term_size=(80, 24), encoding=None)
+        ann = Terminal(conn, process, (80, 24))
+        await ann.wait_for("Who is at this robot", "ann")
+        app = session_pids(host)["ann"]
+        assert app not in spares
+        os.kill(forkserver.pid, signal.SIGKILL)
+        await until(lambda: all(gone(pid) for pid in spares), "the spares ended", 30)
+        assert not gone(app)  # the student's app goes on
+        await ann.close()

@@ -35,7 +35,7 @@ def main(settings: object) -> int:
 
     app: App[None]
     try:
-        given = replace(AppSettings.from_json(settings), db=resolve_db(None))
+        given = _with_db(AppSettings.from_json(settings))
         # an instructor's session is the console: the class, the queue, signing with their
         # own key typed in their own terminal
         app = make_console(given) if given.role == "instructor" else make_app(given)

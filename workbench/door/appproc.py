@@ -129,12 +129,11 @@ def spare_template(
     data_dir: Path,
     record_quota: RecordQuota,
     uploads: UploadLimits,
-    term: str = "xterm-256color",
 ) -> tuple[dict[str, object], dict[str, str]]:
     """The settings and environment a student's session has before it is anybody's (what
     is each session's own, ``SESSION_FIELDS``, is the spare's to take): a spare app's."""
     spec = AppSpec("student", "student", 0, 0, "", data_dir, data_dir, data_dir,
-                   term=term, record_quota=record_quota, uploads=uploads)  # fmt: skip
+                   record_quota=record_quota, uploads=uploads)  # fmt: skip
     return spec.settings().to_json(), spec.env()
 
 

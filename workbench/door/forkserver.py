@@ -212,6 +212,8 @@ class _Zygote:
             os.setsid()  # its own session and process group, before the server learns its pid
             os.close(ready_r)
             os.close(ready_w)
+            if self.spares is not None:
+                self.spares.close()  # (this copy's ends only: the spares are not the app's)
             return lambda: _run_app(self.main, settings, env, fds, request.get("cwd"), memory)
         for fd in (*fds, ready_w):
             os.close(fd)
@@ -323,16 +325,21 @@ def _run_app(
     for fd in fds:
         if fd > 2:
             os.close(fd)
+    limit_memory(memory)
+    _become_app(env, cwd)
+    return main(settings)
+
+
+def _become_app(env: dict[str, str], cwd: str | None) -> None:
+    """In a forked child: an app's priority, signals, environment, folder and argv."""
     signal.signal(signal.SIGINT, signal.default_int_handler)
     lower_priority(APP_NICENESS)
-    limit_memory(memory)
     os.environ.clear()
     os.environ.update(env)
     if cwd:
         with contextlib.suppress(OSError):
             os.chdir(cwd)
     sys.argv = ["workbench"]
-    return main(settings)
 
 
 def _run_spare(main: Callable[..., int], spec: SpareSpec, control: socket.socket) -> int:
@@ -344,14 +351,7 @@ def _run_spare(main: Callable[..., int], spec: SpareSpec, control: socket.socket
     os.dup2(nothing, 1)
     os.close(idle_r)
     os.close(nothing)
-    signal.signal(signal.SIGINT, signal.default_int_handler)
-    lower_priority(APP_NICENESS)
-    os.environ.clear()
-    os.environ.update(spec.env)
-    if spec.cwd:
-        with contextlib.suppress(OSError):
-            os.chdir(spec.cwd)
-    sys.argv = ["workbench"]
+    _become_app(spec.env, spec.cwd)
     return main(spec.settings, control)
 
 

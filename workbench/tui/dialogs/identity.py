@@ -62,9 +62,11 @@ class IdentityDialog(Dialog[tuple[str, str] | None]):
                 yield Button("Start", id="ok", variant="primary", compact=True)
 
     def show_student(self, student: str) -> None:
-        """The student at the robot is ``student`` (a spare app given its session)."""
+        """The student at the robot is ``student`` (a spare app given its session; before the
+        dialog has its fields, they are made with it)."""
         self._student = student
-        self.query_one("#student", Input).value = student
+        for field in self.query("#student").results(Input):
+            field.value = student
 
     def on_mount(self) -> None:
         self.query_one("#partner" if self._fixed else "#student", Input).focus()
