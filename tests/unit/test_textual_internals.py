@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import ast
 import asyncio
+import functools
 import importlib
 import inspect
 import io
@@ -93,6 +94,16 @@ def tui_classes_outside_serving() -> list[type]:
     return found
 
 
+@functools.cache
+def private_names_set_by(base: type) -> frozenset[str]:
+    """The ``self._x`` a Textual class's own source sets or reads (once per class: finding a
+    class's source parses its whole module, and every widget shares Widget and DOMNode)."""
+    try:
+        return frozenset(re.findall(r"\bself\.(_[a-z]\w*)", inspect.getsource(base)))
+    except (OSError, TypeError):
+        return frozenset()
+
+
 def test_no_class_outside_tui_serving_uses_or_replaces_a_private_part_of_its_textual_bases():
     """``self._x`` or ``def _x`` in a class built on Textual's, where a Textual base has ``_x``
     (overriding one by accident is as bad: Textual then calls the workbench's)."""
@@ -103,10 +114,7 @@ def test_no_class_outside_tui_serving_uses_or_replaces_a_private_part_of_its_tex
             continue
         theirs = {name for base in bases for name in vars(base)}
         for base in bases:
-            try:
-                theirs.update(re.findall(r"\bself\.(_[a-z]\w*)", inspect.getsource(base)))
-            except (OSError, TypeError):
-                continue
+            theirs |= private_names_set_by(base)
         source = inspect.getsource(cls)
         ours = set(re.findall(r"\bself\.(_[a-z]\w*)|\bdef (_[a-z]\w*)", source))
         used = {name for pair in ours for name in pair if name}
