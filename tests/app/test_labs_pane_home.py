@@ -4,6 +4,8 @@ came back."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from textual.containers import VerticalScroll
 from textual.pilot import Pilot
 from textual.widgets import Input
@@ -18,6 +20,16 @@ def pane_shows_objectives(app) -> bool:
     return any("[ ] the Unity sensors on port 1" in line for line in screen_lines(app))
 
 
+async def until(pilot: Pilot, done: Callable[[], bool]) -> bool:
+    """Pause until ``done()`` (the pane scrolls to a focused field after a refresh, which a
+    loaded machine can put a few frames later), for at most 10 s."""
+    for _ in range(200):
+        if done():
+            return True
+        await pilot.pause(0.05)
+    return done()
+
+
 def test_the_pane_returns_to_the_objectives(tmp_path):
     app = lab_app(tmp_path / "data")
 
@@ -29,19 +41,16 @@ def test_the_pane_returns_to_the_objectives(tmp_path):
         first.focus()
         await pilot.pause()
         await pilot.press(*"180")
-        await pilot.pause()
-        assert pane.scroll_y > 0 and not pane_shows_objectives(app)  # down at the question
+        down = await until(pilot, lambda: pane.scroll_y > 0 and not pane_shows_objectives(app))
+        assert down, screen_lines(app)  # down at the question
         await pilot.press("shift+tab", "shift+tab")
         await pilot.pause()
         assert screen.focused is screen.query_one("#labs-list")
-        await pilot.pause()
-        assert pane_shows_objectives(app), screen_lines(app)
+        assert await until(pilot, lambda: pane_shows_objectives(app)), screen_lines(app)
         first.focus()
-        await pilot.pause()
-        assert not pane_shows_objectives(app)
+        assert await until(pilot, lambda: not pane_shows_objectives(app)), screen_lines(app)
         await pilot.press("escape", "l")  # to the maze and back
-        await pilot.pause()
-        await pilot.pause()
-        assert app.screen is screen and pane_shows_objectives(app), screen_lines(app)
+        back = await until(pilot, lambda: app.screen is screen and pane_shows_objectives(app))
+        assert back, screen_lines(app)
 
     run(app, body)
