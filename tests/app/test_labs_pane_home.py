@@ -4,11 +4,11 @@ came back."""
 
 from __future__ import annotations
 
-from collections.abc import Callable
-
 from textual.containers import VerticalScroll
 from textual.pilot import Pilot
 from textual.widgets import Input
+
+from tests.waiting import until
 
 from .labs_support import lab_app, open_exercise
 from .support import run, screen_lines
@@ -18,16 +18,6 @@ ACTIVITIES = "unity-simulator/local-best-activities"
 
 def pane_shows_objectives(app) -> bool:
     return any("[ ] the Unity sensors on port 1" in line for line in screen_lines(app))
-
-
-async def until(pilot: Pilot, done: Callable[[], bool]) -> bool:
-    """Pause until ``done()`` (the pane scrolls to a focused field after a refresh, which a
-    loaded machine can put a few frames later), for at most 10 s."""
-    for _ in range(200):
-        if done():
-            return True
-        await pilot.pause(0.05)
-    return done()
 
 
 def test_the_pane_returns_to_the_objectives(tmp_path):
@@ -41,16 +31,17 @@ def test_the_pane_returns_to_the_objectives(tmp_path):
         first.focus()
         await pilot.pause()
         await pilot.press(*"180")
-        down = await until(pilot, lambda: pane.scroll_y > 0 and not pane_shows_objectives(app))
-        assert down, screen_lines(app)  # down at the question
+        # the pane scrolls to the focused field a refresh or two later
+        await until(lambda: pane.scroll_y > 0 and not pane_shows_objectives(app),
+                    "the pane down at the question")  # fmt: skip
         await pilot.press("shift+tab", "shift+tab")
         await pilot.pause()
         assert screen.focused is screen.query_one("#labs-list")
-        assert await until(pilot, lambda: pane_shows_objectives(app)), screen_lines(app)
+        await until(lambda: pane_shows_objectives(app), "the objectives back on the list")
         first.focus()
-        assert await until(pilot, lambda: not pane_shows_objectives(app)), screen_lines(app)
+        await until(lambda: not pane_shows_objectives(app), "the pane down at the field again")
         await pilot.press("escape", "l")  # to the maze and back
-        back = await until(pilot, lambda: app.screen is screen and pane_shows_objectives(app))
-        assert back, screen_lines(app)
+        await until(lambda: app.screen is screen and pane_shows_objectives(app),
+                    "the objectives shown on coming back to the labs")  # fmt: skip
 
     run(app, body)
