@@ -185,6 +185,22 @@ def test_run_draws_its_picture(tmp_path, capsys):
     }
 
 
+def test_run_on_a_micromouse_maze_draws_its_picture(tmp_path, capsys, monkeypatch):
+    """A micromouse maze, named by a path relative to the folder the command runs in, is
+    read again from its file to draw the run (its source says it was turned into blocks)."""
+    (tmp_path / "mazes").mkdir()
+    (tmp_path / "mazes" / "mouse.txt").write_text(
+        "o---o---o---o\n| G         |\no   o---o   o\n| S |       |\no---o---o---o\n"
+    )
+    monkeypatch.chdir(tmp_path)
+    code = main(["run", "--maze", "mazes/mouse.txt", "--algorithm", "right-wall",
+                 "--profile", "erobotic", "--picture", "mouse.svg"])  # fmt: skip
+    _, err = capsys.readouterr()
+    assert code == 0, err
+    assert "picture (path)" in err and "not found" not in err
+    assert path_points((tmp_path / "mouse.svg").read_bytes(), "robot-path") > 10
+
+
 def test_run_refuses_a_picture_it_could_not_write_before_it_runs(tmp_path, capsys):
     maze = maze_file(tmp_path)
     record = tmp_path / "r.jsonl"

@@ -25,6 +25,7 @@ from .metrics import Metrics, TurnCounter, efficiency
 from .record import RecordError, RunRecord, iter_lines, read_record, recorded_driver
 from .sensors import SensorConfigError, SensorSpec
 from .session import Snapshot
+from .wallmaze import source_file
 from .world import Pose
 
 #: the playing speeds offered, as factors of simulated time over wall time
@@ -392,9 +393,10 @@ def replay_maze(
     source = info.get("source")
     if not isinstance(source, str) or not source or source.startswith("<"):
         return None, "the record does not name a maze file, so the maze cannot be drawn"
-    candidates = [Path(source)]
-    if not Path(source).is_absolute():
-        candidates.append(Path(record_path).parent / source)
+    named = Path(source_file(source))  # a micromouse maze was drawn from its file, as blocks
+    candidates = [named]
+    if not named.is_absolute():
+        candidates.append(Path(record_path).parent / named)
     for typed in candidates:
         try:
             candidate = files.for_reading(typed)

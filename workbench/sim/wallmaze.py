@@ -97,6 +97,15 @@ def block_of(wm: WallMaze, cell: Cell) -> Cell:
     return (2 * cell[0] + 1, 2 * (wm.height - 1 - cell[1]) + 1)
 
 
+#: what a wall maze's source gains when it is turned into blocks (the file is still the source)
+AS_BLOCKS = " (as blocks)"
+
+
+def source_file(source: str) -> str:
+    """The file a maze's ``source`` names: a wall maze turned into blocks says so after it."""
+    return source.removesuffix(AS_BLOCKS)
+
+
 def to_blocks(wm: WallMaze) -> Maze:
     """The block maze of a consistent wall maze; goal cells become exits."""
     problems = wall_problems(wm)
@@ -114,7 +123,7 @@ def to_blocks(wm: WallMaze) -> Maze:
         rows=tuple("".join(row) for row in grid),
         exits=tuple(block_of(wm, g) for g in wm.goals),
         name=wm.name,
-        source=f"{wm.source} (as blocks)",
+        source=f"{wm.source}{AS_BLOCKS}",
     )
     if wm.start is None:
         return maze
@@ -206,5 +215,5 @@ def from_blocks(maze: Maze) -> WallMaze:
         heading=maze.heading,
         goals=tuple(cell_of(e) for e in maze.exits),
         name=maze.name,
-        source=maze.source.removesuffix(" (as blocks)"),
+        source=source_file(maze.source),
     )
