@@ -28,24 +28,38 @@ def heading(app: WorkbenchApp) -> float:
     return app.station.snapshot().pose.heading
 
 
-def main_screen(app: WorkbenchApp) -> MainScreen:
-    screen = app.screen
-    assert isinstance(screen, MainScreen)
-    return screen
+async def ready(app: WorkbenchApp) -> MainScreen:
+    """Wait until the main screen is on top with nothing queued on a key's way (the clock's
+    tick, a refresh): under load that can take a few turns after the app starts or a key."""
+    return await until(
+        lambda: (
+            isinstance(app.screen, MainScreen)
+            and not app.keys_on_their_way
+            and app.screen.nothing_on_the_way()
+            and app.screen
+        ),
+        "the main screen ready to take a key at once",
+    )
+
+
+async def take(app: WorkbenchApp, key: str) -> None:
+    """Offer ``key`` as typed once the app is ready for it; it must be taken at once."""
+    await ready(app)
+    assert app.take_typed_key(key), f"{key!r} not taken at once"
 
 
 def test_a_driving_key_taken_at_once_drives_as_its_key_event_does(tmp_path):
     app = make_app(AppSettings(maze_file(tmp_path, ROOM), paused=True, noise="off"))
 
     async def body(pilot: Pilot) -> None:
-        assert app.take_typed_key("d")
+        await take(app, "d")
         assert heading(app) == pytest.approx(90, abs=0.5)
         await pilot.press("d")
         assert heading(app) == pytest.approx(180, abs=0.5)
-        assert app.take_typed_key("p")  # resume: the clock runs the robot in real time
+        await take(app, "p")  # resume: the clock runs the robot in real time
         await pilot.pause()
         assert "running" in run_panel(app)
-        assert app.take_typed_key("p")
+        await take(app, "p")
         await pilot.pause()
         assert "PAUSED" in run_panel(app)
 
@@ -57,14 +71,15 @@ def test_keys_whose_binding_is_not_a_quick_action_come_as_key_events(tmp_path):
     assert not app.take_typed_key("w")  # no screen yet (as while the app starts or ends)
 
     async def body(pilot: Pilot) -> None:
+        await ready(app)
         assert not app.take_typed_key("e")  # opens the editor: a key event does that
         assert not app.take_typed_key("x")  # bound to nothing
         assert isinstance(app.screen, MainScreen)
         app.set_keymap({"drive.right": "l"})  # the keymap moves the binding, and the quick key
-        await pilot.pause()
+        await ready(app)
         assert not app.take_typed_key("d")
         assert heading(app) == pytest.approx(0, abs=0.5)
-        assert app.take_typed_key("l")
+        await take(app, "l")
         assert heading(app) == pytest.approx(90, abs=0.5)
 
     run(app, body)
@@ -78,13 +93,13 @@ def test_no_key_is_taken_at_once_over_a_dialog_or_while_a_key_before_it_is_on_it
         assert isinstance(app.screen, HelpScreen)
         assert not app.take_typed_key("d")
         await pilot.press("escape")
-        assert isinstance(app.screen, MainScreen)
+        await ready(app)
         # a key typed before, still queued for the app: the next waits its turn behind it
         app.post_message(events.Key("a", "a"))
         assert not app.take_typed_key("d")
         await pilot.pause()
         assert heading(app) == pytest.approx(270, abs=0.5)  # the queued 'a' turned left
-        assert app.take_typed_key("d")
+        await take(app, "d")
         turned = heading(app) % 360
         assert min(turned, 360 - turned) < 0.5  # and back to where it started
 
@@ -95,14 +110,14 @@ def test_a_quick_key_is_refused_where_the_screen_refuses_its_action(tmp_path):
     app = make_app(AppSettings(maze_file(tmp_path, ROOM), paused=True, noise="off"))
 
     async def body(pilot: Pilot) -> None:
-        screen = main_screen(app)
+        screen = await ready(app)
         refused = {"drive"}
         checked = screen.check_action
         screen.check_action = lambda action, params: (  # type: ignore[method-assign]
             False if action in refused else checked(action, params)
         )
         assert not app.take_typed_key("d")
-        assert app.take_typed_key("p")
+        await take(app, "p")
 
     run(app, body)
 
@@ -111,19 +126,19 @@ def test_a_change_is_drawn_at_once_and_the_next_within_a_frame_waits_for_the_tim
     app = make_app(AppSettings(maze_file(tmp_path, ROOM), paused=True, noise="off"))
 
     async def body(pilot: Pilot) -> None:
-        screen = main_screen(app)
+        screen = await ready(app)
         await pilot.pause(0.1)
         resumed = []
         timer = screen._update_timer
         resume = timer.resume
         timer.resume = lambda: (resumed.append(monotonic()), resume())[1]  # type: ignore[method-assign]
         screen._frame_at = drawn = monotonic() - 1  # the last frame a second ago
-        app.take_typed_key("p")
+        await take(app, "p")
         await pilot.pause()
         assert screen._frame_at > drawn and not resumed  # drawn in the same wake, no timer
         assert "running" in app.screen.query_one(RunStatus).lines[1]
         screen._frame_at = monotonic() + 60  # as if a frame had just been drawn
-        app.take_typed_key("p")
+        await take(app, "p")
         await pilot.pause()
         assert resumed  # within a frame period of the last: the timer draws it
 

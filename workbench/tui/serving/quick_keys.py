@@ -62,15 +62,17 @@ class QuickKeys(CachedBindingChain):
             self._quick_table = self._quick_bindings(chain)
             self._quick_chain = chain
         found = self._quick_table.get(key)
-        if found is None:
-            return None
-        for node, _ in chain:
-            if node.message_queue_size:
-                return None  # something typed before may still be on its way
+        if found is None or not self.nothing_on_the_way():
+            return None  # (on the way: something typed before it may still be going)
         name, params = found
         if not self.check_action(name, params):
             return None
         return partial(getattr(self, f"action_{name}"), *params)
+
+    def nothing_on_the_way(self) -> bool:
+        """Whether every message pump a key passes through has nothing queued (else a key
+        taken at once could overtake one that is still on its way)."""
+        return not any(node.message_queue_size for node, _ in self._binding_chain)
 
     def _quick_bindings(self, chain: list[tuple[DOMNode, BindingsMap]]) -> dict[str, QuickBinding]:
         table: dict[str, QuickBinding] = {}
