@@ -8,7 +8,6 @@ import os
 import shutil
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -32,26 +31,23 @@ def workbench_command() -> list[str]:
     return [found]
 
 
-def clean_env() -> dict[str, str]:
+def clean_env(data_home: Path) -> dict[str, str]:
     env = {k: v for k, v in os.environ.items() if not k.startswith(("TEXTUAL", "SSH_"))}
     env.update(TERM="xterm-256color", COLUMNS=str(COLUMNS), LINES=str(LINES), LANG="C.UTF-8")
-    # run records go to a throwaway data folder, not the home of whoever runs the tests
-    env["XDG_DATA_HOME"] = DATA_HOME
+    # run records go to the test's own folder, not the home of whoever runs the tests
+    env["XDG_DATA_HOME"] = str(data_home)
     return env
-
-
-DATA_HOME = tempfile.mkdtemp(prefix="workbench-pty-data-")
 
 
 class Terminal:
     """A child process on a pty, its output fed into an emulated 80x24 screen."""
 
-    def __init__(self, args: list[str]) -> None:
+    def __init__(self, args: list[str], data_home: Path) -> None:
         self.screen = pyte.Screen(COLUMNS, LINES)
         self.stream = pyte.ByteStream(self.screen)
         command, *rest = args
         self.child = pexpect.spawn(
-            command, rest, cwd=str(ROOT), env=clean_env(), dimensions=(LINES, COLUMNS)
+            command, rest, cwd=str(ROOT), env=clean_env(data_home), dimensions=(LINES, COLUMNS)
         )
 
     def text(self) -> str:
@@ -95,8 +91,8 @@ class Terminal:
         return self.child.exitstatus
 
 
-def test_workbench_opens_the_app_drives_and_quits_with_ctrl_q():
-    term = Terminal(workbench_command())
+def test_workbench_opens_the_app_drives_and_quits_with_ctrl_q(tmp_path):
+    term = Terminal(workbench_command(), tmp_path)
     try:
         # first the names: the student's is the login name, filled in; the partner is typed
         term.wait_for("Who is at this robot?", "Student", "Partner")
@@ -131,11 +127,11 @@ def test_workbench_opens_the_app_drives_and_quits_with_ctrl_q():
             term.child.terminate(force=True)
 
 
-def test_a_bad_profile_is_refused_before_the_app_starts():
+def test_a_bad_profile_is_refused_before_the_app_starts(tmp_path):
     result = subprocess.run(
         [*workbench_command(), "--profile", "lego"],
         cwd=ROOT,
-        env=clean_env(),
+        env=clean_env(tmp_path),
         capture_output=True,
         text=True,
         timeout=60,
