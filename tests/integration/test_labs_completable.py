@@ -5,7 +5,6 @@ scripted VIPLE program over the real endpoints. Wrong set-ups show the expected 
 from __future__ import annotations
 
 import asyncio
-import tempfile
 from decimal import Decimal
 from pathlib import Path
 
@@ -132,15 +131,15 @@ def answer(q: Question) -> str:
     raise AssertionError(f"no answer to {q.id} in the searched range")
 
 
-def complete(station: LabStation, ex: Exercise, folder: Path | None = None) -> dict[str, str]:
-    """Every objective's work done on ``station`` (a drawn machine is written in ``folder``,
-    else in a temporary folder of its own); the answers to its questions."""
+def complete(station: LabStation, ex: Exercise, folder: Path) -> dict[str, str]:
+    """Every objective's work done on ``station`` (a drawn machine is written in ``folder``);
+    the answers to its questions."""
     kinds = {o.kind for o in ex.objectives}
     for obj in ex.objectives:
         if obj.kind == "exit":
             reach_exit(station, ex, obj)
         elif obj.kind == "fsm-behaviour":
-            drawn = Path(folder or tempfile.mkdtemp()) / "drawn.yaml"  # drawn their own way
+            drawn = folder / "drawn.yaml"  # drawn their own way
             drawn.write_text(renamed_and_reordered())
             station.select_algorithm(drawn)
             station.start()
