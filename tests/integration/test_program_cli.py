@@ -51,6 +51,18 @@ def test_run_prints_measures_prints_and_events(tmp_path, capsys):
     assert "0.50 s  going" in out and "0.50 s  key w" in out
 
 
+def test_a_run_without_the_key_the_program_starts_on_says_which_key_to_press(tmp_path, capsys):
+    path = forward_program(tmp_path)
+    hint = 'no key event fired: the program answers w (Key Press); press one with --keys "w@0.5"'
+    main(["viple", "run", path, "--maze", WEB_MAZE, "--max-time", "2"])
+    out = capsys.readouterr().out
+    assert "distance travelled  0.0 px" in out and hint in out
+    main(["viple", "run", path, "--maze", WEB_MAZE, "--max-time", "2", "--keys", "a@0.5"])
+    assert hint in capsys.readouterr().out  # a key the program does not answer: the same
+    main(["viple", "run", path, "--maze", WEB_MAZE, "--max-time", "2", "--keys", "w@0.5"])
+    assert "no key event fired" not in capsys.readouterr().out
+
+
 def test_run_json_is_deterministic(tmp_path, capsys):
     path = forward_program(tmp_path)
     args = ["viple", "run", path, "--maze", WEB_MAZE, "--keys", "w@0.2", "--max-time", "4"]

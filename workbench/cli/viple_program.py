@@ -195,6 +195,7 @@ def describe_program_run(result: RunResult) -> str:
     if program.stopped is not None:
         lines.append(f"  STOPPED at {program.stopped}")
     lines += printed_summary(program)
+    lines += unpressed_keys(program)
     lines += _listed(
         "events",
         [f"{f.time:7.2f} s  {one_line(f.what, 64)}" for f in program.fired],
@@ -202,6 +203,19 @@ def describe_program_run(result: RunResult) -> str:
     )
     lines += _listed("errors", [one_line(str(e), 1000) for e in program.errors], MAX_ERRORS)
     return "\n".join(lines)
+
+
+def unpressed_keys(program: ProgramController) -> list[str]:
+    """What to do when the program answers keys and none of its Key Press events fired (a
+    program that starts on a key does nothing in a headless run without ``--keys``)."""
+    wanted = sorted({"+".join(sorted(keys)) for keys in program.compiled.key_sets.values() if keys})
+    fired = program.fired
+    if not wanted or len(fired) >= MAX_FIRED or any(f.what.startswith("key ") for f in fired):
+        return []
+    return [
+        f"  no key event fired: the program answers {', '.join(wanted)} (Key Press); press "
+        f'one with --keys "{wanted[0]}@0.5"'
+    ]
 
 
 def _printed_line(p: Printed) -> str:
