@@ -133,3 +133,18 @@ def test_a_nul_character_is_refused_with_its_column_on_every_python_311(text):
     with pytest.raises(ExprError, match="NUL character") as refused:
         compile_expr(text)
     assert refused.value.column == text.index("\x00") + 1
+
+
+def test_an_expression_compiled_again_folds_the_constants_given_this_time():
+    # the same text is compiled once and given again; constants equal in Python but not in
+    # kind (True and 1, 0.0 and -0.0) are folded each their own way
+    assert compile_expr("a * 2", constants={"a": 3})() == 6
+    assert compile_expr("a * 2", constants={"a": 4})() == 8
+    as_bool = compile_expr("a", constants={"a": True})()
+    as_int = compile_expr("a", constants={"a": 1})()
+    assert as_bool is True and type(as_int) is int
+    assert str(compile_expr("a", constants={"a": -0.0})()) == "-0.0"
+    assert str(compile_expr("a", constants={"a": 0.0})()) == "0.0"
+    with pytest.raises(ExprError, match="unknown name"):
+        compile_expr("a + b", names={"a"})  # the names it may read are part of it too
+    assert compile_expr("a + b", names={"a", "b"})({"a": 1, "b": 2}) == 3

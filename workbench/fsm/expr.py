@@ -90,19 +90,42 @@ class Expr:
         return self.evaluate(env if env is not None else {})
 
 
+#: expressions compiled so far, by their text, the names they may read and the constants folded
+#: into them (a machine is built again for every run and every parameter edit, from the same
+#: few texts): at most COMPILED_KEPT, then the table starts afresh
+_compiled: dict[tuple[str, frozenset[str] | None, tuple[tuple[str, str], ...]], Expr] = {}
+COMPILED_KEPT = 4_096
+
+
 def compile_expr(
     text: str,
     names: Collection[str] | None = None,
     constants: Mapping[str, Value] | None = None,
 ) -> Expr:
     """Compile ``text``; ``names`` are the names it may read (None: any), ``constants`` are
-    names whose values are fixed now and are folded into the result."""
+    names whose values are fixed now and are folded into the result. An :class:`Expr` holds
+    no state, so one compiled before for the same text, names and constants is given again."""
     if isinstance(text, bool):
         text = "True" if text else "False"
     elif isinstance(text, int | float):
         text = repr(text)
     if not isinstance(text, str):
         raise ExprError(f"an expression must be text, not {type(text).__name__}")
+    # a constant goes into the key as written (True == 1 and 0.0 == -0.0, yet they fold apart)
+    folded = tuple(sorted((k, repr(v)) for k, v in (constants or {}).items()))
+    key = (text, None if names is None else frozenset(names), folded)
+    found = _compiled.get(key)
+    if found is None:
+        found = _compile(text, names, constants)
+        if len(_compiled) >= COMPILED_KEPT:
+            _compiled.clear()
+        _compiled[key] = found
+    return found
+
+
+def _compile(
+    text: str, names: Collection[str] | None, constants: Mapping[str, Value] | None
+) -> Expr:
     body = text.lstrip()
     lead = len(text) - len(body)
     if not body.strip():
