@@ -148,3 +148,14 @@ def test_an_expression_compiled_again_folds_the_constants_given_this_time():
     with pytest.raises(ExprError, match="unknown name"):
         compile_expr("a + b", names={"a"})  # the names it may read are part of it too
     assert compile_expr("a + b", names={"a", "b"})({"a": 1, "b": 2}) == 3
+
+
+def test_the_table_of_compiled_expressions_holds_a_bounded_amount_of_text():
+    from workbench.fsm import expr
+
+    # a student's many long, different expressions (each edit of a parameter makes new ones)
+    name = "a" * 300
+    for n in range(1_000):  # some 300,000 characters in all
+        assert compile_expr(f"{name} + {n}", constants={name: 1})() == 1 + n
+    assert 0 < expr._compiled_chars <= expr.COMPILED_CHARS
+    assert sum(len(key[0]) for key in expr._compiled) == expr._compiled_chars

@@ -208,9 +208,10 @@ def describe_program_run(result: RunResult) -> str:
 def unpressed_keys(program: ProgramController) -> list[str]:
     """What to do when the program answers keys and none of its Key Press events fired (a
     program that starts on a key does nothing in a headless run without ``--keys``)."""
-    wanted = sorted({"+".join(sorted(keys)) for keys in program.compiled.key_sets.values() if keys})
+    key_sets = program.compiled.key_sets
+    wanted = sorted({"+".join(sorted(keys)) for keys in key_sets.values() if keys})
     fired = program.fired
-    if not wanted or len(fired) >= MAX_FIRED or any(f.what.startswith("key ") for f in fired):
+    if not wanted or len(fired) >= MAX_FIRED or any(f.activity in key_sets for f in fired):
         return []
     return [
         f"  no key event fired: the program answers {', '.join(wanted)} (Key Press); press "

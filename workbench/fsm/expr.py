@@ -92,9 +92,11 @@ class Expr:
 
 #: expressions compiled so far, by their text, the names they may read and the constants folded
 #: into them (a machine is built again for every run and every parameter edit, from the same
-#: few texts): at most COMPILED_KEPT, then the table starts afresh
+#: few texts); what a compiled expression holds grows with its text, so the table holds at most
+#: COMPILED_CHARS characters of text, then starts afresh
 _compiled: dict[tuple[str, frozenset[str] | None, tuple[tuple[str, str], ...]], Expr] = {}
-COMPILED_KEPT = 4_096
+_compiled_chars = 0
+COMPILED_CHARS = 200_000
 
 
 def compile_expr(
@@ -116,10 +118,13 @@ def compile_expr(
     key = (text, None if names is None else frozenset(names), folded)
     found = _compiled.get(key)
     if found is None:
+        global _compiled_chars
         found = _compile(text, names, constants)
-        if len(_compiled) >= COMPILED_KEPT:
+        if _compiled_chars + len(text) > COMPILED_CHARS:
             _compiled.clear()
+            _compiled_chars = 0
         _compiled[key] = found
+        _compiled_chars += len(text)
     return found
 
 
