@@ -23,6 +23,10 @@ class Endpoints:
     seat: Seat = field(default_factory=Seat)
     #: endpoints that could not start, with the reason
     problems: list[str] = field(default_factory=list)
+    #: the last summary, with the statuses and problems it says (worded again when they change)
+    _summary: tuple[list[LinkStatus], list[str], str] | None = field(
+        default=None, init=False, repr=False, compare=False
+    )
 
     @classmethod
     async def open(
@@ -66,8 +70,13 @@ class Endpoints:
 
     def summary(self) -> str:
         """One line for a status bar: each endpoint, its peer and its counters."""
-        parts = [describe(s) for s in self.statuses()]
-        return " | ".join(parts + self.problems)
+        statuses = self.statuses()
+        kept = self._summary
+        if kept is not None and kept[0] == statuses and kept[1] == self.problems:
+            return kept[2]
+        text = " | ".join([describe(s) for s in statuses] + self.problems)
+        self._summary = (statuses, list(self.problems), text)
+        return text
 
     async def close(self) -> None:
         for endpoint in self.active:

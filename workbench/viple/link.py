@@ -247,25 +247,31 @@ class Link:
         self._driver: Driver | None = None
         self._work = 0
         self._bad_log = RateLimitedLog(self.log)
+        #: the last status given, with the values it was made of
+        self._status: tuple[tuple[object, ...], LinkStatus] | None = None
 
     # -- status --------------------------------------------------------------------------
     @property
     def status(self) -> LinkStatus:
-        """The endpoint's status at this moment (a snapshot)."""
-        return LinkStatus(
-            role=self.role,
-            address=self.address,
-            peer=self.peer,
-            messages_in=self.messages_in,
-            messages_out=self.messages_out,
-            invalid=self.invalid,
-            last_rejection=self.last_rejection,
-            connections=self.connections,
-            refused=self.refused,
-            dropped=self.dropped,
-            idled=self.idled,
-            held=self.held,
+        """The endpoint's status at this moment (a snapshot; the same object while nothing in
+        it changed, as the app asks for it every tick)."""
+        key = (
+            self.address,
+            self.peer,
+            self.messages_in,
+            self.messages_out,
+            self.invalid,
+            self.last_rejection,
+            self.connections,
+            self.refused,
+            self.dropped,
+            self.idled,
+            self.held,
         )
+        kept = self._status
+        if kept is None or kept[0] != key:
+            kept = self._status = (key, LinkStatus(self.role, *key))
+        return kept[1]
 
     @property
     def driver(self) -> Driver | None:
