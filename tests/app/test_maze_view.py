@@ -6,6 +6,9 @@ from dataclasses import replace
 
 from textual import events
 from textual.app import App, ComposeResult
+from textual.geometry import Region
+from textual.strip import Strip
+from textual.widget import Widget
 
 from tests.app.support import sync
 from workbench.sim.driver import BY_KEYS
@@ -501,3 +504,38 @@ async def test_the_start_is_marked_apart_from_the_robot_and_the_trail_goes_when_
         view.show(replace(snap(2, 1), time=1.0), 1.0)
         await pilot.pause()
         assert maze_lines(view)[1] == "##S>>           ##"  # no dots left from before
+
+
+def styles_cache_lines(view: MazeView, crop: Region) -> list[Strip]:
+    """The lines Textual's own way makes of the view's rows (its styles cache)."""
+    return Widget.render_lines(view, crop)
+
+
+@sync
+async def test_the_lines_drawn_are_the_ones_textuals_styles_cache_makes():
+    maze = generate(40, 40, 3)  # scrolls both ways at 80x24: the scrollbars show
+    sensors = (SensorSpec("distance", 1, "front"), SensorSpec("touch", 2, "left"))
+    app = Host(maze, unicode=True)
+    async with app.run_test(size=(80, 24)) as pilot:
+        view = app.query_one(MazeView)
+        await pilot.pause()
+        width, height = view.outer_size
+        crops = [
+            Region(0, 0, width, height),
+            Region(0, 3, width, 2),
+            Region(10, 5, 7, 3),
+            Region(width - 4, 0, 4, height),
+        ]
+        for cell, heading in (((1, 1), 0.0), ((40, 39), 90.0), ((79, 79), 225.0)):
+            view.show(snap(*cell, heading, sensors, {1: 3.0, 2: 1}), 1.0)
+            await pilot.pause()
+            for crop in crops:
+                assert view.render_lines(crop) == styles_cache_lines(view, crop), (cell, crop)
+        # styled with a border and padding, the view is drawn Textual's way
+        view.styles.border = ("round", "red")
+        view.styles.padding = (0, 1)
+        await pilot.pause()
+        crop = Region(0, 0, *view.outer_size)
+        drawn = view.render_lines(crop)
+        assert drawn == styles_cache_lines(view, crop)
+        assert drawn[0].text.startswith("╭")

@@ -76,6 +76,23 @@ _RAY_SLACK = 0.6
 STYLE_NAMES = ("wall", "floor", "exit", "start", "trail", "ray", "hit", "touch", "robot", "cursor")
 
 
+def _plain_styles(widget: ScrollView) -> bool:
+    """Nothing of ``widget``'s styles changes its lines on their way to the screen (see
+    :meth:`MazeView.render_lines`)."""
+    styles = widget.styles
+    return (
+        not any(edge for edge, _ in styles.border)
+        and not any(edge for edge, _ in styles.outline)
+        and not any(styles.padding)
+        and not styles.tint.a
+        and styles.text_opacity == 1.0
+        and (not styles.has_rule("hatch") or styles.hatch == "none")
+        and widget.border_title is None
+        and widget.border_subtitle is None
+        and widget.opacity == 1.0
+    )
+
+
 def robot_glyph(heading: float, unicode: bool) -> str:
     """The arrow for a heading in degrees (0 = right, clockwise): 8 directions in Unicode, 4 in
     ASCII."""
@@ -364,10 +381,38 @@ class MazeView(ScrollView, can_focus=False):
         self._styles.clear()
         self._strips = [None] * self._maze.height
 
-    def render_line(self, y: int) -> Strip:
+    def render_lines(self, crop: Region) -> list[Strip]:
+        """The lines of ``crop`` (relative to the widget) straight from the row strips.
+
+        For a widget without border, padding, outline, tint, hatch or opacity, as the maze
+        view is styled, these are the lines Textual's styles cache makes of :meth:`render_line`:
+        each row, the app's line filters applied, cut to the crop's columns. Its set-up for
+        each call (the ancestors' colours, the filters, regions, the border titles) cost more
+        than the rows themselves while the robot moves, a few rows a frame. Styled otherwise,
+        the view is drawn Textual's way.
+        """
+        if not _plain_styles(self):
+            return super().render_lines(crop)
+        background = self.background_colors[1]
+        filters = self.app.get_line_filters()
+        x1, x2 = crop.column_span
+        cut = (x1, x2) != (0, self.outer_size.width)
         scroll_x, scroll_y = self.scroll_offset
         width = self.size.width
-        row = scroll_y + y
+        strips = []
+        for y in crop.line_range:
+            strip = self._line(scroll_y + y, scroll_x, width)
+            for line_filter in filters:
+                strip = strip.apply_filter(line_filter, background)
+            strips.append(strip.crop(x1, x2) if cut else strip)
+        return strips
+
+    def render_line(self, y: int) -> Strip:
+        scroll_x, scroll_y = self.scroll_offset
+        return self._line(scroll_y + y, scroll_x, self.size.width)
+
+    def _line(self, row: int, scroll_x: int, width: int) -> Strip:
+        """Maze row ``row`` as the view shows it, scrolled ``scroll_x`` columns along."""
         base = self._style("")
         if row >= self._maze.height:
             return Strip.blank(width, base)
