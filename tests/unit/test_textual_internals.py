@@ -191,6 +191,7 @@ METHODS = {
     ("textual.screen", "Screen", "_on_timer_update"): ["self"],
     ("textual.screen", "Screen", "refresh_bindings"): ["self"],
     ("textual.widgets._input", "Input", "_on_key"): ["self", "event"],
+    ("textual.widget", "Widget", "_scroll_update"): ["self", "virtual_size"],
 }
 
 

@@ -170,6 +170,7 @@ def open_app(args: argparse.Namespace) -> int:
     if not terminal and not os.environ.get("TEXTUAL_DRIVER"):
         print("workbench: not a terminal, so no app: here is the maze", file=sys.stderr)
         return demo(args)
+    app.holds_process = True
     app.run()
     return app.return_code or 0
 

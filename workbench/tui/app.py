@@ -121,6 +121,9 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
 
     #: frames drawn so far (a plain attribute: a reactive one costs a lookup on every tick)
     frames: int = 0
+    #: the app is its process's one app for the process's life (``workbench`` on a terminal
+    #: sets it; tests run many apps in one process and leave it off)
+    holds_process: bool = False
 
     def __init__(
         self,
@@ -268,10 +271,11 @@ class WorkbenchApp(ScreenHost[None], OrderedKeys):
         self.station.on_activity = self.wake
         if self.settings.connect_hint:
             self.say(self.hint_line())
-        if serves(self):
-            # a served session's process holds this one app for the whole class: what start-up
-            # built lives as long as it, so the garbage collector's full passes (some 70 ms
-            # each while a student drives) leave it alone from the first screen on
+        if self.holds_process or serves(self):
+            # the process holds this one app for its whole life (a served session's, for the
+            # whole class): what start-up built lives as long as it, so the garbage collector's
+            # full passes (some 70 ms each, a stutter of the robot every half minute while it
+            # drives) leave it alone from the first screen on
             self.call_after_refresh(gc.freeze)
         self._start_pusher()
         # what an earlier app could not save: written as soon as the database answers

@@ -13,6 +13,7 @@ from textual.binding import BindingsMap
 from textual.content import Content
 from textual.dom import DOMNode
 from textual.geometry import Size
+from textual.widget import Widget
 from textual.widgets import Checkbox, Footer, Input, RadioButton
 from textual.widgets._footer import FooterKey
 from textual.widgets._toggle_button import ToggleButton
@@ -27,6 +28,7 @@ __all__ = [
     "end_with_error",
     "footer_ready",
     "handled_size",
+    "update_scrollbars",
 ]
 
 
@@ -51,6 +53,12 @@ def end_with_error(app: App[Any], error: Exception) -> None:
 def footer_ready(footer: Footer) -> bool:
     """Whether the footer has read its screen's bindings (its keys can be composed)."""
     return bool(footer._bindings_ready)
+
+
+def update_scrollbars(widget: Widget) -> None:
+    """Bring a scrolling widget's scroll bars (whether they show, their thumbs) and its scroll
+    position up to its virtual size now, as Textual does when it lays the widget out."""
+    widget._scroll_update(widget.virtual_size)
 
 
 def handled_size(app: App[Any]) -> Size | None:

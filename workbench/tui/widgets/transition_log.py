@@ -5,11 +5,14 @@ from __future__ import annotations
 import textwrap
 from collections.abc import Iterable
 
+from textual.geometry import Size
+from textual.reactive import Reactive
 from textual.widget import Widget
 from textual.widgets import Log
 
 from workbench.fsm.machine import Transition
 
+from ..textual_private import update_scrollbars
 from .text import arrow, number
 
 
@@ -30,7 +33,14 @@ class TransitionLog(Log):
     It keeps its newest entry in sight: Textual's log follows only while it is already at its
     end, and the panel above it grows and shrinks with the last transition's text, which would
     leave it behind for good.
+
+    A new entry redraws the log and its scroll bar, not the whole screen: Textual's log grows
+    its scrollable size as a change of layout, and laying out the main screen again took most
+    of a frame's work, at every transition of a running algorithm. (A scroll bar that comes or
+    goes still lays the screen out, as it changes the room the log's lines have.)
     """
+
+    virtual_size: Reactive[Size] = Reactive(Size(0, 0), layout=False)
 
     DEFAULT_CSS = """
     TransitionLog {
@@ -80,6 +90,10 @@ class TransitionLog(Log):
                 lines += textwrap.wrap(text, width, subsequent_indent=" " * 7)
         self.write_lines(lines, scroll_end=False)
         self._follow()
+
+    def watch_virtual_size(self) -> None:
+        if self.is_mounted:
+            update_scrollbars(self)
 
     def on_resize(self) -> None:
         self._follow()
