@@ -36,8 +36,8 @@ class TransitionLog(Log):
 
     A new entry redraws the log and its scroll bar, not the whole screen: Textual's log grows
     its scrollable size as a change of layout, and laying out the main screen again took most
-    of a frame's work, at every transition of a running algorithm. (A scroll bar that comes or
-    goes still lays the screen out, as it changes the room the log's lines have.)
+    of a frame's work, at every transition of a running algorithm. (Its vertical scroll bar
+    always shows, so a new line never changes the room the others have.)
     """
 
     virtual_size: Reactive[Size] = Reactive(Size(0, 0), layout=False)
