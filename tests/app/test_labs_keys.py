@@ -6,6 +6,7 @@ from __future__ import annotations
 from textual.pilot import Pilot
 from textual.widgets import Input, OptionList, Static
 
+from tests.waiting import until
 from workbench.labs.model import load_labs
 from workbench.labs.signoff.instructors import KdfParams, create_instructor
 from workbench.labs.store.store import Store
@@ -103,8 +104,14 @@ def test_each_exercise_opens_at_the_top_with_its_objectives_in_view(tmp_path):
         listing.highlighted = listing.get_option_index("maze-algorithms/which-is-best")
         await pilot.pause()
         assert scroll.scroll_y == 0
+        # the new exercise's text is laid out once it has been read (on a busy machine, some
+        # frames later): then its objectives are in view at the top
         objectives = screen.query_one("#labs-objectives")
-        assert objectives.region.y >= scroll.region.y and objectives.region.height > 0
+        await until(
+            lambda: objectives.region.y >= scroll.region.y and objectives.region.height > 0,
+            "the objectives in view",
+        )
+        assert scroll.scroll_y == 0
 
     run(app, body)
 
