@@ -233,6 +233,8 @@ async def measure_app(maze: Maze, seconds: float, hz: float, speed: float) -> di
                 if panel.states[0]:
                     break
                 await pilot.pause(0.05)
+            else:
+                raise SystemExit(f"the algorithm panel never showed {ALGORITHM}")
             await pilot.pause()
             station.start()
             stats = Stats()

@@ -33,7 +33,7 @@ import logging
 import math
 import time
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import Protocol
 
 from workbench.sim.commands import Command, Stop
@@ -152,6 +152,10 @@ class LinkStatus:
         return self.peer is not None
 
 
+#: what a status is made of, in its order: the link's attributes of the same names
+_STATUS_FIELDS = tuple(f.name for f in fields(LinkStatus))
+
+
 @dataclass
 class Seat:
     """The one driver's seat of a robot, shared by every endpoint serving its session."""
@@ -255,22 +259,10 @@ class Link:
     def status(self) -> LinkStatus:
         """The endpoint's status at this moment (a snapshot; the same object while nothing in
         it changed, as the app asks for it every tick)."""
-        key = (
-            self.address,
-            self.peer,
-            self.messages_in,
-            self.messages_out,
-            self.invalid,
-            self.last_rejection,
-            self.connections,
-            self.refused,
-            self.dropped,
-            self.idled,
-            self.held,
-        )
+        key = tuple(getattr(self, name) for name in _STATUS_FIELDS)
         kept = self._status
         if kept is None or kept[0] != key:
-            kept = self._status = (key, LinkStatus(self.role, *key))
+            kept = self._status = (key, LinkStatus(*key))
         return kept[1]
 
     @property
