@@ -264,3 +264,23 @@ def test_grade_refuses_a_picture_it_could_not_write(tmp_path, capsys):
     code = main(["grade", str(folder), "--maze", "web", "--picture", str(tmp_path / "g.pdf")])
     _, err = capsys.readouterr()
     assert code == 2 and "--picture" in err and "g.pdf" in err and ".svg or .png" in err
+
+
+def test_run_draws_a_long_run_whose_record_reached_the_cap(tmp_path, capsys, monkeypatch):
+    """A command's record stops at the cap every record the workbench writes keeps, so a run
+    too long for it is still drawn (the cap is made small here; a real one is 20 MB, which a
+    run of some hours reaches)."""
+    monkeypatch.setattr("workbench.control.lifecycle.RECORD_CAP", 60_000)
+    maze = tmp_path / "loop.txt"
+    maze.write_text("#######\n#.....#\n#.###.#\n#S....#\n#######\n")  # no exit: it goes round
+    target = tmp_path / "long.svg"
+    record = tmp_path / "long.jsonl"
+    code = main(["run", "--maze", str(maze), "--algorithm", "right-wall", "--profile",
+                 "erobotic", "--max-time", "600", "--record", str(record),
+                 "--picture", str(target)])  # fmt: skip
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    assert "run record          stopped after" in out and "60,000" in out
+    assert record.stat().st_size <= 60_000
+    assert "picture (path)" in err
+    assert path_points(target.read_bytes(), "robot-path") > 10

@@ -22,7 +22,7 @@ from workbench.sim.record import KEEPS_SUMMARY, Recorder, RecordStop
 from workbench.sim.session import Session
 
 from .driving import Driving
-from .recording import RecordQuota, RecordTrouble, open_record
+from .recording import RECORD_CAP, RecordQuota, RecordTrouble, open_record
 
 #: how a run ends (a station's ``RunEntry.ended`` and its record's summary say it)
 EXIT = "exit"
@@ -58,8 +58,10 @@ def ending(session: Session, driving: Driving | None = None) -> Ending | None:
 
 def record_file(path: str) -> Recorder:
     """A record written to the file ``path`` that a command names (raises ``OSError`` when it
-    cannot be created; the command says so in its own words)."""
-    return Recorder(path)
+    cannot be created; the command says so in its own words), under the cap every record the
+    workbench writes keeps (:data:`RECORD_CAP`): pictures and replays read any record it
+    wrote, however long the run."""
+    return Recorder(path, cap=RECORD_CAP)
 
 
 @dataclass
