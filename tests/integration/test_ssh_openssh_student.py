@@ -28,7 +28,11 @@ async def test_a_student_over_openssh_has_no_sign_off_key_and_answers_with_the_p
         key.chmod(0o600)
         student = OpenSshTerminal("ann", host.port, key)
         try:
-            main = await student.start_app()
+            await student.start_app()
+            # the run panel's last line comes after its distance line, maybe in a later packet
+            main = await student.wait_until(
+                lambda t: LISTENING.search(t) is not None, "the session's VIPLE port shown"
+            )
             shown = LISTENING.search(main)
             assert shown is not None, main
             port = shown.group(1)
