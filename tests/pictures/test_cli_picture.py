@@ -284,3 +284,20 @@ def test_run_draws_a_long_run_whose_record_reached_the_cap(tmp_path, capsys, mon
     assert record.stat().st_size <= 60_000
     assert "picture (path)" in err
     assert path_points(target.read_bytes(), "robot-path") > 10
+    # the caption says where the drawn path ends, since the figures are the whole run's
+    stopped = float(out.split("run record          stopped after ")[1].split(" s")[0])
+    said = (
+        f"the record stopped at {stopped:.1f} s (its size limit): "
+        "the path and its marks end there"
+    )
+    assert said in texts(target.read_bytes())
+    over_time = tmp_path / "long-time.svg"
+    code, _, err = _picture(capsys, str(record), "--kind", "time", "-o", str(over_time))
+    assert code == 0, err
+    assert said in texts(over_time.read_bytes())
+    side_by_side = tmp_path / "long-compare.svg"
+    code, _, err = _picture(capsys, str(record), str(record), "-o", str(side_by_side))
+    assert code == 0, err
+    assert f"not out | path ends at {stopped:.1f} s (record stopped)" in texts(
+        side_by_side.read_bytes()
+    )

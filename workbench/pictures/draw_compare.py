@@ -11,7 +11,7 @@ from typing import TYPE_CHECKING
 from .draw_maze import draw_maze
 from .runs import PictureRun
 from .series import event_ticks, label
-from .words import Figures, figures
+from .words import Figures, figures, record_stop_short
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -67,6 +67,9 @@ def draw_compare_figure(fig: Figure, runs: Sequence[PictureRun]) -> None:
         )
         f = figures(run)
         out = f"out at {f.exit_time:.1f} s" if f.exit_time is not None else "not out"
+        stop = record_stop_short(run)
+        if stop is not None:
+            out += f" | {stop}"
         ax.set_title(f"{run_label(k, run)}\n{out}", fontsize=7)
     numbers = [figures(run) for run in runs]
     for j, (title, value) in enumerate(BARS):

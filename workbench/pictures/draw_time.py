@@ -13,7 +13,7 @@ from workbench.sim.driver import Driver
 
 from .runs import PictureRun
 from .series import event_ticks, powers, sensor_series, state_spans
-from .words import figure_lines, heading
+from .words import figure_lines, heading, record_stop
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -153,4 +153,6 @@ def draw_time_figure(fig: Figure, run: PictureRun) -> None:
     ax_band.set_ylabel(band_title(replay.driver), rotation=0, ha="right", va="center")
     ax_band.set_xlabel("time (s)")
     ax_band.set_xlim(times[0], max(times[-1], times[0] + 1e-9))
-    fig.suptitle(f"{heading(run)}\n" + " | ".join(figure_lines(run)), fontsize=9)
+    stop = record_stop(run)
+    title = f"{heading(run)}\n" + " | ".join(figure_lines(run))
+    fig.suptitle(title if stop is None else f"{title}\n{stop}", fontsize=9)

@@ -105,6 +105,39 @@ def figure_lines(run: PictureRun) -> list[str]:
     return [clock, f"{travel} | {turning} | {hits}"]
 
 
+#: why a record stopped before its run ended, by the figure its summary's ``record_capped``
+#: holds (:meth:`workbench.sim.record.Recorder.summary`)
+_STOPPED_BY = {"bytes": "its size limit", "bytes_per_second": "its limit of bytes a second"}
+
+
+def _capped(run: PictureRun) -> dict[str, Any] | None:
+    summary = run.replay.summary
+    capped = summary.get("record_capped") if summary is not None else None
+    return capped if isinstance(capped, dict) else None
+
+
+def _stopped_at(capped: dict[str, Any]) -> str:
+    t = _num(capped, "t", math.nan)
+    return "" if math.isnan(t) else f" at {t:.1f} s"
+
+
+def record_stop(run: PictureRun) -> str | None:
+    """When the record stopped before its run ended, the line that says so: the path drawn
+    and the marks on it end there, while the figures above are the whole run's (None: the
+    record holds the whole run)."""
+    capped = _capped(run)
+    if capped is None:
+        return None
+    why = next((words for key, words in _STOPPED_BY.items() if key in capped), "a limit")
+    return f"the record stopped{_stopped_at(capped)} ({why}): the path and its marks end there"
+
+
+def record_stop_short(run: PictureRun) -> str | None:
+    """:func:`record_stop` in a few words, for a small map's title."""
+    capped = _capped(run)
+    return None if capped is None else f"path ends{_stopped_at(capped)} (record stopped)"
+
+
 def heading(run: PictureRun) -> str:
     """Maze, profile and driver: ``eRobotic lab maze (erobotic) | driver: right-wall``."""
     maze = label(run.maze.name or "unnamed maze")
@@ -113,7 +146,11 @@ def heading(run: PictureRun) -> str:
 
 def caption(run: PictureRun) -> str:
     """The caption under a run's picture: heading, figures, and the record's name."""
-    lines = [heading(run), *figure_lines(run), run.record_words or f"record {label(run.name)}"]
+    lines = [heading(run), *figure_lines(run)]
+    stop = record_stop(run)
+    if stop is not None:
+        lines.append(stop)
+    lines.append(run.record_words or f"record {label(run.name)}")
     if run.note:
         lines.append(terminal_safe(run.note))
     return "\n".join(lines)
