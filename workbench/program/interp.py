@@ -196,6 +196,8 @@ class ProgramController:
         if report_period is not None and not report_period > 0:
             raise ValueError(f"the report period must be above 0 s, not {report_period!r}")
         self.report_period = report_period
+        #: whether sensor reports come at their own pace (else with every tick's readings)
+        self._paced = report_period is not None
         self._reads = bool(compiled.sensors)
         #: each activity's output pins and their links (Program.targets, without the call)
         self._outputs = compiled.program.outputs
@@ -280,6 +282,8 @@ class ProgramController:
         #: the earliest of the times above and the sleeping flows' (what next_due says; kept
         #: up to date at the end of every tick that did something, the only place they change)
         self._due = _NEVER
+        #: before this time, a tick finds nothing to do (see _refresh_due)
+        self._quiet_until = -_NEVER
         self.flows_dropped = 0
         self.steps = 0
         self.state: str | None = None
@@ -327,20 +331,12 @@ class ProgramController:
         ``report``, a robot's report as it arrived, is what a raw sensor gets (None: the
         simulated robot's report is made from the readings)."""
         self.now = t
-        if self.stopped is not None:
-            return []
-        if (
-            t + _SAME < self._due
-            and not self._ready
-            and not self._parked
-            and not self._pushed
-            and not self._typed.held
-            and self.state is not None
-            and (self.report_period is not None or (not readings and report is None))
-        ):
+        if t + _SAME < self._quiet_until and (self._paced or (not readings and report is None)):
             # nothing is due: no Timer ends, no key or sensor report comes and no flow waits to
             # run, so this tick would change nothing (most ticks of a program: its sensors
             # report every 250 ms, the session ticks it every 50 ms)
+            return []
+        if self.stopped is not None:
             return []
         sleeping = self._sleeping
         while sleeping and sleeping[0][0] <= t + _SAME:
@@ -370,7 +366,9 @@ class ProgramController:
         return None if due == _NEVER else due
 
     def _refresh_due(self) -> None:
-        """Work out :meth:`next_due` again, after the flows, keys or reports changed."""
+        """Work out :meth:`next_due` again, after the flows, keys or reports changed, and until
+        when the program is quiet: nothing due, no flow ready or waiting for the next tick, no
+        key typed or held (a stopped program is never quiet; its ticks return at once too)."""
         due = self._next_report
         sleeping = self._sleeping
         if sleeping and sleeping[0][0] < due:
@@ -379,6 +377,8 @@ class ProgramController:
         if self._next_key < len(script) and script[self._next_key].time < due:
             due = script[self._next_key].time
         self._due = due
+        quiet = not (self._ready or self._parked or self._pushed or self._typed.held)
+        self._quiet_until = due if quiet and self.state is not None else -_NEVER
 
     @property
     def timing(self) -> bool:
@@ -405,6 +405,7 @@ class ProgramController:
         if self.stopped is not None:
             return
         self._pushed += self._typed.press(key.lower(), t)
+        self._quiet_until = -_NEVER  # the key fires at the next tick
 
     @property
     def held(self) -> frozenset[str]:
