@@ -324,6 +324,10 @@ def test_a_comparison_with_a_literal_gives_what_it_gives_with_the_same_value_in_
             else:
                 other = scope
             assert as_literal == _outcome(f"value {op} state.x", other), (text, sample)
+            # a global against the literal: as the value against it (the same columns)
+            global_scope = Scope(value=None, state={"v": sample})
+            padded = _outcome(f"value   {op} {text}", scope)  # as wide as state.v
+            assert padded == _outcome(f"state.v {op} {text}", global_scope), (text, sample)
             # the literal written as wide as state.x, so that errors name the same column
             left = f"{text:<7} {op} value"
             assert _outcome(left, scope) == _outcome(f"state.x {op} value", other), (text, sample)
@@ -339,6 +343,8 @@ def test_a_comparison_of_two_numbers_or_two_texts_and_its_errors():
         parse("value < 5")(Scope(value=True))
     with pytest.raises(ExprError, match="> cannot compare String with Int32"):
         parse("value > 5")(Scope(value="a"))
+    with pytest.raises(ExprError, match="column 7: there is no global variable 'Mode'"):
+        parse('state.Mode == "fwd"')(Scope(value=1, state={}))
 
 
 @pytest.mark.parametrize(
