@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from tests.program.builder import ProgramBuilder
 from tests.program.ticking import TICK, run
+from workbench.program import interp
 from workbench.program import kinds as K
 from workbench.program.compiled import compile_program
 from workbench.program.interp import MAPPED_RUNS, RUNS, SENSES, ProgramController
@@ -352,3 +355,134 @@ def test_print_line_writes_reals_as_viple_does(tmp_path):
     c = controller(b, tmp_path)
     run(c, 0.1)
     assert sorted(texts(c)) == ["0.3", "0.666666666666667", "1E+21", "ratio 2.1"]
+
+
+def test_a_tick_with_nothing_due_does_nothing_and_the_report_and_the_timer_ticks_do(tmp_path):
+    """Between two sensor reports, with no Timer ending and no flow ready, a tick sends
+    nothing; the tick at the report fires the sensor, the tick at the Timer's end goes on."""
+    b = ProgramBuilder()
+    main = b.panel("Main")
+    b.robot(main)
+    sensor = main.add(23, "Robot/IoT Controller 0", "1")
+    drive = main.add(20, "value / 100.0", "value / 100.0", "Robot/IoT Controller 0", "3", "5")
+    wait = main.add(3, "120")
+    timer = main.add(15)
+    stop = main.add(20, "0", "0", "Robot/IoT Controller 0", "3", "5")
+    show = main.add(28, "")
+    main.chain(sensor, drive, wait, timer, stop, show)
+    path = b.write(tmp_path / "p.viple")
+    c = ProgramController(compile_program(load_program(path)), report_period=0.25)
+    readings = {"port 1": 40}
+    assert c.start(0.0) == []
+    for t in (0.05, 0.1, 0.15, 0.2):
+        assert c.tick(t, readings, frozenset()) == []
+    assert c.next_due() == 0.25 and c.steps == 0 and c.state == "0 flows"
+    assert c.tick(0.25, readings, frozenset()) == [WheelPowers(0.4, 0.4)]
+    assert c.state == "1 flow" and c.next_due() == pytest.approx(0.37)
+    assert c.tick(0.3, readings, frozenset()) == [] and c.steps == 3
+    assert c.tick(0.37, readings, frozenset()) == [WheelPowers(0.0, 0.0)]
+    assert [p.text for p in c.printed] == ["120"] and c.state == "0 flows" and c.steps == 5
+    assert c.next_due() == 0.5
+
+
+def _run_both_ways(monkeypatch, make, seconds, readings):
+    """The run of a program with its activities' steps prepared, and through the handlers
+    only: everything a user sees of it."""
+    seen = []
+    for prepared in (interp.PREPARED, {}):
+        with monkeypatch.context() as patch:
+            patch.setattr(interp, "PREPARED", prepared)
+            c = make()
+        commands = run(c, seconds, readings)
+        seen.append(
+            (
+                commands,
+                [(p.time, p.text) for p in c.printed],
+                c.fired,
+                [str(e) for e in c.errors],
+                str(c.stopped),
+                c.variables,
+                c.steps,
+                c.changes,
+                c.state,
+                c.running(),
+                c.next_due(),
+            )
+        )
+    return seen
+
+
+def test_prepared_steps_run_as_the_handlers_do_errors_included(tmp_path, monkeypatch):
+    b = ProgramBuilder()
+    b.var("n", "System.Int32")
+    b.var("word", "System.String")
+    main = b.panel("Main")
+    b.robot(main)
+    sensor = main.add(23, "Robot/IoT Controller 0", "1")
+    touch = main.add(22, "Robot/IoT Controller 0", "2")
+    # a three-way If fanning out, a Variable that cannot hold text, a Drive given text
+    cond = main.add(6, "value > 50", "value > 20", "value")
+    store = main.add(1, "n")
+    text = main.add(3, '"fast"')
+    word = main.add(1, "word")
+    bad_drive = main.add(20, "value", "0.5", "Robot/IoT Controller 0", "3", "5")
+    drive = main.add(20, "value / 100", "-0.25", "Robot/IoT Controller 0", "3", "5")
+    wait = main.add(15)
+    show = main.add(28, "")
+    b.link(sensor, cond)
+    b.link(cond, store, pin=0)
+    b.link(cond, text, pin=0)
+    b.link(text, word)
+    b.link(word, store)
+    b.link(word, bad_drive)
+    b.link(cond, drive, pin=1)
+    b.link(cond, show, pin=ELSE)
+    b.link(drive, wait)
+    b.link(wait, show)
+    b.link(touch, show)
+    # a Timer given text, and a Merge loop paced by a 0 ms Timer, both from the start
+    start = main.add(3, '"soon"')
+    bad_wait = main.add(15)
+    main.chain(start, bad_wait)
+    zero = main.add(3, "0")
+    merge = main.add(5)
+    again = main.add(15)
+    count = main.add(2, "state.n + 1")
+    b.link(zero, merge)
+    main.chain(merge, again, count, store)
+    # a loop waking every 10 ms for good
+    ten = main.add(3, "10")
+    tick = main.add(5)
+    pause = main.add(15)
+    same = main.add(2, "value")
+    main.chain(ten, tick, pause, same, tick)
+    path = b.write(tmp_path / "p.viple")
+
+    def make() -> ProgramController:
+        return ProgramController(compile_program(load_program(path)), report_period=0.25)
+
+    def readings(t: float) -> dict[int, float]:
+        return {1: (t * 37) % 90, 2: int(t * 3) % 2}
+
+    prepared, handlers = _run_both_ways(monkeypatch, make, 6.0, readings)
+    assert prepared == handlers
+    errors = prepared[3]
+    assert any("the Timer needs a number of milliseconds, not String" in e for e in errors)
+    assert any("condition 2 gave Double, not true or false" in e for e in errors)
+    assert any("the left power must be a number, not String" in e for e in errors)
+    assert any("'fast' is not a number for a Int32" in e for e in errors)
+    assert prepared[6] > 400  # the 10 ms loop ran at every tick
+
+
+@pytest.mark.parametrize("name", ["web-wall-following.viple", "right-wall.viple"])
+def test_the_shipped_programs_run_the_same_with_prepared_steps(monkeypatch, name):
+    path = str(Path(__file__).resolve().parents[2] / "programs" / name)
+
+    def make() -> ProgramController:
+        return ProgramController(compile_program(load_program(path)), report_period=0.25)
+
+    def readings(t: float) -> dict[int, float]:
+        return {1: 10 + (t * 53) % 90, 2: int(t * 0.7) % 2}
+
+    prepared, handlers = _run_both_ways(monkeypatch, make, 60.0, readings)
+    assert prepared == handlers and prepared[6] > 500

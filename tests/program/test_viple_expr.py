@@ -296,3 +296,83 @@ def test_fuzz_token_soup_raises_only_expr_error(parts):
 def test_fuzz_any_text_raises_only_expr_error(text):
     with contextlib.suppress(ExprError):
         parse(text)(Scope(value="v"))
+
+
+_SAMPLES = [0, 5, 7, -2, 5.0, 2.5, "5", "a", "b", "", True, False, None]
+_OPS = ["==", "=", "!=", "<>", "<", "<=", ">", ">="]
+
+
+def _outcome(text: str, scope: Scope):
+    try:
+        return ("value", parse(text)(scope))
+    except ExprError as exc:
+        return ("error", str(exc))
+
+
+@pytest.mark.parametrize("op", _OPS)
+def test_a_comparison_with_a_literal_gives_what_it_gives_with_the_same_value_in_a_variable(op):
+    """A literal's side of a comparison is known when it is parsed; every pair of values
+    compares (or fails, with the same words) as when neither side is known."""
+    literals = ["0", "5", "7", "-2", "5.0", "2.5", '"5"', '"a"', '""', "true", "false", "null"]
+    for text in literals:
+        known = literal(text) if text not in ("true", "false", "null") else None
+        for sample in _SAMPLES:
+            scope = Scope(value=sample, state={"x": known})
+            as_literal = _outcome(f"value {op} {text}", scope)
+            if text in ("true", "false", "null"):
+                other = Scope(value=sample, state={"x": {"true": True, "false": False}.get(text)})
+            else:
+                other = scope
+            assert as_literal == _outcome(f"value {op} state.x", other), (text, sample)
+            # a global against the literal: as the value against it (the same columns)
+            global_scope = Scope(value=None, state={"v": sample})
+            padded = _outcome(f"value   {op} {text}", scope)  # as wide as state.v
+            assert padded == _outcome(f"state.v {op} {text}", global_scope), (text, sample)
+            # the literal written as wide as state.x, so that errors name the same column
+            left = f"{text:<7} {op} value"
+            assert _outcome(left, scope) == _outcome(f"state.x {op} value", other), (text, sample)
+
+
+def test_a_comparison_of_two_numbers_or_two_texts_and_its_errors():
+    assert parse('value == "fwd" && value != "x"')(Scope(value="fwd")) is True
+    assert parse("value > 75")(Scope(value=75.5)) is True
+    assert parse("value >= 2")(Scope(value=2)) is True
+    assert parse('"b" > value')(Scope(value="a")) is True
+    assert parse("value == null")(Scope(value=None)) is True
+    with pytest.raises(ExprError, match="< cannot compare Boolean with Int32"):
+        parse("value < 5")(Scope(value=True))
+    with pytest.raises(ExprError, match="> cannot compare String with Int32"):
+        parse("value > 5")(Scope(value="a"))
+    with pytest.raises(ExprError, match="column 7: there is no global variable 'Mode'"):
+        parse('state.Mode == "fwd"')(Scope(value=1, state={}))
+
+
+@pytest.mark.parametrize(
+    ("text", "value", "expected"),
+    [
+        ("value > 1 && value < 3", 2, True),
+        ("value > 1 && value < 3", 0, False),
+        ("value < 1 || value > 3", 4, True),
+        ("value < 1 || value > 3", 2, False),
+        ("value < 1 || value > 3", 0, True),
+        ("value > 1 && value", 0, False),
+        ("value < 1 || value", 0, True),
+    ],
+)
+def test_and_and_or_stop_at_the_first_side_that_decides(text, value, expected):
+    assert parse(text)(Scope(value=value)) is expected
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("value && true", "column 7: && needs true or false, not Int32"),
+        ("true && value", "column 6: && needs true or false, not Int32"),
+        ("value || true", "column 7: || needs true or false, not Int32"),
+        ("false || value", "column 7: || needs true or false, not Int32"),
+    ],
+)
+def test_and_and_or_need_true_or_false_on_the_side_they_read(text, message):
+    with pytest.raises(ExprError) as caught:
+        parse(text)(Scope(value=3))
+    assert message in str(caught.value)

@@ -136,7 +136,7 @@ class RunError:
         )
 
 
-@dataclass
+@dataclass(slots=True)
 class Frame:
     """One running custom activity (``block`` None: Main, or an event inside a panel)."""
 
@@ -149,7 +149,7 @@ class Frame:
     joins: dict[int, list[deque[Value]]] = field(default_factory=dict)
 
 
-@dataclass
+@dataclass(slots=True)
 class Flow:
     number: int
     activity: int
@@ -158,7 +158,15 @@ class Flow:
     in_pin: int = 0
     steps: int = 0
     #: While id -> (changes, message) at its last pass, to notice a loop that changes nothing
-    loops: dict[int, tuple[int, Any]] = field(default_factory=dict)
+    #: (None until the flow meets a While: most flows never do, and a flow starts with every
+    #: sensor report)
+    loops: dict[int, tuple[int, Any]] | None = None
+
+
+#: one activity made ready to run: a flow at it -> does the flow go on?
+Step = Callable[[Flow], bool]
+#: sends a message out of one output pin of an activity: the flow, the message -> goes on?
+Send = Callable[[Flow, Value], bool]
 
 
 class _Sleep(Exception):
@@ -188,6 +196,8 @@ class ProgramController:
         if report_period is not None and not report_period > 0:
             raise ValueError(f"the report period must be above 0 s, not {report_period!r}")
         self.report_period = report_period
+        #: whether sensor reports come at their own pace (else with every tick's readings)
+        self._paced = report_period is not None
         self._reads = bool(compiled.sensors)
         #: each activity's output pins and their links (Program.targets, without the call)
         self._outputs = compiled.program.outputs
@@ -217,6 +227,20 @@ class ProgramController:
             for aid, pairs in exprs.items()
             if [i for i, _ in pairs] == list(range(len(pairs)))
         }
+        #: a sensor or event activity's id -> its panel and the links out of it
+        self._fires = {
+            aid: (act.panel, compiled.program.targets(aid))
+            for aid, act in compiled.program.activities.items()
+        }
+        #: the sensor activities in file order: what each does with a report, its id and port
+        self._senses = tuple(
+            (SENSES[kind], aid, port) for aid, (kind, port) in compiled.sensors.items()
+        )
+        #: the scope expressions read, filled in for each activity that runs them (nothing
+        #: keeps it: an expression runs to its end before the next activity starts)
+        self._the_scope = Scope()
+        #: activity id -> the step that runs it (see _prepare)
+        self._steps = {aid: self._prepare(act) for aid, act in self._activities.items()}
         self.reset()
 
     # -- the Controller protocol ----------------------------------------------------------
@@ -242,6 +266,9 @@ class ProgramController:
         self._sleeping: list[tuple[float, int, Flow]] = []
         #: the Joins of Main and of events inside panels (a block call keeps its own)
         self._joins: dict[int, list[deque[Value]]] = {}
+        #: the frame of every flow of Main that no block call made (all of them alike: Main
+        #: has no parameters and keeps its Joins in _joins)
+        self._main = Frame("Main", {})
         self._held: set[str] = set()
         self._next_key = 0
         self._typed = TypedKeys()
@@ -252,6 +279,11 @@ class ProgramController:
         #: a reading's name ("port 3") -> its port
         self._ports: dict[str, int] = {}
         self._next_report = _NEVER
+        #: the earliest of the times above and the sleeping flows' (what next_due says; kept
+        #: up to date at the end of every tick that did something, the only place they change)
+        self._due = _NEVER
+        #: before this time, a tick finds nothing to do (see _refresh_due)
+        self._quiet_until = -_NEVER
         self.flows_dropped = 0
         self.steps = 0
         self.state: str | None = None
@@ -267,6 +299,7 @@ class ProgramController:
         self._hot: dict[int, int] = {}
         #: parts of the messages waiting at Joins
         self._join_parts = 0
+        self._refresh_due()
 
     @property
     def variables(self) -> dict[str, Any]:
@@ -278,12 +311,14 @@ class ProgramController:
         if self.report_period is not None and self._reads:
             self._next_report = t + self.report_period
         program = self.program
-        main = Frame("Main", {})
+        main = self._main
         for aid in program.panels["Main"].activities:
             act = program.activities[aid]
             if act.kind in _STARTS and aid not in program.inputs:
                 self._spawn(aid, None, main)
-        return self._run()
+        commands = self._run()
+        self._refresh_due()
+        return commands
 
     def tick(
         self,
@@ -296,6 +331,11 @@ class ProgramController:
         ``report``, a robot's report as it arrived, is what a raw sensor gets (None: the
         simulated robot's report is made from the readings)."""
         self.now = t
+        if t + _SAME < self._quiet_until and (self._paced or (not readings and report is None)):
+            # nothing is due: no Timer ends, no key or sensor report comes and no flow waits to
+            # run, so this tick would change nothing (most ticks of a program: its sensors
+            # report every 250 ms, the session ticks it every 50 ms)
+            return []
         if self.stopped is not None:
             return []
         sleeping = self._sleeping
@@ -315,11 +355,20 @@ class ProgramController:
             # no sensor
             ports = self._ports
             self._sensors({ports.get(n) or _port(ports, n): v for n, v in readings.items()}, report)
-        return self._run()
+        commands = self._run()
+        self._refresh_due()
+        return commands
 
     def next_due(self) -> float | None:
         """When the program next has something to do at a time of its own: a Timer ends, a
         scripted key is pressed or a sensor report is due (None: nothing is)."""
+        due = self._due
+        return None if due == _NEVER else due
+
+    def _refresh_due(self) -> None:
+        """Work out :meth:`next_due` again, after the flows, keys or reports changed, and until
+        when the program is quiet: nothing due, no flow ready or waiting for the next tick, no
+        key typed or held (a stopped program is never quiet; its ticks return at once too)."""
         due = self._next_report
         sleeping = self._sleeping
         if sleeping and sleeping[0][0] < due:
@@ -327,7 +376,9 @@ class ProgramController:
         script = self.key_script
         if self._next_key < len(script) and script[self._next_key].time < due:
             due = script[self._next_key].time
-        return None if due == _NEVER else due
+        self._due = due
+        quiet = not (self._ready or self._parked or self._pushed or self._typed.held)
+        self._quiet_until = due if quiet and self.state is not None else -_NEVER
 
     @property
     def timing(self) -> bool:
@@ -354,6 +405,7 @@ class ProgramController:
         if self.stopped is not None:
             return
         self._pushed += self._typed.press(key.lower(), t)
+        self._quiet_until = -_NEVER  # the key fires at the next tick
 
     @property
     def held(self) -> frozenset[str]:
@@ -391,8 +443,8 @@ class ProgramController:
         """One sensor report: each sensor activity, in file order, through the handler of its
         kind (:data:`SENSES`)."""
         self._report = report
-        for aid, (kind, port) in self.compiled.sensors.items():
-            SENSES[kind](self, aid, port, readings)
+        for sense, aid, port in self._senses:
+            sense(self, aid, port, readings)
 
     def _sense_raw(self, aid: int, port: int, readings: dict[int, Value]) -> None:
         if self._report is None:  # the simulated robot: a report made from its readings
@@ -432,11 +484,11 @@ class ProgramController:
             self.fired.append(Fired(self.now, aid, what))
 
     def _fire(self, aid: int, value: Value, what: str | None = None) -> None:
-        act = self.program.activities[aid]
+        panel, links = self._fires[aid]
         if what is not None:
             self._fired(aid, what)
-        frame = Frame(act.panel, self._instance_defaults(act.panel))
-        for link in self.program.targets(aid):
+        frame = self._main if panel == "Main" else Frame(panel, self._instance_defaults(panel))
+        for link in links:
             self._spawn(link.target, value, frame, link.in_pin)
 
     def _instance_defaults(self, panel: str) -> dict[str, Value]:
@@ -472,14 +524,17 @@ class ProgramController:
         ready = self._ready
         if not ready and self.state is not None:
             return []  # nothing ran, so nothing changed since the last pass
+        now = self.now
+        limits = self.limits
         window = self._window
-        while window and window[0][0] <= self.now - 1.0 + 1e-9:
+        while window and window[0][0] <= now - 1.0 + 1e-9:
             self._second_steps -= window.popleft()[1]
-        if not window:
+        if not window and self._hot:
             self._hot = {}
         total = 0
-        budget = min(self.limits.tick, self.limits.second - self._second_steps)
+        budget = min(limits.tick, limits.second - self._second_steps)
         hot = self._hot
+        steps = self._steps
         ran: list[Flow] = []  # the flows that took steps in this pass (their count restarts)
         while ready and total < budget and self.stopped is None:
             flow = ready.popleft()
@@ -491,14 +546,23 @@ class ProgramController:
             try:
                 while done < SLICE:
                     done += 1
-                    if not self._step(flow):
-                        ended = True
-                        break
+                    # the activity the flow is at, run by its step; False: the flow has
+                    # ended (a run-time error ends it too, and a limit stops the program)
+                    aid = flow.activity
+                    try:
+                        if steps[aid](flow):
+                            continue
+                    except LimitError as exc:
+                        self._stop(aid, str(exc))
+                    except (ExprError, ValueError, TypeError, OverflowError) as exc:
+                        self._error(aid, str(exc))
+                    ended = True
+                    break
                 else:
                     ready.append(flow)
             except _Sleep as sleep:
                 if sleep.seconds > 0:
-                    due = _whole_ms(self.now + max(sleep.seconds, MIN_WAIT))
+                    due = _whole_ms(now + max(sleep.seconds, MIN_WAIT))
                     heappush(self._sleeping, (due, flow.number, flow))
                 else:
                     ready.append(flow)
@@ -512,18 +576,19 @@ class ProgramController:
         self.steps += total
         self._second_steps += total
         if total:
-            window.append((self.now, total))
+            window.append((now, total))
+        parked = self._parked
         if self.stopped is not None:
             pass
-        elif (ready or self._parked) and self._second_steps >= self.limits.second:
+        elif (ready or parked) and self._second_steps >= limits.second:
             self._over_work()
-        elif self._parked or ready or self._join_parts:
+        elif parked or ready or self._join_parts:
             self._check_memory()
         if self.stopped is not None:
             return self._halted()
         for flow in ran:
             flow.steps = 0
-        busy = len(ready) + len(self._parked) + len(self._sleeping)
+        busy = len(ready) + len(parked) + len(self._sleeping)
         if busy != self._busy or self.state is None:
             self._busy = busy
             self.state = f"{busy} flow{'s' if busy != 1 else ''}"
@@ -531,19 +596,126 @@ class ProgramController:
         return commands
 
     # -- one activity ----------------------------------------------------------------------
-    def _step(self, flow: Flow) -> bool:
-        """Run the activity the flow is at, through the handler of its kind (:data:`RUNS`; a
-        kind named in a mapping file, through :data:`MAPPED_RUNS`); False when the flow has
-        ended."""
-        handler, act = self._handlers[flow.activity]
-        try:
+    def _prepare(self, act) -> Step:
+        """The step that runs ``act``: the handler of its kind (:data:`RUNS`; a kind named in
+        a mapping file, through :data:`MAPPED_RUNS`), or, for the kinds most programs run at
+        every report (:data:`PREPARED`), the same handler with the activity's links, constant
+        and compiled expressions looked up once, here, instead of at every step."""
+        handler, _ = self._handlers[act.id]
+        prepare = PREPARED.get(handler)
+        step = prepare(self, act) if prepare is not None else None
+        if step is not None:
+            return step
+
+        def run(flow: Flow) -> bool:
             return handler(self, flow, act)
-        except LimitError as exc:
-            self._stop(act.id, str(exc))
-            return False
-        except (ExprError, ValueError, TypeError, OverflowError) as exc:
-            self._error(act.id, str(exc))
-            return False
+
+        return run
+
+    def _sender(self, aid: int, pin: int) -> Send:
+        """What :meth:`_go` does for the output ``pin`` of activity ``aid``, its links found
+        once: the first target continues the flow, every other one starts a flow of its own."""
+        out = self._outputs.get(aid)
+        links = out.get(pin) if out else None
+        if not links:
+            return _send_nowhere
+        first = links[0]
+        target, in_pin = first.target, first.in_pin
+        others = links[1:]
+        if not others:
+
+            def send_one(flow: Flow, value: Value) -> bool:
+                flow.activity, flow.value, flow.in_pin = target, value, in_pin
+                return True
+
+            return send_one
+        spawn = self._spawn
+
+        def send_all(flow: Flow, value: Value) -> bool:
+            for link in others:
+                spawn(link.target, value, flow.frame, link.in_pin)
+            flow.activity, flow.value, flow.in_pin = target, value, in_pin
+            return True
+
+        return send_all
+
+    def _prepare_pass_on(self, act) -> Step:
+        send = self._sender(act.id, 0)
+        return lambda flow: send(flow, flow.value)
+
+    def _prepare_data(self, act) -> Step | None:
+        if act.id not in self.compiled.constants:
+            return None
+        send = self._sender(act.id, 0)
+        constant = self.compiled.constants[act.id]
+        return lambda flow: send(flow, constant)
+
+    def _prepare_variable(self, act) -> Step | None:
+        key = self._var_keys[act.id]
+        if key not in self.compiled.globals:
+            return None
+        vtype = self.compiled.globals[key][1]
+        send = self._sender(act.id, 0)
+
+        def run(flow: Flow) -> bool:
+            stored = convert(flow.value, vtype)
+            self.globals[key] = stored
+            self.changes += 1
+            return send(flow, stored)
+
+        return run
+
+    def _prepare_if(self, act) -> Step | None:
+        exprs = self._exprs.get(act.id)
+        if exprs is None or len(exprs) != len(act.values):
+            return None
+        branches = tuple(
+            (index, condition, self._sender(act.id, index)) for index, condition in enumerate(exprs)
+        )
+        otherwise = self._sender(act.id, ELSE)
+        scope = self._scope
+
+        def run(flow: Flow) -> bool:
+            at = scope(flow)
+            for index, condition, send in branches:
+                truth = condition(at)
+                if truth is True:
+                    return send(flow, flow.value)
+                if truth is not False:
+                    _truth(truth, index)  # not true or false: the error
+            return otherwise(flow, flow.value)
+
+        return run
+
+    def _prepare_timer(self, act) -> Step:
+        send = self._sender(act.id, 0)
+
+        def run(flow: Flow) -> bool:
+            value = flow.value
+            _check_timer(value)
+            if not send(flow, value):
+                return False  # nothing waits for the Timer
+            raise _Sleep(max(0.0, float(value)) / 1000.0)
+
+        return run
+
+    def _prepare_drive(self, act) -> Step | None:
+        exprs = self._exprs.get(act.id)
+        if exprs is None or len(exprs) < 2:
+            return None
+        left_power, right_power = exprs[0], exprs[1]
+        send = self._sender(act.id, 0)
+        scope = self._scope
+        command = self._command
+
+        def run(flow: Flow) -> bool:
+            at = scope(flow)
+            left = _power(left_power(at), "left")
+            right = _power(right_power(at), "right")
+            command(WheelPowers(left, right))
+            return send(flow, flow.value)
+
+        return run
 
     def _go(self, flow: Flow, pin: int, value: Value, source: int | None = None) -> bool:
         """Send ``value`` out of ``pin``: the first target continues this flow."""
@@ -559,9 +731,12 @@ class ProgramController:
 
     def _scope(self, flow: Flow) -> Scope:
         value = flow.value
-        return Scope(
-            value, self.globals, flow.frame.instance, value if isinstance(value, dict) else None
-        )
+        scope = self._the_scope
+        scope.value = value
+        scope.state = self.globals
+        scope.instance = flow.frame.instance
+        scope.parts = value if isinstance(value, dict) else None
+        return scope
 
     def _expr(self, aid: int, index: int) -> Callable[[Scope], Value]:
         """The compiled expression ``index`` of activity ``aid``, as the function it runs."""
@@ -616,11 +791,14 @@ class ProgramController:
         value = flow.value
         if _truth(self._expr(act.id, 0)(self._scope(flow)), 0):
             mark = (self.changes, _key(value))
-            if flow.loops.get(act.id) == mark:
+            if flow.loops is None:
+                flow.loops = {}
+            elif flow.loops.get(act.id) == mark:
                 raise _Park()
             flow.loops[act.id] = mark
             return self._go(flow, 0, value)
-        flow.loops.pop(act.id, None)
+        if flow.loops is not None:
+            flow.loops.pop(act.id, None)
         return self._go(flow, 0, value, self.program.loop_end[act.id])
 
     def _end_while(self, flow: Flow, act) -> bool:
@@ -629,13 +807,13 @@ class ProgramController:
 
     def _break(self, flow: Flow, act) -> bool:
         loop = self.program.break_loop[act.id]
-        flow.loops.pop(loop, None)
+        if flow.loops is not None:
+            flow.loops.pop(loop, None)
         return self._go(flow, 0, flow.value, self.program.loop_end[loop])
 
     def _timer(self, flow: Flow, act) -> bool:
         value = flow.value
-        if not isinstance(value, int | float) or isinstance(value, bool):
-            raise ValueError(f"the Timer needs a number of milliseconds, not {type_name(value)}")
+        _check_timer(value)
         if not self._go(flow, 0, value):
             return False  # nothing waits for the Timer
         raise _Sleep(max(0.0, float(value)) / 1000.0)
@@ -663,7 +841,7 @@ class ProgramController:
             if block == flow.frame.panel:
                 self._fired(aid, f"custom event {block}")
                 for link in self.program.targets(aid):
-                    self._spawn(link.target, flow.value, Frame("Main", {}), link.in_pin)
+                    self._spawn(link.target, flow.value, self._main, link.in_pin)
         return False
 
     def _code(self, flow: Flow, act) -> bool:
@@ -847,6 +1025,19 @@ MAPPED_RUNS: dict[str, Callable[[ProgramController, Flow, Any], bool]] = {
     "custom-event": ProgramController._pass_on,
     "ignore": ProgramController._never,
 }
+#: the handlers whose steps are made once for each activity (see ProgramController._prepare):
+#: handler -> what makes the step (None: the activity runs through its handler)
+PREPARED: dict[
+    Callable[[ProgramController, Flow, Any], bool],
+    Callable[[ProgramController, Any], Step | None],
+] = {
+    ProgramController._pass_on: ProgramController._prepare_pass_on,
+    ProgramController._data: ProgramController._prepare_data,
+    ProgramController._variable: ProgramController._prepare_variable,
+    ProgramController._if: ProgramController._prepare_if,
+    ProgramController._timer: ProgramController._prepare_timer,
+    ProgramController._drive: ProgramController._prepare_drive,
+}
 #: the handler of a kind no table names (the loader refuses such a kind: it never runs)
 _NEVER_RUNS = ProgramController._never
 #: sensor activity kind -> what it does with a report (the activity, its port, the readings)
@@ -898,6 +1089,16 @@ def _port(ports: dict[str, int], name: str) -> int:
     """The port of a reading named ``port N`` (kept in ``ports`` for the next report)."""
     port = ports[name] = int(name.split()[-1])
     return port
+
+
+def _send_nowhere(flow: Flow, value: Value) -> bool:
+    return False  # no link leaves the pin: the flow ends
+
+
+def _check_timer(value: Value) -> None:
+    """A Timer waits a number of milliseconds (true and false are not numbers)."""
+    if not isinstance(value, int | float) or isinstance(value, bool):
+        raise ValueError(f"the Timer needs a number of milliseconds, not {type_name(value)}")
 
 
 def _truth(value: Value, index: int) -> bool:

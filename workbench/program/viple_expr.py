@@ -18,6 +18,7 @@ into a tree of small functions, and sizes are bounded before parsing.
 from __future__ import annotations
 
 import math
+import operator
 import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -47,7 +48,7 @@ class LimitError(ExprError):
     Join message's size): a program that meets one is stopped, not only the flow."""
 
 
-@dataclass
+@dataclass(slots=True)
 class Scope:
     """What an expression reads: the message, the globals, the block's parameters, a Join's
     named parts. Dictionaries are keyed by lower-case name."""
@@ -291,6 +292,18 @@ class _Parser:
         self.state: set[str] = set()
         self.instance: set[str] = set()
         self.bare: set[str] = set()
+        #: id of a literal's function -> (its value,), for a comparison to use it as it is
+        self.literals: dict[int, tuple[Value]] = {}
+        #: id of a ``state.X`` read's function -> (key, name, column), for a comparison
+        self.globals_read: dict[int, tuple[str, str, int]] = {}
+        #: the functions of both, so that no id above is reused while parsing
+        self._kept: list[Fn] = []
+
+    def literal(self, value: Value) -> Fn:
+        fn = _const(value)
+        self.literals[id(fn)] = (value,)
+        self._kept.append(fn)
+        return fn
 
     @property
     def tok(self) -> _Tok:
@@ -361,7 +374,10 @@ class _Parser:
         while self.op() in _COMPARE:
             tok = self.tok
             self.i += 1
-            left = _compare(tok.text, left, self.additive(), tok.col)
+            right = self.additive()
+            constant = self.literals.get(id(right))
+            read = self.globals_read.get(id(left))
+            left = _compare(tok.text, left, right, tok.col, constant, read)
         return left
 
     def additive(self) -> Fn:
@@ -395,10 +411,10 @@ class _Parser:
         tok = self.tok
         if tok.kind == "number":
             self.i += 1
-            return _const(_number_literal(tok))
+            return self.literal(_number_literal(tok))
         if tok.kind in ("string", "char"):
             self.i += 1
-            return _const(_string_literal(tok.text))
+            return self.literal(_string_literal(tok.text))
         if tok.kind == "op" and tok.text == "(":
             self.i += 1
             inner = self.conditional()
@@ -414,9 +430,9 @@ class _Parser:
         word = tok.text.lower()
         self.i += 1
         if word in ("true", "false"):
-            return _const(word == "true")
+            return self.literal(word == "true")
         if word == "null":
-            return _const(None)
+            return self.literal(None)
         if word in ("value", "it"):
             return _value
         if word == "iif":
@@ -431,7 +447,10 @@ class _Parser:
             key = member.text.lower()
             if word == "state":
                 self.state.add(key)
-                return _state(key, member.text, member.col)
+                read = _state(key, member.text, member.col)
+                self.globals_read[id(read)] = (key, member.text, member.col)
+                self._kept.append(read)
+                return read
             if word == "instance":
                 self.instance.add(key)
                 return _instance(key, member.text, member.col)
@@ -524,13 +543,15 @@ def _state(key: str, name: str, col: int) -> Fn:
         try:
             return s.state[key]
         except KeyError:
-            raise ExprError(
-                f"there is no global variable {name!r}",
-                col,
-                "declare it in VIPLE's Variables dialog",
-            ) from None
+            raise _no_global(name, col) from None
 
     return read
+
+
+def _no_global(name: str, col: int) -> ExprError:
+    return ExprError(
+        f"there is no global variable {name!r}", col, "declare it in VIPLE's Variables dialog"
+    )
 
 
 def _instance(key: str, name: str, col: int) -> Fn:
@@ -569,11 +590,28 @@ def _choose(c: Fn, a: Fn, b: Fn, col: int) -> Fn:
 
 
 def _or(a: Fn, b: Fn, col: int) -> Fn:
-    return lambda s: _want_bool(a(s), col, "||") or _want_bool(b(s), col, "||")
+    # ``_want_bool(a(s)) or _want_bool(b(s))``, with the checks of true and false written out
+    # (the conditions of a program's Ifs run at every sensor report)
+    def run(s: Scope) -> Value:
+        v = a(s)
+        if v is False:
+            w = b(s)
+            return w if w is True or w is False else _want_bool(w, col, "||")
+        return True if v is True else _want_bool(v, col, "||")
+
+    return run
 
 
 def _and(a: Fn, b: Fn, col: int) -> Fn:
-    return lambda s: _want_bool(a(s), col, "&&") and _want_bool(b(s), col, "&&")
+    # ``_want_bool(a(s)) and _want_bool(b(s))``, written out as in _or
+    def run(s: Scope) -> Value:
+        v = a(s)
+        if v is True:
+            w = b(s)
+            return w if w is True or w is False else _want_bool(w, col, "&&")
+        return False if v is False else _want_bool(v, col, "&&")
+
+    return run
 
 
 def _not(a: Fn, col: int) -> Fn:
@@ -590,12 +628,119 @@ def _negate(a: Fn, col: int) -> Fn:
     return run
 
 
-def _compare(op: str, a: Fn, b: Fn, col: int) -> Fn:
+#: a comparison of two numbers, or of two texts, as Python makes it
+_TESTS: dict[str, Callable[[Any, Any], bool]] = {
+    "==": operator.eq,
+    "=": operator.eq,
+    "!=": operator.ne,
+    "<>": operator.ne,
+    "<": operator.lt,
+    "<=": operator.le,
+    ">": operator.gt,
+    ">=": operator.ge,
+}
+
+
+def _compare(
+    op: str,
+    a: Fn,
+    b: Fn,
+    col: int,
+    constant: tuple[Value] | None = None,
+    global_read: tuple[str, str, int] | None = None,
+) -> Fn:
+    """``a op b``; ``constant`` holds b's value when b is a literal (it is not run then), and
+    ``global_read`` the key, name and column of the global a reads, when a is ``state.X``."""
+    test = _TESTS[op]
+    slow = _compare_values(op, col)
+    # Two numbers (not true or false), or two texts, compare as Python compares them; any
+    # other pair (and a subclass of a number or text) takes the general path, which checks
+    # the types and words the errors. Most conditions compare a value or a global with a
+    # literal, so the literal's side is known when it is parsed, and reading the value or the
+    # global is written into the comparison.
+    if constant is not None and a is _value and type(constant[0]) in (str, int, float):
+        return _value_with(test, slow, constant[0])
+    if constant is not None and global_read is not None and type(constant[0]) in (str, int, float):
+        return _global_with(test, slow, constant[0], *global_read)
+    if constant is not None:
+        y = constant[0]
+        if type(y) is str:
+
+            def text_with(s: Scope) -> Value:
+                x = a(s)
+                return test(x, y) if type(x) is str else slow(x, y)
+
+            return text_with
+        if type(y) is int or type(y) is float:
+
+            def number_with(s: Scope) -> Value:
+                x = a(s)
+                kind = type(x)
+                return test(x, y) if kind is float or kind is int else slow(x, y)
+
+            return number_with
+
+    def run(s: Scope) -> Value:
+        x = a(s)
+        y = b(s)
+        kx, ky = type(x), type(y)
+        if ((kx is float or kx is int) and (ky is float or ky is int)) or kx is ky is str:
+            return test(x, y)
+        return slow(x, y)
+
+    return run
+
+
+def _value_with(test: Callable[[Any, Any], bool], slow: Callable[[Value, Value], Value],
+                y: Value) -> Fn:  # fmt: skip
+    """``value op y`` for a literal text or number y (see _compare)."""
+    if type(y) is str:
+
+        def value_text(s: Scope) -> Value:
+            x = s.value
+            return test(x, y) if type(x) is str else slow(x, y)
+
+        return value_text
+
+    def value_number(s: Scope) -> Value:
+        x = s.value
+        kind = type(x)
+        return test(x, y) if kind is float or kind is int else slow(x, y)
+
+    return value_number
+
+
+def _global_with(test: Callable[[Any, Any], bool], slow: Callable[[Value, Value], Value],
+                 y: Value, key: str, name: str, col: int) -> Fn:  # fmt: skip
+    """``state.NAME op y`` for a literal text or number y (see _compare)."""
+    if type(y) is str:
+
+        def global_text(s: Scope) -> Value:
+            try:
+                x = s.state[key]
+            except KeyError:
+                raise _no_global(name, col) from None
+            return test(x, y) if type(x) is str else slow(x, y)
+
+        return global_text
+
+    def global_number(s: Scope) -> Value:
+        try:
+            x = s.state[key]
+        except KeyError:
+            raise _no_global(name, col) from None
+        kind = type(x)
+        return test(x, y) if kind is float or kind is int else slow(x, y)
+
+    return global_number
+
+
+def _compare_values(op: str, col: int) -> Callable[[Value, Value], Value]:
+    """``x op y`` for values of any types: the types checked, as C# compares them."""
     equality = op in ("==", "=", "!=", "<>")
     negate = op in ("!=", "<>")
 
-    def run(s: Scope) -> Value:
-        x, y = a(s), b(s)
+    def run(x: Value, y: Value) -> Value:
         if _number(x) and _number(y):
             pass
         elif equality and (x is None or y is None or type(x) is type(y)):
