@@ -14,15 +14,18 @@ import pytest
 from rich.cells import cell_len
 from rich.segment import ControlType, Segment
 from rich.style import Style
+from textual.geometry import Region
 from textual.pilot import Pilot
 from textual.strip import Strip
+from textual.widget import Widget
 
 from tests.app.support import run
 from tests.waiting import until
 from workbench.tui.app import WorkbenchApp, make_app
 from workbench.tui.screens.main import MainScreen
-from workbench.tui.serving.compositor import GroupedUpdate, LiveCompositor
+from workbench.tui.serving.compositor import GroupedUpdate, LiveCompositor, merged_crops
 from workbench.tui.widgets.maze_view import MazeView
+from workbench.tui.widgets.transition_log import TransitionLog
 from workbench.wire.settings import AppSettings
 
 Cell = tuple[str, Style | None]
@@ -160,5 +163,59 @@ def test_redrawing_an_unchanged_snapshot_refreshes_nothing():
         assert not screen._dirty_widgets
         assert not screen._compositor._dirty_regions
         assert view.strips_built == built
+
+    run(app, body)
+
+
+def test_groups_of_changes_whose_boxes_overlap_are_rendered_as_one():
+    log = [Region(40, 10, 30, 5)]
+    bar = [Region(69, 12, 1, 3)]
+    apart = [Region(0, 0, 10, 1)]
+    within = [Region(41, 14, 5, 2)]  # overlaps the log's box, reaching below it
+    crops = sorted(merged_crops([log, apart, bar, within]))
+    assert crops[0] == (Region(0, 0, 10, 1), apart)
+    crop, regions = crops[1]
+    assert crop == Region(40, 10, 30, 6)
+    assert sorted(regions) == sorted(log + bar + within)
+
+
+def test_no_widget_is_rendered_twice_for_one_update_while_an_algorithm_runs(monkeypatch):
+    # a new transition changes the log and its scroll bar (whose column is inside the log's
+    # box): rendered as one box, each of them once
+    app = make_app(AppSettings(noise="off"))
+    rendered: list[Widget] = []
+    render_lines = Widget.render_lines
+
+    def counted(widget: Widget, crop: Region) -> list[Strip]:
+        rendered.append(widget)
+        return render_lines(widget, crop)
+
+    monkeypatch.setattr(Widget, "render_lines", counted)
+
+    async def body(pilot: Pilot) -> None:
+        screen = app.screen
+        assert isinstance(screen, MainScreen)
+        compositor = screen._compositor
+        partial = compositor.render_partial_update
+        twice: list[str] = []
+        logged: list[int] = []
+
+        def checked():
+            rendered.clear()
+            update = partial()
+            log = screen.query_one(TransitionLog)
+            if log in rendered:
+                logged.append(len(rendered))
+            twice.extend(repr(w) for w in set(rendered) if rendered.count(w) > 1)
+            return update
+
+        compositor.render_partial_update = checked  # type: ignore[method-assign]
+        station = app.station
+        station.select_algorithm("right-wall")
+        station.apply_algorithm_preset()
+        await pilot.pause()
+        station.start()
+        await until(lambda: len(logged) >= 4, "four updates that drew the transition log")
+        assert twice == []
 
     run(app, body)

@@ -189,6 +189,8 @@ METHODS = {
     ("textual.screen", "Screen", "_clear_tooltip"): ["self"],
     ("textual.screen", "Screen", "_on_idle"): ["self", "event"],
     ("textual.screen", "Screen", "_on_timer_update"): ["self"],
+    ("textual.screen", "Screen", "_refresh_layout"): ["self", "size", "scroll"],
+    ("textual.screen", "Screen", "_compositor_refresh"): ["self"],
     ("textual.screen", "Screen", "refresh_bindings"): ["self"],
     ("textual.widgets._input", "Input", "_on_key"): ["self", "event"],
     ("textual.widget", "Widget", "_scroll_update"): ["self", "virtual_size"],
@@ -256,6 +258,15 @@ def test_a_new_app_has_the_state_the_serving_code_reads():
     assert app._batch_count == 0
     assert app._screen_stack == []
     assert isinstance(DOMNode()._bindings, BindingsMap)
+
+
+def test_a_widget_keeps_its_virtual_size_and_redraw_flag_where_the_single_layout_looks():
+    from textual.reactive import Reactive
+
+    descriptor = inspect.getattr_static(Widget, "virtual_size")
+    assert isinstance(descriptor, Reactive)
+    assert descriptor._layout is True  # what a layout's sizes would ask for, left out
+    assert Widget()._repaint_required is False
 
 
 def test_a_footer_says_when_it_has_read_its_bindings_where_the_key_bar_looks():

@@ -40,6 +40,7 @@ from ..dialogs.path import PathDialog
 from ..dialogs.unsaved import Choice, UnsavedDialog
 from ..host import FollowsUnicode, ShowsSnapshot, StationChanged
 from ..keys import FSM_EDITOR_KEY_IDS, bindings
+from ..serving.single_layout import SingleLayout
 from ..widgets.key_bar import KeyBar
 
 #: seconds after the last key before the text is checked
@@ -69,7 +70,7 @@ def _problem_text(checked: Checked) -> str:
     return "\n".join(lines)
 
 
-class FsmEditorScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
+class FsmEditorScreen(ShowsSnapshot, FollowsUnicode, SingleLayout, Screen[None]):
     """Write, check, save and run an FSM file."""
 
     DEFAULT_CSS = """

@@ -64,6 +64,7 @@ from workbench.sim.session import Snapshot
 from ..host import FollowsUnicode, SetUpDone, ShowsSnapshot
 from ..keys import LABS_KEY_IDS, bindings
 from ..plain import follow_app, prose
+from ..serving.single_layout import SingleLayout
 from ..widgets.choices import Choices
 from ..widgets.field import Field
 from ..widgets.key_bar import KeyBar
@@ -134,7 +135,7 @@ class StoreNews(Message, bubble=False):
         self.event = event
 
 
-class LabsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
+class LabsScreen(ShowsSnapshot, FollowsUnicode, SingleLayout, Screen[None]):
     """Choose an exercise, set it up, watch its objectives, answer its questions."""
 
     DEFAULT_CSS = """

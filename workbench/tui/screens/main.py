@@ -45,6 +45,7 @@ from ..record_words import record_words
 from ..serving.compositor import use_live_compositor
 from ..serving.prompt_frames import PromptFrames
 from ..serving.quick_keys import QuickKeys
+from ..serving.single_layout import SingleLayout
 from ..widgets.algorithm_state import AlgorithmState
 from ..widgets.key_bar import KeyBar
 from ..widgets.key_legend import KeyLegend
@@ -64,7 +65,15 @@ PANEL_HZ = 2.0
 PANEL_WITH_MAZE = 0.6
 
 
-class MainScreen(ShowsSnapshot, ShowsStatus, FollowsUnicode, TakesAllKeys, QuickKeys, PromptFrames):
+class MainScreen(
+    ShowsSnapshot,
+    ShowsStatus,
+    FollowsUnicode,
+    TakesAllKeys,
+    QuickKeys,
+    PromptFrames,
+    SingleLayout,
+):
     """Drive, watch and set up the robot."""
 
     # the side panel moves beside the maze on a wide terminal (app.tcss); only this screen

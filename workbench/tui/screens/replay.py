@@ -30,6 +30,7 @@ from workbench.sim.sensor_kinds import sensor_kind
 from ..host import FollowsUnicode, ToggleUnicode
 from ..keys import REPLAY_KEY_IDS, REPLAY_LEGEND, bindings, legend_text
 from ..picture_saving import save_picture_off_the_loop
+from ..serving.single_layout import SingleLayout
 from ..widgets.key_bar import KeyBar
 from ..widgets.maze_view import MazeView
 from ..widgets.text import count
@@ -61,7 +62,7 @@ def _command(cmd: object) -> str:
     return f"{name} {_number(value)}"
 
 
-class ReplayScreen(FollowsUnicode, Screen[None]):
+class ReplayScreen(FollowsUnicode, SingleLayout, Screen[None]):
     """Step through or play a recorded run; escape goes back."""
 
     AUTO_FOCUS = ""

@@ -29,6 +29,7 @@ from ..dialogs.path import PathDialog
 from ..host import FollowsUnicode, ShowsSnapshot, ToggleUnicode
 from ..keys import RUNS_KEY_IDS, bindings
 from ..picture_saving import save_picture_off_the_loop
+from ..serving.single_layout import SingleLayout
 from ..widgets.key_bar import KeyBar
 from .replay import ReplayScreen
 from .runs_table import (
@@ -50,7 +51,7 @@ OPEN_HELP = (
 )
 
 
-class RunsScreen(ShowsSnapshot, FollowsUnicode, Screen[None]):
+class RunsScreen(ShowsSnapshot, FollowsUnicode, SingleLayout, Screen[None]):
     """The station's runs side by side; enter replays one, ``o`` opens a record file."""
 
     DEFAULT_CSS = """

@@ -10,6 +10,8 @@ second; the modules here cut what each key, tick and frame costs the server (mea
     and a screen's binding chain is built only when it changed;
   * ``prompt_frames`` and ``compositor``: a change is drawn in the wake that made it, rendering
     only the widgets it shows;
+  * ``single_layout``: a change of a widget's size lays the screen out once (Textual laid it out
+    a second time, to the same result), and what the layout resized is drawn in its frame;
   * ``loop_clock``: the simulation's tick as one timer handle, ticking early when a key wakes
     the app anyway;
   * ``warmup``: the stylesheets parsed once in the fork server for every app forked after it.

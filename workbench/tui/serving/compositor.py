@@ -12,7 +12,8 @@ terminal:
 
   * the changed regions are grouped by the front-most widget that holds each of them, and each
     group is rendered on its own (a cell changed in the maze and a line changed in the side panel
-    are no longer one box covering most of the screen);
+    are no longer one box covering most of the screen); groups whose boxes overlap are rendered
+    as one, so that no widget is rendered twice for one update;
   * a widget is asked only for the lines of the group's box, and only if what it shows on the
     screen overlaps that box;
   * once a widget that covers the whole box has been rendered, the widgets behind it are not
@@ -74,8 +75,7 @@ class LiveCompositor(Compositor):
             groups.setdefault(owner, []).append(changed)
         chop_ends = [cut_set[1:] for cut_set in self.cuts]
         updates = []
-        for group in groups.values():
-            crop = Region.from_union(group)
+        for crop, group in merged_crops(groups.values()):
             spans = list(self._regions_to_spans(group))
             rendered = {y for y, _, _ in spans}.__contains__
             chops = self._render_chops(crop, rendered)
@@ -112,6 +112,27 @@ class LiveCompositor(Compositor):
                 and crop_bottom <= y + height
             ):
                 return  # the crop is all this widget's: nothing behind it shows there
+
+
+def merged_crops(groups: Iterable[list[Region]]) -> list[tuple[Region, list[Region]]]:
+    """Each group's crop (the box around its regions), with groups whose crops overlap made one.
+
+    A widget is rendered for every crop it shows in: a scroll bar's own change and the change of
+    the log it scrolls (whose box holds the bar's column), or a panel's and the lines inside it,
+    would render the widgets they share twice. The box around both holds the same widgets.
+    """
+    pending = [(Region.from_union(group), group) for group in groups]
+    merged: list[tuple[Region, list[Region]]] = []
+    while pending:
+        crop, group = pending.pop()
+        for i, (other, regions) in enumerate(merged):
+            if other.overlaps(crop):
+                del merged[i]
+                pending.append((other.union(crop), regions + group))
+                break
+        else:
+            merged.append((crop, group))
+    return merged
 
 
 def use_live_compositor(screen: Screen[Any]) -> None:
