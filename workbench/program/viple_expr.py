@@ -294,9 +294,7 @@ class _Parser:
         self.bare: set[str] = set()
         #: id of a literal's function -> (its value,), for a comparison to use it as it is
         self.literals: dict[int, tuple[Value]] = {}
-        #: id of a ``state.X`` read's function -> (key, name, column), for a comparison
-        self.globals_read: dict[int, tuple[str, str, int]] = {}
-        #: the functions of both, so that no id above is reused while parsing
+        #: the literals' functions, so that no id above is reused while parsing
         self._kept: list[Fn] = []
 
     def literal(self, value: Value) -> Fn:
@@ -375,9 +373,7 @@ class _Parser:
             tok = self.tok
             self.i += 1
             right = self.additive()
-            constant = self.literals.get(id(right))
-            read = self.globals_read.get(id(left))
-            left = _compare(tok.text, left, right, tok.col, constant, read)
+            left = _compare(tok.text, left, right, tok.col, self.literals.get(id(right)))
         return left
 
     def additive(self) -> Fn:
@@ -447,10 +443,7 @@ class _Parser:
             key = member.text.lower()
             if word == "state":
                 self.state.add(key)
-                read = _state(key, member.text, member.col)
-                self.globals_read[id(read)] = (key, member.text, member.col)
-                self._kept.append(read)
-                return read
+                return _state(key, member.text, member.col)
             if word == "instance":
                 self.instance.add(key)
                 return _instance(key, member.text, member.col)
@@ -543,15 +536,13 @@ def _state(key: str, name: str, col: int) -> Fn:
         try:
             return s.state[key]
         except KeyError:
-            raise _no_global(name, col) from None
+            raise ExprError(
+                f"there is no global variable {name!r}",
+                col,
+                "declare it in VIPLE's Variables dialog",
+            ) from None
 
     return read
-
-
-def _no_global(name: str, col: int) -> ExprError:
-    return ExprError(
-        f"there is no global variable {name!r}", col, "declare it in VIPLE's Variables dialog"
-    )
 
 
 def _instance(key: str, name: str, col: int) -> Fn:
@@ -590,26 +581,26 @@ def _choose(c: Fn, a: Fn, b: Fn, col: int) -> Fn:
 
 
 def _or(a: Fn, b: Fn, col: int) -> Fn:
-    # ``_want_bool(a(s)) or _want_bool(b(s))``, with the checks of true and false written out
-    # (the conditions of a program's Ifs run at every sensor report)
-    def run(s: Scope) -> Value:
-        v = a(s)
-        if v is False:
-            w = b(s)
-            return w if w is True or w is False else _want_bool(w, col, "||")
-        return True if v is True else _want_bool(v, col, "||")
-
-    return run
+    return _either(a, b, col, "||", True)
 
 
 def _and(a: Fn, b: Fn, col: int) -> Fn:
-    # ``_want_bool(a(s)) and _want_bool(b(s))``, written out as in _or
+    return _either(a, b, col, "&&", False)
+
+
+def _either(a: Fn, b: Fn, col: int, op: str, decides: bool) -> Fn:
+    """``a op b`` for || (``decides`` True: a true left side is the answer) and && (False):
+    both sides must be true or false, and the right one runs only when the left does not
+    decide. The checks of true and false are written out, as the conditions of a program's
+    Ifs run at every sensor report."""
+    goes_on = not decides
+
     def run(s: Scope) -> Value:
         v = a(s)
-        if v is True:
+        if v is goes_on:
             w = b(s)
-            return w if w is True or w is False else _want_bool(w, col, "&&")
-        return False if v is False else _want_bool(v, col, "&&")
+            return w if w is True or w is False else _want_bool(w, col, op)
+        return decides if v is decides else _want_bool(v, col, op)
 
     return run
 
@@ -641,44 +632,27 @@ _TESTS: dict[str, Callable[[Any, Any], bool]] = {
 }
 
 
-def _compare(
-    op: str,
-    a: Fn,
-    b: Fn,
-    col: int,
-    constant: tuple[Value] | None = None,
-    global_read: tuple[str, str, int] | None = None,
-) -> Fn:
-    """``a op b``; ``constant`` holds b's value when b is a literal (it is not run then), and
-    ``global_read`` the key, name and column of the global a reads, when a is ``state.X``."""
+#: the types that compare as Python compares them, by the type of a literal they meet
+_PLAIN = {str: (str,), int: (int, float), float: (int, float)}
+
+
+def _compare(op: str, a: Fn, b: Fn, col: int, constant: tuple[Value] | None = None) -> Fn:
+    """``a op b``; ``constant`` holds b's value when b is a literal (it is not run then)."""
     test = _TESTS[op]
     slow = _compare_values(op, col)
     # Two numbers (not true or false), or two texts, compare as Python compares them; any
     # other pair (and a subclass of a number or text) takes the general path, which checks
-    # the types and words the errors. Most conditions compare a value or a global with a
-    # literal, so the literal's side is known when it is parsed, and reading the value or the
-    # global is written into the comparison.
-    if constant is not None and a is _value and type(constant[0]) in (str, int, float):
-        return _value_with(test, slow, constant[0])
-    if constant is not None and global_read is not None and type(constant[0]) in (str, int, float):
-        return _global_with(test, slow, constant[0], *global_read)
-    if constant is not None:
+    # the types and words the errors. Most conditions compare something with a literal, whose
+    # type is known when it is parsed.
+    plain = _PLAIN.get(type(constant[0])) if constant is not None else None
+    if constant is not None and plain is not None:
         y = constant[0]
-        if type(y) is str:
 
-            def text_with(s: Scope) -> Value:
-                x = a(s)
-                return test(x, y) if type(x) is str else slow(x, y)
+        def with_literal(s: Scope) -> Value:
+            x = a(s)
+            return test(x, y) if type(x) in plain else slow(x, y)
 
-            return text_with
-        if type(y) is int or type(y) is float:
-
-            def number_with(s: Scope) -> Value:
-                x = a(s)
-                kind = type(x)
-                return test(x, y) if kind is float or kind is int else slow(x, y)
-
-            return number_with
+        return with_literal
 
     def run(s: Scope) -> Value:
         x = a(s)
@@ -689,50 +663,6 @@ def _compare(
         return slow(x, y)
 
     return run
-
-
-def _value_with(test: Callable[[Any, Any], bool], slow: Callable[[Value, Value], Value],
-                y: Value) -> Fn:  # fmt: skip
-    """``value op y`` for a literal text or number y (see _compare)."""
-    if type(y) is str:
-
-        def value_text(s: Scope) -> Value:
-            x = s.value
-            return test(x, y) if type(x) is str else slow(x, y)
-
-        return value_text
-
-    def value_number(s: Scope) -> Value:
-        x = s.value
-        kind = type(x)
-        return test(x, y) if kind is float or kind is int else slow(x, y)
-
-    return value_number
-
-
-def _global_with(test: Callable[[Any, Any], bool], slow: Callable[[Value, Value], Value],
-                 y: Value, key: str, name: str, col: int) -> Fn:  # fmt: skip
-    """``state.NAME op y`` for a literal text or number y (see _compare)."""
-    if type(y) is str:
-
-        def global_text(s: Scope) -> Value:
-            try:
-                x = s.state[key]
-            except KeyError:
-                raise _no_global(name, col) from None
-            return test(x, y) if type(x) is str else slow(x, y)
-
-        return global_text
-
-    def global_number(s: Scope) -> Value:
-        try:
-            x = s.state[key]
-        except KeyError:
-            raise _no_global(name, col) from None
-        kind = type(x)
-        return test(x, y) if kind is float or kind is int else slow(x, y)
-
-    return global_number
 
 
 def _compare_values(op: str, col: int) -> Callable[[Value, Value], Value]:
