@@ -426,18 +426,20 @@ class Walkthrough:
             for o in screen.progress.objectives
         }  # fmt: skip
         pane = screen.query_one("#labs-scroll")
-        objectives_height = screen.query_one("#labs-objectives").region.height
+        objectives = screen.query_one("#labs-objectives")
         pane.focus()
         pane.scroll_home(animate=False)
         await self.pilot.pause()
         views = []
         unseen = set(wanted)
-        for _ in range(objectives_height + 1):
+        while True:
             lines = screen_lines(self.app)
             assert all(line.isascii() for line in lines), "\n".join(lines)
             views.append(" ".join(" ".join(line[PANE:].split()) for line in lines[:-2]))
             unseen = {text for text in unseen if text not in views[-1]}
-            if not unseen or pane.scroll_y >= min(objectives_height, pane.max_scroll_y):
+            # (the pane's layout as it is now: a busy machine may lay it out after the pause)
+            past = min(objectives.region.height, pane.max_scroll_y)
+            if not unseen or pane.scroll_y >= past or len(views) > 200:
                 break  # every line read whole, or scrolled past the objectives
             await self.press("down")
         assert not unseen, (unseen, views)
