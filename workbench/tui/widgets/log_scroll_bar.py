@@ -30,6 +30,9 @@ class LogScrollBar(ScrollBar):
 
     def __init__(self, *, thickness: int = 1) -> None:
         super().__init__(vertical=True, name="vertical", thickness=thickness)
+        #: each row drawn, by its text and style (a bar has a few kinds of row: the same strips
+        #: keep the line filters' work on them)
+        self._row_strips: dict[tuple[str, Style, int], Strip] = {}
 
     def render_lines(self, crop: Region) -> list[Strip]:
         bar = self.render()
@@ -54,8 +57,15 @@ class LogScrollBar(ScrollBar):
             bar_color=bar.style.color or BAR,
         )
         base = self.visual_style.rich_style
-        rows = [
-            Strip([Segment(text, base + style if base else style)], width)
-            for text, style, _ in drawn.segments
-        ]
+        kept = self._row_strips
+        if len(kept) > 64:
+            kept.clear()
+        rows = []
+        for text, style, _ in drawn.segments:
+            if base:
+                style = base + style
+            row = kept.get((text, style, width))
+            if row is None:
+                row = kept[text, style, width] = Strip([Segment(text, style)], width)
+            rows.append(row)
         return plain_lines(self, crop, rows.__getitem__)

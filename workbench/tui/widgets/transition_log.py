@@ -134,7 +134,7 @@ class TransitionLog(Log):
 
     def _style_now(self) -> Style:
         """The log's style, with the lines drawn in another style forgotten."""
-        style = self.rich_style
+        style = self.visual_style.rich_style  # (Textual keeps it until the styles change)
         if style != self._drawn_in:
             self._drawn.clear()
             self._drawn_in = style
