@@ -32,7 +32,7 @@ class LogScrollBar(ScrollBar):
         super().__init__(vertical=True, name="vertical", thickness=thickness)
         #: each row drawn, by its text and style (a bar has a few kinds of row: the same strips
         #: keep the line filters' work on them)
-        self._row_strips: dict[tuple[str, Style, int], Strip] = {}
+        self._row_strips: dict[tuple[str, Style | None, int], Strip] = {}
 
     def render_lines(self, crop: Region) -> list[Strip]:
         bar = self.render()
