@@ -107,7 +107,10 @@ class TransitionLog(Log):
             else:
                 lines += textwrap.wrap(text, width, subsequent_indent=" " * 7)
         self.write_lines(lines, scroll_end=False)
-        self._follow()
+        # at once, so the frame that draws the new entry draws the log scrolled to it (after the
+        # next refresh, that frame drew the log as it was and the next one scrolled it); when
+        # the panel above changes its rows in the same tick, the resize follows again
+        self.scroll_end(animate=False, immediate=True, x_axis=False)
 
     @property
     def vertical_scrollbar(self) -> ScrollBar:
@@ -164,5 +167,5 @@ class TransitionLog(Log):
         self._follow()
 
     def _follow(self) -> None:
-        # after the next layout, when the log's height and length are both known
+        # after the layout, when the log's height and length are both known
         self.scroll_end(animate=False, immediate=False, x_axis=False)
