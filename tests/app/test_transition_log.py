@@ -154,3 +154,32 @@ async def test_the_log_keeps_its_lines_through_a_resize_and_scrolls_back_by_hand
         await pilot.pause()
         assert log.scroll_y == log.max_scroll_y - 3
         assert shown() == lines[-height - 3 : -3]
+
+
+@sync
+async def test_a_new_entry_draws_the_log_once_scrolled_to_it(monkeypatch):
+    # (it scrolled after the next refresh: the log was drawn as it was, then again scrolled)
+    app = Host()
+    async with app.run_test(size=(60, 12)) as pilot:
+        log = app.query_one(TransitionLog)
+        run = object()
+        every = transitions(30)
+        log.show(run, every[:20], "m", False)
+        for _ in range(3):
+            await pilot.pause()
+        drawn: list[list[str]] = []
+        render_lines = TransitionLog.render_lines
+
+        def counted(widget: TransitionLog, crop: Region) -> list[Strip]:
+            lines = render_lines(widget, crop)
+            drawn.append([line.text.rstrip() for line in lines])
+            return lines
+
+        monkeypatch.setattr(TransitionLog, "render_lines", counted)
+        for n in range(21, 26):
+            drawn.clear()
+            log.show(run, every[:n], "m", False)
+            for _ in range(3):
+                await pilot.pause()
+            assert len(drawn) == 1, n
+            assert drawn[0][-1].startswith(f"{n - 1:6.1f} S{n - 1} -> S{n}"), drawn
