@@ -24,6 +24,7 @@ from tests.waiting import until
 from workbench.tui.app import WorkbenchApp, make_app
 from workbench.tui.screens.main import MainScreen
 from workbench.tui.serving.compositor import GroupedUpdate, LiveCompositor, merged_crops
+from workbench.tui.widgets.log_scroll_bar import LogScrollBar
 from workbench.tui.widgets.maze_view import MazeView
 from workbench.tui.widgets.transition_log import TransitionLog
 from workbench.wire.settings import AppSettings
@@ -184,13 +185,23 @@ def test_no_widget_is_rendered_twice_for_one_update_while_an_algorithm_runs(monk
     # box): rendered as one box, each of them once
     app = make_app(AppSettings(noise="off"))
     rendered: list[Widget] = []
-    render_lines = Widget.render_lines
+    depth = [0]  # a widget drawn Textual's way from its own render_lines is one render
 
-    def counted(widget: Widget, crop: Region) -> list[Strip]:
-        rendered.append(widget)
-        return render_lines(widget, crop)
+    def counting(render_lines):
+        def counted(widget: Widget, crop: Region) -> list[Strip]:
+            if not depth[0]:
+                rendered.append(widget)
+            depth[0] += 1
+            try:
+                return render_lines(widget, crop)
+            finally:
+                depth[0] -= 1
 
-    monkeypatch.setattr(Widget, "render_lines", counted)
+        return counted
+
+    # the widgets that draw their own lines, and every other
+    for cls in (Widget, MazeView, TransitionLog, LogScrollBar):
+        monkeypatch.setattr(cls, "render_lines", counting(vars(cls)["render_lines"]))
 
     async def body(pilot: Pilot) -> None:
         screen = app.screen

@@ -208,3 +208,52 @@ async def test_what_a_layout_resizes_is_drawn_once_and_scroll_bars_it_left_alone
         assert counted.layouts == 1
         assert counted.drawn.get(text) == 1  # in the layout's frame, not again after it
         assert counted.drawn.get(log.vertical_scrollbar) is None  # the log did not change
+
+
+class HiddenLog(Screen[None]):
+    """A log hidden until it is shown, as the main screen's transition log is until a run."""
+
+    DEFAULT_CSS = """
+    Log { height: 4; width: 20; display: none; }
+    """
+
+    def __init__(self) -> None:
+        super().__init__()
+        use_live_compositor(self)
+
+    def compose(self) -> ComposeResult:
+        yield Static("above")
+        yield Log()
+
+
+class SingleLayoutHiddenLog(HiddenLog, SingleLayout):
+    pass
+
+
+@pytest.mark.parametrize(("screen_class", "layouts"), [(SingleLayoutHiddenLog, 1), (HiddenLog, 2)])
+@sync
+async def test_a_log_shown_the_first_time_lays_the_screen_out_once_with_its_scroll_bar(
+    screen_class, layouts
+):
+    # Textual shows the log's scroll bar after the layout that placed it, and showing it asks
+    # for a layout that places it again (Textual's own screen: 2)
+    screen = screen_class()
+    app = Host(screen)
+    async with app.run_test(size=(80, 12)) as pilot:
+        await pilot.pause()
+        log = screen.query_one(Log)
+        log.write_lines(f"line {i}" for i in range(10))
+        await settle(app)
+        counted = Counted(screen)
+        log.display = True
+        await settle(app)
+        assert counted.layouts == layouts
+        bar = log.vertical_scrollbar
+        assert bar.display and log.show_vertical_scrollbar
+        assert app.screen.get_widget_at(bar.region.x, bar.region.y)[0] is bar
+        assert bar.window_virtual_size == 10
+        log.display = False  # hidden and shown again: the bar is shown already
+        await settle(app)
+        log.display = True
+        await settle(app)
+        assert counted.layouts == layouts + 2

@@ -194,6 +194,7 @@ METHODS = {
     ("textual.screen", "Screen", "refresh_bindings"): ["self"],
     ("textual.widgets._input", "Input", "_on_key"): ["self", "event"],
     ("textual.widget", "Widget", "_scroll_update"): ["self", "virtual_size"],
+    ("textual.app", "App", "_start_widget"): ["self", "parent", "widget"],
 }
 
 
@@ -267,6 +268,14 @@ def test_a_widget_keeps_its_virtual_size_and_redraw_flag_where_the_single_layout
     assert isinstance(descriptor, Reactive)
     assert descriptor._layout is True  # what a layout's sizes would ask for, left out
     assert Widget()._repaint_required is False
+
+
+def test_a_widget_keeps_its_vertical_scroll_bar_where_a_bar_of_its_own_goes():
+    # (textual_private.own_vertical_scrollbar: Textual's vertical_scrollbar property makes one
+    # there the first time it is asked for)
+    widget = Widget()
+    assert widget._vertical_scrollbar is None
+    assert isinstance(inspect.getattr_static(Widget, "vertical_scrollbar"), property)
 
 
 def test_a_footer_says_when_it_has_read_its_bindings_where_the_key_bar_looks():

@@ -4,6 +4,7 @@ gives, so that they are all in this package (see its description) and checked in
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
 from textual import events
@@ -13,6 +14,7 @@ from textual.binding import BindingsMap
 from textual.content import Content
 from textual.dom import DOMNode
 from textual.geometry import Size
+from textual.scrollbar import ScrollBar
 from textual.widget import Widget
 from textual.widgets import Checkbox, Footer, Input, RadioButton
 from textual.widgets._footer import FooterKey
@@ -28,6 +30,7 @@ __all__ = [
     "end_with_error",
     "footer_ready",
     "handled_size",
+    "own_vertical_scrollbar",
     "update_scrollbars",
 ]
 
@@ -59,6 +62,18 @@ def update_scrollbars(widget: Widget) -> None:
     """Bring a scrolling widget's scroll bars (whether they show, their thumbs) and its scroll
     position up to its virtual size now, as Textual does when it lays the widget out."""
     widget._scroll_update(widget.virtual_size)
+
+
+def own_vertical_scrollbar(widget: Widget, make: Callable[[], ScrollBar]) -> ScrollBar:
+    """The widget's vertical scroll bar, made by ``make`` the first time it is asked for, where
+    Textual makes its own ``ScrollBar`` (for a widget's ``vertical_scrollbar`` property), and
+    started as Textual starts its own: hidden until the widget's first layout shows it."""
+    bar = widget._vertical_scrollbar
+    if bar is None:
+        bar = widget._vertical_scrollbar = make()
+        bar.display = False
+        widget.app._start_widget(widget, bar)
+    return bar
 
 
 def handled_size(app: App[Any]) -> Size | None:

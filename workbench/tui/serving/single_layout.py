@@ -20,6 +20,13 @@ maze) still asks for one, as does everything else a layout may change and which 
     lines then) does so after the layout: the layout is over when the screen draws
     (``_compositor_refresh``), and from there ``virtual_size`` asks for layouts again.
 
+A scroll bar the layout placed does not ask for another layout either. Textual makes each bar
+hidden (``display`` off), places it where its widget's ``show_vertical_scrollbar`` says, and then,
+handing the widget its size, shows it; showing a widget asks for a layout, which placed it all
+the same again (the transition log's bar, the first time a run shows the log, cost the main
+screen a second layout, some 3 ms). Whether a bar is placed is its widget's
+``show_*_scrollbar``, which asks for the layout a bar that comes or goes needs.
+
 The widgets the layout asks to be redrawn (each resized one, and the scroll bars of every
 scrolling one) are drawn in the layout's own frame rather than in a frame of their own after it,
 which drew the same cells again. A scroll bar that the layout left as it was (Textual redraws
@@ -78,6 +85,7 @@ class SingleLayout(Screen):
             for widget in self._compositor.visible_widgets
             if isinstance(widget, ScrollBar) and not widget._repaint_required
         }
+        whole = not scroll or bool(self._layout_widgets)  # (else Textual scrolls the screen)
         self._sizing = True
         VIRTUAL_SIZE._layout = False
         try:
@@ -85,6 +93,8 @@ class SingleLayout(Screen):
         finally:
             self._end_sizing()
             self._bars_before = {}
+        if whole:
+            self._settle_bars()
 
     def _compositor_refresh(self) -> None:
         if self._sizing:
@@ -97,6 +107,12 @@ class SingleLayout(Screen):
         if self._sizing:
             self._sizing = False
             VIRTUAL_SIZE._layout = LAYS_OUT
+
+    def _settle_bars(self) -> None:
+        """The scroll bars this layout placed and showed ask for no layout (see the module)."""
+        for widget in self._compositor.visible_widgets:
+            if isinstance(widget, ScrollBar) and widget._layout_required and widget.display:
+                widget._layout_required = False
 
     def _take_redraws(self) -> None:
         """Have this frame draw what the layout asked to be redrawn (see the module)."""

@@ -14,6 +14,7 @@ from workbench.control.station import LabStation
 from workbench.fsm.machine import FsmController
 from workbench.sim.profiles import get_profile
 
+from .kept_static import KeptStatic
 from .text import arrow, named_title, number, set_border_title
 from .transition_log import TransitionLog, values_text
 
@@ -48,7 +49,7 @@ class AlgorithmState(Vertical):
         super().__init__(id=id, classes=classes)
         set_border_title(self, "Algorithm")
         self._summary = Static(id="algorithm-summary", markup=False)
-        self._states = Static(id="algorithm-states", markup=False)
+        self._states = KeptStatic(id="algorithm-states")
         self._vars = Static(id="algorithm-vars", markup=False)
         self._last = Static(id="algorithm-last", markup=False)
         self._log = TransitionLog(id="algorithm-log")

@@ -39,6 +39,8 @@ from workbench.sim.sensor_kinds import sensor_kind
 from workbench.sim.sensors import MOUNT_ANGLES
 from workbench.sim.session import Snapshot
 
+from .plain_lines import plain_lines, plain_styles
+
 #: what one block shows: its two cells of text and the name of its style
 Token = tuple[str, str]
 
@@ -74,23 +76,6 @@ _QUARTER_STEPS: tuple[Cell, ...] = ((1, 0), (0, 1), (-1, 0), (0, -1))
 _RAY_SLACK = 0.6
 
 STYLE_NAMES = ("wall", "floor", "exit", "start", "trail", "ray", "hit", "touch", "robot", "cursor")
-
-
-def _plain_styles(widget: ScrollView) -> bool:
-    """Nothing of ``widget``'s styles changes its lines on their way to the screen (see
-    :meth:`MazeView.render_lines`)."""
-    styles = widget.styles
-    return (
-        not any(edge for edge, _ in styles.border)
-        and not any(edge for edge, _ in styles.outline)
-        and not any(styles.padding)
-        and not styles.tint.a
-        and styles.text_opacity == 1.0
-        and (not styles.has_rule("hatch") or styles.hatch == "none")
-        and widget.border_title is None
-        and widget.border_subtitle is None
-        and widget.opacity == 1.0
-    )
 
 
 def robot_glyph(heading: float, unicode: bool) -> str:
@@ -391,21 +376,11 @@ class MazeView(ScrollView, can_focus=False):
         than the rows themselves while the robot moves, a few rows a frame. Styled otherwise,
         the view is drawn Textual's way.
         """
-        if not _plain_styles(self):
+        if not plain_styles(self):
             return super().render_lines(crop)
-        background = self.background_colors[1]
-        filters = self.app.get_line_filters()
-        x1, x2 = crop.column_span
-        cut = (x1, x2) != (0, self.outer_size.width)
         scroll_x, scroll_y = self.scroll_offset
         width = self.size.width
-        strips = []
-        for y in crop.line_range:
-            strip = self._line(scroll_y + y, scroll_x, width)
-            for line_filter in filters:
-                strip = strip.apply_filter(line_filter, background)
-            strips.append(strip.crop(x1, x2) if cut else strip)
-        return strips
+        return plain_lines(self, crop, lambda y: self._line(scroll_y + y, scroll_x, width))
 
     def render_line(self, y: int) -> Strip:
         scroll_x, scroll_y = self.scroll_offset
