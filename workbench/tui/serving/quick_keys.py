@@ -99,7 +99,7 @@ def as_key_press(app: App[Any], screen: Screen[Any]) -> None:
     focused, and a tooltip shown on ``screen`` cleared."""
     if not app.app_focus:
         app.app_focus = True
-    if app.focused is not None and any(
-        isinstance(child, Tooltip) and child.display for child in screen.children
-    ):  # (looked for here: Textual's own lookup words an error when there is none)
-        screen._clear_tooltip()
+    for child in screen.children:  # (looked for here: Textual's lookup words an error for none)
+        if isinstance(child, Tooltip) and child.display and app.focused is not None:
+            screen._clear_tooltip()
+            return
