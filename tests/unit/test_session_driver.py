@@ -116,6 +116,34 @@ def test_a_lone_escape_arrives_at_the_parsers_time_limit():
     asyncio.run(go())
 
 
+def test_plain_keys_leave_the_parser_alone_and_an_escape_still_gets_its_time_limit():
+    """A driving key costs its read and its key: the parser's time limit is looked at only
+    when the parser was given something (an Escape, a sequence) or waits for the rest of one."""
+
+    async def go() -> None:
+        async with reading_driver() as (box, driver, w):
+            reading = driver._input_reader
+            parser = reading._parser  # type: ignore[attr-defined]
+            looked: list[int] = []
+            tick = parser.tick
+
+            def counted_tick():  # type: ignore[no-untyped-def]
+                looked.append(1)
+                return tick()
+
+            parser.tick = counted_tick
+            for key in b"wwad ":
+                os.write(w, packets.data(bytes([key])))
+                await settle(box, len(box.keys()) + 1)
+            assert box.keys() == ["w", "w", "a", "d", "space"] and looked == []
+            os.write(w, packets.data(b"\x1b"))
+            await settle(box, 6)
+            assert box.keys()[-1] == "escape" and len(looked) >= 2  # the read, then the limit
+            assert reading._escape is None  # type: ignore[attr-defined]
+
+    asyncio.run(go())
+
+
 def test_meta_packets_reach_the_app_and_the_end_of_input_ends_it():
     async def go() -> None:
         box = PostBox()

@@ -119,6 +119,26 @@ def test_the_reader_splits_any_chunks_and_keeps_what_came_before_the_start():
         packets.PacketReader().feed(packets.GANGLION + b"X\x00\x00\x00\x00")
 
 
+def test_packets_read_one_whole_packet_at_a_time_come_out_the_same():
+    """The server's keys come one packet a read, most of the time; a read may also end inside
+    one, or hold the end of one and the whole of the next."""
+    reader = packets.PacketReader(marked=False)
+    key, frame = packets.data(b"w"), packets.data(b"\x1b[2J" * 10)
+    assert reader.feed(key) == [(b"D", b"w")]
+    assert reader.feed(bytearray(key)) == [(b"D", b"w")]
+    assert reader.feed(frame[:7]) == [] and reader.feed(frame[7:] + key) == [
+        (b"D", b"\x1b[2J" * 10),
+        (b"D", b"w"),
+    ]
+    assert reader.feed(packets.resize(80, 24)) == [
+        (b"M", b'{"type":"resize","width":80,"height":24}')
+    ]
+    assert all(type(k) is bytes and type(p) is bytes for k, p in reader.feed(bytearray(key)))
+    assert reader.pending == 0
+    with pytest.raises(packets.PacketError):
+        reader.feed(b"X\x00\x00\x00\x00")
+
+
 def test_the_app_is_started_with_the_users_name_ports_and_terminal():
     spec = AppSpec(
         "ann", "student", 41000, 41001, "hint", "/d", "/d/w/ann/runs/1", "/d/w/ann",

@@ -259,6 +259,7 @@ def test_a_new_app_has_the_state_the_serving_code_reads():
     assert app._batch_count == 0
     assert app._screen_stack == []
     assert isinstance(DOMNode()._bindings, BindingsMap)
+    assert DOMNode()._parent is None  # (the cached binding chain reads a node's parent there)
 
 
 def test_a_widget_keeps_its_virtual_size_and_redraw_flag_where_the_single_layout_looks():

@@ -71,8 +71,16 @@ class PacketReader:
 
     def feed(self, chunk: bytes) -> list[tuple[bytes, bytes]]:
         """The packets completed by ``chunk``, in order."""
-        packets: list[tuple[bytes, bytes]] = []
         buffer = self._buffer
+        if not buffer and self.started and len(chunk) >= HEADER:
+            # the usual read: one whole packet (a typed key, a frame), nothing held from before
+            size = int.from_bytes(chunk[1:HEADER], "big")
+            if len(chunk) == HEADER + size and size <= MAX_PAYLOAD:
+                kind = bytes(chunk[:1])
+                if kind not in TYPES:
+                    raise PacketError(f"unknown packet type {kind!r} in the app's output")
+                return [(kind, bytes(chunk[HEADER:]))]
+        packets: list[tuple[bytes, bytes]] = []
         buffer += chunk
         if not self.started:
             at = buffer.find(GANGLION)

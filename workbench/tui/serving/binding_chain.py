@@ -9,9 +9,13 @@ second.
 
 :class:`CachedBindingChain` keeps the chain Textual builds and hands it out again until
 something it was built from changes: the focused widget (or its being loaded), the widgets and
-binding maps from it up to the app, or the app's keymap. Any ``refresh_bindings`` (Textual's
-signal that bindings may have changed) drops it too. The chain is only read by Textual (it
-looks keys up in it), never changed, so handing out the same one is safe.
+binding maps from it up to the app, or the app's keymap. A widget's ancestors stay the same
+while it is mounted (Textual moves no widget to another parent, and mounts a removed one no
+more) and each node's binding map is made with the node, so the focused widget and its parent
+stand for the whole chain: checking it is a few reads, not a walk up to the app for every key.
+Any ``refresh_bindings`` (Textual's signal that bindings may have changed) drops it too. The
+chain is only read by Textual (it looks keys up in it), never changed, so handing out the same
+one is safe.
 
 Only for screens whose widgets decide from the key alone whether they take it
 (``check_consume_key``), as every widget of the main screen does.
@@ -33,16 +37,14 @@ class CachedBindingChain(Screen):
     @property
     def _binding_chain(self) -> list[tuple[DOMNode, BindingsMap]]:
         focused = self.focused
-        nodes = (self, self.app) if focused is None else tuple(focused.ancestors_with_self)
         keymap = self.app._keymap
-        key = (
-            focused,
-            focused is not None and focused.loading,
-            id(keymap),
-            len(keymap),
-            *nodes,
-            *(id(node._bindings) for node in nodes),
-        )
+        # a mounted widget keeps its parent (and so every ancestor) until it is removed, and a
+        # node's binding map is made once, with the node: the focused widget and its parent
+        # stand for the nodes of the chain and their maps
+        if focused is None:
+            key: tuple[object, ...] = (None, None, False, id(keymap), len(keymap))
+        else:
+            key = (focused, focused._parent, focused.loading, id(keymap), len(keymap))
         chain = self._chain
         if chain is None or key != self._chain_key:
             chain = self._chain = super()._binding_chain

@@ -41,9 +41,9 @@ from textual.widgets import Tooltip
 
 from .binding_chain import CachedBindingChain
 
-#: what a key is bound to, for the quick path: the action's name and parameters, or None when
-#: its first priority binding is not a quick action of the screen
-QuickBinding = tuple[str, tuple[object, ...]] | None
+#: what a key is bound to, for the quick path: the action's name and parameters and the call
+#: that runs it, or None when its first priority binding is not a quick action of the screen
+QuickBinding = tuple[str, tuple[object, ...], Callable[[], object]] | None
 
 
 class QuickKeys(CachedBindingChain):
@@ -54,20 +54,26 @@ class QuickKeys(CachedBindingChain):
 
     _quick_chain: list[tuple[DOMNode, BindingsMap]] | None = None
     _quick_table: dict[str, QuickBinding]
+    #: the message pumps of the chain, from the focused widget up
+    _quick_nodes: tuple[DOMNode, ...] = ()
 
     def quick_action(self, key: str) -> Callable[[], object] | None:
         """The action to run for ``key`` now, or None for the usual way of a key event."""
         chain = self._binding_chain
         if chain is not self._quick_chain:
             self._quick_table = self._quick_bindings(chain)
+            self._quick_nodes = tuple(node for node, _ in chain)
             self._quick_chain = chain
         found = self._quick_table.get(key)
-        if found is None or not self.nothing_on_the_way():
-            return None  # (on the way: something typed before it may still be going)
-        name, params = found
+        if found is None:
+            return None
+        for node in self._quick_nodes:
+            if node.message_queue_size:
+                return None  # (on the way: something typed before it may still be going)
+        name, params, action = found
         if not self.check_action(name, params):
             return None
-        return partial(getattr(self, f"action_{name}"), *params)
+        return action
 
     def nothing_on_the_way(self) -> bool:
         """Whether every message pump a key passes through has nothing queued (else a key
@@ -83,7 +89,8 @@ class QuickKeys(CachedBindingChain):
                         continue
                     namespace, name, params = parse(binding.action)
                     quick = node is self and not namespace and name in self.QUICK_ACTIONS
-                    table[key] = (name, params) if quick else None
+                    action = partial(getattr(self, f"action_{name}"), *params) if quick else None
+                    table[key] = (name, params, action) if action is not None else None
         return table
 
 
@@ -92,7 +99,7 @@ def as_key_press(app: App[Any], screen: Screen[Any]) -> None:
     focused, and a tooltip shown on ``screen`` cleared."""
     if not app.app_focus:
         app.app_focus = True
-    if app.focused is not None and any(
-        isinstance(child, Tooltip) and child.display for child in screen.children
-    ):  # (looked for here: Textual's own lookup words an error when there is none)
-        screen._clear_tooltip()
+    for child in screen.children:  # (looked for here: Textual's lookup words an error for none)
+        if isinstance(child, Tooltip) and child.display and app.focused is not None:
+            screen._clear_tooltip()
+            return

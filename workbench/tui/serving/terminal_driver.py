@@ -134,6 +134,8 @@ class LoopInput:
         #: typed keys past it are dropped, and the student told how many
         self.budget = KeyBudget()
         self._telling: asyncio.TimerHandle | None = None
+        #: the parser was given text since its time limit was last looked at
+        self._parser_fed = False
 
     def start(self) -> None:
         """Read from the next turn of the loop on: what the driver posted while starting (the
@@ -188,7 +190,8 @@ class LoopInput:
             log(format_exc())
             self.close()
             return
-        self._tick()
+        if self._escape is not None or self._parser_fed:
+            self._tick()  # (plain keys alone leave the parser as it was: nothing to settle)
 
     def _typed(self, text: str) -> None:
         """Hand on the keys of some typed text: plain characters straight, anything else
@@ -200,8 +203,9 @@ class LoopInput:
         parser = self._parser
         if (
             not self._pasting
+            and self._escape is None  # (the parser waits for the rest of a sequence)
+            and (text in plain or all(character in plain for character in text))
             and parser_wait(parser) is None
-            and all(character in plain for character in text)
         ):
             text = self._within_budget(text)
             take = self._take
@@ -213,6 +217,7 @@ class LoopInput:
                 take = None  # the rest of the text follows that key the same way, in order
             self._tail = ""
             return
+        self._parser_fed = True
         seen = self._tail + text
         started, ended = seen.rfind(PASTE_START), seen.rfind(PASTE_END)
         if started != ended:  # both -1 when neither is there
@@ -248,6 +253,9 @@ class LoopInput:
     def _tick(self) -> None:
         """Hand on what the parser's time limit settled (a lone Escape), and wake again at its
         next limit while it waits for the rest of a sequence."""
+        self._parser_fed = False
+        if self._escape is not None:
+            self._escape.cancel()
         self._escape = None
         for event in self._parser.tick():
             self._driver.process_message(event)
