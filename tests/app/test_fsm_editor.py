@@ -265,7 +265,7 @@ def test_a_hostile_file_never_holds_the_editor(tmp_path, monkeypatch):
         area.load_text(f"initial: A\nstates:\n  A:\n    transitions: [{{to: A, when: '{deep}'}}]\n")
         await checked(pilot, editor)
         assert "nest more than 50 deep" in problems(editor)
-        area.load_text(("# " + "x" * 4093 + "\n") * 260)  # over 1 MiB in few lines: cheap to lay out
+        area.load_text(("# " + "x" * 4093 + "\n") * 260)  # over 1 MiB in few, cheap lines
         await checked(pilot, editor)
         assert "over the 1,048,576 bytes an FSM file may hold" in problems(editor)
         await pilot.press("ctrl+s")
