@@ -309,6 +309,8 @@ class World:
         self._last_contact_end = -math.inf
         self._new_collision: str | None = None  # the event of a contact that just started
         self._exit_time: float | None = None
+        #: whether a step may reach an exit: the maze has exits and none is reached yet
+        self._watch_exit = self._has_exits
         self._wheels = (0.0, 0.0)
         self._v = 0.0
         self._w = 0.0
@@ -322,6 +324,8 @@ class World:
         self._step_dt = self.dt
         self._step_dx = self._step_dy = self._step_moved = 0.0
         self._box = (math.inf, -math.inf, math.inf, -math.inf)
+        #: whether the robot's centre is in ``_box`` (as _advance's test of the box finds it)
+        self._in_box = False
 
     def _build_space(self) -> None:
         space = pymunk.Space()
@@ -456,10 +460,59 @@ class World:
         else, and whenever the robot touches a wall, pymunk steps the world.
         """
         part = self._part
-        if part:
+        if part or self._contacts or not self._in_box:
             self._part = 0.0
             return self._advance(self.dt - part, True)
-        return self._advance(self.dt, True)
+        # Most steps are whole steps out of contact that start and end in the free box: those
+        # are done here, without a call of _advance, statement for statement as _advance
+        # does them (the same floating-point operations in the same order; what would add or
+        # store what is already there, such as 0.0 to the distance of a robot standing, is left
+        # out). Any other step (one that leaves the box, or a new straight step to work out)
+        # is _advance's.
+        dt = self.dt
+        target = self._turn_target
+        a0 = self._angle
+        if target is not None:
+            v = 0.0
+            w = (target - a0) / dt
+            rate = self._turn_rate
+            w = rate if w > rate else -rate if w < -rate else w
+        else:
+            v = self._v
+            w = self._w
+        if v:
+            if a0 != self._step_angle or v != self._step_v or dt != self._step_dt:
+                return self._advance(dt, True)
+            x = self._x + self._step_dx
+            y = self._y + self._step_dy
+            xmin, xmax, ymin, ymax = self._box
+            if not (xmin <= x <= xmax and ymin <= y <= ymax):
+                return self._advance(dt, True)
+            moved = self._step_moved
+            self._distance += moved
+            self._x = x
+            self._y = y
+        else:
+            moved = 0.0
+        self._free_w = w
+        self._physics_stale = True
+        a = a0 + w * dt
+        if w:
+            turned = abs(w) * dt
+            self._turned += turned
+            self._moved = moved or turned
+        else:
+            self._moved = moved
+        steps = self._steps + 1
+        self._steps = steps
+        self.time = t = steps * dt
+        self._angle = a
+        self._readings = None
+        # no contact can have started (no physics ran), so as in _advance: events only when a
+        # turn may have finished or an exit may have been reached
+        if (target is not None and abs(target - a) < _TURN_EPS) or self._watch_exit:
+            return self._events(t, self._x, self._y, a, target)
+        return _NO_EVENTS
 
     def step_to(self, t: float) -> tuple[str, ...]:
         """Advance to simulated time ``t`` inside the current step (something is due then,
@@ -515,10 +568,14 @@ class World:
                 self._physics_stale = True
                 a = a0 + w * dt
                 turned = abs(w) * dt if w else 0.0
-        if not free:
+        if free:
+            self._in_box = True
+        else:
             x, y, a = self._physics_step(target, a0, dt)
             moved = math.hypot(x - x0, y - y0)
             turned = abs(a - a0)
+            xmin, xmax, ymin, ymax = self._box
+            self._in_box = xmin <= x <= xmax and ymin <= y <= ymax
         if whole:
             self._steps += 1
             self.time = t = self._steps * self.dt
@@ -531,11 +588,7 @@ class World:
         self._y = y
         self._angle = a
         self._readings = None
-        if (
-            target is None
-            and not self._new_collision
-            and (self._exit_time is not None or not self._has_exits)
-        ):
+        if target is None and not self._new_collision and not self._watch_exit:
             return _NO_EVENTS  # nothing can have happened: the common step ends here
         return self._events(t, x, y, a, target)
 
@@ -573,10 +626,11 @@ class World:
         if self._new_collision:
             events = (*events, self._new_collision)
             self._new_collision = None
-        if self._exit_time is None and self._has_exits:
+        if self._watch_exit:
             inv = self._inv_cell
             if self._exits[(int(y * inv) + 1) * self._wp + int(x * inv) + 1]:
                 self._exit_time = t
+                self._watch_exit = False
                 events = (*events, EXIT)
         return events
 
