@@ -263,7 +263,7 @@ class Session:
         world = self.world
         t = world.time
         self.readings = readings = world.read_sensors()
-        angle = world.angle
+        angle = world._angle  # World.angle without the property's call, on every tick
         last = self._last_angle
         turns = self._turns
         # not turned since the last tick and no sweep to end: the update would change nothing

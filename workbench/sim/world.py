@@ -46,7 +46,7 @@ from .commands import (
 from .maze import Maze
 from .noise import NoiseSettings, motor_gains, noise_settings, turn_factor
 from .profiles import Profile, get_profile
-from .sensor_kinds import MOUNTS, SENSOR_KINDS, sensor_kind
+from .sensor_kinds import MOUNTS, SENSOR_KINDS, Readings, sensor_kind
 from .sensors import SensorSpec, check_ports
 
 TURN_DONE = "turn_done"
@@ -274,12 +274,13 @@ class World:
         self.sensors = tuple(specs)
         # read kind by kind in the table's order (and each kind's sensors in the order given):
         # the noise of a run is drawn in that order
-        self._plan = tuple(
-            (s.port, kind.read(self), MOUNTS.index(s.mount))
-            for kind in SENSOR_KINDS
-            for s in specs
-            if s.kind == kind.name
-        )
+        plan = []
+        for kind in SENSOR_KINDS:
+            mine = tuple((s.port, MOUNTS.index(s.mount)) for s in specs if s.kind == kind.name)
+            if mine:
+                plan.append(kind.read(self, mine))
+        #: the reader of each kind's sensors, for each kind carried, in the table's order
+        self._plan = tuple(plan)
         self._bumpers = tuple(
             sorted({MOUNTS.index(s.mount) for s in specs if sensor_kind(s.kind).bumper})
         )
@@ -324,6 +325,11 @@ class World:
         self._step_dt = self.dt
         self._step_dx = self._step_dy = self._step_moved = 0.0
         self._box = (math.inf, -math.inf, math.inf, -math.inf)
+        #: whether the next whole step, if it ends in the free box, is the straight step
+        #: ``_step_dx``, ``_step_dy`` of a robot driving straight ahead, out of contact, its
+        #: centre in the box, with nothing but the pose and time to change: set by _advance for
+        #: a step it found so, and cleared by anything else (a command, physics, a part step)
+        self._cruise = False
         #: whether the robot's centre is in ``_box`` (as _advance's test of the box finds it)
         self._in_box = False
 
@@ -404,6 +410,7 @@ class World:
 
         Any command abandons a Turn by Degree in progress.
         """
+        self._cruise = False
         self._turn_target = None
         p = self.profile
         if isinstance(command, WheelPowers):
@@ -459,16 +466,33 @@ class World:
         (free motion, exactly what the solver would do with nothing to collide with); anywhere
         else, and whenever the robot touches a wall, pymunk steps the world.
         """
+        if self._cruise:
+            # driving straight on the step _advance last worked out, from a place in the free
+            # box: _advance's free motion with what it would store again left out (the angle,
+            # which w = 0 leaves as it is, the turn, the motion and the pose sent to pymunk)
+            x = self._x + self._step_dx
+            y = self._y + self._step_dy
+            xmin, xmax, ymin, ymax = self._box
+            if xmin <= x <= xmax and ymin <= y <= ymax:
+                self._distance += self._step_moved
+                self._x = x
+                self._y = y
+                steps = self._steps + 1
+                self._steps = steps
+                self.time = t = steps * self.dt
+                self._readings = None
+                if self._watch_exit:
+                    return self._events(t, x, y, self._angle, None)
+                return _NO_EVENTS
+            return self._advance(self.dt, True)
         part = self._part
         if part or self._contacts or not self._in_box:
             self._part = 0.0
             return self._advance(self.dt - part, True)
-        # Most steps are whole steps out of contact that start and end in the free box: those
-        # are done here, without a call of _advance, statement for statement as _advance
-        # does them (the same floating-point operations in the same order; what would add or
-        # store what is already there, such as 0.0 to the distance of a robot standing, is left
-        # out). Any other step (one that leaves the box, or a new straight step to work out)
-        # is _advance's.
+        # a whole step out of contact from a place in the free box, standing, turning in place
+        # or driving an arc (wheels at different speeds, or a motor imbalance): as in _advance
+        # (the same floating-point operations in the same order), without its call, where the
+        # motion stays in the box
         dt = self.dt
         target = self._turn_target
         a0 = self._angle
@@ -481,14 +505,17 @@ class World:
             v = self._v
             w = self._w
         if v:
-            if a0 != self._step_angle or v != self._step_v or dt != self._step_dt:
+            if not w:
+                # straight ahead: _advance works the step out once, and the next steps cruise
                 return self._advance(dt, True)
-            x = self._x + self._step_dx
-            y = self._y + self._step_dy
+            # an arc turns the robot every step, so each step is new (the cache of a
+            # straight step would only be written over): its motion, as _advance works it out
+            x = self._x + v * math.cos(a0) * dt
+            y = self._y + v * math.sin(a0) * dt
             xmin, xmax, ymin, ymax = self._box
             if not (xmin <= x <= xmax and ymin <= y <= ymax):
                 return self._advance(dt, True)
-            moved = self._step_moved
+            moved = abs(v) * dt
             self._distance += moved
             self._x = x
             self._y = y
@@ -508,8 +535,8 @@ class World:
         self.time = t = steps * dt
         self._angle = a
         self._readings = None
-        # no contact can have started (no physics ran), so as in _advance: events only when a
-        # turn may have finished or an exit may have been reached
+        # no contact can have started (no physics ran): events only when a turn may have
+        # finished or an exit may have been reached
         if (target is not None and abs(target - a) < _TURN_EPS) or self._watch_exit:
             return self._events(t, self._x, self._y, a, target)
         return _NO_EVENTS
@@ -558,9 +585,10 @@ class World:
                 x = x0
                 y = y0
                 moved = 0.0
-            xmin, xmax, ymin, ymax = self._box
-            if not (xmin <= x0 <= xmax and ymin <= y0 <= ymax):
-                xmin, xmax, ymin, ymax = self._box = self._free_box(x0, y0)
+            # the box of the block the robot is in, unless it is in the box it has
+            box = self._box if self._in_box else self._free_box(x0, y0)
+            self._box = box
+            xmin, xmax, ymin, ymax = box
             if xmin <= x <= xmax and ymin <= y <= ymax:
                 # free motion: no wall within reach, so no contact can start this step
                 free = True
@@ -570,8 +598,30 @@ class World:
                 turned = abs(w) * dt if w else 0.0
         if free:
             self._in_box = True
+            # the next whole step may be this one again (see step)
+            self._cruise = whole and v != 0.0 and w == 0.0 and target is None and dt == self.dt
         else:
-            x, y, a = self._physics_step(target, a0, dt)
+            self._cruise = False
+            # one pymunk step (not a method of its own: a call would cost every physics step)
+            if self._physics_stale:
+                self._sync_body()
+            if target is not None:
+                # positions integrate with the previous step's velocity: plan one step ahead
+                ahead = a0 + _get_angular_velocity(self._body_ptr) * dt
+                rate = self._turn_rate
+                w = (target - ahead) / dt
+                _set_angular_velocity(self._control_ptr, max(-rate, min(rate, w)))
+            elif self._reaim:
+                v = self._v
+                _set_velocity(self._control_ptr, (v * math.cos(a0), v * math.sin(a0)))
+            # the C step directly: the wrapper's bookkeeping (deferred adds and removals,
+            # first-step mass checks) has nothing to do for this space after it is built
+            _space_step(self._space_ptr, dt)
+            body = self._body_ptr
+            pos = _get_position(body)
+            x = pos.x
+            y = pos.y
+            a = _get_angle(body)
             moved = math.hypot(x - x0, y - y0)
             turned = abs(a - a0)
             xmin, xmax, ymin, ymax = self._box
@@ -591,27 +641,6 @@ class World:
         if target is None and not self._new_collision and not self._watch_exit:
             return _NO_EVENTS  # nothing can have happened: the common step ends here
         return self._events(t, x, y, a, target)
-
-    def _physics_step(
-        self, target: float | None, a0: float, dt: float
-    ) -> tuple[float, float, float]:
-        """One pymunk step of ``dt``; the robot's new x, y and angle."""
-        if self._physics_stale:
-            self._sync_body()
-        if target is not None:
-            # positions integrate with the previous step's velocity: plan one step ahead
-            ahead = a0 + _get_angular_velocity(self._body_ptr) * dt
-            rate = self._turn_rate
-            w = (target - ahead) / dt
-            _set_angular_velocity(self._control_ptr, max(-rate, min(rate, w)))
-        elif self._reaim:
-            v = self._v
-            _set_velocity(self._control_ptr, (v * math.cos(a0), v * math.sin(a0)))
-        # the C step directly: the wrapper's bookkeeping (deferred adds and removals, first-step
-        # mass checks) has nothing to do for this space after it is built
-        _space_step(self._space_ptr, dt)
-        pos = _get_position(self._body_ptr)
-        return pos.x, pos.y, _get_angle(self._body_ptr)
 
     def _events(
         self, t: float, x: float, y: float, a: float, target: float | None
@@ -752,37 +781,53 @@ class World:
             self._dirs_angle = a
         self._contacts_now = None
         out: dict[int, float | int] = {}
-        for port, read, mount in self._plan:
-            out[port] = read(mount)
+        for read in self._plan:
+            read(out)
         self._readings = out
         return out
 
     # the Probe the sensor kinds read, for the step being read (read_sensors sets it up)
-    def echo(self, mount: int) -> float:
-        """How far the ray of a sensor on ``mount`` (an index of MOUNTS) meets a wall, from
-        the sensor's place on the robot, with the run's distance noise; the profile's no-echo
-        value when it meets none within range."""
-        dx, dy = self._dirs[mount]
+    def echoes(self, sensors: Sequence[tuple[int, int]], out: Readings) -> None:
+        """Into ``out`` by port, for distance sensors ``(port, mount)`` (a mount is an index of
+        MOUNTS), in that order: how far each one's ray meets a wall, from the sensor's place on
+        the robot, with the run's distance noise (drawn in that order); the profile's no-echo
+        value for a ray that meets none within range."""
+        # one call for all of a set-up's distance sensors: what the rays need is looked up
+        # once, and each ray is the same arithmetic as one sensor's alone
+        dirs = self._dirs
+        offsets = self._offsets
+        x = self._x
+        y = self._y
         inv = self._inv_cell
-        offset = self._offsets[mount]
-        t = _march(
-            self._solid, self._wp, (self._x + offset * dx) * inv + 1.0,
-            (self._y + offset * dy) * inv + 1.0, dx, dy, self._tmax,
-        )  # fmt: skip
-        if t < 0.0:
-            return self._no_echo
-        d = t * self.cell
-        if self._distance_noise:
-            rel, absolute = self._distance_noise
-            gauss = self._rng.gauss(0.0, rel * d + absolute)
-            d = min(self.profile.sensor_range, max(0.0, d + gauss))
-        return d
+        solid = self._solid
+        wp = self._wp
+        tmax = self._tmax
+        cell = self.cell
+        noise = self._distance_noise
+        for port, mount in sensors:
+            dx, dy = dirs[mount]
+            offset = offsets[mount]
+            t = _march(
+                solid, wp, (x + offset * dx) * inv + 1.0, (y + offset * dy) * inv + 1.0,
+                dx, dy, tmax,
+            )  # fmt: skip
+            if t < 0.0:
+                out[port] = self._no_echo
+                continue
+            d = t * cell
+            if noise:
+                rel, absolute = noise
+                gauss = self._rng.gauss(0.0, rel * d + absolute)
+                d = min(self.profile.sensor_range, max(0.0, d + gauss))
+            out[port] = d
 
     def pressed(self, mount: int) -> bool:
         """Whether a wall touches the robot within the arc of ``mount`` (an index of MOUNTS)."""
         contacts = self._contacts_now
         if contacts is None:
             contacts = self._contacts_now = self._wall_contacts()
+        if not contacts:
+            return False  # the usual answer, away from walls
         ux, uy = self._dirs[mount]
         return any(vx * ux + vy * uy >= _COS45 * math.hypot(vx, vy) for vx, vy in contacts)
 
