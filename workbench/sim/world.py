@@ -255,6 +255,8 @@ class World:
         self._has_exits = any(exits)
         c = self.cell
         self._boxes: dict[int, tuple[float, float, float, float]] = {}
+        #: block key -> the wall blocks around it (_walls_near), made when first needed
+        self._walls_around: dict[int, tuple[tuple[float, float, float, float], ...]] = {}
         self._segments = [
             ((a * c, b * c), (p * c, q * c)) for (a, b), (p, q) in wall_segments(maze)
         ]
@@ -330,7 +332,8 @@ class World:
         #: centre in the box, with nothing but the pose and time to change: set by _advance for
         #: a step it found so, and cleared by anything else (a command, physics, a part step)
         self._cruise = False
-        #: whether the robot's centre is in ``_box`` (as _advance's test of the box finds it)
+        #: whether the robot's centre is in ``_box`` (as _advance's test of the box finds it);
+        #: asked only out of contact, so left False while in contact
         self._in_box = False
 
     def _build_space(self) -> None:
@@ -489,21 +492,37 @@ class World:
         if part or self._contacts or not self._in_box:
             self._part = 0.0
             return self._advance(self.dt - part, True)
-        # a whole step out of contact from a place in the free box, standing, turning in place
+        # a whole step out of contact from a place in the free box, turning in place, standing
         # or driving an arc (wheels at different speeds, or a motor imbalance): as in _advance
-        # (the same floating-point operations in the same order), without its call, where the
-        # motion stays in the box
+        # (the same floating-point operations in the same order; what would add 0.0 or store
+        # what is there is left out), without its call, where the motion stays in the box
         dt = self.dt
-        target = self._turn_target
         a0 = self._angle
+        target = self._turn_target
         if target is not None:
-            v = 0.0
+            # turning in place: _advance's free turn
             w = (target - a0) / dt
             rate = self._turn_rate
             w = rate if w > rate else -rate if w < -rate else w
-        else:
-            v = self._v
-            w = self._w
+            self._free_w = w
+            self._physics_stale = True
+            a = a0 + w * dt
+            if w:
+                turned = abs(w) * dt
+                self._turned += turned
+                self._moved = turned  # nothing moved: 0.0 or turned
+            else:
+                self._moved = 0.0
+            steps = self._steps + 1
+            self._steps = steps
+            self.time = t = steps * dt
+            self._angle = a
+            self._readings = None
+            if abs(target - a) < _TURN_EPS or self._watch_exit:
+                return self._events(t, self._x, self._y, a, target)
+            return _NO_EVENTS
+        v = self._v
+        w = self._w
         if v:
             if not w:
                 # straight ahead: _advance works the step out once, and the next steps cruise
@@ -535,10 +554,10 @@ class World:
         self.time = t = steps * dt
         self._angle = a
         self._readings = None
-        # no contact can have started (no physics ran): events only when a turn may have
-        # finished or an exit may have been reached
-        if (target is not None and abs(target - a) < _TURN_EPS) or self._watch_exit:
-            return self._events(t, self._x, self._y, a, target)
+        # no contact can have started (no physics ran), and no turn is under way: events only
+        # when an exit may have been reached
+        if self._watch_exit:
+            return self._events(t, self._x, self._y, a, None)
         return _NO_EVENTS
 
     def step_to(self, t: float) -> tuple[str, ...]:
@@ -585,9 +604,16 @@ class World:
                 x = x0
                 y = y0
                 moved = 0.0
-            # the box of the block the robot is in, unless it is in the box it has
-            box = self._box if self._in_box else self._free_box(x0, y0)
-            self._box = box
+            box = self._box
+            if not self._in_box:
+                # the free box of the block the robot is in (cached per block): where its
+                # centre may go without coming near a wall
+                inv = self._inv_cell
+                key = (int(y0 * inv) + 1) * self._wp + int(x0 * inv) + 1
+                known = self._boxes.get(key)
+                if known is None:
+                    known = self._boxes[key] = self._make_box(key)
+                self._box = box = known
             xmin, xmax, ymin, ymax = box
             if xmin <= x <= xmax and ymin <= y <= ymax:
                 # free motion: no wall within reach, so no contact can start this step
@@ -624,8 +650,12 @@ class World:
             a = _get_angle(body)
             moved = math.hypot(x - x0, y - y0)
             turned = abs(a - a0)
-            xmin, xmax, ymin, ymax = self._box
-            self._in_box = xmin <= x <= xmax and ymin <= y <= ymax
+            if self._contacts:
+                # only asked out of contact: worked out at the step that ends the contact
+                self._in_box = False
+            else:
+                xmin, xmax, ymin, ymax = self._box
+                self._in_box = xmin <= x <= xmax and ymin <= y <= ymax
         if whole:
             self._steps += 1
             self.time = t = self._steps * self.dt
@@ -663,17 +693,9 @@ class World:
                 events = (*events, EXIT)
         return events
 
-    def _free_box(self, x: float, y: float) -> tuple[float, float, float, float]:
-        """Where the robot's centre may go in its block without coming near a wall:
-        (xmin, xmax, ymin, ymax), cached per block."""
-        inv = self._inv_cell
-        key = (int(y * inv) + 1) * self._wp + int(x * inv) + 1
-        box = self._boxes.get(key)
-        if box is None:
-            box = self._boxes[key] = self._make_box(key)
-        return box
-
     def _make_box(self, key: int) -> tuple[float, float, float, float]:
+        """Where the robot's centre may go in block ``key`` (an index of the padded grid)
+        without coming near a wall: (xmin, xmax, ymin, ymax)."""
         wp = self._wp
         solid = self._solid
         c = self.cell
@@ -682,14 +704,12 @@ class World:
         keep = self._radius + 0.02 * c  # clearance kept from any wall block
         if solid[key]:
             return (math.inf, -math.inf, math.inf, -math.inf)
-
-        def any_solid(*offsets: int) -> bool:
-            return any(solid[key + o] for o in offsets)
-
-        left = any_solid(-1 - wp, -1, -1 + wp)
-        right = any_solid(1 - wp, 1, 1 + wp)
-        up = any_solid(-wp - 1, -wp, -wp + 1)
-        down = any_solid(wp - 1, wp, wp + 1)
+        # a wall among the three blocks on each side (made while a run steps into new blocks,
+        # so plain lookups rather than a generator per side)
+        left = solid[key - 1 - wp] or solid[key - 1] or solid[key - 1 + wp]
+        right = solid[key + 1 - wp] or solid[key + 1] or solid[key + 1 + wp]
+        up = solid[key - wp - 1] or solid[key - wp] or solid[key - wp + 1]
+        down = solid[key + wp - 1] or solid[key + wp] or solid[key + wp + 1]
         x0 = bx * c
         y0 = by * c
         return (
@@ -826,10 +846,12 @@ class World:
         contacts = self._contacts_now
         if contacts is None:
             contacts = self._contacts_now = self._wall_contacts()
-        if not contacts:
-            return False  # the usual answer, away from walls
-        ux, uy = self._dirs[mount]
-        return any(vx * ux + vy * uy >= _COS45 * math.hypot(vx, vy) for vx, vy in contacts)
+        if contacts:
+            ux, uy = self._dirs[mount]
+            for vx, vy in contacts:
+                if vx * ux + vy * uy >= _COS45 * math.hypot(vx, vy):
+                    return True
+        return False
 
     def _wall_contacts(self) -> list[tuple[float, float]]:
         """Vectors from the centre to the nearest point of each wall block within reach."""
@@ -845,20 +867,32 @@ class World:
         if reach < fx < cell - reach and reach < fy < cell - reach:
             return []  # every other block is farther than the reach: none can touch
         reach2 = reach**2
+        key = (by + 1) * self._wp + bx + 1
+        walls = self._walls_around.get(key)
+        if walls is None:
+            walls = self._walls_around[key] = self._walls_near(bx, by)
+        found = []
+        for x0, x1, y0, y1 in walls:
+            # to the block's nearest point: the same numbers as min(max(y, y0), y1) - y
+            ny = y0 - y if y < y0 else y1 - y if y > y1 else 0.0
+            nx = x0 - x if x < x0 else x1 - x if x > x1 else 0.0
+            if nx * nx + ny * ny <= reach2:
+                found.append((nx, ny))
+        return found
+
+    def _walls_near(self, bx: int, by: int) -> tuple[tuple[float, float, float, float], ...]:
+        """The wall blocks among block (bx, by) and its eight neighbours, row by row, each as
+        (x0, x1, y0, y1): what _wall_contacts measures from a place in that block."""
+        cell = self.cell
         wp = self._wp
         solid = self._solid
-        found = []
+        walls = []
         for j in (by - 1, by, by + 1):
             row = (j + 1) * wp + 1
             y0 = j * cell
             y1 = y0 + cell
-            # to the block's nearest point: the same numbers as min(max(y, y0), y1) - y
-            ny = y0 - y if y < y0 else y1 - y if y > y1 else 0.0
             for i in (bx - 1, bx, bx + 1):
                 if solid[row + i]:
                     x0 = i * cell
-                    x1 = x0 + cell
-                    nx = x0 - x if x < x0 else x1 - x if x > x1 else 0.0
-                    if nx * nx + ny * ny <= reach2:
-                        found.append((nx, ny))
-        return found
+                    walls.append((x0, x0 + cell, y0, y1))
+        return tuple(walls)
