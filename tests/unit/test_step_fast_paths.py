@@ -11,6 +11,7 @@ poses, readings and distances the records hold.
 from __future__ import annotations
 
 import math
+import random
 from pathlib import Path
 
 import pytest
@@ -154,3 +155,47 @@ def test_the_turn_count_skipped_on_still_ticks_counts_as_an_update_on_every_tick
             last_angle, last_time = angle, t
             assert session.metrics().turns == counter.current()
     assert counter.current() > 5  # it turned: the count was tested
+
+
+def _contacts_of_all_nine(world: World, x: float, y: float) -> list[tuple[float, float]]:
+    """What World._wall_contacts found before it kept a list of the walls near each side: each
+    of the nine blocks around the robot, measured."""
+    cell = world.cell
+    bx, by = int(x * world._inv_cell), int(y * world._inv_cell)
+    reach = world._touch_reach
+    fx, fy = x - bx * cell, y - by * cell
+    if reach < fx < cell - reach and reach < fy < cell - reach:
+        return []
+    found = []
+    for j in (by - 1, by, by + 1):
+        y0 = j * cell
+        y1 = y0 + cell
+        ny = y0 - y if y < y0 else y1 - y if y > y1 else 0.0
+        for i in (bx - 1, bx, bx + 1):
+            if world._solid[(j + 1) * world._wp + 1 + i]:
+                x0 = i * cell
+                x1 = x0 + cell
+                nx = x0 - x if x < x0 else x1 - x if x > x1 else 0.0
+                if nx * nx + ny * ny <= reach**2:
+                    found.append((nx, ny))
+    return found
+
+
+@pytest.mark.parametrize("profile", ["web", "unity"])
+def test_the_walls_in_touch_reach_are_those_a_search_of_all_nine_blocks_finds(profile):
+    """Random places on the floor, and places a hair either side of the touch reach from a
+    block's sides, where rounding would show first."""
+    maze = load_maze("mazes/web.txt")
+    world = World(maze, profile)
+    cell, reach = world.cell, world._touch_reach
+    rng = random.Random(7)
+    floor = [(i, j) for j, row in enumerate(maze.rows) for i, ch in enumerate(row) if ch != "#"]
+    offsets = [reach + d for d in (-1e-9, -1e-12, 0.0, 1e-12, 1e-9)]
+    offsets += [cell - o for o in offsets]
+    for n in range(20_000):
+        i, j = rng.choice(floor)
+        fx = rng.choice(offsets) if n % 3 == 0 else rng.uniform(0.0, cell)
+        fy = rng.choice(offsets) if n % 5 == 0 else rng.uniform(0.0, cell)
+        x, y = i * cell + fx, j * cell + fy
+        world._x, world._y = x, y
+        assert world._wall_contacts() == _contacts_of_all_nine(world, x, y), (x, y)

@@ -234,13 +234,6 @@ class Session:
             due = self._due
         return events
 
-    def _ask_due(self) -> None:
-        """After the controller ran: when it next has something due."""
-        next_due = self._next_due
-        if next_due is not None:
-            due = next_due()
-            self._due = math.inf if due is None else due
-
     def _wake(self, t: float) -> None:
         """The controller's due work at ``t`` between control ticks: it gets the readings of
         that moment and its commands apply at once (the record shows them at the next tick)."""
@@ -253,7 +246,11 @@ class Session:
         for name, port in self.binding.items():
             named[name] = readings[port]
         commands = controller.tick(t, named, _NONE)
-        self._ask_due()
+        # after the controller ran: when it next has something due (as in _control_tick)
+        next_due = self._next_due
+        if next_due is not None:
+            due = next_due()
+            self._due = _NEVER if due is None else due
         if commands:
             for cmd in commands:
                 world.apply(cmd)
@@ -282,8 +279,11 @@ class Session:
             else:
                 self._started = True
                 commands = controller.start(t)
-            if self._next_due is not None:
-                self._ask_due()
+            # after the controller ran: when it next has something due (inf: nothing)
+            next_due = self._next_due
+            if next_due is not None:
+                due = next_due()
+                self._due = _NEVER if due is None else due
             if commands:
                 for cmd in commands:
                     world.apply(cmd)

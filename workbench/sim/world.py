@@ -229,6 +229,8 @@ class World:
         self._radius = profile.robot_radius
         self._turn_rate = math.radians(profile.turn_rate)
         self._touch_reach = profile.robot_radius + 0.005 * self.cell
+        #: farther than this from a side, no wall on that side is within the touch reach
+        self._touch_far = self._touch_reach * (1.0 + 1e-9) + 1e-9 * self.cell
         self._tmax = profile.sensor_range / self.cell
         self._inv_cell = 1.0 / self.cell
         #: each mount's distance from the centre, in MOUNTS order
@@ -255,7 +257,7 @@ class World:
         self._has_exits = any(exits)
         c = self.cell
         self._boxes: dict[int, tuple[float, float, float, float]] = {}
-        #: block key -> the wall blocks around it (_walls_near), made when first needed
+        #: block key and near sides -> the wall blocks there (_walls_near), made when first needed
         self._walls_around: dict[int, tuple[tuple[float, float, float, float], ...]] = {}
         self._segments = [
             ((a * c, b * c), (p * c, q * c)) for (a, b), (p, q) in wall_segments(maze)
@@ -867,10 +869,17 @@ class World:
         if reach < fx < cell - reach and reach < fy < cell - reach:
             return []  # every other block is farther than the reach: none can touch
         reach2 = reach**2
-        key = (by + 1) * self._wp + bx + 1
+        # Only walls on the sides the robot is near can be within reach: a side farther than
+        # the reach and a margin (far above any rounding of these numbers) is left out, and
+        # each wall that may be near is measured exactly as ever.
+        far = self._touch_far
+        near = (
+            (fx <= far) | ((cell - fx <= far) << 1) | ((fy <= far) << 2) | ((cell - fy <= far) << 3)
+        )
+        key = ((by + 1) * self._wp + bx + 1) * 16 + near
         walls = self._walls_around.get(key)
         if walls is None:
-            walls = self._walls_around[key] = self._walls_near(bx, by)
+            walls = self._walls_around[key] = self._walls_near(bx, by, near)
         found = []
         for x0, x1, y0, y1 in walls:
             # to the block's nearest point: the same numbers as min(max(y, y0), y1) - y
@@ -880,19 +889,24 @@ class World:
                 found.append((nx, ny))
         return found
 
-    def _walls_near(self, bx: int, by: int) -> tuple[tuple[float, float, float, float], ...]:
-        """The wall blocks among block (bx, by) and its eight neighbours, row by row, each as
-        (x0, x1, y0, y1): what _wall_contacts measures from a place in that block."""
+    def _walls_near(
+        self, bx: int, by: int, near: int
+    ) -> tuple[tuple[float, float, float, float], ...]:
+        """The wall blocks among block (bx, by) and its eight neighbours that are on the sides
+        ``near`` names (bits: left, right, up, down; the block's own row and column always),
+        row by row, each as (x0, x1, y0, y1): what _wall_contacts measures."""
         cell = self.cell
         wp = self._wp
         solid = self._solid
+        rows = ((by - 1, near & 4), (by, True), (by + 1, near & 8))
+        columns = ((bx - 1, near & 1), (bx, True), (bx + 1, near & 2))
         walls = []
-        for j in (by - 1, by, by + 1):
+        for j, row_near in rows:
             row = (j + 1) * wp + 1
             y0 = j * cell
             y1 = y0 + cell
-            for i in (bx - 1, bx, bx + 1):
-                if solid[row + i]:
+            for i, column_near in columns:
+                if row_near and column_near and solid[row + i]:
                     x0 = i * cell
                     walls.append((x0, x0 + cell, y0, y1))
         return tuple(walls)
