@@ -301,7 +301,9 @@ class World:
         self._rng = random.Random(self.seed)
         self._gains = motor_gains(self.noise, self._rng)
         self._build_space()
-        self._steps = 0
+        #: whole steps done, a float holding a whole number (exactly, below 2**53), so that
+        #: the time, steps * dt, is a float product (the same number int * float gives)
+        self._steps = 0.0
         #: the part of the current step already done by :meth:`step_to`, seconds
         self._part = 0.0
         self.time = 0.0
@@ -482,7 +484,7 @@ class World:
                 self._distance += self._step_moved
                 self._x = x
                 self._y = y
-                steps = self._steps + 1
+                steps = self._steps + 1.0
                 self._steps = steps
                 self.time = t = steps * self.dt
                 self._readings = None
@@ -515,7 +517,7 @@ class World:
                 self._moved = turned  # nothing moved: 0.0 or turned
             else:
                 self._moved = 0.0
-            steps = self._steps + 1
+            steps = self._steps + 1.0
             self._steps = steps
             self.time = t = steps * dt
             self._angle = a
@@ -551,7 +553,7 @@ class World:
             self._moved = moved or turned
         else:
             self._moved = moved
-        steps = self._steps + 1
+        steps = self._steps + 1.0
         self._steps = steps
         self.time = t = steps * dt
         self._angle = a
@@ -659,7 +661,7 @@ class World:
                 xmin, xmax, ymin, ymax = self._box
                 self._in_box = xmin <= x <= xmax and ymin <= y <= ymax
         if whole:
-            self._steps += 1
+            self._steps += 1.0
             self.time = t = self._steps * self.dt
         else:
             self.time = t = self._steps * self.dt + self._part
