@@ -476,7 +476,9 @@ class World:
         if self._cruise:
             # driving straight on the step _advance last worked out, from a place in the free
             # box: _advance's free motion with what it would store again left out (the angle,
-            # which w = 0 leaves as it is, the turn, the motion and the pose sent to pymunk)
+            # which w = 0 leaves as it is: a0 + 0.0 is a0 for any a0 but -0.0, and the angle
+            # is never -0.0, as it starts at 0 or more and only sums change it; the turn, the
+            # motion and what pymunk is to be told, which the last step stored already)
             x = self._x + self._step_dx
             y = self._y + self._step_dy
             xmin, xmax, ymin, ymax = self._box
