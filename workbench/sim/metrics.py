@@ -38,27 +38,32 @@ class TurnCounter:
 
     def __init__(self) -> None:
         self.turns = 0
-        self._sweep = 0.0
+        #: the degrees swept by the rotation under way (0.0: none), which :meth:`update` ends
+        self.sweep = 0.0
 
     def update(self, signed_degrees: float, seconds: float) -> None:
-        if not signed_degrees and not self._sweep:
+        """``signed_degrees`` of rotation in the last ``seconds``.
+
+        With no rotation and no sweep under way it changes nothing (a caller may skip it then).
+        """
+        if not signed_degrees and not self.sweep:
             return  # not rotating, and no sweep to end: nothing changes
         rotating = seconds > 0 and abs(signed_degrees) / seconds > ROTATING_ABOVE
-        if rotating and (self._sweep == 0.0 or (signed_degrees > 0) == (self._sweep > 0)):
-            self._sweep += signed_degrees
+        if rotating and (self.sweep == 0.0 or (signed_degrees > 0) == (self.sweep > 0)):
+            self.sweep += signed_degrees
             return
         self.finish()
         if rotating:
-            self._sweep = signed_degrees
+            self.sweep = signed_degrees
 
     def finish(self) -> None:
-        if abs(self._sweep) >= TURN_MIN_DEGREES:
+        if abs(self.sweep) >= TURN_MIN_DEGREES:
             self.turns += 1
-        self._sweep = 0.0
+        self.sweep = 0.0
 
     def current(self) -> int:
         """Turns so far, counting a turn still in progress once it is large enough."""
-        return self.turns + (abs(self._sweep) >= TURN_MIN_DEGREES)
+        return self.turns + (abs(self.sweep) >= TURN_MIN_DEGREES)
 
 
 def efficiency(

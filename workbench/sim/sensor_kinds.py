@@ -13,20 +13,26 @@ The values are plain data: the TUI turns a :class:`PanelForm` into text, the cod
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from functools import partial
 from typing import Literal, Protocol
 
 #: the sides a sensor may be mounted on, in the order the world numbers them
 MOUNTS = ("front", "right", "back", "left")
 
 
-class Probe(Protocol):
-    """What a sensor may ask of the world at one step; ``mount`` is an index of MOUNTS."""
+#: the readings of one step by port
+Readings = dict[int, float | int]
 
-    def echo(self, mount: int) -> float:
-        """How far a ray from the sensor meets a wall, with the distance noise of the run (the
-        profile's no-echo value when it meets none within range)."""
+
+class Probe(Protocol):
+    """What a sensor may ask of the world at one step; a mount is an index of MOUNTS."""
+
+    def echoes(self, sensors: Sequence[tuple[int, int]], out: Readings) -> None:
+        """Into ``out`` by port, for sensors ``(port, mount)`` in that order: how far a ray
+        from each meets a wall, with the distance noise of the run (the profile's no-echo value
+        when it meets none within range)."""
         ...
 
     def pressed(self, mount: int) -> bool:
@@ -34,10 +40,11 @@ class Probe(Protocol):
         ...
 
 
-#: how a kind reads the world: given a probe, the function that reads a sensor of this kind on
-#: a mount (an index of MOUNTS) at the probe's current step; made once per sensor set-up, so
-#: the reading itself is one call
-Read = Callable[[Probe], Callable[[int], float | int]]
+#: how a kind reads the world: given a probe and a set-up's sensors of this kind as
+#: ``(port, mount)`` pairs (a mount is an index of MOUNTS), in order, the function that reads
+#: them all at the probe's current step into the readings it is given, in that order; made
+#: once per sensor set-up, so reading them all is one call
+Read = Callable[[Probe, tuple[tuple[int, int], ...]], Callable[[Readings], None]]
 
 #: a reading's unit: the profile's length unit ("length"), or none (a count or a state)
 Unit = Literal["length", "none"]
@@ -89,13 +96,18 @@ class SensorKind:
     bumper: bool = False
 
 
-def _echo(probe: Probe) -> Callable[[int], float]:
-    return probe.echo
+def _echo(probe: Probe, sensors: tuple[tuple[int, int], ...]) -> Callable[[Readings], None]:
+    return partial(probe.echoes, sensors)
 
 
-def _pressed(probe: Probe) -> Callable[[int], int]:
+def _pressed(probe: Probe, sensors: tuple[tuple[int, int], ...]) -> Callable[[Readings], None]:
     pressed = probe.pressed
-    return lambda mount: int(pressed(mount))
+
+    def read(out: Readings) -> None:
+        for port, mount in sensors:
+            out[port] = int(pressed(mount))
+
+    return read
 
 
 DISTANCE = SensorKind(

@@ -24,6 +24,8 @@ from .sensors import SensorSpec
 from .world import EXIT, Pose, World
 
 _NONE: frozenset[str] = frozenset()
+#: the due time of a controller with nothing due
+_NEVER = math.inf
 
 
 class Controller(Protocol):
@@ -192,7 +194,8 @@ class Session:
         something due inside the step is woken at that time."""
         n = self._steps + 1
         due = self._due
-        if due < n * self._dt - _SAME:
+        # nothing due (inf, as a controller without next_due always has) needs no end of step
+        if due != _NEVER and due < n * self._dt - _SAME:
             early = self._wake_within()
             events = self._world_step()
             if early:
@@ -209,8 +212,10 @@ class Session:
             self._commands.append(cmd)
         if n % self.every == 0:
             self._control_tick()
-        elif self._due <= self.world.time + _SAME:
-            self._wake(self.world.time)
+        else:
+            due = self._due
+            if due != _NEVER and due <= self.world.time + _SAME:
+                self._wake(self.world.time)
         return events
 
     def _wake_within(self) -> tuple[str, ...]:
@@ -229,13 +234,6 @@ class Session:
             due = self._due
         return events
 
-    def _ask_due(self) -> None:
-        """After the controller ran: when it next has something due."""
-        next_due = self._next_due
-        if next_due is not None:
-            due = next_due()
-            self._due = math.inf if due is None else due
-
     def _wake(self, t: float) -> None:
         """The controller's due work at ``t`` between control ticks: it gets the readings of
         that moment and its commands apply at once (the record shows them at the next tick)."""
@@ -243,9 +241,16 @@ class Session:
         assert controller is not None
         world = self.world
         self.readings = readings = world.read_sensors()
-        named = {name: readings[port] for name, port in self.binding.items()}
+        # by the controller's names (a plain loop: a comprehension costs a frame of its own)
+        named = {}
+        for name, port in self.binding.items():
+            named[name] = readings[port]
         commands = controller.tick(t, named, _NONE)
-        self._ask_due()
+        # after the controller ran: when it next has something due (as in _control_tick)
+        next_due = self._next_due
+        if next_due is not None:
+            due = next_due()
+            self._due = _NEVER if due is None else due
         if commands:
             for cmd in commands:
                 world.apply(cmd)
@@ -255,20 +260,30 @@ class Session:
         world = self.world
         t = world.time
         self.readings = readings = world.read_sensors()
-        angle = world.angle
-        self._turns.update(math.degrees(angle - self._last_angle), t - self._last_time)
+        angle = world._angle  # World.angle without the property's call, on every tick
+        last = self._last_angle
+        turns = self._turns
+        # not turned since the last tick and no sweep to end: the update would change nothing
+        if angle != last or turns.sweep:
+            turns.update(math.degrees(angle - last), t - self._last_time)
         self._last_angle = angle
         self._last_time = t
         events = self._events
         controller = self.controller
         if controller is not None and run_controller:
             if self._started:
-                named = {name: readings[port] for name, port in self.binding.items()}
+                named = {}  # as in _wake
+                for name, port in self.binding.items():
+                    named[name] = readings[port]
                 commands = controller.tick(t, named, frozenset(events) if events else _NONE)
             else:
                 self._started = True
                 commands = controller.start(t)
-            self._ask_due()
+            # after the controller ran: when it next has something due (inf: nothing)
+            next_due = self._next_due
+            if next_due is not None:
+                due = next_due()
+                self._due = _NEVER if due is None else due
             if commands:
                 for cmd in commands:
                     world.apply(cmd)

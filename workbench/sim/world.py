@@ -46,7 +46,7 @@ from .commands import (
 from .maze import Maze
 from .noise import NoiseSettings, motor_gains, noise_settings, turn_factor
 from .profiles import Profile, get_profile
-from .sensor_kinds import MOUNTS, SENSOR_KINDS, sensor_kind
+from .sensor_kinds import MOUNTS, SENSOR_KINDS, Readings, sensor_kind
 from .sensors import SensorSpec, check_ports
 
 TURN_DONE = "turn_done"
@@ -229,6 +229,8 @@ class World:
         self._radius = profile.robot_radius
         self._turn_rate = math.radians(profile.turn_rate)
         self._touch_reach = profile.robot_radius + 0.005 * self.cell
+        #: farther than this from a side, no wall on that side is within the touch reach
+        self._touch_far = self._touch_reach * (1.0 + 1e-9) + 1e-9 * self.cell
         self._tmax = profile.sensor_range / self.cell
         self._inv_cell = 1.0 / self.cell
         #: each mount's distance from the centre, in MOUNTS order
@@ -255,6 +257,8 @@ class World:
         self._has_exits = any(exits)
         c = self.cell
         self._boxes: dict[int, tuple[float, float, float, float]] = {}
+        #: block key and near sides -> the wall blocks there (_walls_near), made when first needed
+        self._walls_around: dict[int, tuple[tuple[float, float, float, float], ...]] = {}
         self._segments = [
             ((a * c, b * c), (p * c, q * c)) for (a, b), (p, q) in wall_segments(maze)
         ]
@@ -274,12 +278,13 @@ class World:
         self.sensors = tuple(specs)
         # read kind by kind in the table's order (and each kind's sensors in the order given):
         # the noise of a run is drawn in that order
-        self._plan = tuple(
-            (s.port, kind.read(self), MOUNTS.index(s.mount))
-            for kind in SENSOR_KINDS
-            for s in specs
-            if s.kind == kind.name
-        )
+        plan = []
+        for kind in SENSOR_KINDS:
+            mine = tuple((s.port, MOUNTS.index(s.mount)) for s in specs if s.kind == kind.name)
+            if mine:
+                plan.append(kind.read(self, mine))
+        #: the reader of each kind's sensors, for each kind carried, in the table's order
+        self._plan = tuple(plan)
         self._bumpers = tuple(
             sorted({MOUNTS.index(s.mount) for s in specs if sensor_kind(s.kind).bumper})
         )
@@ -296,7 +301,9 @@ class World:
         self._rng = random.Random(self.seed)
         self._gains = motor_gains(self.noise, self._rng)
         self._build_space()
-        self._steps = 0
+        #: whole steps done, a float holding a whole number (exactly, below 2**53), so that
+        #: the time, steps * dt, is a float product (the same number int * float gives)
+        self._steps = 0.0
         #: the part of the current step already done by :meth:`step_to`, seconds
         self._part = 0.0
         self.time = 0.0
@@ -309,6 +316,8 @@ class World:
         self._last_contact_end = -math.inf
         self._new_collision: str | None = None  # the event of a contact that just started
         self._exit_time: float | None = None
+        #: whether a step may reach an exit: the maze has exits and none is reached yet
+        self._watch_exit = self._has_exits
         self._wheels = (0.0, 0.0)
         self._v = 0.0
         self._w = 0.0
@@ -322,6 +331,14 @@ class World:
         self._step_dt = self.dt
         self._step_dx = self._step_dy = self._step_moved = 0.0
         self._box = (math.inf, -math.inf, math.inf, -math.inf)
+        #: whether the next whole step, if it ends in the free box, is the straight step
+        #: ``_step_dx``, ``_step_dy`` of a robot driving straight ahead, out of contact, its
+        #: centre in the box, with nothing but the pose and time to change: set by _advance for
+        #: a step it found so, and cleared by anything else (a command, physics, a part step)
+        self._cruise = False
+        #: whether the robot's centre is in ``_box`` (as _advance's test of the box finds it);
+        #: asked only out of contact, so left False while in contact
+        self._in_box = False
 
     def _build_space(self) -> None:
         space = pymunk.Space()
@@ -400,6 +417,7 @@ class World:
 
         Any command abandons a Turn by Degree in progress.
         """
+        self._cruise = False
         self._turn_target = None
         p = self.profile
         if isinstance(command, WheelPowers):
@@ -455,11 +473,98 @@ class World:
         (free motion, exactly what the solver would do with nothing to collide with); anywhere
         else, and whenever the robot touches a wall, pymunk steps the world.
         """
+        if self._cruise:
+            # driving straight on the step _advance last worked out, from a place in the free
+            # box: _advance's free motion with what it would store again left out (the angle,
+            # which w = 0 leaves as it is: a0 + 0.0 is a0 for any a0 but -0.0, and the angle
+            # is never -0.0, as it starts at 0 or more and only sums change it; the turn, the
+            # motion and what pymunk is to be told, which the last step stored already)
+            x = self._x + self._step_dx
+            y = self._y + self._step_dy
+            xmin, xmax, ymin, ymax = self._box
+            if xmin <= x <= xmax and ymin <= y <= ymax:
+                self._distance += self._step_moved
+                self._x = x
+                self._y = y
+                steps = self._steps + 1.0
+                self._steps = steps
+                self.time = t = steps * self.dt
+                self._readings = None
+                if self._watch_exit:
+                    return self._events(t, x, y, self._angle, None)
+                return _NO_EVENTS
+            return self._advance(self.dt, True)
         part = self._part
-        if part:
+        if part or self._contacts or not self._in_box:
             self._part = 0.0
             return self._advance(self.dt - part, True)
-        return self._advance(self.dt, True)
+        # a whole step out of contact from a place in the free box, turning in place, standing
+        # or driving an arc (wheels at different speeds, or a motor imbalance): as in _advance
+        # (the same floating-point operations in the same order; what would add 0.0 or store
+        # what is there is left out), without its call, where the motion stays in the box
+        dt = self.dt
+        a0 = self._angle
+        target = self._turn_target
+        if target is not None:
+            # turning in place: _advance's free turn
+            w = (target - a0) / dt
+            rate = self._turn_rate
+            w = rate if w > rate else -rate if w < -rate else w
+            self._free_w = w
+            self._physics_stale = True
+            a = a0 + w * dt
+            if w:
+                turned = abs(w) * dt
+                self._turned += turned
+                self._moved = turned  # nothing moved: 0.0 or turned
+            else:
+                self._moved = 0.0
+            steps = self._steps + 1.0
+            self._steps = steps
+            self.time = t = steps * dt
+            self._angle = a
+            self._readings = None
+            if abs(target - a) < _TURN_EPS or self._watch_exit:
+                return self._events(t, self._x, self._y, a, target)
+            return _NO_EVENTS
+        v = self._v
+        w = self._w
+        if v:
+            if not w:
+                # straight ahead: _advance works the step out once, and the next steps cruise
+                return self._advance(dt, True)
+            # an arc turns the robot every step, so each step is new (the cache of a
+            # straight step would only be written over): its motion, as _advance works it out
+            x = self._x + v * math.cos(a0) * dt
+            y = self._y + v * math.sin(a0) * dt
+            xmin, xmax, ymin, ymax = self._box
+            if not (xmin <= x <= xmax and ymin <= y <= ymax):
+                return self._advance(dt, True)
+            moved = abs(v) * dt
+            self._distance += moved
+            self._x = x
+            self._y = y
+        else:
+            moved = 0.0
+        self._free_w = w
+        self._physics_stale = True
+        a = a0 + w * dt
+        if w:
+            turned = abs(w) * dt
+            self._turned += turned
+            self._moved = moved or turned
+        else:
+            self._moved = moved
+        steps = self._steps + 1.0
+        self._steps = steps
+        self.time = t = steps * dt
+        self._angle = a
+        self._readings = None
+        # no contact can have started (no physics ran), and no turn is under way: events only
+        # when an exit may have been reached
+        if self._watch_exit:
+            return self._events(t, self._x, self._y, a, None)
+        return _NO_EVENTS
 
     def step_to(self, t: float) -> tuple[str, ...]:
         """Advance to simulated time ``t`` inside the current step (something is due then,
@@ -505,9 +610,17 @@ class World:
                 x = x0
                 y = y0
                 moved = 0.0
-            xmin, xmax, ymin, ymax = self._box
-            if not (xmin <= x0 <= xmax and ymin <= y0 <= ymax):
-                xmin, xmax, ymin, ymax = self._box = self._free_box(x0, y0)
+            box = self._box
+            if not self._in_box:
+                # the free box of the block the robot is in (cached per block): where its
+                # centre may go without coming near a wall
+                inv = self._inv_cell
+                key = (int(y0 * inv) + 1) * self._wp + int(x0 * inv) + 1
+                known = self._boxes.get(key)
+                if known is None:
+                    known = self._boxes[key] = self._make_box(key)
+                self._box = box = known
+            xmin, xmax, ymin, ymax = box
             if xmin <= x <= xmax and ymin <= y <= ymax:
                 # free motion: no wall within reach, so no contact can start this step
                 free = True
@@ -515,12 +628,42 @@ class World:
                 self._physics_stale = True
                 a = a0 + w * dt
                 turned = abs(w) * dt if w else 0.0
-        if not free:
-            x, y, a = self._physics_step(target, a0, dt)
+        if free:
+            self._in_box = True
+            # the next whole step may be this one again (see step)
+            self._cruise = whole and v != 0.0 and w == 0.0 and target is None and dt == self.dt
+        else:
+            self._cruise = False
+            # one pymunk step (not a method of its own: a call would cost every physics step)
+            if self._physics_stale:
+                self._sync_body()
+            if target is not None:
+                # positions integrate with the previous step's velocity: plan one step ahead
+                ahead = a0 + _get_angular_velocity(self._body_ptr) * dt
+                rate = self._turn_rate
+                w = (target - ahead) / dt
+                _set_angular_velocity(self._control_ptr, max(-rate, min(rate, w)))
+            elif self._reaim:
+                v = self._v
+                _set_velocity(self._control_ptr, (v * math.cos(a0), v * math.sin(a0)))
+            # the C step directly: the wrapper's bookkeeping (deferred adds and removals,
+            # first-step mass checks) has nothing to do for this space after it is built
+            _space_step(self._space_ptr, dt)
+            body = self._body_ptr
+            pos = _get_position(body)
+            x = pos.x
+            y = pos.y
+            a = _get_angle(body)
             moved = math.hypot(x - x0, y - y0)
             turned = abs(a - a0)
+            if self._contacts:
+                # only asked out of contact: worked out at the step that ends the contact
+                self._in_box = False
+            else:
+                xmin, xmax, ymin, ymax = self._box
+                self._in_box = xmin <= x <= xmax and ymin <= y <= ymax
         if whole:
-            self._steps += 1
+            self._steps += 1.0
             self.time = t = self._steps * self.dt
         else:
             self.time = t = self._steps * self.dt + self._part
@@ -531,34 +674,9 @@ class World:
         self._y = y
         self._angle = a
         self._readings = None
-        if (
-            target is None
-            and not self._new_collision
-            and (self._exit_time is not None or not self._has_exits)
-        ):
+        if target is None and not self._new_collision and not self._watch_exit:
             return _NO_EVENTS  # nothing can have happened: the common step ends here
         return self._events(t, x, y, a, target)
-
-    def _physics_step(
-        self, target: float | None, a0: float, dt: float
-    ) -> tuple[float, float, float]:
-        """One pymunk step of ``dt``; the robot's new x, y and angle."""
-        if self._physics_stale:
-            self._sync_body()
-        if target is not None:
-            # positions integrate with the previous step's velocity: plan one step ahead
-            ahead = a0 + _get_angular_velocity(self._body_ptr) * dt
-            rate = self._turn_rate
-            w = (target - ahead) / dt
-            _set_angular_velocity(self._control_ptr, max(-rate, min(rate, w)))
-        elif self._reaim:
-            v = self._v
-            _set_velocity(self._control_ptr, (v * math.cos(a0), v * math.sin(a0)))
-        # the C step directly: the wrapper's bookkeeping (deferred adds and removals, first-step
-        # mass checks) has nothing to do for this space after it is built
-        _space_step(self._space_ptr, dt)
-        pos = _get_position(self._body_ptr)
-        return pos.x, pos.y, _get_angle(self._body_ptr)
 
     def _events(
         self, t: float, x: float, y: float, a: float, target: float | None
@@ -573,24 +691,17 @@ class World:
         if self._new_collision:
             events = (*events, self._new_collision)
             self._new_collision = None
-        if self._exit_time is None and self._has_exits:
+        if self._watch_exit:
             inv = self._inv_cell
             if self._exits[(int(y * inv) + 1) * self._wp + int(x * inv) + 1]:
                 self._exit_time = t
+                self._watch_exit = False
                 events = (*events, EXIT)
         return events
 
-    def _free_box(self, x: float, y: float) -> tuple[float, float, float, float]:
-        """Where the robot's centre may go in its block without coming near a wall:
-        (xmin, xmax, ymin, ymax), cached per block."""
-        inv = self._inv_cell
-        key = (int(y * inv) + 1) * self._wp + int(x * inv) + 1
-        box = self._boxes.get(key)
-        if box is None:
-            box = self._boxes[key] = self._make_box(key)
-        return box
-
     def _make_box(self, key: int) -> tuple[float, float, float, float]:
+        """Where the robot's centre may go in block ``key`` (an index of the padded grid)
+        without coming near a wall: (xmin, xmax, ymin, ymax)."""
         wp = self._wp
         solid = self._solid
         c = self.cell
@@ -599,14 +710,12 @@ class World:
         keep = self._radius + 0.02 * c  # clearance kept from any wall block
         if solid[key]:
             return (math.inf, -math.inf, math.inf, -math.inf)
-
-        def any_solid(*offsets: int) -> bool:
-            return any(solid[key + o] for o in offsets)
-
-        left = any_solid(-1 - wp, -1, -1 + wp)
-        right = any_solid(1 - wp, 1, 1 + wp)
-        up = any_solid(-wp - 1, -wp, -wp + 1)
-        down = any_solid(wp - 1, wp, wp + 1)
+        # a wall among the three blocks on each side (made while a run steps into new blocks,
+        # so plain lookups rather than a generator per side)
+        left = solid[key - 1 - wp] or solid[key - 1] or solid[key - 1 + wp]
+        right = solid[key + 1 - wp] or solid[key + 1] or solid[key + 1 + wp]
+        up = solid[key - wp - 1] or solid[key - wp] or solid[key - wp + 1]
+        down = solid[key + wp - 1] or solid[key + wp] or solid[key + wp + 1]
         x0 = bx * c
         y0 = by * c
         return (
@@ -698,39 +807,57 @@ class World:
             self._dirs_angle = a
         self._contacts_now = None
         out: dict[int, float | int] = {}
-        for port, read, mount in self._plan:
-            out[port] = read(mount)
+        for read in self._plan:
+            read(out)
         self._readings = out
         return out
 
     # the Probe the sensor kinds read, for the step being read (read_sensors sets it up)
-    def echo(self, mount: int) -> float:
-        """How far the ray of a sensor on ``mount`` (an index of MOUNTS) meets a wall, from
-        the sensor's place on the robot, with the run's distance noise; the profile's no-echo
-        value when it meets none within range."""
-        dx, dy = self._dirs[mount]
+    def echoes(self, sensors: Sequence[tuple[int, int]], out: Readings) -> None:
+        """Into ``out`` by port, for distance sensors ``(port, mount)`` (a mount is an index of
+        MOUNTS), in that order: how far each one's ray meets a wall, from the sensor's place on
+        the robot, with the run's distance noise (drawn in that order); the profile's no-echo
+        value for a ray that meets none within range."""
+        # one call for all of a set-up's distance sensors: what the rays need is looked up
+        # once, and each ray is the same arithmetic as one sensor's alone
+        dirs = self._dirs
+        offsets = self._offsets
+        x = self._x
+        y = self._y
         inv = self._inv_cell
-        offset = self._offsets[mount]
-        t = _march(
-            self._solid, self._wp, (self._x + offset * dx) * inv + 1.0,
-            (self._y + offset * dy) * inv + 1.0, dx, dy, self._tmax,
-        )  # fmt: skip
-        if t < 0.0:
-            return self._no_echo
-        d = t * self.cell
-        if self._distance_noise:
-            rel, absolute = self._distance_noise
-            gauss = self._rng.gauss(0.0, rel * d + absolute)
-            d = min(self.profile.sensor_range, max(0.0, d + gauss))
-        return d
+        solid = self._solid
+        wp = self._wp
+        tmax = self._tmax
+        cell = self.cell
+        noise = self._distance_noise
+        for port, mount in sensors:
+            dx, dy = dirs[mount]
+            offset = offsets[mount]
+            t = _march(
+                solid, wp, (x + offset * dx) * inv + 1.0, (y + offset * dy) * inv + 1.0,
+                dx, dy, tmax,
+            )  # fmt: skip
+            if t < 0.0:
+                out[port] = self._no_echo
+                continue
+            d = t * cell
+            if noise:
+                rel, absolute = noise
+                gauss = self._rng.gauss(0.0, rel * d + absolute)
+                d = min(self.profile.sensor_range, max(0.0, d + gauss))
+            out[port] = d
 
     def pressed(self, mount: int) -> bool:
         """Whether a wall touches the robot within the arc of ``mount`` (an index of MOUNTS)."""
         contacts = self._contacts_now
         if contacts is None:
             contacts = self._contacts_now = self._wall_contacts()
-        ux, uy = self._dirs[mount]
-        return any(vx * ux + vy * uy >= _COS45 * math.hypot(vx, vy) for vx, vy in contacts)
+        if contacts:
+            ux, uy = self._dirs[mount]
+            for vx, vy in contacts:
+                if vx * ux + vy * uy >= _COS45 * math.hypot(vx, vy):
+                    return True
+        return False
 
     def _wall_contacts(self) -> list[tuple[float, float]]:
         """Vectors from the centre to the nearest point of each wall block within reach."""
@@ -746,20 +873,44 @@ class World:
         if reach < fx < cell - reach and reach < fy < cell - reach:
             return []  # every other block is farther than the reach: none can touch
         reach2 = reach**2
+        # Only walls on the sides the robot is near can be within reach: a side farther than
+        # the reach and a margin (far above any rounding of these numbers) is left out, and
+        # each wall that may be near is measured exactly as ever.
+        far = self._touch_far
+        near = (
+            (fx <= far) | ((cell - fx <= far) << 1) | ((fy <= far) << 2) | ((cell - fy <= far) << 3)
+        )
+        key = ((by + 1) * self._wp + bx + 1) * 16 + near
+        walls = self._walls_around.get(key)
+        if walls is None:
+            walls = self._walls_around[key] = self._walls_near(bx, by, near)
+        found = []
+        for x0, x1, y0, y1 in walls:
+            # to the block's nearest point: the same numbers as min(max(y, y0), y1) - y
+            ny = y0 - y if y < y0 else y1 - y if y > y1 else 0.0
+            nx = x0 - x if x < x0 else x1 - x if x > x1 else 0.0
+            if nx * nx + ny * ny <= reach2:
+                found.append((nx, ny))
+        return found
+
+    def _walls_near(
+        self, bx: int, by: int, near: int
+    ) -> tuple[tuple[float, float, float, float], ...]:
+        """The wall blocks among block (bx, by) and its eight neighbours that are on the sides
+        ``near`` names (bits: left, right, up, down; the block's own row and column always),
+        row by row, each as (x0, x1, y0, y1): what _wall_contacts measures."""
+        cell = self.cell
         wp = self._wp
         solid = self._solid
-        found = []
-        for j in (by - 1, by, by + 1):
+        rows = ((by - 1, near & 4), (by, True), (by + 1, near & 8))
+        columns = ((bx - 1, near & 1), (bx, True), (bx + 1, near & 2))
+        walls = []
+        for j, row_near in rows:
             row = (j + 1) * wp + 1
             y0 = j * cell
             y1 = y0 + cell
-            # to the block's nearest point: the same numbers as min(max(y, y0), y1) - y
-            ny = y0 - y if y < y0 else y1 - y if y > y1 else 0.0
-            for i in (bx - 1, bx, bx + 1):
-                if solid[row + i]:
+            for i, column_near in columns:
+                if row_near and column_near and solid[row + i]:
                     x0 = i * cell
-                    x1 = x0 + cell
-                    nx = x0 - x if x < x0 else x1 - x if x > x1 else 0.0
-                    if nx * nx + ny * ny <= reach2:
-                        found.append((nx, ny))
-        return found
+                    walls.append((x0, x0 + cell, y0, y1))
+        return tuple(walls)
