@@ -19,24 +19,28 @@ Why it is the same program: each activity's code is the code of its prepared ste
 ``interp.py`` (the same calls, in the same order, on the same values), with the message kept
 in a local variable instead of ``flow.value`` between two activities; a fan-out's other links
 start their flows where the step's sender starts them; and the chain writes the flow's place
-back wherever it stops. So commands, prints, globals, changes, flows and activity counts are
-the step-by-step run's (``tests/program/test_interp.py`` runs programs both ways).
+back wherever it stops. An expression is written out part by part (``viple_expr.Node``) with
+the operations, the order and the checks of true and false of the part's function, and any
+part that goes wrong (or that is not written out) is run by that function on the same
+values, so its error has the same text. So commands, prints, globals, changes, flows,
+activity counts and errors are the step-by-step run's (``ProgramController(fuse=False)``;
+``tests/program/test_fused.py`` runs programs both ways).
 
 Security: the source is made of this module's own text and of names it numbers itself
 (``c0``, ``c1`` ...); every value that comes from the program (ids, pins, constants, names,
 expressions) reaches the code as an argument of the function that makes the chain, never as
 text. Sizes are bounded: :data:`MAX_CHAIN` activities a chain, :data:`MAX_NEST` Ifs nested in
-one, :data:`MAX_FUSED` activities for all the chains of a program (past it, activities run
-step by step).
+one, :data:`MAX_FUSED` activities and :data:`MAX_LINES` lines for all the chains of a program
+(past them, activities run step by step), :data:`MAX_PARTS` expression parts written out.
 """
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
-from . import kinds as K
 from .model import ELSE, Link
 from .viple_expr import Node
 
@@ -53,8 +57,11 @@ MAX_NEST = 8
 MAX_FUSED = 2_000
 #: parts of expressions written out as code for a whole program (past it, and below
 #: MAX_PART_DEPTH parts inside parts, an expression part runs as its function)
-MAX_PARTS = 6_000
+MAX_PARTS = 2_000
 MAX_PART_DEPTH = 16
+#: lines of code for a whole program (a chain stops where its program's lines run out), so
+#: making the chains of the largest program a file may hold takes a fraction of a second
+MAX_LINES = 12_000
 #: the Python operator of each comparison (this module's own text, looked up by the
 #: operator's token)
 _PY_OPS = {"==": "==", "=": "==", "!=": "!=", "<>": "!=", "<": "<", "<=": "<=", ">": ">",
@@ -111,9 +118,11 @@ HELPERS = (
 class _Writer:
     """Writes the chain of one head: activity by activity, an If's pins as branches."""
 
-    def __init__(self, fusable: dict[int, Fusable], budget: int, parts: int) -> None:
+    def __init__(self, fusable: dict[int, Fusable], budget: int, parts: int, lines: int) -> None:
         self.fusable = fusable
         self.budget = budget
+        #: lines this chain may take
+        self.lines = lines
         #: expression parts this chain may still write out
         self.parts = parts
         self.src = _Source()
@@ -126,15 +135,21 @@ class _Writer:
         src = self.src
         src.put(1, "def chain(flow, room):")
         src.put(2, "v = flow.value")
-        src.put(2, "frame = flow.frame")
-        src.put(2, "G = ctl.globals")
-        src.put(2, "at = 0")
         src.put(2, "try:")
         self.activity(head, 1, 3, 0, frozenset())
         src.put(2, "except BaseException:")
         src.put(3, "flow.activity, flow.ran = PLACES[at]")
         src.put(3, "raise")
         src.put(1, "return chain")
+        # the flow's frame and the globals, read once, where the code uses them (every line
+        # that may raise comes after an ``at = ...``, the first of the try's body)
+        used = set(re.findall(r"\w+", "\n".join(src.lines)))
+        prologue = [
+            "        " + line
+            for line, name in (("frame = flow.frame", "frame"), ("G = ctl.globals", "G"))
+            if name in used
+        ]
+        src.lines[2:2] = prologue
         return src
 
     def stop(self, depth: int, target: int, pin: str, ran: int) -> None:
@@ -179,6 +194,7 @@ class _Writer:
             or ran >= MAX_CHAIN
             or nest > MAX_NEST
             or self.size >= self.budget
+            or len(self.src.lines) >= self.lines
         ):
             if target in self.fusable:
                 self.stops.append(target)
@@ -357,14 +373,16 @@ def fuse(
     todo = [h for h in heads if h in fusable]
     fused = 0
     parts = MAX_PARTS
-    while todo and fused < MAX_FUSED:
+    lines = MAX_LINES
+    while todo and fused < MAX_FUSED and lines > 0:
         head = todo.pop(0)
         if head in chains:
             continue
-        writer = _Writer(fusable, MAX_FUSED - fused, parts)
+        writer = _Writer(fusable, MAX_FUSED - fused, parts, lines)
         src = writer.write(head)
         fused += writer.size
         parts = max(0, writer.parts)
+        lines -= len(src.lines)
         chains[head] = _make(src, helpers)
         todo.extend(writer.stops)
     return chains
@@ -379,16 +397,3 @@ def _make(src: _Source, helpers: dict[str, Any]) -> Chain:
     exec(compile(text, "<viple chain>", "exec"), namespace)
     values = [helpers[name] for name in HELPERS]
     return namespace["make"](*values, tuple(src.places), *src.cells)
-
-
-#: the activity kinds whose code a chain may hold, by the handler of their kind
-FUSED_KINDS = (
-    K.DATA,
-    K.VARIABLE,
-    K.CALCULATE,
-    K.IF,
-    K.TIMER,
-    K.DRIVE,
-    K.PRINT_LINE,
-    K.CODE,
-)

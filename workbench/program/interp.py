@@ -358,12 +358,13 @@ class ProgramController:
         """One control tick; ``readings`` ("port N" -> value) fire the sensor activities, and
         ``report``, a robot's report as it arrived, is what a raw sensor gets (None: the
         simulated robot's report is made from the readings)."""
-        self.now = t
         if t + _SAME < self._quiet_until and (self._paced or (not readings and report is None)):
             # nothing is due: no Timer ends, no key or sensor report comes and no flow waits to
             # run, so this tick would change nothing (most ticks of a program: its sensors
-            # report every 250 ms, the session ticks it every 50 ms)
+            # report every 250 ms, the session ticks it every 50 ms); ``now`` is only read
+            # while the program runs, so it is set below
             return []
+        self.now = t
         if self.stopped is not None:
             return []
         sleeping = self._sleeping
@@ -659,7 +660,8 @@ class ProgramController:
         count_flows = self._count_flows
         parked = self._parked
         spare = self._spare
-        ran: list[Flow] = []  # the flows that took steps in this pass (their count restarts)
+        #: the flows that took steps in this pass, when their count matters (it restarts)
+        ran: list[Flow] | None = [] if count_flows else None
         while ready and total < budget and self.stopped is None:
             flow = ready.popleft()
             if count_flows and flow.steps >= FLOW_TICK_STEPS:
@@ -697,7 +699,7 @@ class ProgramController:
                 parked.append(flow)
             else:
                 ready.append(flow)  # its slice is over: the other flows go first
-            if count_flows:
+            if ran is not None:
                 flow.steps += done
                 ran.append(flow)
             hot[flow.activity] = hot.get(flow.activity, 0) + done
@@ -714,11 +716,12 @@ class ProgramController:
             commands = self._halted()
             self._refresh_due()
             return commands
-        for flow in ran:
-            flow.steps = 0
+        if ran is not None:
+            for flow in ran:
+                flow.steps = 0
         sleeping = self._sleeping
         busy = len(ready) + len(parked) + len(sleeping)
-        if busy != self._busy or self.state is None:
+        if busy != self._busy:  # (-1 until the first pass sets the state)
             self._busy = busy
             self.state = f"{busy} flow{'s' if busy != 1 else ''}"
         commands, self.commands = self.commands, []
@@ -737,15 +740,14 @@ class ProgramController:
 
     # -- one activity ----------------------------------------------------------------------
     def _prepare(self, act) -> Step:
-        """The step that runs ``act``: the handler of its kind (:data:`RUNS`; a kind named in
-        a mapping file, through :data:`MAPPED_RUNS`), or, for the kinds most programs run at
-        every report (:data:`PREPARED`), the same handler with the activity's links, constant
-        and compiled expressions looked up once, here, instead of at every step."""
+        """The step that runs ``act``: for the kinds most programs run at every report
+        (:data:`PREPARED`), made here with the activity's links, constant and compiled
+        expressions looked up once instead of at every step; else the handler of its kind
+        (:data:`RUNS`; a kind named in a mapping file, through :data:`MAPPED_RUNS`)."""
+        prepare = PREPARED.get(act.kind) if act.kind not in self.program.kinds else None
+        if prepare is not None:
+            return prepare(self, act)
         handler, _ = self._handlers[act.id]
-        prepare = PREPARED.get(handler)
-        step = prepare(self, act) if prepare is not None else None
-        if step is not None:
-            return step
 
         def run(flow: Flow) -> bool:
             return handler(self, flow, act)
@@ -807,28 +809,29 @@ class ProgramController:
     def _fusable(self, act) -> Fusable | None:
         """What a chain needs to run ``act`` as its prepared step runs it (None: a chain
         cannot hold it; it runs by its own step)."""
-        handler, _ = self._handlers[act.id]
+        kind = act.kind
         pins = self._outputs.get(act.id, {})
         exprs = self._parsed.get(act.id, ())
-        if handler is ProgramController._pass_on:
+        handler, _ = self._handlers[act.id]
+        if kind in _PASS_ON or handler is ProgramController._pass_on:
             return Fusable("pass", (), pins)
-        if handler is ProgramController._data and act.id in self.compiled.constants:
+        if kind == K.DATA and act.id in self.compiled.constants:
             return Fusable("data", (self.compiled.constants[act.id],), pins)
-        if handler is ProgramController._variable:
+        if kind == K.VARIABLE:
             key = self._var_keys[act.id]
             if key in self.compiled.globals:
                 return Fusable("variable", (key, self.compiled.globals[key][1]), pins)
-        if handler is ProgramController._calculate and exprs:
+        if kind == K.CALCULATE and exprs:
             return Fusable("calculate", (exprs[0],), pins)
-        if handler is ProgramController._if and exprs and len(exprs) == len(act.values):
+        if kind == K.IF and exprs and len(exprs) == len(act.values):
             return Fusable("if", exprs, pins)
-        if handler is ProgramController._timer:
+        if kind == K.TIMER:
             return Fusable("timer", (), pins)
-        if handler is ProgramController._drive and len(exprs) >= 2:
+        if kind == K.DRIVE and len(exprs) >= 2:
             return Fusable("drive", exprs[:2], pins)
-        if handler is ProgramController._print_line:
+        if kind == K.PRINT_LINE:
             return Fusable("print", (), pins)
-        if handler is ProgramController._code:
+        if kind == K.CODE:
             return Fusable("code", (), pins)
         return None
 
@@ -863,17 +866,17 @@ class ProgramController:
         send = self._sender(act.id, 0)
         return lambda flow: send(flow, flow.value)
 
-    def _prepare_data(self, act) -> Step | None:
+    def _prepare_data(self, act) -> Step:
         if act.id not in self.compiled.constants:
-            return None
+            return _uncompiled("its value")
         send = self._sender(act.id, 0)
         constant = self.compiled.constants[act.id]
         return lambda flow: send(flow, constant)
 
-    def _prepare_variable(self, act) -> Step | None:
+    def _prepare_variable(self, act) -> Step:
         key = self._var_keys[act.id]
         if key not in self.compiled.globals:
-            return None
+            return _uncompiled("its variable")
         vtype = self.compiled.globals[key][1]
         send = self._sender(act.id, 0)
 
@@ -885,10 +888,10 @@ class ProgramController:
 
         return run
 
-    def _prepare_if(self, act) -> Step | None:
+    def _prepare_if(self, act) -> Step:
         exprs = self._exprs.get(act.id)
         if exprs is None or len(exprs) != len(act.values):
-            return None
+            return _uncompiled("its conditions")
         branches = tuple(
             (index, condition, self._sender(act.id, index)) for index, condition in enumerate(exprs)
         )
@@ -919,10 +922,10 @@ class ProgramController:
 
         return run
 
-    def _prepare_drive(self, act) -> Step | None:
+    def _prepare_drive(self, act) -> Step:
         exprs = self._exprs.get(act.id)
         if exprs is None or len(exprs) < 2:
-            return None
+            return _uncompiled("its wheel powers")
         left_power, right_power = exprs[0], exprs[1]
         send = self._sender(act.id, 0)
         scope = self._scope
@@ -973,29 +976,8 @@ class ProgramController:
     def _never(self, flow: Flow, act) -> bool:
         return False  # a Comment, the Robot, a service mapped to "ignore": never run
 
-    def _data(self, flow: Flow, act) -> bool:
-        return self._go(flow, 0, self.compiled.constants[act.id])
-
     def _calculate(self, flow: Flow, act) -> bool:
         return self._go(flow, 0, self._expr(act.id, 0)(self._scope(flow)))
-
-    def _variable(self, flow: Flow, act) -> bool:
-        key = self._var_keys[act.id]
-        stored = convert(flow.value, self.compiled.globals[key][1])
-        self.globals[key] = stored
-        self.changes += 1
-        return self._go(flow, 0, stored)
-
-    def _if(self, flow: Flow, act) -> bool:
-        scope = self._scope(flow)
-        exprs = self._exprs.get(act.id)
-        if exprs is None or len(exprs) != len(act.values):
-            expr = self.compiled.expr
-            exprs = tuple(expr(act.id, index).run for index in range(len(act.values)))
-        for index, condition in enumerate(exprs):
-            if _truth(condition(scope), index):
-                return self._go(flow, index, flow.value)
-        return self._go(flow, ELSE, flow.value)
 
     def _switch(self, flow: Flow, act) -> bool:
         scope = self._scope(flow)
@@ -1031,22 +1013,8 @@ class ProgramController:
             flow.loops.pop(loop, None)
         return self._go(flow, 0, flow.value, self.program.loop_end[loop])
 
-    def _timer(self, flow: Flow, act) -> bool:
-        value = flow.value
-        _check_timer(value)
-        if not self._go(flow, 0, value):
-            return False  # nothing waits for the Timer
-        raise _Sleep(max(0.0, float(value)) / 1000.0)
-
     def _print_line(self, flow: Flow, act) -> bool:
         self._print(show(flow.value))
-        return self._go(flow, 0, flow.value)
-
-    def _drive(self, flow: Flow, act) -> bool:
-        scope = self._scope(flow)
-        left = _power(self._expr(act.id, 0)(scope), "left")
-        right = _power(self._expr(act.id, 1)(scope), "right")
-        self._command(WheelPowers(left, right))
         return self._go(flow, 0, flow.value)
 
     def _output_pin(self, flow: Flow, act) -> bool:
@@ -1216,19 +1184,13 @@ class ProgramController:
 
 #: activity kind -> its handler (a flow at the activity: does the flow go on?)
 RUNS: dict[int, Callable[[ProgramController, Flow, Any], bool]] = {
-    **dict.fromkeys(_PASS_ON, ProgramController._pass_on),
-    K.DATA: ProgramController._data,
     K.CALCULATE: ProgramController._calculate,
-    K.VARIABLE: ProgramController._variable,
-    K.IF: ProgramController._if,
     K.SWITCH: ProgramController._switch,
     K.WHILE: ProgramController._while,
     K.END_WHILE: ProgramController._end_while,
     K.BREAK: ProgramController._break,
     K.JOIN: ProgramController._join,
-    K.TIMER: ProgramController._timer,
     K.PRINT_LINE: ProgramController._print_line,
-    K.DRIVE: ProgramController._drive,
     K.BLOCK: ProgramController._call,
     K.OUTPUT_PIN: ProgramController._output_pin,
     K.EVENT_PIN: ProgramController._event_pin,
@@ -1245,18 +1207,15 @@ MAPPED_RUNS: dict[str, Callable[[ProgramController, Flow, Any], bool]] = {
     "custom-event": ProgramController._pass_on,
     "ignore": ProgramController._never,
 }
-#: the handlers whose steps are made once for each activity (see ProgramController._prepare):
-#: handler -> what makes the step (None: the activity runs through its handler)
-PREPARED: dict[
-    Callable[[ProgramController, Flow, Any], bool],
-    Callable[[ProgramController, Any], Step | None],
-] = {
-    ProgramController._pass_on: ProgramController._prepare_pass_on,
-    ProgramController._data: ProgramController._prepare_data,
-    ProgramController._variable: ProgramController._prepare_variable,
-    ProgramController._if: ProgramController._prepare_if,
-    ProgramController._timer: ProgramController._prepare_timer,
-    ProgramController._drive: ProgramController._prepare_drive,
+#: the kinds whose steps are made once for each activity (see ProgramController._prepare),
+#: the kinds most programs run at every report: kind -> what makes the step
+PREPARED: dict[int, Callable[[ProgramController, Any], Step]] = {
+    **dict.fromkeys(_PASS_ON, ProgramController._prepare_pass_on),
+    K.DATA: ProgramController._prepare_data,
+    K.VARIABLE: ProgramController._prepare_variable,
+    K.IF: ProgramController._prepare_if,
+    K.TIMER: ProgramController._prepare_timer,
+    K.DRIVE: ProgramController._prepare_drive,
 }
 #: the handler of a kind no table names (the loader refuses such a kind: it never runs)
 _NEVER_RUNS = ProgramController._never
@@ -1309,6 +1268,16 @@ def _port(ports: dict[str, int], name: str) -> int:
     """The port of a reading named ``port N`` (kept in ``ports`` for the next report)."""
     port = ports[name] = int(name.split()[-1])
     return port
+
+
+def _uncompiled(what: str) -> Step:
+    """The step of an activity whose compiled parts are missing (a program made without
+    ``compile_program``, which refuses one): an error when it runs."""
+
+    def run(flow: Flow) -> bool:
+        raise ExprError(f"{what} did not compile")
+
+    return run
 
 
 def _single(aid: int, step: Step) -> Chain:
