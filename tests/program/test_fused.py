@@ -7,6 +7,8 @@ from __future__ import annotations
 import time
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from tests.program import hostile
 from tests.program.builder import ProgramBuilder
@@ -223,3 +225,57 @@ def test_the_shipped_programs_agree_on_the_web_maze_readings(name):
     path = Path(__file__).resolve().parents[2] / "programs" / name
     got = both_ways(path, 120.0, wobbling)
     assert got[6] > 500
+
+
+#: parts of the conditions the fuzz test writes: every kind of part a chain writes out as code
+#: (value, state.X, literals of each type, comparisons, &&, ||, !) and some it runs by their
+#: functions (arithmetic, calls, iif)
+_LEAVES = st.sampled_from(
+    ["value", "state.n", "state.word", "state.flag", "3", "2.5", '"fwd"', "true", "false",
+     "null", "value + 1", "Math.Abs(value)", "iif(state.flag, 1, 2)"]
+)  # fmt: skip
+_COMPARE = st.sampled_from(["==", "=", "!=", "<>", "<", "<=", ">", ">="])
+
+
+def _conditions(leaf: st.SearchStrategy[str]) -> st.SearchStrategy[str]:
+    compared = st.tuples(leaf, _COMPARE, leaf).map(" ".join)
+    return st.recursive(
+        st.one_of(compared, leaf),
+        lambda inner: st.one_of(
+            st.tuples(inner, st.sampled_from(["&&", "||", "and", "or"]), inner).map(
+                lambda t: f"({t[0]}) {t[1]} ({t[2]})"
+            ),
+            inner.map(lambda c: f"!({c})"),
+        ),
+        max_leaves=8,
+    )
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.lists(_conditions(_LEAVES), min_size=1, max_size=3),
+    st.lists(
+        st.one_of(st.integers(-5, 90), st.sampled_from(["fwd", "12", "x", True])),
+        min_size=4,
+        max_size=4,
+    ),
+)
+def test_any_condition_runs_the_same_fused_errors_included(tmp_path_factory, conditions, values):
+    """Whatever an If's conditions are and whatever the sensor reports, the chain's code for
+    them gives the same branches, and the same errors at the same times, as the conditions'
+    functions."""
+    b = ProgramBuilder()
+    b.var("n", "System.Int32")
+    b.var("word", "System.String")
+    b.var("flag", "System.Boolean")
+    m = b.panel("Main")
+    b.robot(m)
+    m.chain(m.add(3, '"fwd"'), m.add(1, "word"))
+    sensor = m.add(25, ROBOT, "1")
+    cond = m.add(6, *conditions)
+    b.link(sensor, cond)
+    for pin in (*range(len(conditions)), ELSE):
+        b.link(cond, m.add(28, ""), pin=pin)
+    b.link(sensor, m.add(1, "n"))
+    path = b.write(tmp_path_factory.mktemp("fuzz") / "p.viple")
+    both_ways(path, 1.1, lambda t: {1: values[int(t * 4) % 4]})

@@ -170,6 +170,14 @@ class Flow:
     wait: float = 0.0
 
 
+def _state(busy: int) -> str:
+    """What a program's state says: how many flows it has."""
+    return f"{busy} flow{'s' if busy != 1 else ''}"
+
+
+#: the states of the fewest flows, made once (the state changes whenever a flow starts or ends)
+_STATES = tuple(_state(n) for n in range(100))
+
 #: the frame of a flow that ended (see ProgramController._spawn)
 _NO_FRAME = Frame("", {})
 
@@ -375,8 +383,8 @@ class ProgramController:
             self._parked = []
         if self._pushed or self._next_key < len(self.key_script) or self._typed.held:
             self._keys(t)
-        if (readings or report is not None) and (
-            t + _SAME >= self._next_report if self._paced else self._report_due(t)
+        if (t + _SAME >= self._next_report if self._paced else self._report_due(t)) and (
+            readings or report is not None
         ):
             # a tick between two reports (of a remote robot, or of the paced simulator) fires
             # no sensor; the next paced report is on the same grid after t (a late tick skips
@@ -657,14 +665,13 @@ class ProgramController:
             budget = limits.tick
         hot = self._hot
         chains = self._chains
-        count_flows = self._count_flows
         parked = self._parked
         spare = self._spare
         #: the flows that took steps in this pass, when their count matters (it restarts)
-        ran: list[Flow] | None = [] if count_flows else None
+        ran: list[Flow] | None = [] if self._count_flows else None
         while ready and total < budget and self.stopped is None:
             flow = ready.popleft()
-            if count_flows and flow.steps >= FLOW_TICK_STEPS:
+            if ran is not None and flow.steps >= FLOW_TICK_STEPS:
                 parked.append(flow)
                 continue
             # one slice: the chains from the flow's activity on, SLICE activities at most;
@@ -707,12 +714,14 @@ class ProgramController:
         if total:
             self._second_steps += total
             window.append((now, total))
-        if self.stopped is None and (ready or parked or self._join_parts):
+        stopped = self.stopped
+        if stopped is None and (ready or parked or self._join_parts):
             if (ready or parked) and self._second_steps >= limits.second:
                 self._over_work()
             else:
                 self._check_memory()
-        if self.stopped is not None:
+            stopped = self.stopped
+        if stopped is not None:
             commands = self._halted()
             self._refresh_due()
             return commands
@@ -723,7 +732,7 @@ class ProgramController:
         busy = len(ready) + len(parked) + len(sleeping)
         if busy != self._busy:  # (-1 until the first pass sets the state)
             self._busy = busy
-            self.state = f"{busy} flow{'s' if busy != 1 else ''}"
+            self.state = _STATES[busy] if busy < len(_STATES) else _state(busy)
         commands, self.commands = self.commands, []
         # _refresh_due, written out (it runs after every tick that runs anything)
         due = self._next_report
