@@ -128,6 +128,10 @@ class _Writer:
         self.src = _Source()
         self.size = 0
         self.temps = 0
+        #: the locals that hold true or false for certain (a comparison's, a ``!``'s, an
+        #: ``&&``'s or ``||``'s value, whose functions give nothing else or raise): their
+        #: checks of true and false are left out
+        self.bools: set[str] = set()
         #: activities a chain stopped at for a reason of its own (they may head chains)
         self.stops: list[int] = []
 
@@ -257,16 +261,23 @@ class _Writer:
             src.put(depth + 1, f"{out} = through({fn}, v, G, frame)")
         elif kind == "compare":
             self._compare(node, out, depth, level)
+            self.bools.add(out)
         elif kind == "either":
             self._either(node, out, depth, level)
+            self.bools.add(out)
         elif kind == "not":
             inner = self.part(node.args[0], depth, level + 1)
-            src.put(depth, f"if {inner} is True:")
-            src.put(depth + 1, f"{out} = False")
-            src.put(depth, f"elif {inner} is False:")
-            src.put(depth + 1, f"{out} = True")
-            src.put(depth, "else:")
-            src.put(depth + 1, f"{out} = not want_bool({inner}, {src.cell(node.data[0])}, '!')")
+            if inner in self.bools:
+                src.put(depth, f"{out} = not {inner}")
+            else:
+                src.put(depth, f"if {inner} is True:")
+                src.put(depth + 1, f"{out} = False")
+                src.put(depth, f"elif {inner} is False:")
+                src.put(depth + 1, f"{out} = True")
+                src.put(depth, "else:")
+                where = f"{src.cell(node.data[0])}, '!'"
+                src.put(depth + 1, f"{out} = not want_bool({inner}, {where})")
+            self.bools.add(out)
         else:
             src.put(depth, f"{out} = through({fn}, v, G, frame)")
         return out
@@ -301,12 +312,22 @@ class _Writer:
         left, right = node.args
         where = f"{src.cell(col)}, {src.cell(op)}"
         x = self.part(left, depth, level + 1)
-        src.put(depth, f"if {x} is {not decides}:")
+        known = x in self.bools
+        src.put(
+            depth, f"if {'not ' if decides else ''}{x}:" if known else f"if {x} is {not decides}:"
+        )
         y = self.part(right, depth + 1, level + 1)
-        src.put(depth + 1, f"if {y} is True or {y} is False:")
-        src.put(depth + 2, f"{out} = {y}")
-        src.put(depth + 1, "else:")
-        src.put(depth + 2, f"{out} = want_bool({y}, {where})")
+        if y in self.bools:
+            src.put(depth + 1, f"{out} = {y}")
+        else:
+            src.put(depth + 1, f"if {y} is True or {y} is False:")
+            src.put(depth + 2, f"{out} = {y}")
+            src.put(depth + 1, "else:")
+            src.put(depth + 2, f"{out} = want_bool({y}, {where})")
+        if known:
+            src.put(depth, "else:")
+            src.put(depth + 1, f"{out} = {decides}")
+            return
         src.put(depth, f"elif {x} is {decides}:")
         src.put(depth + 1, f"{out} = {decides}")
         src.put(depth, "else:")
@@ -323,7 +344,12 @@ class _Writer:
     def _if(self, spec: Fusable, ran: int, depth: int, nest: int, path: frozenset[int]) -> None:
         src = self.src
         for index, condition in enumerate(spec.values):
-            src.put(depth, f"t = {self.expr(condition, depth)}")
+            truth = self.expr(condition, depth)
+            if truth in self.bools:  # true or false for certain: no check
+                src.put(depth, f"if {truth}:")
+                self.send(spec, index, ran, depth + 1, nest + 1, path)
+                continue
+            src.put(depth, f"t = {truth}")
             src.put(depth, "if t is True:")
             self.send(spec, index, ran, depth + 1, nest + 1, path)
             src.put(depth, "if t is not False:")
