@@ -7,11 +7,10 @@ from pathlib import Path
 import pytest
 
 from tests.program.builder import ProgramBuilder
-from tests.program.ticking import TICK, run
-from workbench.program import interp
+from tests.program.ticking import TICK, run, seen
 from workbench.program import kinds as K
 from workbench.program.compiled import compile_program
-from workbench.program.interp import MAPPED_RUNS, RUNS, SENSES, ProgramController
+from workbench.program.interp import MAPPED_RUNS, PREPARED, RUNS, SENSES, ProgramController
 from workbench.program.keys import KeyScriptError, parse_key_script
 from workbench.program.kinds import parse_kind_map
 from workbench.program.loader import load_program
@@ -223,7 +222,7 @@ def test_each_mapped_service_sends_its_command_and_passes_the_message_on(tmp_pat
 
 
 def test_every_activity_kind_a_program_may_hold_has_a_handler():
-    assert set(RUNS) == set(K.KNOWN)
+    assert set(RUNS) | set(PREPARED) == set(K.KNOWN) and not set(RUNS) & set(PREPARED)
     assert set(MAPPED_RUNS) == set(K.MAPPABLE)
     assert set(SENSES) == {K.TOUCH, K.DISTANCE, K.OTHER_SENSOR, K.RAW_SENSOR}
 
@@ -385,34 +384,17 @@ def test_a_tick_with_nothing_due_does_nothing_and_the_report_and_the_timer_ticks
     assert c.next_due() == 0.5
 
 
-def _run_both_ways(monkeypatch, make, seconds, readings):
-    """The run of a program with its activities' steps prepared, and through the handlers
-    only: everything a user sees of it."""
-    seen = []
-    for prepared in (interp.PREPARED, {}):
-        with monkeypatch.context() as patch:
-            patch.setattr(interp, "PREPARED", prepared)
-            c = make()
-        commands = run(c, seconds, readings)
-        seen.append(
-            (
-                commands,
-                [(p.time, p.text) for p in c.printed],
-                c.fired,
-                [str(e) for e in c.errors],
-                str(c.stopped),
-                c.variables,
-                c.steps,
-                c.changes,
-                c.state,
-                c.running(),
-                c.next_due(),
-            )
-        )
-    return seen
+def _run_both_ways(make, seconds, readings):
+    """The run of a program with its chains of activities fused (fused.py), and with every
+    activity run by its own step: everything a user sees of it, each way."""
+    out = []
+    for fuse in (True, False):
+        c = make(fuse)
+        out.append(seen(c, run(c, seconds, readings)))
+    return out
 
 
-def test_prepared_steps_run_as_the_handlers_do_errors_included(tmp_path, monkeypatch):
+def test_fused_chains_run_as_the_steps_do_errors_included(tmp_path):
     b = ProgramBuilder()
     b.var("n", "System.Int32")
     b.var("word", "System.String")
@@ -458,31 +440,33 @@ def test_prepared_steps_run_as_the_handlers_do_errors_included(tmp_path, monkeyp
     main.chain(ten, tick, pause, same, tick)
     path = b.write(tmp_path / "p.viple")
 
-    def make() -> ProgramController:
-        return ProgramController(compile_program(load_program(path)), report_period=0.25)
+    def make(fuse: bool) -> ProgramController:
+        compiled = compile_program(load_program(path))
+        return ProgramController(compiled, report_period=0.25, fuse=fuse)
 
     def readings(t: float) -> dict[int, float]:
         return {1: (t * 37) % 90, 2: int(t * 3) % 2}
 
-    prepared, handlers = _run_both_ways(monkeypatch, make, 6.0, readings)
-    assert prepared == handlers
-    errors = prepared[3]
+    fused, steps = _run_both_ways(make, 6.0, readings)
+    assert fused == steps
+    errors = steps[3]
     assert any("the Timer needs a number of milliseconds, not String" in e for e in errors)
     assert any("condition 2 gave Double, not true or false" in e for e in errors)
     assert any("the left power must be a number, not String" in e for e in errors)
     assert any("'fast' is not a number for a Int32" in e for e in errors)
-    assert prepared[6] > 400  # the 10 ms loop ran at every tick
+    assert steps[6] > 400  # the 10 ms loop ran at every tick
 
 
 @pytest.mark.parametrize("name", ["web-wall-following.viple", "right-wall.viple"])
-def test_the_shipped_programs_run_the_same_with_prepared_steps(monkeypatch, name):
+def test_the_shipped_programs_run_the_same_fused(name):
     path = str(Path(__file__).resolve().parents[2] / "programs" / name)
 
-    def make() -> ProgramController:
-        return ProgramController(compile_program(load_program(path)), report_period=0.25)
+    def make(fuse: bool) -> ProgramController:
+        compiled = compile_program(load_program(path))
+        return ProgramController(compiled, report_period=0.25, fuse=fuse)
 
     def readings(t: float) -> dict[int, float]:
         return {1: 10 + (t * 53) % 90, 2: int(t * 0.7) % 2}
 
-    prepared, handlers = _run_both_ways(monkeypatch, make, 60.0, readings)
-    assert prepared == handlers and prepared[6] > 500
+    fused, steps = _run_both_ways(make, 60.0, readings)
+    assert fused == steps and steps[6] > 500

@@ -21,3 +21,20 @@ def run(c: ProgramController, seconds: float, readings: Readings | None = None) 
         r = readings(i * TICK) if callable(readings) else (readings or {})
         commands += c.tick(i * TICK, {f"port {p}": v for p, v in r.items()}, frozenset())
     return commands
+
+
+def seen(c: ProgramController, commands: list) -> tuple:
+    """Everything a user sees of a run of ``c`` that gave ``commands``."""
+    return (
+        commands,
+        [(p.time, p.text) for p in c.printed],
+        c.fired,
+        [str(e) for e in c.errors],
+        str(c.stopped),
+        c.variables,
+        c.steps,
+        c.changes,
+        c.state,
+        c.running(),
+        c.next_due(),
+    )

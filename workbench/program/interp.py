@@ -24,6 +24,7 @@ when, at which activity and why, the robot is told to stop, and nothing of it ru
 
 from __future__ import annotations
 
+import functools
 import itertools
 import json
 import math
@@ -38,6 +39,7 @@ from workbench.sim.commands import MotorPower, MoveAtPower, Stop, TurnByDegrees,
 from . import kinds as K
 from .code import first_sensor_value
 from .compiled import DEFAULTS, Compiled
+from .fused import COUNT, ENDED, PARKS, SLEEPS, Chain, Fusable, fuse
 from .keys import KeyEvent, TypedKeys
 from .model import ELSE
 from .readings import pressed, sensor_message, touch_problem
@@ -52,6 +54,7 @@ from .viple_expr import (
     parts_of,
     show,
     type_name,
+    want_bool,
 )
 
 SLICE = 50
@@ -161,7 +164,22 @@ class Flow:
     #: (None until the flow meets a While: most flows never do, and a flow starts with every
     #: sensor report)
     loops: dict[int, tuple[int, Any]] | None = None
+    #: the activities a chain ran when one of them raised (see fused.py)
+    ran: int = 0
+    #: the seconds a Timer's chain puts the flow to sleep for
+    wait: float = 0.0
 
+
+def _state(busy: int) -> str:
+    """What a program's state says: how many flows it has."""
+    return f"{busy} flow{'s' if busy != 1 else ''}"
+
+
+#: the states of the fewest flows, made once (the state changes whenever a flow starts or ends)
+_STATES = tuple(_state(n) for n in range(100))
+
+#: the frame of a flow that ended (see ProgramController._spawn)
+_NO_FRAME = Frame("", {})
 
 #: one activity made ready to run: a flow at it -> does the flow go on?
 Step = Callable[[Flow], bool]
@@ -187,7 +205,10 @@ class ProgramController:
         keys: tuple[KeyEvent, ...] = (),
         report_period: float | None = None,
         limits: Limits = Limits(),
+        fuse: bool = True,
     ) -> None:
+        """``fuse``: run the program's chains of activities fused (fused.py), else every
+        activity by its own step (the same run, slower: the tests compare the two)."""
         self.compiled = compiled
         self.program = compiled.program
         self.key_script = keys
@@ -198,6 +219,7 @@ class ProgramController:
         self.report_period = report_period
         #: whether sensor reports come at their own pace (else with every tick's readings)
         self._paced = report_period is not None
+        self._period = report_period if report_period is not None else 0.0
         self._reads = bool(compiled.sensors)
         #: each activity's output pins and their links (Program.targets, without the call)
         self._outputs = compiled.program.outputs
@@ -222,11 +244,13 @@ class ProgramController:
         exprs: dict[int, list[Any]] = {}
         for (aid, index), expression in sorted(compiled.expressions.items()):
             exprs.setdefault(aid, []).append((index, expression))
-        self._exprs = {
-            aid: tuple(e.run for _, e in pairs)
+        #: the same, parsed (what a fused chain writes out as code)
+        self._parsed = {
+            aid: tuple(e for _, e in pairs)
             for aid, pairs in exprs.items()
             if [i for i, _ in pairs] == list(range(len(pairs)))
         }
+        self._exprs = {aid: tuple(e.run for e in parsed) for aid, parsed in self._parsed.items()}
         #: a sensor or event activity's id -> its panel and the links out of it
         self._fires = {
             aid: (act.panel, compiled.program.targets(aid))
@@ -241,6 +265,15 @@ class ProgramController:
         self._the_scope = Scope()
         #: activity id -> the step that runs it (see _prepare)
         self._steps = {aid: self._prepare(act) for aid, act in self._activities.items()}
+        #: activity id -> the chain a flow at it runs (see fused.py): fused from the activity
+        #: on where it heads a chain, else its step alone
+        self._chains = {aid: _single(aid, step) for aid, step in self._steps.items()}
+        if fuse:
+            self._chains.update(self._fuse())
+        #: whether a flow may run FLOW_TICK_STEPS activities in one tick (a tick's budget
+        #: under that never lets one: every flow has run fewer than the tick's total)
+        self._count_flows = limits.tick > FLOW_TICK_STEPS
+        self.next_due = functools.partial(getattr, self, "_due_or_none")
         self.reset()
 
     # -- the Controller protocol ----------------------------------------------------------
@@ -262,6 +295,8 @@ class ProgramController:
         self.now = 0.0
         self._numbers = itertools.count()
         self._ready: deque[Flow] = deque()
+        #: flows that ended, to be made new flows (see _spawn)
+        self._spare: list[Flow] = []
         self._parked: list[Flow] = []
         self._sleeping: list[tuple[float, int, Flow]] = []
         #: the Joins of Main and of events inside panels (a block call keeps its own)
@@ -278,6 +313,9 @@ class ProgramController:
         self._report: str | None = None
         #: a reading's name ("port 3") -> its port
         self._ports: dict[str, int] = {}
+        #: the names of the last report's readings and what the sensor activities do with
+        #: them (see _plan_for)
+        self._plan: tuple[set[str], list[Callable]] | None = None
         self._next_report = _NEVER
         #: the earliest of the times above and the sleeping flows' (what next_due says; kept
         #: up to date at the end of every tick that did something, the only place they change)
@@ -316,9 +354,7 @@ class ProgramController:
             act = program.activities[aid]
             if act.kind in _STARTS and aid not in program.inputs:
                 self._spawn(aid, None, main)
-        commands = self._run()
-        self._refresh_due()
-        return commands
+        return self._run()
 
     def tick(
         self,
@@ -330,12 +366,13 @@ class ProgramController:
         """One control tick; ``readings`` ("port N" -> value) fire the sensor activities, and
         ``report``, a robot's report as it arrived, is what a raw sensor gets (None: the
         simulated robot's report is made from the readings)."""
-        self.now = t
         if t + _SAME < self._quiet_until and (self._paced or (not readings and report is None)):
             # nothing is due: no Timer ends, no key or sensor report comes and no flow waits to
             # run, so this tick would change nothing (most ticks of a program: its sensors
-            # report every 250 ms, the session ticks it every 50 ms)
+            # report every 250 ms, the session ticks it every 50 ms); ``now`` is only read
+            # while the program runs, so it is set below
             return []
+        self.now = t
         if self.stopped is not None:
             return []
         sleeping = self._sleeping
@@ -346,24 +383,33 @@ class ProgramController:
             self._parked = []
         if self._pushed or self._next_key < len(self.key_script) or self._typed.held:
             self._keys(t)
-        if (
-            (readings or report is not None)
-            and (self.report_period is None or t + _SAME >= self._next_report)
-            and self._report_due(t)
+        if (t + _SAME >= self._next_report if self._paced else self._report_due(t)) and (
+            readings or report is not None
         ):
             # a tick between two reports (of a remote robot, or of the paced simulator) fires
-            # no sensor
-            ports = self._ports
-            self._sensors({ports.get(n) or _port(ports, n): v for n, v in readings.items()}, report)
-        commands = self._run()
-        self._refresh_due()
-        return commands
+            # no sensor; the next paced report is on the same grid after t (a late tick skips
+            # the missed ones; as _report_due)
+            if self._paced:
+                start = self._next_report
+                period = self._period
+                self._next_report = start + period * (1 + int((t + _SAME - start) // period))
+            plan = self._plan
+            if report is not None or plan is None or readings.keys() != plan[0]:
+                plan = self._plan = self._plan_for(readings) if report is None else None
+            if plan is not None:
+                for sense in plan[1]:
+                    sense(readings)
+            else:
+                ports = self._ports
+                by_port = {ports.get(n) or _port(ports, n): v for n, v in readings.items()}
+                self._sensors(by_port, report)
+        return self._run()
 
-    def next_due(self) -> float | None:
-        """When the program next has something to do at a time of its own: a Timer ends, a
-        scripted key is pressed or a sensor report is due (None: nothing is)."""
-        due = self._due
-        return None if due == _NEVER else due
+    #: ``next_due()``: when the program next has something to do at a time of its own: a
+    #: Timer ends, a scripted key is pressed or a sensor report is due (None: nothing is).
+    #: The session asks after every tick, so it is a getter of ``_due_or_none`` made in C
+    #: (set in __init__), not a method.
+    next_due: Callable[[], float | None]
 
     def _refresh_due(self) -> None:
         """Work out :meth:`next_due` again, after the flows, keys or reports changed, and until
@@ -377,6 +423,7 @@ class ProgramController:
         if self._next_key < len(script) and script[self._next_key].time < due:
             due = script[self._next_key].time
         self._due = due
+        self._due_or_none = None if due == _NEVER else due
         quiet = not (self._ready or self._parked or self._pushed or self._typed.held)
         self._quiet_until = due if quiet and self.state is not None else -_NEVER
 
@@ -445,6 +492,77 @@ class ProgramController:
         self._report = report
         for sense, aid, port in self._senses:
             sense(self, aid, port, readings)
+
+    def _plan_for(self, named: dict[str, Value]) -> tuple[set[str], list[Callable]] | None:
+        """How a report of readings with these names reaches the sensor activities without
+        making the readings by port first (what ``_sensors`` is given): for each sensor
+        activity in file order, what it does with the reading of the one name of its port.
+        None where that is not the same: a raw sensor (it reads every port), a name that is
+        not ``port N``, two names of one port."""
+        ports: dict[int, str] = {}
+        for name in named:
+            try:
+                port = int(name.split()[-1])
+            except (ValueError, IndexError):
+                return None
+            if port in ports:
+                return None
+            ports[port] = name
+        plan = []
+        for sense, aid, port in self._senses:
+            if sense is ProgramController._sense_raw:
+                return None
+            reading = ports.get(port)
+            if reading is None:
+                continue  # the report has no reading of its port: the activity does nothing
+            if sense is ProgramController._sense_touch:
+                plan.append(self._touch_plan(aid, port, reading))
+            else:
+                plan.append(self._value_plan(aid, reading))
+        return set(named), plan
+
+    def _value_plan(self, aid: int, name: str) -> Callable[[dict[str, Value]], None]:
+        """``_sense_value`` for the reading ``name``, its flows started as ``_fire`` starts
+        them."""
+        panel, links = self._fires[aid]
+        if panel != "Main" or len(links) != 1:
+
+            def fire_all(named: dict[str, Value]) -> None:
+                self._fire(aid, sensor_message(named[name]))
+
+            return fire_all
+        target, in_pin = links[0].target, links[0].in_pin
+        spawn = self._spawn
+
+        def fire_one(named: dict[str, Value]) -> None:
+            value = named[name]
+            if isinstance(value, str):
+                value = sensor_message(value)
+            spawn(target, value, self._main, in_pin)
+
+        return fire_one
+
+    def _touch_plan(self, aid: int, port: int, name: str) -> Callable[[dict[str, Value]], None]:
+        """``_sense_touch`` for the reading ``name``."""
+        by_port = {}
+
+        def touch(named: dict[str, Value]) -> None:
+            value = named[name]
+            kind = type(value)
+            if kind is int or kind is float:
+                # as _sense_touch: the state kept is 1 while pressed (an activity never
+                # pressed has none, which reads as 0)
+                if value != 0:
+                    if not self._touch.get(aid, 0):
+                        self._touch[aid] = 1
+                        self._fire(aid, 1, f"touch {port}")
+                elif self._touch.get(aid, 0):
+                    self._touch[aid] = 0
+            else:
+                by_port[port] = value
+                self._sense_touch(aid, port, by_port)
+
+        return touch
 
     def _sense_raw(self, aid: int, port: int, readings: dict[int, Value]) -> None:
         if self._report is None:  # the simulated robot: a report made from its readings
@@ -518,11 +636,21 @@ class ProgramController:
                 self._error(aid, f"more than {MAX_FLOWS:,} flows at once: new messages dropped")
             return
         self.changes += 1
-        self._ready.append(Flow(next(self._numbers), aid, value, frame, in_pin))
+        spare = self._spare
+        if spare:  # a flow that ended, made a new one (nothing holds an ended flow)
+            flow = spare.pop()
+            flow.number, flow.activity, flow.value = next(self._numbers), aid, value
+            flow.frame, flow.in_pin, flow.steps = frame, in_pin, 0
+            self._ready.append(flow)
+        else:
+            self._ready.append(Flow(next(self._numbers), aid, value, frame, in_pin))
 
     def _run(self) -> list[Any]:
+        """Run the ready flows (their slices in turn, within the tick's budget); then work
+        out what is due next (``_refresh_due``, written out at the end)."""
         ready = self._ready
         if not ready and self.state is not None:
+            self._refresh_due()
             return []  # nothing ran, so nothing changed since the last pass
         now = self.now
         limits = self.limits
@@ -532,85 +660,189 @@ class ProgramController:
         if not window and self._hot:
             self._hot = {}
         total = 0
-        budget = min(limits.tick, limits.second - self._second_steps)
+        budget = limits.second - self._second_steps
+        if limits.tick < budget:
+            budget = limits.tick
         hot = self._hot
-        steps = self._steps
-        ran: list[Flow] = []  # the flows that took steps in this pass (their count restarts)
+        chains = self._chains
+        parked = self._parked
+        spare = self._spare
+        #: the flows that took steps in this pass, when their count matters (it restarts)
+        ran: list[Flow] | None = [] if self._count_flows else None
         while ready and total < budget and self.stopped is None:
             flow = ready.popleft()
-            if flow.steps >= FLOW_TICK_STEPS:
-                self._parked.append(flow)
+            if ran is not None and flow.steps >= FLOW_TICK_STEPS:
+                parked.append(flow)
                 continue
+            # one slice: the chains from the flow's activity on, SLICE activities at most;
+            # a run-time error ends the flow, a limit stops the program
             done = 0
-            ended = False
-            try:
-                while done < SLICE:
-                    done += 1
-                    # the activity the flow is at, run by its step; False: the flow has
-                    # ended (a run-time error ends it too, and a limit stops the program)
-                    aid = flow.activity
-                    try:
-                        if steps[aid](flow):
-                            continue
-                    except LimitError as exc:
-                        self._stop(aid, str(exc))
-                    except (ExprError, ValueError, TypeError, OverflowError) as exc:
-                        self._error(aid, str(exc))
-                    ended = True
-                    break
-                else:
-                    ready.append(flow)
-            except _Sleep as sleep:
-                if sleep.seconds > 0:
-                    due = _whole_ms(now + max(sleep.seconds, MIN_WAIT))
+            while True:
+                try:
+                    result = chains[flow.activity](flow, SLICE - done)
+                except LimitError as exc:
+                    result = flow.ran | ENDED
+                    self._stop(flow.activity, str(exc))
+                except (ExprError, ValueError, TypeError, OverflowError) as exc:
+                    result = flow.ran | ENDED
+                    self._error(flow.activity, str(exc))
+                done += result & COUNT
+                if result < ENDED and done < SLICE:
+                    continue
+                break
+            total += done
+            if result & ENDED:
+                # it keeps nothing alive
+                flow.frame, flow.value, flow.loops = _NO_FRAME, None, None
+                spare.append(flow)
+                continue
+            if result & SLEEPS:
+                if flow.wait > 0:
+                    due = _whole_ms(now + max(flow.wait, MIN_WAIT))
                     heappush(self._sleeping, (due, flow.number, flow))
                 else:
                     ready.append(flow)
-            except _Park:
-                self._parked.append(flow)
-            if not ended:
+            elif result & PARKS:
+                parked.append(flow)
+            else:
+                ready.append(flow)  # its slice is over: the other flows go first
+            if ran is not None:
                 flow.steps += done
                 ran.append(flow)
-                hot[flow.activity] = hot.get(flow.activity, 0) + done
-            total += done
+            hot[flow.activity] = hot.get(flow.activity, 0) + done
         self.steps += total
-        self._second_steps += total
         if total:
+            self._second_steps += total
             window.append((now, total))
-        parked = self._parked
-        if self.stopped is not None:
-            pass
-        elif (ready or parked) and self._second_steps >= limits.second:
-            self._over_work()
-        elif parked or ready or self._join_parts:
-            self._check_memory()
-        if self.stopped is not None:
-            return self._halted()
-        for flow in ran:
-            flow.steps = 0
-        busy = len(ready) + len(parked) + len(self._sleeping)
-        if busy != self._busy or self.state is None:
+        stopped = self.stopped
+        if stopped is None and (ready or parked or self._join_parts):
+            if (ready or parked) and self._second_steps >= limits.second:
+                self._over_work()
+            else:
+                self._check_memory()
+            stopped = self.stopped
+        if stopped is not None:
+            commands = self._halted()
+            self._refresh_due()
+            return commands
+        if ran is not None:
+            for flow in ran:
+                flow.steps = 0
+        sleeping = self._sleeping
+        busy = len(ready) + len(parked) + len(sleeping)
+        if busy != self._busy:  # (-1 until the first pass sets the state)
             self._busy = busy
-            self.state = f"{busy} flow{'s' if busy != 1 else ''}"
+            self.state = _STATES[busy] if busy < len(_STATES) else _state(busy)
         commands, self.commands = self.commands, []
+        # _refresh_due, written out (it runs after every tick that runs anything)
+        due = self._next_report
+        if sleeping and sleeping[0][0] < due:
+            due = sleeping[0][0]
+        script = self.key_script
+        if self._next_key < len(script) and script[self._next_key].time < due:
+            due = script[self._next_key].time
+        self._due = due
+        self._due_or_none = None if due == _NEVER else due
+        quiet = not (ready or parked or self._pushed or self._typed.held)
+        self._quiet_until = due if quiet else -_NEVER
         return commands
 
     # -- one activity ----------------------------------------------------------------------
     def _prepare(self, act) -> Step:
-        """The step that runs ``act``: the handler of its kind (:data:`RUNS`; a kind named in
-        a mapping file, through :data:`MAPPED_RUNS`), or, for the kinds most programs run at
-        every report (:data:`PREPARED`), the same handler with the activity's links, constant
-        and compiled expressions looked up once, here, instead of at every step."""
+        """The step that runs ``act``: for the kinds most programs run at every report
+        (:data:`PREPARED`), made here with the activity's links, constant and compiled
+        expressions looked up once instead of at every step; else the handler of its kind
+        (:data:`RUNS`; a kind named in a mapping file, through :data:`MAPPED_RUNS`)."""
+        prepare = PREPARED.get(act.kind) if act.kind not in self.program.kinds else None
+        if prepare is not None:
+            return prepare(self, act)
         handler, _ = self._handlers[act.id]
-        prepare = PREPARED.get(handler)
-        step = prepare(self, act) if prepare is not None else None
-        if step is not None:
-            return step
 
         def run(flow: Flow) -> bool:
             return handler(self, flow, act)
 
         return run
+
+    def _fuse(self) -> dict[int, Chain]:
+        """The fused chains of the program (fused.py): each activity whose prepared step a
+        chain can hold, described once, and the chains of the activities a flow starts or
+        goes on at after a step of its own (a start, an event, a fan-out, a Timer's end, the
+        activity after one that is not fused)."""
+        fusable = {}
+        for aid, act in self._activities.items():
+            spec = self._fusable(act)
+            if spec is not None:
+                fusable[aid] = spec
+        program = self.program
+        heads = [
+            aid
+            for aid, act in self._activities.items()
+            if act.kind in _STARTS and act.panel == "Main" and aid not in program.inputs
+        ]
+        heads += [aid for aid, act in self._activities.items() if act.kind == K.INPUT_PIN]
+        for aid, pins in self._outputs.items():
+            on_its_own = aid not in fusable or self._activities[aid].kind == K.TIMER
+            for links in pins.values():
+                heads += [link.target for link in (links if on_its_own else links[1:])]
+        for aid in (*self.compiled.sensors, *self.compiled.event_blocks):
+            heads += [link.target for link in program.targets(aid)]
+        for act in self._activities.values():
+            if act.kind in (K.KEY_PRESS, K.KEY_RELEASE):
+                heads += [link.target for link in program.targets(act.id)]
+        scope = self._the_scope
+
+        def through(fn: Callable[[Scope], Value], value: Value, state, frame: Frame) -> Value:
+            """An expression's part run by its function, on the scope ``_scope`` fills."""
+            scope.value = value
+            scope.state = state
+            scope.instance = frame.instance
+            scope.parts = value if isinstance(value, dict) else None
+            return fn(scope)
+
+        helpers = {
+            "ctl": self,
+            "through": through,
+            "want_bool": want_bool,
+            "spawn": self._spawn,
+            "command": self._command,
+            "show": show,
+            "convert": convert,
+            "truth": _truth,
+            "check_timer": _check_timer,
+            "power": _power,
+            "WheelPowers": WheelPowers,
+            "first_sensor_value": first_sensor_value,
+        }
+        return fuse(fusable, dict.fromkeys(heads), helpers)
+
+    def _fusable(self, act) -> Fusable | None:
+        """What a chain needs to run ``act`` as its prepared step runs it (None: a chain
+        cannot hold it; it runs by its own step)."""
+        kind = act.kind
+        pins = self._outputs.get(act.id, {})
+        exprs = self._parsed.get(act.id, ())
+        handler, _ = self._handlers[act.id]
+        if kind in _PASS_ON or handler is ProgramController._pass_on:
+            return Fusable("pass", (), pins)
+        if kind == K.DATA and act.id in self.compiled.constants:
+            return Fusable("data", (self.compiled.constants[act.id],), pins)
+        if kind == K.VARIABLE:
+            key = self._var_keys[act.id]
+            if key in self.compiled.globals:
+                return Fusable("variable", (key, self.compiled.globals[key][1]), pins)
+        if kind == K.CALCULATE and exprs:
+            return Fusable("calculate", (exprs[0],), pins)
+        if kind == K.IF and exprs and len(exprs) == len(act.values):
+            return Fusable("if", exprs, pins)
+        if kind == K.TIMER:
+            return Fusable("timer", (), pins)
+        if kind == K.DRIVE and len(exprs) >= 2:
+            return Fusable("drive", exprs[:2], pins)
+        if kind == K.PRINT_LINE:
+            return Fusable("print", (), pins)
+        if kind == K.CODE:
+            return Fusable("code", (), pins)
+        return None
 
     def _sender(self, aid: int, pin: int) -> Send:
         """What :meth:`_go` does for the output ``pin`` of activity ``aid``, its links found
@@ -643,17 +875,17 @@ class ProgramController:
         send = self._sender(act.id, 0)
         return lambda flow: send(flow, flow.value)
 
-    def _prepare_data(self, act) -> Step | None:
+    def _prepare_data(self, act) -> Step:
         if act.id not in self.compiled.constants:
-            return None
+            return _uncompiled("its value")
         send = self._sender(act.id, 0)
         constant = self.compiled.constants[act.id]
         return lambda flow: send(flow, constant)
 
-    def _prepare_variable(self, act) -> Step | None:
+    def _prepare_variable(self, act) -> Step:
         key = self._var_keys[act.id]
         if key not in self.compiled.globals:
-            return None
+            return _uncompiled("its variable")
         vtype = self.compiled.globals[key][1]
         send = self._sender(act.id, 0)
 
@@ -665,10 +897,10 @@ class ProgramController:
 
         return run
 
-    def _prepare_if(self, act) -> Step | None:
+    def _prepare_if(self, act) -> Step:
         exprs = self._exprs.get(act.id)
         if exprs is None or len(exprs) != len(act.values):
-            return None
+            return _uncompiled("its conditions")
         branches = tuple(
             (index, condition, self._sender(act.id, index)) for index, condition in enumerate(exprs)
         )
@@ -699,10 +931,10 @@ class ProgramController:
 
         return run
 
-    def _prepare_drive(self, act) -> Step | None:
+    def _prepare_drive(self, act) -> Step:
         exprs = self._exprs.get(act.id)
         if exprs is None or len(exprs) < 2:
-            return None
+            return _uncompiled("its wheel powers")
         left_power, right_power = exprs[0], exprs[1]
         send = self._sender(act.id, 0)
         scope = self._scope
@@ -753,29 +985,8 @@ class ProgramController:
     def _never(self, flow: Flow, act) -> bool:
         return False  # a Comment, the Robot, a service mapped to "ignore": never run
 
-    def _data(self, flow: Flow, act) -> bool:
-        return self._go(flow, 0, self.compiled.constants[act.id])
-
     def _calculate(self, flow: Flow, act) -> bool:
         return self._go(flow, 0, self._expr(act.id, 0)(self._scope(flow)))
-
-    def _variable(self, flow: Flow, act) -> bool:
-        key = self._var_keys[act.id]
-        stored = convert(flow.value, self.compiled.globals[key][1])
-        self.globals[key] = stored
-        self.changes += 1
-        return self._go(flow, 0, stored)
-
-    def _if(self, flow: Flow, act) -> bool:
-        scope = self._scope(flow)
-        exprs = self._exprs.get(act.id)
-        if exprs is None or len(exprs) != len(act.values):
-            expr = self.compiled.expr
-            exprs = tuple(expr(act.id, index).run for index in range(len(act.values)))
-        for index, condition in enumerate(exprs):
-            if _truth(condition(scope), index):
-                return self._go(flow, index, flow.value)
-        return self._go(flow, ELSE, flow.value)
 
     def _switch(self, flow: Flow, act) -> bool:
         scope = self._scope(flow)
@@ -811,22 +1022,8 @@ class ProgramController:
             flow.loops.pop(loop, None)
         return self._go(flow, 0, flow.value, self.program.loop_end[loop])
 
-    def _timer(self, flow: Flow, act) -> bool:
-        value = flow.value
-        _check_timer(value)
-        if not self._go(flow, 0, value):
-            return False  # nothing waits for the Timer
-        raise _Sleep(max(0.0, float(value)) / 1000.0)
-
     def _print_line(self, flow: Flow, act) -> bool:
         self._print(show(flow.value))
-        return self._go(flow, 0, flow.value)
-
-    def _drive(self, flow: Flow, act) -> bool:
-        scope = self._scope(flow)
-        left = _power(self._expr(act.id, 0)(scope), "left")
-        right = _power(self._expr(act.id, 1)(scope), "right")
-        self._command(WheelPowers(left, right))
         return self._go(flow, 0, flow.value)
 
     def _output_pin(self, flow: Flow, act) -> bool:
@@ -996,19 +1193,13 @@ class ProgramController:
 
 #: activity kind -> its handler (a flow at the activity: does the flow go on?)
 RUNS: dict[int, Callable[[ProgramController, Flow, Any], bool]] = {
-    **dict.fromkeys(_PASS_ON, ProgramController._pass_on),
-    K.DATA: ProgramController._data,
     K.CALCULATE: ProgramController._calculate,
-    K.VARIABLE: ProgramController._variable,
-    K.IF: ProgramController._if,
     K.SWITCH: ProgramController._switch,
     K.WHILE: ProgramController._while,
     K.END_WHILE: ProgramController._end_while,
     K.BREAK: ProgramController._break,
     K.JOIN: ProgramController._join,
-    K.TIMER: ProgramController._timer,
     K.PRINT_LINE: ProgramController._print_line,
-    K.DRIVE: ProgramController._drive,
     K.BLOCK: ProgramController._call,
     K.OUTPUT_PIN: ProgramController._output_pin,
     K.EVENT_PIN: ProgramController._event_pin,
@@ -1025,18 +1216,15 @@ MAPPED_RUNS: dict[str, Callable[[ProgramController, Flow, Any], bool]] = {
     "custom-event": ProgramController._pass_on,
     "ignore": ProgramController._never,
 }
-#: the handlers whose steps are made once for each activity (see ProgramController._prepare):
-#: handler -> what makes the step (None: the activity runs through its handler)
-PREPARED: dict[
-    Callable[[ProgramController, Flow, Any], bool],
-    Callable[[ProgramController, Any], Step | None],
-] = {
-    ProgramController._pass_on: ProgramController._prepare_pass_on,
-    ProgramController._data: ProgramController._prepare_data,
-    ProgramController._variable: ProgramController._prepare_variable,
-    ProgramController._if: ProgramController._prepare_if,
-    ProgramController._timer: ProgramController._prepare_timer,
-    ProgramController._drive: ProgramController._prepare_drive,
+#: the kinds whose steps are made once for each activity (see ProgramController._prepare),
+#: the kinds most programs run at every report: kind -> what makes the step
+PREPARED: dict[int, Callable[[ProgramController, Any], Step]] = {
+    **dict.fromkeys(_PASS_ON, ProgramController._prepare_pass_on),
+    K.DATA: ProgramController._prepare_data,
+    K.VARIABLE: ProgramController._prepare_variable,
+    K.IF: ProgramController._prepare_if,
+    K.TIMER: ProgramController._prepare_timer,
+    K.DRIVE: ProgramController._prepare_drive,
 }
 #: the handler of a kind no table names (the loader refuses such a kind: it never runs)
 _NEVER_RUNS = ProgramController._never
@@ -1089,6 +1277,36 @@ def _port(ports: dict[str, int], name: str) -> int:
     """The port of a reading named ``port N`` (kept in ``ports`` for the next report)."""
     port = ports[name] = int(name.split()[-1])
     return port
+
+
+def _uncompiled(what: str) -> Step:
+    """The step of an activity whose compiled parts are missing (a program made without
+    ``compile_program``, which refuses one): an error when it runs."""
+
+    def run(flow: Flow) -> bool:
+        raise ExprError(f"{what} did not compile")
+
+    return run
+
+
+def _single(aid: int, step: Step) -> Chain:
+    """The chain of one activity run by its own step (see fused.py for what a chain
+    returns)."""
+
+    def chain(flow: Flow, room: int) -> int:
+        try:
+            goes_on = step(flow)
+        except _Sleep as sleep:
+            flow.wait = sleep.seconds
+            return 1 | SLEEPS
+        except _Park:
+            return 1 | PARKS
+        except BaseException:
+            flow.activity, flow.ran = aid, 1  # the step may have moved the flow already
+            raise
+        return 1 if goes_on else 1 | ENDED
+
+    return chain
 
 
 def _send_nowhere(flow: Flow, value: Value) -> bool:

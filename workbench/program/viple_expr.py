@@ -122,6 +122,23 @@ def bounded(value: Value, col: int | None = None) -> Value:
     return value
 
 
+@dataclass(frozen=True, slots=True)
+class Node:
+    """One part of a parsed expression, for code that runs it without its functions
+    (``fused.py``): ``fn`` runs it; ``kind`` says what it is, ``args`` its parts and ``data``
+    what its function was made with. Kinds: ``literal`` (data: the value), ``value``,
+    ``state`` (data: the lower-case key), ``compare`` (data: the operator, the function for
+    values of any types, and the types that compare as Python compares them when the right
+    side is a literal, else None), ``either`` (``||`` or ``&&``; data: the column, the
+    operator and the answer a left side equal to it decides), ``not`` (data: the column),
+    and ``other``: anything else, run only by its function."""
+
+    kind: str
+    fn: Fn
+    args: tuple[Node, ...] = ()
+    data: tuple[Any, ...] = ()
+
+
 @dataclass(frozen=True)
 class Expression:
     text: str
@@ -130,6 +147,8 @@ class Expression:
     state_names: frozenset[str]
     instance_names: frozenset[str]
     bare_names: frozenset[str]
+    #: the parts of the expression (see Node)
+    tree: Node | None = None
 
     def __call__(self, scope: Scope) -> Value:
         return self.run(scope)
@@ -292,16 +311,25 @@ class _Parser:
         self.state: set[str] = set()
         self.instance: set[str] = set()
         self.bare: set[str] = set()
-        #: id of a literal's function -> (its value,), for a comparison to use it as it is
-        self.literals: dict[int, tuple[Value]] = {}
-        #: the literals' functions, so that no id above is reused while parsing
-        self._kept: list[Fn] = []
+        #: id of a function made here -> what it is (its Node keeps the function, so no id
+        #: is reused while parsing)
+        self.nodes: dict[int, Node] = {}
+
+    def node(self, fn: Fn) -> Node:
+        """What the function ``fn`` made here is (``other`` when it was not noted)."""
+        return self.nodes.get(id(fn)) or Node("other", fn)
+
+    def noted(self, kind: str, fn: Fn, args: tuple[Fn, ...] = (), data: tuple = ()) -> Fn:
+        self.nodes[id(fn)] = Node(kind, fn, tuple(self.node(a) for a in args), data)
+        return fn
 
     def literal(self, value: Value) -> Fn:
-        fn = _const(value)
-        self.literals[id(fn)] = (value,)
-        self._kept.append(fn)
-        return fn
+        return self.noted("literal", _const(value), (), (value,))
+
+    def literal_value(self, fn: Fn) -> tuple[Value] | None:
+        """(the value,) when ``fn`` is a literal's function."""
+        node = self.nodes.get(id(fn))
+        return node.data if node is not None and node.kind == "literal" else None
 
     @property
     def tok(self) -> _Tok:
@@ -356,7 +384,8 @@ class _Parser:
         while self.op() == "||":
             col = self.tok.col
             self.i += 1
-            left = _or(left, self.logical_and(), col)
+            right = self.logical_and()
+            left = self.noted("either", _or(left, right, col), (left, right), (col, "||", True))
         return left
 
     def logical_and(self) -> Fn:
@@ -364,7 +393,8 @@ class _Parser:
         while self.op() == "&&":
             col = self.tok.col
             self.i += 1
-            left = _and(left, self.comparison(), col)
+            right = self.comparison()
+            left = self.noted("either", _and(left, right, col), (left, right), (col, "&&", False))
         return left
 
     def comparison(self) -> Fn:
@@ -373,7 +403,11 @@ class _Parser:
             tok = self.tok
             self.i += 1
             right = self.additive()
-            left = _compare(tok.text, left, right, tok.col, self.literals.get(id(right)))
+            constant = self.literal_value(right)
+            fn = _compare(tok.text, left, right, tok.col, constant)
+            plain = _PLAIN.get(type(constant[0])) if constant is not None else None
+            slow = _compare_values(tok.text, tok.col)
+            left = self.noted("compare", fn, (left, right), (tok.text, slow, plain))
         return left
 
     def additive(self) -> Fn:
@@ -400,7 +434,9 @@ class _Parser:
             self.deeper()
             inner = self.unary()
             self.depth -= 1
-            return _negate(inner, col) if op == "-" else _not(inner, col)
+            if op == "-":
+                return _negate(inner, col)
+            return self.noted("not", _not(inner, col), (inner,), (col,))
         return self.primary()
 
     def primary(self) -> Fn:
@@ -430,7 +466,7 @@ class _Parser:
         if word == "null":
             return self.literal(None)
         if word in ("value", "it"):
-            return _value
+            return self.noted("value", _value)
         if word == "iif":
             args = self.arguments(tok, 3)
             return _choose(args[0], args[1], args[2], tok.col)
@@ -443,7 +479,7 @@ class _Parser:
             key = member.text.lower()
             if word == "state":
                 self.state.add(key)
-                return _state(key, member.text, member.col)
+                return self.noted("state", _state(key, member.text, member.col), (), (key,))
             if word == "instance":
                 self.instance.add(key)
                 return _instance(key, member.text, member.col)
@@ -491,7 +527,12 @@ def parse(text: str) -> Expression:
     parser = _Parser(text)
     run = parser.parse()
     return Expression(
-        text, run, frozenset(parser.state), frozenset(parser.instance), frozenset(parser.bare)
+        text,
+        run,
+        frozenset(parser.state),
+        frozenset(parser.instance),
+        frozenset(parser.bare),
+        parser.node(run),
     )
 
 
@@ -570,14 +611,14 @@ def _part(key: str, name: str, col: int) -> Fn:
     return read
 
 
-def _want_bool(v: Value, col: int, op: str) -> bool:
+def want_bool(v: Value, col: int, op: str) -> bool:
     if not isinstance(v, bool):
         raise ExprError(f"{op} needs true or false, not {type_name(v)} {show(v)[:30]!r}", col)
     return v
 
 
 def _choose(c: Fn, a: Fn, b: Fn, col: int) -> Fn:
-    return lambda s: a(s) if _want_bool(c(s), col, "the condition") else b(s)
+    return lambda s: a(s) if want_bool(c(s), col, "the condition") else b(s)
 
 
 def _or(a: Fn, b: Fn, col: int) -> Fn:
@@ -599,14 +640,14 @@ def _either(a: Fn, b: Fn, col: int, op: str, decides: bool) -> Fn:
         v = a(s)
         if v is goes_on:
             w = b(s)
-            return w if w is True or w is False else _want_bool(w, col, op)
-        return decides if v is decides else _want_bool(v, col, op)
+            return w if w is True or w is False else want_bool(w, col, op)
+        return decides if v is decides else want_bool(v, col, op)
 
     return run
 
 
 def _not(a: Fn, col: int) -> Fn:
-    return lambda s: not _want_bool(a(s), col, "!")
+    return lambda s: not want_bool(a(s), col, "!")
 
 
 def _negate(a: Fn, col: int) -> Fn:
