@@ -102,6 +102,8 @@ def run_tree(tree: Path, table: list[tuple[str, list[str]]], out: Path, jobs: in
 
 def first_difference(old: Path, new: Path) -> str | None:
     """Where two files part, or None when they are the same bytes (a missing file counts)."""
+    if not old.exists() and not new.exists():
+        return None  # neither run wrote one (it stopped on an error both trees print)
     if not old.exists() or not new.exists():
         return f"{old.name}: {'missing before' if not old.exists() else 'missing now'}"
     a = old.read_bytes().splitlines()
