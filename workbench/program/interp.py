@@ -647,7 +647,7 @@ class ProgramController:
 
     def _run(self) -> list[Any]:
         """Run the ready flows (their slices in turn, within the tick's budget); then work
-        out what is due next (``_refresh_due``, written out at the end)."""
+        out what is due next (``_refresh_due``)."""
         ready = self._ready
         if not ready and self.state is not None:
             self._refresh_due()
@@ -734,17 +734,7 @@ class ProgramController:
             self._busy = busy
             self.state = _STATES[busy] if busy < len(_STATES) else _state(busy)
         commands, self.commands = self.commands, []
-        # _refresh_due, written out (it runs after every tick that runs anything)
-        due = self._next_report
-        if sleeping and sleeping[0][0] < due:
-            due = sleeping[0][0]
-        script = self.key_script
-        if self._next_key < len(script) and script[self._next_key].time < due:
-            due = script[self._next_key].time
-        self._due = due
-        self._due_or_none = None if due == _NEVER else due
-        quiet = not (ready or parked or self._pushed or self._typed.held)
-        self._quiet_until = due if quiet else -_NEVER
+        self._refresh_due()
         return commands
 
     # -- one activity ----------------------------------------------------------------------
