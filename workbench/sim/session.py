@@ -234,6 +234,13 @@ class Session:
             due = self._due
         return events
 
+    def _ask_due(self) -> None:
+        """After the controller ran: when it next has something due (inf: nothing)."""
+        next_due = self._next_due
+        if next_due is not None:
+            due = next_due()
+            self._due = _NEVER if due is None else due
+
     def _wake(self, t: float) -> None:
         """The controller's due work at ``t`` between control ticks: it gets the readings of
         that moment and its commands apply at once (the record shows them at the next tick)."""
@@ -246,11 +253,7 @@ class Session:
         for name, port in self.binding.items():
             named[name] = readings[port]
         commands = controller.tick(t, named, _NONE)
-        # after the controller ran: when it next has something due (as in _control_tick)
-        next_due = self._next_due
-        if next_due is not None:
-            due = next_due()
-            self._due = _NEVER if due is None else due
+        self._ask_due()
         if commands:
             for cmd in commands:
                 world.apply(cmd)
@@ -260,7 +263,7 @@ class Session:
         world = self.world
         t = world.time
         self.readings = readings = world.read_sensors()
-        angle = world._angle  # World.angle without the property's call, on every tick
+        angle = world.angle
         last = self._last_angle
         turns = self._turns
         # not turned since the last tick and no sweep to end: the update would change nothing
@@ -279,11 +282,7 @@ class Session:
             else:
                 self._started = True
                 commands = controller.start(t)
-            # after the controller ran: when it next has something due (inf: nothing)
-            next_due = self._next_due
-            if next_due is not None:
-                due = next_due()
-                self._due = _NEVER if due is None else due
+            self._ask_due()
             if commands:
                 for cmd in commands:
                     world.apply(cmd)

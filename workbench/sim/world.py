@@ -510,42 +510,27 @@ class World:
             w = (target - a0) / dt
             rate = self._turn_rate
             w = rate if w > rate else -rate if w < -rate else w
-            self._free_w = w
-            self._physics_stale = True
-            a = a0 + w * dt
-            if w:
-                turned = abs(w) * dt
-                self._turned += turned
-                self._moved = turned  # nothing moved: 0.0 or turned
-            else:
-                self._moved = 0.0
-            steps = self._steps + 1.0
-            self._steps = steps
-            self.time = t = steps * dt
-            self._angle = a
-            self._readings = None
-            if abs(target - a) < _TURN_EPS or self._watch_exit:
-                return self._events(t, self._x, self._y, a, target)
-            return _NO_EVENTS
-        v = self._v
-        w = self._w
-        if v:
-            if not w:
-                # straight ahead: _advance works the step out once, and the next steps cruise
-                return self._advance(dt, True)
-            # an arc turns the robot every step, so each step is new (the cache of a
-            # straight step would only be written over): its motion, as _advance works it out
-            x = self._x + v * math.cos(a0) * dt
-            y = self._y + v * math.sin(a0) * dt
-            xmin, xmax, ymin, ymax = self._box
-            if not (xmin <= x <= xmax and ymin <= y <= ymax):
-                return self._advance(dt, True)
-            moved = abs(v) * dt
-            self._distance += moved
-            self._x = x
-            self._y = y
-        else:
             moved = 0.0
+        else:
+            v = self._v
+            w = self._w
+            if v:
+                if not w:
+                    # straight ahead: _advance works the step out once, and the next steps cruise
+                    return self._advance(dt, True)
+                # an arc turns the robot every step, so each step is new (the cache of a
+                # straight step would only be written over): its motion, as _advance works it out
+                x = self._x + v * math.cos(a0) * dt
+                y = self._y + v * math.sin(a0) * dt
+                xmin, xmax, ymin, ymax = self._box
+                if not (xmin <= x <= xmax and ymin <= y <= ymax):
+                    return self._advance(dt, True)
+                moved = abs(v) * dt
+                self._distance += moved
+                self._x = x
+                self._y = y
+            else:
+                moved = 0.0
         self._free_w = w
         self._physics_stale = True
         a = a0 + w * dt
@@ -560,10 +545,10 @@ class World:
         self.time = t = steps * dt
         self._angle = a
         self._readings = None
-        # no contact can have started (no physics ran), and no turn is under way: events only
-        # when an exit may have been reached
-        if self._watch_exit:
-            return self._events(t, self._x, self._y, a, None)
+        # no contact can have started (no physics ran): events only when a turn may have ended
+        # or an exit may have been reached
+        if self._watch_exit or (target is not None and abs(target - a) < _TURN_EPS):
+            return self._events(t, self._x, self._y, a, target)
         return _NO_EVENTS
 
     def step_to(self, t: float) -> tuple[str, ...]:
