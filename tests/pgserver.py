@@ -167,10 +167,14 @@ class PgServer:
     def freeze(self) -> list[int]:
         """Stop the whole server (SIGSTOP): its sockets stay open and its machine's kernel
         still acknowledges, but nothing answers. Returns the processes for :meth:`thaw`."""
-        pids = self.processes()
-        for pid in pids:
-            os.kill(pid, signal.SIGSTOP)
-        return pids
+        stopped = []
+        for pid in self.processes():
+            try:
+                os.kill(pid, signal.SIGSTOP)
+            except ProcessLookupError:
+                continue  # a backend that ended since it was listed: nothing to stop
+            stopped.append(pid)
+        return stopped
 
     @staticmethod
     def thaw(pids: list[int]) -> None:
