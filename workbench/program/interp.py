@@ -218,7 +218,7 @@ class ProgramController:
             raise ValueError(f"the report period must be above 0 s, not {report_period!r}")
         self.report_period = report_period
         #: whether sensor reports come at their own pace (else with every tick's readings)
-        self._paced = report_period is not None
+        self.paced: bool = report_period is not None
         self._period = report_period if report_period is not None else 0.0
         self._reads = bool(compiled.sensors)
         #: each activity's output pins and their links (Program.targets, without the call)
@@ -320,8 +320,10 @@ class ProgramController:
         #: the earliest of the times above and the sleeping flows' (what next_due says; kept
         #: up to date at the end of every tick that did something, the only place they change)
         self._due = _NEVER
-        #: before this time, a tick finds nothing to do (see _refresh_due)
-        self._quiet_until = -_NEVER
+        #: before this time, a tick finds nothing to do (see _refresh_due): any tick of a
+        #: :attr:`paced` program, else one that brings no readings and no report (the session
+        #: leaves such ticks out)
+        self.quiet_until = -_NEVER
         self.flows_dropped = 0
         self.steps = 0
         self.state: str | None = None
@@ -366,7 +368,7 @@ class ProgramController:
         """One control tick; ``readings`` ("port N" -> value) fire the sensor activities, and
         ``report``, a robot's report as it arrived, is what a raw sensor gets (None: the
         simulated robot's report is made from the readings)."""
-        if t + _SAME < self._quiet_until and (self._paced or (not readings and report is None)):
+        if t + _SAME < self.quiet_until and (self.paced or (not readings and report is None)):
             # nothing is due: no Timer ends, no key or sensor report comes and no flow waits to
             # run, so this tick would change nothing (most ticks of a program: its sensors
             # report every 250 ms, the session ticks it every 50 ms); ``now`` is only read
@@ -383,13 +385,13 @@ class ProgramController:
             self._parked = []
         if self._pushed or self._next_key < len(self.key_script) or self._typed.held:
             self._keys(t)
-        if (t + _SAME >= self._next_report if self._paced else self._report_due(t)) and (
+        if (t + _SAME >= self._next_report if self.paced else self._report_due(t)) and (
             readings or report is not None
         ):
             # a tick between two reports (of a remote robot, or of the paced simulator) fires
             # no sensor; the next paced report is on the same grid after t (a late tick skips
             # the missed ones; as _report_due)
-            if self._paced:
+            if self.paced:
                 start = self._next_report
                 period = self._period
                 self._next_report = start + period * (1 + int((t + _SAME - start) // period))
@@ -425,7 +427,7 @@ class ProgramController:
         self._due = due
         self._due_or_none = None if due == _NEVER else due
         quiet = not (self._ready or self._parked or self._pushed or self._typed.held)
-        self._quiet_until = due if quiet and self.state is not None else -_NEVER
+        self.quiet_until = due if quiet and self.state is not None else -_NEVER
 
     @property
     def timing(self) -> bool:
@@ -452,7 +454,7 @@ class ProgramController:
         if self.stopped is not None:
             return
         self._pushed += self._typed.press(key.lower(), t)
-        self._quiet_until = -_NEVER  # the key fires at the next tick
+        self.quiet_until = -_NEVER  # the key fires at the next tick
 
     @property
     def held(self) -> frozenset[str]:

@@ -10,6 +10,7 @@ import contextlib
 import errno
 import hashlib
 import json
+import math
 import os
 import platform
 from collections.abc import Iterator
@@ -44,6 +45,87 @@ def versions() -> dict[str, str]:
 
 def _r(value: float) -> float:
     return round(value, 4)
+
+
+def _dumps(obj: object) -> str:
+    return json.dumps(obj, separators=(",", ":"))
+
+
+def tick_line(
+    t: float,
+    pose: tuple[float, float, float],
+    sensors: dict[int, float | int],
+    commands: list[object],
+    state: str | None,
+    events: list[str],
+    variables: dict[str, Any] | None = None,
+) -> str:
+    """A tick's line, without its newline: the JSON of ``tick_json``'s object, character for
+    character. Most lines of a record are a time, a pose and plain numbers by port; those are
+    put together here (a float's JSON is its ``repr``, an int's its ``str``), the rest goes
+    through :mod:`json` (a run records 20 lines a simulated second, idle or not)."""
+    x, y, heading = pose
+    head = [f'{{"t":{_r(t)!r},"pose":[{_r(x)!r},{_r(y)!r},{_r(heading)!r}],"sensors":{{']
+    plain = type(t) is float and type(x) is type(y) is type(heading) is float
+    first = True
+    for port, value in sensors.items():
+        kind = type(value)
+        if kind is float:
+            value = round(value, 4)
+            if value - value != 0.0:  # inf or nan: json spells them its own way
+                plain = False
+                break
+            text = repr(value)
+        elif kind is int:
+            text = str(value)
+        else:
+            plain = False
+            break
+        if type(port) is not int:
+            plain = False
+            break
+        head.append(f'"{port}":{text}' if first else f',"{port}":{text}')
+        first = False
+    if not plain or not math.isfinite(x + y + heading + t):
+        return _dumps(tick_json(t, pose, sensors, commands, state, events, variables))
+    head.append("}")
+    if commands:
+        head.append(',"cmd":' + _dumps([command_json(c) for c in commands]))
+    if state is not None:
+        head.append(',"state":' + _dumps(state))
+    if variables:
+        plain_vars = {k: (_r(v) if isinstance(v, float) else v) for k, v in variables.items()}
+        head.append(',"vars":' + _dumps(plain_vars))
+    if events:
+        head.append(',"events":' + _dumps(events))
+    head.append("}")
+    return "".join(head)
+
+
+def tick_json(
+    t: float,
+    pose: tuple[float, float, float],
+    sensors: dict[int, float | int],
+    commands: list[object],
+    state: str | None,
+    events: list[str],
+    variables: dict[str, Any] | None = None,
+) -> dict[str, Any]:
+    """A tick's line as an object (``docs/run-record.md``)."""
+    line: dict[str, Any] = {
+        "t": _r(t),
+        "pose": [_r(pose[0]), _r(pose[1]), _r(pose[2])],
+        "sensors": {str(p): (_r(v) if isinstance(v, float) else v) for p, v in sensors.items()},
+    }
+    if commands:
+        line["cmd"] = [command_json(c) for c in commands]
+    if state is not None:
+        line["state"] = state
+    if variables:
+        line["vars"] = {k: (_r(v) if isinstance(v, float) else v) for k, v in variables.items()}
+    if events:
+        line["events"] = events
+    return line
 
 
 def command_json(cmd: object) -> dict[str, Any]:
@@ -149,7 +231,10 @@ class Recorder:
     def _write(self, obj: dict[str, Any], summary: bool = False, t: float | None = None) -> None:
         if self.stopped is not None and not (summary and self.stopped.reason in KEEPS_SUMMARY):
             return
-        data = (json.dumps(obj, separators=(",", ":")) + "\n").encode()
+        self._put((_dumps(obj) + "\n").encode(), summary, t)
+
+    def _put(self, data: bytes, summary: bool = False, t: float | None = None) -> None:
+        """One whole line (``data`` ends with its newline) into the record, within its caps."""
         if self.rate is not None and t is not None:
             second = int(t + 1e-9)
             if second != self._second:
@@ -225,20 +310,9 @@ class Recorder:
     ) -> None:
         if self.stopped is not None:
             return
-        line: dict[str, Any] = {
-            "t": _r(t),
-            "pose": [_r(pose[0]), _r(pose[1]), _r(pose[2])],
-            "sensors": {str(p): (_r(v) if isinstance(v, float) else v) for p, v in sensors.items()},
-        }
-        if commands:
-            line["cmd"] = [command_json(c) for c in commands]
-        if state is not None:
-            line["state"] = state
-        if variables:
-            line["vars"] = {k: (_r(v) if isinstance(v, float) else v) for k, v in variables.items()}
-        if events:
-            line["events"] = events
-        self._write(line, t=t)
+        self._put(
+            (tick_line(t, pose, sensors, commands, state, events, variables) + "\n").encode(), t=t
+        )
 
     def summary(self, metrics: dict[str, Any], **extra: Any) -> None:
         stop = self.stopped

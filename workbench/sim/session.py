@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Any, Protocol, runtime_checkable
 
 from .driver import NOBODY, Driver
 from .maze import Maze
@@ -46,6 +46,20 @@ class Controller(Protocol):
 #: program's Timer or sensor report): ``next_due() -> float | None``; the session then wakes it
 #: with :meth:`Controller.tick` at exactly that simulated time, between physics steps if need be
 NEXT_DUE = "next_due"
+
+
+@runtime_checkable
+class Quiet(Protocol):
+    """A controller that says until when its control ticks would find nothing to do (a VIPLE
+    program between its Timers and sensor reports): the session leaves those ticks out."""
+
+    #: its sensor reports come at their own pace, so ``quiet_until`` holds whatever readings
+    #: a tick brings
+    paced: bool
+    #: before this simulated time a tick changes nothing and commands nothing
+    quiet_until: float
+
+
 #: times closer than this are the same moment, seconds
 _SAME = 1e-9
 
@@ -89,6 +103,8 @@ class Session:
         self.shortest_blocks = maze.shortest_path_length()
         self.controller: Controller | None = None
         self._next_due: Callable[[], float | None] | None = None
+        #: the controller again where it is :class:`Quiet` and paced, else None
+        self._quiet: Quiet | None = None
         self.binding: dict[str, int] = {}
         self.driver = NOBODY
         self._reset_run_state()
@@ -112,6 +128,7 @@ class Session:
         """Let ``controller`` drive; ``binding`` maps its sensor names to ports."""
         self.controller = controller
         self._next_due = getattr(controller, NEXT_DUE, None)
+        self._quiet = controller if isinstance(controller, Quiet) and controller.paced else None
         self.binding = dict(binding)
         self.driver = driver
         self._started = False
@@ -120,6 +137,7 @@ class Session:
     def detach(self, driver: Driver = NOBODY) -> None:
         self.controller = None
         self._next_due = None
+        self._quiet = None
         self._due = math.inf
         self.binding = {}
         self.driver = driver
@@ -173,6 +191,7 @@ class Session:
         self.shortest_blocks = maze.shortest_path_length()
         self.controller = None
         self._next_due = None
+        self._quiet = None
         self.binding = {}
         self._reset_run_state()
 
@@ -273,7 +292,10 @@ class Session:
         self._last_time = t
         events = self._events
         controller = self.controller
-        if controller is not None and run_controller:
+        quiet = self._quiet
+        if quiet is not None and t + _SAME < quiet.quiet_until and self._started:
+            pass  # its tick would find nothing to do (no Timer ends, no report or key comes)
+        elif controller is not None and run_controller:
             if self._started:
                 named = {}  # as in _wake
                 for name, port in self.binding.items():

@@ -453,10 +453,12 @@ class World:
         right *= gr
         self._v = v = 0.5 * (left + right)
         self._w = w = (left - right) / p.track_width
-        control = self._control
+        # the control body's C setters directly (what its properties call, without their
+        # Python wrappers: a program or a driver at 20 Hz sends a command nearly every tick)
+        control = self._control_ptr
         a = self._angle
-        control.velocity = (v * math.cos(a), v * math.sin(a))
-        control.angular_velocity = w
+        _set_velocity(control, (v * math.cos(a), v * math.sin(a)))
+        _set_angular_velocity(control, w)
         self._reaim = v != 0.0 and w != 0.0
 
     @property
@@ -670,7 +672,7 @@ class World:
         events = _NO_EVENTS
         if target is not None and abs(target - a) < _TURN_EPS:
             self._turn_target = None
-            self._control.angular_velocity = 0.0
+            _set_angular_velocity(self._control_ptr, 0.0)
             self._free_w = 0.0
             events = (TURN_DONE,)
         if self._new_collision:
