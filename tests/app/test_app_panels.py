@@ -292,6 +292,48 @@ def test_the_transition_log_follows_the_newest_transitions():
     run(app, body)
 
 
+def test_the_algorithm_panel_keeps_its_rows_while_it_runs_and_fits_them_when_paused():
+    """Running, the algorithm panel's texts never give back rows (the panel does not jump
+    with each shorter transition, and no frame lays the screen out for it); paused, each text
+    takes just the rows it needs again."""
+    app = unity_app()
+    station = app.station
+
+    def rows(widget: Static) -> tuple[int, int]:
+        size = widget.size
+        width = widget.content_region.width
+        return widget.get_content_height(size, size, width), widget.size.height
+
+    async def body(pilot: Pilot) -> None:
+        station.select_algorithm("right-wall")
+        await pilot.press("x")
+        station.pacer.paused = False
+        panel = app.screen.query_one(AlgorithmState)
+        texts = [panel.query_one(f"#algorithm-{name}", Static) for name in ("summary", "last")]
+        kept = [0, 0]
+        shorter = 0
+        history = station.driving.controller.history
+        while len(history) < 12:
+            station.step(30)
+            app.refresh_views()
+            await pilot.pause()
+            for i, widget in enumerate(texts):
+                needed, height = rows(widget)
+                assert height >= kept[i] and height >= needed
+                shorter += needed < height
+                kept[i] = height
+        assert shorter  # some text did get shorter than the rows it keeps
+        await pilot.press("p")
+        app.refresh_views()
+        await pilot.pause()
+        assert station.paused
+        for widget in texts:
+            needed, height = rows(widget)
+            assert height == needed
+
+    run(app, body)
+
+
 def test_pause_step_and_reset_from_the_dialog():
     app = unity_app()
     station = app.station

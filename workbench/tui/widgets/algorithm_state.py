@@ -53,6 +53,8 @@ class AlgorithmState(Vertical):
         self._vars = Static(id="algorithm-vars", markup=False)
         self._last = Static(id="algorithm-last", markup=False)
         self._log = TransitionLog(id="algorithm-log")
+        #: whether the texts fit their rows to their length at once (see update_in_place)
+        self._fit = True
 
     def compose(self) -> ComposeResult:
         yield self._summary
@@ -78,6 +80,14 @@ class AlgorithmState(Vertical):
         controller = running if isinstance(running, FsmController) else None
         unit = get_profile(station.profile).unit
         log = self._log
+        # the texts keep the rows they took while the algorithm runs; they fit them again when
+        # it is paused (frames come a step at a time then) or not running
+        fit = controller is None or station.paused
+        if fit and not self._fit:
+            # the rows kept while it ran go back to what the texts take
+            for text in (self._summary, self._states, self._vars, self._last):
+                text.refresh(layout=True)
+        self._fit = fit
         if definition is None:
             set_border_title(self, "Algorithm")
             self.summary = "none chosen: the keys drive. g chooses one."
@@ -127,7 +137,7 @@ class AlgorithmState(Vertical):
 
     def watch_summary(self, text: str) -> None:
         # the timer counts down every tick: lay out again only when the height changes
-        update_in_place(self._summary, text)
+        update_in_place(self._summary, text, self._fit)
 
     def watch_states(self, value: tuple[tuple[str, ...], str | None]) -> None:
         names, current = value
@@ -136,29 +146,32 @@ class AlgorithmState(Vertical):
             for name in names
         ]
         widget = self._states
-        update_in_place(widget, Content("").join(parts))
+        update_in_place(widget, Content("").join(parts), self._fit)
         widget.display = bool(names)
 
     def watch_variables(self, text: str) -> None:
         widget = self._vars
-        update_in_place(widget, f"vars: {text}" if text else "")
+        update_in_place(widget, f"vars: {text}" if text else "", self._fit)
         widget.display = bool(text)
 
     def watch_last(self, text: str) -> None:
         widget = self._last
-        update_in_place(widget, text)
+        update_in_place(widget, text, self._fit)
         widget.display = bool(text)
 
 
-def update_in_place(widget: Static, content: str | Content) -> None:
+def update_in_place(widget: Static, content: str | Content, fit: bool = True) -> None:
     """Show ``content`` in ``widget``, laying the panel out again only when it takes another
-    number of rows at the widget's width (a new layout is most of a frame's work; the state
-    highlighted, the timer and the last transition change many times a minute)."""
+    number of rows at the widget's width; with ``fit`` False (an algorithm running), only when
+    it needs more: a shorter text keeps the rows it had, blank at the end. A new layout is most
+    of a frame's work, and the state highlighted, the timer and the last transition change many
+    times a minute: a panel that grew and shrank with each of them also jumped as it ran."""
     region = widget.content_region
     if not widget.is_mounted or not widget.display or region.width <= 0:
         widget.update(content)
         return
     widget.update(content, layout=False)
     size = widget.size
-    if widget.get_content_height(size, size, region.width) != region.height:
+    rows = widget.get_content_height(size, size, region.width)
+    if rows > region.height or (fit and rows != region.height):
         widget.refresh(layout=True)
