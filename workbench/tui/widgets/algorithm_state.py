@@ -38,6 +38,10 @@ class AlgorithmState(Vertical):
     AlgorithmState > #algorithm-last {
         color: $text-muted;
     }
+    /* while it runs, the last transition has the rows most transitions take from the start */
+    AlgorithmState.-running > #algorithm-last {
+        min-height: 3;
+    }
     """
 
     summary: var[str] = var("", init=False)
@@ -83,6 +87,7 @@ class AlgorithmState(Vertical):
         # the texts keep the rows they took while the algorithm runs; they fit them again when
         # it is paused (frames come a step at a time then) or not running
         fit = controller is None or station.paused
+        self.set_class(not fit, "-running")
         if fit and not self._fit:
             # the rows kept while it ran go back to what the texts take
             for text in (self._summary, self._states, self._vars, self._last):
