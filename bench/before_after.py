@@ -74,7 +74,12 @@ def main() -> None:
             ["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"],
             capture_output=True, text=True, check=True,
         ).stdout.strip()  # fmt: skip
-        trees = (("old " + rev, old), ("new " + here, ROOT))
+        dirty = subprocess.run(
+            ["git", "-C", str(ROOT), "status", "--porcelain", "--untracked-files=no"],
+            capture_output=True, text=True, check=True,
+        ).stdout.strip()  # fmt: skip
+        # the tree as it is: HEAD, and the changes not committed yet if there are any
+        trees = (("old " + rev, old), ("new " + here + (" with changes" if dirty else ""), ROOT))
         figures: dict[str, list[list[str]]] = {name: [] for name, _tree in trees}
         print(f"{options.bench} {' '.join(options.args)}: {options.rounds} rounds, old first")
         for round_no in range(1, options.rounds + 1):
