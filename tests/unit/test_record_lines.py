@@ -1,8 +1,9 @@
 """A tick's record line is the JSON of its object, character for character, however it is
-put together (``workbench.sim.record.tick_line`` builds the plain ones by hand)."""
+put together (the recorder builds the plain ones by hand)."""
 
 from __future__ import annotations
 
+import io
 import json
 import math
 
@@ -10,11 +11,38 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from workbench.sim.commands import MotorPower, Stop, TurnByDegrees, WheelPowers
-from workbench.sim.record import Recorder, _dumps, tick_json, tick_line
+from workbench.sim.record import Recorder, command_json
+
+
+def rounded(value):
+    return round(value, 4) if isinstance(value, float) else value
+
+
+def tick_object(t, pose, sensors, commands, state, events, variables):
+    """A tick's line as an object, as ``docs/run-record.md`` lays it out."""
+    line = {
+        "t": round(t, 4),
+        "pose": [round(v, 4) for v in pose],
+        "sensors": {
+            str(p): (round(v, 4) if isinstance(v, float) else v) for p, v in sensors.items()
+        },
+    }
+    if commands:
+        line["cmd"] = [command_json(c) for c in commands]
+    if state is not None:
+        line["state"] = state
+    if variables:
+        line["vars"] = {
+            k: (round(v, 4) if isinstance(v, float) else v) for k, v in variables.items()
+        }
+    if events:
+        line["events"] = events
+    return line
+
 
 numbers = st.floats(allow_nan=True, allow_infinity=True) | st.floats(-1e4, 1e4)
 readings = st.dictionaries(
-    st.integers(-3, 12) | st.sampled_from(["3", "a\"b"]),
+    st.integers(-3, 12) | st.sampled_from(["3", 'a"b']),
     numbers | st.integers(-5, 10**20) | st.booleans() | st.none(),
     max_size=5,
 )
@@ -40,8 +68,12 @@ variables = st.none() | st.dictionaries(
     variables=variables,
 )
 def test_a_tick_line_is_the_json_of_its_object(t, pose, sensors, cmds, state, events, variables):
-    line = tick_line(t, pose, sensors, cmds, state, events, variables)
-    assert line == _dumps(tick_json(t, pose, sensors, cmds, state, events, variables))
+    out = io.StringIO()
+    Recorder(out, rate=None).tick(t, pose, sensors, cmds, state, events, variables)
+    line = out.getvalue().removesuffix("\n")
+    assert "\n" not in line
+    expected = tick_object(t, pose, sensors, cmds, state, events, variables)
+    assert line == json.dumps(expected, separators=(",", ":"))
 
 
 def test_the_lines_of_a_plain_run_read_back_as_written(tmp_path):

@@ -51,81 +51,37 @@ def _dumps(obj: object) -> str:
     return json.dumps(obj, separators=(",", ":"))
 
 
-def tick_line(
-    t: float,
-    pose: tuple[float, float, float],
-    sensors: dict[int, float | int],
-    commands: list[object],
-    state: str | None,
-    events: list[str],
-    variables: dict[str, Any] | None = None,
-) -> str:
-    """A tick's line, without its newline: the JSON of ``tick_json``'s object, character for
-    character. Most lines of a record are a time, a pose and plain numbers by port; those are
-    put together here (a float's JSON is its ``repr``, an int's its ``str``), the rest goes
-    through :mod:`json` (a run records 20 lines a simulated second, idle or not)."""
+def _plain_head(
+    t: float, pose: tuple[float, float, float], sensors: dict[int, float | int]
+) -> list[str] | None:
+    """The line's time, pose and sensors put together by hand, as :mod:`json` writes them (a
+    float's JSON is its ``repr``, an int's its ``str``), where they are finite floats and ints
+    by int ports, as nearly every line's are (a run records 20 lines a simulated second, idle
+    or not); None for anything else, which goes through :mod:`json`."""
     x, y, heading = pose
+    if not (type(t) is type(x) is type(y) is type(heading) is float):
+        return None
+    if not math.isfinite(x + y + heading + t):
+        return None
     head = [f'{{"t":{_r(t)!r},"pose":[{_r(x)!r},{_r(y)!r},{_r(heading)!r}],"sensors":{{']
-    plain = type(t) is float and type(x) is type(y) is type(heading) is float
     first = True
     for port, value in sensors.items():
         kind = type(value)
         if kind is float:
             value = round(value, 4)
             if value - value != 0.0:  # inf or nan: json spells them its own way
-                plain = False
-                break
+                return None
             text = repr(value)
         elif kind is int:
             text = str(value)
         else:
-            plain = False
-            break
+            return None
         if type(port) is not int:
-            plain = False
-            break
+            return None
         head.append(f'"{port}":{text}' if first else f',"{port}":{text}')
         first = False
-    if not plain or not math.isfinite(x + y + heading + t):
-        return _dumps(tick_json(t, pose, sensors, commands, state, events, variables))
     head.append("}")
-    if commands:
-        head.append(',"cmd":' + _dumps([command_json(c) for c in commands]))
-    if state is not None:
-        head.append(',"state":' + _dumps(state))
-    if variables:
-        plain_vars = {k: (_r(v) if isinstance(v, float) else v) for k, v in variables.items()}
-        head.append(',"vars":' + _dumps(plain_vars))
-    if events:
-        head.append(',"events":' + _dumps(events))
-    head.append("}")
-    return "".join(head)
-
-
-def tick_json(
-    t: float,
-    pose: tuple[float, float, float],
-    sensors: dict[int, float | int],
-    commands: list[object],
-    state: str | None,
-    events: list[str],
-    variables: dict[str, Any] | None = None,
-) -> dict[str, Any]:
-    """A tick's line as an object (``docs/run-record.md``)."""
-    line: dict[str, Any] = {
-        "t": _r(t),
-        "pose": [_r(pose[0]), _r(pose[1]), _r(pose[2])],
-        "sensors": {str(p): (_r(v) if isinstance(v, float) else v) for p, v in sensors.items()},
-    }
-    if commands:
-        line["cmd"] = [command_json(c) for c in commands]
-    if state is not None:
-        line["state"] = state
-    if variables:
-        line["vars"] = {k: (_r(v) if isinstance(v, float) else v) for k, v in variables.items()}
-    if events:
-        line["events"] = events
-    return line
+    return head
 
 
 def command_json(cmd: object) -> dict[str, Any]:
@@ -308,11 +264,31 @@ class Recorder:
         events: list[str],
         variables: dict[str, Any] | None = None,
     ) -> None:
+        """One control tick's line (``docs/run-record.md``): the JSON of an object with "t",
+        "pose" and "sensors", then "cmd", "state", "vars" and "events" where there are any."""
         if self.stopped is not None:
             return
-        self._put(
-            (tick_line(t, pose, sensors, commands, state, events, variables) + "\n").encode(), t=t
-        )
+        head = _plain_head(t, pose, sensors)
+        if head is None:
+            line = {
+                "t": _r(t),
+                "pose": [_r(pose[0]), _r(pose[1]), _r(pose[2])],
+                "sensors": {
+                    str(p): (_r(v) if isinstance(v, float) else v) for p, v in sensors.items()
+                },
+            }
+            head = [_dumps(line)[:-1]]  # (its closing brace comes after the parts below)
+        if commands:
+            head.append(',"cmd":' + _dumps([command_json(c) for c in commands]))
+        if state is not None:
+            head.append(',"state":' + _dumps(state))
+        if variables:
+            plain = {k: (_r(v) if isinstance(v, float) else v) for k, v in variables.items()}
+            head.append(',"vars":' + _dumps(plain))
+        if events:
+            head.append(',"events":' + _dumps(events))
+        head.append("}\n")
+        self._put("".join(head).encode(), t=t)
 
     def summary(self, metrics: dict[str, Any], **extra: Any) -> None:
         stop = self.stopped

@@ -90,8 +90,8 @@ class AlgorithmState(Vertical):
         self.set_class(not fit, "-running")
         if fit and not self._fit:
             # the rows kept while it ran go back to what the texts take
-            for text in (self._summary, self._states, self._vars, self._last):
-                text.refresh(layout=True)
+            for widget in (self._summary, self._states, self._vars, self._last):
+                widget.refresh(layout=True)
         self._fit = fit
         if definition is None:
             set_border_title(self, "Algorithm")
