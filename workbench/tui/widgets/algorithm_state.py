@@ -88,8 +88,9 @@ class AlgorithmState(Vertical):
         # it is paused (frames come a step at a time then) or not running
         fit = controller is None or station.paused
         self.set_class(not fit, "-running")
-        if fit and not self._fit:
-            # the rows kept while it ran go back to what the texts take
+        if fit != self._fit:
+            # a run starts, pauses, goes on or ends: the screen is laid out again anyway, and
+            # each text takes its own rows (those kept while it ran go back)
             for widget in (self._summary, self._states, self._vars, self._last):
                 widget.refresh(layout=True)
         self._fit = fit
