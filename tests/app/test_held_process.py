@@ -29,9 +29,7 @@ def test_the_app_workbench_starts_on_a_terminal_holds_its_process(tmp_path, monk
 
 
 @pytest.mark.parametrize("holds", [True, False])
-def test_an_app_that_holds_its_process_freezes_its_start_up_objects(
-    tmp_path, monkeypatch, holds
-):
+def test_an_app_that_holds_its_process_freezes_its_start_up_objects(tmp_path, monkeypatch, holds):
     frozen: list[int] = []
     monkeypatch.setattr(gc, "freeze", lambda: frozen.append(1))
     app = make_app(AppSettings(paused=True, student="ann", record_dir=tmp_path / "runs"))

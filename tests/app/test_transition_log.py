@@ -29,8 +29,7 @@ class Host(App):
 
 def transitions(n: int) -> list[Transition]:
     return [
-        Transition(float(i), f"S{i}", f"S{i + 1}", "front < 0.3", {"front": 0.25})
-        for i in range(n)
+        Transition(float(i), f"S{i}", f"S{i + 1}", "front < 0.3", {"front": 0.25}) for i in range(n)
     ]
 
 

@@ -150,6 +150,7 @@ async def test_a_student_sticks_to_one_server_and_outlives_its_loss(tmp_path, pg
         lost.process.wait()
         end_left_over(helpers)
         await again.closed(timeout=30)
+
         # the next page goes to the other server, which asks for a login first
         async def refused_there() -> bool:
             try:
@@ -173,4 +174,3 @@ async def test_a_student_sticks_to_one_server_and_outlives_its_loss(tmp_path, pg
             helpers = web.helpers()
             stop(web.process)
             end_left_over(helpers)
-

@@ -55,9 +55,7 @@ async def test_a_second_tab_takes_the_workbench_over_and_the_first_is_told(tmp_p
 
 @sync
 async def test_a_page_that_does_not_come_back_ends_its_app_after_the_grace(tmp_path):
-    async with web_host(
-        tmp_path, [Account("ann", password=PASSWORD)], reattach_grace=0.5
-    ) as host:
+    async with web_host(tmp_path, [Account("ann", password=PASSWORD)], reattach_grace=0.5) as host:
         browser = host.browser()
         await browser.login("ann")
         page = await browser.page()

@@ -287,8 +287,7 @@ def test_run_draws_a_long_run_whose_record_reached_the_cap(tmp_path, capsys, mon
     # the caption says where the drawn path ends, since the figures are the whole run's
     stopped = float(out.split("run record          stopped after ")[1].split(" s")[0])
     said = (
-        f"the record stopped at {stopped:.1f} s (its size limit): "
-        "the path and its marks end there"
+        f"the record stopped at {stopped:.1f} s (its size limit): the path and its marks end there"
     )
     assert said in texts(target.read_bytes())
     over_time = tmp_path / "long-time.svg"

@@ -52,9 +52,7 @@ def private_module(name: str) -> bool:
 
 
 def outside_serving() -> list[Path]:
-    return [
-        p for p in sorted(ROOT.rglob("*.py")) if SERVING not in p.parents and p != PRIVATE
-    ]
+    return [p for p in sorted(ROOT.rglob("*.py")) if SERVING not in p.parents and p != PRIVATE]
 
 
 def textual_private_names() -> set[str]:
@@ -175,7 +173,10 @@ METHODS = {
     ("textual._compositor", "ChopsUpdate", "__init__"): ["self", "chops", "spans", "chop_ends"],
     ("textual._compositor", "CompositorUpdate", "render_segments"): ["self", "console"],
     ("textual._compositor", "Compositor", "render_update"): [
-        "self", "full", "screen_stack", "simplify"
+        "self",
+        "full",
+        "screen_stack",
+        "simplify",
     ],
     ("textual.app", "App", "_display"): ["self", "screen", "renderable"],
     ("textual.drivers.web_driver", "WebDriver", "_enable_mouse_support"): ["self"],

@@ -45,9 +45,7 @@ class PasswordDesk:
     """Checks passwords against the users file under the login rules of ``guard`` and the
     waiting caps of ``gate``."""
 
-    def __init__(
-        self, users: UsersFile, guard: LoginGuard, gate: ConnectionGate[Any]
-    ) -> None:
+    def __init__(self, users: UsersFile, guard: LoginGuard, gate: ConnectionGate[Any]) -> None:
         self.users = users
         self.guard = guard
         self.gate = gate
@@ -105,4 +103,3 @@ class PasswordDesk:
     def lock_words(self) -> str:
         policy = self.guard.policy
         return f"locked for {describe_duration(policy.lock_for)} after {policy.lock_after} failures"
-

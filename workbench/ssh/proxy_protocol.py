@@ -29,6 +29,7 @@ V2_MAX_BODY = 512
 #: the longest version 1 (text) header, its CRLF included
 V1_MAX = 107
 
+
 class ProxyHeaderError(ValueError):
     """The bytes are not a PROXY protocol header this server takes."""
 

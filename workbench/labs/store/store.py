@@ -427,6 +427,7 @@ class Store:
         rows = self.read("SELECT version, name FROM schema_migrations ORDER BY version")
         return [(int(v), str(n)) for v, n in rows]
 
+
 def _create_database(path: Path) -> None:
     """Make a new, empty workbench database at ``path``, private to the account: built under
     another name and then linked into place, so that no other process ever finds an empty file
