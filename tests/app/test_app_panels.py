@@ -293,8 +293,9 @@ def test_the_transition_log_follows_the_newest_transitions():
 
 
 def test_the_algorithm_panel_keeps_its_rows_while_it_runs_and_fits_them_when_paused():
-    """Running, the algorithm panel's texts never give back rows (the panel does not jump
-    with each shorter transition, and no frame lays the screen out for it); paused, each text
+    """Running, a shorter text in the algorithm panel keeps the rows it had (the panel does not
+    jump with each shorter transition, and no frame lays the screen out for it): the heights
+    change only in a frame where some text needed more rows than it had. Paused, each text
     takes just the rows it needs again."""
     app = unity_app()
     station = app.station
@@ -310,18 +311,19 @@ def test_the_algorithm_panel_keeps_its_rows_while_it_runs_and_fits_them_when_pau
         station.pacer.paused = False
         panel = app.screen.query_one(AlgorithmState)
         texts = [panel.query_one(f"#algorithm-{name}", Static) for name in ("summary", "last")]
-        kept = [0, 0]
+        kept = [rows(widget)[1] for widget in texts]
         shorter = 0
         history = station.driving.controller.history
         while len(history) < 12:
             station.step(30)
             app.refresh_views()
             await pilot.pause()
-            for i, widget in enumerate(texts):
-                needed, height = rows(widget)
-                assert height >= kept[i] and height >= needed
-                shorter += needed < height
-                kept[i] = height
+            now = [rows(widget) for widget in texts]
+            assert all(height >= needed for needed, height in now)
+            if not any(needed > was for (needed, _), was in zip(now, kept, strict=True)):
+                assert [height for _, height in now] == kept  # no text grew: no layout
+            shorter += sum(needed < height for needed, height in now)
+            kept = [height for _, height in now]
         assert shorter  # some text did get shorter than the rows it keeps
         await pilot.press("p")
         app.refresh_views()
