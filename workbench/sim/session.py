@@ -105,7 +105,7 @@ class Session:
         self._next_due: Callable[[], float | None] | None = None
         #: the controller again where it is :class:`Quiet` and paced, else None
         self._quiet: Quiet | None = None
-        self.binding: dict[str, int] = {}
+        self.binding = {}
         self.driver = NOBODY
         self._reset_run_state()
 
@@ -124,6 +124,18 @@ class Session:
         self.last_events: tuple[str, ...] = ()
 
     # -- who drives ---------------------------------------------------------------------
+    @property
+    def binding(self) -> dict[str, int]:
+        """The controller's sensor names -> ports. Change it by assigning a new dict: each
+        control tick walks the (name, port) pairs taken when it was set (a tuple, without an
+        items() view per tick)."""
+        return self._binding
+
+    @binding.setter
+    def binding(self, binding: dict[str, int]) -> None:
+        self._binding = binding
+        self._ports = tuple(binding.items())
+
     def attach(self, controller: Controller, binding: dict[str, int], driver: Driver) -> None:
         """Let ``controller`` drive; ``binding`` maps its sensor names to ports."""
         self.controller = controller
@@ -214,7 +226,10 @@ class Session:
         n = self._steps + 1
         due = self._due
         # nothing due (inf, as a controller without next_due always has) needs no end of step
-        if due != _NEVER and due < n * self._dt - _SAME:
+        # and no wake after it: the common step tests that once
+        if due == _NEVER:
+            events = self._world_step()
+        elif due < n * self._dt - _SAME:
             early = self._wake_within()
             events = self._world_step()
             if early:
@@ -231,7 +246,7 @@ class Session:
             self._commands.append(cmd)
         if n % self.every == 0:
             self._control_tick()
-        else:
+        elif due != _NEVER:  # (nothing makes it due during the step but a wake)
             due = self._due
             if due != _NEVER and due <= self.world.time + _SAME:
                 self._wake(self.world.time)
@@ -269,7 +284,7 @@ class Session:
         self.readings = readings = world.read_sensors()
         # by the controller's names (a plain loop: a comprehension costs a frame of its own)
         named = {}
-        for name, port in self.binding.items():
+        for name, port in self._ports:
             named[name] = readings[port]
         commands = controller.tick(t, named, _NONE)
         self._ask_due()
@@ -298,13 +313,14 @@ class Session:
         elif controller is not None and run_controller:
             if self._started:
                 named = {}  # as in _wake
-                for name, port in self.binding.items():
+                for name, port in self._ports:
                     named[name] = readings[port]
                 commands = controller.tick(t, named, frozenset(events) if events else _NONE)
             else:
                 self._started = True
                 commands = controller.start(t)
-            self._ask_due()
+            if self._next_due is not None:  # (an FSM has none: no call to ask nothing)
+                self._ask_due()
             if commands:
                 for cmd in commands:
                     world.apply(cmd)

@@ -307,7 +307,9 @@ class World:
         #: the part of the current step already done by :meth:`step_to`, seconds
         self._part = 0.0
         self.time = 0.0
-        self._x, self._y, self._angle = self._start
+        #: the heading in radians, not wrapped: its change over time is the robot's signed
+        #: turning (a plain attribute, as ``time`` is: the session reads it every control tick)
+        self._x, self._y, self.angle = self._start
         self._distance = 0.0
         self._turned = 0.0
         self._collisions = 0
@@ -395,7 +397,7 @@ class World:
     def _is_touch(self, normal: pymunk.Vec2d) -> bool:
         """Whether a contact along ``normal`` (from the robot to the wall) meets a bumper
         gently: within a touch sensor's arc, at no more than TOUCH_SPEED blocks a second."""
-        a = self._angle
+        a = self.angle
         c = math.cos(a)
         s = math.sin(a)
         dirs = ((c, s), (-s, c), (-c, -s), (s, -c))
@@ -435,7 +437,7 @@ class World:
                 raise WorldError(f"cannot turn by {command.degrees!r} degrees")
             self._wheels = (0.0, 0.0)
             turn = math.radians(degrees) * turn_factor(self.noise, self._rng)
-            self._turn_target = self._angle + turn
+            self._turn_target = self.angle + turn
         elif isinstance(command, MotorPower):
             speed = command.power * p.max_wheel_speed
             left, right = self._wheels
@@ -456,7 +458,7 @@ class World:
         # the control body's C setters directly (what its properties call, without their
         # Python wrappers: a program or a driver at 20 Hz sends a command nearly every tick)
         control = self._control_ptr
-        a = self._angle
+        a = self.angle
         _set_velocity(control, (v * math.cos(a), v * math.sin(a)))
         _set_angular_velocity(control, w)
         self._reaim = v != 0.0 and w != 0.0
@@ -493,7 +495,7 @@ class World:
                 self.time = t = steps * self.dt
                 self._readings = None
                 if self._watch_exit:
-                    return self._events(t, x, y, self._angle, None)
+                    return self._events(t, x, y, self.angle, None)
                 return _NO_EVENTS
             return self._advance(self.dt, True)
         part = self._part
@@ -505,7 +507,7 @@ class World:
         # (the same floating-point operations in the same order; what would add 0.0 or store
         # what is there is left out), without its call, where the motion stays in the box
         dt = self.dt
-        a0 = self._angle
+        a0 = self.angle
         target = self._turn_target
         if target is not None:
             # turning in place: _advance's free turn
@@ -545,7 +547,7 @@ class World:
         steps = self._steps + 1.0
         self._steps = steps
         self.time = t = steps * dt
-        self._angle = a
+        self.angle = a
         self._readings = None
         # no contact can have started (no physics ran): events only when a turn may have ended
         # or an exit may have been reached
@@ -571,7 +573,7 @@ class World:
         target = self._turn_target
         x0 = self._x
         y0 = self._y
-        a0 = self._angle
+        a0 = self.angle
         free = False
         if self._contacts == 0:
             if target is not None:
@@ -659,7 +661,7 @@ class World:
         self._moved = moved or turned
         self._x = x
         self._y = y
-        self._angle = a
+        self.angle = a
         self._readings = None
         if target is None and not self._new_collision and not self._watch_exit:
             return _NO_EVENTS  # nothing can have happened: the common step ends here
@@ -714,7 +716,7 @@ class World:
 
     def _sync_body(self) -> None:
         """Hand the directly integrated pose and motion back to pymunk before it steps again."""
-        a = self._angle
+        a = self.angle
         v = self._v if self._turn_target is None else 0.0
         velocity = (v * math.cos(a), v * math.sin(a))
         ptr = self._body_ptr
@@ -739,13 +741,8 @@ class World:
     @property
     def pose(self) -> Pose:
         """Centre (x, y) in world units and heading in degrees, 0 = right, clockwise."""
-        heading = math.degrees(self._angle) % 360.0
+        heading = math.degrees(self.angle) % 360.0
         return Pose(self._x, self._y, 0.0 if heading == 360.0 else heading)
-
-    @property
-    def angle(self) -> float:
-        """Heading in radians, not wrapped: its change over time is the robot's signed turning."""
-        return self._angle
 
     @property
     def block(self) -> tuple[int, int]:
@@ -785,7 +782,7 @@ class World:
         """
         if self._readings is not None:
             return self._readings
-        a = self._angle
+        a = self.angle
         if a != self._dirs_angle:
             c = math.cos(a)
             s = math.sin(a)
