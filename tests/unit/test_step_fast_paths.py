@@ -20,7 +20,9 @@ from workbench.control.headless import AlgorithmPilot, RunSpec, run
 from workbench.fsm.algorithms import load_algorithm
 from workbench.fsm.machine import FsmController, bind_sensors
 from workbench.program.pilot import ProgramPilot
+from workbench.sim import world as world_module
 from workbench.sim.commands import MotorPower, MoveAtPower, Stop, TurnByDegrees, WheelPowers
+from workbench.sim.generate import generate
 from workbench.sim.maze import Maze
 from workbench.sim.mazeio import load_maze
 from workbench.sim.metrics import TurnCounter
@@ -199,3 +201,67 @@ def test_the_walls_in_touch_reach_are_those_a_search_of_all_nine_blocks_finds(pr
         x, y = i * cell + fx, j * cell + fy
         world._x, world._y = x, y
         assert world._wall_contacts() == _contacts_of_all_nine(world, x, y), (x, y)
+
+
+def _pymunk_steps_counted(monkeypatch) -> list[int]:
+    """Count the steps pymunk takes from now on (one counter: the list's only item)."""
+    counter = [0]
+    space_step = world_module._space_step
+
+    def counted(space: object, dt: float) -> None:
+        counter[0] += 1
+        space_step(space, dt)
+
+    monkeypatch.setattr(world_module, "_space_step", counted)
+    return counter
+
+
+def _pymunk_takes_every_step_out_of_the_free_box(monkeypatch) -> None:
+    # a joint that always holds an impulse: no step is found to be pymunk's free motion
+    monkeypatch.setattr(world_module, "_get_impulse", lambda constraint: 1.0)
+
+
+@pytest.mark.parametrize("name", RUNS)
+def test_a_run_is_the_same_when_pymunk_takes_every_step_out_of_the_free_box(
+    name, tmp_path, monkeypatch
+):
+    """Out of the free box, a step pymunk would take exactly as free motion (no wall within
+    the box's clearance, both bodies moving alike, no joint impulse held, no contact
+    remembered) is taken without pymunk: letting pymunk take every such step gives the same
+    record byte for byte."""
+    spec = RUNS[name]
+    stepped = _pymunk_steps_counted(monkeypatch)
+    fast = run(_recorded(spec, tmp_path / "fast.jsonl"))
+    fast_steps, stepped[0] = stepped[0], 0
+    _pymunk_takes_every_step_out_of_the_free_box(monkeypatch)
+    slow = run(_recorded(spec, tmp_path / "slow.jsonl"))
+    assert fast.metrics == slow.metrics
+    assert (tmp_path / "fast.jsonl").read_bytes() == (tmp_path / "slow.jsonl").read_bytes()
+    assert stepped[0] >= fast_steps
+
+
+@pytest.mark.parametrize("profile", ["erobotic", "web", "unity"])
+def test_poses_along_corridors_are_the_same_when_pymunk_takes_every_step(profile, monkeypatch):
+    """Right-wall following through a perfect maze, past the corners of the walls beside the
+    corridors (out of the free box, within reach of no wall): every step's pose, events and
+    odometry, with the short cut and without it; and the short cut was taken."""
+    maze = generate(8, 8, seed=4, style="perfect", exit="none")
+    definition = load_algorithm("right-wall")
+    sensors = [SensorSpec("distance", 1, "front"), SensorSpec("distance", 2, "right")]
+
+    def trace() -> list[tuple]:
+        session = Session(maze, profile, sensors, "off", seed=0)
+        controller = FsmController(definition, {}, profile)
+        session.attach(controller, bind_sensors(definition, sensors, profile), "fsm")
+        out: list[tuple] = []
+        for _ in range(4000):
+            events = session.step()
+            out.append((session.world.pose, events, session.world.odometry))
+        return out
+
+    stepped = _pymunk_steps_counted(monkeypatch)
+    fast = trace()
+    fast_steps, stepped[0] = stepped[0], 0
+    _pymunk_takes_every_step_out_of_the_free_box(monkeypatch)
+    assert trace() == fast
+    assert stepped[0] > fast_steps + 100, "the short cut was hardly taken: this tests nothing"

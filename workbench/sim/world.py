@@ -76,6 +76,7 @@ _set_position = _cp.cpBodySetPosition
 _set_angle = _cp.cpBodySetAngle
 _set_velocity = _cp.cpBodySetVelocity
 _set_angular_velocity = _cp.cpBodySetAngularVelocity
+_get_impulse = _cp.cpConstraintGetImpulse
 
 
 class WorldError(ValueError):
@@ -257,6 +258,8 @@ class World:
         self._has_exits = any(exits)
         c = self.cell
         self._boxes: dict[int, tuple[float, float, float, float]] = {}
+        #: block key -> the places out of reach of every wall near it (_make_reach), as needed
+        self._reaches: dict[int, tuple[float, float, float, float, float, float, float, float]] = {}
         #: block key and near sides -> the wall blocks there (_walls_near), made when first needed
         self._walls_around: dict[int, tuple[tuple[float, float, float, float], ...]] = {}
         self._segments = [
@@ -329,10 +332,15 @@ class World:
         self._readings = None
         self._free_w = 0.0
         self._physics_stale = False
+        #: whether pymunk's body lags behind only in its place (after steps _advance found
+        #: pymunk would take exactly as free motion): its velocities are what they would be
+        self._place_stale = False
         self._step_angle = self._step_v = math.nan  # the cached step of straight driving
         self._step_dt = self.dt
         self._step_dx = self._step_dy = self._step_moved = 0.0
         self._box = (math.inf, -math.inf, math.inf, -math.inf)
+        #: the block ``_box`` is of (0: a corner of the padding, a wall, with no free box)
+        self._box_key = 0
         #: whether the next whole step, if it ends in the free box, is the straight step
         #: ``_step_dx``, ``_step_dy`` of a robot driving straight ahead, out of contact, its
         #: centre in the box, with nothing but the pose and time to change: set by _advance for
@@ -341,6 +349,12 @@ class World:
         #: whether the robot's centre is in ``_box`` (as _advance's test of the box finds it);
         #: asked only out of contact, so left False while in contact
         self._in_box = False
+        #: whether pymunk's next step, if it meets no wall, moves the robot exactly as free
+        #: motion does (see _sync_body, which finds it so; a command or a contact clears it)
+        self._exact = False
+        #: pymunk steps still to go before a contact that ended is forgotten (its arbiter,
+        #: whose impulses a new contact of the same pair would start from, is dropped)
+        self._remembered = 0
 
     def _build_space(self) -> None:
         space = pymunk.Space()
@@ -381,10 +395,14 @@ class World:
         self._body_ptr = body._body
         self._control = control
         self._control_ptr = control._body
+        self._pivot_ptr = pivot._constraint
+        self._gear_ptr = gear._constraint
+        self._persistence = int(space.collision_persistence)
 
     def _contact_begin(self, arbiter: pymunk.Arbiter, space: pymunk.Space, data: object) -> None:
         if space is not self._space:
             return
+        self._exact = False
         if self._contacts == 0 and self.time - self._last_contact_end > _COLLISION_GAP:
             if self._bumpers and self._is_touch(arbiter.normal):
                 self._touches += 1
@@ -420,6 +438,7 @@ class World:
         Any command abandons a Turn by Degree in progress.
         """
         self._cruise = False
+        self._exact = False
         self._turn_target = None
         p = self.profile
         if isinstance(command, WheelPowers):
@@ -609,6 +628,7 @@ class World:
                 if known is None:
                     known = self._boxes[key] = self._make_box(key)
                 self._box = box = known
+                self._box_key = key
             xmin, xmax, ymin, ymax = box
             if xmin <= x <= xmax and ymin <= y <= ymax:
                 # free motion: no wall within reach, so no contact can start this step
@@ -626,31 +646,59 @@ class World:
             # one pymunk step (not a method of its own: a call would cost every physics step)
             if self._physics_stale:
                 self._sync_body()
-            if target is not None:
-                # positions integrate with the previous step's velocity: plan one step ahead
-                ahead = a0 + _get_angular_velocity(self._body_ptr) * dt
-                rate = self._turn_rate
-                w = (target - ahead) / dt
-                _set_angular_velocity(self._control_ptr, max(-rate, min(rate, w)))
-            elif self._reaim:
-                v = self._v
-                _set_velocity(self._control_ptr, (v * math.cos(a0), v * math.sin(a0)))
-            # the C step directly: the wrapper's bookkeeping (deferred adds and removals,
-            # first-step mass checks) has nothing to do for this space after it is built
-            _space_step(self._space_ptr, dt)
-            body = self._body_ptr
-            pos = _get_position(body)
-            x = pos.x
-            y = pos.y
-            a = _get_angle(body)
-            moved = math.hypot(x - x0, y - y0)
-            turned = abs(a - a0)
-            if self._contacts:
-                # only asked out of contact: worked out at the step that ends the contact
-                self._in_box = False
-            else:
+            exact = False
+            if self._exact and not self._contacts and whole and target is None and not w:
+                # the end of the step out of every wall's reach: of the places in the box's
+                # block that keep the box's clearance wall by wall (_make_reach)
+                reach = self._reaches.get(self._box_key)
+                if reach is None:
+                    reach = self._reaches[self._box_key] = self._make_reach(self._box_key)
+                ax0, ax1, ay0, ay1, bx0, bx1, by0, by1 = reach
+                exact = (ax0 <= x <= ax1 and ay0 <= y <= ay1) or (
+                    bx0 <= x <= bx1 and by0 <= y <= by1
+                )
+            if exact:
+                # pymunk's step, which would meet no wall, moves the robot exactly as free motion
+                # does (see _sync_body): that motion, with the odometry of a pymunk step; pymunk's
+                # body is given the place at its next step, its motion being what the step left
+                self._place_stale = True
+                a = a0
+                moved = math.hypot(x - x0, y - y0)
+                turned = abs(a - a0)
                 xmin, xmax, ymin, ymax = self._box
                 self._in_box = xmin <= x <= xmax and ymin <= y <= ymax
+            else:
+                if self._place_stale:
+                    _set_position(self._body_ptr, (x0, y0))
+                    self._place_stale = False
+                if target is not None:
+                    # positions integrate with the previous step's velocity: plan one step ahead
+                    ahead = a0 + _get_angular_velocity(self._body_ptr) * dt
+                    rate = self._turn_rate
+                    w = (target - ahead) / dt
+                    _set_angular_velocity(self._control_ptr, max(-rate, min(rate, w)))
+                elif self._reaim:
+                    v = self._v
+                    _set_velocity(self._control_ptr, (v * math.cos(a0), v * math.sin(a0)))
+                # the C step directly: the wrapper's bookkeeping (deferred adds and removals,
+                # first-step mass checks) has nothing to do for this space after it is built
+                _space_step(self._space_ptr, dt)
+                body = self._body_ptr
+                pos = _get_position(body)
+                x = pos.x
+                y = pos.y
+                a = _get_angle(body)
+                moved = math.hypot(x - x0, y - y0)
+                turned = abs(a - a0)
+                if self._contacts:
+                    # only asked out of contact: worked out at the step that ends the contact
+                    self._in_box = False
+                    self._remembered = self._persistence + 1
+                else:
+                    if self._remembered:
+                        self._remembered -= 1
+                    xmin, xmax, ymin, ymax = self._box
+                    self._in_box = xmin <= x <= xmax and ymin <= y <= ymax
         if whole:
             self._steps += 1.0
             self.time = t = self._steps * self.dt
@@ -714,6 +762,40 @@ class World:
             y0 + c - (keep if down else 0.0),
         )
 
+    def _make_reach(
+        self, key: int
+    ) -> tuple[float, float, float, float, float, float, float, float]:
+        """Two boxes (x0, x1, y0, y1 each) that together hold the places in block ``key`` out
+        of the clearance of every wall block around it: one kept from the walls straight left
+        and right and from any wall in the rows above and below, the other the same turned a
+        quarter (a wall on a diagonal is in a row and a column, so each box keeps clear of it)."""
+        wp = self._wp
+        solid = self._solid
+        c = self.cell
+        keep = self._radius + 0.02 * c  # the free box's clearance
+        if solid[key]:
+            return (math.inf, -math.inf, math.inf, -math.inf) * 2
+        left = solid[key - 1]
+        right = solid[key + 1]
+        up = solid[key - wp]
+        down = solid[key + wp]
+        row_up = solid[key - wp - 1] or up or solid[key - wp + 1]
+        row_down = solid[key + wp - 1] or down or solid[key + wp + 1]
+        column_left = solid[key - 1 - wp] or left or solid[key - 1 + wp]
+        column_right = solid[key + 1 - wp] or right or solid[key + 1 + wp]
+        x0 = (key % wp - 1) * c
+        y0 = (key // wp - 1) * c
+        return (
+            x0 + (keep if left else 0.0),
+            x0 + c - (keep if right else 0.0),
+            y0 + (keep if row_up else 0.0),
+            y0 + c - (keep if row_down else 0.0),
+            x0 + (keep if column_left else 0.0),
+            x0 + c - (keep if column_right else 0.0),
+            y0 + (keep if up else 0.0),
+            y0 + c - (keep if down else 0.0),
+        )
+
     def _sync_body(self) -> None:
         """Hand the directly integrated pose and motion back to pymunk before it steps again."""
         a = self.angle
@@ -728,6 +810,22 @@ class World:
         _set_velocity(control, velocity)
         _set_angular_velocity(control, self._free_w)
         self._physics_stale = False
+        self._place_stale = False
+        # Now both bodies move alike, along the heading and not turning, if the robot drives
+        # straight or stands. Then, while the joints hold no impulse and no contact is
+        # remembered, a pymunk step that meets no wall changes neither velocity (the joints
+        # find nothing to correct) and moves the robot by its velocity times the step, the
+        # same floating-point operations as free motion; and so does every such step after it
+        # until a command or a contact (which clear _exact).
+        self._exact = (
+            not self._free_w
+            and not self._w
+            and self._turn_target is None
+            and not self._contacts
+            and not self._remembered
+            and _get_impulse(self._pivot_ptr) == 0.0
+            and _get_impulse(self._gear_ptr) == 0.0
+        )
 
     def run(self, seconds: float) -> list[tuple[float, str]]:
         """Step for ``seconds`` of simulated time; the (time, event) pairs that happened."""
