@@ -643,7 +643,8 @@ class World:
             self._cruise = whole and v != 0.0 and w == 0.0 and target is None and dt == self.dt
         else:
             self._cruise = False
-            # one pymunk step (not a method of its own: a call would cost every physics step)
+            # one pymunk step, or one taken as pymunk would take it (not a method of its own:
+            # a call would cost every physics step)
             if self._physics_stale:
                 self._sync_body()
             exact = False
