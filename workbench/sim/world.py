@@ -649,8 +649,9 @@ class World:
                 self._sync_body()
             exact = False
             if self._exact and not self._contacts and whole and target is None and not w:
-                # the end of the step out of every wall's reach: of the places in the box's
-                # block that keep the box's clearance wall by wall (_make_reach)
+                # the end of the step out of every wall's reach: among the places of the box's
+                # block that keep the box's clearance wall by wall (_make_reach), or else of the
+                # block the step ends in
                 reach = self._reaches.get(self._box_key)
                 if reach is None:
                     reach = self._reaches[self._box_key] = self._make_reach(self._box_key)
@@ -658,6 +659,8 @@ class World:
                 exact = (ax0 <= x <= ax1 and ay0 <= y <= ay1) or (
                     bx0 <= x <= bx1 and by0 <= y <= by1
                 )
+                if not exact:
+                    exact = self._out_of_reach(x, y)
             if exact:
                 # pymunk's step, which would meet no wall, moves the robot exactly as free motion
                 # does (see _sync_body): that motion, with the odometry of a pymunk step; pymunk's
@@ -762,6 +765,17 @@ class World:
             y0 + (keep if up else 0.0),
             y0 + c - (keep if down else 0.0),
         )
+
+    def _out_of_reach(self, x: float, y: float) -> bool:
+        """Whether the robot's centre at (x, y) is among the places of the block it is in
+        that keep the free box's clearance from every wall block (_make_reach)."""
+        inv = self._inv_cell
+        key = (int(y * inv) + 1) * self._wp + int(x * inv) + 1
+        reach = self._reaches.get(key)
+        if reach is None:
+            reach = self._reaches[key] = self._make_reach(key)
+        ax0, ax1, ay0, ay1, bx0, bx1, by0, by1 = reach
+        return (ax0 <= x <= ax1 and ay0 <= y <= ay1) or (bx0 <= x <= bx1 and by0 <= y <= by1)
 
     def _make_reach(
         self, key: int
