@@ -332,6 +332,12 @@ class Session:
         return self.controller is None and self._scheduled is None and self.world.still
 
     @property
+    def settled(self) -> bool:
+        """As :attr:`still`, with the robot standing to the eye (:attr:`World.settled`): what
+        is left to change can not be seen."""
+        return self.controller is None and self._scheduled is None and self.world.settled
+
+    @property
     def reached_exit(self) -> bool:
         return self.world.odometry.exit_time is not None
 
