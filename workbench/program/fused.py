@@ -25,9 +25,9 @@ part that goes wrong (or that is not written out) is run by that function on the
 values, so its error has the same text. Where every value a call needs is known when the
 chain is made (a Data's constant stored by a Variable, a Timer of a known wait, a Robot Drive
 of two literal powers), the call is made then, once, and the code holds its result; a call
-that raises is left in the code, to raise as the step does. So commands, prints, globals, changes, flows,
-activity counts and errors are the step-by-step run's (``ProgramController(fuse=False)``;
-``tests/program/test_fused.py`` runs programs both ways).
+that raises is left in the code, to raise as the step does. So commands, prints, globals,
+changes, flows, activity counts and errors are the step-by-step run's
+(``ProgramController(fuse=False)``; ``tests/program/test_fused.py`` runs programs both ways).
 
 Security: the source is made of this module's own text and of names it numbers itself
 (``c0``, ``c1`` ...); every value that comes from the program (ids, pins, constants, names,

@@ -394,7 +394,12 @@ class ProgramController:
             if self.paced:
                 start = self._next_report
                 period = self._period
-                self._next_report = start + period * (1 + int((t + _SAME - start) // period))
+                late = t + _SAME - start
+                # a report on time (late by less than a period, so the floor is 0): the same
+                # sum, without the division
+                self._next_report = (
+                    start + period if late < period else start + period * (1 + int(late // period))
+                )
             plan = self._plan
             if report is not None or plan is None or readings.keys() != plan[0]:
                 plan = self._plan = self._plan_for(readings) if report is None else None
@@ -699,8 +704,12 @@ class ProgramController:
                 spare.append(flow)
                 continue
             if result & SLEEPS:
-                if flow.wait > 0:
-                    due = _whole_ms(now + max(flow.wait, MIN_WAIT))
+                wait = flow.wait
+                if wait > 0:
+                    # _whole_ms(now + max(wait, MIN_WAIT)), without its calls
+                    due = now + (wait if wait > MIN_WAIT else MIN_WAIT)
+                    if due < 1e12:
+                        due = math.ceil(due * 1000.0 - 1e-6) / 1000.0
                     heappush(self._sleeping, (due, flow.number, flow))
                 else:
                     ready.append(flow)
