@@ -308,6 +308,7 @@ class ProgramController:
         self._next_key = 0
         self._typed = TypedKeys()
         self._pushed: list[KeyEvent] = []
+        self._note_keys()
         self._touch: dict[int, int] = {}
         #: the report being handed to the sensor activities (a raw sensor's message)
         self._report: str | None = None
@@ -377,15 +378,16 @@ class ProgramController:
         self.now = t
         if self.stopped is not None:
             return []
+        soon = t + _SAME
         sleeping = self._sleeping
-        while sleeping and sleeping[0][0] <= t + _SAME:
+        while sleeping and sleeping[0][0] <= soon:
             self._ready.append(heappop(sleeping)[2])
         if self._parked:
             self._ready.extend(self._parked)
             self._parked = []
-        if self._pushed or self._next_key < len(self.key_script) or self._typed.held:
+        if self._keys_pending:
             self._keys(t)
-        if (t + _SAME >= self._next_report if self.paced else self._report_due(t)) and (
+        if (soon >= self._next_report if self.paced else self._report_due(t)) and (
             readings or report is not None
         ):
             # a tick between two reports (of a remote robot, or of the paced simulator) fires
@@ -394,7 +396,7 @@ class ProgramController:
             if self.paced:
                 start = self._next_report
                 period = self._period
-                late = t + _SAME - start
+                late = soon - start
                 # a report on time (late by less than a period, so the floor is 0): the same
                 # sum, without the division
                 self._next_report = (
@@ -426,12 +428,11 @@ class ProgramController:
         sleeping = self._sleeping
         if sleeping and sleeping[0][0] < due:
             due = sleeping[0][0]
-        script = self.key_script
-        if self._next_key < len(script) and script[self._next_key].time < due:
-            due = script[self._next_key].time
+        if self._key_due < due:
+            due = self._key_due
         self._due = due
         self._due_or_none = None if due == _NEVER else due
-        quiet = not (self._ready or self._parked or self._pushed or self._typed.held)
+        quiet = not (self._ready or self._parked or self._keys_typed)
         self.quiet_until = due if quiet and self.state is not None else -_NEVER
 
     @property
@@ -459,7 +460,19 @@ class ProgramController:
         if self.stopped is not None:
             return
         self._pushed += self._typed.press(key.lower(), t)
+        self._note_keys()
         self.quiet_until = -_NEVER  # the key fires at the next tick
+
+    def _note_keys(self) -> None:
+        """After the keys changed (the script's next key, keys typed or held): when the next
+        scripted key is due, and whether a tick has keys to see to (what ``tick`` and
+        ``_refresh_due`` read, instead of asking the script and the typed keys each time)."""
+        script = self.key_script
+        left = self._next_key < len(script)
+        self._key_due = script[self._next_key].time if left else _NEVER
+        #: keys typed and not yet fired, or one held until its release is due
+        self._keys_typed = bool(self._pushed or self._typed.held)
+        self._keys_pending = left or self._keys_typed
 
     @property
     def held(self) -> frozenset[str]:
@@ -479,6 +492,7 @@ class ProgramController:
         pushed, self._pushed = self._pushed, []
         for event in pushed:
             self._key_event(event)
+        self._note_keys()
 
     def _key_event(self, event: KeyEvent) -> None:
         """One press or release, from a key script or typed: the one way keys reach events."""
@@ -1166,6 +1180,7 @@ class ProgramController:
         self._joins = {}
         self._join_parts = 0
         self._pushed = []
+        self._note_keys()
         self.commands = []
         self.state = "stopped"
         return [Stop()]
