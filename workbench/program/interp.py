@@ -720,7 +720,9 @@ class ProgramController:
             if result & SLEEPS:
                 wait = flow.wait
                 if wait > 0:
-                    # _whole_ms(now + max(wait, MIN_WAIT)), without its calls
+                    # at least MIN_WAIT, up to the clock's next whole millisecond (the time
+                    # itself when it is one, or when it lies beyond any run: an endless wait
+                    # stays endless)
                     due = now + (wait if wait > MIN_WAIT else MIN_WAIT)
                     if due < 1e12:
                         due = math.ceil(due * 1000.0 - 1e-6) / 1000.0
@@ -1279,14 +1281,6 @@ def convert(value: Value, vtype: str) -> Value:
         if not isinstance(value, bool):
             raise ValueError(f"{type_name(value)} cannot be stored in a Boolean")
     return value
-
-
-def _whole_ms(t: float) -> float:
-    """``t`` rounded up to the clock's next whole millisecond (``t`` itself when it is one, or
-    when it lies beyond any run: an endless wait stays endless)."""
-    if not t < 1e12:
-        return t
-    return math.ceil(t * 1000.0 - 1e-6) / 1000.0
 
 
 def _port(ports: dict[str, int], name: str) -> int:
