@@ -199,6 +199,21 @@ class _Park(Exception):
 class ProgramController:
     """A :class:`workbench.sim.session.Controller` that runs a VIPLE program."""
 
+    # every attribute a slot: a tick reads and sets a hundred of them, and a slot is found
+    # without a dictionary's lookup (there are too many for the instance dictionaries CPython
+    # shares between objects of a class)
+    __slots__ = (
+        "_activities", "_busy", "_chains", "_count_flows", "_due", "_due_or_none", "_exprs",
+        "_fires", "_handlers", "_held", "_hot", "_join_parts", "_joins", "_key_due",
+        "_keys_pending", "_keys_typed", "_main", "_next_key", "_next_report", "_numbers",
+        "_outputs", "_parked", "_parsed", "_period", "_plan", "_ports", "_pushed", "_reads",
+        "_ready", "_report", "_runs", "_second_steps", "_senses", "_sleeping", "_spare", "_steps",
+        "_the_scope", "_touch", "_typed", "_var_keys", "_window", "changes", "commands", "compiled",
+        "errors", "errors_total", "fired", "flows_dropped", "globals", "key_script", "limits",
+        "next_due", "now", "paced", "printed", "printed_dropped", "printed_total", "program",
+        "quiet_until", "recent", "report_period", "state", "steps", "stopped",
+    )  # fmt: skip
+
     def __init__(
         self,
         compiled: Compiled,
