@@ -279,3 +279,53 @@ def test_any_condition_runs_the_same_fused_errors_included(tmp_path_factory, con
     b.link(sensor, m.add(1, "n"))
     path = b.write(tmp_path_factory.mktemp("fuzz") / "p.viple")
     both_ways(path, 1.1, lambda t: {1: values[int(t * 4) % 4]})
+
+
+def test_known_messages_and_literal_powers_are_worked_out_once_and_agree(tmp_path):
+    """A Data's constant stored by a Variable, a Timer of a known wait and a Robot Drive of two
+    literal powers run as values made when the chain is made; the ones that would raise (a
+    text for an Int32, a Timer of text, a power of text) still raise as the steps do."""
+    b = ProgramBuilder()
+    b.var("n", "System.Int32")
+    b.var("word", "System.String")
+    m = b.panel("Main")
+    b.robot(m)
+    sensor = m.add(23, ROBOT, "1")
+    cond = m.add(6, "value > 50", "value > 20")
+    b.link(sensor, cond)
+    # known all along: 7 stored as text, a drive of -0.2 and 0.4, a Timer of 250 ms
+    m.chain(m.add(3, "7"), m.add(1, "word"), m.add(20, "-0.2", "0.4", ROBOT, "3", "5"))
+    fast = m.add(3, "250")
+    b.link(cond, fast, pin=0)
+    m.chain(fast, m.add(1, "n"), m.add(20, "0.5", "--0.5", ROBOT, "3", "5"), m.add(15))
+    # known, but each goes wrong: "abc" is no Int32, a Timer of text, a power of text
+    wrong = m.add(3, '"abc"')
+    b.link(cond, wrong, pin=1)
+    b.link(wrong, m.add(1, "n"))
+    b.link(wrong, m.add(15))
+    b.link(wrong, m.add(20, '"fast"', "0.5", ROBOT, "3", "5"))
+    b.link(cond, m.add(20, '-"a"', "0.5", ROBOT, "3", "5"), pin=ELSE)
+    got = both_ways(b.write(tmp_path / "p.viple"), 6.0, lambda t: {1: (t * 37) % 80})
+    commands, errors = got[0], got[3]
+    assert {(c.left, c.right) for c in commands} >= {(-0.2, 0.4), (0.5, 0.5)}
+    assert any("is not a number for a Int32" in e for e in errors)
+    assert any("the Timer needs a number of milliseconds" in e for e in errors)
+    assert any("the left power must be a number" in e for e in errors)
+    assert any("- needs a number" in e for e in errors)
+    assert got[5]["word"] == "7"
+
+
+def test_a_literal_drive_makes_its_command_once(tmp_path):
+    """The chain of a Robot Drive of two literal powers sends the one command it made when it
+    was made, at every pass (the same frozen value each time)."""
+    b = ProgramBuilder()
+    m = b.panel("Main")
+    b.robot(m)
+    sensor = m.add(23, ROBOT, "1")
+    b.link(sensor, m.add(20, "0.3", "-0.3", ROBOT, "3", "5"))
+    compiled = compile_program(load_program(str(b.write(tmp_path / "p.viple"))))
+    c = ProgramController(compiled, (), 0.25)
+    commands = run(c, 2.0, {1: 10})
+    assert len(commands) == 8
+    assert all(cmd is commands[0] for cmd in commands)
+    assert (commands[0].left, commands[0].right) == (0.3, -0.3)

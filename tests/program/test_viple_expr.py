@@ -376,3 +376,18 @@ def test_and_and_or_need_true_or_false_on_the_side_they_read(text, message):
     with pytest.raises(ExprError) as caught:
         parse(text)(Scope(value=3))
     assert message in str(caught.value)
+
+
+def test_a_negated_number_literal_is_a_literal_and_a_negated_text_still_fails_as_it_runs():
+    for text, value in (("-0.2", -0.2), ("--3", 3), ("-(1.5)", -1.5), ("- 0", 0)):
+        expression = parse(text)
+        assert expression.tree is not None and expression.tree.kind == "literal"
+        assert expression.tree.data == (value,)
+        assert expression.run(SCOPE) == value and type(expression.run(SCOPE)) is type(value)
+    # a comparison with it compares as with the value itself
+    assert parse("value > -30").run(SCOPE) is True
+    assert parse("-value").tree.kind != "literal"
+    wrong = parse('-"a"')
+    assert wrong.tree is None or wrong.tree.kind != "literal"
+    with pytest.raises(ExprError, match="- needs a number, not String"):
+        wrong.run(SCOPE)

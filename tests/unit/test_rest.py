@@ -101,3 +101,68 @@ def test_a_long_rest_tick_keeps_all_the_time_it_owes():
     assert s.session.world.time == pytest.approx(0.25, abs=1 / 60)
     s.advance(1.0, lag=1.25)
     assert s.session.world.time == pytest.approx(1.25, abs=1 / 60)
+
+
+def _pressed_into_a_wall() -> LabStation:
+    """A station whose robot drove into a wall and was stopped there."""
+    s = station()
+    s.key("w")
+    for _ in range(400):  # 20 s at most: the start's corridor ends in a wall
+        s.advance(0.05)
+        if s.session.world.in_contact:
+            break
+    assert s.session.world.in_contact
+    s.advance(0.5)  # pressed on into it
+    s.key("space")
+    return s
+
+
+def test_a_robot_stopped_against_a_wall_rests_while_the_solver_eases_it_off():
+    s = _pressed_into_a_wall()
+    w = s.session.world
+    rested = None
+    for step in range(1, 601):  # 10 s
+        s.step(1)
+        if rested is None and s.at_rest:
+            rested = step, w.pose
+            assert not s.idle  # time still moves the robot: a dialog does not hold it
+        if w.still:
+            break
+    assert w.still and rested is not None
+    first, pose = rested
+    # at rest within 3 s, well before the creep ends, and what was left of it is invisible
+    assert first <= 180 < step
+    assert abs(w.pose.x - pose.x) + abs(w.pose.y - pose.y) < 1e-8 * w.cell
+
+
+@pytest.mark.parametrize("rest_tick", [0.5, 4.0])
+def test_a_rest_against_a_wall_gives_the_run_of_twenty_ticks_a_second(rest_tick):
+    """Stopped against a wall, left there, then driven off: the same poses, readings and
+    odometry, and the same record, whether the rest is ticked at 20 Hz or seldom."""
+
+    def drive(rest: float) -> tuple[list[tuple], str]:
+        s = _pressed_into_a_wall()
+        s.pacer.clock = lambda: 0.0
+        seen = []
+        wall = 0.0
+
+        def keep_up(until: float) -> None:
+            nonlocal wall
+            while wall < until - 1e-9:
+                seconds = min(rest if s.at_rest else 0.05, until - wall)
+                s.advance(seconds, rest + s.pacer.max_lag if s.at_rest else None)
+                wall += seconds
+                seen.append(s.at_rest)
+
+        for at, key in ((8.0, "s"), (8.7, "space"), (12.0, "d"), (12.5, "w")):
+            keep_up(at)
+            s.key(key)
+            w = s.session.world
+            seen.append((key, round(w.time, 9), w.pose, dict(s.session.readings)))
+        keep_up(15.0)
+        w = s.session.world
+        seen.append(("end", w.pose, w.odometry))
+        run = s.run_so_far()
+        return [v for v in seen if not isinstance(v, bool)], repr(run)
+
+    assert drive(rest_tick) == drive(0.05)

@@ -143,3 +143,43 @@ def test_a_new_maze_goes_into_the_same_session_with_its_setup():
     assert session.world.block == CORRIDOR.start and session.metrics().distance == 0
     session.command(MoveAtPower(1.0))
     assert session.run(max_time=30).reached_exit  # the corridor's exit, on the new maze
+
+
+class _Dues:
+    """A controller with things due at the given times, in order: it notes when each one
+    is reached (the first tick at or within a nanosecond after it)."""
+
+    state = None
+
+    def __init__(self, dues: list[float]) -> None:
+        self.variables: dict = {}
+        self.dues = list(dues)
+        self.reached: list[tuple[float, float]] = []
+
+    def start(self, t):
+        return []
+
+    def tick(self, t, readings, events):
+        while self.dues and t + 1e-9 >= self.dues[0]:
+            self.reached.append((self.dues.pop(0), t))
+        return []
+
+    def next_due(self):
+        return self.dues[0] if self.dues else None
+
+
+def test_a_controller_is_woken_at_each_time_it_has_something_due_and_no_other():
+    """Inside a step, on a step's end, a hair before or after one, on a control tick, far
+    off: each due time is reached at that very time (to the nanosecond), never early."""
+    dt = 1 / 60
+    # (the controller starts at the first control tick, 0.05 s, and is asked from then on)
+    dues = [0.051, 0.0605, 5 * dt, 7 * dt - 4e-10, 8 * dt + 4e-10, 0.25, 0.2501, 0.3, 1.0]
+    dues += [1.0 + 1e-10, 2.0 - 5e-9, 2.5, 1e297]
+    controller = _Dues(dues)
+    session = Session(ROOM, "erobotic", noise="off")
+    session.attach(controller, {}, Driver.program("dues"))
+    session.run(max_time=3.0)
+    assert controller.dues == [1e297]  # far beyond the run: never reached
+    assert [d for d, _ in controller.reached] == dues[:-1]
+    for due, t in controller.reached:
+        assert due - 1e-9 <= t <= due + 1e-9, (due, t)

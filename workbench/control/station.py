@@ -367,12 +367,14 @@ class LabStation:
 
     @property
     def at_rest(self) -> bool:
-        """True while time changes nothing but the clock until someone acts: paused, or (at a
-        set speed) :attr:`idle`. Stepping then gives the same run however seldom a front end
-        ticks."""
+        """True while time changes nothing that can be seen until someone acts: paused, or (at
+        a set speed) the robot standing to the eye (:attr:`Session.settled`: :attr:`idle`, or
+        stopped against a wall and creeping off it by less than a billionth of a block a
+        step) with nobody driving it. Stepping then gives the same run however seldom a front
+        end ticks: every step owed is still taken."""
         if self.pacer.paused:
             return True
-        return self.pacer.speed is not None and self.idle
+        return self.pacer.speed is not None and self.live_viple is None and self.session.settled
 
     # -- speed ---------------------------------------------------------------------------
     def set_speed(self, speed: float | None) -> bool:

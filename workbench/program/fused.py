@@ -22,9 +22,12 @@ start their flows where the step's sender starts them; and the chain writes the 
 back wherever it stops. An expression is written out part by part (``viple_expr.Node``) with
 the operations, the order and the checks of true and false of the part's function, and any
 part that goes wrong (or that is not written out) is run by that function on the same
-values, so its error has the same text. So commands, prints, globals, changes, flows,
-activity counts and errors are the step-by-step run's (``ProgramController(fuse=False)``;
-``tests/program/test_fused.py`` runs programs both ways).
+values, so its error has the same text. Where every value a call needs is known when the
+chain is made (a Data's constant stored by a Variable, a Timer of a known wait, a Robot Drive
+of two literal powers), the call is made then, once, and the code holds its result; a call
+that raises is left in the code, to raise as the step does. So commands, prints, globals,
+changes, flows, activity counts and errors are the step-by-step run's
+(``ProgramController(fuse=False)``; ``tests/program/test_fused.py`` runs programs both ways).
 
 Security: the source is made of this module's own text and of names it numbers itself
 (``c0``, ``c1`` ...); every value that comes from the program (ids, pins, constants, names,
@@ -118,8 +121,16 @@ HELPERS = (
 class _Writer:
     """Writes the chain of one head: activity by activity, an If's pins as branches."""
 
-    def __init__(self, fusable: dict[int, Fusable], budget: int, parts: int, lines: int) -> None:
+    def __init__(
+        self,
+        fusable: dict[int, Fusable],
+        budget: int,
+        parts: int,
+        lines: int,
+        helpers: dict[str, Any],
+    ) -> None:
         self.fusable = fusable
+        self.helpers = helpers
         self.budget = budget
         #: lines this chain may take
         self.lines = lines
@@ -134,6 +145,9 @@ class _Writer:
         self.bools: set[str] = set()
         #: activities a chain stopped at for a reason of its own (they may head chains)
         self.stops: list[int] = []
+        #: (the value,) where the code being written holds a message known when the chain is
+        #: made (a Data's constant, a Variable's store of one), else None; see :meth:`folded`
+        self.known: tuple[Any] | None = None
 
     def write(self, head: int) -> _Source:
         src = self.src
@@ -214,6 +228,7 @@ class _Writer:
 
     def _data(self, spec: Fusable, ran: int, depth: int, nest: int, path: frozenset[int]) -> None:
         self.src.put(depth, f"v = {self.src.cell(spec.values[0])}")
+        self.known = (spec.values[0],)
         self.send(spec, 0, ran, depth, nest, path)
 
     def _variable(
@@ -221,10 +236,25 @@ class _Writer:
     ) -> None:
         src = self.src
         key, vtype = spec.values
-        src.put(depth, f"v = convert(v, {src.cell(vtype)})")
+        # a known message stored is known too: its conversion is made here, once
+        stored = self.folded(self.helpers["convert"], self.known[0], vtype) if self.known else None
+        if stored is not None:
+            src.put(depth, f"v = {src.cell(stored[0])}")
+        else:
+            src.put(depth, f"v = convert(v, {src.cell(vtype)})")
+        self.known = stored
         src.put(depth, f"G[{src.cell(key)}] = v")
         src.put(depth, "ctl.changes += 1")
         self.send(spec, 0, ran, depth, nest, path)
+
+    def folded(self, fn: Callable[..., Any], *args: Any) -> tuple[Any] | None:
+        """(``fn(*args)``,) worked out now, for code whose values are all known when the chain
+        is made, so that it does not run again at every pass; None where it raises (the code
+        then runs it, and raises the same error, as the activity's own step does)."""
+        try:
+            return (fn(*args),)
+        except Exception:
+            return None
 
     # -- expressions: each part's value in a local of its own ------------------------------
     def temp(self) -> str:
@@ -339,26 +369,35 @@ class _Writer:
     ) -> None:
         value = self.expr(spec.values[0], depth)
         self.src.put(depth, f"v = {value}")
+        self.known = None
         self.send(spec, 0, ran, depth, nest, path)
 
     def _if(self, spec: Fusable, ran: int, depth: int, nest: int, path: frozenset[int]) -> None:
         src = self.src
+        # each branch's code ends in a return; the code after it holds the message as it was
+        known = self.known
         for index, condition in enumerate(spec.values):
             truth = self.expr(condition, depth)
             if truth in self.bools:  # true or false for certain: no check
                 src.put(depth, f"if {truth}:")
                 self.send(spec, index, ran, depth + 1, nest + 1, path)
+                self.known = known
                 continue
             src.put(depth, f"t = {truth}")
             src.put(depth, "if t is True:")
             self.send(spec, index, ran, depth + 1, nest + 1, path)
+            self.known = known
             src.put(depth, "if t is not False:")
             src.put(depth + 1, f"truth(t, {index})")
         self.send(spec, ELSE, ran, depth, nest, path)
 
     def _timer(self, spec: Fusable, ran: int, depth: int, nest: int, path: frozenset[int]) -> None:
         src = self.src
-        src.put(depth, "check_timer(v)")
+        # a known number of milliseconds passes the check, and its wait is worked out, once
+        known = self.known
+        wait = self.folded(_wait, self.helpers["check_timer"], known[0]) if known else None
+        if wait is None:
+            src.put(depth, "check_timer(v)")
         links = spec.pins.get(0, ())
         if not links:
             src.put(depth, f"return {ran | ENDED}")
@@ -369,16 +408,32 @@ class _Writer:
         src.put(depth, f"flow.activity = {src.cell(first.target)}")
         src.put(depth, "flow.value = v")
         src.put(depth, f"flow.in_pin = {src.cell(first.in_pin)}")
-        src.put(depth, "flow.wait = max(0.0, float(v)) / 1000.0")
+        if wait is None:
+            src.put(depth, "flow.wait = max(0.0, float(v)) / 1000.0")
+        else:
+            src.put(depth, f"flow.wait = {src.cell(wait[0])}")
         src.put(depth, f"return {ran | SLEEPS}")
 
     def _drive(self, spec: Fusable, ran: int, depth: int, nest: int, path: frozenset[int]) -> None:
         src = self.src
         left, right = spec.values
-        src.put(depth, f"left = power({self.expr(left, depth)}, 'left')")
-        src.put(depth, f"right = power({self.expr(right, depth)}, 'right')")
-        src.put(depth, "command(WheelPowers(left, right))")
+        # two literal powers: the command is the same at every pass, made once (a command is
+        # a frozen value, so one object may be sent any number of times)
+        fixed = None
+        if _literal(left) and _literal(right):
+            fixed = self.folded(self._wheels, left.tree.data[0], right.tree.data[0])
+        if fixed is not None:
+            src.put(depth, f"command({src.cell(fixed[0])})")
+        else:
+            src.put(depth, f"left = power({self.expr(left, depth)}, 'left')")
+            src.put(depth, f"right = power({self.expr(right, depth)}, 'right')")
+            src.put(depth, "command(WheelPowers(left, right))")
         self.send(spec, 0, ran, depth, nest, path)
+
+    def _wheels(self, left: Any, right: Any) -> Any:
+        """The command the code below makes of these powers (raising as it would)."""
+        power = self.helpers["power"]
+        return self.helpers["WheelPowers"](power(left, "left"), power(right, "right"))
 
     def _print(self, spec: Fusable, ran: int, depth: int, nest: int, path: frozenset[int]) -> None:
         self.src.put(depth, "ctl._print(show(v))")
@@ -386,7 +441,19 @@ class _Writer:
 
     def _code(self, spec: Fusable, ran: int, depth: int, nest: int, path: frozenset[int]) -> None:
         self.src.put(depth, "v = first_sensor_value(v)")
+        self.known = None
         self.send(spec, 0, ran, depth, nest, path)
+
+
+def _literal(expression: Any) -> bool:
+    """Whether an expression is a literal (its value in its tree's data)."""
+    return expression.tree is not None and expression.tree.kind == "literal"
+
+
+def _wait(check_timer: Callable[[Any], None], value: Any) -> float:
+    """The seconds a Timer's code below waits for ``value``, its check first."""
+    check_timer(value)
+    return max(0.0, float(value)) / 1000.0
 
 
 def fuse(
@@ -404,7 +471,7 @@ def fuse(
         head = todo.pop(0)
         if head in chains:
             continue
-        writer = _Writer(fusable, MAX_FUSED - fused, parts, lines)
+        writer = _Writer(fusable, MAX_FUSED - fused, parts, lines, helpers)
         src = writer.write(head)
         fused += writer.size
         parts = max(0, writer.parts)

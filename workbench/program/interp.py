@@ -199,6 +199,21 @@ class _Park(Exception):
 class ProgramController:
     """A :class:`workbench.sim.session.Controller` that runs a VIPLE program."""
 
+    # every attribute a slot: a tick reads and sets a hundred of them, and a slot is found
+    # without a dictionary's lookup (there are too many for the instance dictionaries CPython
+    # shares between objects of a class)
+    __slots__ = (
+        "_activities", "_busy", "_chains", "_count_flows", "_due", "_due_or_none", "_exprs",
+        "_fires", "_handlers", "_held", "_hot", "_join_parts", "_joins", "_key_due",
+        "_keys_pending", "_keys_typed", "_main", "_next_key", "_next_report", "_numbers",
+        "_outputs", "_parked", "_parsed", "_period", "_plan", "_ports", "_pushed", "_reads",
+        "_ready", "_report", "_runs", "_second_steps", "_senses", "_sleeping", "_spare", "_steps",
+        "_the_scope", "_touch", "_typed", "_var_keys", "_window", "changes", "commands", "compiled",
+        "errors", "errors_total", "fired", "flows_dropped", "globals", "key_script", "limits",
+        "next_due", "now", "paced", "printed", "printed_dropped", "printed_total", "program",
+        "quiet_until", "recent", "report_period", "state", "steps", "stopped",
+    )  # fmt: skip
+
     def __init__(
         self,
         compiled: Compiled,
@@ -308,6 +323,7 @@ class ProgramController:
         self._next_key = 0
         self._typed = TypedKeys()
         self._pushed: list[KeyEvent] = []
+        self._note_keys()
         self._touch: dict[int, int] = {}
         #: the report being handed to the sensor activities (a raw sensor's message)
         self._report: str | None = None
@@ -377,15 +393,16 @@ class ProgramController:
         self.now = t
         if self.stopped is not None:
             return []
+        soon = t + _SAME
         sleeping = self._sleeping
-        while sleeping and sleeping[0][0] <= t + _SAME:
+        while sleeping and sleeping[0][0] <= soon:
             self._ready.append(heappop(sleeping)[2])
         if self._parked:
             self._ready.extend(self._parked)
             self._parked = []
-        if self._pushed or self._next_key < len(self.key_script) or self._typed.held:
+        if self._keys_pending:
             self._keys(t)
-        if (t + _SAME >= self._next_report if self.paced else self._report_due(t)) and (
+        if (soon >= self._next_report if self.paced else self._report_due(t)) and (
             readings or report is not None
         ):
             # a tick between two reports (of a remote robot, or of the paced simulator) fires
@@ -394,7 +411,12 @@ class ProgramController:
             if self.paced:
                 start = self._next_report
                 period = self._period
-                self._next_report = start + period * (1 + int((t + _SAME - start) // period))
+                late = soon - start
+                # a report on time (late by less than a period, so the floor is 0): the same
+                # sum, without the division
+                self._next_report = (
+                    start + period if late < period else start + period * (1 + int(late // period))
+                )
             plan = self._plan
             if report is not None or plan is None or readings.keys() != plan[0]:
                 plan = self._plan = self._plan_for(readings) if report is None else None
@@ -421,12 +443,11 @@ class ProgramController:
         sleeping = self._sleeping
         if sleeping and sleeping[0][0] < due:
             due = sleeping[0][0]
-        script = self.key_script
-        if self._next_key < len(script) and script[self._next_key].time < due:
-            due = script[self._next_key].time
+        if self._key_due < due:
+            due = self._key_due
         self._due = due
         self._due_or_none = None if due == _NEVER else due
-        quiet = not (self._ready or self._parked or self._pushed or self._typed.held)
+        quiet = not (self._ready or self._parked or self._keys_typed)
         self.quiet_until = due if quiet and self.state is not None else -_NEVER
 
     @property
@@ -454,7 +475,19 @@ class ProgramController:
         if self.stopped is not None:
             return
         self._pushed += self._typed.press(key.lower(), t)
+        self._note_keys()
         self.quiet_until = -_NEVER  # the key fires at the next tick
+
+    def _note_keys(self) -> None:
+        """After the keys changed (the script's next key, keys typed or held): when the next
+        scripted key is due, and whether a tick has keys to see to (what ``tick`` and
+        ``_refresh_due`` read, instead of asking the script and the typed keys each time)."""
+        script = self.key_script
+        left = self._next_key < len(script)
+        self._key_due = script[self._next_key].time if left else _NEVER
+        #: keys typed and not yet fired, or one held until its release is due
+        self._keys_typed = bool(self._pushed or self._typed.held)
+        self._keys_pending = left or self._keys_typed
 
     @property
     def held(self) -> frozenset[str]:
@@ -474,6 +507,7 @@ class ProgramController:
         pushed, self._pushed = self._pushed, []
         for event in pushed:
             self._key_event(event)
+        self._note_keys()
 
     def _key_event(self, event: KeyEvent) -> None:
         """One press or release, from a key script or typed: the one way keys reach events."""
@@ -699,8 +733,14 @@ class ProgramController:
                 spare.append(flow)
                 continue
             if result & SLEEPS:
-                if flow.wait > 0:
-                    due = _whole_ms(now + max(flow.wait, MIN_WAIT))
+                wait = flow.wait
+                if wait > 0:
+                    # at least MIN_WAIT, up to the clock's next whole millisecond (the time
+                    # itself when it is one, or when it lies beyond any run: an endless wait
+                    # stays endless)
+                    due = now + (wait if wait > MIN_WAIT else MIN_WAIT)
+                    if due < 1e12:
+                        due = math.ceil(due * 1000.0 - 1e-6) / 1000.0
                     heappush(self._sleeping, (due, flow.number, flow))
                 else:
                     ready.append(flow)
@@ -1157,6 +1197,7 @@ class ProgramController:
         self._joins = {}
         self._join_parts = 0
         self._pushed = []
+        self._note_keys()
         self.commands = []
         self.state = "stopped"
         return [Stop()]
@@ -1255,14 +1296,6 @@ def convert(value: Value, vtype: str) -> Value:
         if not isinstance(value, bool):
             raise ValueError(f"{type_name(value)} cannot be stored in a Boolean")
     return value
-
-
-def _whole_ms(t: float) -> float:
-    """``t`` rounded up to the clock's next whole millisecond (``t`` itself when it is one, or
-    when it lies beyond any run: an endless wait stays endless)."""
-    if not t < 1e12:
-        return t
-    return math.ceil(t * 1000.0 - 1e-6) / 1000.0
 
 
 def _port(ports: dict[str, int], name: str) -> int:

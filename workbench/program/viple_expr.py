@@ -331,6 +331,21 @@ class _Parser:
         node = self.nodes.get(id(fn))
         return node.data if node is not None and node.kind == "literal" else None
 
+    def negated(self, inner: Fn, col: int) -> Fn:
+        """``-inner``: a literal itself where ``inner`` is a number's literal (``-0.2``, as
+        programs write negative powers), so a comparison with it, and a fused chain, take it as
+        the constant it is; anything else, and a literal whose negation is an error (``-"a"``),
+        negated as it runs, which raises that error every time."""
+        fn = _negate(inner, col)
+        constant = self.literal_value(inner)
+        if constant is not None and _number(constant[0]):
+            try:
+                value = fn(Scope())
+            except ExprError:
+                return fn
+            return self.literal(value)
+        return fn
+
     @property
     def tok(self) -> _Tok:
         return self.toks[self.i]
@@ -435,7 +450,7 @@ class _Parser:
             inner = self.unary()
             self.depth -= 1
             if op == "-":
-                return _negate(inner, col)
+                return self.negated(inner, col)
             return self.noted("not", _not(inner, col), (inner,), (col,))
         return self.primary()
 

@@ -116,7 +116,7 @@ class Session:
         self._commands: list[Any] = []
         self._started = False
         #: when the controller next has something due (inf: nothing; asked each time it ran)
-        self._due = math.inf
+        self._set_due(_NEVER)
         self._turns = TurnCounter()
         self._last_angle = self.world.angle
         self._last_time = 0.0
@@ -144,13 +144,13 @@ class Session:
         self.binding = dict(binding)
         self.driver = driver
         self._started = False
-        self._due = math.inf
+        self._set_due(_NEVER)
 
     def detach(self, driver: Driver = NOBODY) -> None:
         self.controller = None
         self._next_due = None
         self._quiet = None
-        self._due = math.inf
+        self._set_due(_NEVER)
         self.binding = {}
         self.driver = driver
 
@@ -224,12 +224,9 @@ class Session:
         """One physics step (and a control tick every ``every`` steps); a controller with
         something due inside the step is woken at that time."""
         n = self._steps + 1
-        due = self._due
-        # nothing due (inf, as a controller without next_due always has) needs no end of step
-        # and no wake after it: the common step tests that once
-        if due == _NEVER:
-            events = self._world_step()
-        elif due < n * self._dt - _SAME:
+        # something due inside this step? (only asked from a step near the due time: never, as
+        # for a controller without next_due, when nothing is due)
+        if n >= self._due_near and self._due < n * self._dt - _SAME:
             early = self._wake_within()
             events = self._world_step()
             if early:
@@ -246,10 +243,8 @@ class Session:
             self._commands.append(cmd)
         if n % self.every == 0:
             self._control_tick()
-        elif due != _NEVER:  # (nothing makes it due during the step but a wake)
-            due = self._due
-            if due != _NEVER and due <= self.world.time + _SAME:
-                self._wake(self.world.time)
+        elif n >= self._due_near and self._due <= self.world.time + _SAME:
+            self._wake(self.world.time)
         return events
 
     def _wake_within(self) -> tuple[str, ...]:
@@ -273,7 +268,21 @@ class Session:
         next_due = self._next_due
         if next_due is not None:
             due = next_due()
-            self._due = _NEVER if due is None else due
+            self._set_due(_NEVER if due is None else due)
+
+    def _set_due(self, due: float) -> None:
+        """The controller next has something due at ``due``: :meth:`step` tests whether it
+        falls inside a step (``due < n * dt - _SAME``) or at its end (``due <= time + _SAME``)
+        from the step two before the one it falls in on, and leaves the tests out before."""
+        self._due = due
+        if abs(due) < self._dt * 1e14:
+            # of any earlier step n, n * dt is more than a step short of due, so both tests
+            # are false (the rounding of these products is far under a step)
+            self._due_near: float = int(due / self._dt) - 2
+        elif due == _NEVER or due != due:
+            self._due_near = _NEVER  # nothing due, or nan: neither test ever holds
+        else:
+            self._due_near = 0  # beyond any run: both tests at every step, as ever
 
     def _wake(self, t: float) -> None:
         """The controller's due work at ``t`` between control ticks: it gets the readings of
@@ -346,6 +355,12 @@ class Session:
         """True while nothing on the robot changes but the clock: it stands with its motors off,
         no controller drives it and no command waits to be applied."""
         return self.controller is None and self._scheduled is None and self.world.still
+
+    @property
+    def settled(self) -> bool:
+        """As :attr:`still`, with the robot standing to the eye (:attr:`World.settled`): what
+        is left to change can not be seen."""
+        return self.controller is None and self._scheduled is None and self.world.settled
 
     @property
     def reached_exit(self) -> bool:

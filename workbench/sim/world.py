@@ -66,6 +66,9 @@ _TURN_EPS = 1e-7
 #: contacts that start again within this time after the last one ended are the same collision
 _COLLISION_GAP = 0.1
 _COS45 = math.sqrt(0.5)
+#: a step that moved the robot less than this share of a block, with its motors off and no
+#: turn under way, leaves it standing to the eye (see World.settled)
+_SETTLED_SHARE = 1e-9
 _NO_EVENTS: tuple[str, ...] = ()
 # the chipmunk calls of the hot loop, bypassing pymunk's per-call wrappers (pymunk is pinned <8)
 _space_step = _cp.cpSpaceStep
@@ -232,6 +235,7 @@ class World:
         self._touch_reach = profile.robot_radius + 0.005 * self.cell
         #: farther than this from a side, no wall on that side is within the touch reach
         self._touch_far = self._touch_reach * (1.0 + 1e-9) + 1e-9 * self.cell
+        self._settled_moved = _SETTLED_SHARE * self.cell
         self._tmax = profile.sensor_range / self.cell
         self._inv_cell = 1.0 / self.cell
         #: each mount's distance from the centre, in MOUNTS order
@@ -868,6 +872,24 @@ class World:
         """True while the robot stands: its motors are off, no turn is under way and the last
         step moved it not at all (so the next steps will not either)."""
         return self._turn_target is None and not (self._v or self._w or self._moved)
+
+    @property
+    def settled(self) -> bool:
+        """True while the robot stands to the eye: :attr:`still`, or motors off, no turn under
+        way and the last step moved it less than a billionth of a block.
+
+        The second case is a robot stopped while pressed into a wall: the contact solver eases
+        it back out by a set share of what is left each step (pymunk's collision bias, a tenth
+        at 60 steps a second), so it creeps for a few seconds, over a hundred steps, before a
+        step leaves it exactly where it was. Each step of that creep is smaller than the one
+        before by that share, so once one moves less than a billionth of a block, all that is
+        left of it is some billionths at most: nothing any view can show.
+        """
+        return (
+            self._turn_target is None
+            and not (self._v or self._w)
+            and (self._moved < self._settled_moved)
+        )
 
     @property
     def in_contact(self) -> bool:
