@@ -55,42 +55,48 @@ def test_a_turn_an_algorithm_or_max_speed_is_never_rest_but_pause_always_is():
     assert not s.at_rest
 
 
+def _play(s: LabStation, keys, until: float, rest_tick: float) -> list[tuple]:
+    """Tick ``s`` as the app does (20 Hz while things move, once per ``rest_tick`` at rest,
+    keeping all the time owed), pressing each (time, key) of ``keys`` when its time comes:
+    what the station showed at each key and at ``until``."""
+    # a clock that never moves: the frame budget (wall time) never cuts a tick short, so a
+    # loaded machine runs the same steps as a quiet one
+    s.pacer.clock = lambda: 0.0
+    seen = []
+    wall = 0.0
+
+    def keep_up(t: float) -> None:
+        nonlocal wall
+        while wall < t - 1e-9:
+            if s.at_rest:
+                seconds = min(rest_tick, t - wall)
+                s.advance(seconds, rest_tick + s.pacer.max_lag)
+            else:
+                seconds = min(0.05, t - wall)
+                s.advance(seconds)
+            wall += seconds
+
+    for at, key in keys:
+        keep_up(at)
+        s.key(key)
+        w = s.session.world
+        seen.append((key, round(w.time, 9), w.pose, dict(s.session.readings)))
+    keep_up(until)
+    w = s.session.world
+    seen.append(("end", round(w.time, 9), w.pose, w.odometry))
+    return seen
+
+
 @pytest.mark.parametrize("speed", [s for s in SPEEDS if s is not None])
 def test_ticking_once_a_second_at_rest_gives_the_run_of_twenty_ticks_a_second(speed):
     """A key, a rest, another key: the same times, poses and distances either way, when the
     seldom-ticking station runs what it owes before each command (as the app does)."""
+    keys = ((0.0, "w"), (1.0, "space"), (4.0, "d"), (4.6, "space"), (9.0, "w"))
 
     def drive(rest_tick: float) -> list[tuple]:
         s = station(noise="low")
         s.pacer.speed = speed
-        # a clock that never moves: the frame budget (wall time) never cuts a tick short,
-        # so a loaded machine runs the same steps as a quiet one
-        s.pacer.clock = lambda: 0.0
-        seen = []
-        wall = 0.0
-
-        def tick(seconds: float, lag: float | None = None) -> None:
-            nonlocal wall
-            s.advance(seconds, lag)
-            wall += seconds
-
-        def keep_up(until: float) -> None:
-            # the app: 20 Hz while things move, one tick per rest_tick while at rest
-            while wall < until - 1e-9:
-                if s.at_rest:
-                    tick(min(rest_tick, until - wall), lag=rest_tick + s.pacer.max_lag)
-                else:
-                    tick(min(0.05, until - wall))
-
-        for at, key in ((0.0, "w"), (1.0, "space"), (4.0, "d"), (4.6, "space"), (9.0, "w")):
-            keep_up(at)
-            s.key(key)
-            w = s.session.world
-            seen.append((key, round(w.time, 9), w.pose, dict(s.session.readings)))
-        keep_up(10.0)
-        w = s.session.world
-        seen.append(("end", round(w.time, 9), w.pose, w.odometry))
-        return seen
+        return _play(s, keys, 10.0, rest_tick)
 
     assert drive(1.0) == drive(0.05)
 
@@ -137,32 +143,13 @@ def test_a_robot_stopped_against_a_wall_rests_while_the_solver_eases_it_off():
 
 @pytest.mark.parametrize("rest_tick", [0.5, 4.0])
 def test_a_rest_against_a_wall_gives_the_run_of_twenty_ticks_a_second(rest_tick):
-    """Stopped against a wall, left there, then driven off: the same poses, readings and
-    odometry, and the same record, whether the rest is ticked at 20 Hz or seldom."""
+    """Stopped against a wall, left there while the solver eases the robot off it, then
+    driven away: the same times, poses, readings, odometry and run whether the rest is ticked
+    at 20 Hz or seldom."""
+    keys = ((8.0, "s"), (8.7, "space"), (12.0, "d"), (12.5, "w"))
 
-    def drive(rest: float) -> tuple[list[tuple], str]:
+    def drive(rest: float) -> tuple[list[tuple], object]:
         s = _pressed_into_a_wall()
-        s.pacer.clock = lambda: 0.0
-        seen = []
-        wall = 0.0
-
-        def keep_up(until: float) -> None:
-            nonlocal wall
-            while wall < until - 1e-9:
-                seconds = min(rest if s.at_rest else 0.05, until - wall)
-                s.advance(seconds, rest + s.pacer.max_lag if s.at_rest else None)
-                wall += seconds
-                seen.append(s.at_rest)
-
-        for at, key in ((8.0, "s"), (8.7, "space"), (12.0, "d"), (12.5, "w")):
-            keep_up(at)
-            s.key(key)
-            w = s.session.world
-            seen.append((key, round(w.time, 9), w.pose, dict(s.session.readings)))
-        keep_up(15.0)
-        w = s.session.world
-        seen.append(("end", w.pose, w.odometry))
-        run = s.run_so_far()
-        return [v for v in seen if not isinstance(v, bool)], repr(run)
+        return _play(s, keys, 15.0, rest), s.run_so_far()
 
     assert drive(rest_tick) == drive(0.05)
