@@ -183,3 +183,33 @@ def test_a_controller_is_woken_at_each_time_it_has_something_due_and_no_other():
     assert [d for d, _ in controller.reached] == dues[:-1]
     for due, t in controller.reached:
         assert due - 1e-9 <= t <= due + 1e-9, (due, t)
+
+
+class _Readings:
+    """A controller that notes the readings it is given by name."""
+
+    def __init__(self) -> None:
+        self.seen: list[dict[str, object]] = []
+
+    def start(self, t: float) -> list:
+        return []
+
+    def tick(self, t: float, readings: dict, events: frozenset) -> list:
+        self.seen.append(dict(readings))
+        return []
+
+
+def test_a_controller_gets_its_readings_by_the_names_of_its_binding():
+    session = Session(ROOM, "erobotic", noise="off")
+    controller = _Readings()
+    ports = [spec.port for spec in session.world.sensors]
+    session.attach(controller, {"first": ports[0]}, Driver.program("names"))
+    session.run(max_time=0.2)
+    assert controller.seen and set(controller.seen[-1]) == {"first"}
+    # a new binding is a new mapping, which the next tick uses; the one read is not changed
+    with pytest.raises(TypeError):
+        session.binding["second"] = ports[1]  # type: ignore[index]
+    session.binding = {"second": ports[-1]}
+    session.run(max_time=0.4)
+    assert set(controller.seen[-1]) == {"second"}
+    assert controller.seen[-1]["second"] == session.readings[ports[-1]]

@@ -11,8 +11,9 @@ commands to :meth:`Session.command`, and read :meth:`Session.snapshot`.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
+from types import MappingProxyType
 from typing import Any, Protocol, runtime_checkable
 
 from .driver import NOBODY, Driver
@@ -125,23 +126,23 @@ class Session:
 
     # -- who drives ---------------------------------------------------------------------
     @property
-    def binding(self) -> dict[str, int]:
-        """The controller's sensor names -> ports. Change it by assigning a new dict: each
-        control tick walks the (name, port) pairs taken when it was set (a tuple, without an
-        items() view per tick)."""
-        return self._binding
+    def binding(self) -> Mapping[str, int]:
+        """The controller's sensor names -> ports, read-only: change it by assigning a new
+        mapping. Each control tick walks the (name, port) pairs taken when it was set (a
+        tuple, without an items() view per tick), which a change in place would not reach."""
+        return MappingProxyType(self._binding)
 
     @binding.setter
-    def binding(self, binding: dict[str, int]) -> None:
-        self._binding = binding
-        self._ports = tuple(binding.items())
+    def binding(self, binding: Mapping[str, int]) -> None:
+        self._binding = dict(binding)
+        self._ports = tuple(self._binding.items())
 
     def attach(self, controller: Controller, binding: dict[str, int], driver: Driver) -> None:
         """Let ``controller`` drive; ``binding`` maps its sensor names to ports."""
         self.controller = controller
         self._next_due = getattr(controller, NEXT_DUE, None)
         self._quiet = controller if isinstance(controller, Quiet) and controller.paced else None
-        self.binding = dict(binding)
+        self.binding = binding  # (the setter keeps a copy)
         self.driver = driver
         self._started = False
         self._set_due(_NEVER)
